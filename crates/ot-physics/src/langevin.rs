@@ -196,7 +196,7 @@ fn sym_eig<const D: usize>(m: &SMatrix<f64, D, D>) -> (SVector<f64, D>, SMatrix<
     ) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
         (
             SVector::from_fn(|i, _| vals[i]),
-            SMatrix::from_fn(|i, j| vec(i, j)),
+            SMatrix::from_fn(vec),
         )
     }
     match D {
