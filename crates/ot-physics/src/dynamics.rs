@@ -41,8 +41,32 @@ impl<const D: usize> Dynamics<'_, D> {
     }
 }
 
+/// Largest step (s) that cannot carry the particle across the well unseen.
+///
+/// Inside six largest waists of the centre (where the force exceeds 1e-11 of
+/// its peak) a step may move the particle by at most half the smallest
+/// waist; outside, moving away, there is no limit; outside, approaching, a
+/// step may reach the edge of that region but not beyond.
+#[inline]
+fn crossing_limit<const D: usize>(model: &TrapModel<D>, y: &Phase<D>) -> f64 {
+    let speed = y.v.norm();
+    if model.mass.is_none() || speed == 0.0 {
+        return f64::INFINITY;
+    }
+    let reach = 6.0 * model.well.waists().max();
+    let dist = y.r.norm();
+    if dist > reach && y.r.dot(&y.v) >= 0.0 {
+        return f64::INFINITY;
+    }
+    (0.5 * model.length_scale()).max(dist - reach) / speed
+}
+
 impl<const D: usize> OdeSystem for Dynamics<'_, D> {
     type State = Phase<D>;
+    #[inline]
+    fn max_step(&self, y: &Phase<D>) -> f64 {
+        crossing_limit(self.model, y)
+    }
     #[inline(always)]
     fn rhs(&self, y: &Phase<D>) -> Phase<D> {
         let a = self.accel(y);
@@ -59,6 +83,10 @@ impl<const D: usize> OdeSystem for Dynamics<'_, D> {
 
 impl<const D: usize> OdeSystem for Variational<'_, D> {
     type State = PhaseVar<D>;
+    #[inline]
+    fn max_step(&self, y: &PhaseVar<D>) -> f64 {
+        crossing_limit(self.model, &y.p)
+    }
     #[inline(always)]
     fn rhs(&self, y: &PhaseVar<D>) -> PhaseVar<D> {
         let m = self.model;

@@ -22,7 +22,10 @@ fn force_is_minus_gradient_and_jacobian_matches_finite_differences() {
         assert!((f[i] + grad).abs() < 1e-7 * f.norm(), "axis {i}");
         let col = (w.force(&rp) - w.force(&rm)) / (2.0 * h);
         for j in 0..3 {
-            assert!((jac[(j, i)] - col[j]).abs() < 1e-6 * jac.norm(), "J[{j},{i}]");
+            assert!(
+                (jac[(j, i)] - col[j]).abs() < 1e-6 * jac.norm(),
+                "J[{j},{i}]"
+            );
         }
     }
     // the Jacobian of a gradient field is symmetric
@@ -77,28 +80,61 @@ fn bad_parameters_give_typed_errors_naming_the_field() {
             format!("depth [J] = {shown} is out of range: allowed finite and > 0")
         );
         let e = Well2::new(DEPTH, [600e-9, v]).unwrap_err();
-        assert!(matches!(e, PhysicsError::OutOfRange { field: "waist_y [m]", .. }));
-        let e = TrapModel::builder(DEPTH, WAISTS).mass(v).build().unwrap_err();
-        assert!(matches!(e, PhysicsError::OutOfRange { field: "mass [kg]", .. }));
+        assert!(matches!(
+            e,
+            PhysicsError::OutOfRange {
+                field: "waist_y [m]",
+                ..
+            }
+        ));
+        let e = TrapModel::builder(DEPTH, WAISTS)
+            .mass(v)
+            .build()
+            .unwrap_err();
+        assert!(matches!(
+            e,
+            PhysicsError::OutOfRange {
+                field: "mass [kg]",
+                ..
+            }
+        ));
         let e = TrapModel::builder(DEPTH, WAISTS)
             .mass(MASS)
             .stokes_drag(v, 1e-3)
             .build()
             .unwrap_err();
-        assert!(matches!(e, PhysicsError::OutOfRange { field: "radius [m]", .. }));
+        assert!(matches!(
+            e,
+            PhysicsError::OutOfRange {
+                field: "radius [m]",
+                ..
+            }
+        ));
         let e = TrapModel::builder(DEPTH, WAISTS)
             .mass(MASS)
             .stokes_drag(0.5e-6, v)
             .build()
             .unwrap_err();
-        assert!(matches!(e, PhysicsError::OutOfRange { field: "viscosity [Pa s]", .. }));
+        assert!(matches!(
+            e,
+            PhysicsError::OutOfRange {
+                field: "viscosity [Pa s]",
+                ..
+            }
+        ));
         let e = TrapModel::builder(DEPTH, WAISTS)
             .mass(MASS)
             .stokes_drag(0.5e-6, 1e-3)
             .temperature(Some(v))
             .build()
             .unwrap_err();
-        assert!(matches!(e, PhysicsError::OutOfRange { field: "temperature [K]", .. }));
+        assert!(matches!(
+            e,
+            PhysicsError::OutOfRange {
+                field: "temperature [K]",
+                ..
+            }
+        ));
     }
     let e = Well3::new(DEPTH, [1e-6, 1e-6, -2e-6]).unwrap_err();
     assert_eq!(
@@ -119,7 +155,13 @@ fn bad_parameters_give_typed_errors_naming_the_field() {
 #[test]
 fn effects_need_their_parameters() {
     let e = TrapModel::builder(DEPTH, WAISTS).build().unwrap_err();
-    assert!(matches!(e, PhysicsError::Missing { needed_by: "any dynamics", .. }));
+    assert!(matches!(
+        e,
+        PhysicsError::Missing {
+            needed_by: "any dynamics",
+            ..
+        }
+    ));
     let e = TrapModel::builder(DEPTH, WAISTS)
         .mass(MASS)
         .temperature(Some(293.15))
@@ -134,7 +176,13 @@ fn effects_need_their_parameters() {
         .radius(Some(0.5e-6))
         .build()
         .unwrap_err();
-    assert!(matches!(e, PhysicsError::Missing { field: "viscosity [Pa s]", .. }));
+    assert!(matches!(
+        e,
+        PhysicsError::Missing {
+            field: "viscosity [Pa s]",
+            ..
+        }
+    ));
     // Stokes: γ = 6πηr
     let m = TrapModel::builder(DEPTH, WAISTS)
         .stokes_drag(0.5e-6, 1e-3)
