@@ -10,11 +10,11 @@ use ot_physics::state::Tolerance;
 use ot_physics::{Composition, Method, Phase, PhysicsError, Propagator, TrapModel};
 
 fn reference(model: TrapModel<2>, dt: f64) -> Propagator<2> {
-    Propagator::new(model, Method::Adaptive { rtol: 1e-13 }, dt).unwrap()
+    Propagator::new(model, Method::Adaptive { rtol: 1e-13 }, dt).expect("valid reference")
 }
 
 fn energy(model: &TrapModel<2>, y: &Phase<2>) -> f64 {
-    0.5 * model.mass.unwrap() * y.v.norm_squared() + model.well.potential(&y.r)
+    0.5 * model.mass.expect("inertia on") * y.v.norm_squared() + model.well.potential(&y.r)
 }
 
 #[test]
