@@ -1,4 +1,5 @@
 //! Thermal mode, validated in the harmonic limit: a 1 µm polystyrene bead
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 //! in water at 20 °C, κ = 0.1 pN/nm, sampled at 78 125 Hz for 10 s.
 
 use nalgebra::Vector2;

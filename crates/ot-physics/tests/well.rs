@@ -1,4 +1,5 @@
 //! The Gaussian well: force is minus the gradient, exact zeros, validation.
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
 mod common;
 use common::*;
