@@ -1,6 +1,6 @@
 //! Physics of the integrators: analytic limits, conservation, reversibility,
-#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 //! convergence orders and the hard cases.
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
 mod common;
 use common::*;

@@ -1,6 +1,6 @@
 //! The flow map of a tick: Jacobians from the variational equations agree
-#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 //! with finite differences; batches agree with single calls.
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
 mod common;
 use common::*;

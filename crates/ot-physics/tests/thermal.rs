@@ -1,6 +1,6 @@
 //! Thermal mode, validated in the harmonic limit: a 1 µm polystyrene bead
-#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 //! in water at 20 °C, κ = 0.1 pN/nm, sampled at 78 125 Hz for 10 s.
+#![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
 use nalgebra::Vector2;
 use ot_physics::analysis::{autocorrelation, block_periodogram, fit_corner_aliased, mean_variance};
