@@ -42,6 +42,7 @@ pub mod flow;
 pub mod integrate;
 pub mod langevin;
 pub mod model;
+pub mod paper;
 pub mod state;
 pub mod well;
 
