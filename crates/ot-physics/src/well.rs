@@ -65,7 +65,7 @@ impl<const D: usize> GaussianWell<D> {
         for i in 0..D {
             q += self.k[i] * r[i] * r[i];
         }
-        (-q).exp()
+        crate::fastexp::exp(-q)
     }
 
     /// Restoring force `-∇P` at `r` (N). Exactly zero (never NaN) where the
@@ -74,9 +74,15 @@ impl<const D: usize> GaussianWell<D> {
     pub fn force(&self, r: &SVector<f64, D>) -> SVector<f64, D> {
         let e = self.envelope(r);
         // e == 0 far away: return exact zeros (r·0 could be inf·0 = NaN).
-        let s = if e == 0.0 { 0.0 } else { -2.0 * self.depth * e };
+        if e == 0.0 {
+            return SVector::zeros();
+        }
+        let s = -2.0 * self.depth * e;
         let ra = &r.data.0[0];
-        let f: [f64; D] = std::array::from_fn(|i| if s == 0.0 { 0.0 } else { s * self.k[i] * ra[i] });
+        let mut f = [0.0; D];
+        for i in 0..D {
+            f[i] = s * self.k[i] * ra[i];
+        }
         SVector::from(f)
     }
 
