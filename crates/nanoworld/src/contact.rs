@@ -170,8 +170,6 @@ impl World {
             pull_off_n: weakest.1,
         });
         self.contact = TipContact::Free;
-        // The tip leaves the contact: it restarts from the cursor (undeflected cantilever).
-        self.place_tip(self.cursor);
         let target_atom = match a.target {
             Target::Atom(i) => Some(i),
             _ => None,
@@ -218,6 +216,9 @@ impl World {
                 }
             }
         }
+        // The tip (with whatever it still carries) leaves the contact and restarts from the
+        // cursor (game: the tip is the cursor; physical: the undeflected cantilever).
+        self.place_tip(self.cursor);
     }
 
     fn bond(&mut self, a: usize, b: usize) {

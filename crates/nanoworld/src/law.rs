@@ -81,6 +81,16 @@ impl PairLaw {
         2.0 * self.coef_n_m2 / (gap_m * gap_m * gap_m)
     }
 
+    /// Gap beyond which the pair is out of reach (m): the activation gap (game) or ten
+    /// snap gaps, where the Hamaker force has fallen below 1 % of its snap value (physical).
+    pub fn reach_m(&self) -> f64 {
+        if self.cutoff_gap_m.is_finite() {
+            self.cutoff_gap_m
+        } else {
+            10.0 * self.snap_gap_m
+        }
+    }
+
     /// Whether the pair interacts at all.
     pub fn is_on(&self) -> bool {
         self.coef_n_m2 > 0.0

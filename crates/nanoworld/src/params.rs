@@ -370,8 +370,8 @@ impl Params {
     /// The teaching game with the paper's behaviour, in nanometre-sized SI values:
     /// a 40 × 40 substrate (0.3 nm spacing), 0.3 nm tip, 0.15 nm atoms, snap force 0.3 nN
     /// for tip pairs, pull-off 10×, atom–atom bonds twice and atom–substrate bonds half as
-    /// strong as tip–atom ones (the paper's ordering), a loading zone, three foundation atoms
-    /// and a four-slot house on them.
+    /// strong as tip–atom ones (the paper's ordering), a loading zone, a row of five
+    /// foundation atoms and a seven-slot house (three columns, the middle one higher).
     pub fn game_default() -> Self {
         let a = 0.3e-9;
         let snap = 0.15e-9;
@@ -387,7 +387,7 @@ impl Params {
         let r = 0.15e-9;
         let hollow = |i: usize, j: usize| [(i as f64 + 0.5) * a, (j as f64 + 0.5) * a];
         let rest_z = ((2.0 * r) * (2.0 * r) - 2.0 * (a / 2.0) * (a / 2.0)).sqrt();
-        let foundation: Vec<[f64; 2]> = (18..21).map(|i| hollow(i, 20)).collect();
+        let foundation: Vec<[f64; 2]> = (16..21).map(|i| hollow(i, 20)).collect();
         let above = |xy: [f64; 2], level: f64| [xy[0], xy[1], rest_z + level * 2.0 * r];
         Params {
             substrate: SubstrateParams {
@@ -420,11 +420,17 @@ impl Params {
                 spawn_xy_m: hollow(6, 6),
             }),
             house: Some(HouseParams {
+                // Three columns one atom apart (windows between them), the middle one
+                // higher: a gable. Columns are 0.6 nm apart, so a descending atom always
+                // meets the atom below its slot before any neighbour.
                 slots_m: vec![
                     above(foundation[0], 1.0),
-                    above(foundation[1], 1.0),
                     above(foundation[2], 1.0),
-                    above(foundation[1], 2.0),
+                    above(foundation[4], 1.0),
+                    above(foundation[0], 2.0),
+                    above(foundation[2], 2.0),
+                    above(foundation[4], 2.0),
+                    above(foundation[2], 3.0),
                 ],
                 tolerance_m: 0.05e-9,
             }),

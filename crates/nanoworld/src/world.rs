@@ -419,12 +419,15 @@ impl World {
         {
             return;
         }
+        // The new atom must appear out of reach of every other body, so that spawning
+        // never snaps anything on the tick it happens.
         let p = self.rest_position(zone.spawn_xy_m);
-        let clear = 2.0 * self.params.atoms.radius_m;
+        let ra = self.params.atoms.radius_m;
+        let clear = 2.0 * ra + self.laws.get(PairKind::AtomAtom).reach_m();
         if self.atoms.iter().any(|a| (a.position - p).norm() < clear) {
             return;
         }
-        let tip_clear = self.params.tip.radius_m + self.params.atoms.radius_m;
+        let tip_clear = self.params.tip.radius_m + ra + self.laws.get(PairKind::TipAtom).reach_m();
         if (self.tip - p).norm() < tip_clear {
             return;
         }
