@@ -44,6 +44,7 @@ mod params;
 mod physical;
 mod script;
 mod substrate;
+mod view;
 mod world;
 
 pub use curve::{CurveSpec, ForceCurve, force_distance_curve};
@@ -57,6 +58,7 @@ pub use params::{
 };
 pub use script::{ScriptError, house_script, house_waypoints, polyline};
 pub use substrate::Substrate;
+pub use view::{BodyContact, BodyKind, BodyView};
 pub use world::{
     Anchor, BrokenLink, Event, Member, MovableAtom, StepReport, Target, TipContact, TipInput, World,
 };

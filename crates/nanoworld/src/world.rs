@@ -343,7 +343,7 @@ impl World {
         }
         let mut events = Vec::new();
         self.tick += 1;
-        self.time_s = self.tick as f64 * dt_s;
+        self.time_s += dt_s;
         let prev = self.history;
         self.history = [Some(self.cursor), prev[0]];
         self.cursor = input.position_m;
@@ -552,7 +552,7 @@ impl World {
     pub fn tick(&self) -> u64 {
         self.tick
     }
-    /// Simulated time: ticks × the last dt (s).
+    /// Simulated time: the sum of all tick lengths (s).
     pub fn time_s(&self) -> f64 {
         self.time_s
     }

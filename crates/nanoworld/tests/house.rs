@@ -3,7 +3,8 @@
 
 use nalgebra::Vector3;
 use nanoworld::{
-    BrokenLink, Event, Member, Params, StepReport, Target, TipContact, World, house_script,
+    BodyContact, BodyKind, BodyView, BrokenLink, Event, Member, Params, StepReport, Target,
+    TipContact, World, house_script,
 };
 
 fn run(world: &mut World, step_m: f64) -> Vec<StepReport> {
@@ -134,6 +135,21 @@ fn atom_on_tip_transfers_onto_another_atom_and_tip_leaves_it() {
         e,
         Event::Snap { member: Member::Atom(m), target: Target::Atom(0), .. } if *m == c
     )));
+    // The renderer's view: tip anchored, the carried atom riding, atom 0 touched.
+    let view: Vec<BodyView> = w.bodies().collect();
+    assert_eq!(view.len(), 1 + w.atoms().len() + w.substrate().len());
+    assert_eq!(
+        (view[0].kind, view[0].contact),
+        (BodyKind::Tip, BodyContact::Anchored)
+    );
+    assert_eq!(view[1].contact, BodyContact::Touched);
+    assert_eq!(view[1 + c].contact, BodyContact::Carried);
+    assert_eq!(view[1 + c].position_m, w.atoms()[c].position_m());
+    assert!(
+        view[1 + w.atoms().len()..]
+            .iter()
+            .all(|b| b.kind == BodyKind::Substrate && b.contact == BodyContact::Free)
+    );
     // Pull away: the tip–atom bond (weaker) breaks at 10× its snap force; the atom stays.
     let ev = go(&mut w, Vector3::new(r.x, r.y, high));
     assert!(ev.iter().any(
