@@ -471,6 +471,22 @@ fn main() -> Res<()> {
         f_po,
         &format!("≤ k_c h/F = {:.1e}", kc * ph_h / f_po),
     )?;
+    let cc = ah * r / 6.0;
+    let hpo = z0 + f_po / kc;
+    let mut dpo = hpo;
+    for _ in 0..100 {
+        dpo -= (kc * (hpo - dpo) - cc / (dpo * dpo)) / (-kc + 2.0 * cc / dpo.powi(3));
+    }
+    let prim = |x: f64| -cc / x + cc * cc / (2.0 * kc * x.powi(4));
+    let p_area =
+        0.5 * kc * ((hpo - z0).powi(2) - (1.5 * z_jtc - z0).powi(2)) - (prim(dpo) - prim(z_jtc));
+    row(
+        &mut md,
+        "physical: hysteresis loop area (J)",
+        pc.hysteresis_j,
+        p_area,
+        "O(h) (test)",
+    )?;
     row(
         &mut md,
         "physical: pull-off / jump force, k_c = A·R/(95 z0³)",

@@ -181,3 +181,35 @@ fn physical_tenfold_pull_off_with_k_c_near_ar_over_95_z0_cubed() {
         );
     }
 }
+
+/// Quasi-static cantilever loop area: between the jump base gap h_jtc and the pull-off base
+/// gap h_po the approach is on the free branch and the retraction on the contact line
+/// k_c·(h − z0); elsewhere both legs coincide. With the free branch parametrised by the tip
+/// gap D (h = D + C/(k_c·D²), F = C/D², C = A·R/6):
+/// area = k_c·[(h_po − z0)² − (h_jtc − z0)²]/2 − [−C/D + C²/(2·k_c·D⁴)] from z_jtc to D_po.
+#[test]
+fn physical_hysteresis_area_matches_quasi_static_integral() {
+    let (p, a, r, z0, kc) = physical(Some(95.0));
+    let c = a * r / 6.0;
+    let d_jtc = (2.0 * c / kc).cbrt();
+    let h_jtc = 1.5 * d_jtc;
+    let f_po = c / (z0 * z0);
+    let h_po = z0 + f_po / kc;
+    // Stable free-branch root at h_po: k_c·(h_po − D)·D² = C, D > z_jtc (Newton from above).
+    let mut d = h_po;
+    for _ in 0..100 {
+        let g = kc * (h_po - d) - c / (d * d);
+        let dg = -kc + 2.0 * c / (d * d * d);
+        d -= g / dg;
+    }
+    assert!(d > d_jtc && (kc * (h_po - d) - c / (d * d)).abs() < 1e-18);
+    let prim = |x: f64| -c / x + c * c / (2.0 * kc * x.powi(4));
+    let exact = 0.5 * kc * ((h_po - z0).powi(2) - (h_jtc - z0).powi(2)) - (prim(d) - prim(d_jtc));
+    let mut errs = Vec::new();
+    for steps in [50_000, 100_000, 200_000] {
+        let cv = force_distance_curve(&p, &spec(3e-9, 0.0, steps)).expect("valid");
+        errs.push((cv.hysteresis_j - exact).abs() / exact);
+    }
+    assert!(errs[2] < 1e-3, "{errs:?} (exact {exact:e} J)");
+    assert!(errs[2] < errs[0], "{errs:?}");
+}

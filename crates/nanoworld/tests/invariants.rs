@@ -101,3 +101,55 @@ proptest! {
         prop_assert!(snaps >= 1 && releases >= 1, "path must cross snap and release");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Random low sweeps over the loading zone and the foundation (so atoms spawn, attach,
+    /// anchor, transfer): the state stays consistent after every tick.
+    #[test]
+    fn state_stays_consistent(
+        physical in any::<bool>(),
+        legs in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0), 2..12),
+    ) {
+        let p = if physical { Params::physical_default() } else { Params::game_default() };
+        let (lo, span, zmax) = if physical { (5e-9, 40e-9, 45e-9) } else { (1e-9, 6e-9, 2.5e-9) };
+        let zmin = p.substrate.atom_radius_m + p.tip.radius_m;
+        let mut w = World::new(p.clone(), Vector3::new(2e-9, 2e-9, zmax)).expect("valid");
+        let mut pts = vec![w.cursor_m()];
+        for (a, b, c) in legs {
+            pts.push(Vector3::new(lo + a * span, lo + b * span, zmin + c * (zmax - zmin)));
+        }
+        let step = if physical { 20e-12 } else { 2e-12 };
+        for i in nanoworld::polyline(&pts, step) {
+            let r = w.step(&i, 1e-3).expect("valid");
+            prop_assert!(r.force_n.iter().all(|v| v.is_finite()));
+            let atoms = w.atoms();
+            let carried: Vec<usize> = (0..atoms.len()).filter(|&i| atoms[i].is_carried()).collect();
+            prop_assert_eq!(&carried, w.carried());
+            for (i, a) in atoms.iter().enumerate() {
+                for &j in a.bonds() {
+                    prop_assert!(j != i && atoms[j].bonds().contains(&i), "bond {i}-{j} not mutual");
+                }
+                if let Some(o) = a.carried_offset_m() {
+                    prop_assert!((a.position_m() - (w.tip_position_m() + o)).norm() < 1e-18);
+                    prop_assert!(!a.on_substrate());
+                }
+            }
+            if let nanoworld::TipContact::Anchored(an) = w.tip_contact() {
+                prop_assert_eq!(an.tip_position_m, w.tip_position_m());
+                let (pm, rm) = match an.member {
+                    nanoworld::Member::Tip => (w.tip_position_m(), p.tip.radius_m),
+                    nanoworld::Member::Atom(c) => (atoms[c].position_m(), p.atoms.radius_m),
+                };
+                let gap = match an.target {
+                    nanoworld::Target::Atom(t) => (pm - atoms[t].position_m()).norm() - rm - p.atoms.radius_m,
+                    nanoworld::Target::SubstrateAtom(j) => (pm - w.substrate().positions()[j]).norm() - rm - p.substrate.atom_radius_m,
+                    nanoworld::Target::SubstratePlane => pm.z - rm - p.substrate.atom_radius_m,
+                };
+                let cg = w.laws().get(PairKind::AtomAtom).contact_gap_m;
+                prop_assert!((gap - cg).abs() < 1e-17, "anchored gap {gap:e} vs contact {cg:e}");
+            }
+        }
+    }
+}
