@@ -178,3 +178,57 @@ impl PairLaws {
         &self.laws[kind.index()]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The game law is continuous at the activation gap, equals the snap force at the snap
+    /// gap, is held there below it, and its stiffening is minus its derivative.
+    #[test]
+    fn game_law_shape() {
+        let laws = PairLaws::from_params(&Params::game_default());
+        for k in PairKind::ALL {
+            let l = laws.get(k);
+            let w = l.cutoff_gap_m;
+            assert!(l.force(w * (1.0 - 1e-12)) < 1e-9 * l.snap_force_n);
+            assert_eq!(l.force(w), 0.0);
+            assert_eq!(l.force(l.snap_gap_m), l.snap_force_n);
+            assert_eq!(l.force(0.5 * l.snap_gap_m), l.snap_force_n);
+            assert_eq!(l.force(-1.0), l.snap_force_n);
+            let z = 0.3e-9;
+            let h = 1e-16;
+            let numeric = -(l.force(z + h) - l.force(z - h)) / (2.0 * h);
+            assert!((numeric - l.stiffening(z)).abs() < 1e-6 * l.stiffening(z));
+        }
+    }
+
+    /// Physical pull-off is DMT 2π·R_eff·W with W = A/(12π·z0²).
+    #[test]
+    fn physical_pull_off_is_dmt() {
+        let p = Params::physical_default();
+        let laws = PairLaws::from_params(&p);
+        let Interaction::Physical(ph) = &p.interaction else {
+            unreachable!("physical default")
+        };
+        let z0 = ph.contact_gap_m;
+        let (rt, ra) = (p.tip.radius_m, p.atoms.radius_m);
+        let cases = [
+            (PairKind::TipSubstrate, ph.hamaker_j.tip_substrate, rt),
+            (
+                PairKind::TipAtom,
+                ph.hamaker_j.tip_atom,
+                rt * ra / (rt + ra),
+            ),
+            (PairKind::AtomAtom, ph.hamaker_j.atom_atom, ra / 2.0),
+            (PairKind::AtomSubstrate, ph.hamaker_j.atom_substrate, ra),
+        ];
+        for (k, a, r_eff) in cases {
+            let w_adh = a / (12.0 * std::f64::consts::PI * z0 * z0);
+            let dmt = 2.0 * std::f64::consts::PI * r_eff * w_adh;
+            let l = laws.get(k);
+            assert!((l.pull_off_n - dmt).abs() < 1e-14 * dmt, "{k:?}");
+            assert_eq!(l.contact_gap_m, z0);
+        }
+    }
+}

@@ -172,3 +172,46 @@ impl World {
         Solve::Fold
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Params;
+
+    /// The analytic Jacobian used by Newton's method matches central differences of the
+    /// force, for a tip carrying a particle near the plane and two other particles.
+    #[test]
+    fn jacobian_matches_central_differences() {
+        let mut p = Params::physical_default();
+        p.loading_zone = None;
+        p.initial_atoms_xy_m = vec![[20e-9, 20e-9], [38e-9, 22e-9], [45e-9, 40e-9]];
+        let mut w = World::new(p, Vector3::new(20e-9, 20e-9, 40e-9)).expect("valid");
+        // Carry particle 0 below the tip with a lateral tilt.
+        let tip = Vector3::new(21e-9, 19.5e-9, 33e-9);
+        w.place_tip(tip);
+        w.atoms[0].carried_offset = Some(Vector3::new(3e-9, 1e-9, -24.6e-9));
+        w.atoms[0].on_substrate = false;
+        w.carried = vec![0];
+        w.place_tip(tip);
+        let x = Vector3::new(24e-9, 21e-9, 33.2e-9);
+        let (_, j, margin) = w.force_jacobian(x);
+        assert!(margin > 0.0);
+        let h = 1e-13;
+        let mut worst: f64 = 0.0;
+        let scale = j.abs().max();
+        for k in 0..3 {
+            let mut e = Vector3::zeros();
+            e[k] = h;
+            let (fp, _, _) = w.force_jacobian(x + e);
+            let (fm, _, _) = w.force_jacobian(x - e);
+            let col = (fp - fm) / (2.0 * h);
+            for r in 0..3 {
+                worst = worst.max((col[r] - j[(r, k)]).abs() / scale);
+            }
+        }
+        assert!(
+            scale > 0.0 && worst < 1e-6,
+            "relative Jacobian error {worst:e}"
+        );
+    }
+}
