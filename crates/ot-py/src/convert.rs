@@ -1,0 +1,188 @@
+//! numpy arrays in and out, argument checks and error mapping.
+//!
+//! Every check here is about the *shape* of what Python passed (array
+//! dimensions, finite numbers, integer ranges) and names the argument; the
+//! physical ranges are checked by the wrapped crates and their typed errors are
+//! raised unchanged as `ValueError`.
+
+use nalgebra::SVector;
+use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+/// Raise a crate error as `ValueError` with its `Display` text (which names
+/// the field and the allowed range).
+pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// Format a shape the way numpy prints it: `(3,)`, `(4, 2)`.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => {
+            let parts: Vec<String> = shape.iter().map(|s| s.to_string()).collect();
+            format!("({})", parts.join(", "))
+        }
+    }
+}
+
+/// An array-like of numbers read as float64: data in row-major order and shape.
+pub(crate) struct Numbers {
+    /// Values in C (row-major) order.
+    pub data: Vec<f64>,
+    /// numpy shape.
+    pub shape: Vec<usize>,
+}
+
+/// Read any array-like of numbers (list, tuple, numpy array of any real dtype).
+pub(crate) fn numbers(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Numbers> {
+    let arr: PyArrayLikeDyn<'_, f64, AllowTypeChange> = obj.extract().map_err(|e: PyErr| {
+        PyValueError::new_err(format!("{name}: expected an array of real numbers ({e})"))
+    })?;
+    let view = arr.as_array();
+    Ok(Numbers {
+        shape: view.shape().to_vec(),
+        data: view.iter().copied().collect(),
+    })
+}
+
+/// Fail on the first non-finite value, naming its index.
+fn all_finite(n: &Numbers, name: &str, unit: &str) -> PyResult<()> {
+    let Some(k) = n.data.iter().position(|v| !v.is_finite()) else {
+        return Ok(());
+    };
+    let mut idx = Vec::with_capacity(n.shape.len());
+    let mut rest = k;
+    for (d, _) in n.shape.iter().enumerate() {
+        let stride: usize = n.shape[d + 1..].iter().product();
+        idx.push((rest / stride).to_string());
+        rest %= stride;
+    }
+    Err(PyValueError::new_err(format!(
+        "{name}[{}] = {:e} is out of range: allowed finite ({unit})",
+        idx.join(", "),
+        n.data[k]
+    )))
+}
+
+fn to_vectors<const D: usize>(data: &[f64]) -> Vec<SVector<f64, D>> {
+    data.chunks_exact(D)
+        .map(SVector::<f64, D>::from_column_slice)
+        .collect()
+}
+
+/// An `(N, D)` array of finite numbers as N vectors.
+pub(crate) fn rows<const D: usize>(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    unit: &str,
+) -> PyResult<Vec<SVector<f64, D>>> {
+    let n = numbers(obj, name)?;
+    if n.shape.len() != 2 || n.shape[1] != D {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected shape (N, {D}), got {}",
+            shape_text(&n.shape)
+        )));
+    }
+    all_finite(&n, name, unit)?;
+    Ok(to_vectors(&n.data))
+}
+
+/// A `(D,)` array of finite numbers.
+pub(crate) fn vector<const D: usize>(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    unit: &str,
+) -> PyResult<SVector<f64, D>> {
+    let n = numbers(obj, name)?;
+    if n.shape != [D] {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected shape ({D},), got {}",
+            shape_text(&n.shape)
+        )));
+    }
+    all_finite(&n, name, unit)?;
+    Ok(SVector::<f64, D>::from_column_slice(&n.data))
+}
+
+/// A `(D,)` array (one vector for all rows) or an `(N, D)` array (one per row).
+pub(crate) fn one_or_rows<const D: usize>(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    unit: &str,
+    n_rows: usize,
+) -> PyResult<Vec<SVector<f64, D>>> {
+    let n = numbers(obj, name)?;
+    let ok = n.shape == [D] || n.shape == [n_rows, D];
+    if !ok {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected shape ({D},) or ({n_rows}, {D}), got {}",
+            shape_text(&n.shape)
+        )));
+    }
+    all_finite(&n, name, unit)?;
+    Ok(to_vectors(&n.data))
+}
+
+/// A `(D,)` array or an `(N, D)` array of finite numbers; returns the vectors
+/// and whether a single vector was given.
+pub(crate) fn point_or_rows<const D: usize>(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    unit: &str,
+) -> PyResult<(Vec<SVector<f64, D>>, bool)> {
+    let n = numbers(obj, name)?;
+    let single = n.shape == [D];
+    if !(single || (n.shape.len() == 2 && n.shape[1] == D)) {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected shape ({D},) or (N, {D}), got {}",
+            shape_text(&n.shape)
+        )));
+    }
+    all_finite(&n, name, unit)?;
+    Ok((to_vectors(&n.data), single))
+}
+
+/// A Python integer in `lo ..= hi`.
+pub(crate) fn int_in(obj: &Bound<'_, PyAny>, name: &str, lo: i128, hi: i128) -> PyResult<i128> {
+    let v: i128 = obj
+        .extract()
+        .map_err(|_| PyTypeError::new_err(format!("{name}: expected an integer")))?;
+    if (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{name} = {v} is out of range: allowed {lo} ..= {hi}"
+        )))
+    }
+}
+
+/// N vectors as an `(N, D)` float64 array.
+pub(crate) fn array2<'py, const D: usize>(
+    py: Python<'py>,
+    v: &[SVector<f64, D>],
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let flat: Vec<f64> = v.iter().flat_map(|x| x.iter().copied()).collect();
+    PyArray1::from_vec(py, flat).reshape([v.len(), D])
+}
+
+/// A vector as a `(D,)` float64 array.
+pub(crate) fn array1<'py, const D: usize>(
+    py: Python<'py>,
+    v: &SVector<f64, D>,
+) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, v.as_slice())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shape_text;
+
+    #[test]
+    fn shapes_print_like_numpy() {
+        assert_eq!(shape_text(&[3]), "(3,)");
+        assert_eq!(shape_text(&[4, 2]), "(4, 2)");
+        assert_eq!(shape_text(&[]), "()");
+    }
+}

@@ -1,0 +1,33 @@
+//! # ot-py — the Python wheel `nanohaptics`
+//!
+//! numpy bindings to the nanohaptics crates, built with maturin
+//! (`import nanohaptics`). SI units throughout (J, m, kg, s, Pa·s, K, N).
+//!
+//! What it is for: driving the simulators from Python — the optical-trap
+//! flow map, trajectories and thermal runs of `ot-physics`
+//! ([`trap::GaussianTrap`]), and the nano world of `nanoworld`.
+//!
+//! What it is not: it holds no physics. Every number comes from the wrapped
+//! crates; this crate only converts arrays, checks their shapes, releases
+//! the GIL during batch work, and raises the crates' typed errors as
+//! `ValueError` with their text (which names the field and the allowed
+//! range). The user guide is `docs/python.md`; the type stub is
+//! `crates/ot-py/nanohaptics.pyi`.
+
+mod convert;
+pub mod trap;
+
+use pyo3::prelude::*;
+
+/// Haptic manipulation at the nanoscale: optical-trap dynamics and the nano
+/// world, from Python. SI units throughout (J, m, kg, s, Pa·s, K, N).
+#[pymodule]
+fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<trap::GaussianTrap>()?;
+    m.add_function(wrap_pyfunction!(trap::paper_trap, m)?)?;
+    m.add("PAPER_DT", ot_physics::paper::DT)?;
+    let [vx, vy] = ot_physics::paper::V0_MOVING;
+    m.add("PAPER_V0_MOVING", (vx, vy))?;
+    Ok(())
+}

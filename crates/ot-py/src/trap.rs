@@ -1,0 +1,580 @@
+//! `nanohaptics.GaussianTrap`: the optical-well model of `ot-physics` with its
+//! flow map, trajectories and thermal runs.
+
+// Python signatures with keyword options map to long Rust parameter lists.
+#![allow(clippy::too_many_arguments)]
+
+use nalgebra::SVector;
+use numpy::{PyArray1, PyArray2};
+use ot_physics::langevin::{Scheme, ThermalRun, simulate};
+use ot_physics::{Method, Phase, Propagator, TrapModel, paper};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use crate::convert::{
+    array1, array2, int_in, one_or_rows, point_or_rows, rows, value_error, vector,
+};
+
+/// The model in its dimension.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Model {
+    /// The paper's planar well.
+    D2(TrapModel<2>),
+    /// A 3D well with an axial waist.
+    D3(TrapModel<3>),
+}
+
+/// Run `$body` with `$m` bound to the `TrapModel<D>` of either dimension.
+macro_rules! with_model {
+    ($model:expr, $m:ident => $body:expr) => {
+        match $model {
+            Model::D2($m) => $body,
+            Model::D3($m) => $body,
+        }
+    };
+}
+
+/// A particle in an elliptic Gaussian optical well
+/// ``P = -depth * exp(-ln2 * (x²/a² + y²/b² [+ z²/c²]))``, SI units throughout.
+///
+/// Args:
+///     depth: well depth P0 (J), > 0.
+///     waist: the pair of lateral half-depth radii (a, b) (m), each > 0.
+///     mass: particle mass (kg), or None for an overdamped particle (needs drag).
+///     axial_waist: axial half-depth radius c (m); makes the trap 3D.
+///     radius: particle radius (m); with viscosity switches Stokes drag
+///         γ = 6πηr on.
+///     viscosity: fluid viscosity η (Pa·s).
+///     temperature: temperature (K); switches thermal noise on for
+///         :meth:`brownian` (needs radius and viscosity).
+///     external_force: constant external force (N), one entry per axis.
+///
+/// Positions handed to :meth:`force`, :meth:`potential`, :meth:`trajectory`
+/// and :meth:`brownian` are particle positions relative to the trap centre;
+/// ``offsets`` of :meth:`displacement` are trap-centre positions relative to
+/// the particle (the paper's convention). Raises ValueError naming the
+/// argument and its allowed range.
+#[pyclass(frozen, module = "nanohaptics")]
+#[derive(Debug, Clone)]
+pub struct GaussianTrap {
+    pub(crate) model: Model,
+    radius: Option<f64>,
+    viscosity: Option<f64>,
+    temperature: Option<f64>,
+}
+
+impl GaussianTrap {
+    /// Wrap a validated model (no radius/viscosity/temperature recorded).
+    fn from_model(model: Model) -> Self {
+        Self {
+            model,
+            radius: None,
+            viscosity: None,
+            temperature: None,
+        }
+    }
+
+    /// The model without thermal noise: the deterministic dynamics the flow
+    /// map and trajectories integrate.
+    pub(crate) fn deterministic(&self) -> Model {
+        match self.model {
+            Model::D2(mut m) => {
+                m.kt = None;
+                Model::D2(m)
+            }
+            Model::D3(mut m) => {
+                m.kt = None;
+                Model::D3(m)
+            }
+        }
+    }
+
+    /// Spatial dimension (2 or 3).
+    pub(crate) fn dim(&self) -> usize {
+        match self.model {
+            Model::D2(_) => 2,
+            Model::D3(_) => 3,
+        }
+    }
+}
+
+/// Parse an integration method with its options, rejecting options the
+/// method does not use (rather than ignoring them).
+pub(crate) fn parse_method(
+    method: &str,
+    rtol: Option<f64>,
+    substeps: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Method> {
+    let n = match substeps {
+        None => None,
+        Some(obj) => Some(int_in(obj, "substeps", 1, 10_000_000)? as u32),
+    };
+    let m = Method::from_name(method, rtol, n).map_err(value_error)?;
+    let adaptive = matches!(m, Method::Adaptive { .. } | Method::Dopri5 { .. });
+    if rtol.is_some() && !adaptive {
+        return Err(PyValueError::new_err(format!(
+            "rtol is used only by \"adaptive\" and \"dopri5\", not by method {method:?}"
+        )));
+    }
+    if n.is_some() && (adaptive || m == Method::PaperRk4) {
+        return Err(PyValueError::new_err(format!(
+            "substeps is used only by \"rk4\", \"rk8\", \"symplectic\", \"yoshida4\" and \"yoshida6\", not by method {method:?}"
+        )));
+    }
+    Ok(m)
+}
+
+/// An overdamped particle has no velocity state: refuse a nonzero one.
+fn check_overdamped_velocity<const D: usize>(
+    model: &TrapModel<D>,
+    v: &[SVector<f64, D>],
+) -> PyResult<()> {
+    if model.mass.is_none() && v.iter().any(|x| x.iter().any(|c| *c != 0.0)) {
+        return Err(PyValueError::new_err(
+            "velocity: must be zero for an overdamped trap (mass=None): it has no velocity state",
+        ));
+    }
+    Ok(())
+}
+
+fn positive(value: f64, name: &str, unit: &str) -> PyResult<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{name} = {value:e} is out of range: allowed finite and > 0 ({unit})"
+        )))
+    }
+}
+
+fn displacement_d<const D: usize>(
+    py: Python<'_>,
+    model: TrapModel<D>,
+    offsets: &Bound<'_, PyAny>,
+    velocity: &Bound<'_, PyAny>,
+    dt: f64,
+    method: Method,
+) -> PyResult<Py<PyArray2<f64>>> {
+    let offsets = rows::<D>(offsets, "offsets", "m")?;
+    let velocities = one_or_rows::<D>(velocity, "velocity", "m/s", offsets.len())?;
+    check_overdamped_velocity(&model, &velocities)?;
+    let prop = Propagator::new(model, method, dt).map_err(value_error)?;
+    let out = py
+        .detach(|| {
+            let mut out = vec![SVector::<f64, D>::zeros(); offsets.len()];
+            prop.flow_batch(&offsets, &velocities, &mut out)
+                .map(|_| out)
+        })
+        .map_err(value_error)?;
+    Ok(array2(py, &out)?.unbind())
+}
+
+type Trajectory<const D: usize> = (Vec<f64>, Vec<SVector<f64, D>>, Vec<SVector<f64, D>>);
+
+fn trajectory_d<const D: usize>(
+    py: Python<'_>,
+    model: TrapModel<D>,
+    offset: &Bound<'_, PyAny>,
+    velocity: &Bound<'_, PyAny>,
+    duration: f64,
+    samples: usize,
+    method: Method,
+) -> PyResult<Py<PyTuple>> {
+    let offset = vector::<D>(offset, "offset", "m")?;
+    let v0 = vector::<D>(velocity, "velocity", "m/s")?;
+    check_overdamped_velocity(&model, &[v0])?;
+    let h = duration / (samples - 1) as f64;
+    let prop = Propagator::new(model, method, h).map_err(value_error)?;
+    let (t, r, v): Trajectory<D> = py
+        .detach(|| {
+            let mut y = Phase { r: -offset, v: v0 };
+            if model.mass.is_none() {
+                // Overdamped: the velocity is the drift velocity (F + F_ext)/γ.
+                let g = model.drag.unwrap_or(f64::INFINITY);
+                y.v = (model.well.force(&y.r) + model.external_force) / g;
+            }
+            let mut t = Vec::with_capacity(samples);
+            let mut r = Vec::with_capacity(samples);
+            let mut v = Vec::with_capacity(samples);
+            t.push(0.0);
+            r.push(y.r);
+            v.push(y.v);
+            for k in 1..samples {
+                y = prop.phase(&y)?.end;
+                t.push(k as f64 * h);
+                r.push(y.r);
+                v.push(y.v);
+            }
+            Ok::<_, ot_physics::PhysicsError>((t, r, v))
+        })
+        .map_err(value_error)?;
+    let t = PyArray1::from_vec(py, t);
+    let tuple = PyTuple::new(
+        py,
+        [
+            t.into_any(),
+            array2(py, &r)?.into_any(),
+            array2(py, &v)?.into_any(),
+        ],
+    )?;
+    Ok(tuple.unbind())
+}
+
+fn brownian_d<const D: usize>(
+    py: Python<'_>,
+    model: TrapModel<D>,
+    run: ThermalRun,
+    start: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Py<PyArray2<f64>>> {
+    let r0 = match start {
+        Some(s) => vector::<D>(s, "start", "m")?,
+        None => SVector::zeros(),
+    };
+    let start = Phase {
+        r: r0,
+        v: SVector::zeros(),
+    };
+    let out = py
+        .detach(|| simulate(&model, start, &run))
+        .map_err(value_error)?;
+    Ok(array2(py, &out)?.unbind())
+}
+
+fn force_d<const D: usize>(
+    py: Python<'_>,
+    model: &TrapModel<D>,
+    positions: &Bound<'_, PyAny>,
+) -> PyResult<Py<PyAny>> {
+    let (p, single) = point_or_rows::<D>(positions, "positions", "m")?;
+    let f: Vec<SVector<f64, D>> = p
+        .iter()
+        .map(|r| model.well.force(r) + model.external_force)
+        .collect();
+    Ok(if single {
+        array1(py, &f[0]).into_any().unbind()
+    } else {
+        array2(py, &f)?.into_any().unbind()
+    })
+}
+
+fn potential_d<const D: usize>(
+    py: Python<'_>,
+    model: &TrapModel<D>,
+    positions: &Bound<'_, PyAny>,
+) -> PyResult<Py<PyAny>> {
+    let (p, single) = point_or_rows::<D>(positions, "positions", "m")?;
+    let e: Vec<f64> = p.iter().map(|r| model.well.potential(r)).collect();
+    Ok(if single {
+        e[0].into_pyobject(py)?.into_any().unbind()
+    } else {
+        PyArray1::from_vec(py, e).into_any().unbind()
+    })
+}
+
+fn tuple_of<'py>(py: Python<'py>, v: &[f64]) -> PyResult<Bound<'py, PyTuple>> {
+    PyTuple::new(py, v.iter().copied())
+}
+
+#[pymethods]
+impl GaussianTrap {
+    #[new]
+    #[pyo3(signature = (depth, waist, mass, *, axial_waist=None, radius=None, viscosity=None, temperature=None, external_force=None))]
+    fn new(
+        depth: f64,
+        waist: &Bound<'_, PyAny>,
+        mass: Option<f64>,
+        axial_waist: Option<f64>,
+        radius: Option<f64>,
+        viscosity: Option<f64>,
+        temperature: Option<f64>,
+        external_force: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let numbers = crate::convert::numbers(waist, "waist")?;
+        if numbers.shape != [2] {
+            return Err(PyValueError::new_err(format!(
+                "waist: expected the pair (a, b) of lateral waists in m, got {} values",
+                numbers.data.len()
+            )));
+        }
+        let (a, b) = (numbers.data[0], numbers.data[1]);
+        let model = match axial_waist {
+            None => {
+                let f = match external_force {
+                    Some(f) => vector::<2>(f, "external_force", "N")?.into(),
+                    None => [0.0; 2],
+                };
+                Model::D2(
+                    TrapModel::builder(depth, [a, b])
+                        .maybe_mass(mass)
+                        .radius(radius)
+                        .viscosity(viscosity)
+                        .temperature(temperature)
+                        .external_force(f)
+                        .build()
+                        .map_err(value_error)?,
+                )
+            }
+            Some(c) => {
+                let f = match external_force {
+                    Some(f) => vector::<3>(f, "external_force", "N")?.into(),
+                    None => [0.0; 3],
+                };
+                Model::D3(
+                    TrapModel::builder(depth, [a, b, c])
+                        .maybe_mass(mass)
+                        .radius(radius)
+                        .viscosity(viscosity)
+                        .temperature(temperature)
+                        .external_force(f)
+                        .build()
+                        .map_err(value_error)?,
+                )
+            }
+        };
+        Ok(Self {
+            model,
+            radius,
+            viscosity,
+            temperature,
+        })
+    }
+
+    /// Displacements (m) of the particle after ``dt`` (s), one per trap offset.
+    ///
+    /// Args:
+    ///     offsets: (N, D) trap-centre positions relative to the particle (m).
+    ///     velocity: the particle's initial velocity (m/s): one (D,) vector
+    ///         for all rows or an (N, D) array. Must be zero when mass is None.
+    ///     dt: the interval (s), > 0.
+    ///     method: "adaptive" (DOP853 with error control, default),
+    ///         "dopri5", "paper-rk4" (one RK4 step: the paper's difference
+    ///         equation), "rk4", "rk8", "symplectic", "yoshida4", "yoshida6".
+    ///     rtol: relative tolerance of "adaptive"/"dopri5" (default 1e-7).
+    ///     substeps: equal substeps of the fixed-step methods (default 16,
+    ///         3 for "rk8").
+    ///
+    /// Returns:
+    ///     (N, D) float64 array of displacements (m). Thermal noise is not
+    ///     applied here (see :meth:`brownian`). The GIL is released while
+    ///     the batch runs.
+    #[pyo3(signature = (offsets, velocity, dt, *, method="adaptive", rtol=None, substeps=None))]
+    fn displacement(
+        &self,
+        py: Python<'_>,
+        offsets: &Bound<'_, PyAny>,
+        velocity: &Bound<'_, PyAny>,
+        dt: f64,
+        method: &str,
+        rtol: Option<f64>,
+        substeps: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Py<PyArray2<f64>>> {
+        let method = parse_method(method, rtol, substeps)?;
+        with_model!(self.deterministic(), m => displacement_d(py, m, offsets, velocity, dt, method))
+    }
+
+    /// Positions and velocities at ``samples`` evenly spaced times over
+    /// ``duration`` with the trap fixed at the origin.
+    ///
+    /// Args:
+    ///     offset: (D,) trap-centre position relative to the particle at t = 0 (m).
+    ///     velocity: (D,) initial velocity (m/s); zero when mass is None.
+    ///     duration: total time (s), > 0.
+    ///     samples: number of samples including t = 0 and t = duration, >= 2.
+    ///     method, rtol, substeps: as in :meth:`displacement`; the method is
+    ///         applied over each interval duration / (samples - 1).
+    ///
+    /// Returns:
+    ///     (t, positions, velocities): t (S,) in s; positions (S, D) of the
+    ///     particle relative to the trap centre in m (the first row is
+    ///     ``-offset``); velocities (S, D) in m/s (overdamped: the drift
+    ///     velocity).
+    #[pyo3(signature = (offset, velocity, duration, samples, *, method="adaptive", rtol=None, substeps=None))]
+    fn trajectory(
+        &self,
+        py: Python<'_>,
+        offset: &Bound<'_, PyAny>,
+        velocity: &Bound<'_, PyAny>,
+        duration: f64,
+        samples: &Bound<'_, PyAny>,
+        method: &str,
+        rtol: Option<f64>,
+        substeps: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Py<PyTuple>> {
+        let method = parse_method(method, rtol, substeps)?;
+        let duration = positive(duration, "duration", "s")?;
+        let samples = int_in(samples, "samples", 2, 10_000_000)? as usize;
+        with_model!(self.deterministic(), m => trajectory_d(py, m, offset, velocity, duration, samples, method))
+    }
+
+    /// Thermal motion: positions (m) relative to the trap centre (the trap
+    /// fixed at the origin), sampled at ``sample_rate``.
+    ///
+    /// Needs radius, viscosity and temperature. The particle starts at rest
+    /// at ``start`` (default: the trap centre); the first sample is one
+    /// interval after the start, so there are round(duration·sample_rate)
+    /// samples. Samples are instantaneous positions (they alias: see the
+    /// guide). Same seed, same bits.
+    ///
+    /// Args:
+    ///     duration: simulated time (s), > 0.
+    ///     sample_rate: output rate (Hz), > 0.
+    ///     seed: random seed, an integer 0 ..= 2**64 - 1.
+    ///     method: "auto" (overdamped when m/γ < h/100 or mass is None,
+    ///         otherwise BAOAB), "baoab", or "overdamped".
+    ///     substeps: integration steps per sample interval, 1 ..= 1000000.
+    ///     start: (D,) start position relative to the trap centre (m).
+    ///
+    /// Returns:
+    ///     (N, D) float64 array of positions (m). The GIL is released.
+    #[pyo3(signature = (duration, sample_rate, *, seed, method="auto", substeps=None, start=None))]
+    fn brownian(
+        &self,
+        py: Python<'_>,
+        duration: f64,
+        sample_rate: f64,
+        seed: &Bound<'_, PyAny>,
+        method: &str,
+        substeps: Option<&Bound<'_, PyAny>>,
+        start: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Py<PyArray2<f64>>> {
+        let seed = int_in(seed, "seed", 0, i128::from(u64::MAX))? as u64;
+        let scheme = Scheme::from_name(method).map_err(value_error)?;
+        let substeps = match substeps {
+            Some(s) => int_in(s, "substeps", 1, 1_000_000)? as u32,
+            None => 1,
+        };
+        let run = ThermalRun {
+            duration,
+            sample_rate,
+            substeps,
+            scheme,
+            seed,
+        };
+        with_model!(self.model, m => brownian_d(py, m, run, start))
+    }
+
+    /// Force on the particle (N): the well's restoring force plus the
+    /// external force, at ``positions`` relative to the trap centre (m).
+    ///
+    /// ``positions`` is one (D,) point (returns (D,)) or an (N, D) array
+    /// (returns (N, D)).
+    fn force(&self, py: Python<'_>, positions: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        with_model!(&self.model, m => force_d(py, m, positions))
+    }
+
+    /// Potential energy of the well (J) at ``positions`` relative to the
+    /// trap centre (m): a float for one (D,) point, an (N,) array for (N, D).
+    fn potential(&self, py: Python<'_>, positions: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        with_model!(&self.model, m => potential_d(py, m, positions))
+    }
+
+    /// Spatial dimension: 2, or 3 with an axial waist.
+    #[getter]
+    fn dimension(&self) -> usize {
+        self.dim()
+    }
+
+    /// Well depth P0 (J).
+    #[getter]
+    fn depth(&self) -> f64 {
+        with_model!(&self.model, m => m.well.depth())
+    }
+
+    /// Lateral waists (a, b) (m).
+    #[getter]
+    fn waist<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let w = with_model!(&self.model, m => m.well.waists().as_slice().to_vec());
+        tuple_of(py, &w[..2])
+    }
+
+    /// Axial waist c (m), or None for a 2D trap.
+    #[getter]
+    fn axial_waist(&self) -> Option<f64> {
+        match &self.model {
+            Model::D2(_) => None,
+            Model::D3(m) => Some(m.well.waists()[2]),
+        }
+    }
+
+    /// Particle mass (kg), or None (overdamped).
+    #[getter]
+    fn mass(&self) -> Option<f64> {
+        with_model!(&self.model, m => m.mass)
+    }
+
+    /// Particle radius (m), or None.
+    #[getter]
+    fn radius(&self) -> Option<f64> {
+        self.radius
+    }
+
+    /// Fluid viscosity (Pa·s), or None.
+    #[getter]
+    fn viscosity(&self) -> Option<f64> {
+        self.viscosity
+    }
+
+    /// Temperature (K), or None (no thermal noise).
+    #[getter]
+    fn temperature(&self) -> Option<f64> {
+        self.temperature
+    }
+
+    /// Stokes drag coefficient γ = 6πηr (kg/s), or None (no drag).
+    #[getter]
+    fn drag(&self) -> Option<f64> {
+        with_model!(&self.model, m => m.drag)
+    }
+
+    /// Small-oscillation stiffness per axis κ_i = 2·ln2·P0 / w_i² (N/m).
+    #[getter]
+    fn stiffness<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let k = with_model!(&self.model, m => m.well.stiffness().as_slice().to_vec());
+        tuple_of(py, &k)
+    }
+
+    /// Constant external force per axis (N).
+    #[getter]
+    fn external_force<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let f = with_model!(&self.model, m => m.external_force.as_slice().to_vec());
+        tuple_of(py, &f)
+    }
+
+    fn __repr__(&self) -> String {
+        let w = with_model!(&self.model, m => m.well.waists().as_slice().to_vec());
+        let mass = with_model!(&self.model, m => m.mass);
+        let opt = |v: Option<f64>| v.map_or("None".to_string(), |x| format!("{x:e}"));
+        let mut s = format!(
+            "GaussianTrap(depth={:e}, waist=({:e}, {:e}), mass={}",
+            self.depth(),
+            w[0],
+            w[1],
+            opt(mass)
+        );
+        if let Some(c) = w.get(2) {
+            s.push_str(&format!(", axial_waist={c:e}"));
+        }
+        for (name, v) in [
+            ("radius", self.radius),
+            ("viscosity", self.viscosity),
+            ("temperature", self.temperature),
+        ] {
+            if v.is_some() {
+                s.push_str(&format!(", {name}={}", opt(v)));
+            }
+        }
+        s.push(')');
+        s
+    }
+}
+
+/// The optical-tweezers paper's trap (Lee, Lyons & LeBrun): depth 1e-15 J
+/// (1e-6 nJ), waists (600e-9, 300e-9) m, mass 1e-15 kg (1e-12 g); no drag,
+/// no noise. Use with ``PAPER_DT`` = 1e-6 s and ``PAPER_V0_MOVING`` =
+/// (0.1, 0.1) m/s (100 nm/µs).
+#[pyfunction]
+pub fn paper_trap() -> PyResult<GaussianTrap> {
+    let model = paper::model().map_err(value_error)?;
+    Ok(GaussianTrap::from_model(Model::D2(model)))
+}
