@@ -128,3 +128,94 @@ class GaussianTrap:
 def paper_trap() -> GaussianTrap:
     """The optical-tweezers paper's trap: depth 1e-15 J, waists (600e-9,
     300e-9) m, mass 1e-15 kg, no drag, no noise."""
+
+# ---------------------------------------------------------------- nano world
+
+NanoParams = Union[Literal["game", "physical"], dict, None]
+Member = Tuple[Literal["tip", "atom"], Optional[int]]
+Target = Tuple[Literal["substrate_atom", "substrate_plane", "atom"], Optional[int]]
+
+class NanoWorld:
+    """The nano world of the teaching game: AFM tip (the cursor) over fixed
+    substrate atoms, movable atoms, van der Waals attraction, snap-to-contact,
+    adhesion, tenfold pull-off, atom transfer, a house blueprint.
+
+    start: (3,) initial cursor position (m). params: "game" (default),
+    "physical", or a dict with the scene-table layout (see nano_params()).
+    """
+
+    def __init__(self, start: ArrayLike, *, params: NanoParams = None) -> None: ...
+    def step(self, position: ArrayLike, dt_s: float = 1e-3) -> dict:
+        """One tick: {"force": (3,) N, "unlimited_force": (3,) N,
+        "saturated": bool, "events": list[dict]}."""
+    def run(self, positions: ArrayLike, dt_s: float = 1e-3) -> dict:
+        """One tick per row of (T, 3) cursor positions (m): {"force" (T, 3) N,
+        "unlimited_force" (T, 3) N, "saturated" (T,) bool, "tip" (T, 3) m,
+        "anchored" (T,) bool, "carried" (T,) int, "score" (T,) int,
+        "events": list[(tick, dict)]}. The GIL is released."""
+    def set_params(self, params: NanoParams) -> None:
+        """Run-time change (strengths, masses, gravity, ...; not the geometry)."""
+    def house_script(self, step_m: float = 2e-12) -> F64Array:
+        """(T, 3) cursor positions (m) of the scripted house session."""
+    @property
+    def params(self) -> dict:
+        """The parameters in force (scene-table layout)."""
+    @property
+    def tip_position(self) -> F64Array:
+        """(3,) tip centre (m)."""
+    @property
+    def cursor(self) -> F64Array:
+        """(3,) last cursor position (m)."""
+    @property
+    def contact(self) -> Optional[dict]:
+        """None when free, else {"member": Member, "target": Target,
+        "pair": str, "tip_position": (3,) m, "normal": (3,)}."""
+    @property
+    def atoms(self) -> F64Array:
+        """(M, 3) movable-atom centres (m)."""
+    @property
+    def carried(self) -> list[int]:
+        """Indices of the atoms on the tip."""
+    @property
+    def atom_on_substrate(self) -> npt.NDArray[np.bool_]:
+        """(M,) whether each atom is bonded to the substrate."""
+    @property
+    def atom_bonds(self) -> list[list[int]]:
+        """Per atom, the atoms it is bonded to."""
+    @property
+    def substrate(self) -> F64Array:
+        """(S, 3) substrate-atom centres (m)."""
+    @property
+    def radii(self) -> dict:
+        """{"tip", "atom", "substrate"} radii (m)."""
+    @property
+    def laws(self) -> dict:
+        """Per pair ("tip_substrate", "tip_atom", "atom_atom",
+        "atom_substrate"): snap_gap_m, snap_force_n, pull_off_n,
+        stiffness_n_per_m, contact_gap_m, cutoff_gap_m, floor_gap_m,
+        coef_n_m2, shift_n."""
+    @property
+    def house(self) -> dict:
+        """{"slots" (K, 3) m, "tolerance_m", "filled", "score", "complete"}."""
+    @property
+    def tick(self) -> int:
+        """Ticks stepped so far."""
+    @property
+    def time(self) -> float:
+        """Simulated time (s)."""
+
+def nano_params(mode: Literal["game", "physical"] = "game") -> dict:
+    """The default nano-world parameters as an editable dict."""
+
+def force_distance_curve(
+    params: NanoParams = None,
+    *,
+    xy_m: Optional[ArrayLike] = None,
+    far_gap_m: float = 2e-9,
+    near_gap_m: float = 0.0,
+    steps: Optional[int] = None,
+    dt_s: float = 1e-3,
+) -> dict:
+    """Approach-retract curve of the bare tip: {"approach_gap", "approach_force",
+    "retract_gap", "retract_force" ((steps+1,) m and N), "snap_index",
+    "pull_off_index" (int or None), "hysteresis" (J)}."""

@@ -15,6 +15,8 @@
 //! `crates/ot-py/nanohaptics.pyi`.
 
 mod convert;
+pub mod nano;
+mod params_dict;
 pub mod trap;
 
 use pyo3::prelude::*;
@@ -26,6 +28,9 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<trap::GaussianTrap>()?;
     m.add_function(wrap_pyfunction!(trap::paper_trap, m)?)?;
+    m.add_class::<nano::NanoWorld>()?;
+    m.add_function(wrap_pyfunction!(nano::nano_params, m)?)?;
+    m.add_function(wrap_pyfunction!(nano::force_distance_curve, m)?)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;
     m.add("PAPER_V0_MOVING", (vx, vy))?;

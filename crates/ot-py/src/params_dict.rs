@@ -1,0 +1,150 @@
+//! `nanoworld::Params` to and from Python dicts.
+//!
+//! The dict has exactly the layout of the scene's TOML table (field names
+//! with their units, `interaction = {"game": {...}}` or `{"physical": {...}}`),
+//! so `tomllib.load(f)` of a scene table can be passed as is. Reading goes
+//! through `json.dumps` and serde (`deny_unknown_fields`); writing mirrors the
+//! struct field by field.
+
+use nanoworld::{
+    GamePair, GameParams, HouseParams, Interaction, LoadingZone, Pairs, Params, PhysicalParams,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+
+/// `params` as Python passes it: "game", "physical", a dict, or None (game).
+pub(crate) fn params_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Params> {
+    let Some(obj) = obj else {
+        return Ok(Params::game_default());
+    };
+    if obj.is_none() {
+        return Ok(Params::game_default());
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        return match s.to_str()? {
+            "game" => Ok(Params::game_default()),
+            "physical" => Ok(Params::physical_default()),
+            other => Err(PyValueError::new_err(format!(
+                "params = {other:?}: allowed \"game\", \"physical\" or a dict of the scene table"
+            ))),
+        };
+    }
+    if !obj.is_instance_of::<PyDict>() {
+        return Err(PyValueError::new_err(
+            "params: allowed \"game\", \"physical\" or a dict of the scene table",
+        ));
+    }
+    let json = obj
+        .py()
+        .import("json")?
+        .call_method1("dumps", (obj,))
+        .map_err(|e| PyValueError::new_err(format!("params: not JSON-serialisable ({e})")))?;
+    let text: String = json.extract()?;
+    serde_json::from_str::<Params>(&text).map_err(|e| PyValueError::new_err(format!("params: {e}")))
+}
+
+fn pairs<'py, T>(
+    py: Python<'py>,
+    p: &Pairs<T>,
+    f: impl Fn(&T) -> PyResult<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("tip_substrate", f(&p.tip_substrate)?)?;
+    d.set_item("tip_atom", f(&p.tip_atom)?)?;
+    d.set_item("atom_atom", f(&p.atom_atom)?)?;
+    d.set_item("atom_substrate", f(&p.atom_substrate)?)?;
+    Ok(d)
+}
+
+fn game_pair<'py>(py: Python<'py>, g: &GamePair) -> PyResult<Bound<'py, PyAny>> {
+    let d = PyDict::new(py);
+    d.set_item("strength_n_m2", g.strength_n_m2)?;
+    d.set_item("activation_gap_m", g.activation_gap_m)?;
+    d.set_item("snap_gap_m", g.snap_gap_m)?;
+    d.set_item("stiffness_n_per_m", g.stiffness_n_per_m)?;
+    Ok(d.into_any())
+}
+
+fn interaction<'py>(py: Python<'py>, i: &Interaction) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    match i {
+        Interaction::Game(GameParams {
+            pull_off_ratio,
+            pairs: ps,
+        }) => {
+            let g = PyDict::new(py);
+            g.set_item("pull_off_ratio", *pull_off_ratio)?;
+            g.set_item("pairs", pairs(py, ps, |x| game_pair(py, x))?)?;
+            d.set_item("game", g)?;
+        }
+        Interaction::Physical(PhysicalParams {
+            hamaker_j,
+            contact_gap_m,
+            cantilever_stiffness_n_per_m,
+        }) => {
+            let g = PyDict::new(py);
+            g.set_item(
+                "hamaker_j",
+                pairs(py, hamaker_j, |x| Ok(x.into_pyobject(py)?.into_any()))?,
+            )?;
+            g.set_item("contact_gap_m", *contact_gap_m)?;
+            g.set_item(
+                "cantilever_stiffness_n_per_m",
+                *cantilever_stiffness_n_per_m,
+            )?;
+            d.set_item("physical", g)?;
+        }
+    }
+    Ok(d)
+}
+
+fn zone<'py>(py: Python<'py>, z: &LoadingZone) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("min_xy_m", z.min_xy_m.to_vec())?;
+    d.set_item("max_xy_m", z.max_xy_m.to_vec())?;
+    d.set_item("spawn_xy_m", z.spawn_xy_m.to_vec())?;
+    Ok(d)
+}
+
+fn house<'py>(py: Python<'py>, h: &HouseParams) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let slots: Vec<Vec<f64>> = h.slots_m.iter().map(|s| s.to_vec()).collect();
+    d.set_item("slots_m", slots)?;
+    d.set_item("tolerance_m", h.tolerance_m)?;
+    Ok(d)
+}
+
+/// The scene table of `p` as a dict (round-trips through [`params_from_py`]).
+pub(crate) fn params_to_py<'py>(py: Python<'py>, p: &Params) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let s = PyDict::new(py);
+    s.set_item("nx", p.substrate.nx)?;
+    s.set_item("ny", p.substrate.ny)?;
+    s.set_item("spacing_m", p.substrate.spacing_m)?;
+    s.set_item("atom_radius_m", p.substrate.atom_radius_m)?;
+    d.set_item("substrate", s)?;
+    let t = PyDict::new(py);
+    t.set_item("radius_m", p.tip.radius_m)?;
+    d.set_item("tip", t)?;
+    let a = PyDict::new(py);
+    a.set_item("radius_m", p.atoms.radius_m)?;
+    a.set_item("mass_kg", p.atoms.mass_kg)?;
+    a.set_item("max_count", p.atoms.max_count)?;
+    d.set_item("atoms", a)?;
+    d.set_item("interaction", interaction(py, &p.interaction)?)?;
+    d.set_item("gravity_m_s2", p.gravity_m_s2)?;
+    d.set_item("inertia", p.inertia)?;
+    d.set_item("max_force_n", p.max_force_n)?;
+    match &p.loading_zone {
+        Some(z) => d.set_item("loading_zone", zone(py, z)?)?,
+        None => d.set_item("loading_zone", py.None())?,
+    }
+    let xy: Vec<Vec<f64>> = p.initial_atoms_xy_m.iter().map(|s| s.to_vec()).collect();
+    d.set_item("initial_atoms_xy_m", xy)?;
+    match &p.house {
+        Some(h) => d.set_item("house", house(py, h)?)?,
+        None => d.set_item("house", py.None())?,
+    }
+    Ok(d)
+}
