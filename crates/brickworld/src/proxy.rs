@@ -70,10 +70,18 @@ fn deepest_penetration(
     ball: &Ball,
     held: &Option<HeldShape>,
     p: Vector,
+    only_fixed: bool,
 ) -> Option<(f64, ProxyContact)> {
     let mut best: Option<(f64, ProxyContact)> = None;
     for (pose, shape) in parts(ball, held, p) {
         for (handle, co) in qp.intersect_shape(pose, shape) {
+            let fixed = co
+                .parent()
+                .and_then(|h| qp.bodies.get(h))
+                .is_none_or(|rb| rb.is_fixed());
+            if only_fixed && !fixed {
+                continue;
+            }
             let pos12 = pose.inv_mul(co.position());
             if let Ok(Some(c)) = qp.dispatcher.contact(&pos12, shape, co.shape(), 0.0) {
                 let depth = -c.dist;
@@ -136,9 +144,11 @@ pub fn update_proxy(
 ) -> ProxyUpdate {
     let mut p = start;
     let mut out = ProxyUpdate::default();
-    // 1. Push out of anything that moved into the god-object.
-    for _ in 0..4 {
-        match deepest_penetration(qp, ball, held, p) {
+    // 1. Push out of anything that moved into the god-object; the fixed ground and obstacles
+    //    last, so that a cursor caught between a brick and the ground ends in the brick (which
+    //    the hand then pushes away), never under the ground.
+    for only_fixed in [false, false, false, false, true, true, true, true] {
+        match deepest_penetration(qp, ball, held, p, only_fixed) {
             Some((depth, c)) => {
                 if out.penetration_before_m == 0.0 {
                     out.penetration_before_m = depth;
@@ -146,7 +156,8 @@ pub fn update_proxy(
                 p += c.normal * (depth + 2.0 * SKIN_M);
                 out.contacts.push(c);
             }
-            None => break,
+            None if only_fixed => break,
+            None => {}
         }
     }
     // 2. Sweep toward the target, sliding on the surfaces met.
@@ -158,7 +169,8 @@ pub fn update_proxy(
         compute_impact_geometry_on_penetration: true,
     };
     for _ in 0..4 {
-        let d = constrain(target - p, &planes);
+        let full = target - p;
+        let d = constrain(full, &planes);
         if d.length_squared() < 1e-24 {
             break;
         }
@@ -179,7 +191,8 @@ pub fn update_proxy(
         }
         match first {
             None => {
-                p += d;
+                // Unconstrained: land exactly on the cursor (no rounding residue in the force).
+                p = if d == full { target } else { p + d };
                 break;
             }
             Some((toi, c)) => {

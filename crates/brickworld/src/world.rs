@@ -566,9 +566,9 @@ impl World {
         let c = Vector::from_array(input.position_m());
         self.cursor = c;
         if !self.started {
-            // The first sample places the proxy (pushed out of anything by the update below).
-            self.proxy = c;
-            self.motion.reset(c.to_array());
+            // The first sample: the proxy comes down from the top of the workspace onto the
+            // cursor, so it starts outside every solid even if the cursor starts inside one.
+            self.proxy = Vector::new(c.x, c.y, self.params.workspace_half_extent_m);
             self.started = true;
         }
         let buttons = input.buttons();
@@ -612,6 +612,9 @@ impl World {
             proxy::update_proxy(&qp, &ball, &held_shape, self.proxy, c)
         };
         self.proxy = upd.position;
+        if self.tick == 0 {
+            self.motion.reset(self.proxy.to_array());
+        }
         self.motion.push(self.proxy.to_array());
         if let Some(h) = self.held {
             let body = self.bricks[h.brick.0 as usize].body;
