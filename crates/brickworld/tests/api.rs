@@ -276,3 +276,90 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn loading_zone_spawns_one_brick_per_entry_when_the_spot_is_clear() {
+    let p = Params::default();
+    let z = p.loading_zone.clone().unwrap();
+    let mut w = world(p);
+    let inside = [z.spawn_m[0] + 0.05, z.spawn_m[1] + 0.1, 0.2];
+    let outside = [z.max_m[0] + 0.2, 0.0, 0.2];
+    let mut spawned = 0;
+    for _ in 0..3 {
+        for _ in 0..50 {
+            spawned += idle(&mut w, outside)
+                .events
+                .iter()
+                .filter(|e| matches!(e, Event::Spawned { .. }))
+                .count();
+        }
+        for _ in 0..50 {
+            spawned += idle(&mut w, inside)
+                .events
+                .iter()
+                .filter(|e| matches!(e, Event::Spawned { .. }))
+                .count();
+        }
+    }
+    // Three entries, but the first brick still occupies the spawn spot.
+    assert_eq!(spawned, 1);
+    assert_eq!(w.brick_count(), 1);
+    let b = w.brick(BrickId(0)).unwrap();
+    let h = w.params().brick_half_extents_m;
+    assert!((b.position_m[0] - z.spawn_m[0]).abs() < 1e-6);
+    assert!(
+        (b.position_m[2] - h[2]).abs() < 1e-3,
+        "rests on the ground: {:?}",
+        b.position_m
+    );
+}
+
+#[test]
+fn run_time_switches_wake_resting_bricks() {
+    // A brick resting on a 20° ramp with mu = 0.6 (holds: tan 20° = 0.36).
+    let mut p = bare();
+    let h = p.brick_half_extents_m;
+    let th = 20.0_f64;
+    p.obstacles = vec![brickworld::Obstacle {
+        center_m: [0.0, 0.0, 0.5],
+        half_extents_m: [0.6, 0.3, 0.05],
+        rotation_deg: [0.0, th, 0.0],
+    }];
+    let up = 0.05 + h[2];
+    let t = th.to_radians();
+    let c = [up * t.sin(), 0.0, 0.5 + up * t.cos()];
+    p.bricks = vec![BrickPlacement {
+        center_m: c,
+        rotation_deg: [0.0, th, 0.0],
+    }];
+    let mut w = world(p);
+    for _ in 0..2000 {
+        idle(&mut w, [1.5, 1.5, 1.5]);
+    }
+    let b = w.brick(BrickId(0)).unwrap();
+    assert!(b.sleeping, "brick at rest on the ramp falls asleep");
+    let x_rest = b.position_m[0];
+    assert!((x_rest - c[0]).abs() < 1e-3);
+    // Friction down to 0.2 < tan 20°: it must slide now, although it was asleep.
+    w.set_friction(0.2).unwrap();
+    for _ in 0..300 {
+        idle(&mut w, [1.5, 1.5, 1.5]);
+    }
+    let slid = w.brick(BrickId(0)).unwrap().position_m[0] - x_rest;
+    assert!(slid > 0.02, "slid only {slid} m");
+    // Gravity off: a brick released in mid-air stays there.
+    w.set_gravity(0.0).unwrap();
+    let id = w.add_brick(at([-1.0, -1.0, 0.5])).unwrap();
+    for _ in 0..500 {
+        idle(&mut w, [1.5, 1.5, 1.5]);
+    }
+    let z = w.brick(id).unwrap().position_m[2];
+    assert!((z - 0.5).abs() < 1e-12, "floating brick moved to {z}");
+    // Gravity back on: it falls (it had gone to sleep in mid-air).
+    w.set_gravity(9.81).unwrap();
+    for _ in 0..500 {
+        idle(&mut w, [1.5, 1.5, 1.5]);
+    }
+    let z = w.brick(id).unwrap().position_m[2];
+    assert!(z < 0.1, "brick should have fallen, z = {z}");
+}
