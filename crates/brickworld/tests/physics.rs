@@ -430,3 +430,92 @@ fn weight_and_inertia_forces_are_m_g_and_minus_m_a() {
         assert!((rep.force_n[2] + m * g).abs() < 1e-9);
     }
 }
+
+#[test]
+fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
+    let mut p = bare();
+    let h = p.brick_half_extents_m;
+    p.bricks = vec![at([0.0, 0.0, h[2]]), at([0.5, 0.0, h[2]])];
+    let k = p.proxy_stiffness_n_m;
+    let mut w = world(p);
+    for _ in 0..600 {
+        idle(&mut w, PARK);
+    }
+    grab_brick(&mut w);
+    let mut c = w.proxy_position_m();
+    // Lift 10 cm, then push 3 cm below the ground.
+    for _ in 0..200 {
+        c[2] += 0.0005;
+        hold(&mut w, c, true);
+    }
+    let mut worst = 0.0_f64;
+    let mut rep = hold(&mut w, c, true);
+    for _ in 0..400 {
+        c[2] -= 0.0005;
+        rep = hold(&mut w, c, true);
+        let b = w.brick(BrickId(0)).unwrap();
+        worst = worst.max(-(b.position_m[2] - h[2]));
+    }
+    println!(
+        "carried brick pressed into the ground: worst sink {worst:.2e} m, spring {:?}",
+        rep.spring_force_n
+    );
+    assert!(
+        worst <= 1e-3,
+        "carried brick sank {worst} m into the ground"
+    );
+    // The spring pushes the hand back up by k times the cursor's depth below the proxy.
+    let depth = w.proxy_position_m()[2] - c[2];
+    assert!((rep.spring_force_n[2] - k * depth).abs() < 1e-9 && depth > 0.02);
+    // Standing on the ground, a quarter turn about y would stand the brick on its end through
+    // the ground: refused, and nothing moves.
+    let before = w.brick(BrickId(0)).unwrap();
+    let turn_y = brickworld::Buttons {
+        center: true,
+        rotate_y: true,
+        ..brickworld::Buttons::default()
+    };
+    let rep = w.step(&w.input(c, turn_y).unwrap());
+    assert!(
+        rep.events.contains(&Event::RotationBlocked {
+            brick: BrickId(0),
+            axis: brickworld::Axis::Y
+        }),
+        "{:?}",
+        rep.events
+    );
+    assert_eq!(
+        w.brick(BrickId(0)).unwrap().orientation_xyzw,
+        before.orientation_xyzw
+    );
+    hold(&mut w, c, true);
+    // Slide it sideways into the other brick: it stops at the face.
+    for _ in 0..300 {
+        c[2] = 2.0 * h[2] + 0.02;
+        c[0] += 0.002;
+        hold(&mut w, c, true);
+        let b0 = w.brick(BrickId(0)).unwrap().position_m[0];
+        let b1 = w.brick(BrickId(1)).unwrap().position_m[0];
+        worst = worst.max((b0 + h[0]) - (b1 - h[0]));
+    }
+    println!("against the other brick: worst overlap {worst:.2e} m");
+    assert!(
+        worst <= 1e-3,
+        "carried brick entered the other brick by {worst} m"
+    );
+    // Lifted clear, a quarter turn about z is allowed.
+    c[2] += 0.1;
+    for _ in 0..100 {
+        hold(&mut w, c, true);
+    }
+    let turn_z = brickworld::Buttons {
+        center: true,
+        rotate_z: true,
+        ..brickworld::Buttons::default()
+    };
+    let rep = w.step(&w.input(c, turn_z).unwrap());
+    assert!(rep.events.contains(&Event::Rotated {
+        brick: BrickId(0),
+        axis: brickworld::Axis::Z
+    }));
+}
