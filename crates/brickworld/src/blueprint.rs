@@ -63,3 +63,76 @@ impl Score {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rot(deg: [f64; 3]) -> Rotation {
+        placement_rotation(&BrickPlacement {
+            center_m: [0.0; 3],
+            rotation_deg: deg,
+        })
+    }
+
+    #[test]
+    fn half_turns_of_a_box_are_the_same_orientation() {
+        for d in [
+            [180.0, 0.0, 0.0],
+            [0.0, 180.0, 0.0],
+            [0.0, 0.0, 180.0],
+            [0.0, 0.0, -180.0],
+        ] {
+            assert!(
+                cuboid_orientation_error_rad(Rotation::IDENTITY, rot(d)) < 1e-12,
+                "{d:?}"
+            );
+        }
+        let e = cuboid_orientation_error_rad(Rotation::IDENTITY, rot([0.0, 0.0, 90.0]));
+        assert!((e - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        let e = cuboid_orientation_error_rad(rot([0.0, 0.0, 90.0]), rot([0.0, 0.0, 93.0]));
+        assert!((e - 3f64.to_radians()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_slot_is_filled_within_both_tolerances_only() {
+        let bp = Blueprint {
+            slots: vec![],
+            position_tolerance_m: 0.01,
+            angle_tolerance_deg: 5.0,
+        };
+        let slot = BrickPlacement {
+            center_m: [1.0, 0.0, 0.03],
+            rotation_deg: [0.0, 0.0, 90.0],
+        };
+        let c = Vector::new(1.005, 0.0, 0.03);
+        assert!(fills(&bp, &slot, c, rot([0.0, 0.0, 94.0])).is_some());
+        assert!(
+            fills(&bp, &slot, c, rot([0.0, 0.0, -86.0])).is_some(),
+            "half-turn symmetric"
+        );
+        assert!(fills(&bp, &slot, c, rot([0.0, 0.0, 84.0])).is_none());
+        assert!(
+            fills(
+                &bp,
+                &slot,
+                Vector::new(1.02, 0.0, 0.03),
+                rot([0.0, 0.0, 90.0])
+            )
+            .is_none()
+        );
+        let s = Score {
+            filled: 3,
+            total: 4,
+        };
+        assert_eq!(s.fraction(), 0.75);
+        assert_eq!(
+            Score {
+                filled: 0,
+                total: 0
+            }
+            .fraction(),
+            0.0
+        );
+    }
+}

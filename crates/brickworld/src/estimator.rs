@@ -129,3 +129,65 @@ impl MotionEstimator {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn feed(m: &mut MotionEstimator, f: impl Fn(f64) -> f64, n: usize) {
+        m.reset([f(0.0), 0.0, 0.0]);
+        for i in 1..=n {
+            m.push([f(i as f64 * m.dt()), 0.0, 0.0]);
+        }
+    }
+
+    #[test]
+    fn both_estimators_are_exact_for_quadratic_motion() {
+        let dt = 1e-3;
+        let (x0, v0, a) = (0.1, -0.3, 2.5);
+        let f = |t: f64| x0 + v0 * t + 0.5 * a * t * t;
+        for kind in [
+            AccelEstimator::Paper,
+            AccelEstimator::SavitzkyGolay { window: 5 },
+            AccelEstimator::SavitzkyGolay { window: 21 },
+        ] {
+            let mut m = MotionEstimator::new(dt, kind);
+            let n = 100;
+            feed(&mut m, f, n);
+            let t = n as f64 * dt;
+            assert!((m.acceleration()[0] - a).abs() < 1e-6, "{kind:?}");
+            assert!((m.velocity()[0] - (v0 + a * t)).abs() < 1e-9, "{kind:?}");
+        }
+    }
+
+    #[test]
+    fn noise_gains_match_their_closed_forms() {
+        let dt = 1e-3;
+        let p = MotionEstimator::new(dt, AccelEstimator::Paper);
+        let expected = 6f64.sqrt() / (4.0 * dt * dt);
+        assert!((p.accel_noise_gain() - expected).abs() < 1e-9 * expected);
+        for n in [5usize, 21, 41] {
+            let m = MotionEstimator::new(dt, AccelEstimator::SavitzkyGolay { window: n });
+            let nf = n as f64;
+            let closed =
+                2.0 * (180.0 / (nf * (nf * nf - 1.0) * (nf * nf - 4.0))).sqrt() / (dt * dt);
+            assert!(
+                (m.accel_noise_gain() - closed).abs() < 1e-9 * closed,
+                "window {n}"
+            );
+        }
+        let sg21 = MotionEstimator::new(dt, AccelEstimator::SavitzkyGolay { window: 21 });
+        let ratio = p.accel_noise_gain() / sg21.accel_noise_gain();
+        assert!((ratio - 45.9).abs() < 0.1, "ratio {ratio}");
+    }
+
+    #[test]
+    fn stencil_lags_two_ticks_on_a_cubic() {
+        // For x = t³/6, a(t) = t: the central stencil returns a at t - 2 dt exactly.
+        let dt = 1e-3;
+        let mut m = MotionEstimator::new(dt, AccelEstimator::Paper);
+        feed(&mut m, |t| t * t * t / 6.0, 50);
+        let t = 50.0 * dt;
+        assert!((m.acceleration()[0] - (t - m.accel_lag_s())).abs() < 1e-9);
+    }
+}

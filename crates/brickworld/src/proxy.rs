@@ -215,3 +215,26 @@ pub fn update_proxy(
     out.position = p;
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constrain_slides_on_planes_and_stops_in_corners() {
+        let z = Vector::Z;
+        let x = Vector::X;
+        // Into the floor: keep only the tangential part.
+        let d = constrain(Vector::new(0.3, 0.2, -1.0), &[z]);
+        assert_eq!(d, Vector::new(0.3, 0.2, 0.0));
+        // Away from the floor: unchanged.
+        let d = constrain(Vector::new(0.3, 0.2, 1.0), &[z]);
+        assert_eq!(d, Vector::new(0.3, 0.2, 1.0));
+        // Into floor and wall: along their crease.
+        let d = constrain(Vector::new(-1.0, 0.5, -1.0), &[z, x]);
+        assert!((d - Vector::new(0.0, 0.5, 0.0)).length() < 1e-15);
+        // Into three planes meeting in a corner: no motion.
+        let d = constrain(Vector::new(-1.0, -1.0, -1.0), &[z, x, Vector::Y]);
+        assert_eq!(d, Vector::ZERO);
+    }
+}
