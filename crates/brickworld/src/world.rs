@@ -215,7 +215,6 @@ pub struct World {
     buttons: Buttons,
     motion: MotionEstimator,
     touching: Vec<Touch>,
-    pushed: Vec<RigidBodyHandle>,
     in_zone: bool,
     slots: Vec<Option<BrickId>>,
     tick: u64,
@@ -297,7 +296,6 @@ impl World {
             buttons: Buttons::default(),
             motion,
             touching: Vec::new(),
-            pushed: Vec::new(),
             in_zone: false,
             slots,
             tick: 0,
@@ -575,13 +573,6 @@ impl World {
         let prev = self.buttons;
         self.buttons = buttons;
 
-        // Forces the cursor applied to bricks last tick are replaced by this tick's.
-        for h in self.pushed.drain(..) {
-            if let Some(rb) = self.phys.bodies.get_mut(h) {
-                rb.reset_forces(false);
-            }
-        }
-
         // 1. Buttons: release before grab so one tick can't do both on one brick.
         if prev.center && !buttons.center {
             self.release(&mut events);
@@ -659,16 +650,15 @@ impl World {
             })
             .collect();
         if !pushes.is_empty() && spring.length_squared() > 0.0 {
-            // The hand pushes with the reaction of the spring it feels, shared by the contacts.
-            let share = -spring / pushes.len() as f64;
+            // The hand pushes with the reaction of the spring it feels, shared by the contacts,
+            // at the contact points, as the impulse of that force over this tick. (A user force
+            // at a point would be the natural call, but rapier 0.36 does not resist the torque
+            // of user forces with contacts: 10 N pressed 5 cm off-centre launched a resting
+            // 0.5 kg brick 0.45 m up. Velocity impulses are resisted correctly.)
+            let share = -spring * (self.params.dt_s / pushes.len() as f64);
             for (body, point) in pushes {
                 if let Some(rb) = self.phys.bodies.get_mut(body) {
-                    // Through the centre of mass: in rapier 0.36 an off-centre user force on a
-                    // brick resting on the ground injects energy (10 N pressed 5 cm off-centre
-                    // launched a 0.5 kg brick 0.45 m up), so the contact point is not used.
-                    let _ = point;
-                    rb.add_force(share, true);
-                    self.pushed.push(body);
+                    rb.apply_impulse_at_point(share, point, true);
                 }
             }
         }

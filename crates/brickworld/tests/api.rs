@@ -226,6 +226,7 @@ fn rotate_buttons_turn_the_carried_brick_by_quarter_turns() {
         hold(&mut w, [0.0, 0.0, 0.06 + i as f64 * 0.001], true);
     }
     let c = w.cursor_position_m();
+    let q0 = w.brick(BrickId(0)).unwrap().orientation_xyzw;
     let b = Buttons {
         center: true,
         rotate_z: true,
@@ -243,11 +244,17 @@ fn rotate_buttons_turn_the_carried_brick_by_quarter_turns() {
             .iter()
             .any(|e| matches!(e, Event::Rotated { .. }))
     );
+    // q = Rz(90°) q0, with Rz(90°) = (0, 0, s, s), s = 1/√2 (quaternion product by hand).
     let q = w.brick(BrickId(0)).unwrap().orientation_xyzw;
-    let half = std::f64::consts::FRAC_1_SQRT_2;
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let [x, y, z, ww] = q0;
+    let expected = [s * (x - y), s * (x + y), s * (ww + z), s * (ww - z)];
+    for k in 0..4 {
+        assert!((q[k] - expected[k]).abs() < 1e-12, "{q:?} vs {expected:?}");
+    }
     assert!(
-        (q[2] - half).abs() < 1e-6 && (q[3] - half).abs() < 1e-6,
-        "{q:?}"
+        q0[0].abs() < 1e-3 && q0[1].abs() < 1e-3,
+        "brick was lying flat: {q0:?}"
     );
 }
 

@@ -519,3 +519,44 @@ fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
         axis: brickworld::Axis::Z
     }));
 }
+
+/// A brick on a ledge (edge x = 0) with its centre 1 cm inside the edge; the cursor presses
+/// down 5 mm at `press_x`. Returns how far the brick dropped after 2 s (m).
+fn press_on_ledge(press_x: f64) -> f64 {
+    let mut p = bare();
+    let h = p.brick_half_extents_m;
+    p.obstacles = vec![Obstacle {
+        center_m: [-0.5, 0.0, 0.1],
+        half_extents_m: [0.5, 0.5, 0.1],
+        rotation_deg: [0.0; 3],
+    }];
+    let z0 = 0.2 + h[2];
+    p.bricks = vec![at([-0.01, 0.0, z0])];
+    let r = p.proxy_radius_m;
+    let mut w = world(p);
+    for _ in 0..300 {
+        idle(&mut w, [press_x, 0.0, z0 + 0.1]);
+    }
+    let top = z0 + h[2];
+    for i in 0..2000 {
+        // Come down at 0.1 m/s and hold 5 mm below the top surface.
+        let z = (top + r + 0.02 - 1e-4 * i as f64).max(top + r - 0.005);
+        idle(&mut w, [press_x, 0.0, z]);
+    }
+    z0 - w.brick(BrickId(0)).unwrap().position_m[2]
+}
+
+#[test]
+fn pressing_the_overhanging_end_tips_the_brick_pressing_inside_does_not() {
+    let inside = press_on_ledge(-0.06);
+    let outside = press_on_ledge(0.08);
+    println!("press at -6 cm: dropped {inside:.5} m; at +8 cm: dropped {outside:.5} m");
+    assert!(
+        inside < 1e-3,
+        "pressed over the ledge, the brick must stay: dropped {inside}"
+    );
+    assert!(
+        outside > 0.1,
+        "pressed on the overhang (5 N x 8 cm > M g x 1 cm), it tips: {outside}"
+    );
+}
