@@ -79,8 +79,25 @@ fn slide_distance(mu: f64, theta_deg: f64) -> f64 {
 }
 
 #[test]
+fn brick_on_steeper_incline_slides_with_g_sin_minus_mu_cos() {
+    for mu in [0.3, 0.6, 1.0] {
+        let th = f64::atan(mu) + 3f64.to_radians();
+        let d = slide_distance(mu, th.to_degrees());
+        let expected = 0.5 * 9.81 * (th.sin() - mu * th.cos());
+        println!(
+            "mu = {mu}, θ = {:.2}°: slid {d:.4} m in 1 s, analytic {expected:.4} m",
+            th.to_degrees()
+        );
+        assert!(
+            (d - expected).abs() < 0.02 * expected,
+            "mu {mu}: {d} vs {expected}"
+        );
+    }
+}
+
+#[test]
 fn brick_on_incline_starts_sliding_at_tan_theta_equals_mu_within_1_degree() {
-    for mu in [0.3, 0.6] {
+    for mu in [0.3, 0.6, 1.0] {
         let critical = f64::atan(mu).to_degrees();
         let mut first_slide = None;
         let mut th = critical - 3.0;
