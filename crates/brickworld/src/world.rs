@@ -207,6 +207,7 @@ pub struct World {
     params: Params,
     device: DeviceLimits,
     phys: PhysicsWorld,
+    ground: ColliderHandle,
     obstacles: Vec<ColliderHandle>,
     bricks: Vec<Brick>,
     held: Option<Held>,
@@ -260,7 +261,7 @@ impl World {
             .static_contact_softness
             .natural_frequency = 2.0 * params.contact_frequency_hz;
         let ground = phys.insert_body(RigidBodyBuilder::fixed());
-        phys.insert_collider(
+        let ground_collider = phys.insert_collider(
             ColliderBuilder::cuboid(GROUND_HALF_EXTENT_M, GROUND_HALF_EXTENT_M, 1.0)
                 .translation(Vector::new(0.0, 0.0, -1.0))
                 .friction(params.friction)
@@ -292,6 +293,7 @@ impl World {
             params,
             device,
             phys,
+            ground: ground_collider,
             obstacles,
             bricks: Vec::new(),
             held: None,
@@ -505,9 +507,20 @@ impl World {
         })
     }
 
-    /// Height of the ground plane, m (always 0: the ground is `z <= 0`).
-    pub fn ground_height_m(&self) -> f64 {
-        0.0
+    /// The ground slab as a renderer sees it: its top face is the plane z = 0.
+    pub fn ground(&self) -> BoxView {
+        let co = &self.phys.colliders[self.ground];
+        let half = co
+            .shape()
+            .as_cuboid()
+            .map_or([GROUND_HALF_EXTENT_M, GROUND_HALF_EXTENT_M, 1.0], |c| {
+                arr(c.half_extents)
+            });
+        BoxView {
+            position_m: arr(co.position().translation),
+            orientation_xyzw: quat(co.position().rotation),
+            half_extents_m: half,
+        }
     }
 
     /// Centre of the cursor sphere (the god-object / proxy), m.

@@ -311,6 +311,12 @@ fn loading_zone_spawns_one_brick_per_entry_when_the_spot_is_clear() {
     // Three entries, but the first brick still occupies the spawn spot.
     assert_eq!(spawned, 1);
     assert_eq!(w.brick_count(), 1);
+    let g = w.ground();
+    assert_eq!(
+        g.position_m[2] + g.half_extents_m[2],
+        0.0,
+        "ground top face is z = 0"
+    );
     let b = w.brick(BrickId(0)).unwrap();
     let h = w.params().brick_half_extents_m;
     assert!((b.position_m[0] - z.spawn_m[0]).abs() < 1e-6);

@@ -445,6 +445,13 @@ fn weight_and_inertia_forces_are_m_g_and_minus_m_a() {
         rep = hold(&mut w, pos, true);
         assert_eq!(rep.inertia_force_n, [0.0; 3]);
         assert!((rep.force_n[2] + m * g).abs() < 1e-9);
+        // A heavier brick weighs more; gravity off, nothing.
+        w.set_brick_mass(0.8).unwrap();
+        rep = hold(&mut w, pos, true);
+        assert!((rep.force_n[2] + 0.8 * g).abs() < 1e-9, "{:?}", rep.force_n);
+        w.set_gravity(0.0).unwrap();
+        rep = hold(&mut w, pos, true);
+        assert_eq!(rep.weight_force_n, [0.0; 3]);
     }
 }
 
