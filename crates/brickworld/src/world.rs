@@ -289,6 +289,8 @@ impl World {
         let motion = MotionEstimator::new(params.dt_s, params.accel_estimator);
         let slots = vec![None; params.blueprint.slots.len()];
         let initial = params.bricks.clone();
+        // Until the first sample: the top centre of the workspace.
+        let top = Vector::new(0.0, 0.0, params.workspace_half_extent_m);
         let mut world = World {
             params,
             device,
@@ -297,8 +299,8 @@ impl World {
             obstacles,
             bricks: Vec::new(),
             held: None,
-            proxy: Vector::new(0.0, 0.0, 0.3),
-            cursor: Vector::new(0.0, 0.0, 0.3),
+            proxy: top,
+            cursor: top,
             buttons: Buttons::default(),
             motion,
             touching: Vec::new(),
@@ -523,12 +525,13 @@ impl World {
         }
     }
 
-    /// Centre of the cursor sphere (the god-object / proxy), m.
+    /// Centre of the cursor sphere (the god-object / proxy), m. Before the first step: the top
+    /// centre of the workspace, `[0, 0, workspace_half_extent_m]`.
     pub fn proxy_position_m(&self) -> [f64; 3] {
         arr(self.proxy)
     }
 
-    /// Last device cursor position, m.
+    /// Last device cursor position, m (same placeholder as the proxy before the first step).
     pub fn cursor_position_m(&self) -> [f64; 3] {
         arr(self.cursor)
     }
