@@ -519,6 +519,18 @@ fn main() {
     }
     plot_estimators(&est);
     plot_speed_error(&pts);
+
+    // 5. The scripted house-task session.
+    let (secs, score, traj, w) = build_wall();
+    writeln!(
+        md,
+        "\n### Scripted house task\n\n`script::WallScript` builds a 4-slot wall (two courses, one brick turned 90°) from the loading zone \
+         in {secs:.1} s of simulated time; score **{}/{}**. Side and top views below (grey outlines: blueprint slots; blue: cursor path).\n",
+        score.filled, score.total
+    )
+    .unwrap();
+    plot_wall(&w, &traj);
+    writeln!(md, "![scripted wall](../figures/brickworld-wall.png)\n").unwrap();
     writeln!(
         md,
         "\n![acceleration estimators](../figures/brickworld-accel-estimators.png)\n\n![speed vs error](../figures/brickworld-speed-error.png)\n"
@@ -536,6 +548,112 @@ fn main() {
         "wrote docs/bench/brickworld.md in {:.0} s",
         t0.elapsed().as_secs_f64()
     );
+}
+
+/// Blueprint of the scripted session (same as the test `scripted_session_builds_the_wall`).
+fn wall_params() -> Params {
+    let h = Params::default().brick_half_extents_m;
+    let (z0, z1) = (h[2], 3.0 * h[2]);
+    let step = 2.0 * h[0] + 0.004;
+    let mut p = Params::default();
+    p.blueprint.slots = vec![
+        at([0.0, 0.0, z0]),
+        at([step, 0.0, z0]),
+        at([step / 2.0, 0.0, z1]),
+        BrickPlacement {
+            center_m: [2.0 * step + h[1] + 0.05, h[0] - h[1], z0],
+            rotation_deg: [0.0, 0.0, 90.0],
+        },
+    ];
+    p
+}
+
+/// Runs the scripted wall session; returns (simulated s, score, cursor path, world).
+fn build_wall() -> (f64, brickworld::Score, Vec<[f64; 3]>, World) {
+    let mut w = World::new(wall_params(), DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut script = brickworld::script::WallScript::new(&w, [0.3, -0.4, 0.35]).unwrap();
+    let mut traj = Vec::new();
+    let mut ticks = 0usize;
+    while !script.done() && ticks < 60_000 {
+        let i = script.next_input(&w).unwrap();
+        w.step(&i);
+        if ticks % 10 == 0 {
+            traj.push(w.proxy_position_m());
+        }
+        ticks += 1;
+    }
+    for _ in 0..1000 {
+        step_idle(&mut w, [0.3, -0.4, 0.35]);
+    }
+    (ticks as f64 * 1e-3, w.score(), traj, w)
+}
+
+/// World-frame AABB (min, max) of a box with centre `c`, orientation `q` ([x,y,z,w]), half-extents `h`.
+fn aabb(c: [f64; 3], q: [f64; 4], h: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let r = rapier3d_f64::math::Rotation::from_xyzw(q[0], q[1], q[2], q[3]);
+    let m = rapier3d_f64::math::Matrix::from_quat(r);
+    let mut e = [0.0; 3];
+    for (i, ei) in e.iter_mut().enumerate() {
+        *ei = (0..3).map(|j| m.col(j)[i].abs() * h[j]).sum();
+    }
+    (
+        [c[0] - e[0], c[1] - e[1], c[2] - e[2]],
+        [c[0] + e[0], c[1] + e[1], c[2] + e[2]],
+    )
+}
+
+fn plot_wall(w: &World, traj: &[[f64; 3]]) {
+    let root =
+        BitMapBackend::new("docs/figures/brickworld-wall.png", (1000, 450)).into_drawing_area();
+    root.fill(&WHITE).unwrap();
+    let (left, right) = root.split_horizontally(500);
+    let h = w.params().brick_half_extents_m;
+    for (area, axes, title) in [
+        (left, (0usize, 2usize), "side view (x, z)"),
+        (right, (0usize, 1usize), "top view (x, y)"),
+    ] {
+        let (a, b) = axes;
+        let yr = if b == 2 { -0.02..0.45 } else { -0.45..0.45 };
+        let mut ch = ChartBuilder::on(&area)
+            .caption(title, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(30)
+            .y_label_area_size(45)
+            .build_cartesian_2d(-0.7..0.6, yr)
+            .unwrap();
+        ch.configure_mesh().x_desc("m").y_desc("m").draw().unwrap();
+        if let Some(z) = &w.params().loading_zone {
+            if b == 1 {
+                ch.draw_series(std::iter::once(Rectangle::new(
+                    [(z.min_m[0], z.min_m[1]), (z.max_m[0], z.max_m[1])],
+                    YELLOW.mix(0.3).filled(),
+                )))
+                .unwrap();
+            }
+        }
+        ch.draw_series(LineSeries::new(
+            traj.iter().map(|p| (p[a], p[b])),
+            BLUE.mix(0.4),
+        ))
+        .unwrap();
+        for s in w.slots() {
+            let (lo, hi) = aabb(s.position_m, s.orientation_xyzw, h);
+            ch.draw_series(std::iter::once(Rectangle::new(
+                [(lo[a], lo[b]), (hi[a], hi[b])],
+                BLACK.mix(0.3).stroke_width(3),
+            )))
+            .unwrap();
+        }
+        for br in w.bricks() {
+            let (lo, hi) = aabb(br.position_m, br.orientation_xyzw, br.half_extents_m);
+            ch.draw_series(std::iter::once(Rectangle::new(
+                [(lo[a], lo[b]), (hi[a], hi[b])],
+                RGBColor(178, 60, 40).mix(0.8).filled(),
+            )))
+            .unwrap();
+        }
+    }
+    root.present().unwrap();
 }
 
 fn plot_estimators(est: &[EstimatorRow]) {
