@@ -555,7 +555,10 @@ fn wall_params() -> Params {
     let h = Params::default().brick_half_extents_m;
     let (z0, z1) = (h[2], 3.0 * h[2]);
     let step = 2.0 * h[0] + 0.004;
-    let mut p = Params::default();
+    let mut p = Params {
+        loading_zone: Some(brickworld::LoadingZone::default()),
+        ..Params::default()
+    };
     p.blueprint.slots = vec![
         at([0.0, 0.0, z0]),
         at([step, 0.0, z0]),

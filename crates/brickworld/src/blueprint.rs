@@ -45,7 +45,7 @@ pub fn fills(
 }
 
 /// The task's score.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Score {
     /// Slots filled by a resting, not carried brick.
     pub filled: usize,

@@ -1,9 +1,11 @@
 //! One tick of device input: cursor position and the four buttons.
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::InputError;
 
 /// The four buttons of a Novint Falcon grip.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Buttons {
     /// Centre button: hold to grab and carry a brick, release to drop (or throw) it.
     pub center: bool,

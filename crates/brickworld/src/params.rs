@@ -5,13 +5,13 @@
 //! Run-time switches (gravity, restitution, friction, inertia, brick mass) are changed through
 //! the validated setters on [`crate::World`], which reuse the same range checks.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::ParamError;
 
 /// The world frame is right-handed with `z` up; the ground is the plane `z = 0`.
 /// Gravity (when on) points along `-z`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Params {
     /// Physics and haptic time step in s. The haptic loop runs at `1 / dt_s` (1 kHz by default).
@@ -51,7 +51,8 @@ pub struct Params {
     pub contact_frequency_hz: f64,
     /// Whether resting bricks may fall asleep (stop being simulated until disturbed).
     pub sleeping: bool,
-    /// The loading zone that supplies bricks; `None` disables spawning.
+    /// The loading zone that supplies bricks; `None` (the default: no `[loading_zone]` table)
+    /// disables spawning. [`LoadingZone::default`] is a 30 cm × 60 cm zone left of the origin.
     pub loading_zone: Option<LoadingZone>,
     /// The house to build; empty slots means no task.
     pub blueprint: Blueprint,
@@ -81,7 +82,7 @@ impl Default for Params {
             solver_iterations: 4,
             contact_frequency_hz: 500.0,
             sleeping: true,
-            loading_zone: Some(LoadingZone::default()),
+            loading_zone: None,
             blueprint: Blueprint::default(),
             bricks: Vec::new(),
             obstacles: Vec::new(),
@@ -90,7 +91,7 @@ impl Default for Params {
 }
 
 /// Estimator of the cursor acceleration used for the inertial force `F = -M a`.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
 pub enum AccelEstimator {
     /// The paper's stencil over the last five samples, `a = (B4 - 2 B2 + B0) / (2 dt)²`
@@ -108,7 +109,7 @@ pub enum AccelEstimator {
 
 /// The loading zone: an axis-aligned rectangle on the ground. When the cursor enters it (from
 /// outside), a brick appears at `spawn_m` if that spot is clear.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadingZone {
     /// Lower corner (x, y) of the zone in m.
@@ -134,7 +135,7 @@ impl Default for LoadingZone {
 
 /// Pose of a brick: centre in m and orientation as a rotation vector in degrees
 /// (axis times angle; `[0, 0, 90]` is a quarter turn about z).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BrickPlacement {
     /// Centre of the brick in the world frame, m.
@@ -145,7 +146,7 @@ pub struct BrickPlacement {
 }
 
 /// A fixed box (table, ramp, wall).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Obstacle {
     /// Centre in the world frame, m.
@@ -158,7 +159,7 @@ pub struct Obstacle {
 }
 
 /// The house to build: brick slots and the tolerances that decide whether a slot is filled.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Blueprint {
     /// Target brick poses.
@@ -181,7 +182,7 @@ impl Default for Blueprint {
 }
 
 /// Limits of the haptic device the world renders to (CHAI3D-style device specification).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DeviceLimits {
     /// Largest stiffness the device renders stably, N/m.

@@ -7,6 +7,8 @@ use rapier3d_f64::prelude::{
     RigidBodyBuilder, RigidBodyHandle, RigidBodyType,
 };
 
+use serde::Serialize;
+
 use crate::blueprint::{self, Score};
 use crate::error::{InputError, ParamError, WorldError};
 use crate::estimator::MotionEstimator;
@@ -16,11 +18,11 @@ use crate::params::{AccelEstimator, BrickPlacement, DeviceLimits, Lo, Params, ra
 use crate::proxy::{self, HeldShape};
 
 /// Identifier of a brick: its index in creation order (stable, never reused).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 pub struct BrickId(pub u32);
 
 /// What the cursor can touch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 pub enum Touch {
     /// The ground plane `z = 0`.
     Ground,
@@ -31,7 +33,7 @@ pub enum Touch {
 }
 
 /// A world axis (for the rotate buttons).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub enum Axis {
     /// x.
     X,
@@ -42,7 +44,7 @@ pub enum Axis {
 }
 
 /// Something that happened during a step, in the order it happened.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub enum Event {
     /// A brick appeared in the loading zone.
     Spawned {
@@ -111,7 +113,7 @@ pub enum Event {
 }
 
 /// What one step produced for the device and the logs.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StepReport {
     /// Index of the tick just simulated (0 for the first step).
     pub tick: u64,
@@ -136,7 +138,7 @@ pub struct StepReport {
 }
 
 /// A brick as a renderer or recorder sees it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct BrickView {
     /// Its id.
     pub id: BrickId,
@@ -155,7 +157,7 @@ pub struct BrickView {
 }
 
 /// A fixed box as a renderer sees it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct BoxView {
     /// Centre, m.
     pub position_m: [f64; 3],
@@ -166,7 +168,7 @@ pub struct BoxView {
 }
 
 /// A blueprint slot and whether it is filled.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SlotView {
     /// Target centre, m.
     pub position_m: [f64; 3],

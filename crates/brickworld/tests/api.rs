@@ -37,10 +37,12 @@ fn bad_parameters_name_the_field_and_range() {
         p.validate().unwrap_err().to_string(),
         "parameter `accel_estimator.savitzky_golay.window` = 3 is out of range: allowed [5, 201]"
     );
-    let mut p = Params::default();
-    if let Some(z) = p.loading_zone.as_mut() {
-        z.max_m[0] = z.min_m[0];
-    }
+    let mut z = brickworld::LoadingZone::default();
+    z.max_m[0] = z.min_m[0];
+    let p = Params {
+        loading_zone: Some(z),
+        ..Params::default()
+    };
     assert_eq!(
         p.validate().unwrap_err().to_string(),
         "parameter `loading_zone.max_m[0]` is invalid: must exceed loading_zone.min_m[0] = -0.6"
@@ -76,6 +78,22 @@ fn toml_parameters_parse_and_reject_unknown_fields() {
         e,
         "parameter `friction` = -1 is out of range: allowed [0, 10]"
     );
+}
+
+#[test]
+fn parameters_round_trip_through_toml() {
+    let mut p = wall_params();
+    p.accel_estimator = AccelEstimator::SavitzkyGolay { window: 31 };
+    p.bricks = vec![at([0.1, 0.2, 0.03])];
+    p.obstacles = vec![brickworld::Obstacle {
+        center_m: [0.0, 1.0, 0.1],
+        half_extents_m: [0.5, 0.2, 0.1],
+        rotation_deg: [0.0, 10.0, 0.0],
+    }];
+    let text = toml::to_string(&p).unwrap();
+    assert_eq!(Params::from_toml(&text).unwrap(), p, "{text}");
+    let none = toml::to_string(&Params::default()).unwrap();
+    assert_eq!(Params::from_toml(&none).unwrap().loading_zone, None);
 }
 
 #[test]
@@ -138,7 +156,10 @@ fn session(p: Params) -> (Vec<u64>, Vec<Vec<Event>>) {
 
 fn wall_params() -> Params {
     let h = Params::default().brick_half_extents_m;
-    let mut p = Params::default();
+    let mut p = Params {
+        loading_zone: Some(brickworld::LoadingZone::default()),
+        ..Params::default()
+    };
     let (z0, z1) = (h[2], 3.0 * h[2]);
     let step = 2.0 * h[0] + 0.004;
     p.blueprint.slots = vec![
@@ -286,7 +307,10 @@ proptest! {
 
 #[test]
 fn loading_zone_spawns_one_brick_per_entry_when_the_spot_is_clear() {
-    let p = Params::default();
+    let p = Params {
+        loading_zone: Some(brickworld::LoadingZone::default()),
+        ..Params::default()
+    };
     let z = p.loading_zone.clone().unwrap();
     let mut w = world(p);
     let inside = [z.spawn_m[0] + 0.05, z.spawn_m[1] + 0.1, 0.2];
@@ -375,4 +399,16 @@ fn run_time_switches_wake_resting_bricks() {
     }
     let z = w.brick(id).unwrap().position_m[2];
     assert!(z < 0.1, "brick should have fallen, z = {z}");
+}
+
+#[test]
+fn world_can_move_to_the_haptic_thread() {
+    fn send<T: Send + 'static>(_: &T) {}
+    let w = world(bare());
+    send(&w);
+    let h = std::thread::spawn(move || {
+        let mut w = w;
+        idle(&mut w, [0.0, 0.0, 0.2]).tick
+    });
+    assert_eq!(h.join().unwrap(), 0);
 }

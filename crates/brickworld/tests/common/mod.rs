@@ -5,10 +5,7 @@ use brickworld::{BrickPlacement, Buttons, DeviceLimits, Params, StepReport, Worl
 
 /// Parameters with no loading zone and no blueprint: only what a test adds.
 pub fn bare() -> Params {
-    Params {
-        loading_zone: None,
-        ..Params::default()
-    }
+    Params::default()
 }
 
 /// A brick at `c` (m), axis aligned.
