@@ -124,6 +124,9 @@ pub struct StepReport {
     pub saturated: bool,
     /// Proxy spring `k (p - c)`, N (`-k d n` against one surface).
     pub spring_force_n: [f64; 3],
+    /// Local stiffness of the rendered force field this tick, N/m: `proxy_stiffness_n_m` while
+    /// the cursor (or carried brick) touches something, 0 in free space (where `p = c`).
+    pub stiffness_n_m: f64,
     /// Weight of the carried brick `-M g z`, N (zero when nothing is carried or gravity is off).
     pub weight_force_n: [f64; 3],
     /// Inertial force of the carried brick `-M a`, N (zero when nothing is carried or inertia is off).
@@ -720,6 +723,11 @@ impl World {
             force_n: arr(force),
             saturated,
             spring_force_n: arr(spring),
+            stiffness_n_m: if self.touching.is_empty() {
+                0.0
+            } else {
+                self.params.proxy_stiffness_n_m
+            },
             weight_force_n: arr(weight),
             inertia_force_n: arr(inertia),
             acceleration_m_s2: arr(accel),

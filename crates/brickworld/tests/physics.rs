@@ -491,6 +491,7 @@ fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
     // The spring pushes the hand back up by k times the cursor's depth below the proxy.
     let depth = w.proxy_position_m()[2] - c[2];
     assert!((rep.spring_force_n[2] - k * depth).abs() < 1e-9 && depth > 0.02);
+    assert_eq!(rep.stiffness_n_m, k);
     // Standing on the ground, a quarter turn about y would stand the brick on its end through
     // the ground: refused, and nothing moves.
     let before = w.brick(BrickId(0)).unwrap();
