@@ -280,7 +280,7 @@ fn rotate_buttons_turn_the_carried_brick_by_quarter_turns() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(16))]
+    #![proptest_config(ProptestConfig { cases: 16, failure_persistence: None, ..ProptestConfig::default() })]
     /// Whatever the cursor does, the force is finite and within the device limit, and the cursor
     /// sphere never sinks into the ground by more than 1 mm.
     #[test]
