@@ -395,7 +395,7 @@ fn main() {
         "Stack sink: how far the top of a 10-brick stack settles below the exact stack (contact compliance). \
          Drift: largest motion of any stack brick between 2 s and 10 s. Cursor sink: deepest the cursor sphere \
          gets into a resting brick pressed at 0.5 m/s. Tick: p50/p99 of the 100-brick scene with sleeping \
-         disabled (worst case: everything simulated).\n"
+         disabled (worst case: everything simulated). Defaults: 4 iterations, 500 Hz.\n"
     )
     .unwrap();
     writeln!(
@@ -427,7 +427,8 @@ fn main() {
             let tm = time_ticks(&mut w, 1500);
             writeln!(
                 md,
-                "| {it} | {hz} | {:.3} | {:.4} | {:.4} | {:.1} | {:.1} |",
+                "| {it}{} | {hz} | {:.3} | {:.4} | {:.4} | {:.1} | {:.1} |",
+                if drift > 1e-3 { " (stack falls)" } else { "" },
                 sink * 1e3,
                 drift * 1e3,
                 cs * 1e3,
