@@ -22,12 +22,7 @@ fn main() -> Result<(), ot_physics::PhysicsError> {
         (Method::PaperRk4, "one RK4 step (the paper)"),
         (Method::Rk4 { substeps: 16 }, "16 substeps"),
         (Method::Dopri5 { rtol: 1e-8 }, "rtol 1e-8"),
-        (
-            Method::Adaptive {
-                rtol: DEFAULT_RTOL,
-            },
-            "default",
-        ),
+        (Method::Adaptive { rtol: DEFAULT_RTOL }, "default"),
         (
             Method::Symplectic {
                 substeps: 16,
@@ -54,6 +49,8 @@ fn main() -> Result<(), ot_physics::PhysicsError> {
         );
     }
     let _ = paper::DT;
-    println!("\nFull work-precision sweep: cargo run --release -p ot-physics --example bench_report");
+    println!(
+        "\nFull work-precision sweep: cargo run --release -p ot-physics --example bench_report"
+    );
     Ok(())
 }

@@ -38,6 +38,7 @@
 pub mod analysis;
 pub mod dynamics;
 pub mod error;
+pub mod fastexp;
 pub mod flow;
 pub mod integrate;
 pub mod langevin;

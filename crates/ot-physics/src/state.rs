@@ -88,13 +88,20 @@ impl<const D: usize> OdeState for Phase<D> {
     }
     #[inline(always)]
     fn combine(&self, h: f64, terms: &[(f64, &Self)]) -> Self {
-        let mut out = *self;
+        let mut r = self.r.data.0[0];
+        let mut v = self.v.data.0[0];
         for (c, k) in terms {
             let s = h * c;
-            out.r.axpy(s, &k.r, 1.0);
-            out.v.axpy(s, &k.v, 1.0);
+            let (kr, kv) = (&k.r.data.0[0], &k.v.data.0[0]);
+            for i in 0..D {
+                r[i] += s * kr[i];
+                v[i] += s * kv[i];
+            }
         }
-        out
+        Self {
+            r: SVector::from(r),
+            v: SVector::from(v),
+        }
     }
 
     #[inline]

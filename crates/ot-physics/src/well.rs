@@ -60,12 +60,13 @@ impl<const D: usize> GaussianWell<D> {
     /// `exp(-ln2 Σ r_i²/w_i²)`, in [0, 1].
     #[inline(always)]
     fn envelope(&self, r: &SVector<f64, D>) -> f64 {
-        let r = &r.data.0[0];
-        let mut q = 0.0;
-        for i in 0..D {
-            q += self.k[i] * r[i] * r[i];
-        }
-        (-q).exp()
+        let q: f64 = self
+            .k
+            .iter()
+            .zip(&r.data.0[0])
+            .map(|(k, x)| k * x * x)
+            .sum();
+        crate::fastexp::exp(-q)
     }
 
     /// Restoring force `-∇P` at `r` (N). Exactly zero (never NaN) where the
@@ -74,9 +75,15 @@ impl<const D: usize> GaussianWell<D> {
     pub fn force(&self, r: &SVector<f64, D>) -> SVector<f64, D> {
         let e = self.envelope(r);
         // e == 0 far away: return exact zeros (r·0 could be inf·0 = NaN).
-        let s = if e == 0.0 { 0.0 } else { -2.0 * self.depth * e };
+        if e == 0.0 {
+            return SVector::zeros();
+        }
+        let s = -2.0 * self.depth * e;
         let ra = &r.data.0[0];
-        let f: [f64; D] = std::array::from_fn(|i| if s == 0.0 { 0.0 } else { s * self.k[i] * ra[i] });
+        let mut f = [0.0; D];
+        for ((fi, k), x) in f.iter_mut().zip(&self.k).zip(ra) {
+            *fi = s * k * x;
+        }
         SVector::from(f)
     }
 

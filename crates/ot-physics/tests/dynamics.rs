@@ -98,7 +98,7 @@ fn symplectic_energy_error_stays_bounded_over_a_million_steps() {
     assert!(early < 1e-3, "early {early}");
     assert!(late < 1.5 * early, "early {early}, late {late}");
     // RK4 at a comparable cost does drift (it is not symplectic).
-    let sys = Dynamics { model: &model };
+    let sys = Dynamics::new(&model);
     let mut z = y0;
     for _ in 0..250_000 {
         z = rk4(&sys, &z, 4.0 * h, 1);
@@ -166,7 +166,7 @@ fn measured_convergence_orders() {
         .iter()
         .map(|y| refp.phase(y).unwrap().end.r)
         .collect();
-    let sys = Dynamics { model: &model };
+    let sys = Dynamics::new(&model);
     // Fixed steps for the embedded pairs: infinite tolerance, step ratio pinned to 1.
     let fixed = StepControl {
         fac_min: 1.0,

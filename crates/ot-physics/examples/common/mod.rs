@@ -98,7 +98,12 @@ pub fn errors(p: &Problem, displacements: &[Vector2<f64>]) -> (f64, f64) {
 }
 
 /// Measure one of our methods.
-pub fn measure(p: &Problem, method: Method, setting: &str, min_ms: f64) -> Result<Row, PhysicsError> {
+pub fn measure(
+    p: &Problem,
+    method: Method,
+    setting: &str,
+    min_ms: f64,
+) -> Result<Row, PhysicsError> {
     let prop = Propagator::new(p.model, method, paper::DT)?;
     let mut disp = Vec::with_capacity(p.starts.len());
     let mut evals = 0u64;
@@ -129,6 +134,9 @@ pub fn our_settings() -> Vec<(Method, String)> {
     let mut v = vec![(Method::PaperRk4, "1 step".to_string())];
     for n in [2u32, 4, 8, 16, 32, 64, 128] {
         v.push((Method::Rk4 { substeps: n }, format!("n={n}")));
+    }
+    for n in [1u32, 2, 3, 4, 6, 8, 12] {
+        v.push((Method::Rk8 { substeps: n }, format!("n={n}")));
     }
     for e in [4, 6, 8, 10, 12] {
         let rtol = 10f64.powi(-e);
