@@ -33,9 +33,10 @@ fn bench(c: &mut Criterion) {
         let p = Propagator::new(model, m, paper::DT).expect("valid method");
         let (d, _, evals) = p.flow(&offset, &v0).expect("flow");
         let err_nm = (d - reference).norm() / 1e-9;
-        g.bench_function(format!("{} err={err_nm:.1e}nm evals={evals}", m.name()), |b| {
-            b.iter(|| p.flow(black_box(&offset), black_box(&v0)))
-        });
+        g.bench_function(
+            format!("{} err={err_nm:.1e}nm evals={evals}", m.name()),
+            |b| b.iter(|| p.flow(black_box(&offset), black_box(&v0))),
+        );
     }
     g.finish();
     let p = Propagator::new(model, Method::default(), paper::DT).expect("valid");
