@@ -20,6 +20,8 @@ Method = Literal[
 ]
 ThermalScheme = Literal["auto", "baoab", "overdamped"]
 
+DEFAULT_RTOL: float
+"""Default relative tolerance of the adaptive methods."""
 PAPER_DT: float
 """The paper's haptic tick Δt = 1e-6 s."""
 PAPER_V0_MOVING: Tuple[float, float]
@@ -219,3 +221,68 @@ def force_distance_curve(
     """Approach-retract curve of the bare tip: {"approach_gap", "approach_force",
     "retract_gap", "retract_force" ((steps+1,) m and N), "snap_index",
     "pull_off_index" (int or None), "hysteresis" (J)}."""
+
+# ---------------------------------------------------------------- brick world
+
+Buttons = Union[None, dict, Sequence[bool]]
+
+class BrickWorld:
+    """The macro world of the teaching game: bricks under gravity (rapier),
+    a cursor proxy (god-object), grab/throw/rotate, a blueprint score.
+
+    params: None or a dict (scene-table layout; missing fields take defaults).
+    device: "falcon" (3000 N/m, 9 N) or {"max_stiffness_n_m", "max_force_n"}.
+    Buttons: None, {"center", "rotate_x", "rotate_y", "rotate_z"} or 4 bools.
+    """
+
+    def __init__(self, params: Optional[dict] = None, *, device: Union[str, dict, None] = None) -> None: ...
+    def add_brick(self, center_m: ArrayLike, rotation_deg: Optional[ArrayLike] = None) -> int:
+        """Add a brick (centre m, rotation vector in degrees); returns its id."""
+    def step(self, position_m: ArrayLike, buttons: Buttons = None) -> dict:
+        """One tick: {"tick", "force_n", "saturated", "spring_force_n",
+        "stiffness_n_m", "weight_force_n", "inertia_force_n",
+        "acceleration_m_s2", "proxy_penetration_m", "events"}."""
+    def run(self, positions_m: ArrayLike, buttons: Union[Buttons, ArrayLike] = None) -> dict:
+        """One tick per row of (T, 3) positions; buttons None, one set, or (T, 4).
+        Per-tick arrays: force, spring_force, weight_force, inertia_force (T, 3) N,
+        acceleration (T, 3) m/s², proxy, cursor (T, 3) m, buttons (T, 4) bool,
+        saturated (T,), stiffness (T,) N/m, penetration (T,) m, held (T,) id or -1,
+        filled (T,) slots; events list[(tick, dict)]. GIL released."""
+    def run_wall_script(self, start_m: ArrayLike, max_ticks: int = 40000, settle_ticks: int = 1000) -> dict:
+        """Run the scripted wall builder; same arrays as run()."""
+    def brick(self, id: int) -> dict:
+        """One brick: position_m, orientation_xyzw, half_extents_m, velocity_m_s, held, sleeping."""
+    @property
+    def bricks(self) -> dict:
+        """id (B,), position (B, 3) m, orientation (B, 4) xyzw, half_extents (B, 3) m,
+        velocity (B, 3) m/s, held (B,), sleeping (B,)."""
+    @property
+    def proxy_position(self) -> F64Array: ...
+    @property
+    def cursor_position(self) -> F64Array: ...
+    @property
+    def held_brick(self) -> Optional[int]: ...
+    @property
+    def touching(self) -> list[dict]: ...
+    @property
+    def slots(self) -> list[dict]: ...
+    @property
+    def score(self) -> dict:
+        """{"filled": int, "total": int}."""
+    @property
+    def obstacles(self) -> list[dict]: ...
+    @property
+    def awake_brick_count(self) -> int: ...
+    @property
+    def params(self) -> dict: ...
+    @property
+    def device(self) -> dict: ...
+    @property
+    def tick(self) -> int: ...
+    @property
+    def time(self) -> float: ...
+    def set_gravity(self, g_m_s2: float) -> None: ...
+    def set_restitution(self, e: float) -> None: ...
+    def set_friction(self, mu: float) -> None: ...
+    def set_inertia(self, on: bool) -> None: ...
+    def set_brick_mass(self, kg: float) -> None: ...

@@ -167,6 +167,16 @@ pub(crate) fn array2<'py, const D: usize>(
     PyArray1::from_vec(py, flat).reshape([v.len(), D])
 }
 
+/// Flat row-major data as a `(rows, cols)` float64 array.
+pub(crate) fn array2_flat(
+    py: Python<'_>,
+    flat: Vec<f64>,
+    cols: usize,
+) -> PyResult<Bound<'_, PyArray2<f64>>> {
+    let rows = flat.len().checked_div(cols).unwrap_or(0);
+    PyArray1::from_vec(py, flat).reshape([rows, cols])
+}
+
 /// A vector as a `(D,)` float64 array.
 pub(crate) fn array1<'py, const D: usize>(
     py: Python<'py>,

@@ -5,7 +5,9 @@
 //!
 //! What it is for: driving the simulators from Python — the optical-trap
 //! flow map, trajectories and thermal runs of `ot-physics`
-//! ([`trap::GaussianTrap`]), and the nano world of `nanoworld`.
+//! ([`trap::GaussianTrap`]), the nano world of `nanoworld`
+//! ([`nano::NanoWorld`]) and the brick world of `brickworld`
+//! ([`brick::BrickWorld`]).
 //!
 //! What it is not: it holds no physics. Every number comes from the wrapped
 //! crates; this crate only converts arrays, checks their shapes, releases
@@ -14,7 +16,9 @@
 //! range). The user guide is `docs/python.md`; the type stub is
 //! `crates/ot-py/nanohaptics.pyi`.
 
+pub mod brick;
 mod convert;
+mod json;
 pub mod nano;
 mod params_dict;
 pub mod trap;
@@ -29,8 +33,10 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<trap::GaussianTrap>()?;
     m.add_function(wrap_pyfunction!(trap::paper_trap, m)?)?;
     m.add_class::<nano::NanoWorld>()?;
+    m.add_class::<brick::BrickWorld>()?;
     m.add_function(wrap_pyfunction!(nano::nano_params, m)?)?;
     m.add_function(wrap_pyfunction!(nano::force_distance_curve, m)?)?;
+    m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;
     m.add("PAPER_V0_MOVING", (vx, vy))?;

@@ -35,13 +35,7 @@ pub(crate) fn params_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Params>
             "params: allowed \"game\", \"physical\" or a dict of the scene table",
         ));
     }
-    let json = obj
-        .py()
-        .import("json")?
-        .call_method1("dumps", (obj,))
-        .map_err(|e| PyValueError::new_err(format!("params: not JSON-serialisable ({e})")))?;
-    let text: String = json.extract()?;
-    serde_json::from_str::<Params>(&text).map_err(|e| PyValueError::new_err(format!("params: {e}")))
+    crate::json::from_py(obj, "params")
 }
 
 fn pairs<'py, T>(

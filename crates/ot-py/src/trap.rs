@@ -350,7 +350,7 @@ impl GaussianTrap {
     ///     method: "adaptive" (DOP853 with error control, default),
     ///         "dopri5", "paper-rk4" (one RK4 step: the paper's difference
     ///         equation), "rk4", "rk8", "symplectic", "yoshida4", "yoshida6".
-    ///     rtol: relative tolerance of "adaptive"/"dopri5" (default 1e-7).
+    ///     rtol: relative tolerance of "adaptive"/"dopri5" (default DEFAULT_RTOL).
     ///     substeps: equal substeps of the fixed-step methods (default 16,
     ///         3 for "rk8").
     ///

@@ -1,0 +1,518 @@
+//! `nanohaptics.BrickWorld`: the macro world of the teaching game
+//! (`brickworld`): bricks under gravity, the cursor proxy, grab/throw/rotate.
+
+use brickworld::script::WallScript;
+use brickworld::{
+    BrickId, BrickPlacement, Buttons, CursorInput, DeviceLimits, Params, StepReport, World,
+};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString};
+
+use crate::convert::{array2_flat, int_in, numbers, vector};
+use crate::json::{from_py, tagged_to_py, to_py};
+
+const BUTTON_KEYS: [&str; 4] = ["center", "rotate_x", "rotate_y", "rotate_z"];
+
+fn buttons_of(b: [bool; 4]) -> Buttons {
+    Buttons {
+        center: b[0],
+        rotate_x: b[1],
+        rotate_y: b[2],
+        rotate_z: b[3],
+    }
+}
+
+/// Buttons as Python passes them: None (all up), a dict with keys among
+/// center/rotate_x/rotate_y/rotate_z, or a sequence of four truth values.
+fn parse_buttons(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Buttons> {
+    let Some(obj) = obj else {
+        return Ok(Buttons::default());
+    };
+    if obj.is_none() {
+        return Ok(Buttons::default());
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut b = [false; 4];
+        for (k, v) in d.iter() {
+            let key: String = k.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "{name}: keys must be strings among {BUTTON_KEYS:?}"
+                ))
+            })?;
+            let Some(i) = BUTTON_KEYS.iter().position(|n| *n == key) else {
+                return Err(PyValueError::new_err(format!(
+                    "{name}: unknown button {key:?}: allowed {BUTTON_KEYS:?}"
+                )));
+            };
+            b[i] = v.is_truthy()?;
+        }
+        return Ok(buttons_of(b));
+    }
+    let n = numbers(obj, name)?;
+    if n.shape != [4] {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected a dict or 4 values (center, rotate_x, rotate_y, rotate_z), got {} values",
+            n.data.len()
+        )));
+    }
+    Ok(buttons_of([
+        n.data[0] != 0.0,
+        n.data[1] != 0.0,
+        n.data[2] != 0.0,
+        n.data[3] != 0.0,
+    ]))
+}
+
+fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceLimits> {
+    let Some(obj) = obj else {
+        return Ok(DeviceLimits::NOVINT_FALCON);
+    };
+    if let Ok(s) = obj.cast::<PyString>() {
+        return match s.to_str()? {
+            "falcon" => Ok(DeviceLimits::NOVINT_FALCON),
+            other => Err(PyValueError::new_err(format!(
+                "device = {other:?}: allowed \"falcon\" or a dict with max_stiffness_n_m and max_force_n"
+            ))),
+        };
+    }
+    let d: DeviceLimits = from_py(obj, "device")?;
+    d.validate()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(d)
+}
+
+fn brick_id(world: &World, obj: &Bound<'_, PyAny>) -> PyResult<BrickId> {
+    let id = int_in(obj, "brick", 0, i128::from(u32::MAX))? as u32;
+    let b = BrickId(id);
+    world
+        .brick(b)
+        .map(|_| b)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+fn err(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// Per-tick record of a batch.
+struct Tick {
+    report: StepReport,
+    proxy: [f64; 3],
+    held: i64,
+    filled: usize,
+}
+
+/// Per-tick arrays of a batch, as a dict.
+fn ticks_to_py<'py>(
+    py: Python<'py>,
+    ticks: &[Tick],
+    inputs: &[CursorInput],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let flat = |f: fn(&StepReport) -> [f64; 3]| -> Vec<f64> {
+        ticks.iter().flat_map(|t| f(&t.report)).collect()
+    };
+    d.set_item("force", array2_flat(py, flat(|r| r.force_n), 3)?)?;
+    d.set_item(
+        "spring_force",
+        array2_flat(py, flat(|r| r.spring_force_n), 3)?,
+    )?;
+    d.set_item(
+        "weight_force",
+        array2_flat(py, flat(|r| r.weight_force_n), 3)?,
+    )?;
+    d.set_item(
+        "inertia_force",
+        array2_flat(py, flat(|r| r.inertia_force_n), 3)?,
+    )?;
+    d.set_item(
+        "acceleration",
+        array2_flat(py, flat(|r| r.acceleration_m_s2), 3)?,
+    )?;
+    let proxy: Vec<f64> = ticks.iter().flat_map(|t| t.proxy).collect();
+    d.set_item("proxy", array2_flat(py, proxy, 3)?)?;
+    let cursor: Vec<f64> = inputs.iter().flat_map(|i| i.position_m()).collect();
+    d.set_item("cursor", array2_flat(py, cursor, 3)?)?;
+    let buttons: Vec<bool> = inputs
+        .iter()
+        .flat_map(|i| {
+            let b = i.buttons();
+            [b.center, b.rotate_x, b.rotate_y, b.rotate_z]
+        })
+        .collect();
+    d.set_item(
+        "buttons",
+        PyArray1::from_vec(py, buttons).reshape([inputs.len(), 4])?,
+    )?;
+    let sat: Vec<bool> = ticks.iter().map(|t| t.report.saturated).collect();
+    d.set_item("saturated", PyArray1::from_vec(py, sat))?;
+    let k: Vec<f64> = ticks.iter().map(|t| t.report.stiffness_n_m).collect();
+    d.set_item("stiffness", PyArray1::from_vec(py, k))?;
+    let pen: Vec<f64> = ticks.iter().map(|t| t.report.proxy_penetration_m).collect();
+    d.set_item("penetration", PyArray1::from_vec(py, pen))?;
+    let held: Vec<i64> = ticks.iter().map(|t| t.held).collect();
+    d.set_item("held", PyArray1::from_vec(py, held))?;
+    let filled: Vec<i64> = ticks.iter().map(|t| t.filled as i64).collect();
+    d.set_item("filled", PyArray1::from_vec(py, filled))?;
+    let ev = PyList::empty(py);
+    for (i, t) in ticks.iter().enumerate() {
+        for e in &t.report.events {
+            ev.append((i, tagged_to_py(py, e)?))?;
+        }
+    }
+    d.set_item("events", ev)?;
+    Ok(d)
+}
+
+fn record(world: &World, report: StepReport) -> Tick {
+    Tick {
+        report,
+        proxy: world.proxy_position_m(),
+        held: world.held_brick().map_or(-1, |b| i64::from(b.0)),
+        filled: world.score().filled,
+    }
+}
+
+/// The macro world of the teaching game: bricks on the ground (z = 0) under
+/// gravity, simulated with rapier, handled through a haptic cursor proxy.
+///
+/// Args:
+///     params: None (defaults) or a dict with the scene-table layout; missing
+///         fields take their defaults (see :attr:`params` for the full set:
+///         dt_s, gravity_m_s2, restitution, friction, inertia, brick_mass_kg,
+///         brick_half_extents_m, loading_zone, blueprint, bricks, ...).
+///     device: "falcon" (Novint Falcon: 3000 N/m, 9 N) or a dict
+///         {"max_stiffness_n_m": ..., "max_force_n": ...}.
+///
+/// Units: m, kg, s, N; quaternions are [x, y, z, w]. Buttons are None, a
+/// dict with keys among center/rotate_x/rotate_y/rotate_z, or four truth
+/// values in that order.
+#[pyclass(module = "nanohaptics")]
+pub struct BrickWorld {
+    world: World,
+}
+
+#[pymethods]
+impl BrickWorld {
+    #[new]
+    #[pyo3(signature = (params=None, *, device=None))]
+    fn new(params: Option<&Bound<'_, PyAny>>, device: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let p: Params = match params {
+            Some(obj) if !obj.is_none() => from_py(obj, "params")?,
+            _ => Params::default(),
+        };
+        let dev = device_from_py(device)?;
+        Ok(Self {
+            world: World::new(p, dev).map_err(err)?,
+        })
+    }
+
+    /// Add a brick with its centre at ``center_m`` (3,) (m), turned by the
+    /// rotation vector ``rotation_deg`` (axis · angle, degrees). Returns its id.
+    #[pyo3(signature = (center_m, rotation_deg=None))]
+    fn add_brick(
+        &mut self,
+        center_m: &Bound<'_, PyAny>,
+        rotation_deg: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<u32> {
+        let c = vector::<3>(center_m, "center_m", "m")?;
+        let r = match rotation_deg {
+            Some(r) => vector::<3>(r, "rotation_deg", "deg")?,
+            None => nalgebra::Vector3::zeros(),
+        };
+        let id = self
+            .world
+            .add_brick(BrickPlacement {
+                center_m: [c.x, c.y, c.z],
+                rotation_deg: [r.x, r.y, r.z],
+            })
+            .map_err(err)?;
+        Ok(id.0)
+    }
+
+    /// One tick of ``params["dt_s"]`` with the cursor at ``position_m`` (3,)
+    /// (m, inside the workspace box) and the given buttons.
+    ///
+    /// Returns:
+    ///     the step report as a dict: "tick", "force_n" (device force, N,
+    ///     within the device limit), "saturated", "spring_force_n",
+    ///     "stiffness_n_m", "weight_force_n", "inertia_force_n",
+    ///     "acceleration_m_s2", "proxy_penetration_m" and "events" (dicts
+    ///     with a "type" key: "grabbed", "released", "thrown", "rotated",
+    ///     "spawned", "touch_began", "slot_filled", ...).
+    #[pyo3(signature = (position_m, buttons=None))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        position_m: &Bound<'py, PyAny>,
+        buttons: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let p = vector::<3>(position_m, "position_m", "m")?;
+        let b = parse_buttons(buttons, "buttons")?;
+        let input = self.world.input([p.x, p.y, p.z], b).map_err(err)?;
+        let r = self.world.step(&input);
+        let d = to_py(py, &r)?;
+        let ev = PyList::empty(py);
+        for e in &r.events {
+            ev.append(tagged_to_py(py, e)?)?;
+        }
+        d.set_item("events", ev)?;
+        Ok(d)
+    }
+
+    /// Step once per row of ``positions_m`` (T, 3) (m) with ``buttons``: None,
+    /// one button set for every tick, or a (T, 4) array of truth values. All
+    /// rows are checked before the first tick; the GIL is released while the
+    /// ticks run.
+    ///
+    /// Returns:
+    ///     dict of per-tick arrays: "force", "spring_force", "weight_force",
+    ///     "inertia_force" (T, 3) N, "acceleration" (T, 3) m/s², "proxy"
+    ///     (T, 3) m (after the tick), "cursor" (T, 3) m, "buttons" (T, 4)
+    ///     bool, "saturated" (T,) bool, "stiffness" (T,) N/m, "penetration"
+    ///     (T,) m, "held" (T,) int (brick id or -1), "filled" (T,) int
+    ///     (blueprint slots filled), and "events": list of (tick, dict).
+    #[pyo3(signature = (positions_m, buttons=None))]
+    fn run<'py>(
+        &mut self,
+        py: Python<'py>,
+        positions_m: &Bound<'py, PyAny>,
+        buttons: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let path = crate::convert::rows::<3>(positions_m, "positions_m", "m")?;
+        let per_tick: Vec<Buttons> = match buttons {
+            Some(b) if !b.is_none() && !b.is_instance_of::<PyDict>() => {
+                let n = numbers(b, "buttons")?;
+                if n.shape == [4] {
+                    vec![parse_buttons(Some(b), "buttons")?; path.len()]
+                } else if n.shape == [path.len(), 4] {
+                    n.data
+                        .chunks_exact(4)
+                        .map(|c| buttons_of([c[0] != 0.0, c[1] != 0.0, c[2] != 0.0, c[3] != 0.0]))
+                        .collect()
+                } else {
+                    return Err(PyValueError::new_err(format!(
+                        "buttons: expected None, a dict, 4 values or shape ({}, 4)",
+                        path.len()
+                    )));
+                }
+            }
+            other => vec![parse_buttons(other, "buttons")?; path.len()],
+        };
+        let mut inputs = Vec::with_capacity(path.len());
+        for (i, (p, b)) in path.iter().zip(&per_tick).enumerate() {
+            inputs.push(
+                self.world
+                    .input([p.x, p.y, p.z], *b)
+                    .map_err(|e| PyValueError::new_err(format!("positions_m[{i}]: {e}")))?,
+            );
+        }
+        let world = &mut self.world;
+        let ticks: Vec<Tick> = py.detach(|| {
+            inputs
+                .iter()
+                .map(|i| {
+                    let r = world.step(i);
+                    record(world, r)
+                })
+                .collect()
+        });
+        ticks_to_py(py, &ticks, &inputs)
+    }
+
+    /// Run the scripted wall builder (a loading zone and a blueprint are
+    /// needed) from the cursor at ``start_m`` (3,) (m, outside the loading
+    /// zone) until every slot has been served or ``max_ticks`` ticks, then
+    /// ``settle_ticks`` more with the cursor parked. Same per-tick arrays as
+    /// :meth:`run`; the GIL is released.
+    #[pyo3(signature = (start_m, max_ticks=40_000, settle_ticks=1000))]
+    fn run_wall_script<'py>(
+        &mut self,
+        py: Python<'py>,
+        start_m: &Bound<'py, PyAny>,
+        max_ticks: usize,
+        settle_ticks: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let s = vector::<3>(start_m, "start_m", "m")?;
+        let start = [s.x, s.y, s.z];
+        let park = self
+            .world
+            .input(start, Buttons::default())
+            .map_err(|e| PyValueError::new_err(format!("start_m: {e}")))?;
+        let mut script = WallScript::new(&self.world, start).ok_or_else(|| {
+            PyValueError::new_err("loading_zone is missing: the wall script fetches bricks from it")
+        })?;
+        let world = &mut self.world;
+        let (ticks, inputs) = py
+            .detach(|| {
+                let mut ticks = Vec::new();
+                let mut inputs = Vec::new();
+                while !script.done() && ticks.len() < max_ticks {
+                    let i = script.next_input(world)?;
+                    let r = world.step(&i);
+                    ticks.push(record(world, r));
+                    inputs.push(i);
+                }
+                for _ in 0..settle_ticks {
+                    let r = world.step(&park);
+                    ticks.push(record(world, r));
+                    inputs.push(park);
+                }
+                Ok::<_, brickworld::InputError>((ticks, inputs))
+            })
+            .map_err(err)?;
+        ticks_to_py(py, &ticks, &inputs)
+    }
+
+    /// Every brick: {"id" (B,) int, "position" (B, 3) m, "orientation"
+    /// (B, 4) [x, y, z, w], "half_extents" (B, 3) m, "velocity" (B, 3) m/s,
+    /// "held" (B,) bool, "sleeping" (B,) bool}, in id order.
+    #[getter]
+    fn bricks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let b: Vec<_> = self.world.bricks().collect();
+        let d = PyDict::new(py);
+        let ids: Vec<i64> = b.iter().map(|v| i64::from(v.id.0)).collect();
+        d.set_item("id", PyArray1::from_vec(py, ids))?;
+        let f3 = |f: fn(&brickworld::BrickView) -> [f64; 3]| -> Vec<f64> {
+            b.iter().flat_map(f).collect()
+        };
+        d.set_item("position", array2_flat(py, f3(|v| v.position_m), 3)?)?;
+        let q: Vec<f64> = b.iter().flat_map(|v| v.orientation_xyzw).collect();
+        d.set_item(
+            "orientation",
+            PyArray1::from_vec(py, q).reshape([b.len(), 4])?,
+        )?;
+        d.set_item(
+            "half_extents",
+            array2_flat(py, f3(|v| v.half_extents_m), 3)?,
+        )?;
+        d.set_item("velocity", array2_flat(py, f3(|v| v.velocity_m_s), 3)?)?;
+        let held: Vec<bool> = b.iter().map(|v| v.held).collect();
+        d.set_item("held", PyArray1::from_vec(py, held))?;
+        let sl: Vec<bool> = b.iter().map(|v| v.sleeping).collect();
+        d.set_item("sleeping", PyArray1::from_vec(py, sl))?;
+        Ok(d)
+    }
+
+    /// One brick by id: {"id", "position_m", "orientation_xyzw",
+    /// "half_extents_m", "velocity_m_s", "held", "sleeping"}.
+    fn brick<'py>(&self, py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let b = brick_id(&self.world, id)?;
+        to_py(py, &self.world.brick(b).map_err(err)?)
+    }
+
+    /// Proxy (god-object) centre (3,) m: never inside a brick or the ground.
+    #[getter]
+    fn proxy_position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.world.proxy_position_m())
+    }
+
+    /// Last cursor position (3,) m.
+    #[getter]
+    fn cursor_position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.world.cursor_position_m())
+    }
+
+    /// Id of the carried brick, or None.
+    #[getter]
+    fn held_brick(&self) -> Option<u32> {
+        self.world.held_brick().map(|b| b.0)
+    }
+
+    /// What the cursor (or carried brick) touches: list of dicts
+    /// ({"type": "ground"}, {"type": "brick", "value": id}, ...).
+    #[getter]
+    fn touching<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let l = PyList::empty(py);
+        for t in self.world.touching() {
+            l.append(tagged_to_py(py, t)?)?;
+        }
+        Ok(l)
+    }
+
+    /// Blueprint slots: list of {"position_m", "orientation_xyzw", "filled_by"}.
+    #[getter]
+    fn slots<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let s: Vec<_> = self.world.slots().collect();
+        to_py(py, &s)
+    }
+
+    /// House score: {"filled": int, "total": int}.
+    #[getter]
+    fn score<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.world.score())
+    }
+
+    /// Fixed boxes besides the ground: list of {"position_m", "orientation_xyzw", "half_extents_m"}.
+    #[getter]
+    fn obstacles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let o: Vec<_> = self.world.obstacles().collect();
+        to_py(py, &o)
+    }
+
+    /// Bricks the physics engine is simulating (not asleep).
+    #[getter]
+    fn awake_brick_count(&self) -> usize {
+        self.world.awake_brick_count()
+    }
+
+    /// The parameters in force, as a full dict (scene-table layout).
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, self.world.params())
+    }
+
+    /// The device limits: {"max_stiffness_n_m", "max_force_n"}.
+    #[getter]
+    fn device<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, self.world.device())
+    }
+
+    /// Ticks stepped so far.
+    #[getter]
+    fn tick(&self) -> u64 {
+        self.world.tick()
+    }
+
+    /// Simulated time (s).
+    #[getter]
+    fn time(&self) -> f64 {
+        self.world.time_s()
+    }
+
+    /// Gravity magnitude (m/s², 0 switches it off), validated.
+    fn set_gravity(&mut self, g_m_s2: f64) -> PyResult<()> {
+        self.world.set_gravity(g_m_s2).map_err(err)
+    }
+
+    /// Restitution of every contact (0..1), validated.
+    fn set_restitution(&mut self, e: f64) -> PyResult<()> {
+        self.world.set_restitution(e).map_err(err)
+    }
+
+    /// Coulomb friction coefficient of every contact, validated.
+    fn set_friction(&mut self, mu: f64) -> PyResult<()> {
+        self.world.set_friction(mu).map_err(err)
+    }
+
+    /// Whether the inertial force -M a of a carried brick is felt.
+    fn set_inertia(&mut self, on: bool) {
+        self.world.set_inertia(on)
+    }
+
+    /// Mass of every brick (kg), validated.
+    fn set_brick_mass(&mut self, kg: f64) -> PyResult<()> {
+        self.world.set_brick_mass(kg).map_err(err)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "BrickWorld(bricks={}, tick={}, held={:?})",
+            self.world.brick_count(),
+            self.world.tick(),
+            self.world.held_brick().map(|b| b.0)
+        )
+    }
+}
