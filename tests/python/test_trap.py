@@ -398,3 +398,11 @@ def test_brownian_errors_name_the_argument(paper):
     )
     with pytest.raises(TypeError, match="seed: expected an integer"):
         bead.brownian(1.0, 1e3, seed=1.5)
+
+
+def test_default_tolerance_is_the_crate_default(paper):
+    offsets = np.array([[-100 * NM, -50 * NM], [400 * NM, 250 * NM]])
+    d = paper.displacement(offsets, nh.PAPER_V0_MOVING, 1e-6)
+    assert np.array_equal(d, paper.displacement(offsets, nh.PAPER_V0_MOVING, 1e-6, rtol=nh.DEFAULT_RTOL))
+    assert not np.array_equal(d, paper.displacement(offsets, nh.PAPER_V0_MOVING, 1e-6, rtol=1e-12))
+    assert 1e-14 <= nh.DEFAULT_RTOL <= 1e-3
