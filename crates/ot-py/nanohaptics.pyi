@@ -62,6 +62,19 @@ class GaussianTrap:
         """(N, D) displacements (m) after dt (s) for (N, D) trap-centre offsets
         relative to the particle (m); velocity (m/s) is (D,) or (N, D).
         The GIL is released during the batch."""
+    def flow_jacobian(
+        self,
+        offsets: ArrayLike,
+        velocity: ArrayLike,
+        dt: float,
+        *,
+        method: Method = "adaptive",
+        rtol: Optional[float] = None,
+        substeps: Optional[int] = None,
+    ) -> dict:
+        """{"displacement" (N, D) m, "velocity" (N, D) m/s, "d_offset" (N, D, D),
+        "d_velocity" (N, D, D) s, "dv_offset" (N, D, D) 1/s} from the
+        variational equations; [n, i, j] = ∂(row i)/∂(column j)."""
     def trajectory(
         self,
         offset: ArrayLike,

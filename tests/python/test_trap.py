@@ -406,3 +406,35 @@ def test_default_tolerance_is_the_crate_default(paper):
     assert np.array_equal(d, paper.displacement(offsets, nh.PAPER_V0_MOVING, 1e-6, rtol=nh.DEFAULT_RTOL))
     assert not np.array_equal(d, paper.displacement(offsets, nh.PAPER_V0_MOVING, 1e-6, rtol=1e-12))
     assert 1e-14 <= nh.DEFAULT_RTOL <= 1e-3
+
+
+def test_flow_jacobian_matches_finite_differences(paper):
+    offsets = np.array([[-100 * NM, -50 * NM], [350 * NM, 120 * NM], [0.0, 0.0]])
+    v0 = np.array(nh.PAPER_V0_MOVING)
+    j = paper.flow_jacobian(offsets, v0, 1e-6, rtol=1e-12)
+    assert j["d_offset"].shape == (3, 2, 2) and j["displacement"].shape == (3, 2)
+    # Same dynamics; the step control also watches the sensitivities, so not the same bits.
+    np.testing.assert_allclose(
+        j["displacement"], paper.displacement(offsets, v0, 1e-6, rtol=1e-12), rtol=1e-9, atol=1e-18
+    )
+    h, hv = 1e-11, 1e-5
+    for col in range(2):
+        e = np.zeros(2)
+        e[col] = h
+        fd = (paper.displacement(offsets + e, v0, 1e-6, rtol=1e-12)
+              - paper.displacement(offsets - e, v0, 1e-6, rtol=1e-12)) / (2 * h)
+        np.testing.assert_allclose(j["d_offset"][:, :, col], fd, rtol=1e-5, atol=1e-6)
+        ev = np.zeros(2)
+        ev[col] = hv
+        fdv = np.stack([
+            (paper.displacement(offsets[n : n + 1], v0 + ev, 1e-6, rtol=1e-12)
+             - paper.displacement(offsets[n : n + 1], v0 - ev, 1e-6, rtol=1e-12))[0] / (2 * hv)
+            for n in range(3)
+        ])
+        np.testing.assert_allclose(j["d_velocity"][:, :, col], fdv, rtol=1e-5, atol=1e-12)
+    # At rest at the centre: ∂d/∂offset = I − cos(ω_i Δt) per axis (linear oscillator).
+    kx, ky = paper.stiffness
+    w = np.sqrt(np.array([kx, ky]) / paper.mass)
+    j0 = paper.flow_jacobian([[0.0, 0.0]], (0.0, 0.0), 1e-6, rtol=1e-12)["d_offset"][0]
+    np.testing.assert_allclose(np.diag(j0), 1 - np.cos(w * 1e-6), rtol=1e-8)
+    assert j0[0, 1] == 0.0 and j0[1, 0] == 0.0

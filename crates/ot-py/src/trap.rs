@@ -5,12 +5,12 @@
 #![allow(clippy::too_many_arguments)]
 
 use nalgebra::SVector;
-use numpy::{PyArray1, PyArray2};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use ot_physics::langevin::{Scheme, ThermalRun, simulate};
 use ot_physics::{Method, Phase, Propagator, TrapModel, paper};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyDict, PyTuple};
 
 use crate::convert::{
     array1, array2, int_in, one_or_rows, point_or_rows, rows, value_error, vector,
@@ -168,6 +168,63 @@ fn displacement_d<const D: usize>(
         })
         .map_err(value_error)?;
     Ok(array2(py, &out)?.unbind())
+}
+
+/// Row-major flattening of D×D matrices (numpy's [i, j] order).
+fn flat_matrices<const D: usize>(m: &[nalgebra::SMatrix<f64, D, D>]) -> Vec<f64> {
+    m.iter()
+        .flat_map(|a| (0..D * D).map(move |k| a[(k / D, k % D)]))
+        .collect()
+}
+
+fn flow_jacobian_d<'py, const D: usize>(
+    py: Python<'py>,
+    model: TrapModel<D>,
+    offsets: &Bound<'py, PyAny>,
+    velocity: &Bound<'py, PyAny>,
+    dt: f64,
+    method: Method,
+) -> PyResult<Bound<'py, PyDict>> {
+    let offsets = rows::<D>(offsets, "offsets", "m")?;
+    let velocities = one_or_rows::<D>(velocity, "velocity", "m/s", offsets.len())?;
+    check_overdamped_velocity(&model, &velocities)?;
+    let prop = Propagator::new(model, method, dt).map_err(value_error)?;
+    let flows = py
+        .detach(|| {
+            offsets
+                .iter()
+                .enumerate()
+                .map(|(i, o)| {
+                    let v = if velocities.len() == 1 {
+                        &velocities[0]
+                    } else {
+                        &velocities[i]
+                    };
+                    prop.flow_jacobian(o, v)
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(value_error)?;
+    let n = flows.len();
+    let d = PyDict::new(py);
+    let disp: Vec<SVector<f64, D>> = flows.iter().map(|f| f.displacement).collect();
+    let vel: Vec<SVector<f64, D>> = flows.iter().map(|f| f.velocity).collect();
+    d.set_item("displacement", array2(py, &disp)?)?;
+    d.set_item("velocity", array2(py, &vel)?)?;
+    for (name, m) in [
+        (
+            "d_offset",
+            flows.iter().map(|f| f.d_offset).collect::<Vec<_>>(),
+        ),
+        ("d_velocity", flows.iter().map(|f| f.d_velocity).collect()),
+        ("dv_offset", flows.iter().map(|f| f.dv_offset).collect()),
+    ] {
+        d.set_item(
+            name,
+            PyArray1::from_vec(py, flat_matrices(&m)).reshape([n, D, D])?,
+        )?;
+    }
+    Ok(d)
 }
 
 type Trajectory<const D: usize> = (Vec<f64>, Vec<SVector<f64, D>>, Vec<SVector<f64, D>>);
@@ -371,6 +428,29 @@ impl GaussianTrap {
     ) -> PyResult<Py<PyArray2<f64>>> {
         let method = parse_method(method, rtol, substeps)?;
         with_model!(self.deterministic(), m => displacement_d(py, m, offsets, velocity, dt, method))
+    }
+
+    /// The flow map with its derivatives (variational equations), per offset.
+    ///
+    /// Same arguments as :meth:`displacement`. Returns a dict of arrays:
+    /// "displacement" (N, D) m, "velocity" (N, D) end velocity in m/s,
+    /// "d_offset" (N, D, D) ∂displacement/∂offset (dimensionless),
+    /// "d_velocity" (N, D, D) ∂displacement/∂v0 (s), "dv_offset" (N, D, D)
+    /// ∂(end velocity)/∂offset (1/s); element [n, i, j] is ∂(row i)/∂(column j).
+    /// The GIL is released.
+    #[pyo3(signature = (offsets, velocity, dt, *, method="adaptive", rtol=None, substeps=None))]
+    fn flow_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        offsets: &Bound<'py, PyAny>,
+        velocity: &Bound<'py, PyAny>,
+        dt: f64,
+        method: &str,
+        rtol: Option<f64>,
+        substeps: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let method = parse_method(method, rtol, substeps)?;
+        with_model!(self.deterministic(), m => flow_jacobian_d(py, m, offsets, velocity, dt, method))
     }
 
     /// Positions and velocities at ``samples`` evenly spaced times over
