@@ -49,6 +49,22 @@ impl Mesh {
         }
         w / (4.0 * std::f64::consts::PI)
     }
+    /// Distance from `p` to the surface (m).
+    pub fn distance(&self, p: &V3) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let q = closest_on_triangle(
+                    p,
+                    &self.vertices[t[0] as usize],
+                    &self.vertices[t[1] as usize],
+                    &self.vertices[t[2] as usize],
+                );
+                (q - p).norm()
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Enclosed volume (m³), positive for outward orientation.
     pub fn volume(&self) -> f64 {
         self.triangles
@@ -63,6 +79,40 @@ impl Mesh {
             })
             .sum()
     }
+}
+
+/// Closest point of triangle `abc` to `p` (Ericson, Real-Time Collision
+/// Detection, §5.1.5).
+fn closest_on_triangle(p: &V3, a: &V3, b: &V3, c: &V3) -> V3 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return *a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return *b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return *c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let den = 1.0 / (va + vb + vc);
+    a + ab * (vb * den) + ac * (vc * den)
 }
 
 /// Unit icosphere with `level` subdivisions (10·4^level + 2 vertices).
@@ -130,7 +180,7 @@ pub fn icosphere(level: u32) -> Mesh {
 
 /// The 3D working envelope of `prop`'s tick for velocity `v0` (m/s): rays on
 /// an icosphere of `level` subdivisions, marched out to `reach` waists in
-/// steps of `step` waists, fold points bisected to 1e-6 waist.
+/// steps of `step` waists, fold points bisected to 1e-4 waist (a fold point off by δ maps O(δ²) inside).
 pub fn working_envelope_3d(
     prop: &Propagator<3>,
     v0: &V3,
@@ -183,7 +233,7 @@ pub fn working_envelope_3d(
         let (mut a, mut b) = changes[0];
         let (da, _) = det_at(&(u * a), &mut evals)?;
         let sa = da >= 0.0;
-        while b - a > 1e-6 {
+        while b - a > 1e-4 {
             let m = 0.5 * (a + b);
             let (dm, _) = det_at(&(u * m), &mut evals)?;
             if (dm >= 0.0) == sa { a = m } else { b = m }

@@ -10,11 +10,22 @@ use ot_physics::{Flow, Propagator};
 /// Largest grid the sampler accepts (vertices).
 pub const MAX_VERTICES: usize = 4_000_000;
 
-/// Default grid spacing (waists per axis) for a tick of `omega_dt` radians
-/// of the fastest oscillation: 0.3 waist for the paper's tick (ωΔt ≈ 3.9),
-/// finer for longer ticks whose map folds more often.
-pub fn default_cell_waists(omega_dt: f64) -> f64 {
-    (1.2 / omega_dt.max(1e-9)).clamp(0.02, 0.3)
+/// Default grid spacing (waists per axis) for a propagator: 0.3 waist for
+/// the paper's tick (ωΔt ≈ 3.9 rad of the fastest oscillation), finer for
+/// longer ticks whose map folds more often (1.2/ωΔt), and finer again by
+/// `ωh` when the integrator's own step `h` exceeds 1/ω (the one-step RK4 of
+/// the paper: its polynomial map is far more curved than the true flow).
+pub fn default_cell_waists(prop: &Propagator<2>) -> f64 {
+    let omega_dt = prop.model().fastest_rate() * prop.dt();
+    let steps = match prop.method() {
+        ot_physics::Method::PaperRk4 => 1.0,
+        ot_physics::Method::Rk4 { substeps } | ot_physics::Method::Symplectic { substeps, .. } => {
+            f64::from(substeps)
+        }
+        _ => f64::INFINITY,
+    };
+    let omega_h = omega_dt / steps;
+    (1.2 / omega_dt.max(1e-9) / omega_h.max(1.0)).clamp(0.02, 0.3)
 }
 
 /// The flow map of one tick sampled on a regular grid of offsets.
@@ -49,7 +60,7 @@ impl SampledMap {
         let model = prop.model();
         let s = match cell_waists {
             Some(s) => positive("cell_waists [waists]", s)?,
-            None => default_cell_waists(model.fastest_rate() * prop.dt()),
+            None => default_cell_waists(prop),
         };
         let w = model.well.waists();
         let ext = region.hi - region.lo;
