@@ -351,3 +351,65 @@ pub fn directed_hausdorff(a: &[V2], b: &[V2], step: f64) -> f64 {
 pub fn hausdorff(a: &[V2], b: &[V2], step: f64) -> f64 {
     directed_hausdorff(a, b, step).max(directed_hausdorff(b, a, step))
 }
+
+/// A polygon with its edges bucketed in horizontal strips, for fast
+/// containment tests against many points.
+#[derive(Debug, Clone)]
+pub struct PolygonIndex {
+    poly: Vec<V2>,
+    y0: f64,
+    dy: f64,
+    strips: Vec<Vec<usize>>,
+}
+
+impl PolygonIndex {
+    /// Index `poly` with `strips` horizontal strips.
+    pub fn new(poly: &[V2], strips: usize) -> Self {
+        let strips_n = strips.max(1);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in poly {
+            lo = lo.min(p.y);
+            hi = hi.max(p.y);
+        }
+        let dy = ((hi - lo) / strips_n as f64).max(f64::MIN_POSITIVE);
+        let mut st = vec![Vec::new(); strips_n];
+        let n = poly.len();
+        for i in 0..n {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            let s0 = (((a.y.min(b.y) - lo) / dy) as usize).min(strips_n - 1);
+            let s1 = (((a.y.max(b.y) - lo) / dy) as usize).min(strips_n - 1);
+            for s in st.iter_mut().take(s1 + 1).skip(s0) {
+                s.push(i);
+            }
+        }
+        Self {
+            poly: poly.to_vec(),
+            y0: lo,
+            dy,
+            strips: st,
+        }
+    }
+
+    /// Whether `p` lies inside (even–odd rule).
+    pub fn contains(&self, p: &V2) -> bool {
+        if p.y < self.y0 || self.strips.is_empty() {
+            return false;
+        }
+        let s = ((p.y - self.y0) / self.dy) as usize;
+        if s >= self.strips.len() {
+            return false;
+        }
+        let n = self.poly.len();
+        let mut inside = false;
+        for &i in &self.strips[s] {
+            let (a, b) = (self.poly[i], self.poly[(i + 1) % n]);
+            if (a.y > p.y) != (b.y > p.y) {
+                let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                if p.x < x {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+}

@@ -28,6 +28,11 @@ pub struct PaperEnvelope {
     pub targets: usize,
     /// Targets found solvable.
     pub solvable: usize,
+    /// Target grid shape (points per axis).
+    pub shape: [usize; 2],
+    /// Solvable flag per target, index `a * shape[1] + b` for the target
+    /// `t_lo + spacing · (a, b)`.
+    pub solved: Vec<bool>,
     /// Newton runs.
     pub newton_runs: u64,
     /// Force evaluations (offset grid included).
@@ -231,7 +236,6 @@ pub fn paper_envelope(
     }
     // contour of the solvable set: marching squares at level ½
     let val = |a: usize, b: usize| if solvable[a * nt[1] + b] { 1.0 } else { 0.0 };
-    let pt = |a: usize, b: usize| t_lo + V2::new(spacing * a as f64, spacing * b as f64);
     let mut segs: Vec<(Vec<V2>, bool)> = Vec::new();
     for a in 0..nt[0] - 1 {
         for b in 0..nt[1] - 1 {
@@ -243,7 +247,9 @@ pub fn paper_envelope(
                 val(c[3].0, c[3].1) - 0.5,
             ];
             let xs = square_crossings(g);
-            let to = |u: &V2| pt(a, b) + u * spacing;
+            // from integer indices so that a crossing shared by two cells is
+            // bit-identical in both (the contour's segments then connect)
+            let to = |u: &V2| t_lo + V2::new(a as f64 + u.x, b as f64 + u.y) * spacing;
             if xs.len() == 2 {
                 segs.push((vec![to(&xs[0]), to(&xs[1])], false));
             } else if xs.len() == 4 {
@@ -257,6 +263,8 @@ pub fn paper_envelope(
         polygon,
         targets: nt[0] * nt[1],
         solvable: solvable.iter().filter(|x| **x).count(),
+        shape: nt,
+        solved: solvable.clone(),
         newton_runs: runs,
         evals,
     })

@@ -9,7 +9,7 @@
 //! the reachable set (to the sampling's resolution, reported as `spacing`).
 
 use crate::error::Result;
-use crate::geometry::{contains, nearest_on_boundary};
+use crate::geometry::{PolygonIndex, nearest_on_boundary};
 use crate::region::OffsetRegion;
 use nalgebra::Vector2;
 use ot_physics::Propagator;
@@ -155,8 +155,9 @@ impl Reference {
     /// Errors of `poly` (m); boundary points every `step` (m).
     pub fn errors(&self, prop: &Propagator<2>, poly: &[V2], step: f64) -> Result<RefErrors> {
         let mut outside: f64 = 0.0;
+        let index = PolygonIndex::new(poly, 512);
         for p in &self.images {
-            if !contains(poly, p) {
+            if !index.contains(p) {
                 outside = outside.max(nearest_on_boundary(poly, p).1);
             }
         }
