@@ -17,7 +17,7 @@
 use crate::error::{Result, finite_vec, positive};
 use crate::geometry::{self, outer_boundary};
 use crate::region::{DEFAULT_MARGIN_WAISTS, OffsetRegion, free_drift};
-use crate::sample::SampledMap;
+use crate::sample::{SampledMap, coarse_companion};
 use nalgebra::{Matrix2, Vector2};
 use ot_physics::Propagator;
 use std::collections::BTreeSet;
@@ -37,6 +37,10 @@ pub struct EnvelopeOptions {
     pub cell_waists: Option<f64>,
     /// Offset region (`None`: [`OffsetRegion::around_drift`] with 3 waists).
     pub region: Option<OffsetRegion>,
+    /// Sample the grid interior with half the RK4 substeps
+    /// ([`crate::sample::coarse_companion`]); fold points and the region's
+    /// edge always use the full propagator.
+    pub coarse_grid: bool,
 }
 
 impl Default for EnvelopeOptions {
@@ -45,6 +49,7 @@ impl Default for EnvelopeOptions {
             tol: DEFAULT_TOL,
             cell_waists: None,
             region: None,
+            coarse_grid: true,
         }
     }
 }
@@ -108,7 +113,12 @@ pub fn working_envelope_with(
         Some(r) => r,
         None => OffsetRegion::around_drift(prop, v0, DEFAULT_MARGIN_WAISTS)?,
     };
-    let map = SampledMap::build(prop, v0, &region, opt.cell_waists)?;
+    let coarse = if opt.coarse_grid {
+        coarse_companion(prop, v0)
+    } else {
+        None
+    };
+    let map = SampledMap::build_with(prop, coarse.as_ref(), v0, &region, opt.cell_waists)?;
     envelope_from_map(prop, &map, opt.tol)
 }
 

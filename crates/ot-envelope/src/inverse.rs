@@ -179,7 +179,7 @@ impl<'a> TrapSolver<'a> {
                     let e2 = map.disp[ia] - map.disp[ib] + map.jac[ib] * step;
                     nl = nl.max(e1.amax()).max(e2.amax());
                 }
-                let g = 2.0 * nl + 1e-12;
+                let g = 2.0 * nl + map.interior_error + 1e-12;
                 boxes.push((lo - V2::repeat(g), hi + V2::repeat(g)));
                 margins.push(g);
             }

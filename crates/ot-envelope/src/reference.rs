@@ -96,11 +96,11 @@ impl Reference {
         })
     }
 
-    /// Index of the sample whose image is nearest to `p`.
-    pub fn nearest(&self, p: &V2) -> usize {
+    /// Indices of the `k` samples whose images are nearest to `p`, nearest first.
+    pub fn nearest_k(&self, p: &V2, k: usize) -> Vec<usize> {
         let ci = ((p.x - self.lo.x) / self.cell).floor() as i64;
         let cj = ((p.y - self.lo.y) / self.cell).floor() as i64;
-        let mut best = (f64::INFINITY, 0usize);
+        let mut found: Vec<(f64, usize)> = Vec::new();
         for r in 0i64.. {
             for i in ci - r..=ci + r {
                 for j in cj - r..=cj + r {
@@ -110,25 +110,40 @@ impl Reference {
                     if i < 0 || j < 0 || i >= self.nb[0] as i64 || j >= self.nb[1] as i64 {
                         continue;
                     }
-                    for &k in &self.buckets[i as usize * self.nb[1] + j as usize] {
-                        let d = (self.images[k as usize] - p).norm();
-                        if d < best.0 {
-                            best = (d, k as usize);
-                        }
+                    for &q in &self.buckets[i as usize * self.nb[1] + j as usize] {
+                        found.push(((self.images[q as usize] - p).norm(), q as usize));
                     }
                 }
             }
-            if best.0 < (r as f64) * self.cell || r as usize > self.nb[0] + self.nb[1] {
+            found.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let done = found.len() >= k && found[k - 1].0 < (r as f64) * self.cell;
+            if done || r as usize > self.nb[0] + self.nb[1] {
                 break;
             }
         }
-        best.1
+        found.into_iter().take(k).map(|x| x.1).collect()
     }
 
-    /// Distance (m) from `p` to the reachable set: nearest sample, then
-    /// Levenberg–Marquardt on `|F(o) − p|²` with `prop`.
+    /// Index of the sample whose image is nearest to `p`.
+    pub fn nearest(&self, p: &V2) -> usize {
+        self.nearest_k(p, 1).first().copied().unwrap_or(0)
+    }
+
+    /// Distance (m) from `p` to the reachable set: Levenberg–Marquardt on
+    /// `|F(o) − p|²` with `prop` from the offsets of the 8 nearest samples
+    /// (a folded map has local minima on other sheets); the smallest wins.
     pub fn distance(&self, prop: &Propagator<2>, p: &V2) -> Result<f64> {
-        let k = self.nearest(p);
+        let mut best = f64::INFINITY;
+        for k in self.nearest_k(p, 8) {
+            best = best.min(self.polish(prop, p, k)?);
+            if best < 1e-13 {
+                break;
+            }
+        }
+        Ok(best)
+    }
+
+    fn polish(&self, prop: &Propagator<2>, p: &V2, k: usize) -> Result<f64> {
         let mut o = self.offsets[k];
         let mut best = (self.images[k] - p).norm();
         let mut mu = 1e-3;

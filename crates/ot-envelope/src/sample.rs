@@ -45,6 +45,42 @@ pub struct SampledMap {
     pub jac: Vec<Matrix2<f64>>,
     /// Force evaluations spent building the grid.
     pub evals: u64,
+    /// Estimated bound on the displacement error of interior vertices (m):
+    /// zero when every vertex used the main propagator, else twice the
+    /// largest difference seen between the coarse and the main map at probe
+    /// vertices (the 8 where the well acts most, and a 1-in-4 lattice).
+    pub interior_error: f64,
+}
+
+/// The coarse companion of a propagator for sampling grid interiors: RK4
+/// with half the substeps, used only in the gentle regime where it keeps
+/// every fold sign of the full map — the method is RK4 with at least 8
+/// substeps, the tick spans at most one oscillation (`rate·Δt ≤ 2π`) and the
+/// coarse step resolves it (`rate·Δt/(n/2) ≤ 1`), with `rate` the larger of
+/// the well's fastest frequency and the crossing rate `|v0|/w_min`. The
+/// paper's tick qualifies; long ticks and fast particles sample at full
+/// accuracy. The fold *signs* need far less accuracy than the fold *points*,
+/// which are always computed with the full propagator.
+pub fn coarse_companion(prop: &Propagator<2>, v0: &Vector2<f64>) -> Option<Propagator<2>> {
+    let model = prop.model();
+    let rate = model.fastest_rate().max(v0.norm() / model.length_scale());
+    match prop.method() {
+        ot_physics::Method::Rk4 { substeps } if substeps >= 8 => {
+            let half = substeps / 2;
+            let omega_dt = rate * prop.dt();
+            if omega_dt <= std::f64::consts::TAU && omega_dt / f64::from(half) <= 1.0 {
+                Propagator::new(
+                    *model,
+                    ot_physics::Method::Rk4 { substeps: half },
+                    prop.dt(),
+                )
+                .ok()
+            } else {
+                None
+            }
+        }
+        _ => None,
+    }
 }
 
 impl SampledMap {
@@ -52,6 +88,18 @@ impl SampledMap {
     /// spacing of `cell_waists` waists per axis (`None`: [`default_cell_waists`]).
     pub fn build(
         prop: &Propagator<2>,
+        v0: &Vector2<f64>,
+        region: &OffsetRegion,
+        cell_waists: Option<f64>,
+    ) -> Result<Self> {
+        Self::build_with(prop, None, v0, region, cell_waists)
+    }
+
+    /// [`SampledMap::build`] with the interior vertices sampled by `coarse`
+    /// (the region's edge always by `prop`), and the interior error measured.
+    pub fn build_with(
+        prop: &Propagator<2>,
+        coarse: Option<&Propagator<2>>,
         v0: &Vector2<f64>,
         region: &OffsetRegion,
         cell_waists: Option<f64>,
@@ -91,10 +139,34 @@ impl SampledMap {
         for i in 0..n[0] {
             for j in 0..n[1] {
                 let o = region.lo + Vector2::new(h.x * i as f64, h.y * j as f64);
-                let f: Flow<2> = prop.flow_jacobian(&o, v0)?;
+                let edge = i == 0 || j == 0 || i + 1 == n[0] || j + 1 == n[1];
+                let p = if edge { prop } else { coarse.unwrap_or(prop) };
+                let f: Flow<2> = p.flow_jacobian(&o, v0)?;
                 disp.push(f.displacement);
                 jac.push(f.d_offset);
                 evals += f.evals;
+            }
+        }
+        let mut interior_error = 0.0;
+        if coarse.is_some() && n[0] > 2 && n[1] > 2 {
+            let free = crate::region::free_drift(prop.model(), v0, prop.dt());
+            let mut inner: Vec<(f64, usize, usize)> = (1..n[0] - 1)
+                .flat_map(|i| (1..n[1] - 1).map(move |j| (i, j)))
+                .map(|(i, j)| ((disp[i * n[1] + j] - free).norm(), i, j))
+                .collect();
+            inner.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+            // probes: the 8 vertices where the well acts most, and every
+            // fourth vertex of the interior lattice
+            let lattice = (1..n[0] - 1)
+                .step_by(4)
+                .flat_map(|i| (1..n[1] - 1).step_by(4).map(move |j| (0.0, i, j)));
+            let probes: Vec<(f64, usize, usize)> =
+                inner.iter().take(8).copied().chain(lattice).collect();
+            for &(_, i, j) in &probes {
+                let o = region.lo + Vector2::new(h.x * i as f64, h.y * j as f64);
+                let (d, _, e) = prop.flow(&o, v0)?;
+                evals += e;
+                interior_error = f64::max(interior_error, 2.0 * (d - disp[i * n[1] + j]).norm());
             }
         }
         Ok(Self {
@@ -105,6 +177,7 @@ impl SampledMap {
             disp,
             jac,
             evals,
+            interior_error,
         })
     }
 

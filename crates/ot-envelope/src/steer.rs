@@ -7,7 +7,7 @@ use crate::envelope::{Envelope, EnvelopeOptions, envelope_from_map};
 use crate::error::{Result, finite_vec, positive};
 use crate::inverse::{Choice, TrapSolver};
 use crate::region::{DEFAULT_MARGIN_WAISTS, OffsetRegion};
-use crate::sample::SampledMap;
+use crate::sample::{SampledMap, coarse_companion};
 use nalgebra::Vector2;
 use ot_physics::Propagator;
 use serde::Deserialize;
@@ -110,7 +110,8 @@ impl Controller {
         finite_vec("cursor [m]", cursor.as_slice())?;
         let v0 = particle.velocity;
         let region = OffsetRegion::around_drift(prop, &v0, self.params.margin_waists)?;
-        let map = SampledMap::build(prop, &v0, &region, None)?;
+        let coarse = coarse_companion(prop, &v0);
+        let map = SampledMap::build_with(prop, coarse.as_ref(), &v0, &region, None)?;
         let opts = EnvelopeOptions {
             tol: self.params.tol,
             ..Default::default()

@@ -145,3 +145,33 @@ fn small_steering_region_bounds_the_envelope_by_its_edge() {
         "outside {outside} nm, overreach {over} nm"
     );
 }
+
+#[test]
+fn coarse_grid_interior_changes_nothing_beyond_the_tolerance() {
+    use ot_envelope::sample::coarse_companion;
+    let p = paper();
+    for v0 in [v(0.0, 0.0), v(0.1, 0.1), v(-0.08, 0.05)] {
+        let full = working_envelope_with(
+            &p,
+            &v0,
+            &EnvelopeOptions {
+                coarse_grid: false,
+                ..Default::default()
+            },
+        )
+        .expect("envelope");
+        let fast = working_envelope_with(&p, &v0, &EnvelopeOptions::default()).expect("envelope");
+        assert!(
+            (fast.evals as f64) < 0.75 * full.evals as f64,
+            "{} vs {}",
+            fast.evals,
+            full.evals
+        );
+        assert!(hausdorff(&full.polygon, &fast.polygon, 2.0 * NM) < fast.tol);
+    }
+    // long ticks and fast particles always sample at full accuracy
+    assert!(coarse_companion(&p, &v(0.0, 0.0)).is_some());
+    assert!(coarse_companion(&p, &v(3.0, 1.0)).is_none());
+    assert!(coarse_companion(&prop([600e-9, 300e-9], 48, 5e-6), &v(0.0, 0.0)).is_none());
+    assert!(coarse_companion(&prop([600e-9, 300e-9], 1, 1e-6), &v(0.0, 0.0)).is_none());
+}
