@@ -2,9 +2,9 @@
 //! by a target displacement (paper §2.2, Fig. 7).
 //!
 //! Seeding is complete on the sampled region: a solution inside a grid cell
-//! means the target lies in the cell's image, which is contained in the box
-//! of the corner images grown by the map's measured nonlinearity along the
-//! cell edges (×2 for safety). Newton with the exact Jacobian of the
+//! means the target lies in the cell's image, which lies within the
+//! piecewise-linear image of the cell's corners grown by the map's measured
+//! nonlinearity along the cell edges (about 4× the interpolation error). Newton with the exact Jacobian of the
 //! propagator's own map polishes every candidate to ≤ 1e-12 m.
 
 use crate::error::{EnvelopeError, Result, finite_vec, positive};
@@ -19,6 +19,12 @@ type V2 = Vector2<f64>;
 
 /// Default residual tolerance of a solution (m): 1e-3 nm.
 pub const DEFAULT_RESIDUAL: f64 = 1e-12;
+
+/// Safety factor on the measured nonlinearity of a cell: the cell's image
+/// lies within `NL_SAFETY · nl` of the piecewise-linear image of its corners,
+/// where `nl` is the largest linearisation error along its edges (the
+/// interpolation error inside a cell is about `nl / 4`).
+pub const NL_SAFETY: f64 = 1.0;
 
 /// Roots closer than this (in waists, per-axis scaled) are one root.
 pub const DEDUP_WAISTS: f64 = 1e-5;
@@ -179,7 +185,7 @@ impl<'a> TrapSolver<'a> {
                     let e2 = map.disp[ia] - map.disp[ib] + map.jac[ib] * step;
                     nl = nl.max(e1.amax()).max(e2.amax());
                 }
-                let g = 2.0 * nl + map.interior_error + 1e-12;
+                let g = NL_SAFETY * nl + map.interior_error + 1e-12;
                 boxes.push((lo - V2::repeat(g), hi + V2::repeat(g)));
                 margins.push(g);
             }

@@ -177,7 +177,7 @@ fn boundary_targets_solvable_just_inside_and_not_just_outside() {
     let we = working_envelope(&p, &v0, None).expect("envelope");
     let s = TrapSolver::new(&p, &v0, Some(we.region), None).expect("solver");
     let c = we.polygon.iter().sum::<Vector2<f64>>() / we.polygon.len() as f64;
-    for k in (0..we.polygon.len()).step_by(we.polygon.len() / 24) {
+    for k in (0..we.polygon.len()).step_by(we.polygon.len() / 60) {
         let b = we.polygon[k];
         let out = (b - c).normalize();
         let inner = b - out * (2.0 * we.tol);
