@@ -260,3 +260,17 @@ fn range_limited_solve_returns_the_closest_reachable_displacement() {
         .expect("bounded");
     assert!(b.reachable && b.miss <= 1e-12);
 }
+
+/// The dense version of the completeness checks (30×30 targets per case,
+/// brute-force grids of 600–900 cells a side); about a minute.
+/// Run: `cargo test --release -p ot-envelope --test inverse -- --ignored`
+#[test]
+#[ignore]
+fn dense_completeness_all_cases() {
+    check_complete(&paper(), v(0.0, 0.0), 30, 600, 2);
+    check_complete(&paper(), v(0.1, 0.1), 30, 600, 2);
+    check_complete(&prop([600e-9, 300e-9], 48, 5e-6), v(0.0, 0.0), 30, 900, 6);
+    check_complete(&prop([30e-6, 300e-9], 8, 1e-6), v(0.0, 0.0), 30, 600, 2);
+    check_complete(&paper(), v(3.0, 1.0), 30, 600, 2);
+    check_complete(&prop([600e-9, 300e-9], 12, 1.3e-6), v(0.1, 0.1), 30, 600, 2);
+}
