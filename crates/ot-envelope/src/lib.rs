@@ -43,6 +43,7 @@ pub mod clip;
 pub mod envelope;
 pub mod envelope3;
 pub mod error;
+mod folds;
 pub mod geometry;
 pub mod inverse;
 pub mod paper;
