@@ -39,6 +39,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod bounded;
 pub mod clip;
 pub mod envelope;
 pub mod envelope3;
@@ -52,6 +53,7 @@ pub mod region;
 pub mod sample;
 pub mod steer;
 
+pub use bounded::{Bounded, SteeringRange};
 pub use clip::{ClipMode, Clipped, clip_command};
 pub use envelope::{
     DEFAULT_TOL, Envelope, EnvelopeOptions, envelope_from_map, working_envelope,

@@ -2,8 +2,8 @@
 
 mod common;
 use common::*;
+use ot_envelope::bounded::SteeringRange;
 use ot_envelope::geometry::{contains, outer_boundary, signed_area};
-use ot_envelope::inverse::SteeringRange;
 use ot_envelope::{
     EnvelopeOptions, OffsetRegion, solve_trap, working_envelope, working_envelope_with,
 };

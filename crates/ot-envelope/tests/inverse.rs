@@ -4,8 +4,9 @@
 mod common;
 use common::*;
 use nalgebra::Vector2;
+use ot_envelope::bounded::SteeringRange;
 use ot_envelope::geometry::nearest_on_boundary;
-use ot_envelope::inverse::{Choice, SteeringRange, TrapSolver};
+use ot_envelope::inverse::{Choice, TrapSolver};
 use ot_envelope::{Solutions, solve_trap, working_envelope};
 
 /// Preimage count of `t` under the piecewise-linear interpolation of the map
