@@ -2,7 +2,7 @@
 //! paper-method baseline, and writes `docs/bench/ot-envelope.md` plus
 //! `docs/figures/ot-envelope-bench.png`.
 //!
-//! Run: `cargo run --release -p ot-envelope --example bench_report`
+//! Run: `cargo run --release -p ot-envelope --example ot-envelope-report`
 //! (about two minutes; single thread).
 
 use nalgebra::{Vector2, Vector3};

@@ -194,10 +194,7 @@ fn sym_eig<const D: usize>(m: &SMatrix<f64, D, D>) -> (SVector<f64, D>, SMatrix<
         vals: &[f64],
         vec: impl Fn(usize, usize) -> f64,
     ) -> (SVector<f64, D>, SMatrix<f64, D, D>) {
-        (
-            SVector::from_fn(|i, _| vals[i]),
-            SMatrix::from_fn(vec),
-        )
+        (SVector::from_fn(|i, _| vals[i]), SMatrix::from_fn(vec))
     }
     match D {
         2 => {

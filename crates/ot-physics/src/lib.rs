@@ -38,10 +38,12 @@
 pub mod analysis;
 pub mod dynamics;
 pub mod error;
+pub mod fastexp;
 pub mod flow;
 pub mod integrate;
 pub mod langevin;
 pub mod model;
+pub mod paper;
 pub mod state;
 pub mod well;
 

@@ -20,6 +20,13 @@ pub trait OdeSystem {
     type State: OdeState;
     /// The right-hand side `f(y)`.
     fn rhs(&self, y: &Self::State) -> Self::State;
+    /// Largest step (s) the adaptive methods may take from `y`, whatever
+    /// their error estimate says: an embedded pair cannot see a feature it
+    /// steps over entirely (a fast particle crossing the well).
+    #[inline]
+    fn max_step(&self, _y: &Self::State) -> f64 {
+        f64::INFINITY
+    }
 }
 
 /// Error tolerances of an adaptive method.
@@ -81,13 +88,20 @@ impl<const D: usize> OdeState for Phase<D> {
     }
     #[inline(always)]
     fn combine(&self, h: f64, terms: &[(f64, &Self)]) -> Self {
-        let mut out = *self;
+        let mut r = self.r.data.0[0];
+        let mut v = self.v.data.0[0];
         for (c, k) in terms {
             let s = h * c;
-            out.r.axpy(s, &k.r, 1.0);
-            out.v.axpy(s, &k.v, 1.0);
+            let (kr, kv) = (&k.r.data.0[0], &k.v.data.0[0]);
+            for i in 0..D {
+                r[i] += s * kr[i];
+                v[i] += s * kv[i];
+            }
         }
-        out
+        Self {
+            r: SVector::from(r),
+            v: SVector::from(v),
+        }
     }
 
     #[inline]
@@ -128,10 +142,26 @@ impl<const D: usize> OdeState for PhaseVar<D> {
         out
     }
 
-    /// Error control on the phase only; the sensitivities ride along on the
-    /// same steps (their error follows the phase error for smooth fields).
+    /// Error control on the phase and on the sensitivities (a particle at
+    /// rest at the centre has a zero phase error but a nonzero Jacobian).
+    /// Sensitivity scales: `rtol` for `∂r/∂r0` and `∂v/∂v0`, `rtol/ω` for
+    /// `∂r/∂v0`, `rtol·ω` for `∂v/∂r0`, with `ω = atol_v/atol_r`.
     #[inline]
     fn error_ratio(err: &Self, y0: &Self, y1: &Self, tol: &Tolerance) -> f64 {
+        let w = tol.atol_v / tol.atol_r;
+        let block =
+            |e: &SMatrix<f64, D, D>, a: &SMatrix<f64, D, D>, b: &SMatrix<f64, D, D>, atol: f64| {
+                let mut worst: f64 = 0.0;
+                for i in 0..D * D {
+                    let sc = atol + tol.rtol * a[i].abs().max(b[i].abs());
+                    worst = worst.max((e[i] / sc).abs());
+                }
+                worst
+            };
         Phase::error_ratio(&err.p, &y0.p, &y1.p, tol)
+            .max(block(&err.jrr, &y0.jrr, &y1.jrr, tol.rtol))
+            .max(block(&err.jrv, &y0.jrv, &y1.jrv, tol.rtol / w))
+            .max(block(&err.jvr, &y0.jvr, &y1.jvr, tol.rtol * w))
+            .max(block(&err.jvv, &y0.jvv, &y1.jvv, tol.rtol))
     }
 }

@@ -16,7 +16,7 @@ pub struct GaussianWell<const D: usize> {
     depth: f64,
     waists: SVector<f64, D>,
     /// `ln2 / w_i²` (1/m²), precomputed.
-    k: SVector<f64, D>,
+    k: [f64; D],
 }
 
 /// The paper's 2D well.
@@ -34,7 +34,7 @@ impl<const D: usize> GaussianWell<D> {
         for (i, &wi) in waists.iter().enumerate() {
             w[i] = positive(WAIST_FIELDS[i.min(2)], wi)?;
         }
-        let k = w.map(|wi| LN2 / (wi * wi));
+        let k = std::array::from_fn(|i| LN2 / (w[i] * w[i]));
         Ok(Self {
             depth,
             waists: w,
@@ -58,29 +58,33 @@ impl<const D: usize> GaussianWell<D> {
     }
 
     /// `exp(-ln2 Σ r_i²/w_i²)`, in [0, 1].
-    #[inline]
+    #[inline(always)]
     fn envelope(&self, r: &SVector<f64, D>) -> f64 {
-        let mut q = 0.0;
-        for i in 0..D {
-            q += self.k[i] * r[i] * r[i];
-        }
-        (-q).exp()
+        let q: f64 = self
+            .k
+            .iter()
+            .zip(&r.data.0[0])
+            .map(|(k, x)| k * x * x)
+            .sum();
+        crate::fastexp::exp(-q)
     }
 
     /// Restoring force `-∇P` at `r` (N). Exactly zero (never NaN) where the
     /// Gaussian underflows, however far away `r` is.
-    #[inline]
+    #[inline(always)]
     pub fn force(&self, r: &SVector<f64, D>) -> SVector<f64, D> {
         let e = self.envelope(r);
+        // e == 0 far away: return exact zeros (r·0 could be inf·0 = NaN).
         if e == 0.0 {
             return SVector::zeros();
         }
         let s = -2.0 * self.depth * e;
-        let mut f = SVector::<f64, D>::zeros();
-        for i in 0..D {
-            f[i] = s * self.k[i] * r[i];
+        let ra = &r.data.0[0];
+        let mut f = [0.0; D];
+        for ((fi, k), x) in f.iter_mut().zip(&self.k).zip(ra) {
+            *fi = s * k * x;
         }
-        f
+        SVector::from(f)
     }
 
     /// Force (N) and its Jacobian `∂F_i/∂r_j` (N/m) at `r`.
@@ -91,7 +95,7 @@ impl<const D: usize> GaussianWell<D> {
             return (SVector::zeros(), SMatrix::zeros());
         }
         let s = -2.0 * self.depth * e;
-        let kr = self.k.component_mul(r);
+        let kr = SVector::<f64, D>::from(self.k).component_mul(r);
         let f = kr * s;
         // ∂F_i/∂r_j = s (k_i δ_ij − 2 k_i r_i k_j r_j)
         let mut h = kr * kr.transpose() * (-2.0 * s);
@@ -103,6 +107,6 @@ impl<const D: usize> GaussianWell<D> {
 
     /// Small-oscillation stiffness per axis `κ_i = 2 ln2 P0 / w_i²` (N/m).
     pub fn stiffness(&self) -> SVector<f64, D> {
-        self.k * (2.0 * self.depth)
+        SVector::<f64, D>::from(self.k) * (2.0 * self.depth)
     }
 }

@@ -64,6 +64,7 @@ pub fn dopri5<S: OdeSystem>(
                 reason: "step limit reached before the end of the interval (stiff problem: use more substeps or an overdamped model)",
             });
         }
+        h = h.min(sys.max_step(&y));
         let last = time + h >= t * (1.0 - 1e-14);
         if last {
             h = t - time;
