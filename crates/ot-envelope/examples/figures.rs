@@ -403,9 +403,9 @@ fn fig8() -> Res<()> {
         let b = paper_envelope(&conv, &v0, &ours.region, 0.3, t_lo, t_hi, spacing)?;
         let t = s.elapsed().as_secs_f64();
         let title = format!(
-            "paper method, targets every {:.0} nm: {:.2} s (red); ours (blue)",
+            "paper method, targets every {:.0} nm: {:.1} ms (red); ours (blue)",
             spacing / NM,
-            t
+            t * 1e3
         );
         let mut c = panel(
             &areas[k],
