@@ -16,6 +16,7 @@
 
 mod dop853;
 mod dopri5;
+mod driver;
 mod rk4;
 mod symplectic;
 
