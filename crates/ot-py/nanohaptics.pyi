@@ -144,6 +144,64 @@ def paper_trap() -> GaussianTrap:
     """The optical-tweezers paper's trap: depth 1e-15 J, waists (600e-9,
     300e-9) m, mass 1e-15 kg, no drag, no noise."""
 
+# ---------------------------------------------------------------- envelope (ot-envelope)
+
+def solve_trap(
+    trap: GaussianTrap,
+    velocity: ArrayLike,
+    dt: float,
+    target: ArrayLike,
+    *,
+    method: Method = "rk4",
+    rtol: Optional[float] = None,
+    substeps: Optional[int] = None,
+) -> F64Array:
+    """(M, 2) trap offsets (m, trap centre relative to the particle) that move a
+    particle of velocity (2,) m/s by target (2,) m in dt s; (0, 2) if none in the
+    search region (3 waists around the free drift). Default tick: rk4 x 8."""
+
+def working_envelope(
+    trap: GaussianTrap,
+    velocity: ArrayLike,
+    dt: float,
+    *,
+    tol: Optional[float] = None,
+    method: Method = "rk4",
+    rtol: Optional[float] = None,
+    substeps: Optional[int] = None,
+) -> F64Array:
+    """(K, 2) polygon of reachable displacements (m), counter-clockwise, first
+    vertex not repeated; tol (m) default 0.5e-9."""
+
+def clip_command(
+    trap: GaussianTrap,
+    velocity: ArrayLike,
+    dt: float,
+    command: ArrayLike,
+    *,
+    mode: Literal["radial", "nearest"] = "radial",
+    tol: Optional[float] = None,
+    method: Method = "rk4",
+    rtol: Optional[float] = None,
+    substeps: Optional[int] = None,
+) -> Tuple[F64Array, F64Array]:
+    """(allowed (2,), excess (2,)) in m; excess = command - allowed."""
+
+def working_envelope_3d(
+    trap: GaussianTrap,
+    velocity: ArrayLike,
+    dt: float,
+    *,
+    level: Optional[int] = None,
+    reach: float = 3.0,
+    step: float = 0.1,
+    method: Method = "rk4",
+    rtol: Optional[float] = None,
+    substeps: Optional[int] = None,
+) -> Tuple[F64Array, npt.NDArray[np.int64]]:
+    """(vertices (V, 3) m, triangles (T, 3) int64) closed outward mesh of the
+    3D working envelope; level 0..6 (default 4), reach and step in waists."""
+
 # ---------------------------------------------------------------- nano world
 
 NanoParams = Union[Literal["game", "physical"], dict, None]

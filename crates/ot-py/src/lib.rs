@@ -18,6 +18,7 @@
 
 pub mod brick;
 mod convert;
+pub mod envelope;
 mod json;
 pub mod nano;
 mod params_dict;
@@ -36,6 +37,10 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<brick::BrickWorld>()?;
     m.add_function(wrap_pyfunction!(nano::nano_params, m)?)?;
     m.add_function(wrap_pyfunction!(nano::force_distance_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(envelope::solve_trap, m)?)?;
+    m.add_function(wrap_pyfunction!(envelope::working_envelope, m)?)?;
+    m.add_function(wrap_pyfunction!(envelope::clip_command, m)?)?;
+    m.add_function(wrap_pyfunction!(envelope::working_envelope_3d, m)?)?;
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

@@ -126,7 +126,7 @@ pub(crate) fn parse_method(
 }
 
 /// An overdamped particle has no velocity state: refuse a nonzero one.
-fn check_overdamped_velocity<const D: usize>(
+pub(crate) fn check_overdamped_velocity<const D: usize>(
     model: &TrapModel<D>,
     v: &[SVector<f64, D>],
 ) -> PyResult<()> {

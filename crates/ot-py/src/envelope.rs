@@ -1,0 +1,225 @@
+//! The inverse trap solver, working envelope and command clipping of
+//! `ot-envelope`, on a [`GaussianTrap`].
+
+use nalgebra::{SVector, Vector3};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use ot_envelope::envelope3::working_envelope_3d as envelope3;
+use ot_envelope::{ClipMode, clip_command as clip, solve_trap as solve, working_envelope as we};
+use ot_physics::{Propagator, TrapModel};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use crate::convert::{array1, array2, int_in, value_error, vector};
+use crate::trap::{GaussianTrap, Model, check_overdamped_velocity, parse_method};
+
+/// RK4 substeps used when `method="rk4"` and no `substeps` is given: within
+/// 0.21 nm of converged dynamics at the paper's constants (ot-envelope guide).
+const DEFAULT_RK4_SUBSTEPS: i64 = 8;
+
+/// The tick map of a trap: its deterministic model, a method and Δt.
+fn tick<const D: usize>(
+    py: Python<'_>,
+    model: TrapModel<D>,
+    dt: f64,
+    method: &str,
+    rtol: Option<f64>,
+    substeps: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Propagator<D>> {
+    let default = DEFAULT_RK4_SUBSTEPS.into_pyobject(py)?.into_any();
+    let substeps = match substeps {
+        None if method == "rk4" => Some(&default),
+        s => s,
+    };
+    let m = parse_method(method, rtol, substeps)?;
+    Propagator::new(model, m, dt).map_err(value_error)
+}
+
+fn planar(trap: &GaussianTrap, call: &str) -> PyResult<TrapModel<2>> {
+    match trap.deterministic() {
+        Model::D2(m) => Ok(m),
+        Model::D3(_) => Err(PyValueError::new_err(format!(
+            "trap: {call} needs a 2D trap (axial_waist=None); use working_envelope_3d for 3D"
+        ))),
+    }
+}
+
+fn velocity2(model: &TrapModel<2>, velocity: &Bound<'_, PyAny>) -> PyResult<SVector<f64, 2>> {
+    let v = vector::<2>(velocity, "velocity", "m/s")?;
+    check_overdamped_velocity(model, &[v])?;
+    Ok(v)
+}
+
+/// Every trap offset (trap centre relative to the particle, m) that moves a
+/// particle of initial ``velocity`` (2,) (m/s) by ``target`` (2,) (m) in one
+/// tick ``dt`` (s), found by Newton with the exact Jacobian inside
+/// ot-envelope's default search region (3 waists around the free drift).
+///
+/// Args:
+///     trap: a 2D :class:`GaussianTrap`.
+///     method, rtol, substeps: the tick's integrator, as in
+///         :meth:`GaussianTrap.displacement`; default "rk4" with 8 substeps.
+///
+/// Returns:
+///     (M, 2) float64 array of offsets (m), in a deterministic order;
+///     (0, 2) when no offset in the region reaches the target. The GIL is
+///     released.
+#[pyfunction]
+#[pyo3(signature = (trap, velocity, dt, target, *, method="rk4", rtol=None, substeps=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn solve_trap<'py>(
+    py: Python<'py>,
+    trap: &GaussianTrap,
+    velocity: &Bound<'py, PyAny>,
+    dt: f64,
+    target: &Bound<'py, PyAny>,
+    method: &str,
+    rtol: Option<f64>,
+    substeps: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let model = planar(trap, "solve_trap")?;
+    let v0 = velocity2(&model, velocity)?;
+    let target = vector::<2>(target, "target", "m")?;
+    let prop = tick(py, model, dt, method, rtol, substeps)?;
+    let s = py
+        .detach(|| solve(&prop, &v0, &target))
+        .map_err(value_error)?;
+    array2(py, s.offsets())
+}
+
+/// The working envelope: the boundary of every displacement (m) reachable in
+/// one tick ``dt`` (s) by a particle of initial ``velocity`` (2,) (m/s).
+///
+/// Args:
+///     trap: a 2D :class:`GaussianTrap`.
+///     tol: geometric tolerance of the polygon (m); default 0.5e-9.
+///     method, rtol, substeps: as in :func:`solve_trap`.
+///
+/// Returns:
+///     (K, 2) float64 polygon of displacements (m), counter-clockwise, first
+///     vertex not repeated. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (trap, velocity, dt, *, tol=None, method="rk4", rtol=None, substeps=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn working_envelope<'py>(
+    py: Python<'py>,
+    trap: &GaussianTrap,
+    velocity: &Bound<'py, PyAny>,
+    dt: f64,
+    tol: Option<f64>,
+    method: &str,
+    rtol: Option<f64>,
+    substeps: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let model = planar(trap, "working_envelope")?;
+    let v0 = velocity2(&model, velocity)?;
+    let prop = tick(py, model, dt, method, rtol, substeps)?;
+    let e = py.detach(|| we(&prop, &v0, tol)).map_err(value_error)?;
+    array2(py, &e.polygon)
+}
+
+/// Clip a commanded displacement ``command`` (2,) (m) to the working
+/// envelope of this tick (paper §2.4).
+///
+/// Args:
+///     trap, velocity, dt, tol, method, rtol, substeps: as in
+///         :func:`working_envelope` (the envelope is computed for the call).
+///     mode: "radial" (the paper's rule: along the segment from zero
+///         displacement, or the free drift when zero is unreachable, to the
+///         command, stop at the first crossing) or "nearest" (the nearest
+///         boundary point).
+///
+/// Returns:
+///     (allowed, excess): two (2,) arrays (m); excess = command − allowed,
+///     zero inside the envelope.
+#[pyfunction]
+#[pyo3(signature = (trap, velocity, dt, command, *, mode="radial", tol=None, method="rk4", rtol=None, substeps=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn clip_command<'py>(
+    py: Python<'py>,
+    trap: &GaussianTrap,
+    velocity: &Bound<'py, PyAny>,
+    dt: f64,
+    command: &Bound<'py, PyAny>,
+    mode: &str,
+    tol: Option<f64>,
+    method: &str,
+    rtol: Option<f64>,
+    substeps: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let model = planar(trap, "clip_command")?;
+    let v0 = velocity2(&model, velocity)?;
+    let command = vector::<2>(command, "command", "m")?;
+    let mode = match mode {
+        "radial" | "nearest" => ClipMode::from_name(mode).map_err(value_error)?,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "mode = {other:?}: allowed \"radial\", \"nearest\""
+            )));
+        }
+    };
+    let prop = tick(py, model, dt, method, rtol, substeps)?;
+    let c = py
+        .detach(|| we(&prop, &v0, tol).and_then(|e| clip(&e, &command, mode)))
+        .map_err(value_error)?;
+    PyTuple::new(py, [array1(py, &c.allowed), array1(py, &c.excess)])
+}
+
+/// The 3D working envelope as a closed triangle mesh of displacements (m):
+/// rays on an icosphere of ``level`` subdivisions (0 ..= 6, default 4), marched out to
+/// ``reach`` waists in steps of ``step`` waists.
+///
+/// Args:
+///     trap: a 3D :class:`GaussianTrap` (with axial_waist).
+///     velocity: (3,) initial velocity (m/s).
+///     dt: the tick (s).
+///     method, rtol, substeps: as in :func:`solve_trap`.
+///
+/// Returns:
+///     (vertices, triangles): (V, 3) float64 displacements (m) and (T, 3)
+///     int64 vertex indices, outward-facing counter-clockwise.
+#[pyfunction]
+#[pyo3(signature = (trap, velocity, dt, *, level=None, reach=3.0, step=0.1, method="rk4", rtol=None, substeps=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn working_envelope_3d<'py>(
+    py: Python<'py>,
+    trap: &GaussianTrap,
+    velocity: &Bound<'py, PyAny>,
+    dt: f64,
+    level: Option<&Bound<'py, PyAny>>,
+    reach: f64,
+    step: f64,
+    method: &str,
+    rtol: Option<f64>,
+    substeps: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let Model::D3(model) = trap.deterministic() else {
+        return Err(PyValueError::new_err(
+            "trap: working_envelope_3d needs a 3D trap (give axial_waist)",
+        ));
+    };
+    let v: Vector3<f64> = vector::<3>(velocity, "velocity", "m/s")?;
+    check_overdamped_velocity(&model, &[v])?;
+    let level = match level {
+        Some(l) => int_in(l, "level", 0, 6)? as u32,
+        None => 4,
+    };
+    let prop = tick(py, model, dt, method, rtol, substeps)?;
+    let e = py
+        .detach(|| envelope3(&prop, &v, level, reach, step))
+        .map_err(value_error)?;
+    let tri: Vec<i64> = e
+        .mesh
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(i64::from))
+        .collect();
+    let n = e.mesh.triangles.len();
+    PyTuple::new(
+        py,
+        [
+            array2(py, &e.mesh.vertices)?.into_any(),
+            PyArray1::from_vec(py, tri).reshape([n, 3])?.into_any(),
+        ],
+    )
+}
