@@ -5,7 +5,8 @@
 //!
 //! What it is for: driving the simulators from Python — the optical-trap
 //! flow map, trajectories and thermal runs of `ot-physics`
-//! ([`trap::GaussianTrap`]), the nano world of `nanoworld`
+//! ([`trap::GaussianTrap`]), the inverse solver and working envelope of
+//! `ot-envelope` ([`envelope`]), the nano world of `nanoworld`
 //! ([`nano::NanoWorld`]) and the brick world of `brickworld`
 //! ([`brick::BrickWorld`]).
 //!
@@ -26,8 +27,10 @@ pub mod trap;
 
 use pyo3::prelude::*;
 
-/// Haptic manipulation at the nanoscale: optical-trap dynamics and the nano
-/// world, from Python. SI units throughout (J, m, kg, s, Pa·s, K, N).
+/// Haptic manipulation at the nanoscale, from Python: optical-trap dynamics
+/// (GaussianTrap), the inverse trap solver and working envelope (solve_trap,
+/// working_envelope, clip_command), the nano world (NanoWorld) and the brick
+/// world (BrickWorld). SI units throughout (J, m, kg, s, Pa·s, K, N).
 #[pymodule]
 fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
