@@ -1,0 +1,2 @@
+//! The `nanohaptics` command-line program.
+fn main() {}
