@@ -451,4 +451,40 @@ stiffness_n_per_m = 5000.0
         assert_eq!(names[1], ("button.down", "minus"));
         assert_eq!(names.last().unwrap().0, "deadline.missed");
     }
+
+    use proptest::prelude::*;
+
+    fn coord() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            -0.05f64..0.05,
+            Just(f64::NAN),
+            Just(f64::INFINITY),
+            Just(-1e300),
+            Just(1e300)
+        ]
+    }
+
+    proptest! {
+        /// Whatever the device reports, the force sent is finite, within the device maximum,
+        /// and zero whenever the input is invalid.
+        #[test]
+        fn sent_force_is_always_finite_and_bounded(
+            samples in proptest::collection::vec(((coord(), coord(), coord()), 0u32..64), 1..200),
+            k in 1.0f64..1e9,
+        ) {
+            let text = WALL.replace("5000.0", &format!("{k:?}"));
+            let mut l = looped(&text);
+            for ((x, y, z), b) in samples {
+                let s = DeviceSample { position_m: [x, y, z], buttons: Buttons(b) };
+                let invalid = HapticLoop::check_sample(&FALCON, &s).is_some();
+                let r = l.tick(s, false);
+                prop_assert!(vec3::is_finite(r.device_force_n));
+                prop_assert!(vec3::norm(r.device_force_n) <= FALCON.max_force_n);
+                if invalid {
+                    prop_assert_eq!(r.device_force_n, [0.0; 3]);
+                    prop_assert!(r.status & status::INPUT_INVALID != 0);
+                }
+            }
+        }
+    }
 }

@@ -138,35 +138,31 @@ pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
         if divergence.is_some() {
             return Ok(());
         }
-        let got: Vec<_> = t.msgs.iter().filter(|m| m.channel.verified()).collect();
         let want = &expected[t.tick as usize];
-        for k in 0..got.len().max(want.len()) {
-            let div = match (want.get(k), got.get(k)) {
-                (Some((wc, wd)), Some(g)) if *wc == g.channel => {
-                    compared += 1;
-                    if *wd == g.data.as_slice() {
-                        continue;
-                    }
-                    Some((g.channel, describe(g.channel, wd, &g.data, n_fields)))
+        for ch in Channel::ALL.into_iter().filter(|c| c.verified()) {
+            let w: Vec<&[u8]> = want.iter().filter(|m| m.0 == ch).map(|m| m.1).collect();
+            let g: Vec<&[u8]> = t
+                .msgs
+                .iter()
+                .filter(|m| m.channel == ch)
+                .map(|m| m.data.as_slice())
+                .collect();
+            let mut detail = None;
+            for (a, b) in w.iter().zip(&g) {
+                compared += 1;
+                if a != b {
+                    detail = Some(describe(ch, a, b, n_fields));
+                    break;
                 }
-                (Some((wc, _)), Some(g)) => Some((
-                    *wc,
-                    format!(
-                        "recorded a message on {}, replay produced one on {}",
-                        wc.topic(),
-                        g.channel.topic()
-                    ),
-                )),
-                (Some((wc, _)), None) => {
-                    Some((*wc, "recorded a message that replay did not produce".into()))
-                }
-                (None, Some(g)) => Some((
-                    g.channel,
-                    "replay produced a message that was not recorded".into(),
-                )),
-                (None, None) => None,
-            };
-            if let Some((ch, detail)) = div {
+            }
+            if detail.is_none() && w.len() != g.len() {
+                detail = Some(if w.len() < g.len() {
+                    "replay produced a message that was not recorded".to_string()
+                } else {
+                    "recorded a message that replay did not produce".to_string()
+                });
+            }
+            if let Some(detail) = detail {
                 divergence = Some(Divergence {
                     tick: t.tick,
                     channel: ch.topic().to_string(),
