@@ -148,3 +148,46 @@ impl TickEncoder {
         }
     }
 }
+
+/// Writes `rec` (e.g. the salvaged part of a truncated recording) as a new, complete MCAP
+/// file; the metadata records are copied. Returns what the writer did.
+pub fn rewrite(
+    rec: &Recording,
+    path: &std::path::Path,
+) -> Result<WriteSummary, writer::RecordError> {
+    let mut w = Recorder::create(
+        path,
+        RecorderSetup {
+            description: rec.description.clone(),
+            flush_every_ns: 1_000_000_000,
+        },
+    )?;
+    let mut cur: Option<TickMessages> = None;
+    for m in rec
+        .messages
+        .iter()
+        .filter(|m| m.channel != Channel::Description)
+    {
+        if cur.as_ref().is_some_and(|c| c.log_time_ns != m.log_time_ns) {
+            if let Some(c) = cur.take() {
+                w.write(c)?;
+            }
+        }
+        let c = cur.get_or_insert_with(|| TickMessages {
+            tick: 0,
+            log_time_ns: m.log_time_ns,
+            msgs: Vec::new(),
+        });
+        c.msgs.push(OutMsg {
+            channel: m.channel,
+            data: m.data.clone(),
+        });
+    }
+    if let Some(c) = cur {
+        w.write(c)?;
+    }
+    for (name, md) in &rec.metadata {
+        w.metadata(name, md.clone())?;
+    }
+    w.finish()
+}
