@@ -186,6 +186,23 @@ impl SessionArrays {
         }
     }
 
+    /// Reserves room for `ticks` more ticks, so that no array grows (and copies) mid-session.
+    pub fn reserve(&mut self, ticks: usize) {
+        let n = self.state_fields.len();
+        self.tick.reserve(ticks);
+        self.device_position_m.reserve(ticks);
+        self.device_buttons.reserve(ticks);
+        self.deadline_missed.reserve(ticks);
+        self.cursor_m.reserve(ticks);
+        self.state.reserve(ticks * n);
+        self.world_force_n.reserve(ticks);
+        self.device_force_n.reserve(ticks);
+        self.engagement.reserve(ticks);
+        self.status.reserve(ticks);
+        self.compute_ns.reserve(ticks);
+        self.start_late_ns.reserve(ticks);
+    }
+
     /// Time of each tick, s.
     pub fn time_s(&self) -> Vec<f64> {
         self.tick
@@ -288,7 +305,8 @@ pub fn drive(
     let mut enc = TickEncoder::new(lp);
     let rate = lp.config().rate_hz;
     let mut compute = Vec::with_capacity(ticks as usize);
-    let mut jitter = Vec::new();
+    let realtime = matches!(pacing, Pacing::Realtime);
+    let mut jitter = Vec::with_capacity(if realtime { ticks as usize } else { 0 });
     let mut missed_count = 0;
     let start = Instant::now();
     let pacer = match pacing {
@@ -453,6 +471,7 @@ pub fn run_session(
     };
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let mut arrays = SessionArrays::new(rate, fields);
+    arrays.reserve(ticks as usize);
     let mut sink = |t: TickMessages| -> Result<(), SessionError> {
         if let Some(rec) = recorder.as_mut() {
             // Arrays are decoded from the very bytes that are recorded.

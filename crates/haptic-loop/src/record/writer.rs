@@ -1,7 +1,10 @@
 //! The MCAP writer thread.
 //!
-//! The tick hands its encoded messages to an unbounded channel (a pointer move, never a wait on
-//! I/O or compression); a dedicated thread writes them into zstd-compressed chunks. Every second
+//! The tick appends its encoded messages to a shared queue with `try_lock` (if the writer
+//! happens to hold the lock, the tick keeps them in a local buffer and hands them over on a
+//! later tick): the tick never waits and never wakes another thread (a wake-up can make the
+//! scheduler preempt the waker). The writer thread polls the queue every 2 ms, swaps it out and
+//! writes the messages into zstd-compressed chunks. Every second
 //! of session time the thread closes the chunk and flushes it to the file, so a crash loses at
 //! most the last second. The thread compresses single-threaded (`compression_threads(0)`) to
 //! leave the other core to the loop.
@@ -13,10 +16,19 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, mpsc};
 use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// How often the writer thread drains the queue.
+const POLL: Duration = Duration::from_millis(2);
+
+struct Shared {
+    queue: Mutex<Vec<Cmd>>,
+    done: AtomicBool,
+    failed: AtomicBool,
+}
 
 /// Errors while recording.
 #[derive(Clone, Debug, thiserror::Error)]
@@ -63,9 +75,9 @@ enum Cmd {
 
 /// Handle to the writer thread.
 pub struct Recorder {
-    tx: Option<mpsc::Sender<Cmd>>,
+    shared: Arc<Shared>,
+    local: Vec<Cmd>,
     handle: Option<JoinHandle<Result<WriteSummary, RecordError>>>,
-    queued: Arc<AtomicUsize>,
     max_queued: usize,
     path: String,
 }
@@ -162,11 +174,23 @@ fn write_msgs(
 fn run_thread(
     path: String,
     setup: RecorderSetup,
-    rx: mpsc::Receiver<Cmd>,
-    queued: Arc<AtomicUsize>,
+    shared: Arc<Shared>,
     ready: mpsc::Sender<Result<(), RecordError>>,
 ) -> Result<WriteSummary, RecordError> {
-    let (mut w, ids) = match open(&path, &setup) {
+    let res = write_all(&path, &setup, &shared, ready);
+    if res.is_err() {
+        shared.failed.store(true, Ordering::Release);
+    }
+    res
+}
+
+fn write_all(
+    path: &str,
+    setup: &RecorderSetup,
+    shared: &Shared,
+    ready: mpsc::Sender<Result<(), RecordError>>,
+) -> Result<WriteSummary, RecordError> {
+    let (mut w, ids) = match open(path, setup) {
         Ok(x) => {
             let _ = ready.send(Ok(()));
             x
@@ -182,34 +206,48 @@ fn run_thread(
         channel: Channel::Description,
         data: setup.description.encode(),
     };
-    sum.messages += write_msgs(&mut w, &ids, &mut seq, 0, &[desc], &path)?;
-    w.flush().map_err(|e| io_err(&path, e))?;
+    sum.messages += write_msgs(&mut w, &ids, &mut seq, 0, &[desc], path)?;
+    w.flush().map_err(|e| io_err(path, e))?;
     let mut next_flush = setup.flush_every_ns;
-    for cmd in rx {
-        match cmd {
-            Cmd::Tick(t) => {
-                queued.fetch_sub(1, Ordering::Relaxed);
-                if t.log_time_ns >= next_flush {
-                    // Close the chunk of the previous second and push it to the OS.
-                    w.flush().map_err(|e| io_err(&path, e))?;
-                    sum.flushes += 1;
-                    while next_flush <= t.log_time_ns {
-                        next_flush += setup.flush_every_ns;
+    let mut batch: Vec<Cmd> = Vec::new();
+    loop {
+        // Read the flag before draining: whatever was queued before `done` is then drained.
+        let done = shared.done.load(Ordering::Acquire);
+        {
+            let mut q = shared
+                .queue
+                .lock()
+                .map_err(|_| RecordError::WriterStopped("queue lock poisoned".into()))?;
+            std::mem::swap(&mut *q, &mut batch);
+        }
+        for cmd in batch.drain(..) {
+            match cmd {
+                Cmd::Tick(t) => {
+                    if t.log_time_ns >= next_flush {
+                        // Close the chunk of the previous second and push it to the OS.
+                        w.flush().map_err(|e| io_err(path, e))?;
+                        sum.flushes += 1;
+                        while next_flush <= t.log_time_ns {
+                            next_flush += setup.flush_every_ns;
+                        }
                     }
+                    sum.messages +=
+                        write_msgs(&mut w, &ids, &mut seq, t.log_time_ns, &t.msgs, path)?;
                 }
-                sum.messages += write_msgs(&mut w, &ids, &mut seq, t.log_time_ns, &t.msgs, &path)?;
-            }
-            Cmd::Metadata(name, metadata) => {
-                w.write_metadata(&mcap::records::Metadata { name, metadata })
-                    .map_err(|e| io_err(&path, e))?;
+                Cmd::Metadata(name, metadata) => {
+                    w.write_metadata(&mcap::records::Metadata { name, metadata })
+                        .map_err(|e| io_err(path, e))?;
+                }
             }
         }
+        if done {
+            break;
+        }
+        std::thread::sleep(POLL);
     }
-    w.finish().map_err(|e| io_err(&path, e))?;
+    w.finish().map_err(|e| io_err(path, e))?;
     drop(w);
-    sum.bytes = std::fs::metadata(&path)
-        .map_err(|e| io_err(&path, e))?
-        .len();
+    sum.bytes = std::fs::metadata(path).map_err(|e| io_err(path, e))?.len();
     Ok(sum)
 }
 
@@ -217,14 +255,17 @@ impl Recorder {
     /// Creates the file and starts the writer thread.
     pub fn create(path: &Path, setup: RecorderSetup) -> Result<Recorder, RecordError> {
         let path_s = path.display().to_string();
-        let (tx, rx) = mpsc::channel();
         let (ready_tx, ready_rx) = mpsc::channel();
-        let queued = Arc::new(AtomicUsize::new(0));
-        let q2 = queued.clone();
+        let shared = Arc::new(Shared {
+            queue: Mutex::new(Vec::with_capacity(4096)),
+            done: AtomicBool::new(false),
+            failed: AtomicBool::new(false),
+        });
+        let s2 = shared.clone();
         let p2 = path_s.clone();
         let handle = std::thread::Builder::new()
             .name("mcap-writer".into())
-            .spawn(move || run_thread(p2, setup, rx, q2, ready_tx))
+            .spawn(move || run_thread(p2, setup, s2, ready_tx))
             .map_err(|e| io_err(&path_s, e))?;
         match ready_rx.recv() {
             Ok(Ok(())) => {}
@@ -232,39 +273,53 @@ impl Recorder {
             Err(_) => return Err(RecordError::WriterStopped("writer thread died".into())),
         }
         Ok(Recorder {
-            tx: Some(tx),
+            shared,
+            local: Vec::with_capacity(64),
             handle: Some(handle),
-            queued,
             max_queued: 0,
             path: path_s,
         })
     }
 
-    /// Hands a tick's messages to the writer thread (never blocks).
+    fn hand_over(&mut self) {
+        if let Ok(mut q) = self.shared.queue.try_lock() {
+            q.append(&mut self.local);
+            self.max_queued = self.max_queued.max(q.len());
+        }
+    }
+
+    /// Queues a tick's messages for the writer thread (never blocks, never wakes a thread).
     pub fn write(&mut self, t: TickMessages) -> Result<(), RecordError> {
-        let q = self.queued.fetch_add(1, Ordering::Relaxed) + 1;
-        self.max_queued = self.max_queued.max(q);
-        match &self.tx {
-            Some(tx) => tx
-                .send(Cmd::Tick(t))
-                .map_err(|_| RecordError::WriterStopped(format!("{}: writer gone", self.path))),
-            None => Err(RecordError::WriterStopped("already finished".into())),
+        if self.shared.failed.load(Ordering::Acquire) {
+            return Err(RecordError::WriterStopped(format!(
+                "{}: the writer failed (its error is returned by finish)",
+                self.path
+            )));
         }
+        self.local.push(Cmd::Tick(t));
+        self.hand_over();
+        Ok(())
     }
 
-    /// Writes a metadata record (e.g. the session summary).
+    /// Queues a metadata record (e.g. the session summary).
     pub fn metadata(&mut self, name: &str, m: BTreeMap<String, String>) -> Result<(), RecordError> {
-        match &self.tx {
-            Some(tx) => tx
-                .send(Cmd::Metadata(name.to_string(), m))
-                .map_err(|_| RecordError::WriterStopped(format!("{}: writer gone", self.path))),
-            None => Err(RecordError::WriterStopped("already finished".into())),
-        }
+        self.local.push(Cmd::Metadata(name.to_string(), m));
+        self.hand_over();
+        Ok(())
     }
 
-    /// Closes the queue, waits for the thread to write the summary and returns what it did.
+    /// Hands over what is left, waits for the thread to write the summary and returns what it
+    /// did (or the first error it met).
     pub fn finish(mut self) -> Result<WriteSummary, RecordError> {
-        self.tx = None;
+        {
+            let mut q = self
+                .shared
+                .queue
+                .lock()
+                .map_err(|_| RecordError::WriterStopped("queue lock poisoned".into()))?;
+            q.append(&mut self.local);
+        }
+        self.shared.done.store(true, Ordering::Release);
         let h = self
             .handle
             .take()
@@ -279,7 +334,10 @@ impl Recorder {
 
 impl Drop for Recorder {
     fn drop(&mut self) {
-        self.tx = None;
+        if let Ok(mut q) = self.shared.queue.lock() {
+            q.append(&mut self.local);
+        }
+        self.shared.done.store(true, Ordering::Release);
         if let Some(h) = self.handle.take() {
             let _ = h.join();
         }
