@@ -222,3 +222,65 @@ fn golden_recordings_replay_bit_exactly() {
     }
     assert!(n >= 1, "no golden recordings in {}", dir.display());
 }
+
+#[test]
+fn realtime_session_replays_exactly_including_its_missed_deadlines() {
+    let p = tmp("rt.mcap");
+    let mut o = wall_opts(Some(p.clone()));
+    o.realtime = true;
+    o.seconds = Some(0.5);
+    let report = run_session(&o, &mut |_, _| {}).unwrap();
+    let a = &report.arrays;
+    assert_eq!(a.tick.len(), 500);
+    assert_eq!(a.start_late_ns.len(), 500);
+    assert!(a.start_late_ns.iter().all(|&l| l >= 0));
+    // Whatever the machine did, each missed deadline is logged as an input, flagged in the
+    // status, and sent zero force; replay reproduces the session bit for bit.
+    let missed: Vec<usize> = (0..500).filter(|&i| a.deadline_missed[i]).collect();
+    assert_eq!(missed.len() as u64, report.stats.missed);
+    for &i in &missed {
+        assert!(a.status[i] & 4 != 0);
+        assert_eq!(a.device_force_n[i], [0.0; 3]);
+    }
+    assert_eq!(
+        a.status.iter().filter(|s| **s & 4 != 0).count(),
+        missed.len()
+    );
+    let v = verify(&read_recording_file(&p, false).unwrap()).unwrap();
+    assert!(v.ok(), "{:?}", v.divergence);
+}
+
+#[test]
+fn touch_device_caps_at_its_own_limits() {
+    let mut o = wall_opts(None);
+    o.device = Some(haptic_loop::DeviceModel::Touch);
+    o.operator = OperatorChoice::Rigid;
+    o.script = Some(
+        "[script]\nname = 'ramp'\n[[waypoint]]\nt_s = 0.0\nposition_mm = [0.0, 0.0, 0.0]\n\
+         [[waypoint]]\nt_s = 2.0\nposition_mm = [0.0, 0.0, -30.0]\n"
+            .to_string(),
+    );
+    let a = run_session(&o, &mut |_, _| {}).unwrap().arrays;
+    assert!(
+        a.state_column("stiffness_n_per_m")
+            .unwrap()
+            .iter()
+            .all(|&k| k == 400.0)
+    );
+    let peak = a
+        .device_force_n
+        .iter()
+        .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
+        .fold(0.0, f64::max);
+    assert_eq!(peak, 3.3);
+    // Buttons of the Falcon script do not exist on a Touch: the script is refused by name.
+    let e = haptic_loop::device::Script::from_toml(
+        &std::fs::read_to_string(root().join("scenes/wall.script.toml")).unwrap(),
+        haptic_loop::DeviceModel::Touch.specs(),
+    );
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "script: `button[0].name`: device `touch` has no button `centre` (allowed: button1, \
+         button2)"
+    );
+}
