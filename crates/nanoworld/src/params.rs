@@ -1,0 +1,472 @@
+//! World parameters: what never changes during a step (MuJoCo's `mjModel`).
+//!
+//! Every field is SI. [`Params`] deserializes from a TOML table with
+//! `deny_unknown_fields`; [`Params::validate`] returns a typed error naming the
+//! field and its allowed range. Interaction strengths, masses, gravity and the
+//! force limit may change at run time through [`crate::World::set_params`];
+//! geometry (substrate, radii, initial atoms) may not.
+
+use serde::Deserialize;
+
+use crate::error::ParamError;
+
+/// Largest substrate the world accepts (atoms).
+pub const MAX_SUBSTRATE_ATOMS: usize = 4_000_000;
+/// Largest number of movable atoms the world accepts.
+pub const MAX_MOVABLE_ATOMS: usize = 100_000;
+
+/// All parameters of a nano world.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Params {
+    /// The fixed (teal) substrate layer.
+    pub substrate: SubstrateParams,
+    /// The AFM tip apex (the cursor).
+    pub tip: TipParams,
+    /// The movable (orange) atoms.
+    pub atoms: AtomParams,
+    /// Force laws: the teaching game's or real constants.
+    pub interaction: Interaction,
+    /// Gravitational acceleration along −z (m/s²); 0 switches weight off. Range [0, 1000].
+    #[serde(default)]
+    pub gravity_m_s2: f64,
+    /// Include the inertial force −m·a of carried atoms (a from the last three cursor positions).
+    #[serde(default)]
+    pub inertia: bool,
+    /// Largest force magnitude the device may be sent (N, world units). Larger forces are
+    /// scaled down to it and flagged in [`crate::StepReport::saturated`]. Range (0, 1].
+    pub max_force_n: f64,
+    /// Where new movable atoms appear; `None` switches spawning off.
+    #[serde(default)]
+    pub loading_zone: Option<LoadingZone>,
+    /// Movable atoms present at the start, resting on the substrate at these (x, y) (m).
+    #[serde(default)]
+    pub initial_atoms_xy_m: Vec<[f64; 2]>,
+    /// The house blueprint; `None` switches scoring off.
+    #[serde(default)]
+    pub house: Option<HouseParams>,
+}
+
+/// A square lattice of fixed substrate atoms with centres at z = 0,
+/// at (i·spacing, j·spacing) for 0 ≤ i < nx, 0 ≤ j < ny.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SubstrateParams {
+    /// Atoms along x. Range [1, 4·10⁶], nx·ny ≤ 4·10⁶.
+    pub nx: usize,
+    /// Atoms along y. Range [1, 4·10⁶], nx·ny ≤ 4·10⁶.
+    pub ny: usize,
+    /// Lattice spacing (m). Range (0, 1e-6].
+    pub spacing_m: f64,
+    /// Substrate atom radius (m). Range (0, spacing_m].
+    pub atom_radius_m: f64,
+}
+
+/// The AFM tip apex, a sphere.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TipParams {
+    /// Apex radius (m). Range (0, 1e-6].
+    pub radius_m: f64,
+}
+
+/// The movable atoms (in physical mode: nanoparticles), spheres.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AtomParams {
+    /// Radius (m). Range (0, 1e-6].
+    pub radius_m: f64,
+    /// Mass of one atom (kg). Range [0, 1]; felt only through gravity and inertia.
+    pub mass_kg: f64,
+    /// Most movable atoms that may exist; spawning stops there. Range [0, 10⁵].
+    pub max_count: usize,
+}
+
+/// Axis-aligned rectangle in the substrate plane; while the tip is above it and no
+/// uncarried atom lies in it, one atom appears resting at `spawn_xy_m`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadingZone {
+    /// Lower corner (x, y) (m).
+    pub min_xy_m: [f64; 2],
+    /// Upper corner (x, y) (m); each component > the lower one.
+    pub max_xy_m: [f64; 2],
+    /// Where a new atom appears (x, y) (m); inside the zone and over the substrate.
+    pub spawn_xy_m: [f64; 2],
+}
+
+/// The house blueprint: slots that must each hold an uncarried movable atom.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HouseParams {
+    /// Slot centres (m).
+    pub slots_m: Vec<[f64; 3]>,
+    /// An atom fills a slot when its centre is within this distance (m). Range (0, 1e-6].
+    pub tolerance_m: f64,
+}
+
+/// Which force laws the world uses.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum Interaction {
+    /// The teaching game's laws: F = A/z² inside an activation gap, snap inside a snap gap,
+    /// adhesion F = k·z in contact, release at `pull_off_ratio` × the snap force.
+    Game(GameParams),
+    /// Real constants: Hamaker sphere–plane / sphere–sphere attraction, jump-to-contact where
+    /// the force gradient exceeds the cantilever stiffness, DMT pull-off 2πR_eff·W.
+    Physical(PhysicalParams),
+}
+
+/// One value per pair of body types.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pairs<T> {
+    /// Tip ↔ substrate atom (physical mode: tip ↔ substrate plane).
+    pub tip_substrate: T,
+    /// Tip ↔ movable atom.
+    pub tip_atom: T,
+    /// Movable atom ↔ movable atom.
+    pub atom_atom: T,
+    /// Movable atom ↔ substrate atom (physical mode: ↔ substrate plane).
+    pub atom_substrate: T,
+}
+
+/// Game-mode parameters.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GameParams {
+    /// Pull-off force over snap force (the paper: 10). Range [1, 1000].
+    pub pull_off_ratio: f64,
+    /// Per-pair laws.
+    pub pairs: Pairs<GamePair>,
+}
+
+/// Game-mode law of one pair type. Surface gap z = centre distance − radii.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GamePair {
+    /// A in F = A·(1/z² − 1/w²) (N·m²); 0 switches the pair off. Range [0, 1e-20].
+    pub strength_n_m2: f64,
+    /// Activation gap w (m): no force beyond it. Range (snap_gap_m, 1e-6].
+    pub activation_gap_m: f64,
+    /// Snap gap z_s (m): contact snaps inside it. Range (0, activation_gap_m).
+    pub snap_gap_m: f64,
+    /// Adhesion stiffness k in F = k·z while in contact (N/m). Range (0, 1e6].
+    pub stiffness_n_per_m: f64,
+}
+
+/// Physical-mode parameters (real constants).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicalParams {
+    /// Hamaker constant per pair (J); 0 switches the pair off. Range [0, 1e-17].
+    pub hamaker_j: Pairs<f64>,
+    /// Contact (intermolecular cut-off) gap z0 (m), typically 0.165 nm. Range (0, 1e-8].
+    pub contact_gap_m: f64,
+    /// Cantilever spring constant k_c (N/m) between the cursor (cantilever base) and the tip.
+    /// Range (0, 1e4].
+    pub cantilever_stiffness_n_per_m: f64,
+}
+
+impl PhysicalParams {
+    /// Cantilever stiffness k_c = A·R/(3·ratio^{3/2}·z0³) (N/m) for which a sphere–plane
+    /// contact of Hamaker constant `hamaker_j` (J) and radius `radius_m` (m) pulls off at
+    /// `ratio` × its jump-to-contact force. For ratio 10 this is A·R/(94.87·z0³) ≈ A·R/(95·z0³).
+    pub fn stiffness_for_pull_off_ratio(
+        hamaker_j: f64,
+        radius_m: f64,
+        contact_gap_m: f64,
+        ratio: f64,
+    ) -> f64 {
+        hamaker_j * radius_m / (3.0 * ratio.powf(1.5) * contact_gap_m.powi(3))
+    }
+}
+
+fn check(
+    field: &str,
+    value: f64,
+    ok: bool,
+    allowed: impl FnOnce() -> String,
+) -> Result<(), ParamError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError::range(field, value, allowed()))
+    }
+}
+
+fn positive_up_to(field: &str, value: f64, max: f64) -> Result<(), ParamError> {
+    check(field, value, value > 0.0 && value <= max, || {
+        format!("0 < value <= {max:e}")
+    })
+}
+
+fn nonneg_up_to(field: &str, value: f64, max: f64) -> Result<(), ParamError> {
+    check(field, value, (0.0..=max).contains(&value), || {
+        format!("0 <= value <= {max:e}")
+    })
+}
+
+fn finite(field: &str, value: f64) -> Result<(), ParamError> {
+    check(field, value, true, || "a finite number".to_string())
+}
+
+impl GamePair {
+    fn validate(&self, prefix: &str) -> Result<(), ParamError> {
+        nonneg_up_to(
+            &format!("{prefix}.strength_n_m2"),
+            self.strength_n_m2,
+            1e-20,
+        )?;
+        positive_up_to(
+            &format!("{prefix}.activation_gap_m"),
+            self.activation_gap_m,
+            1e-6,
+        )?;
+        let w = self.activation_gap_m;
+        check(
+            &format!("{prefix}.snap_gap_m"),
+            self.snap_gap_m,
+            self.snap_gap_m > 0.0 && self.snap_gap_m < w,
+            || format!("0 < value < activation_gap_m = {w:e}"),
+        )?;
+        positive_up_to(
+            &format!("{prefix}.stiffness_n_per_m"),
+            self.stiffness_n_per_m,
+            1e6,
+        )
+    }
+}
+
+impl Params {
+    /// Check every field; the first violation is returned, naming the field and its range.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let s = &self.substrate;
+        check("substrate.nx", s.nx as f64, s.nx >= 1, || {
+            format!("1 <= nx, nx*ny <= {MAX_SUBSTRATE_ATOMS}")
+        })?;
+        check("substrate.ny", s.ny as f64, s.ny >= 1, || {
+            format!("1 <= ny, nx*ny <= {MAX_SUBSTRATE_ATOMS}")
+        })?;
+        let n = s.nx.saturating_mul(s.ny);
+        check(
+            "substrate.nx*ny",
+            n as f64,
+            n <= MAX_SUBSTRATE_ATOMS,
+            || format!("1 <= nx*ny <= {MAX_SUBSTRATE_ATOMS}"),
+        )?;
+        positive_up_to("substrate.spacing_m", s.spacing_m, 1e-6)?;
+        positive_up_to("substrate.atom_radius_m", s.atom_radius_m, s.spacing_m)?;
+        positive_up_to("tip.radius_m", self.tip.radius_m, 1e-6)?;
+        positive_up_to("atoms.radius_m", self.atoms.radius_m, 1e-6)?;
+        nonneg_up_to("atoms.mass_kg", self.atoms.mass_kg, 1.0)?;
+        check(
+            "atoms.max_count",
+            self.atoms.max_count as f64,
+            self.atoms.max_count <= MAX_MOVABLE_ATOMS,
+            || format!("0 <= value <= {MAX_MOVABLE_ATOMS}"),
+        )?;
+        nonneg_up_to("gravity_m_s2", self.gravity_m_s2, 1000.0)?;
+        positive_up_to("max_force_n", self.max_force_n, 1.0)?;
+        match &self.interaction {
+            Interaction::Game(g) => {
+                check(
+                    "interaction.game.pull_off_ratio",
+                    g.pull_off_ratio,
+                    (1.0..=1000.0).contains(&g.pull_off_ratio),
+                    || "1 <= value <= 1000".to_string(),
+                )?;
+                g.pairs
+                    .tip_substrate
+                    .validate("interaction.game.pairs.tip_substrate")?;
+                g.pairs
+                    .tip_atom
+                    .validate("interaction.game.pairs.tip_atom")?;
+                g.pairs
+                    .atom_atom
+                    .validate("interaction.game.pairs.atom_atom")?;
+                g.pairs
+                    .atom_substrate
+                    .validate("interaction.game.pairs.atom_substrate")?;
+            }
+            Interaction::Physical(p) => {
+                let h = &p.hamaker_j;
+                let pre = "interaction.physical.hamaker_j";
+                nonneg_up_to(&format!("{pre}.tip_substrate"), h.tip_substrate, 1e-17)?;
+                nonneg_up_to(&format!("{pre}.tip_atom"), h.tip_atom, 1e-17)?;
+                nonneg_up_to(&format!("{pre}.atom_atom"), h.atom_atom, 1e-17)?;
+                nonneg_up_to(&format!("{pre}.atom_substrate"), h.atom_substrate, 1e-17)?;
+                positive_up_to("interaction.physical.contact_gap_m", p.contact_gap_m, 1e-8)?;
+                positive_up_to(
+                    "interaction.physical.cantilever_stiffness_n_per_m",
+                    p.cantilever_stiffness_n_per_m,
+                    1e4,
+                )?;
+            }
+        }
+        let (x_max, y_max) = (
+            (s.nx - 1) as f64 * s.spacing_m,
+            (s.ny - 1) as f64 * s.spacing_m,
+        );
+        let over_substrate =
+            |v: [f64; 2]| v[0] >= 0.0 && v[0] <= x_max && v[1] >= 0.0 && v[1] <= y_max;
+        let sub_range = || format!("inside the substrate, 0..={x_max:e} x 0..={y_max:e} m");
+        if let Some(z) = &self.loading_zone {
+            for k in 0..2 {
+                finite(&format!("loading_zone.min_xy_m[{k}]"), z.min_xy_m[k])?;
+                let lo = z.min_xy_m[k];
+                check(
+                    &format!("loading_zone.max_xy_m[{k}]"),
+                    z.max_xy_m[k],
+                    z.max_xy_m[k] > lo,
+                    || format!("value > min_xy_m[{k}] = {lo:e}"),
+                )?;
+                let hi = z.max_xy_m[k];
+                check(
+                    &format!("loading_zone.spawn_xy_m[{k}]"),
+                    z.spawn_xy_m[k],
+                    z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && over_substrate(z.spawn_xy_m),
+                    || format!("inside the zone [{lo:e}, {hi:e}] and {}", sub_range()),
+                )?;
+            }
+        }
+        check(
+            "initial_atoms_xy_m.len()",
+            self.initial_atoms_xy_m.len() as f64,
+            self.initial_atoms_xy_m.len() <= self.atoms.max_count,
+            || format!("at most atoms.max_count = {}", self.atoms.max_count),
+        )?;
+        let min_sep = 2.0 * self.atoms.radius_m * (1.0 - 1e-9);
+        for (i, a) in self.initial_atoms_xy_m.iter().enumerate() {
+            for k in 0..2 {
+                check(
+                    &format!("initial_atoms_xy_m[{i}][{k}]"),
+                    a[k],
+                    over_substrate(*a),
+                    sub_range,
+                )?;
+            }
+            for (j, b) in self.initial_atoms_xy_m[..i].iter().enumerate() {
+                let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                check(&format!("initial_atoms_xy_m[{i}]"), d, d >= min_sep, || {
+                    format!(
+                        "distance to initial_atoms_xy_m[{j}] >= 2*atoms.radius_m = {:e} m",
+                        2.0 * self.atoms.radius_m
+                    )
+                })?;
+            }
+        }
+        if let Some(h) = &self.house {
+            positive_up_to("house.tolerance_m", h.tolerance_m, 1e-6)?;
+            for (i, s) in h.slots_m.iter().enumerate() {
+                for (k, v) in s.iter().enumerate() {
+                    finite(&format!("house.slots_m[{i}][{k}]"), *v)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The teaching game with the paper's behaviour, in nanometre-sized SI values:
+    /// a 40 × 40 substrate (0.3 nm spacing), 0.3 nm tip, 0.15 nm atoms, snap force 0.3 nN
+    /// for tip pairs, pull-off 10×, atom–atom bonds twice and atom–substrate bonds half as
+    /// strong as tip–atom ones (the paper's ordering), a loading zone, a row of five
+    /// foundation atoms and a seven-slot house (three columns, the middle one higher).
+    pub fn game_default() -> Self {
+        let a = 0.3e-9;
+        let snap = 0.15e-9;
+        let w = 0.6e-9;
+        // A such that A·(1/z_s² − 1/w²) = 0.3 nN.
+        let a_tip = 0.3e-9 / (1.0 / (snap * snap) - 1.0 / (w * w));
+        let pair = |scale: f64| GamePair {
+            strength_n_m2: a_tip * scale,
+            activation_gap_m: w,
+            snap_gap_m: snap,
+            stiffness_n_per_m: 2.0,
+        };
+        let r = 0.15e-9;
+        let hollow = |i: usize, j: usize| [(i as f64 + 0.5) * a, (j as f64 + 0.5) * a];
+        let rest_z = ((2.0 * r) * (2.0 * r) - 2.0 * (a / 2.0) * (a / 2.0)).sqrt();
+        let foundation: Vec<[f64; 2]> = (16..21).map(|i| hollow(i, 20)).collect();
+        let above = |xy: [f64; 2], level: f64| [xy[0], xy[1], rest_z + level * 2.0 * r];
+        Params {
+            substrate: SubstrateParams {
+                nx: 40,
+                ny: 40,
+                spacing_m: a,
+                atom_radius_m: 0.15e-9,
+            },
+            tip: TipParams { radius_m: 0.3e-9 },
+            atoms: AtomParams {
+                radius_m: r,
+                mass_kg: 1.0e-25,
+                max_count: 64,
+            },
+            interaction: Interaction::Game(GameParams {
+                pull_off_ratio: 10.0,
+                pairs: Pairs {
+                    tip_substrate: pair(1.0),
+                    tip_atom: pair(1.0),
+                    atom_atom: pair(2.0),
+                    atom_substrate: pair(0.5),
+                },
+            }),
+            gravity_m_s2: 9.81,
+            inertia: true,
+            max_force_n: 10e-9,
+            loading_zone: Some(LoadingZone {
+                min_xy_m: [1.0e-9, 1.0e-9],
+                max_xy_m: [3.0e-9, 3.0e-9],
+                spawn_xy_m: hollow(6, 6),
+            }),
+            house: Some(HouseParams {
+                // Three columns one atom apart (windows between them), the middle one
+                // higher: a gable. Columns are 0.6 nm apart, so a descending atom always
+                // meets the atom below its slot before any neighbour.
+                slots_m: vec![
+                    above(foundation[0], 1.0),
+                    above(foundation[2], 1.0),
+                    above(foundation[4], 1.0),
+                    above(foundation[0], 2.0),
+                    above(foundation[2], 2.0),
+                    above(foundation[4], 2.0),
+                    above(foundation[2], 3.0),
+                ],
+                tolerance_m: 0.05e-9,
+            }),
+            initial_atoms_xy_m: foundation,
+        }
+    }
+
+    /// Real constants: A = 1e-19 J tip–substrate, 20 nm tip, 5 nm gold-like particles
+    /// (A = 2e-19 J to the tip, 4e-19 J to each other, 1e-19 J to the substrate), z0 = 0.165 nm,
+    /// and the cantilever k_c = A·R/(95·z0³) ≈ 4.7 N/m that gives the paper's tenfold pull-off.
+    pub fn physical_default() -> Self {
+        let mut p = Self::game_default();
+        let (a_ts, r_tip, z0) = (1e-19, 20e-9, 0.165e-9);
+        p.tip.radius_m = r_tip;
+        p.atoms.radius_m = 5e-9;
+        p.atoms.mass_kg = 1.0e-21;
+        p.max_force_n = 100e-9;
+        p.interaction = Interaction::Physical(PhysicalParams {
+            hamaker_j: Pairs {
+                tip_substrate: a_ts,
+                tip_atom: 2e-19,
+                atom_atom: 4e-19,
+                atom_substrate: 1e-19,
+            },
+            contact_gap_m: z0,
+            cantilever_stiffness_n_per_m: a_ts * r_tip / (95.0 * z0 * z0 * z0),
+        });
+        p.substrate.nx = 200;
+        p.substrate.ny = 200;
+        p.loading_zone = Some(LoadingZone {
+            min_xy_m: [5e-9, 5e-9],
+            max_xy_m: [20e-9, 20e-9],
+            spawn_xy_m: [12e-9, 12e-9],
+        });
+        p.initial_atoms_xy_m = Vec::new();
+        p.house = None;
+        p
+    }
+}

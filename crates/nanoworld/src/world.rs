@@ -1,0 +1,579 @@
+//! The world state (MuJoCo's `mjData`) and the step that advances it.
+//!
+//! One [`World::step`] per haptic tick: the cursor position goes in; the tip moves (game
+//! mode: the tip is the cursor; physical mode: the tip hangs from the cursor on a
+//! cantilever spring and sits at its quasi-static equilibrium), contacts snap and break,
+//! atoms spawn and transfer, and the force to render comes out with typed events.
+
+use nalgebra::Vector3;
+
+use crate::error::{ParamError, StepError};
+use crate::house::HouseStatus;
+use crate::law::{PairKind, PairLaws};
+use crate::params::{Interaction, LoadingZone, Params};
+use crate::substrate::Substrate;
+
+/// Device input for one tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipInput {
+    /// Cursor position in the world frame (m): the tip apex centre in game mode, the
+    /// cantilever base (where the undeflected tip centre would be) in physical mode.
+    pub position_m: Vector3<f64>,
+}
+
+/// A body of the tip assembly: the tip itself or an atom it carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Member {
+    /// The AFM tip apex.
+    Tip,
+    /// Carried movable atom with this index.
+    Atom(usize),
+}
+
+/// What a member of the tip assembly touches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Target {
+    /// Substrate atom with this index (game mode).
+    SubstrateAtom(usize),
+    /// The substrate as a Hamaker half-space (physical mode).
+    SubstratePlane,
+    /// Uncarried movable atom with this index.
+    Atom(usize),
+}
+
+impl Target {
+    pub(crate) fn is_substrate(&self) -> bool {
+        matches!(self, Target::SubstrateAtom(_) | Target::SubstratePlane)
+    }
+}
+
+/// Which link of the chain tip → (carried atom) → target → target's support broke at pull-off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BrokenLink {
+    /// The tip's own contact with the target (tip–substrate or tip–atom).
+    TipContact,
+    /// The tip's hold on its carried atoms: they stay on the target (atom transfer).
+    TipCarried,
+    /// The carried atom's contact with the target: the tip leaves with its atoms.
+    CarriedContact,
+    /// The target atom's own support (substrate or bonds): the target leaves with the tip.
+    TargetSupport,
+}
+
+/// A typed event, listed in the order it happened within the tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Event {
+    /// A movable atom appeared in the loading zone.
+    AtomSpawned {
+        /// Index of the new atom.
+        atom: usize,
+    },
+    /// The tip assembly jumped into contact (snap-to-contact / jump-to-contact).
+    Snap {
+        /// The assembly member that touches.
+        member: Member,
+        /// What it touches.
+        target: Target,
+        /// Pair type of the contact.
+        pair: PairKind,
+        /// Surface gap just before the jump (m).
+        gap_m: f64,
+        /// The pair's snap force (N).
+        snap_force_n: f64,
+    },
+    /// An uncarried atom jumped onto the tip (it was less bound than the tip holds it).
+    AtomAttached {
+        /// Index of the atom.
+        atom: usize,
+        /// Tip–atom surface gap just before the jump (m).
+        gap_m: f64,
+    },
+    /// The pull on an anchored tip exceeded the weakest link's pull-off force.
+    PullOff {
+        /// The member that was in contact.
+        member: Member,
+        /// What it was touching.
+        target: Target,
+        /// The link that broke.
+        broken: BrokenLink,
+        /// Pull along the contact normal at release (N).
+        pull_n: f64,
+        /// Pull-off force of the broken link (N).
+        pull_off_n: f64,
+    },
+    /// An atom left the tip and stays bonded to `onto`.
+    AtomTransferred {
+        /// Index of the atom.
+        atom: usize,
+        /// What it now rests on (for a carried cluster: the member's target).
+        onto: Target,
+    },
+    /// An uncarried atom was pulled off its support and is now carried.
+    AtomPickedUp {
+        /// Index of the atom.
+        atom: usize,
+    },
+    /// A blueprint slot became filled.
+    SlotFilled {
+        /// Slot index.
+        slot: usize,
+    },
+    /// A blueprint slot became empty.
+    SlotEmptied {
+        /// Slot index.
+        slot: usize,
+    },
+    /// Every slot is filled (emitted on the tick it becomes true).
+    HouseComplete,
+}
+
+/// What one tick produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepReport {
+    /// Force to render on the device (N, world frame), finite, |F| ≤ `max_force_n`.
+    pub force_n: Vector3<f64>,
+    /// The force before the device limit was applied (N).
+    pub unlimited_force_n: Vector3<f64>,
+    /// Whether `force_n` was scaled down to `max_force_n`.
+    pub saturated: bool,
+    /// Events in the order they happened.
+    pub events: Vec<Event>,
+}
+
+/// A movable (orange) atom.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MovableAtom {
+    pub(crate) position: Vector3<f64>,
+    pub(crate) carried_offset: Option<Vector3<f64>>,
+    pub(crate) on_substrate: bool,
+    pub(crate) bonds: Vec<usize>,
+}
+
+impl MovableAtom {
+    /// Centre (m).
+    pub fn position_m(&self) -> Vector3<f64> {
+        self.position
+    }
+    /// Whether the tip carries it.
+    pub fn is_carried(&self) -> bool {
+        self.carried_offset.is_some()
+    }
+    /// Offset from the tip centre while carried (m).
+    pub fn carried_offset_m(&self) -> Option<Vector3<f64>> {
+        self.carried_offset
+    }
+    /// Whether it is bonded to the substrate.
+    pub fn on_substrate(&self) -> bool {
+        self.on_substrate
+    }
+    /// Indices of the movable atoms it is bonded to, ascending.
+    pub fn bonds(&self) -> &[usize] {
+        &self.bonds
+    }
+}
+
+/// A contact holding the tip assembly in place.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Anchor {
+    /// The member in contact.
+    pub member: Member,
+    /// What it touches.
+    pub target: Target,
+    /// Pair type of the contact.
+    pub pair: PairKind,
+    /// Where the tip centre is held (m).
+    pub tip_position_m: Vector3<f64>,
+    /// Unit contact normal, from the target towards the member.
+    pub normal: Vector3<f64>,
+}
+
+/// The tip's contact state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TipContact {
+    /// Free: the tip follows the cursor (game) or its cantilever equilibrium (physical).
+    Free,
+    /// Held by a contact until the pull exceeds the weakest link's pull-off force.
+    Anchored(Anchor),
+}
+
+/// A member–target pair that may not snap again until its gap exceeds the snap gap
+/// (so a released contact does not re-form on the next tick).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Disarm {
+    pub member: Member,
+    /// `None`: the whole substrate.
+    pub target_atom: Option<usize>,
+}
+
+/// The nano world: parameters, derived laws, substrate and state.
+#[derive(Debug, Clone)]
+pub struct World {
+    pub(crate) params: Params,
+    pub(crate) laws: PairLaws,
+    pub(crate) substrate: Substrate,
+    pub(crate) atoms: Vec<MovableAtom>,
+    pub(crate) carried: Vec<usize>,
+    pub(crate) cursor: Vector3<f64>,
+    pub(crate) tip: Vector3<f64>,
+    pub(crate) contact: TipContact,
+    pub(crate) disarmed: Vec<Disarm>,
+    pub(crate) history: [Option<Vector3<f64>>; 2],
+    pub(crate) tick: u64,
+    pub(crate) time_s: f64,
+    pub(crate) house: HouseStatus,
+}
+
+impl World {
+    /// Build a world from validated parameters; the tip starts free at `start_m`.
+    pub fn new(params: Params, start_m: Vector3<f64>) -> Result<World, ParamError> {
+        params.validate()?;
+        for (k, v) in start_m.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(ParamError::range(
+                    format!("start_m[{k}]"),
+                    *v,
+                    "a finite number of metres",
+                ));
+            }
+        }
+        let laws = PairLaws::from_params(&params);
+        let substrate = Substrate::new(&params.substrate, substrate_reach(&params, &laws));
+        let mut w = World {
+            laws,
+            substrate,
+            atoms: Vec::new(),
+            carried: Vec::new(),
+            cursor: start_m,
+            tip: start_m,
+            contact: TipContact::Free,
+            disarmed: Vec::new(),
+            history: [None, None],
+            tick: 0,
+            time_s: 0.0,
+            house: HouseStatus::new(params.house.as_ref()),
+            params,
+        };
+        let xy = w.params.initial_atoms_xy_m.clone();
+        for a in xy {
+            let p = w.rest_position(a);
+            w.atoms.push(MovableAtom {
+                position: p,
+                carried_offset: None,
+                on_substrate: true,
+                bonds: Vec::new(),
+            });
+        }
+        // Initial atoms that touch are bonded.
+        let touch =
+            2.0 * w.params.atoms.radius_m + w.contact_gap() + 1e-6 * w.params.atoms.radius_m;
+        for i in 0..w.atoms.len() {
+            for j in 0..i {
+                if (w.atoms[i].position - w.atoms[j].position).norm() <= touch {
+                    w.atoms[i].bonds.push(j);
+                    w.atoms[j].bonds.push(i);
+                }
+            }
+        }
+        for a in &mut w.atoms {
+            a.bonds.sort_unstable();
+        }
+        let mut ev = Vec::new();
+        w.update_house(&mut ev);
+        Ok(w)
+    }
+
+    /// Replace the parameters at run time. Strengths, stiffnesses, pull-off ratio, masses,
+    /// gravity, inertia, force limit, loading zone and house may change; the mode and the
+    /// geometry (substrate, radii, contact gap) may not.
+    pub fn set_params(&mut self, params: Params) -> Result<(), ParamError> {
+        params.validate()?;
+        let old = &self.params;
+        if params.substrate != old.substrate {
+            return Err(ParamError::NotChangeableAtRunTime { field: "substrate" });
+        }
+        if params.tip.radius_m != old.tip.radius_m {
+            return Err(ParamError::NotChangeableAtRunTime {
+                field: "tip.radius_m",
+            });
+        }
+        if params.atoms.radius_m != old.atoms.radius_m {
+            return Err(ParamError::NotChangeableAtRunTime {
+                field: "atoms.radius_m",
+            });
+        }
+        match (&params.interaction, &old.interaction) {
+            (Interaction::Game(_), Interaction::Game(_)) => {}
+            (Interaction::Physical(a), Interaction::Physical(b)) => {
+                if a.contact_gap_m != b.contact_gap_m {
+                    return Err(ParamError::NotChangeableAtRunTime {
+                        field: "interaction.physical.contact_gap_m",
+                    });
+                }
+            }
+            _ => {
+                return Err(ParamError::NotChangeableAtRunTime {
+                    field: "interaction (game/physical mode)",
+                });
+            }
+        }
+        let laws = PairLaws::from_params(&params);
+        // The cell list must cover the new reach (activation gaps may grow).
+        let reach = substrate_reach(&params, &laws);
+        if reach > self.substrate.cell_m() {
+            self.substrate = Substrate::new(&params.substrate, reach);
+        }
+        self.house.reset_blueprint(params.house.as_ref());
+        self.params = params;
+        self.laws = laws;
+        Ok(())
+    }
+
+    /// Advance one tick of length `dt_s` (s) with the cursor at `input`.
+    pub fn step(&mut self, input: &TipInput, dt_s: f64) -> Result<StepReport, StepError> {
+        for (k, v) in input.position_m.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(StepError::NonFinitePosition {
+                    axis: ['x', 'y', 'z'][k],
+                    value: *v,
+                });
+            }
+        }
+        if !(dt_s > 0.0 && dt_s <= 1.0) {
+            return Err(StepError::BadDt(dt_s));
+        }
+        let mut events = Vec::new();
+        self.tick += 1;
+        self.time_s += dt_s;
+        let prev = self.history;
+        self.history = [Some(self.cursor), prev[0]];
+        self.cursor = input.position_m;
+        let load = self.load(dt_s);
+
+        self.maybe_spawn(&mut events);
+        if let TipContact::Anchored(a) = self.contact {
+            self.maybe_release(&a, &mut events);
+        }
+        if self.contact == TipContact::Free {
+            if self.laws.physical {
+                self.free_physical(load, &mut events);
+            } else {
+                self.free_game(&mut events);
+            }
+        }
+        let unlimited = match self.contact {
+            TipContact::Anchored(a) => {
+                self.laws.get(a.pair).stiffness_n_per_m * (a.tip_position_m - self.cursor)
+            }
+            TipContact::Free => {
+                if self.laws.physical {
+                    self.laws.get(PairKind::TipSubstrate).stiffness_n_per_m
+                        * (self.tip - self.cursor)
+                } else {
+                    self.assembly_force_game(self.tip) + load
+                }
+            }
+        };
+        self.update_house(&mut events);
+        let max = self.params.max_force_n;
+        let norm = unlimited.norm();
+        let (force, saturated) = if norm > max {
+            (unlimited * (max / norm), true)
+        } else {
+            (unlimited, false)
+        };
+        Ok(StepReport {
+            force_n: force,
+            unlimited_force_n: unlimited,
+            saturated,
+            events,
+        })
+    }
+
+    /// Weight and inertial force on the carried atoms (N).
+    fn load(&self, dt_s: f64) -> Vector3<f64> {
+        let m = self.params.atoms.mass_kg * self.carried.len() as f64;
+        if m == 0.0 {
+            return Vector3::zeros();
+        }
+        let mut f = Vector3::new(0.0, 0.0, -m * self.params.gravity_m_s2);
+        if self.params.inertia
+            && let [Some(c1), Some(c2)] = self.history
+        {
+            let a = (self.cursor - 2.0 * c1 + c2) / (dt_s * dt_s);
+            f -= m * a;
+        }
+        f
+    }
+
+    fn maybe_spawn(&mut self, events: &mut Vec<Event>) {
+        let Some(zone) = self.params.loading_zone.clone() else {
+            return;
+        };
+        if self.atoms.len() >= self.params.atoms.max_count || !in_zone(&zone, &self.cursor) {
+            return;
+        }
+        if self
+            .atoms
+            .iter()
+            .any(|a| !a.is_carried() && in_zone(&zone, &a.position))
+        {
+            return;
+        }
+        // The new atom must appear out of reach of every other body, so that spawning
+        // never snaps anything on the tick it happens.
+        let p = self.rest_position(zone.spawn_xy_m);
+        let ra = self.params.atoms.radius_m;
+        let clear = 2.0 * ra + self.laws.get(PairKind::AtomAtom).reach_m();
+        if self.atoms.iter().any(|a| (a.position - p).norm() < clear) {
+            return;
+        }
+        let tip_clear = self.params.tip.radius_m + ra + self.laws.get(PairKind::TipAtom).reach_m();
+        if (self.tip - p).norm() < tip_clear {
+            return;
+        }
+        self.atoms.push(MovableAtom {
+            position: p,
+            carried_offset: None,
+            on_substrate: true,
+            bonds: Vec::new(),
+        });
+        events.push(Event::AtomSpawned {
+            atom: self.atoms.len() - 1,
+        });
+    }
+
+    /// Centre of a movable atom resting on the substrate at `xy` (m).
+    pub fn rest_position(&self, xy: [f64; 2]) -> Vector3<f64> {
+        let r = self.params.atoms.radius_m;
+        let rs = self.substrate.radius_m();
+        if self.laws.physical {
+            return Vector3::new(xy[0], xy[1], rs + self.contact_gap() + r);
+        }
+        let reach = r + rs;
+        let probe = Vector3::new(xy[0], xy[1], 0.0);
+        let mut z = r;
+        self.substrate.for_each_within(&probe, reach, |_, q| {
+            let d2 = (q.x - xy[0]).powi(2) + (q.y - xy[1]).powi(2);
+            z = z.max(q.z + (reach * reach - d2).max(0.0).sqrt());
+        });
+        Vector3::new(xy[0], xy[1], z)
+    }
+
+    pub(crate) fn contact_gap(&self) -> f64 {
+        self.laws.get(PairKind::AtomAtom).contact_gap_m
+    }
+
+    pub(crate) fn member_pos_radius(&self, m: Member) -> (Vector3<f64>, f64) {
+        match m {
+            Member::Tip => (self.tip, self.params.tip.radius_m),
+            Member::Atom(i) => (self.atoms[i].position, self.params.atoms.radius_m),
+        }
+    }
+
+    /// Members of the tip assembly: the tip, then carried atoms in ascending index order.
+    pub(crate) fn members(&self) -> impl Iterator<Item = Member> + '_ {
+        std::iter::once(Member::Tip).chain(self.carried.iter().map(|&i| Member::Atom(i)))
+    }
+
+    /// Move the tip and its carried atoms so the tip centre is at `p`.
+    pub(crate) fn place_tip(&mut self, p: Vector3<f64>) {
+        self.tip = p;
+        for &i in &self.carried {
+            if let Some(o) = self.atoms[i].carried_offset {
+                self.atoms[i].position = p + o;
+            }
+        }
+    }
+
+    /// Pull-off force holding an uncarried atom where it is (N): the strongest of its bonds.
+    pub(crate) fn binding(&self, i: usize) -> f64 {
+        let a = &self.atoms[i];
+        let mut b: f64 = 0.0;
+        if a.on_substrate {
+            b = b.max(self.laws.get(PairKind::AtomSubstrate).pull_off_n);
+        }
+        if !a.bonds.is_empty() {
+            b = b.max(self.laws.get(PairKind::AtomAtom).pull_off_n);
+        }
+        b
+    }
+
+    // ---- read access -------------------------------------------------------------------
+
+    /// The parameters in force.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+    /// The derived pair laws (snap gaps, snap and pull-off forces, stiffnesses).
+    pub fn laws(&self) -> &PairLaws {
+        &self.laws
+    }
+    /// The substrate atoms.
+    pub fn substrate(&self) -> &Substrate {
+        &self.substrate
+    }
+    /// The movable atoms, by index.
+    pub fn atoms(&self) -> &[MovableAtom] {
+        &self.atoms
+    }
+    /// Indices of the carried atoms, ascending.
+    pub fn carried(&self) -> &[usize] {
+        &self.carried
+    }
+    /// Tip (apex) centre (m).
+    pub fn tip_position_m(&self) -> Vector3<f64> {
+        self.tip
+    }
+    /// Tip apex radius (m).
+    pub fn tip_radius_m(&self) -> f64 {
+        self.params.tip.radius_m
+    }
+    /// Movable atom radius (m).
+    pub fn atom_radius_m(&self) -> f64 {
+        self.params.atoms.radius_m
+    }
+    /// Last cursor position (m).
+    pub fn cursor_m(&self) -> Vector3<f64> {
+        self.cursor
+    }
+    /// The tip's contact state.
+    pub fn tip_contact(&self) -> TipContact {
+        self.contact
+    }
+    /// The loading zone, if any.
+    pub fn loading_zone(&self) -> Option<&LoadingZone> {
+        self.params.loading_zone.as_ref()
+    }
+    /// Blueprint slots, their fill state and the score.
+    pub fn house(&self) -> &HouseStatus {
+        &self.house
+    }
+    /// Ticks stepped so far.
+    pub fn tick(&self) -> u64 {
+        self.tick
+    }
+    /// Simulated time: the sum of all tick lengths (s).
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+}
+
+fn in_zone(z: &LoadingZone, p: &Vector3<f64>) -> bool {
+    p.x >= z.min_xy_m[0] && p.x <= z.max_xy_m[0] && p.y >= z.min_xy_m[1] && p.y <= z.max_xy_m[1]
+}
+
+/// Largest centre distance at which anything interacts with a substrate atom (m).
+fn substrate_reach(p: &Params, laws: &PairLaws) -> f64 {
+    let rs = p.substrate.atom_radius_m;
+    let reach = |r: f64, k: PairKind| {
+        let l = laws.get(k);
+        let g = if l.cutoff_gap_m.is_finite() {
+            l.cutoff_gap_m
+        } else {
+            l.snap_gap_m
+        };
+        r + rs + g.max(l.snap_gap_m)
+    };
+    reach(p.tip.radius_m, PairKind::TipSubstrate)
+        .max(reach(p.atoms.radius_m, PairKind::AtomSubstrate))
+}

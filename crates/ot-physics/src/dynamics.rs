@@ -1,0 +1,164 @@
+//! Right-hand sides: the equations of motion and their variational
+//! equations, for the effects a [`TrapModel`] switched on.
+
+use crate::model::TrapModel;
+use crate::state::{OdeSystem, Phase, PhaseVar};
+use nalgebra::{SMatrix, SVector};
+
+/// Which equations of motion a model needs, with its coefficients
+/// precomputed (no division or option test per evaluation).
+#[derive(Debug, Clone, Copy)]
+enum Kind {
+    /// `v̇ = (F + F_ext)/m`.
+    Conservative { inv_mass: f64 },
+    /// `v̇ = (F + F_ext)/m − (γ/m) v`.
+    Damped { inv_mass: f64, rate: f64 },
+    /// `ṙ = (F + F_ext)/γ`.
+    Overdamped { inv_drag: f64 },
+}
+
+impl Kind {
+    fn of<const D: usize>(m: &TrapModel<D>) -> Self {
+        match (m.mass, m.drag) {
+            (Some(mass), None) => Self::Conservative {
+                inv_mass: 1.0 / mass,
+            },
+            (Some(mass), Some(g)) => Self::Damped {
+                inv_mass: 1.0 / mass,
+                rate: g / mass,
+            },
+            // A validated model without mass has drag.
+            (None, g) => Self::Overdamped {
+                inv_drag: 1.0 / g.unwrap_or(f64::INFINITY),
+            },
+        }
+    }
+}
+
+/// Deterministic equations of motion (noise is handled by `langevin`).
+///
+/// With inertia: `ṙ = v`, `v̇ = (F(r) − γv + F_ext)/m`. Overdamped:
+/// `ṙ = (F(r) + F_ext)/γ` with `v̇ = 0` (the velocity slot is unused).
+#[derive(Debug, Clone, Copy)]
+pub struct Dynamics<'a, const D: usize> {
+    model: &'a TrapModel<D>,
+    kind: Kind,
+}
+
+/// The equations of motion together with their variational equations.
+#[derive(Debug, Clone, Copy)]
+pub struct Variational<'a, const D: usize> {
+    model: &'a TrapModel<D>,
+    kind: Kind,
+}
+
+impl<'a, const D: usize> Dynamics<'a, D> {
+    /// The equations of motion of `model`.
+    pub fn new(model: &'a TrapModel<D>) -> Self {
+        Self {
+            model,
+            kind: Kind::of(model),
+        }
+    }
+}
+
+impl<'a, const D: usize> Variational<'a, D> {
+    /// The variational equations of `model`.
+    pub fn new(model: &'a TrapModel<D>) -> Self {
+        Self {
+            model,
+            kind: Kind::of(model),
+        }
+    }
+}
+
+/// Largest step (s) that cannot carry the particle across the well unseen.
+///
+/// Inside six largest waists of the centre (where the force exceeds 1e-11 of
+/// its peak) a step may move the particle by at most half the smallest
+/// waist; outside, moving away, there is no limit; outside, approaching, a
+/// step may reach the edge of that region but not beyond.
+#[inline]
+fn crossing_limit<const D: usize>(model: &TrapModel<D>, y: &Phase<D>) -> f64 {
+    let speed = y.v.norm();
+    if model.mass.is_none() || speed == 0.0 {
+        return f64::INFINITY;
+    }
+    let reach = 6.0 * model.well.waists().max();
+    let dist = y.r.norm();
+    if dist > reach && y.r.dot(&y.v) >= 0.0 {
+        return f64::INFINITY;
+    }
+    (0.5 * model.length_scale()).max(dist - reach) / speed
+}
+
+impl<const D: usize> OdeSystem for Dynamics<'_, D> {
+    type State = Phase<D>;
+    #[inline]
+    fn max_step(&self, y: &Phase<D>) -> f64 {
+        crossing_limit(self.model, y)
+    }
+    #[inline(always)]
+    fn rhs(&self, y: &Phase<D>) -> Phase<D> {
+        let f = self.model.well.force(&y.r) + self.model.external_force;
+        match self.kind {
+            Kind::Conservative { inv_mass } => Phase {
+                r: y.v,
+                v: f * inv_mass,
+            },
+            Kind::Damped { inv_mass, rate } => Phase {
+                r: y.v,
+                v: f * inv_mass - y.v * rate,
+            },
+            Kind::Overdamped { inv_drag } => Phase {
+                r: f * inv_drag,
+                v: SVector::zeros(),
+            },
+        }
+    }
+}
+
+impl<const D: usize> OdeSystem for Variational<'_, D> {
+    type State = PhaseVar<D>;
+    #[inline]
+    fn max_step(&self, y: &PhaseVar<D>) -> f64 {
+        crossing_limit(self.model, &y.p)
+    }
+    #[inline(always)]
+    fn rhs(&self, y: &PhaseVar<D>) -> PhaseVar<D> {
+        let (fw, h) = self.model.well.force_and_gradient(&y.p.r);
+        let f = fw + self.model.external_force;
+        match self.kind {
+            Kind::Conservative { inv_mass } => PhaseVar {
+                p: Phase {
+                    r: y.p.v,
+                    v: f * inv_mass,
+                },
+                jrr: y.jvr,
+                jrv: y.jvv,
+                jvr: (h * y.jrr) * inv_mass,
+                jvv: (h * y.jrv) * inv_mass,
+            },
+            Kind::Damped { inv_mass, rate } => PhaseVar {
+                p: Phase {
+                    r: y.p.v,
+                    v: f * inv_mass - y.p.v * rate,
+                },
+                jrr: y.jvr,
+                jrv: y.jvv,
+                jvr: (h * y.jrr) * inv_mass - y.jvr * rate,
+                jvv: (h * y.jrv) * inv_mass - y.jvv * rate,
+            },
+            Kind::Overdamped { inv_drag } => PhaseVar {
+                p: Phase {
+                    r: f * inv_drag,
+                    v: SVector::zeros(),
+                },
+                jrr: (h * y.jrr) * inv_drag,
+                jrv: (h * y.jrv) * inv_drag,
+                jvr: SMatrix::zeros(),
+                jvv: SMatrix::zeros(),
+            },
+        }
+    }
+}

@@ -1,0 +1,85 @@
+//! Typed errors for every parameter the crate accepts.
+
+use thiserror::Error;
+
+/// A bad parameter or an unsupported combination of effects and method.
+///
+/// Every variant names the offending field and, where it applies, the range
+/// that would have been accepted, so callers (scene files, the Python wheel)
+/// can show the message unchanged.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PhysicsError {
+    /// A number lies outside its allowed range (or is NaN / infinite).
+    #[error("{field} = {value:e} is out of range: allowed {allowed}")]
+    OutOfRange {
+        /// Name of the parameter, with its unit (e.g. `waist_x [m]`).
+        field: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// Human-readable allowed range, e.g. `finite and > 0`.
+        allowed: &'static str,
+    },
+    /// An effect was switched on without a parameter it needs.
+    #[error("{field} is required by {needed_by}")]
+    Missing {
+        /// The missing parameter.
+        field: &'static str,
+        /// The effect or method that needs it.
+        needed_by: &'static str,
+    },
+    /// The chosen integrator cannot handle the model's effects.
+    #[error("method {method} cannot integrate this model: {reason}")]
+    Unsupported {
+        /// The integrator name as users type it.
+        method: &'static str,
+        /// Why not, and what to use instead.
+        reason: &'static str,
+    },
+    /// An array has the wrong length.
+    #[error("{field} has length {got}: expected {expected}")]
+    Length {
+        /// The argument.
+        field: &'static str,
+        /// What was expected, e.g. `1 or 1000`.
+        expected: String,
+        /// What was given.
+        got: usize,
+    },
+    /// An unknown method name.
+    #[error("unknown method {name:?}: allowed {allowed}")]
+    UnknownMethod {
+        /// What was asked for.
+        name: String,
+        /// The accepted names.
+        allowed: &'static str,
+    },
+}
+
+/// Result alias used across the crate.
+pub type Result<T> = std::result::Result<T, PhysicsError>;
+
+/// Check that `value` is finite and strictly positive.
+pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(PhysicsError::OutOfRange {
+            field,
+            value,
+            allowed: "finite and > 0",
+        })
+    }
+}
+
+/// Check that `value` is finite (any sign).
+pub(crate) fn finite(field: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(PhysicsError::OutOfRange {
+            field,
+            value,
+            allowed: "finite",
+        })
+    }
+}

@@ -1,0 +1,360 @@
+//! Named integration methods and the [`Propagator`] that applies one to a
+//! [`TrapModel`] over a fixed interval.
+//!
+//! | name          | method                                   | order | evals per (sub)step |
+//! |---------------|------------------------------------------|-------|---------------------|
+//! | `paper-rk4`   | ONE classical RK4 step per Δt (the paper) | 4     | 4                   |
+//! | `rk4`         | classical RK4, `n` equal substeps         | 4     | 4                   |
+//! | `rk8`         | DOP853's 8th-order formula, `n` substeps  | 8     | 12                  |
+//! | `dopri5`      | Dormand–Prince 5(4), error control        | 5     | 6 (FSAL)            |
+//! | `adaptive`    | DOP853 8(5,3), error control (default)    | 8     | 12                  |
+//! | `symplectic`  | Störmer–Verlet, `n` substeps              | 2     | 1                   |
+//! | `yoshida4`    | Yoshida triple-jump of Verlet             | 4     | 3                   |
+//! | `yoshida6`    | Yoshida 6th-order composition             | 6     | 9                   |
+//!
+//! Thermal noise is integrated by [`crate::langevin`], not here.
+
+mod dop853;
+mod dopri5;
+mod rk4;
+mod symplectic;
+
+pub use dop853::{dop853, rk8};
+pub use dopri5::dopri5;
+pub use rk4::{rk4, rk4_step};
+pub use symplectic::{Composition, symplectic};
+
+use crate::dynamics::{Dynamics, Variational};
+use crate::error::{PhysicsError, Result, positive};
+use crate::model::TrapModel;
+use crate::state::{Phase, PhaseVar, Tolerance};
+
+/// Default relative tolerance of the adaptive methods: reaches ≤ 0.01 nm on
+/// the paper problem (see BENCHMARKS.md).
+pub const DEFAULT_RTOL: f64 = 1e-7;
+
+/// An integration method, as users name it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Exactly the paper's difference equation: one RK4 step of length Δt.
+    PaperRk4,
+    /// Classical RK4 with `substeps` equal steps per Δt.
+    Rk4 {
+        /// Number of substeps (≥ 1).
+        substeps: u32,
+    },
+    /// DOP853's 8th-order formula with `substeps` equal steps, no error
+    /// control (12 evaluations per step).
+    Rk8 {
+        /// Number of substeps (≥ 1).
+        substeps: u32,
+    },
+    /// Dormand–Prince 5(4) with error control.
+    Dopri5 {
+        /// Relative tolerance (dimensionless; absolute scales are the
+        /// smallest waist and waist × fastest rate).
+        rtol: f64,
+    },
+    /// DOP853 with error control: the default.
+    Adaptive {
+        /// Relative tolerance, as for [`Method::Dopri5`].
+        rtol: f64,
+    },
+    /// A symplectic composition with `substeps` equal steps per Δt
+    /// (conservative models only).
+    Symplectic {
+        /// Number of substeps (≥ 1).
+        substeps: u32,
+        /// Which composition.
+        composition: Composition,
+    },
+}
+
+impl Default for Method {
+    fn default() -> Self {
+        Self::Adaptive { rtol: DEFAULT_RTOL }
+    }
+}
+
+/// Accepted method names.
+pub const METHOD_NAMES: &str = "\"paper-rk4\", \"rk4\", \"rk8\", \"dopri5\", \"adaptive\", \"symplectic\", \"yoshida4\", \"yoshida6\"";
+
+impl Method {
+    /// Build a method from its name, with optional tolerance and substeps
+    /// (defaults: `rtol` = [`DEFAULT_RTOL`], 16 substeps).
+    pub fn from_name(name: &str, rtol: Option<f64>, substeps: Option<u32>) -> Result<Self> {
+        let rtol = rtol.unwrap_or(DEFAULT_RTOL);
+        let n = substeps.unwrap_or(16);
+        let m = match name {
+            "paper-rk4" => Self::PaperRk4,
+            "rk4" => Self::Rk4 { substeps: n },
+            "rk8" => Self::Rk8 {
+                substeps: substeps.unwrap_or(3),
+            },
+            "dopri5" => Self::Dopri5 { rtol },
+            "adaptive" | "dop853" => Self::Adaptive { rtol },
+            "symplectic" | "verlet" => Self::Symplectic {
+                substeps: n,
+                composition: Composition::Verlet,
+            },
+            "yoshida4" => Self::Symplectic {
+                substeps: n,
+                composition: Composition::Yoshida4,
+            },
+            "yoshida6" => Self::Symplectic {
+                substeps: n,
+                composition: Composition::Yoshida6,
+            },
+            _ => {
+                return Err(PhysicsError::UnknownMethod {
+                    name: name.to_string(),
+                    allowed: METHOD_NAMES,
+                });
+            }
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// The method's name as users type it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::PaperRk4 => "paper-rk4",
+            Self::Rk4 { .. } => "rk4",
+            Self::Rk8 { .. } => "rk8",
+            Self::Dopri5 { .. } => "dopri5",
+            Self::Adaptive { .. } => "adaptive",
+            Self::Symplectic { composition, .. } => match composition {
+                Composition::Verlet => "symplectic",
+                Composition::Yoshida4 => "yoshida4",
+                Composition::Yoshida6 => "yoshida6",
+            },
+        }
+    }
+
+    /// Check the method's own parameters.
+    pub fn validate(&self) -> Result<()> {
+        match *self {
+            Self::Rk4 { substeps } | Self::Rk8 { substeps } | Self::Symplectic { substeps, .. } => {
+                if substeps == 0 || substeps > 10_000_000 {
+                    return Err(PhysicsError::OutOfRange {
+                        field: "substeps",
+                        value: f64::from(substeps),
+                        allowed: "1 ..= 10000000",
+                    });
+                }
+            }
+            Self::Dopri5 { rtol } | Self::Adaptive { rtol } => {
+                if !(rtol.is_finite() && (1e-14..=1e-1).contains(&rtol)) {
+                    return Err(PhysicsError::OutOfRange {
+                        field: "rtol",
+                        value: rtol,
+                        allowed: "1e-14 ..= 0.1",
+                    });
+                }
+            }
+            Self::PaperRk4 => {}
+        }
+        Ok(())
+    }
+}
+
+/// Counters of an adaptive integration.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AdaptiveStats {
+    /// Right-hand-side (force) evaluations.
+    pub evals: u64,
+    /// Accepted steps.
+    pub accepted: u64,
+    /// Rejected steps.
+    pub rejected: u64,
+}
+
+/// Step-size controller settings (Hairer's PI controller).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepControl {
+    /// Safety factor (dimensionless).
+    pub safety: f64,
+    /// Smallest step-size ratio.
+    pub fac_min: f64,
+    /// Largest step-size ratio.
+    pub fac_max: f64,
+    /// PI stabilisation exponent β.
+    pub beta: f64,
+    /// Hard limit on steps per interval.
+    pub max_steps: u64,
+}
+
+impl Default for StepControl {
+    fn default() -> Self {
+        Self {
+            safety: 0.9,
+            fac_min: 0.2,
+            fac_max: 10.0,
+            beta: 0.04,
+            max_steps: 1_000_000,
+        }
+    }
+}
+
+impl StepControl {
+    /// Step-size multiplier for error ratio `err` (previous accepted `prev`)
+    /// of a method whose local error is of order `q`.
+    #[inline]
+    pub fn factor(&self, err: f64, prev: f64, q: f64) -> f64 {
+        if err <= 0.0 {
+            return self.fac_max;
+        }
+        let expo = 1.0 / q - 0.75 * self.beta;
+        let f = self.safety * err.powf(-expo) * prev.powf(self.beta);
+        f.clamp(self.fac_min, self.fac_max)
+    }
+}
+
+/// A method bound to a model and an interval Δt, validated once, then
+/// applied to many initial states (the batch and haptic-tick use).
+#[derive(Debug, Clone, Copy)]
+pub struct Propagator<const D: usize> {
+    model: TrapModel<D>,
+    method: Method,
+    dt: f64,
+    tol: Tolerance,
+    h0: f64,
+    ctl: StepControl,
+}
+
+/// Result of one propagation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Propagated<S> {
+    /// The end state.
+    pub end: S,
+    /// Force evaluations spent.
+    pub evals: u64,
+}
+
+impl<const D: usize> Propagator<D> {
+    /// Bind `method` to `model` over `dt` (s). Fails if the method cannot
+    /// integrate the model (thermal noise on; symplectic with drag or
+    /// overdamped) or if `dt` is not finite and > 0.
+    pub fn new(model: TrapModel<D>, method: Method, dt: f64) -> Result<Self> {
+        let dt = positive("dt [s]", dt)?;
+        method.validate()?;
+        if model.kt.is_some() {
+            return Err(PhysicsError::Unsupported {
+                method: method.name(),
+                reason: "thermal noise is on: use langevin::simulate (BAOAB or overdamped)",
+            });
+        }
+        if matches!(method, Method::Symplectic { .. }) && !model.is_conservative() {
+            return Err(PhysicsError::Unsupported {
+                method: method.name(),
+                reason: "symplectic methods need a conservative model (inertia on, no drag)",
+            });
+        }
+        let rate = model.fastest_rate();
+        let l = model.length_scale();
+        let rate_or_dt = if rate > 0.0 { rate } else { 1.0 / dt };
+        let (rtol, q) = match method {
+            Method::Dopri5 { rtol } => (rtol, 5.0),
+            Method::Adaptive { rtol } => (rtol, 8.0),
+            _ => (DEFAULT_RTOL, 4.0),
+        };
+        let tol = Tolerance {
+            rtol,
+            atol_r: rtol * l,
+            atol_v: rtol * l * rate_or_dt,
+        };
+        // First trial step: the local error of order q at rate ω is ~ (ωh)^q.
+        let h0 = (2.0 * rtol.powf(1.0 / q) / rate_or_dt).min(dt);
+        let mut ctl = StepControl::default();
+        if matches!(method, Method::Adaptive { .. }) {
+            ctl.beta = 0.0;
+            ctl.fac_min = 0.333;
+            ctl.fac_max = 6.0;
+        }
+        Ok(Self {
+            model,
+            method,
+            dt,
+            tol,
+            h0,
+            ctl,
+        })
+    }
+
+    /// The bound model.
+    pub fn model(&self) -> &TrapModel<D> {
+        &self.model
+    }
+    /// The bound method.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+    /// The interval (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// Propagate a phase over Δt.
+    pub fn phase(&self, y0: &Phase<D>) -> Result<Propagated<Phase<D>>> {
+        let sys = Dynamics::new(&self.model);
+        let dt = self.dt;
+        let (end, evals) = match self.method {
+            Method::PaperRk4 => (rk4(&sys, y0, dt, 1), 4),
+            Method::Rk4 { substeps } => (rk4(&sys, y0, dt, substeps), 4 * u64::from(substeps)),
+            Method::Rk8 { substeps } => (rk8(&sys, y0, dt, substeps), 12 * u64::from(substeps)),
+            Method::Dopri5 { .. } => {
+                let (y, s) = dopri5(&sys, y0, dt, &self.tol, self.h0, &self.ctl)?;
+                (y, s.evals)
+            }
+            Method::Adaptive { .. } => {
+                let (y, s) = dop853(&sys, y0, dt, &self.tol, self.h0, &self.ctl)?;
+                (y, s.evals)
+            }
+            Method::Symplectic {
+                substeps,
+                composition,
+            } => symplectic(&self.model, y0, dt, substeps, composition),
+        };
+        Ok(Propagated {
+            end: self.finish(end, y0),
+            evals,
+        })
+    }
+
+    /// Overdamped models carry no velocity; report the drift velocity at the end.
+    fn finish(&self, mut end: Phase<D>, _y0: &Phase<D>) -> Phase<D> {
+        if self.model.mass.is_none() {
+            let g = self.model.drag.unwrap_or(f64::INFINITY);
+            end.v = (self.model.well.force(&end.r) + self.model.external_force) / g;
+        }
+        end
+    }
+
+    /// Propagate a phase and its sensitivities over Δt (variational
+    /// equations). Fixed-step methods give the exact derivative of their own
+    /// discrete map; symplectic methods use RK4 with the same substeps for
+    /// the sensitivities.
+    pub fn phase_var(&self, y0: &Phase<D>) -> Result<Propagated<PhaseVar<D>>> {
+        let sys = Variational::new(&self.model);
+        let dt = self.dt;
+        let yv = PhaseVar::identity(*y0);
+        let (mut end, evals) = match self.method {
+            Method::PaperRk4 => (rk4(&sys, &yv, dt, 1), 4),
+            Method::Rk4 { substeps } | Method::Symplectic { substeps, .. } => {
+                (rk4(&sys, &yv, dt, substeps), 4 * u64::from(substeps))
+            }
+            Method::Rk8 { substeps } => (rk8(&sys, &yv, dt, substeps), 12 * u64::from(substeps)),
+            Method::Dopri5 { .. } => {
+                let (y, s) = dopri5(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
+                (y, s.evals)
+            }
+            Method::Adaptive { .. } => {
+                let (y, s) = dop853(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
+                (y, s.evals)
+            }
+        };
+        end.p = self.finish(end.p, y0);
+        Ok(Propagated { end, evals })
+    }
+}
