@@ -11,7 +11,7 @@
 //! println!("{} ticks, peak force {peak} N", report.arrays.tick.len());
 //! ```
 
-use crate::device::script::Script;
+use crate::device::script::{OperatorKind, Script};
 use crate::device::{
     DeviceError, DeviceModel, HapticDevice, OperatorParams, ScriptError, ScriptedDevice,
     SimulatedOperator, TickTime,
@@ -102,7 +102,8 @@ pub enum OperatorChoice {
     Rigid,
     /// A simulated hand follows the script and is pushed by the rendered force.
     Hand(OperatorParams),
-    /// A hand with the script's `[operator]` parameters (or the defaults).
+    /// As the script says (`[script] operator`): a hand with its `[operator]` parameters (or
+    /// the defaults), or a rigid stylus.
     ScriptHand,
 }
 
@@ -437,6 +438,10 @@ pub fn run_session(
                 format!("{p:?}"),
             )
         }
+        OperatorChoice::ScriptHand if script.operator_kind == OperatorKind::Rigid => (
+            Box::new(ScriptedDevice::new(script.clone(), specs.clone())),
+            "rigid".into(),
+        ),
         OperatorChoice::ScriptHand => {
             let p = script.operator.unwrap_or_default();
             (

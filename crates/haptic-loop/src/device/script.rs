@@ -10,6 +10,7 @@
 //! [script]
 //! name = "press the wall"
 //! duration_s = 3.0            # optional; default: the last waypoint or button time
+//! operator = "hand"           # optional: "hand" (default) or "rigid", when the caller leaves it
 //!
 //! [operator]                  # optional: parameters of the simulated operator's hand
 //! mass_kg = 0.3
@@ -76,6 +77,19 @@ struct ScriptHeader {
     name: String,
     #[serde(default)]
     duration_s: Option<f64>,
+    #[serde(default)]
+    operator: OperatorKind,
+}
+
+/// How a script wants to be played when the caller does not choose (`[script] operator`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OperatorKind {
+    /// Through the simulated hand (parameters from `[operator]` or the defaults).
+    #[default]
+    Hand,
+    /// Exactly, by a rigid stylus (e.g. a path that must be followed to a fraction of an atom).
+    Rigid,
 }
 
 #[derive(Deserialize)]
@@ -126,6 +140,8 @@ pub struct Script {
     pub buttons: Vec<ButtonEvent>,
     /// Operator hand parameters given by the script, if any.
     pub operator: Option<OperatorParams>,
+    /// How the script wants to be played by default.
+    pub operator_kind: OperatorKind,
 }
 
 fn check(field: String, value: f64, ok: bool, allowed: &str) -> Result<(), ScriptError> {
@@ -245,6 +261,7 @@ impl Script {
             waypoints,
             buttons,
             operator: file.operator,
+            operator_kind: file.script.operator,
         })
     }
 

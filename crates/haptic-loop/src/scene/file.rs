@@ -4,7 +4,7 @@
 //! ```toml
 //! [scene]
 //! name = "stiff wall"
-//! kind = "wall"                        # which world: "wall"
+//! kind = "wall"                        # which world: "wall", "nanoworld"
 //! default_script = "wall-press.script.toml"   # relative to the scene file
 //!
 //! [device]
@@ -28,6 +28,7 @@
 //! ```
 
 use super::Scene;
+use super::nano::{NanoScene, NanoSection};
 use super::wall::{WallParams, WallScene};
 use crate::device::{DeviceModel, DeviceSpecs};
 use crate::haptic::{LoopConfig, Mapping};
@@ -224,10 +225,13 @@ pub struct SceneFile {
     /// `[wall]`: parameters of the wall scene.
     #[serde(default)]
     pub wall: Option<WallParams>,
+    /// `[nanoworld]`: the nano world (crate `nanoworld`).
+    #[serde(default)]
+    pub nanoworld: Option<NanoSection>,
 }
 
 /// The world kinds this build knows.
-pub const KINDS: &[&str] = &["wall"];
+pub const KINDS: &[&str] = &["wall", "nanoworld"];
 
 impl SceneFile {
     /// Parses a scene file's text (no validation of ranges yet).
@@ -303,6 +307,10 @@ pub fn load_scene(text: &str, device: Option<DeviceModel>) -> Result<LoadedScene
             let p = file.wall.clone().ok_or_else(|| missing("wall"))?;
             Box::new(WallScene::new(p, cap, dt)?)
         }
+        "nanoworld" => {
+            let p = file.nanoworld.clone().ok_or_else(|| missing("nanoworld"))?;
+            Box::new(NanoScene::new(p, cap, dt)?)
+        }
         other => {
             return Err(SceneError::Kind {
                 kind: other.to_string(),
@@ -367,7 +375,7 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&WALL.replace("kind = \"wall\"", "kind = \"moon\"")),
-            "scene: `scene.kind` = \"moon\" is not a known world (allowed: wall)"
+            "scene: `scene.kind` = \"moon\" is not a known world (allowed: wall, nanoworld)"
         );
         assert!(
             err(&format!("{WALL}[device]\nmodel = \"phantom\"\n"))

@@ -6,6 +6,7 @@
 //! fields) and the primitives a renderer draws.
 
 pub mod file;
+pub mod nano;
 pub mod wall;
 
 use crate::device::Buttons;
