@@ -60,11 +60,12 @@ impl<const D: usize> GaussianWell<D> {
     /// `exp(-ln2 Σ r_i²/w_i²)`, in [0, 1].
     #[inline(always)]
     fn envelope(&self, r: &SVector<f64, D>) -> f64 {
-        let r = &r.data.0[0];
-        let mut q = 0.0;
-        for i in 0..D {
-            q += self.k[i] * r[i] * r[i];
-        }
+        let q: f64 = self
+            .k
+            .iter()
+            .zip(&r.data.0[0])
+            .map(|(k, x)| k * x * x)
+            .sum();
         crate::fastexp::exp(-q)
     }
 
@@ -80,8 +81,8 @@ impl<const D: usize> GaussianWell<D> {
         let s = -2.0 * self.depth * e;
         let ra = &r.data.0[0];
         let mut f = [0.0; D];
-        for i in 0..D {
-            f[i] = s * self.k[i] * ra[i];
+        for ((fi, k), x) in f.iter_mut().zip(&self.k).zip(ra) {
+            *fi = s * k * x;
         }
         SVector::from(f)
     }
