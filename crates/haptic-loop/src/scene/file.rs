@@ -4,7 +4,7 @@
 //! ```toml
 //! [scene]
 //! name = "stiff wall"
-//! kind = "wall"                        # which world: "wall", "nanoworld"
+//! kind = "wall"                        # which world: "wall", "nanoworld", "brickworld"
 //! default_script = "wall-press.script.toml"   # relative to the scene file
 //!
 //! [device]
@@ -28,6 +28,7 @@
 //! ```
 
 use super::Scene;
+use super::brick::{BrickScene, BrickSection};
 use super::nano::{NanoScene, NanoSection};
 use super::wall::{WallParams, WallScene};
 use crate::device::{DeviceModel, DeviceSpecs};
@@ -228,10 +229,13 @@ pub struct SceneFile {
     /// `[nanoworld]`: the nano world (crate `nanoworld`).
     #[serde(default)]
     pub nanoworld: Option<NanoSection>,
+    /// `[brickworld]`: the macro world (crate `brickworld`).
+    #[serde(default)]
+    pub brickworld: Option<BrickSection>,
 }
 
 /// The world kinds this build knows.
-pub const KINDS: &[&str] = &["wall", "nanoworld"];
+pub const KINDS: &[&str] = &["wall", "nanoworld", "brickworld"];
 
 impl SceneFile {
     /// Parses a scene file's text (no validation of ranges yet).
@@ -311,6 +315,20 @@ pub fn load_scene(text: &str, device: Option<DeviceModel>) -> Result<LoadedScene
             let p = file.nanoworld.clone().ok_or_else(|| missing("nanoworld"))?;
             Box::new(NanoScene::new(p, cap, dt)?)
         }
+        "brickworld" => {
+            let p = file
+                .brickworld
+                .clone()
+                .ok_or_else(|| missing("brickworld"))?;
+            let fmax = config.specs.max_force_n / config.mapping.force_scale;
+            Box::new(BrickScene::new(
+                p,
+                cap,
+                fmax,
+                dt,
+                config.specs.button_names,
+            )?)
+        }
         other => {
             return Err(SceneError::Kind {
                 kind: other.to_string(),
@@ -375,7 +393,7 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&WALL.replace("kind = \"wall\"", "kind = \"moon\"")),
-            "scene: `scene.kind` = \"moon\" is not a known world (allowed: wall, nanoworld)"
+            "scene: `scene.kind` = \"moon\" is not a known world (allowed: wall, nanoworld, brickworld)"
         );
         assert!(
             err(&format!("{WALL}[device]\nmodel = \"phantom\"\n"))

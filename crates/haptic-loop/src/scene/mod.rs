@@ -5,6 +5,7 @@
 //! the force on the cursor (world frame, N), events, and on request its state (named f64
 //! fields) and the primitives a renderer draws.
 
+pub mod brick;
 pub mod file;
 pub mod nano;
 pub mod wall;
