@@ -149,6 +149,17 @@ fn main() {
     );
     plot_wall(&figs.join("haptic-loop-wall.png"), &pen, a);
 
+    // 5. Every world scene with its default script, logging on.
+    let mut worlds = Vec::new();
+    for name in ["nanoworld", "brickworld"] {
+        let src = SceneSource::from_path(&root.join(format!("scenes/{name}.toml"))).unwrap();
+        let mut o = SessionOptions::new(src);
+        o.out = Some(tmp.join(format!("{name}.mcap")));
+        let r = run_session(&o, &mut |_, _| {}).unwrap();
+        let rec = read_recording_file(o.out.as_ref().unwrap(), false).unwrap();
+        let ok = verify(&rec).unwrap().ok();
+        worlds.push((name, r, ok));
+    }
     let load_end = load();
     // Report.
     let row = |name: &str, s: &Percentiles| {
@@ -201,6 +212,16 @@ fn main() {
         &rt.stats,
         &rt.arrays.compute_ns,
     );
+    for (name, r, _) in &worlds {
+        md += &row2(
+            &format!(
+                "{name}, default script ({:.1} s), batch, logging on",
+                r.stats.ticks as f64 / 1e3
+            ),
+            &r.stats,
+            &r.arrays.compute_ns,
+        );
+    }
     let _ = writeln!(
         md,
         "\nReal-time pacing (20 s): start jitter p99 {:.1} µs, max {:.1} µs; {} missed deadlines \
@@ -253,6 +274,26 @@ fn main() {
         v.ticks as f64 / replay_s,
         replay_s
     );
+    let _ = writeln!(
+        md,
+        "| scene | MCAP kB per minute | replay bit-exact |\n|---|---|---|"
+    );
+    let _ = writeln!(
+        md,
+        "| wall (60 s) | {:.0} | {} |",
+        bytes_per_min / 1e3,
+        v.ok()
+    );
+    for (name, r, ok) in &worlds {
+        let w = r.written.as_ref().unwrap();
+        let _ = writeln!(
+            md,
+            "| {name} ({:.1} s) | {:.0} | {ok} |",
+            r.stats.ticks as f64 / 1e3,
+            w.bytes as f64 / 1e3 * 60.0 / (r.stats.ticks as f64 / 1e3)
+        );
+    }
+    let _ = writeln!(md);
     let _ = writeln!(
         md,
         "Accuracy of the rendered force (rigid stylus pushed 21 mm into a 5000 N/m wall):\n"
