@@ -419,6 +419,24 @@ fn thermal_validation() -> Result<String, BoxError> {
     Ok(s)
 }
 
+/// A fixed, distinguishable colour per method family (peers in black/grey).
+fn family_color(family: &str, i: usize) -> RGBAColor {
+    let rgb = match family {
+        "paper-rk4" => RGBColor(220, 20, 60),
+        "rk4" => RGBColor(46, 139, 87),
+        "rk8" => RGBColor(30, 90, 220),
+        "dopri5" => RGBColor(0, 170, 200),
+        "adaptive" => RGBColor(255, 140, 0),
+        "symplectic" => RGBColor(138, 43, 226),
+        "yoshida4" => RGBColor(230, 60, 200),
+        "yoshida6" => RGBColor(150, 90, 40),
+        "ode_solvers Dop853" => RGBColor(0, 0, 0),
+        "scipy DOP853" => RGBColor(140, 140, 140),
+        _ => return Palette99::pick(i).to_rgba(),
+    };
+    rgb.to_rgba()
+}
+
 fn plot(ours: &[Row], peer: &[Row], scipy: Option<&Scipy>, path: &Path) -> Result<(), BoxError> {
     let root = BitMapBackend::new(path, (1400, 600)).into_drawing_area();
     root.fill(&WHITE)?;
@@ -485,7 +503,7 @@ fn plot(ours: &[Row], peer: &[Row], scipy: Option<&Scipy>, path: &Path) -> Resul
             BLACK.mix(0.4).stroke_width(1),
         ))?;
         for (i, fam) in families.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
+            let color = family_color(fam, i);
             let pts: Vec<(f64, f64)> = all
                 .iter()
                 .filter(|r| &r.method == fam && r.max_err_nm > 0.0)

@@ -140,7 +140,7 @@ pub fn our_settings() -> Vec<(Method, String)> {
     for n in [1u32, 2, 3, 4, 6, 8, 12] {
         v.push((Method::Rk8 { substeps: n }, format!("n={n}")));
     }
-    for e in [4, 6, 8, 10, 12] {
+    for e in [4, 5, 6, 7, 8, 10, 12] {
         let rtol = 10f64.powi(-e);
         v.push((Method::Dopri5 { rtol }, format!("rtol=1e-{e}")));
     }
