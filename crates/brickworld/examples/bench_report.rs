@@ -1,5 +1,5 @@
 //! Measures brickworld's speed and error and writes `docs/bench/brickworld.md` plus
-//! `docs/figures/brickworld-*.png`. Run: `cargo run --release -p brickworld --example bench_report`.
+//! `docs/figures/brickworld-*.png`. Run: `cargo run --release -p brickworld --example brickworld-report`.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::fmt::Write as _;
@@ -287,7 +287,7 @@ fn main() {
         md,
         "One tick = one 1 ms step of the whole world: god-object proxy update, buttons, loading zone, \
          rapier step (f64, enhanced determinism, {} solver iterations, contacts {} Hz), blueprint, device force. \
-         Measured in one run of `cargo run --release -p brickworld --example bench_report` on the shared 2-core machine; \
+         Measured in one run of `cargo run --release -p brickworld --example brickworld-report` on the shared 2-core machine; \
          compare ratios, not absolute times.\n",
         base.solver_iterations, base.contact_frequency_hz
     )
