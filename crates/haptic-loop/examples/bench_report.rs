@@ -3,7 +3,7 @@
 //! (stiffness cap, force clamp, bit-exact replay). Writes `docs/bench/haptic-loop.md` and
 //! `docs/figures/haptic-loop-*.png`.
 //!
-//! `cargo run --release -p haptic-loop --example bench_report` (about 1 minute: it includes a
+//! `cargo run --release -p haptic-loop --example haptic-loop-report` (about 1 minute: it includes a
 //! 20 s real-time session).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -331,7 +331,7 @@ fn plot_ticks(path: &Path, series: &[(&str, &Vec<u64>, RGBColor)]) {
         / 1e3;
     let mut chart = ChartBuilder::on(&area)
         .caption(
-            "tick work: fraction of ticks above a time",
+            "tick work (up to the writer hand-off): fraction of ticks above a time",
             ("sans-serif", 20),
         )
         .margin(10)
