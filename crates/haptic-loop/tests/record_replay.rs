@@ -284,3 +284,13 @@ fn touch_device_caps_at_its_own_limits() {
          button2)"
     );
 }
+
+#[test]
+fn an_unwritable_recording_path_is_a_typed_error() {
+    let o = wall_opts(Some(PathBuf::from("/nonexistent-dir/x.mcap")));
+    let e = run_session(&o, &mut |_, _| {}).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "recording /nonexistent-dir/x.mcap: No such file or directory (os error 2)"
+    );
+}
