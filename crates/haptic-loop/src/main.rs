@@ -150,7 +150,10 @@ fn print_summary(r: &SessionReport) {
     let s = &r.stats;
     println!(
         "{} ({}, {} device, {} operator)",
-        r.description.scene_name, r.description.mode, r.description.device_model, j["operator"]
+        r.description.scene_name,
+        r.description.mode,
+        r.description.device_model,
+        r.description.operator
     );
     println!(
         "  {} ticks ({:.3} s), peak force {:.3} N, {} clamped ticks, {} events",

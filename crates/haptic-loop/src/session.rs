@@ -435,7 +435,7 @@ pub fn run_session(
             p.validate()?;
             (
                 Box::new(SimulatedOperator::new(script.clone(), specs.clone(), *p)),
-                format!("{p:?}"),
+                hand_name(p),
             )
         }
         OperatorChoice::ScriptHand if script.operator_kind == OperatorKind::Rigid => (
@@ -446,7 +446,7 @@ pub fn run_session(
             let p = script.operator.unwrap_or_default();
             (
                 Box::new(SimulatedOperator::new(script.clone(), specs.clone(), p)),
-                format!("{p:?}"),
+                hand_name(&p),
             )
         }
     };
@@ -510,6 +510,13 @@ pub fn run_session(
         stats,
         written,
     })
+}
+
+fn hand_name(p: &OperatorParams) -> String {
+    format!(
+        "hand ({} kg, {} N/m, {} N·s/m)",
+        p.mass_kg, p.stiffness_n_per_m, p.damping_n_s_per_m
+    )
 }
 
 fn push_checked(a: &mut SessionArrays, m: &OutMsg) -> Result<(), SessionError> {
