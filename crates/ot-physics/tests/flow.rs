@@ -157,6 +157,7 @@ proptest! {
         let e = |r: &Vector2<f64>, v: &Vector2<f64>| 0.5 * MASS * v.norm_squared() + model.well.potential(r);
         let e0 = e(&-o, &v0);
         let e1 = e(&(d - o), &v);
-        prop_assert!((e1 - e0).abs() < 1e-6 * DEPTH, "ΔE = {:e} J", e1 - e0);
+        // the default tolerance is rtol 1e-6 on the phase: energy to ~1e-6 P0
+        prop_assert!((e1 - e0).abs() < 1e-5 * DEPTH, "ΔE = {:e} J", e1 - e0);
     }
 }

@@ -4,7 +4,7 @@
 //! ```toml
 //! [scene]
 //! name = "stiff wall"
-//! kind = "wall"                        # which world: "wall", "nanoworld", "brickworld"
+//! kind = "wall"                        # which world: "wall", "nanoworld", "brickworld", "optical_tweezers"
 //! default_script = "wall-press.script.toml"   # relative to the scene file
 //!
 //! [device]
@@ -30,6 +30,7 @@
 use super::Scene;
 use super::brick::{BrickScene, BrickSection};
 use super::nano::{NanoScene, NanoSection};
+use super::optical::{OpticalScene, OtParams};
 use super::wall::{WallParams, WallScene};
 use crate::device::{DeviceModel, DeviceSpecs};
 use crate::haptic::{LoopConfig, Mapping};
@@ -232,10 +233,14 @@ pub struct SceneFile {
     /// `[brickworld]`: the macro world (crate `brickworld`).
     #[serde(default)]
     pub brickworld: Option<BrickSection>,
+    /// `[optical_tweezers]`: the optical-tweezers steering scene (crates `ot-physics`,
+    /// `ot-envelope`).
+    #[serde(default)]
+    pub optical_tweezers: Option<OtParams>,
 }
 
 /// The world kinds this build knows.
-pub const KINDS: &[&str] = &["wall", "nanoworld", "brickworld"];
+pub const KINDS: &[&str] = &["wall", "nanoworld", "brickworld", "optical_tweezers"];
 
 impl SceneFile {
     /// Parses a scene file's text (no validation of ranges yet).
@@ -315,6 +320,13 @@ pub fn load_scene(text: &str, device: Option<DeviceModel>) -> Result<LoadedScene
             let p = file.nanoworld.clone().ok_or_else(|| missing("nanoworld"))?;
             Box::new(NanoScene::new(p, cap, dt)?)
         }
+        "optical_tweezers" => {
+            let p = file
+                .optical_tweezers
+                .clone()
+                .ok_or_else(|| missing("optical_tweezers"))?;
+            Box::new(OpticalScene::new(p, cap)?)
+        }
         "brickworld" => {
             let p = file
                 .brickworld
@@ -393,7 +405,7 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&WALL.replace("kind = \"wall\"", "kind = \"moon\"")),
-            "scene: `scene.kind` = \"moon\" is not a known world (allowed: wall, nanoworld, brickworld)"
+            "scene: `scene.kind` = \"moon\" is not a known world (allowed: wall, nanoworld, brickworld, optical_tweezers)"
         );
         assert!(
             err(&format!("{WALL}[device]\nmodel = \"phantom\"\n"))

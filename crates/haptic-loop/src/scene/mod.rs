@@ -8,6 +8,7 @@
 pub mod brick;
 pub mod file;
 pub mod nano;
+pub mod optical;
 pub mod wall;
 
 use crate::device::Buttons;

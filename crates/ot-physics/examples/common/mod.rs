@@ -268,3 +268,20 @@ pub fn cheapest_within<'a>(rows: &'a [Row], method: &str, target_nm: f64) -> Opt
         .filter(|r| r.method == method && r.max_err_nm <= target_nm)
         .min_by(|a, b| a.ns_per_traj.total_cmp(&b.ns_per_traj))
 }
+
+/// CPU time (ns) of one method family at exactly `target_nm` max error,
+/// interpolated linearly in log(time)–log(error) between the two settings
+/// that bracket it. `None` if no pair of settings brackets the target.
+pub fn time_at_error(rows: &[Row], method: &str, target_nm: f64) -> Option<f64> {
+    let mut pts: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.method == method && r.max_err_nm > 0.0)
+        .map(|r| (r.max_err_nm.ln(), r.ns_per_traj.ln()))
+        .collect();
+    pts.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let t = target_nm.ln();
+    pts.windows(2).find_map(|w| {
+        let ((e0, c0), (e1, c1)) = (w[0], w[1]);
+        (e0 >= t && t >= e1 && e0 > e1).then(|| (c0 + (c1 - c0) * (e0 - t) / (e0 - e1)).exp())
+    })
+}
