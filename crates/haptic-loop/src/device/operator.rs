@@ -7,6 +7,11 @@
 //! the order measured for a hand holding a stylus. The rendered force of tick `n` acts during
 //! the step from `n` to `n + 1` (one tick of device latency, as on hardware).
 //!
+//! Optionally (`yield_force_n > 0`) the operator also *slows down* when pushed, as the paper's
+//! operators did ("the reaction force made it natural for the operator to slow down"): the
+//! script's clock advances at `1 / (1 + |F| / yield_force_n)` of real time, so a felt force of
+//! `yield_force_n` halves the intended speed. Off by default (a purely passive hand).
+//!
 //! The device's mechanical end stop is modelled too: the stylus cannot leave the workspace
 //! sphere (its outward velocity is removed at the boundary), as a real linkage cannot.
 
@@ -25,6 +30,9 @@ pub struct OperatorParams {
     pub stiffness_n_per_m: f64,
     /// Damping relative to the intended velocity, N·s/m. Allowed: 0–1000.
     pub damping_n_s_per_m: f64,
+    /// Felt force that halves the operator's intended speed, N (0: off, a passive hand).
+    /// Allowed: 0–100.
+    pub yield_force_n: f64,
 }
 
 impl Default for OperatorParams {
@@ -33,6 +41,7 @@ impl Default for OperatorParams {
             mass_kg: 0.3,
             stiffness_n_per_m: 300.0,
             damping_n_s_per_m: 12.0,
+            yield_force_n: 0.0,
         }
     }
 }
@@ -44,6 +53,7 @@ impl OperatorParams {
             ("mass_kg", self.mass_kg, 0.01, 10.0),
             ("stiffness_n_per_m", self.stiffness_n_per_m, 1.0, 1.0e4),
             ("damping_n_s_per_m", self.damping_n_s_per_m, 0.0, 1.0e3),
+            ("yield_force_n", self.yield_force_n, 0.0, 100.0),
         ];
         for (field, value, lo, hi) in fields {
             if !(value.is_finite() && value >= lo && value <= hi) {
@@ -70,10 +80,11 @@ impl OperatorParams {
                 "mass_kg" => self.mass_kg = v,
                 "stiffness_n_per_m" => self.stiffness_n_per_m = v,
                 "damping_n_s_per_m" => self.damping_n_s_per_m = v,
+                "yield_force_n" => self.yield_force_n = v,
                 other => {
                     return Err(ScriptError::Parse(format!(
                         "operator: unknown key `{other}` (allowed: mass_kg, stiffness_n_per_m, \
-                         damping_n_s_per_m)"
+                         damping_n_s_per_m, yield_force_n)"
                     )));
                 }
             }
@@ -93,6 +104,7 @@ pub struct SimulatedOperator {
     velocity_m_per_s: Vec3,
     force_n: Vec3,
     next_tick: u64,
+    intent_time_s: f64,
 }
 
 impl SimulatedOperator {
@@ -107,6 +119,7 @@ impl SimulatedOperator {
             velocity_m_per_s: [0.0; 3],
             force_n: [0.0; 3],
             next_tick: 0,
+            intent_time_s: 0.0,
         }
     }
 
@@ -115,10 +128,28 @@ impl SimulatedOperator {
         self.velocity_m_per_s
     }
 
-    fn step(&mut self, t_s: f64, dt_s: f64) {
+    /// The script's clock, s (equal to the session time unless the operator slows down).
+    pub fn intent_time_s(&self) -> f64 {
+        self.intent_time_s
+    }
+
+    /// One step from tick `time.index − 1` to `time.index`.
+    fn step(&mut self, time: TickTime) {
         let p = &self.params;
+        let dt_s = time.dt_s;
+        // Rate of the operator's plan: 1 (its clock is the exact tick time), or slower under a
+        // felt force.
+        let (t_s, rate) = if p.yield_force_n > 0.0 {
+            let rate = 1.0 / (1.0 + vec3::norm(self.force_n) / p.yield_force_n);
+            let t = self.intent_time_s;
+            self.intent_time_s += rate * dt_s;
+            (t, rate)
+        } else {
+            self.intent_time_s = time.time_s;
+            (time.time_s - dt_s, 1.0)
+        };
         let xi = self.script.position(t_s);
-        let vi = self.script.velocity(t_s);
+        let vi = vec3::scale(self.script.velocity(t_s), rate);
         let spring = vec3::scale(vec3::sub(xi, self.position_m), p.stiffness_n_per_m);
         let damper = vec3::scale(vec3::sub(vi, self.velocity_m_per_s), p.damping_n_s_per_m);
         let acc = vec3::scale(
@@ -155,12 +186,12 @@ impl HapticDevice for SimulatedOperator {
         }
         if time.index > 0 {
             // Advance from the previous tick to this one under the last rendered force.
-            self.step(time.time_s - time.dt_s, time.dt_s);
+            self.step(time);
         }
         self.next_tick += 1;
         Ok(DeviceSample {
             position_m: self.position_m,
-            buttons: self.script.buttons(time.time_s),
+            buttons: self.script.buttons(self.intent_time_s),
         })
     }
 

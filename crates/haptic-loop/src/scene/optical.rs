@@ -109,20 +109,37 @@ impl OpticalScene {
             1.0,
             1000.0,
         )?;
-        check_positive("optical_tweezers.particle_diameter_um", p.particle_diameter_um, 1e3)?;
+        check_positive(
+            "optical_tweezers.particle_diameter_um",
+            p.particle_diameter_um,
+            1e3,
+        )?;
         check_positive("optical_tweezers.cursor_radius_nm", p.cursor_radius_nm, 1e6)?;
-        check_positive("optical_tweezers.stiffness_n_per_m", p.stiffness_n_per_m, cap_n_per_m)
-            .map_err(|_| {
-                super::file::out_of_range(
-                    "optical_tweezers.stiffness_n_per_m",
-                    p.stiffness_n_per_m,
-                    format!(
-                        "0 < stiffness ≤ {cap_n_per_m} N/m, the device's limit mapped to the world"
-                    ),
-                )
-            })?;
-        check_range("optical_tweezers.velocity_retain", p.velocity_retain, 0.0, 1.0)?;
-        check_positive("optical_tweezers.envelope_draw_scale", p.envelope_draw_scale, 1e6)?;
+        check_positive(
+            "optical_tweezers.stiffness_n_per_m",
+            p.stiffness_n_per_m,
+            cap_n_per_m,
+        )
+        .map_err(|_| {
+            super::file::out_of_range(
+                "optical_tweezers.stiffness_n_per_m",
+                p.stiffness_n_per_m,
+                format!(
+                    "0 < stiffness ≤ {cap_n_per_m} N/m, the device's limit mapped to the world"
+                ),
+            )
+        })?;
+        check_range(
+            "optical_tweezers.velocity_retain",
+            p.velocity_retain,
+            0.0,
+            1.0,
+        )?;
+        check_positive(
+            "optical_tweezers.envelope_draw_scale",
+            p.envelope_draw_scale,
+            1e6,
+        )?;
         for (k, c) in p.start_um.iter().enumerate() {
             check_range(&format!("optical_tweezers.start_um[{k}]"), *c, -1e6, 1e6)?;
         }
@@ -211,9 +228,15 @@ impl Scene for OpticalScene {
             if gap <= self.particle_r_m + self.cursor_r_m {
                 self.grabbed = true;
                 self.controller.reset();
-                out.events.push(Event::new("ot.grab", format!("cursor {gap:e} m from the particle centre")));
+                out.events.push(Event::new(
+                    "ot.grab",
+                    format!("cursor {gap:e} m from the particle centre"),
+                ));
             } else {
-                out.events.push(Event::new("ot.grab_missed", format!("cursor {gap:e} m from the particle centre")));
+                out.events.push(Event::new(
+                    "ot.grab_missed",
+                    format!("cursor {gap:e} m from the particle centre"),
+                ));
             }
         }
         if !button && self.grabbed {
@@ -238,7 +261,8 @@ impl Scene for OpticalScene {
                     self.envelope = s.envelope.polygon;
                 }
                 Err(e) => {
-                    out.events.push(Event::new("ot.controller_error", e.to_string()));
+                    out.events
+                        .push(Event::new("ot.controller_error", e.to_string()));
                 }
             }
         } else {
@@ -246,7 +270,10 @@ impl Scene for OpticalScene {
         }
         let clipping = self.excess.norm() > 0.0;
         if clipping && !self.clipping {
-            out.events.push(Event::new("ot.clipped", "command outside the working envelope"));
+            out.events.push(Event::new(
+                "ot.clipped",
+                "command outside the working envelope",
+            ));
         }
         self.clipping = clipping;
         if let Err(e) = self.advance() {
