@@ -283,4 +283,27 @@ mod tests {
             "script: `mass_kg` = 0 is out of range (allowed: 0.01 ≤ mass_kg ≤ 10)"
         );
     }
+
+    #[test]
+    fn a_yielding_hand_runs_its_plan_at_half_speed_under_its_yield_force() {
+        let params = OperatorParams {
+            yield_force_n: 2.0,
+            ..OperatorParams::default()
+        };
+        let mut op = SimulatedOperator::new(hold_script(), FALCON, params);
+        let mut free = SimulatedOperator::new(hold_script(), FALCON, OperatorParams::default());
+        for n in 0..1001 {
+            op.sample(TickTime::new(n, 1000)).unwrap();
+            free.sample(TickTime::new(n, 1000)).unwrap();
+            op.set_force([0.0, 2.0, 0.0]);
+            free.set_force([0.0, 2.0, 0.0]);
+        }
+        // 1000 steps of 1 ms at rate 1 / (1 + 2/2): the plan is at 0.5 s, the free one at 1 s.
+        assert!(
+            (op.intent_time_s() - 0.5).abs() < 1e-12,
+            "{}",
+            op.intent_time_s()
+        );
+        assert_eq!(free.intent_time_s(), 1.0);
+    }
 }
