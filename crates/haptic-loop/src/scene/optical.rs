@@ -60,6 +60,9 @@ pub struct OtParams {
     /// Particle (and trap) start, µm.
     #[serde(default)]
     pub start_um: [f64; 2],
+    /// Geometric tolerance of the working envelope, nm (default: `ot_envelope::DEFAULT_TOL`).
+    #[serde(default)]
+    pub envelope_tol_nm: Option<f64>,
 }
 
 fn default_substeps() -> u32 {
@@ -140,6 +143,13 @@ impl OpticalScene {
             p.envelope_draw_scale,
             1e6,
         )?;
+        let tol = match p.envelope_tol_nm {
+            Some(t) => {
+                check_positive("optical_tweezers.envelope_tol_nm", t, 1e3)?;
+                t * 1e-9
+            }
+            None => ot_envelope::DEFAULT_TOL,
+        };
         for (k, c) in p.start_um.iter().enumerate() {
             check_range(&format!("optical_tweezers.start_um[{k}]"), *c, -1e6, 1e6)?;
         }
@@ -159,7 +169,7 @@ impl OpticalScene {
         let controller = Controller::new(SteerParams {
             stiffness: p.stiffness_n_per_m,
             mode: p.clip,
-            tol: ot_envelope::DEFAULT_TOL,
+            tol,
             margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
         })
         .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
