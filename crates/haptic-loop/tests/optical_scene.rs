@@ -84,3 +84,58 @@ fn scene_errors_name_the_field() {
             .contains("unknown variant `sideways`")
     );
 }
+
+/// The paper's experiment in miniature: dragging faster than the trap can follow, force
+/// feedback keeps the cursor much closer to the particle than no feedback, and a hand that
+/// slows down under the force keeps it closer still.
+#[test]
+fn feedback_keeps_the_cursor_near_the_particle() {
+    use haptic_loop::device::OperatorParams;
+    use haptic_loop::session::OperatorChoice;
+    let drag = "[script]\nname = 'drag'\nduration_s = 1.2\n\
+                [[button]]\nt_s = 0.3\nname = 'centre'\ndown = true\n\
+                [[waypoint]]\nt_s = 0.5\nposition_mm = [0.0, 0.0, 0.0]\n\
+                [[waypoint]]\nt_s = 0.75\nposition_mm = [10.0, 0.0, 0.0]\n";
+    let text = std::fs::read_to_string(root().join("scenes/optical_tweezers.toml")).unwrap();
+    let run = |feedback: bool, op: OperatorParams| {
+        let t = if feedback {
+            text.clone()
+        } else {
+            text.replace("feedback = true", "feedback = false")
+        };
+        let mut o = SessionOptions::new(SceneSource { text: t, dir: None });
+        o.script = Some(drag.to_string());
+        o.operator = OperatorChoice::Hand(op);
+        let a = run_session(&o, &mut |_, _| {}).unwrap().arrays;
+        let f = a
+            .device_force_n
+            .iter()
+            .map(|f| f[0].abs())
+            .fold(0.0, f64::max);
+        (
+            a.state_column("lag_m")
+                .unwrap()
+                .into_iter()
+                .fold(0.0, f64::max),
+            f,
+        )
+    };
+    let passive = OperatorParams::default();
+    let (off, f_off) = run(false, passive);
+    let (on, f_on) = run(true, passive);
+    let (on_y, _) = run(
+        true,
+        OperatorParams {
+            yield_force_n: 0.5,
+            ..passive
+        },
+    );
+    assert_eq!(f_off, 0.0, "no feedback, no force");
+    assert!(f_on > 1.0, "the wall is felt: {f_on} N");
+    assert!(
+        off > 4e-6,
+        "without feedback the cursor runs ahead: {off} m"
+    );
+    assert!(on < 0.4 * off, "feedback: {on} m vs {off} m");
+    assert!(on_y < 0.6 * on, "yielding hand: {on_y} m vs {on} m");
+}
