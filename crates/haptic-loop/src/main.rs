@@ -69,7 +69,7 @@ enum Cmd {
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
         /// Folder for the recordings.
-        #[arg(long, default_value = "demo-out")]
+        #[arg(long, default_value = "target/demo")]
         out: PathBuf,
         /// Print the summary as JSON.
         #[arg(long)]
