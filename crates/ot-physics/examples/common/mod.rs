@@ -130,6 +130,33 @@ pub fn measure(
     })
 }
 
+/// Measure one of our fixed-step methods through `flow_batch` (lockstep
+/// lanes); the row's method name gets a ` batch` suffix.
+pub fn measure_batch(
+    p: &Problem,
+    method: Method,
+    setting: &str,
+    min_ms: f64,
+) -> Result<Row, PhysicsError> {
+    let prop = Propagator::new(p.model, method, paper::DT)?;
+    let offsets: Vec<Vector2<f64>> = p.starts.iter().map(|s| s.0).collect();
+    let vels: Vec<Vector2<f64>> = p.starts.iter().map(|s| s.1).collect();
+    let mut disp = vec![Vector2::zeros(); offsets.len()];
+    let evals = prop.flow_batch(&offsets, &vels, &mut disp)?;
+    let (max_err_nm, mean_err_nm) = errors(p, &disp);
+    let ns = time_per_call(p.starts.len(), min_ms, || {
+        let _ = black_box(prop.flow_batch(black_box(&offsets), &vels, &mut disp));
+    });
+    Ok(Row {
+        method: format!("{} batch", method.name()),
+        setting: setting.to_string(),
+        max_err_nm,
+        mean_err_nm,
+        ns_per_traj: ns,
+        evals_per_traj: evals as f64 / p.starts.len() as f64,
+    })
+}
+
 /// The settings swept for each of our methods.
 pub fn our_settings() -> Vec<(Method, String)> {
     use ot_physics::Composition::*;
