@@ -357,3 +357,27 @@ class BrickWorld:
     def set_friction(self, mu: float) -> None: ...
     def set_inertia(self, on: bool) -> None: ...
     def set_brick_mass(self, kg: float) -> None: ...
+
+# ---------------------------------------------------------------- haptic loop sessions
+
+import os
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+def run_scene(
+    scene: PathLike,
+    *,
+    script: Optional[PathLike] = None,
+    seconds: Optional[float] = None,
+    operator: Union[Literal["script", "rigid", "hand"], dict, None] = None,
+    device: Optional[Literal["falcon", "touch"]] = None,
+    out: Optional[PathLike] = None,
+) -> dict:
+    """Run a scene in batch mode with a script; per-tick arrays: tick, time_s,
+    device_position_m (T, 3), device_buttons, deadline_missed, cursor_m (T, 3),
+    state (T, F) with state_fields, world_force_n (T, 3), device_force_n (T, 3),
+    engagement, status, compute_ns, start_late_ns, events [(tick, name, detail)],
+    rate_hz, stats. Optionally records to `out` (MCAP)."""
+
+def read_recording(path: PathLike, *, salvage: bool = False) -> dict:
+    """An MCAP recording as the arrays of run_scene (without stats)."""

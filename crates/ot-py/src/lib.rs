@@ -7,8 +7,9 @@
 //! flow map, trajectories and thermal runs of `ot-physics`
 //! ([`trap::GaussianTrap`]), the inverse solver and working envelope of
 //! `ot-envelope` ([`envelope`]), the nano world of `nanoworld`
-//! ([`nano::NanoWorld`]) and the brick world of `brickworld`
-//! ([`brick::BrickWorld`]).
+//! ([`nano::NanoWorld`]), the brick world of `brickworld`
+//! ([`brick::BrickWorld`]) and the sessions and recordings of `haptic-loop`
+//! ([`session`]).
 //!
 //! What it is not: it holds no physics. Every number comes from the wrapped
 //! crates; this crate only converts arrays, checks their shapes, releases
@@ -23,6 +24,7 @@ pub mod envelope;
 mod json;
 pub mod nano;
 mod params_dict;
+pub mod session;
 pub mod trap;
 
 use pyo3::prelude::*;
@@ -30,7 +32,8 @@ use pyo3::prelude::*;
 /// Haptic manipulation at the nanoscale, from Python: optical-trap dynamics
 /// (GaussianTrap), the inverse trap solver and working envelope (solve_trap,
 /// working_envelope, clip_command), the nano world (NanoWorld) and the brick
-/// world (BrickWorld). SI units throughout (J, m, kg, s, Pa·s, K, N).
+/// world (BrickWorld), and haptic-loop sessions and recordings (run_scene,
+/// read_recording). SI units throughout (J, m, kg, s, Pa·s, K, N).
 #[pymodule]
 fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
@@ -44,6 +47,8 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(envelope::working_envelope, m)?)?;
     m.add_function(wrap_pyfunction!(envelope::clip_command, m)?)?;
     m.add_function(wrap_pyfunction!(envelope::working_envelope_3d, m)?)?;
+    m.add_function(wrap_pyfunction!(session::run_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(session::read_recording, m)?)?;
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

@@ -1,0 +1,194 @@
+//! Sessions of the haptic loop (`haptic-loop`): run a scene with a script and
+//! get per-tick arrays back; read an MCAP recording into the same arrays.
+
+use haptic_loop::DeviceModel;
+use haptic_loop::device::OperatorParams;
+use haptic_loop::record::RecordingError;
+use haptic_loop::session::{
+    OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions, read_arrays,
+    run_session,
+};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString};
+use std::path::PathBuf;
+
+use crate::convert::array2_flat;
+use crate::json::{from_py, to_py};
+
+/// File errors as `OSError`, everything else (bad scene, script, options,
+/// corrupt recording) as `ValueError`, with the crate's text.
+fn session_error(e: SessionError) -> PyErr {
+    match e {
+        SessionError::Io { .. } | SessionError::Recording(RecordingError::Io { .. }) => {
+            PyOSError::new_err(e.to_string())
+        }
+        other => PyValueError::new_err(other.to_string()),
+    }
+}
+
+fn path_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<PathBuf> {
+    obj.extract::<PathBuf>()
+        .map_err(|_| PyValueError::new_err(format!("{name}: expected a path (str or os.PathLike)")))
+}
+
+/// Per-tick arrays as a dict of numpy arrays.
+fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let time = a.time_s();
+    let n = a.tick.len();
+    let fields = a.state_fields.len();
+    d.set_item("rate_hz", a.rate_hz)?;
+    d.set_item("state_fields", a.state_fields)?;
+    let tick: Vec<i64> = a.tick.iter().map(|&t| t as i64).collect();
+    d.set_item("tick", PyArray1::from_vec(py, tick))?;
+    d.set_item("time_s", PyArray1::from_vec(py, time))?;
+    let v3 = |v: Vec<[f64; 3]>| v.into_iter().flatten().collect::<Vec<f64>>();
+    d.set_item(
+        "device_position_m",
+        array2_flat(py, v3(a.device_position_m), 3)?,
+    )?;
+    let buttons: Vec<i64> = a.device_buttons.iter().map(|&b| i64::from(b)).collect();
+    d.set_item("device_buttons", PyArray1::from_vec(py, buttons))?;
+    d.set_item("deadline_missed", PyArray1::from_vec(py, a.deadline_missed))?;
+    d.set_item("cursor_m", array2_flat(py, v3(a.cursor_m), 3)?)?;
+    let rows = a.state.len().checked_div(fields).unwrap_or(n);
+    d.set_item(
+        "state",
+        PyArray1::from_vec(py, a.state).reshape([rows, fields])?,
+    )?;
+    d.set_item("world_force_n", array2_flat(py, v3(a.world_force_n), 3)?)?;
+    d.set_item("device_force_n", array2_flat(py, v3(a.device_force_n), 3)?)?;
+    d.set_item("engagement", PyArray1::from_vec(py, a.engagement))?;
+    d.set_item("status", PyArray1::from_vec(py, a.status))?;
+    let ev = PyList::empty(py);
+    for (t, name, detail) in a.events {
+        ev.append((t, name, detail))?;
+    }
+    d.set_item("events", ev)?;
+    let compute: Vec<i64> = a.compute_ns.iter().map(|&c| c as i64).collect();
+    d.set_item("compute_ns", PyArray1::from_vec(py, compute))?;
+    d.set_item("start_late_ns", PyArray1::from_vec(py, a.start_late_ns))?;
+    Ok(d)
+}
+
+fn operator_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OperatorChoice> {
+    let Some(obj) = obj else {
+        return Ok(OperatorChoice::ScriptHand);
+    };
+    if let Ok(s) = obj.cast::<PyString>() {
+        return match s.to_str()? {
+            "script" => Ok(OperatorChoice::ScriptHand),
+            "rigid" => Ok(OperatorChoice::Rigid),
+            "hand" => Ok(OperatorChoice::Hand(OperatorParams::default())),
+            other => Err(PyValueError::new_err(format!(
+                "operator = {other:?}: allowed \"script\", \"rigid\", \"hand\" or a dict of hand parameters"
+            ))),
+        };
+    }
+    Ok(OperatorChoice::Hand(from_py(obj, "operator")?))
+}
+
+fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<DeviceModel>> {
+    match obj {
+        None => Ok(None),
+        Some(o) => {
+            let name: String = o.extract().map_err(|_| {
+                PyValueError::new_err("device: allowed \"falcon\" or \"touch\"".to_string())
+            })?;
+            match name.as_str() {
+                "falcon" => Ok(Some(DeviceModel::Falcon)),
+                "touch" => Ok(Some(DeviceModel::Touch)),
+                other => Err(PyValueError::new_err(format!(
+                    "device = {other:?}: allowed \"falcon\" or \"touch\""
+                ))),
+            }
+        }
+    }
+}
+
+/// Run a scene of the haptic loop in batch mode (no wall clock) with a
+/// script driving the device, and return every tick as arrays.
+///
+/// Args:
+///     scene: path to a scene TOML file (``scenes/*.toml``).
+///     script: path to a script TOML file; default: the scene's
+///         ``default_script``.
+///     seconds: session length (s), 0 < seconds <= 3600; default: the
+///         script's duration.
+///     operator: "script" (as the script says, default), "rigid" (the stylus
+///         follows the script exactly), "hand" (a simulated hand with default
+///         parameters, pushed by the rendered force) or a dict of hand
+///         parameters (mass_kg, stiffness_n_per_m, damping_n_s_per_m,
+///         yield_force_n).
+///     device: None (the scene's), "falcon" or "touch".
+///     out: path of an MCAP recording to write, or None.
+///
+/// Returns:
+///     dict: "rate_hz", "state_fields" (names of the state columns), per-tick
+///     arrays "tick", "time_s", "device_position_m" (T, 3) (device frame),
+///     "device_buttons" (T,) bits, "deadline_missed", "cursor_m" (T, 3)
+///     (world frame), "state" (T, F), "world_force_n" (T, 3),
+///     "device_force_n" (T, 3) (force sent, device frame), "engagement",
+///     "status", "compute_ns" (wall clock, not reproducible),
+///     "start_late_ns", "events" [(tick, name, detail)], and "stats" (tick
+///     timing). The GIL is released while the session runs.
+#[pyfunction]
+#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None))]
+pub fn run_scene<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyAny>,
+    script: Option<&Bound<'py, PyAny>>,
+    seconds: Option<f64>,
+    operator: Option<&Bound<'py, PyAny>>,
+    device: Option<&Bound<'py, PyAny>>,
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let scene_path = path_arg(scene, "scene")?;
+    let source = SceneSource::from_path(&scene_path).map_err(session_error)?;
+    let mut opts = SessionOptions::new(source);
+    if let Some(s) = script {
+        let p = path_arg(s, "script")?;
+        let text = std::fs::read_to_string(&p)
+            .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", p.display())))?;
+        opts.script = Some(text);
+    }
+    opts.seconds = seconds;
+    opts.operator = operator_from_py(operator)?;
+    opts.device = device_from_py(device)?;
+    opts.out = match out {
+        Some(o) => Some(path_arg(o, "out")?),
+        None => None,
+    };
+    let report = py
+        .detach(|| run_session(&opts, &mut |_, _| {}))
+        .map_err(session_error)?;
+    let stats = to_py(py, &report.stats)?;
+    let d = arrays_to_py(py, report.arrays)?;
+    d.set_item("stats", stats)?;
+    Ok(d)
+}
+
+/// Read an MCAP recording of the haptic loop into the per-tick arrays of
+/// :func:`run_scene` (without "stats").
+///
+/// Args:
+///     path: the recording.
+///     salvage: accept a truncated file's complete part instead of failing.
+///
+/// Raises OSError when the file cannot be read and ValueError when it is not
+/// a valid recording (naming what is wrong).
+#[pyfunction]
+#[pyo3(signature = (path, *, salvage=false))]
+pub fn read_recording<'py>(
+    py: Python<'py>,
+    path: &Bound<'py, PyAny>,
+    salvage: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = path_arg(path, "path")?;
+    let a = py
+        .detach(|| read_arrays(&p, salvage))
+        .map_err(session_error)?;
+    arrays_to_py(py, a)
+}

@@ -1,0 +1,105 @@
+"""run_scene and read_recording (haptic-loop): sessions as numpy arrays."""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import nanohaptics as nh
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENES = ROOT / "scenes"
+RECORDINGS = ROOT / "recordings"
+TIMING = ("compute_ns", "start_late_ns")  # wall clock: not reproducible
+
+
+def same(a, b, skip=TIMING):
+    assert set(a) - {"stats"} == set(b) - {"stats"}
+    for k in b:
+        if k in skip or k == "stats":
+            continue
+        if isinstance(b[k], np.ndarray):
+            assert a[k].dtype == b[k].dtype and np.array_equal(a[k], b[k]), k
+        else:
+            assert a[k] == b[k], k
+
+
+@pytest.mark.parametrize("scene", ["wall", "nanoworld", "brickworld", "optical_tweezers"])
+def test_golden_recordings_are_recomputed_bit_for_bit(scene):
+    golden = nh.read_recording(RECORDINGS / f"{scene}.mcap")
+    n = len(golden["tick"])
+    assert n >= 1000 and np.array_equal(golden["tick"], np.arange(n))
+    assert golden["state"].shape == (n, len(golden["state_fields"]))
+    assert np.array_equal(golden["time_s"], golden["tick"] / golden["rate_hz"])
+    run = nh.run_scene(SCENES / f"{scene}.toml", seconds=n / golden["rate_hz"])
+    same(run, golden)
+    assert run["stats"]["ticks"] == n
+
+
+def test_a_written_recording_reads_back_identically(tmp_path):
+    out = tmp_path / "nano.mcap"
+    run = nh.run_scene(str(SCENES / "nanoworld.toml"), seconds=2.0, out=out)
+    back = nh.read_recording(out)
+    same(back, run, skip=())  # timing is logged too, so even it matches
+    assert any(name == "nano.atom_attached" for _, name, _ in back["events"])
+    # A truncated file: refused, or salvaged as a prefix of the session.
+    cut = tmp_path / "cut.mcap"
+    data = out.read_bytes()
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    with pytest.raises(ValueError):
+        nh.read_recording(cut)
+    part = nh.read_recording(cut, salvage=True)
+    k = len(part["tick"])
+    assert 0 < k < len(run["tick"])
+    assert np.array_equal(part["device_position_m"], run["device_position_m"][:k])
+    kf = len(part["device_force_n"])  # channels of the last, partly written tick may differ
+    assert k - 1 <= kf <= k
+    assert np.array_equal(part["device_force_n"], run["device_force_n"][:kf])
+
+
+def test_wall_scene_caps_stiffness_and_clamps_force():
+    run = nh.run_scene(SCENES / "wall.toml")
+    k = run["state"][:, run["state_fields"].index("stiffness_n_per_m")]
+    assert k.max() == 3000.0  # 5000 N/m requested, the Falcon's cap rendered
+    f = np.linalg.norm(run["device_force_n"], axis=1)
+    assert np.all(np.isfinite(f)) and f.max() <= 8.0 * (1 + 1e-12)  # the Falcon's 8 N
+    assert any("stiffness_capped" in name for _, name, _ in run["events"])
+
+
+def test_operator_choices_change_the_motion():
+    rigid = nh.run_scene(SCENES / "wall.toml", operator="rigid")
+    hand = nh.run_scene(SCENES / "wall.toml", operator="hand")
+    soft = nh.run_scene(SCENES / "wall.toml", operator={"stiffness_n_per_m": 100.0})
+    assert not np.array_equal(rigid["device_position_m"], hand["device_position_m"])
+    assert not np.array_equal(hand["device_position_m"], soft["device_position_m"])
+    # Another device: the script's buttons are checked against it.
+    with pytest.raises(ValueError) as e:
+        nh.run_scene(SCENES / "wall.toml", device="touch")
+    assert str(e.value) == (
+        "script: `button[0].name`: device `touch` has no button `centre` (allowed: button1, button2)"
+    )
+
+
+def test_session_errors(tmp_path):
+    with pytest.raises(OSError, match="nope.toml"):
+        nh.run_scene(SCENES / "nope.toml")
+    cases = [
+        (lambda: nh.run_scene(SCENES / "wall.toml", seconds=0.0),
+         "session length 0 s is out of range (allowed: 0 < seconds ≤ 3600)"),
+        (lambda: nh.run_scene(SCENES / "wall.toml", operator="robot"),
+         'operator = "robot": allowed "script", "rigid", "hand" or a dict of hand parameters'),
+        (lambda: nh.run_scene(SCENES / "wall.toml", device="phantom"),
+         'device = "phantom": allowed "falcon" or "touch"'),
+        (lambda: nh.run_scene(42), "scene: expected a path (str or os.PathLike)"),
+    ]
+    for fn, msg in cases:
+        with pytest.raises(ValueError) as e:
+            fn()
+        assert str(e.value) == msg
+    with pytest.raises(ValueError, match="^operator: unknown field `speed`"):
+        nh.run_scene(SCENES / "wall.toml", operator={"speed": 1.0})
+    not_mcap = tmp_path / "scene.mcap"
+    shutil.copy(SCENES / "wall.toml", not_mcap)
+    with pytest.raises(ValueError):
+        nh.read_recording(not_mcap)
