@@ -4,6 +4,7 @@ SI units throughout: J, m, kg, s, N, Pa·s, K. Bad arguments raise ValueError
 naming the argument and its allowed range.
 """
 
+import os
 from typing import Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -359,8 +360,6 @@ class BrickWorld:
     def set_brick_mass(self, kg: float) -> None: ...
 
 # ---------------------------------------------------------------- haptic loop sessions
-
-import os
 
 PathLike = Union[str, "os.PathLike[str]"]
 
