@@ -1,0 +1,74 @@
+//! A rendered RGBA image and its PNG encoding.
+
+use std::path::Path;
+
+use tiny_skia::Pixmap;
+
+use crate::camera::check_size;
+use crate::error::RenderError;
+
+/// An RGBA image, 8 bits per channel, sRGB, top-left origin.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub(crate) pixmap: Pixmap,
+}
+
+impl Image {
+    /// A blank (transparent) image of `width_px` × `height_px`.
+    pub fn new(width_px: u32, height_px: u32) -> Result<Image, RenderError> {
+        check_size(width_px, height_px)?;
+        let pixmap = Pixmap::new(width_px, height_px).ok_or(RenderError::ImageSize {
+            width_px,
+            height_px,
+            max: crate::camera::MAX_SIDE_PX,
+        })?;
+        Ok(Image { pixmap })
+    }
+
+    /// Width, px.
+    pub fn width(&self) -> u32 {
+        self.pixmap.width()
+    }
+
+    /// Height, px.
+    pub fn height(&self) -> u32 {
+        self.pixmap.height()
+    }
+
+    /// The straight (not premultiplied) RGBA of the pixel at column `x`, row `y`, or `None`
+    /// outside the image.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<[u8; 4]> {
+        let p = self.pixmap.pixel(x, y)?.demultiply();
+        Some([p.red(), p.green(), p.blue(), p.alpha()])
+    }
+
+    /// All pixels as straight RGBA bytes, row by row.
+    pub fn to_rgba8(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.pixmap.data().len());
+        for p in self.pixmap.pixels() {
+            let c = p.demultiply();
+            out.extend_from_slice(&[c.red(), c.green(), c.blue(), c.alpha()]);
+        }
+        out
+    }
+
+    /// Premultiplied RGBA bytes as stored, row by row (equal to straight RGBA where the image
+    /// is opaque).
+    pub fn data(&self) -> &[u8] {
+        self.pixmap.data()
+    }
+
+    /// The image as PNG bytes.
+    pub fn encode_png(&self) -> Result<Vec<u8>, RenderError> {
+        self.pixmap
+            .encode_png()
+            .map_err(|e| RenderError::Png(e.to_string()))
+    }
+
+    /// Writes the image as a PNG file.
+    pub fn save_png(&self, path: impl AsRef<Path>) -> Result<(), RenderError> {
+        let bytes = self.encode_png()?;
+        std::fs::write(path.as_ref(), bytes)
+            .map_err(|e| RenderError::Png(format!("{}: {e}", path.as_ref().display())))
+    }
+}
