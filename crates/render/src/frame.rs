@@ -534,13 +534,11 @@ impl Frame {
             let Some(path) = pb.finish() else { continue };
             let lit = amb + (1.0 - amb) * dot(n, light).max(0.0);
             let face = color.times(lit);
-            pm.fill_path(
-                &path,
-                &solid(face),
-                FillRule::Winding,
-                Transform::identity(),
-                None,
-            );
+            // the face interior without anti-aliasing (4× cheaper); its anti-aliased hairline
+            // edge below covers the staircase
+            let mut fill = solid(face);
+            fill.anti_alias = false;
+            pm.fill_path(&path, &fill, FillRule::Winding, Transform::identity(), None);
             pm.stroke_path(
                 &path,
                 &solid(face.times(0.7)),
@@ -659,9 +657,10 @@ impl Frame {
             }
         }
         let Some(path) = pb.finish() else { return };
+        // a 1 px (hairline) dashed stroke: dashes of a wider stroke would each be filled
         let w = self.style.line_width_px;
         let stroke = Stroke {
-            width: w,
+            width: 1.0,
             dash: StrokeDash::new(vec![3.0 * w, 2.0 * w], 0.0),
             ..Stroke::default()
         };
