@@ -48,3 +48,8 @@ pub use gif::{GifWriter, Palette, frame_delays_cs};
 pub use image::Image;
 pub use math::Vec3;
 pub use primitive::{Primitive, Rgba};
+
+/// The user guide's examples (`docs/render.md`), compiled and run as doc-tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/render.md")]
+pub struct UserGuide;
