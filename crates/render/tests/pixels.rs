@@ -592,3 +592,124 @@ fn reddish_dim(p: [u8; 4]) -> bool {
 fn bluish_dim(p: [u8; 4]) -> bool {
     i32::from(p[2]) > 2 * i32::from(p[0]) && i32::from(p[2]) > i32::from(p[1]) + 10
 }
+
+#[test]
+fn beam_ellipse_fill_outline_and_side_view() {
+    // top view, 1e8 px/m: a = 600 nm → 60 px, b = 300 nm → 30 px about (200, 150)
+    let beam = Primitive::Ellipse {
+        center_m: [0.0; 3],
+        semi_axes_m: [600e-9, 300e-9],
+        color: RED,
+    };
+    let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
+    f.push(beam.clone()).expect("beam");
+    let img = f.finish().expect("image");
+    let b = bg();
+    // inside: a third of the colour's alpha over the background
+    let inside = px(&img, 200.5, 150.5);
+    let want = |c: f64, bgc: u8| (c * 255.0 / 3.0 + f64::from(bgc) * (2.0 / 3.0)).round();
+    for k in 0..3 {
+        assert!(
+            (f64::from(inside[k]) - want(RED.0[k], b[k])).abs() <= 2.0,
+            "{inside:?}"
+        );
+    }
+    // the outline on the axes, at 60 px along x and 30 px along y
+    assert!(reddish(px(&img, 260.0, 150.5)));
+    assert!(reddish(px(&img, 140.0, 150.5)));
+    assert!(reddish(px(&img, 200.5, 120.0)));
+    // outside the ellipse, in its bounding box corner: background
+    assert_eq!(px(&img, 250.5, 128.5), b);
+    // side view: the ellipse is edge-on, a horizontal line through the image centre 120 px long
+    let cam = Camera::new(View::Side, [0.0; 3], 1e8, 400, 300).expect("camera");
+    let mut f = Frame::new(cam, Style::default()).expect("frame");
+    f.push(beam).expect("beam");
+    let img = f.finish().expect("image");
+    assert!(reddish(px(&img, 200.5, 150.0)));
+    assert!(reddish(px(&img, 255.5, 150.0)));
+    assert_eq!(px(&img, 265.5, 150.0), b);
+    assert_eq!(px(&img, 200.5, 140.5), b);
+}
+
+#[test]
+fn side_view_puts_plus_z_up() {
+    let cam = Camera::new(View::Side, [0.0; 3], 1e8, 400, 300).expect("camera");
+    let mut f = Frame::new(cam, Style::default()).expect("frame");
+    f.push(Primitive::Sphere {
+        center_m: [0.0, 0.0, 1e-6],
+        radius_m: 0.2e-6,
+        color: BLUE,
+    })
+    .expect("sphere");
+    let img = f.finish().expect("image");
+    assert!(bluish(px(&img, 200.5, 50.5)));
+    assert_eq!(px(&img, 200.5, 250.5), bg());
+}
+
+#[test]
+fn slot_is_dashed_and_cursor_shows_what_is_behind() {
+    // a 2 µm × 1 µm slot seen from above: its top edge y = 100 px from x = 100 to 300
+    let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
+    f.push(Primitive::Slot {
+        center_m: [0.0; 3],
+        half_extents_m: [1e-6, 0.5e-6, 0.2e-6],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+        color: INK,
+    })
+    .expect("slot");
+    let img = f.finish().expect("image");
+    let ink: Vec<bool> = (110..290)
+        .map(|x| img.pixel(x, 100).expect("pixel")[0] < 128)
+        .collect();
+    let on = ink.iter().filter(|&&d| d).count();
+    // dashes of 6 px and gaps of 4 px (line width 2): about 60 % ink, never solid
+    assert!((90..=125).contains(&on), "{on} of 180 px inked");
+    let switches = ink.windows(2).filter(|w| w[0] != w[1]).count();
+    assert!(switches >= 30, "{switches} dash ends");
+    // a see-through cursor over a red particle: the particle still shows through it
+    let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
+    f.push(Primitive::Sphere {
+        center_m: [0.0; 3],
+        radius_m: 0.5e-6,
+        color: RED,
+    })
+    .expect("particle");
+    f.push(Primitive::Cursor {
+        center_m: [0.2e-6, 0.0, 0.0],
+        radius_m: 0.2e-6,
+        color: Rgba([0.1, 0.2, 0.85, 0.4]),
+    })
+    .expect("cursor");
+    let img = f.finish().expect("image");
+    let p = px(&img, 228.5, 158.5); // inside the cursor, off its cross-hair
+    assert!(p[0] > 60 && p[2] > 60, "blend of both: {p:?}");
+}
+
+#[test]
+fn things_far_outside_the_image_leave_it_blank() {
+    let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
+    for far in [1e-3, 1e6, 1e30] {
+        f.push(Primitive::Sphere {
+            center_m: [far, 0.0, 0.0],
+            radius_m: 1e-6,
+            color: RED,
+        })
+        .expect("sphere");
+        f.push(Primitive::Polyline {
+            points_m: vec![[far, far, 0.0], [2.0 * far, far, 0.0]],
+            closed: false,
+            color: RED,
+        })
+        .expect("line");
+        f.push(Primitive::Box {
+            center_m: [-far, 0.0, 0.0],
+            half_extents_m: [1e-6; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            color: RED,
+        })
+        .expect("box");
+    }
+    let img = f.finish().expect("image");
+    let b = bg();
+    assert!(img.to_rgba8().chunks_exact(4).all(|p| p == b));
+}
