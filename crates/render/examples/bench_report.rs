@@ -46,6 +46,7 @@ struct Run {
     /// CPU time of the whole session (palette, render, encode), s, if measured.
     cpu_s: Option<f64>,
     stored_frac: f64,
+    switches: u64,
     mean_err: f64,
     max_err: u8,
 }
@@ -120,6 +121,7 @@ fn run_session(
         }
     }
     let stored = gif.pixels_stored();
+    let switches = gif.palette_switches();
     let mut w = gif.finish()?;
     std::io::Write::flush(&mut w)?;
     drop(w);
@@ -137,6 +139,7 @@ fn run_session(
         palette,
         gif_bytes,
         cpu_s,
+        switches,
         stored_frac: stored as f64 / (frames as f64 * f64::from(W * H)),
         mean_err: err_sum / err_n.max(1) as f64,
         max_err,
@@ -374,15 +377,18 @@ fn report(
     )?;
     writeln!(
         md,
-        "| session | primitives / frame | render ms/frame | GIF ms/frame | frames/s (wall) | 1800 frames, wall | 1800 frames, CPU | target ≤ {TARGET_S} s CPU | GIF size | pixels stored | palette error, mean / max (8-bit) |"
+        "| session | primitives / frame | render ms/frame | GIF ms/frame | frames/s (wall) | 1800 frames, wall | 1800 frames, CPU | target ≤ {TARGET_S} s CPU | GIF size | pixels stored | palette switches | palette error, mean / max (8-bit) |"
     )?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|")?;
+    writeln!(
+        md,
+        "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|"
+    )?;
     for r in runs {
         let n = r.frames as f64;
         let judged = r.session_cpu_s().unwrap_or(r.session_s());
         writeln!(
             md,
-            "| {} | {} | {:.2} | {:.2} | {:.0} | {:.1} s | {} | {} ({:.1} s) | {:.2} MB | {:.1} % | {:.2} / {} |",
+            "| {} | {} | {:.2} | {:.2} | {:.0} | {:.1} s | {} | {} ({:.1} s) | {:.2} MB | {:.1} % | {} | {:.2} / {} |",
             r.name,
             r.primitives,
             r.render.as_secs_f64() * 1e3 / n,
@@ -399,6 +405,7 @@ fn report(
             judged,
             r.gif_bytes as f64 / 1e6,
             100.0 * r.stored_frac,
+            r.switches,
             r.mean_err,
             r.max_err,
         )?;
@@ -409,7 +416,11 @@ fn report(
          cut over three sample frames, built once). *Pixels stored*: share of all frame pixels \
          written to the GIF after cropping each frame to the rectangle that changed. *Palette \
          error*: |GIF colour − rendered colour| per channel over every 100th frame (255 colours, \
-         15-bit lookup); its measurement is inside the CPU time (about 1 % of it).\n"
+         15-bit lookup); its measurement is inside the CPU time (about 1 % of it). *Palette \
+         switches*: frames where more than {:.2} % of the pixels were off by more than {} and \
+         the writer moved to a palette made from that frame.\n",
+        100.0 * render::BAD_PIXEL_SHARE,
+        render::BAD_PIXEL_ERROR
     )?;
     writeln!(md, "![time per frame](../figures/render-speed.png)\n")?;
     writeln!(md, "### Geometry\n")?;

@@ -5,7 +5,9 @@
 //! once per palette, so indexing a frame costs one table read per pixel. After the first
 //! frame, each frame is stored as the smallest rectangle holding every pixel whose palette
 //! index changed, with unchanged pixels inside it transparent (disposal: keep), which is what
-//! keeps a long session's GIF small and fast to encode.
+//! keeps a long session's GIF small and fast to encode. A frame whose colours the palette does
+//! not represent (more than [`BAD_PIXEL_SHARE`] of its pixels off by more than
+//! [`BAD_PIXEL_ERROR`]) switches the writer to a palette made from that frame.
 
 use std::io::Write;
 
@@ -24,6 +26,9 @@ fn key(r: u8, g: u8, b: u8) -> usize {
 pub struct Palette {
     colors: Vec<[u8; 3]>,
     lut: Vec<u8>,
+    /// Per 15-bit cell: the largest channel error of any colour in the cell against the
+    /// palette colour it maps to, 8-bit units.
+    cell_err: Vec<u8>,
 }
 
 #[derive(Clone, Copy, Default)]
@@ -127,7 +132,7 @@ impl Palette {
     }
 
     fn with_colors(colors: Vec<[u8; 3]>, hist: &[Bin]) -> Palette {
-        let lut = (0..BINS)
+        let lut: Vec<u8> = (0..BINS)
             .map(|k| {
                 // representative of the bin: its mean if seen, else its centre
                 let rep = if hist[k].n > 0 {
@@ -149,7 +154,24 @@ impl Palette {
                 best.1
             })
             .collect();
-        Palette { colors, lut }
+        let cell_err = (0..BINS)
+            .map(|k| {
+                let c = colors[usize::from(lut[k])];
+                let lo = [((k >> 10) & 31) * 8, ((k >> 5) & 31) * 8, (k & 31) * 8];
+                (0..3)
+                    .map(|j| {
+                        let v = usize::from(c[j]);
+                        v.abs_diff(lo[j]).max(v.abs_diff(lo[j] + 7))
+                    })
+                    .max()
+                    .unwrap_or(0) as u8
+            })
+            .collect();
+        Palette {
+            colors,
+            lut,
+            cell_err,
+        }
     }
 
     /// The colours, 8-bit RGB.
@@ -187,7 +209,19 @@ pub struct GifWriter<W: Write> {
     sub: Vec<u8>,
     frames: u64,
     bytes_hint: u64,
+    /// The palette in force when it is not the global one (flat RGB, transparent entry last).
+    local: Option<Vec<u8>>,
+    switches: u64,
 }
+
+/// A pixel counts as badly represented when some colour of its 15-bit cell (5 bits per
+/// channel) is farther than this from the cell's palette colour in some channel (8-bit units;
+/// a bound on the pixel's own error that costs one table read).
+pub const BAD_PIXEL_ERROR: u8 = 40;
+/// When more than this share of a frame's pixels are badly represented (a colour appeared that
+/// the palette's sample frames did not have), the writer switches to a palette made from that
+/// frame, carried as a local palette from then on.
+pub const BAD_PIXEL_SHARE: f64 = 0.0005;
 
 impl<W: Write> GifWriter<W> {
     /// A GIF of `width` × `height` px (1..=65535) at `fps` frames per second (in (0, 50]:
@@ -240,6 +274,8 @@ impl<W: Write> GifWriter<W> {
             sub: Vec::new(),
             frames: 0,
             bytes_hint: 0,
+            local: None,
+            switches: 0,
         })
     }
 
@@ -251,6 +287,23 @@ impl<W: Write> GifWriter<W> {
     /// Pixels stored in the frames so far (after cropping to what changed).
     pub fn pixels_stored(&self) -> u64 {
         self.bytes_hint
+    }
+
+    /// How many times a frame with colours the palette did not represent made the writer
+    /// switch to a palette built from that frame (see [`BAD_PIXEL_SHARE`]).
+    pub fn palette_switches(&self) -> u64 {
+        self.switches
+    }
+
+    /// Palette indices of `img` into `self.cur`; returns how many pixels are badly represented.
+    fn index(&mut self, img: &Image) -> usize {
+        let mut bad = 0;
+        for (dst, px) in self.cur.iter_mut().zip(img.data().chunks_exact(4)) {
+            let k = key(px[0], px[1], px[2]);
+            *dst = self.palette.lut[k];
+            bad += usize::from(self.palette.cell_err[k] > BAD_PIXEL_ERROR);
+        }
+        bad
     }
 
     /// Appends one image (it must have the GIF's size).
@@ -265,12 +318,21 @@ impl<W: Write> GifWriter<W> {
         }
         let w = self.width as usize;
         let h = self.height as usize;
-        for (dst, px) in self.cur.iter_mut().zip(img.data().chunks_exact(4)) {
-            *dst = self.palette.lut[key(px[0], px[1], px[2])];
+        let bad = self.index(img);
+        let mut full = self.frames == 0;
+        if bad as f64 > BAD_PIXEL_SHARE * (w * h) as f64 {
+            self.palette = Palette::from_images(&[img], 255)?;
+            let mut flat: Vec<u8> = self.palette.colors.iter().flatten().copied().collect();
+            flat.extend_from_slice(&[0, 0, 0]);
+            self.local = Some(flat);
+            self.switches += 1;
+            self.index(img);
+            full = true;
         }
         let transparent = self.palette.colors.len() as u8;
         let delay = delay_cs(self.frames, self.fps);
-        let frame = if self.frames == 0 {
+        let palette = self.local.clone();
+        let frame = if full {
             self.bytes_hint += (w * h) as u64;
             gif::Frame {
                 delay,
@@ -278,6 +340,7 @@ impl<W: Write> GifWriter<W> {
                 width: self.width as u16,
                 height: self.height as u16,
                 buffer: std::borrow::Cow::Borrowed(&self.cur),
+                palette,
                 ..gif::Frame::default()
             }
         } else {
@@ -327,6 +390,7 @@ impl<W: Write> GifWriter<W> {
                 width: (x1 - x0 + 1) as u16,
                 height: (y1 - y0 + 1) as u16,
                 buffer: std::borrow::Cow::Borrowed(&self.sub),
+                palette,
                 ..gif::Frame::default()
             }
         };

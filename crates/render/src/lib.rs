@@ -44,7 +44,7 @@ mod text;
 pub use camera::{Camera, MAX_SIDE_PX, Projected, View};
 pub use error::RenderError;
 pub use frame::{Frame, Style, format_length, nice_length_m};
-pub use gif::{GifWriter, Palette, frame_delays_cs};
+pub use gif::{BAD_PIXEL_ERROR, BAD_PIXEL_SHARE, GifWriter, Palette, frame_delays_cs};
 pub use image::Image;
 pub use math::Vec3;
 pub use primitive::{Primitive, Rgba};

@@ -176,3 +176,78 @@ fn bad_gif_settings_are_refused() {
         "palette needs at least one image with at least one pixel"
     );
 }
+
+#[test]
+fn a_colour_missing_from_the_palette_switches_to_a_frame_palette() {
+    // palette from a frame with only the red particle; later a green particle appears
+    let cam = Camera::new(View::Top, [0.0; 3], 1e8, W, H).expect("camera");
+    let draw = |green: bool| {
+        let mut f = Frame::new(cam, Style::default()).expect("frame");
+        f.push(Primitive::Sphere {
+            center_m: [-3e-7, 0.0, 0.0],
+            radius_m: 1e-7,
+            color: Rgba([0.85, 0.15, 0.1, 1.0]),
+        })
+        .expect("red");
+        if green {
+            f.push(Primitive::Sphere {
+                center_m: [3e-7, 0.0, 0.0],
+                radius_m: 2e-7,
+                color: Rgba([0.1, 0.8, 0.2, 1.0]),
+            })
+            .expect("green");
+        }
+        f.finish().expect("image")
+    };
+    let (red_only, both) = (draw(false), draw(true));
+    let pal = Palette::from_images(&[&red_only], 255).expect("palette");
+    let mut g = GifWriter::new(Vec::new(), W, H, 30.0, pal).expect("writer");
+    g.add_frame(&red_only).expect("frame 0");
+    g.add_frame(&both).expect("frame 1");
+    g.add_frame(&both).expect("frame 2");
+    g.add_frame(&red_only).expect("frame 3");
+    assert_eq!(g.palette_switches(), 1);
+    let d = decode_local(&g.finish().expect("gif"));
+    assert_eq!(d.len(), 4);
+    // the green particle's centre (110, 60) decodes green in frames 1 and 2
+    let want = both.pixel(110, 60).expect("pixel");
+    for (i, canvas) in d.iter().enumerate().skip(1).take(2) {
+        let c = canvas[60 * W as usize + 110];
+        for k in 0..3 {
+            assert!(c[k].abs_diff(want[k]) <= 8, "frame {i}: {c:?} vs {want:?}");
+        }
+    }
+    // and is background again in frame 3
+    let bg = Style::default().background.to_u8();
+    let c = d[3][60 * W as usize + 110];
+    for k in 0..3 {
+        assert!(c[k].abs_diff(bg[k]) <= 4, "frame 3: {c:?}");
+    }
+}
+
+/// Composited RGB canvases, honouring per-frame (local) palettes.
+fn decode_local(bytes: &[u8]) -> Vec<Vec<[u8; 3]>> {
+    let mut opts = gif::DecodeOptions::new();
+    opts.set_color_output(gif::ColorOutput::Indexed);
+    let mut dec = opts.read_info(bytes).expect("gif header");
+    let (w, h) = (usize::from(dec.width()), usize::from(dec.height()));
+    let global: Vec<u8> = dec.global_palette().expect("global").to_vec();
+    let mut canvas = vec![[0u8; 3]; w * h];
+    let mut out = Vec::new();
+    while let Some(fr) = dec.read_next_frame().expect("frame") {
+        let pal = fr.palette.clone().unwrap_or_else(|| global.clone());
+        for y in 0..usize::from(fr.height) {
+            for x in 0..usize::from(fr.width) {
+                let idx = fr.buffer[y * usize::from(fr.width) + x];
+                if Some(idx) == fr.transparent {
+                    continue;
+                }
+                let k = 3 * usize::from(idx);
+                canvas[(usize::from(fr.top) + y) * w + usize::from(fr.left) + x] =
+                    [pal[k], pal[k + 1], pal[k + 2]];
+            }
+        }
+        out.push(canvas.clone());
+    }
+    out
+}
