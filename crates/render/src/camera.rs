@@ -7,7 +7,8 @@
 //! scale bar is exact.
 
 use crate::error::{RenderError, finite, finite3};
-use crate::math::{Vec3, cross, dot, normalize, sub};
+use crate::math::{Vec3, add, axes, cross, dot, normalize, scale, sub};
+use crate::primitive::Primitive;
 
 /// Largest image side the renderer makes, px.
 pub const MAX_SIDE_PX: u32 = 8192;
@@ -77,6 +78,91 @@ impl View {
         }
         Ok(())
     }
+}
+
+impl std::str::FromStr for View {
+    type Err = RenderError;
+
+    /// `top`, `side` or `oblique` (the default oblique view), as typed on a command line.
+    fn from_str(s: &str) -> Result<View, RenderError> {
+        match s {
+            "top" => Ok(View::Top),
+            "side" => Ok(View::Side),
+            "oblique" => Ok(View::oblique_default()),
+            other => Err(RenderError::UnknownName {
+                field: "view".into(),
+                got: other.into(),
+                allowed: "top, side, oblique",
+            }),
+        }
+    }
+}
+
+/// The axis-aligned box (m) holding every primitive's extent: spheres and cursors with their
+/// radius, boxes and slots with their rotated corners, ellipses with their semi-axes,
+/// polylines and arrows with their points; labels count by their anchor only (text has no
+/// size in metres). `None` when there is nothing with a position.
+pub fn bounds(prims: &[Primitive]) -> Option<(Vec3, Vec3)> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut grow = |p: Vec3| {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    };
+    for p in prims {
+        match p {
+            Primitive::Sphere {
+                center_m, radius_m, ..
+            }
+            | Primitive::Cursor {
+                center_m, radius_m, ..
+            } => {
+                grow(sub(*center_m, [*radius_m; 3]));
+                grow(add(*center_m, [*radius_m; 3]));
+            }
+            Primitive::Box {
+                center_m,
+                half_extents_m,
+                rotation,
+                ..
+            }
+            | Primitive::Slot {
+                center_m,
+                half_extents_m,
+                rotation,
+                ..
+            } => {
+                let n = rotation.iter().map(|v| v * v).sum::<f64>().sqrt();
+                let ax = axes(rotation.map(|v| v / n));
+                for k in 0..8 {
+                    let mut c = *center_m;
+                    for (i, a) in ax.iter().enumerate() {
+                        let sgn = if k & (1 << i) == 0 { -1.0 } else { 1.0 };
+                        c = add(c, scale(*a, sgn * half_extents_m[i]));
+                    }
+                    grow(c);
+                }
+            }
+            Primitive::Ellipse {
+                center_m,
+                semi_axes_m,
+                ..
+            } => {
+                let e = [semi_axes_m[0], semi_axes_m[1], 0.0];
+                grow(sub(*center_m, e));
+                grow(add(*center_m, e));
+            }
+            Primitive::Polyline { points_m, .. } => points_m.iter().for_each(|q| grow(*q)),
+            Primitive::Arrow { from_m, to_m, .. } => {
+                grow(*from_m);
+                grow(*to_m);
+            }
+            Primitive::Label { position_m, .. } => grow(*position_m),
+        }
+    }
+    (lo[0] <= hi[0]).then_some((lo, hi))
 }
 
 /// A point after projection.
@@ -211,6 +297,24 @@ impl Camera {
         Camera::new(view, center, s, width_px, height_px)
     }
 
+    /// A camera from `view` that fits every primitive ([`bounds`]) into the image with
+    /// `margin` (fraction of each side, in [0, 0.45]) free around them. A single point (or
+    /// nothing) has no extent to fit and gives an error.
+    pub fn fit_primitives(
+        view: View,
+        prims: &[Primitive],
+        width_px: u32,
+        height_px: u32,
+        margin: f64,
+    ) -> Result<Camera, RenderError> {
+        let (lo, hi) = bounds(prims).ok_or(RenderError::OutOfRange {
+            field: "fit.primitives".into(),
+            value: 0.0,
+            allowed: "at least one primitive with a position",
+        })?;
+        Camera::fit(view, lo, hi, width_px, height_px, margin)
+    }
+
     /// Projects a world point (m).
     pub fn project(&self, p_m: Vec3) -> Projected {
         let d = sub(p_m, self.center_m);
@@ -328,6 +432,59 @@ mod tests {
         assert!((c.pixels_per_m() - 80.0).abs() < 1e-12);
         let p = c.project([1.0, 2.0, 0.0]);
         assert!((p.y_px - 40.0).abs() < 1e-9 && (p.x_px - 280.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn fitted_primitives_land_inside_the_margin() {
+        use crate::primitive::Rgba;
+        let c = Rgba([1.0, 0.0, 0.0, 1.0]);
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let prims = vec![
+            Primitive::Sphere {
+                center_m: [1.0, 2.0, 0.5],
+                radius_m: 0.5,
+                color: c,
+            },
+            Primitive::Box {
+                center_m: [-1.0, 0.0, 0.0],
+                half_extents_m: [1.0, 0.1, 0.1],
+                rotation: [0.0, 0.0, h, h], // long axis turned onto y
+                color: c,
+            },
+        ];
+        let (lo, hi) = bounds(&prims).expect("bounds");
+        assert!((lo[0] + 1.1).abs() < 1e-12 && (hi[0] - 1.5).abs() < 1e-12);
+        assert!((lo[1] + 1.0).abs() < 1e-12 && (hi[1] - 2.5).abs() < 1e-12);
+        for view in [View::Top, View::Side, View::oblique_default()] {
+            let cam = Camera::fit_primitives(view, &prims, 300, 200, 0.1).expect("camera");
+            for k in 0..8 {
+                let p = [
+                    if k & 1 == 0 { lo[0] } else { hi[0] },
+                    if k & 2 == 0 { lo[1] } else { hi[1] },
+                    if k & 4 == 0 { lo[2] } else { hi[2] },
+                ];
+                let q = cam.project(p);
+                assert!(
+                    (30.0 - 1e-9..=270.0 + 1e-9).contains(&q.x_px),
+                    "{view:?} {q:?}"
+                );
+                assert!(
+                    (20.0 - 1e-9..=180.0 + 1e-9).contains(&q.y_px),
+                    "{view:?} {q:?}"
+                );
+            }
+        }
+        assert!(Camera::fit_primitives(View::Top, &[], 10, 10, 0.1).is_err());
+    }
+
+    #[test]
+    fn views_parse_from_their_names() {
+        assert_eq!("top".parse::<View>(), Ok(View::Top));
+        assert_eq!("oblique".parse::<View>(), Ok(View::oblique_default()));
+        assert_eq!(
+            "front".parse::<View>().unwrap_err().to_string(),
+            "view = \"front\" is not known: allowed top, side, oblique"
+        );
     }
 
     #[test]

@@ -25,6 +25,16 @@ pub enum RenderError {
         /// The allowed range, written out, e.g. `(0, 50] frames/s`.
         allowed: &'static str,
     },
+    /// A name that is not one of the allowed ones.
+    #[error("{field} = {got:?} is not known: allowed {allowed}")]
+    UnknownName {
+        /// Name of the field, e.g. `view`.
+        field: String,
+        /// The name given.
+        got: String,
+        /// The allowed names.
+        allowed: &'static str,
+    },
     /// An image size the renderer cannot make.
     #[error("image size {width_px}x{height_px} px is out of range: allowed 1..={max} px per side")]
     ImageSize {

@@ -41,7 +41,7 @@ mod order;
 pub mod primitive;
 mod text;
 
-pub use camera::{Camera, MAX_SIDE_PX, Projected, View};
+pub use camera::{Camera, MAX_SIDE_PX, Projected, View, bounds};
 pub use error::RenderError;
 pub use frame::{Frame, Style, format_length, nice_length_m};
 pub use gif::{BAD_PIXEL_ERROR, BAD_PIXEL_SHARE, GifWriter, Palette, frame_delays_cs};
