@@ -64,13 +64,14 @@ pub(crate) struct TextPath {
 }
 
 /// Lays out one line of `text` with its baseline starting at (`x`, `y`) px, `size_px` pixels
-/// per em. Characters missing from the font draw as the font's missing-glyph box.
+/// per em. Characters missing from the font draw as the font's missing-glyph box; control
+/// characters (e.g. a newline) are skipped.
 pub(crate) fn layout(text: &str, x: f32, y: f32, size_px: f32) -> Result<TextPath, RenderError> {
     let face = face()?;
     let k = size_px / f32::from(face.units_per_em());
     let mut pb = PathBuilder::new();
     let mut pen = x;
-    for ch in text.chars() {
+    for ch in text.chars().filter(|c| !c.is_control()) {
         let g = face.glyph_index(ch).unwrap_or(GlyphId(0));
         let mut sink = Sink {
             pb: &mut pb,
@@ -101,5 +102,8 @@ mod tests {
         // glyphs sit above the baseline (y grows downward) and within the advance
         assert!(bounds.top() < -5.0 && bounds.bottom() <= 3.0);
         assert!(bounds.right() <= a.width_px + 1.0);
+        // control characters take no room
+        let c = layout("1 \num\n", 0.0, 0.0, 10.0).expect("font");
+        assert_eq!(c.width_px, a.width_px);
     }
 }

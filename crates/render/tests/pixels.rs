@@ -708,6 +708,18 @@ fn things_far_outside_the_image_leave_it_blank() {
             color: RED,
         })
         .expect("box");
+        f.push(Primitive::Arrow {
+            from_m: [0.0, far, 0.0],
+            to_m: [0.0, 2.0 * far, 0.0],
+            color: RED,
+        })
+        .expect("arrow");
+        f.push(Primitive::Label {
+            position_m: [far, -far, 0.0],
+            text: "far".into(),
+            color: RED,
+        })
+        .expect("label");
     }
     let img = f.finish().expect("image");
     let b = bg();
