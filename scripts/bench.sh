@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates BENCHMARKS.md and the plots under docs/figures/ in one command:
-# every crate's `bench_report` example writes docs/bench/<crate>.md, then the
+# every crate's report example (`<crate>-report`, examples/bench_report.rs)
+# writes docs/bench/<crate>.md, then the
 # sections are assembled in a fixed order. A Python venv with scipy (the
 # ot-physics peer) is created in .venv-bench on first use.
 set -euo pipefail
@@ -17,8 +18,8 @@ export NANOHAPTICS_PYTHON="$PWD/.venv-bench/bin/python"
 order=(ot-physics ot-envelope haptic-loop brickworld nanoworld render)
 for crate in "${order[@]}"; do
   if [ -f "crates/$crate/examples/bench_report.rs" ]; then
-    echo "==> $crate bench_report"
-    cargo run --release -q -p "$crate" --example bench_report > /dev/null
+    echo "==> $crate-report"
+    cargo run --release -q -p "$crate" --example "$crate-report" > /dev/null
   fi
 done
 

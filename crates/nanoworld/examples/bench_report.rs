@@ -1,7 +1,7 @@
 //! Measures the nano world's speed and accuracy and writes `docs/bench/nanoworld.md` plus
 //! `docs/figures/nanoworld-*.png`.
 //!
-//! Run: `cargo run --release -p nanoworld --example bench_report` (about a minute).
+//! Run: `cargo run --release -p nanoworld --example nanoworld-report` (about a minute).
 
 use std::error::Error;
 use std::fmt::Write as _;
@@ -234,7 +234,7 @@ fn main() -> Res<()> {
     writeln!(md, "## nanoworld\n")?;
     writeln!(
         md,
-        "`cargo run --release -p nanoworld --example bench_report` (one run, one machine shared with other jobs; quote ratios, not absolute times).\n"
+        "`cargo run --release -p nanoworld --example nanoworld-report` (one run, one machine shared with other jobs; quote ratios, not absolute times).\n"
     )?;
 
     // ---- tick cost against substrate size --------------------------------------------------

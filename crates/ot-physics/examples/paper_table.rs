@@ -50,7 +50,7 @@ fn main() -> Result<(), ot_physics::PhysicsError> {
     }
     let _ = paper::DT;
     println!(
-        "\nFull work-precision sweep: cargo run --release -p ot-physics --example bench_report"
+        "\nFull work-precision sweep: cargo run --release -p ot-physics --example ot-physics-report"
     );
     Ok(())
 }

@@ -1,0 +1,81 @@
+//! Typed errors: every one names the offending field and the allowed range.
+
+use thiserror::Error;
+
+/// A scene parameter (or a run-time switch) is outside its allowed range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ParamError {
+    /// A number is outside its closed/open range. `range` is human readable, e.g. `"(0, 1e4]"`.
+    #[error("parameter `{field}` = {value} is out of range: allowed {range}")]
+    OutOfRange {
+        /// Dotted path of the field, e.g. `blueprint.slots[2].center_m[0]`.
+        field: String,
+        /// The rejected value (may be NaN or infinite).
+        value: f64,
+        /// The allowed range, written as an interval.
+        range: String,
+    },
+    /// A count is outside its allowed range.
+    #[error("parameter `{field}` = {value} is out of range: allowed {range}")]
+    CountOutOfRange {
+        /// Dotted path of the field.
+        field: String,
+        /// The rejected count.
+        value: usize,
+        /// The allowed range, written as an interval.
+        range: String,
+    },
+    /// A structural constraint between fields does not hold (e.g. `min < max`).
+    #[error("parameter `{field}` is invalid: {reason}")]
+    Inconsistent {
+        /// Dotted path of the field.
+        field: String,
+        /// What must hold.
+        reason: String,
+    },
+}
+
+/// A cursor sample from a device or script cannot be used.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum InputError {
+    /// A position component is NaN or infinite.
+    #[error("cursor input `position_m[{axis}]` = {value} is not finite")]
+    NotFinite {
+        /// Component index 0..3 (x, y, z).
+        axis: usize,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A position component is outside the world's workspace box.
+    #[error(
+        "cursor input `position_m[{axis}]` = {value} m is outside the workspace: allowed [-{limit}, {limit}] m"
+    )]
+    OutsideWorkspace {
+        /// Component index 0..3 (x, y, z).
+        axis: usize,
+        /// The rejected value in m.
+        value: f64,
+        /// The workspace half-extent in m (`Params::workspace_half_extent_m`).
+        limit: f64,
+    },
+}
+
+/// An operation on a built world was refused.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum WorldError {
+    /// Bad parameter.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// Bad cursor input.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// `add_brick` would exceed `Params::max_bricks`.
+    #[error("cannot add brick: `max_bricks` = {max} reached")]
+    TooManyBricks {
+        /// The limit in force.
+        max: usize,
+    },
+    /// A brick id that this world never issued.
+    #[error("unknown brick id {0}")]
+    UnknownBrick(u32),
+}

@@ -1,0 +1,411 @@
+//! World parameters (what never changes during a step), deserializable from a TOML table.
+//!
+//! Every field is SI and says its unit in its name where a human types it. [`Params::validate`]
+//! checks every field against its range and returns a [`ParamError`] naming the field.
+//! Run-time switches (gravity, restitution, friction, inertia, brick mass) are changed through
+//! the validated setters on [`crate::World`], which reuse the same range checks.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ParamError;
+
+/// The world frame is right-handed with `z` up; the ground is the plane `z = 0`.
+/// Gravity (when on) points along `-z`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// Physics and haptic time step in s. The haptic loop runs at `1 / dt_s` (1 kHz by default).
+    /// Range `[1e-4, 1e-2]`.
+    pub dt_s: f64,
+    /// Magnitude of gravity in m/s² (0 switches gravity off). Range `[0, 100]`.
+    pub gravity_m_s2: f64,
+    /// Coefficient of restitution of every contact (0 = no bounce). Range `[0, 1]`.
+    pub restitution: f64,
+    /// Coulomb friction coefficient of every contact (0 = frictionless). Range `[0, 10]`.
+    pub friction: f64,
+    /// Whether the inertial force `-M a` of a held brick is sent to the device.
+    pub inertia: bool,
+    /// How the cursor acceleration for the inertial force is estimated.
+    pub accel_estimator: AccelEstimator,
+    /// Mass of one brick in kg. Range `[1e-3, 100]`.
+    pub brick_mass_kg: f64,
+    /// Half-extents of a brick along its local x, y, z axes in m. Each in `[1e-3, 1]`.
+    pub brick_half_extents_m: [f64; 3],
+    /// Stiffness of the proxy spring `F = -k d n` in N/m. Range `(0, device max stiffness]`.
+    pub proxy_stiffness_n_m: f64,
+    /// Radius of the cursor sphere (the god-object) in m. Range `[1e-4, 0.1]`.
+    pub proxy_radius_m: f64,
+    /// A brick can be grabbed when the cursor sphere is within this gap of its surface, in m.
+    /// Range `[0, 0.1]`.
+    pub grab_distance_m: f64,
+    /// A release faster than this is reported as a throw, in m/s. Range `[0, 100]`.
+    pub throw_min_speed_m_s: f64,
+    /// Cursor inputs must satisfy `|x|, |y|, |z| <= workspace_half_extent_m` (m). Range `(0, 100]`.
+    pub workspace_half_extent_m: f64,
+    /// Largest number of bricks the world may hold. Range `[0, 10000]`.
+    pub max_bricks: usize,
+    /// Rigid-body solver iterations per step (rapier substeps). Range `[1, 64]`.
+    pub solver_iterations: usize,
+    /// Natural frequency of rapier's soft contact constraints, Hz (rapier's default, 30 Hz, is
+    /// tuned for 60 Hz games and lets a 10-brick stack settle 31 mm). Range `[1, 1000]`.
+    pub contact_frequency_hz: f64,
+    /// Whether resting bricks may fall asleep (stop being simulated until disturbed).
+    pub sleeping: bool,
+    /// The loading zone that supplies bricks; `None` (the default: no `[loading_zone]` table)
+    /// disables spawning. [`LoadingZone::default`] is a 30 cm × 60 cm zone left of the origin.
+    pub loading_zone: Option<LoadingZone>,
+    /// The house to build; empty slots means no task.
+    pub blueprint: Blueprint,
+    /// Bricks present at the start.
+    pub bricks: Vec<BrickPlacement>,
+    /// Fixed boxes (tables, ramps, walls) besides the ground.
+    pub obstacles: Vec<Obstacle>,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Self {
+            dt_s: 1e-3,
+            gravity_m_s2: 9.81,
+            restitution: 0.2,
+            friction: 0.6,
+            inertia: true,
+            accel_estimator: AccelEstimator::Paper,
+            brick_mass_kg: 0.5,
+            brick_half_extents_m: [0.1, 0.05, 0.03],
+            proxy_stiffness_n_m: 1000.0,
+            proxy_radius_m: 0.005,
+            grab_distance_m: 0.005,
+            throw_min_speed_m_s: 0.2,
+            workspace_half_extent_m: 2.0,
+            max_bricks: 200,
+            solver_iterations: 4,
+            contact_frequency_hz: 500.0,
+            sleeping: true,
+            loading_zone: None,
+            blueprint: Blueprint::default(),
+            bricks: Vec::new(),
+            obstacles: Vec::new(),
+        }
+    }
+}
+
+/// Estimator of the cursor acceleration used for the inertial force `F = -M a`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum AccelEstimator {
+    /// The paper's stencil over the last five samples, `a = (B4 - 2 B2 + B0) / (2 dt)²`
+    /// (the paper omits the `(2 dt)²` scale). Exact for quadratic motion, 2 ticks of lag,
+    /// noise gain `sqrt(6) / (4 dt²)` times the position noise.
+    Paper,
+    /// Least-squares quadratic fit (Savitzky–Golay) over the last `window` samples; the
+    /// acceleration is twice the fitted quadratic coefficient. Exact for quadratic motion,
+    /// `(window - 1) / 2` ticks of lag, far less noise. `window` in `[5, 201]`.
+    SavitzkyGolay {
+        /// Number of samples in the fit (ticks).
+        window: usize,
+    },
+}
+
+/// The loading zone: an axis-aligned rectangle on the ground. When the cursor enters it (from
+/// outside), a brick appears at `spawn_m` if that spot is clear.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadingZone {
+    /// Lower corner (x, y) of the zone in m.
+    pub min_m: [f64; 2],
+    /// Upper corner (x, y) of the zone in m; must exceed `min_m` on both axes.
+    pub max_m: [f64; 2],
+    /// Height of the zone above the ground in m (the cursor must be below it). Range `(0, 10]`.
+    pub height_m: f64,
+    /// Where the spawned brick's centre appears (x, y) in m; it rests flat on the ground.
+    pub spawn_m: [f64; 2],
+}
+
+impl Default for LoadingZone {
+    fn default() -> Self {
+        Self {
+            min_m: [-0.6, -0.3],
+            max_m: [-0.3, 0.3],
+            height_m: 0.5,
+            spawn_m: [-0.45, 0.0],
+        }
+    }
+}
+
+/// Pose of a brick: centre in m and orientation as a rotation vector in degrees
+/// (axis times angle; `[0, 0, 90]` is a quarter turn about z).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BrickPlacement {
+    /// Centre of the brick in the world frame, m.
+    pub center_m: [f64; 3],
+    /// Rotation vector (axis · angle) in degrees.
+    #[serde(default)]
+    pub rotation_deg: [f64; 3],
+}
+
+/// A fixed box (table, ramp, wall).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Obstacle {
+    /// Centre in the world frame, m.
+    pub center_m: [f64; 3],
+    /// Half-extents along the box's local axes, m. Each in `[1e-3, 100]`.
+    pub half_extents_m: [f64; 3],
+    /// Rotation vector (axis · angle) in degrees.
+    #[serde(default)]
+    pub rotation_deg: [f64; 3],
+}
+
+/// The house to build: brick slots and the tolerances that decide whether a slot is filled.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Blueprint {
+    /// Target brick poses.
+    pub slots: Vec<BrickPlacement>,
+    /// A slot is filled by a brick whose centre is within this distance, m. Range `(0, 1]`.
+    pub position_tolerance_m: f64,
+    /// ... and whose orientation is within this angle (up to the box's symmetries), degrees.
+    /// Range `(0, 90]`.
+    pub angle_tolerance_deg: f64,
+}
+
+impl Default for Blueprint {
+    fn default() -> Self {
+        Self {
+            slots: Vec::new(),
+            position_tolerance_m: 0.01,
+            angle_tolerance_deg: 5.0,
+        }
+    }
+}
+
+/// Limits of the haptic device the world renders to (CHAI3D-style device specification).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviceLimits {
+    /// Largest stiffness the device renders stably, N/m.
+    pub max_stiffness_n_m: f64,
+    /// Largest force magnitude the device can produce, N.
+    pub max_force_n: f64,
+}
+
+impl DeviceLimits {
+    /// Nominal Novint Falcon figures: about 9 N peak force; a few kN/m of stable stiffness.
+    pub const NOVINT_FALCON: DeviceLimits = DeviceLimits {
+        max_stiffness_n_m: 3000.0,
+        max_force_n: 9.0,
+    };
+
+    /// Checks both limits are finite and positive.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        range(
+            "device.max_stiffness_n_m",
+            self.max_stiffness_n_m,
+            Lo::Open(0.0),
+            1e7,
+        )?;
+        range("device.max_force_n", self.max_force_n, Lo::Open(0.0), 1e5)
+    }
+}
+
+/// Lower bound of a range check.
+#[derive(Clone, Copy)]
+pub(crate) enum Lo {
+    /// `[lo, ...`
+    Closed(f64),
+    /// `(lo, ...`
+    Open(f64),
+}
+
+/// Checks `value` lies in `lo .. hi]` (upper bound closed); NaN always fails.
+pub(crate) fn range(field: &str, value: f64, lo: Lo, hi: f64) -> Result<(), ParamError> {
+    let (ok_lo, lo_txt) = match lo {
+        Lo::Closed(l) => (value >= l, format!("[{l}")),
+        Lo::Open(l) => (value > l, format!("({l}")),
+    };
+    if ok_lo && value <= hi {
+        Ok(())
+    } else {
+        Err(ParamError::OutOfRange {
+            field: field.to_string(),
+            value,
+            range: format!("{lo_txt}, {hi}]"),
+        })
+    }
+}
+
+fn count(field: &str, value: usize, lo: usize, hi: usize) -> Result<(), ParamError> {
+    if (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(ParamError::CountOutOfRange {
+            field: field.to_string(),
+            value,
+            range: format!("[{lo}, {hi}]"),
+        })
+    }
+}
+
+fn finite3(field: &str, v: &[f64; 3], limit: f64) -> Result<(), ParamError> {
+    for (i, x) in v.iter().enumerate() {
+        range(&format!("{field}[{i}]"), *x, Lo::Closed(-limit), limit)?;
+    }
+    Ok(())
+}
+
+fn placement(field: &str, p: &BrickPlacement) -> Result<(), ParamError> {
+    finite3(&format!("{field}.center_m"), &p.center_m, 100.0)?;
+    finite3(&format!("{field}.rotation_deg"), &p.rotation_deg, 3600.0)
+}
+
+impl Params {
+    /// Parses a TOML table and validates it.
+    pub fn from_toml(text: &str) -> Result<Params, ParamsFromTomlError> {
+        let p: Params =
+            toml::from_str(text).map_err(|e| ParamsFromTomlError::Toml(e.to_string()))?;
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// Checks every field against its documented range (device-independent part).
+    pub fn validate(&self) -> Result<(), ParamError> {
+        range("dt_s", self.dt_s, Lo::Closed(1e-4), 1e-2)?;
+        range("gravity_m_s2", self.gravity_m_s2, Lo::Closed(0.0), 100.0)?;
+        range("restitution", self.restitution, Lo::Closed(0.0), 1.0)?;
+        range("friction", self.friction, Lo::Closed(0.0), 10.0)?;
+        if let AccelEstimator::SavitzkyGolay { window } = self.accel_estimator {
+            count("accel_estimator.savitzky_golay.window", window, 5, 201)?;
+        }
+        range("brick_mass_kg", self.brick_mass_kg, Lo::Closed(1e-3), 100.0)?;
+        for (i, h) in self.brick_half_extents_m.iter().enumerate() {
+            range(
+                &format!("brick_half_extents_m[{i}]"),
+                *h,
+                Lo::Closed(1e-3),
+                1.0,
+            )?;
+        }
+        range(
+            "proxy_stiffness_n_m",
+            self.proxy_stiffness_n_m,
+            Lo::Open(0.0),
+            1e7,
+        )?;
+        range("proxy_radius_m", self.proxy_radius_m, Lo::Closed(1e-4), 0.1)?;
+        range(
+            "grab_distance_m",
+            self.grab_distance_m,
+            Lo::Closed(0.0),
+            0.1,
+        )?;
+        range(
+            "throw_min_speed_m_s",
+            self.throw_min_speed_m_s,
+            Lo::Closed(0.0),
+            100.0,
+        )?;
+        range(
+            "workspace_half_extent_m",
+            self.workspace_half_extent_m,
+            Lo::Open(0.0),
+            100.0,
+        )?;
+        count("max_bricks", self.max_bricks, 0, 10_000)?;
+        count("solver_iterations", self.solver_iterations, 1, 64)?;
+        range(
+            "contact_frequency_hz",
+            self.contact_frequency_hz,
+            Lo::Closed(1.0),
+            1000.0,
+        )?;
+        if let Some(z) = &self.loading_zone {
+            for i in 0..2 {
+                range(
+                    &format!("loading_zone.min_m[{i}]"),
+                    z.min_m[i],
+                    Lo::Closed(-100.0),
+                    100.0,
+                )?;
+                range(
+                    &format!("loading_zone.max_m[{i}]"),
+                    z.max_m[i],
+                    Lo::Closed(-100.0),
+                    100.0,
+                )?;
+                if z.min_m[i] >= z.max_m[i] {
+                    return Err(ParamError::Inconsistent {
+                        field: format!("loading_zone.max_m[{i}]"),
+                        reason: format!("must exceed loading_zone.min_m[{i}] = {}", z.min_m[i]),
+                    });
+                }
+                range(
+                    &format!("loading_zone.spawn_m[{i}]"),
+                    z.spawn_m[i],
+                    Lo::Closed(-100.0),
+                    100.0,
+                )?;
+            }
+            range("loading_zone.height_m", z.height_m, Lo::Open(0.0), 10.0)?;
+        }
+        for (i, s) in self.blueprint.slots.iter().enumerate() {
+            placement(&format!("blueprint.slots[{i}]"), s)?;
+        }
+        range(
+            "blueprint.position_tolerance_m",
+            self.blueprint.position_tolerance_m,
+            Lo::Open(0.0),
+            1.0,
+        )?;
+        range(
+            "blueprint.angle_tolerance_deg",
+            self.blueprint.angle_tolerance_deg,
+            Lo::Open(0.0),
+            90.0,
+        )?;
+        count("bricks", self.bricks.len(), 0, self.max_bricks)?;
+        for (i, b) in self.bricks.iter().enumerate() {
+            placement(&format!("bricks[{i}]"), b)?;
+        }
+        for (i, o) in self.obstacles.iter().enumerate() {
+            finite3(&format!("obstacles[{i}].center_m"), &o.center_m, 100.0)?;
+            finite3(
+                &format!("obstacles[{i}].rotation_deg"),
+                &o.rotation_deg,
+                3600.0,
+            )?;
+            for (k, h) in o.half_extents_m.iter().enumerate() {
+                range(
+                    &format!("obstacles[{i}].half_extents_m[{k}]"),
+                    *h,
+                    Lo::Closed(1e-3),
+                    100.0,
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the parameters that depend on the device (the proxy stiffness).
+    pub fn validate_for_device(&self, device: &DeviceLimits) -> Result<(), ParamError> {
+        device.validate()?;
+        range(
+            "proxy_stiffness_n_m",
+            self.proxy_stiffness_n_m,
+            Lo::Open(0.0),
+            device.max_stiffness_n_m,
+        )
+    }
+}
+
+/// Failure to read parameters from TOML text.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamsFromTomlError {
+    /// The text is not valid TOML for [`Params`] (unknown field, wrong type, ...).
+    #[error("invalid brickworld parameters: {0}")]
+    Toml(String),
+    /// The table parsed but a value is out of range.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+}

@@ -1,0 +1,40 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use brickworld::{BrickPlacement, Buttons, DeviceLimits, Params, StepReport, World};
+
+/// Parameters with no loading zone and no blueprint: only what a test adds.
+pub fn bare() -> Params {
+    Params::default()
+}
+
+/// A brick at `c` (m), axis aligned.
+pub fn at(c: [f64; 3]) -> BrickPlacement {
+    BrickPlacement {
+        center_m: c,
+        rotation_deg: [0.0; 3],
+    }
+}
+
+/// Builds a world with the Falcon limits.
+pub fn world(p: Params) -> World {
+    World::new(p, DeviceLimits::NOVINT_FALCON).expect("valid test params")
+}
+
+/// Steps with the cursor parked at `pos` (m), no buttons.
+pub fn idle(w: &mut World, pos: [f64; 3]) -> StepReport {
+    let i = w
+        .input(pos, Buttons::default())
+        .expect("cursor inside workspace");
+    w.step(&i)
+}
+
+/// Steps with the cursor at `pos` and the centre button as given.
+pub fn hold(w: &mut World, pos: [f64; 3], center: bool) -> StepReport {
+    let b = Buttons {
+        center,
+        ..Buttons::default()
+    };
+    let i = w.input(pos, b).expect("cursor inside workspace");
+    w.step(&i)
+}
