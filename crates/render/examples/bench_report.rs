@@ -196,14 +196,27 @@ fn main() -> Result<(), BoxError> {
 
     eprintln!("[1/4] figures…");
     let fig9 = fig9_state();
-    let mut f = Frame::new(tweezers_camera(960, 720)?, Style::default())?;
-    draw_tweezers(&mut f, &fig9, true)?;
-    f.scale_bar(Some(1e-6), ink())?;
-    f.title(
-        "Optical tweezers, paper Fig. 9(b): steering right beyond the working envelope",
-        ink(),
-    )?;
-    f.finish()?.save_png(figs.join("render-fig9.png"))?;
+    let mut panels = Image::new(1600, 640)?;
+    for (k, (state, title)) in [
+        (
+            fig9a_state(),
+            "(a) initial screen: particle in the beam, cursor on the left",
+        ),
+        (
+            fig9.clone(),
+            "(b) steered right beyond the working envelope (×100)",
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut f = Frame::new(tweezers_camera(800, 640)?, Style::default())?;
+        draw_tweezers(&mut f, &state, true)?;
+        f.scale_bar(Some(1e-6), ink())?;
+        f.title(title, ink())?;
+        panels.draw_image(&f.finish()?, 800 * k as i32, 0);
+    }
+    panels.save_png(figs.join("render-fig9.png"))?;
     let mut f = Frame::new(bricks_camera(800, 600)?, Style::default())?;
     draw_bricks(&mut f, 41.0, true)?;
     f.title("Brick world at t = 41 s (oblique view)", ink())?;
@@ -443,9 +456,9 @@ fn report(
     writeln!(md, "### Paper Fig. 9, reproduced\n")?;
     writeln!(
         md,
-        "![Fig. 9 layout](../figures/render-fig9.png)\n\nParticle of 1 µm on a 2.9 µm grid, the \
-         beam as a rod of elliptic cross-section (a = 600 nm, b = 300 nm), the cursor 250 nm \
-         ahead, the working envelope for one 0.2 µs cycle at 50 nm/µs (computed here with the \
+        "![Fig. 9 layout](../figures/render-fig9.png)\n\n(a) The initial screen: a particle of \
+         1 µm on a 2.9 µm grid, the beam as a rod of elliptic cross-section (a = 600 nm, \
+         b = 300 nm), the cursor to the left. (b) Steering: the cursor 250 nm ahead, the working envelope for one 0.2 µs cycle at 50 nm/µs (computed here with the \
          paper's one-step RK4 map over trap positions: reach {:.1} nm along +x, {:.1} nm along \
          +y) drawn ×100, and the reaction force {:.1} pN (spring 0.05 pN/nm on the excess) \
          against the steering motion, drawn at 0.1 µm/pN.\n",

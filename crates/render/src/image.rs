@@ -58,6 +58,19 @@ impl Image {
         self.pixmap.data()
     }
 
+    /// Draws `other` over this image with its top-left corner at column `x`, row `y` (px; parts
+    /// outside are clipped), blending by its alpha. Used to put panels side by side.
+    pub fn draw_image(&mut self, other: &Image, x: i32, y: i32) {
+        self.pixmap.draw_pixmap(
+            x,
+            y,
+            other.pixmap.as_ref(),
+            &tiny_skia::PixmapPaint::default(),
+            tiny_skia::Transform::identity(),
+            None,
+        );
+    }
+
     /// The image as PNG bytes.
     pub fn encode_png(&self) -> Result<Vec<u8>, RenderError> {
         self.pixmap
@@ -70,5 +83,35 @@ impl Image {
         let bytes = self.encode_png()?;
         std::fs::write(path.as_ref(), bytes)
             .map_err(|e| RenderError::Png(format!("{}: {e}", path.as_ref().display())))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn panels_land_where_asked_and_clip() {
+        let mut big = Image::new(20, 10).expect("image");
+        big.pixmap.fill(tiny_skia::Color::WHITE);
+        let mut small = Image::new(4, 4).expect("image");
+        small
+            .pixmap
+            .fill(tiny_skia::Color::from_rgba8(200, 0, 0, 255));
+        big.draw_image(&small, 18, 3); // half outside on the right
+        assert_eq!(big.pixel(18, 3), Some([200, 0, 0, 255]));
+        assert_eq!(big.pixel(19, 6), Some([200, 0, 0, 255]));
+        assert_eq!(big.pixel(17, 3), Some([255, 255, 255, 255]));
+        assert_eq!(big.pixel(18, 7), Some([255, 255, 255, 255]));
+    }
+
+    #[test]
+    fn png_round_trip_keeps_the_pixels() {
+        let mut img = Image::new(3, 2).expect("image");
+        img.pixmap
+            .fill(tiny_skia::Color::from_rgba8(10, 20, 30, 255));
+        let png = img.encode_png().expect("png");
+        let back = tiny_skia::Pixmap::decode_png(&png).expect("decode");
+        assert_eq!(back.data(), img.data());
     }
 }

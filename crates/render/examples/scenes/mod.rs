@@ -164,6 +164,18 @@ pub fn fig9_state() -> Tweezers {
     }
 }
 
+/// Fig. 9(a): the initial screen, particle at rest in the trap, the cursor to its left, nothing
+/// grabbed (so no envelope and no force).
+pub fn fig9a_state() -> Tweezers {
+    Tweezers {
+        particle_m: [0.0, 0.0, 0.0],
+        trap_m: [0.0, 0.0, 0.0],
+        cursor_m: [-1.2e-6, 0.0, 0.0],
+        envelope_m: Vec::new(),
+        force_n: [0.0; 3],
+    }
+}
+
 /// Envelopes for velocities of 50 nm/µs in 36 directions, for animation.
 pub fn envelope_table() -> Vec<Vec<[f64; 2]>> {
     (0..36)
@@ -272,7 +284,9 @@ pub fn draw_tweezers(f: &mut Frame, s: &Tweezers, labels: bool) -> Result<(), Re
             ]
         })
         .collect();
-    f.scaled_loop(&env, s.particle_m, 100.0, envelope_color())?;
+    if !env.is_empty() {
+        f.scaled_loop(&env, s.particle_m, 100.0, envelope_color())?;
+    }
     let tip = [
         s.cursor_m[0] + FORCE_SCALE_M_PER_N * s.force_n[0],
         s.cursor_m[1] + FORCE_SCALE_M_PER_N * s.force_n[1],
@@ -311,12 +325,16 @@ pub fn draw_tweezers(f: &mut Frame, s: &Tweezers, labels: bool) -> Result<(), Re
                 envelope_color(),
             ),
             (
-                [tip[0] - 0.5e-6, tip[1] - 0.45e-6, 0.0],
+                [tip[0] - 1.2e-6, tip[1] - 1.0e-6, 0.0],
                 format!("force {:.1} pN", fmag * 1e12),
                 force_color(),
             ),
         ];
-        for (p, text, color) in items {
+        let grabbed = !s.envelope_m.is_empty();
+        for (k, (p, text, color)) in items.into_iter().enumerate() {
+            if !grabbed && k >= 3 {
+                break;
+            }
             f.push(Primitive::Label {
                 position_m: p,
                 text,
