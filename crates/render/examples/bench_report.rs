@@ -47,6 +47,12 @@ struct Run {
     cpu_s: Option<f64>,
     stored_frac: f64,
     switches: u64,
+    /// Mean time to encode one frame as PNG, s, and its mean size, bytes (sampled frames).
+    png_s: f64,
+    png_bytes: f64,
+    /// The same with the png crate's default (balanced) compression.
+    png_default_s: f64,
+    png_default_bytes: f64,
     mean_err: f64,
     max_err: u8,
 }
@@ -96,6 +102,8 @@ fn run_session(
     let (mut render, mut encode) = (Duration::ZERO, Duration::ZERO);
     let mut primitives = 0;
     let (mut err_sum, mut err_n, mut max_err) = (0.0f64, 0u64, 0u8);
+    let (mut png_t, mut png_b, mut png_n) = (Duration::ZERO, 0usize, 0u32);
+    let (mut pngd_t, mut pngd_b) = (Duration::ZERO, 0usize);
     for i in 0..frames {
         let a = Instant::now();
         frame.clear();
@@ -108,6 +116,14 @@ fn run_session(
         encode += c - b;
         primitives = primitives.max(frame.primitives().len());
         if i % 100 == 7 {
+            // PNG cost (what `render --out DIR` adds per frame), timed apart
+            let p0 = Instant::now();
+            png_b += img.encode_png()?.len();
+            png_t += p0.elapsed();
+            png_n += 1;
+            let p1 = Instant::now();
+            pngd_b += png_default(&img)?.len();
+            pngd_t += p1.elapsed();
             // palette error on every 100th frame (not timed)
             for px in img.data().chunks_exact(4) {
                 let q = pal.colors()[usize::from(pal.index_of([px[0], px[1], px[2]]))];
@@ -140,10 +156,28 @@ fn run_session(
         gif_bytes,
         cpu_s,
         switches,
+        png_s: png_t.as_secs_f64() / f64::from(png_n.max(1)),
+        png_bytes: png_b as f64 / f64::from(png_n.max(1)),
+        png_default_s: pngd_t.as_secs_f64() / f64::from(png_n.max(1)),
+        png_default_bytes: pngd_b as f64 / f64::from(png_n.max(1)),
         stored_frac: stored as f64 / (frames as f64 * f64::from(W * H)),
         mean_err: err_sum / err_n.max(1) as f64,
         max_err,
     })
+}
+
+/// PNG bytes with the png crate's default settings (balanced deflate, adaptive filter), for
+/// comparison with `Image::encode_png` (fast deflate).
+fn png_default(img: &Image) -> Result<Vec<u8>, BoxError> {
+    let data = img.to_rgba8();
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, img.width(), img.height());
+    enc.set_color(png::ColorType::Rgba);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header()?;
+    w.write_image_data(&data)?;
+    w.finish()?;
+    Ok(out)
 }
 
 /// Measured radius (px) of a ×100 loop of radius 3 nm at 1e8 px/m (expected 30 px): the mean
@@ -435,6 +469,33 @@ fn report(
         100.0 * render::BAD_PIXEL_SHARE,
         render::BAD_PIXEL_ERROR
     )?;
+    writeln!(
+        md,
+        "Writing every frame as a PNG as well (`nanohaptics render REC --out DIR`) adds the \
+         PNG encoding, measured (wall-clock) on every 100th frame. `Image::encode_png` uses the \
+         png crate's fast deflate; its default (balanced deflate, adaptive filter) is shown for \
+         comparison, same frames, same run:\n"
+    )?;
+    writeln!(
+        md,
+        "| session | PNG ms/frame (fast) | size (fast) | PNG ms/frame (default) | size (default) | speed-up | 1800 frames with PNGs: CPU above + fast PNG time |"
+    )?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|")?;
+    for r in runs {
+        let cpu = r.session_cpu_s().unwrap_or(r.session_s());
+        writeln!(
+            md,
+            "| {} | {:.2} | {:.0} kB | {:.2} | {:.0} kB | {:.1}× | {:.1} s |",
+            r.name,
+            r.png_s * 1e3,
+            r.png_bytes / 1e3,
+            r.png_default_s * 1e3,
+            r.png_default_bytes / 1e3,
+            r.png_default_s / r.png_s,
+            cpu + r.png_s * SECONDS * FPS
+        )?;
+    }
+    writeln!(md)?;
     writeln!(md, "![time per frame](../figures/render-speed.png)\n")?;
     writeln!(md, "### Geometry\n")?;
     writeln!(
