@@ -32,6 +32,7 @@
 //! ```
 
 pub mod camera;
+mod draw;
 pub mod error;
 pub mod frame;
 pub mod gif;
