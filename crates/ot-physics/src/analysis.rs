@@ -58,21 +58,10 @@ pub fn block_periodogram(x: &[f64], fs: f64, block: usize) -> (Vec<f64>, Vec<f64
     (freqs, psd)
 }
 
-/// Corner frequency (Hz) from the exact aliased (AR(1)) spectrum of
-/// instantaneous samples. `1/S(f)` is linear in `cos 2πfΔt`; a weighted
-/// least-squares fit of that line (weights `S²`, i.e. relative errors) gives
-/// `c`, hence `fc = −ln c / (2πΔt)`. Returns `None` if the fit is degenerate.
-pub fn fit_corner_aliased(freqs: &[f64], psd: &[f64], fs: f64) -> Option<f64> {
-    let dt = 1.0 / fs;
-    // weighted LSQ of y = α + β u, y = 1/S, u = cos(2π f dt), w = S²
+/// Weighted least-squares line `y = α + β u` through `(u, y, w)` points.
+fn weighted_line(points: impl Iterator<Item = (f64, f64, f64)>) -> Option<(f64, f64)> {
     let (mut sw, mut su, mut sy, mut suu, mut suy) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for (f, s) in freqs.iter().zip(psd) {
-        if *s <= 0.0 {
-            continue;
-        }
-        let u = (2.0 * std::f64::consts::PI * f * dt).cos();
-        let y = 1.0 / s;
-        let w = s * s;
+    for (u, y, w) in points {
         sw += w;
         su += w * u;
         sy += w * y;
@@ -84,7 +73,32 @@ pub fn fit_corner_aliased(freqs: &[f64], psd: &[f64], fs: f64) -> Option<f64> {
         return None;
     }
     let beta = (sw * suy - su * sy) / det;
-    let alpha = (sy - beta * su) / sw;
+    Some(((sy - beta * su) / sw, beta))
+}
+
+/// Points `(u(f), 1/S, S²)` of a periodogram: `1/S` is the quantity fitted,
+/// `S²` weights its residuals as relative errors of `S`.
+fn inverse_psd_points<'a>(
+    freqs: &'a [f64],
+    psd: &'a [f64],
+    u: impl Fn(f64) -> f64 + 'a,
+) -> impl Iterator<Item = (f64, f64, f64)> + 'a {
+    freqs
+        .iter()
+        .zip(psd)
+        .filter(|(_, s)| **s > 0.0)
+        .map(move |(f, s)| (u(*f), 1.0 / s, s * s))
+}
+
+/// Corner frequency (Hz) from the exact aliased (AR(1)) spectrum of
+/// instantaneous samples. `1/S(f)` is linear in `cos 2πfΔt`; a weighted
+/// least-squares fit of that line (weights `S²`, i.e. relative errors) gives
+/// `c`, hence `fc = −ln c / (2πΔt)`. Returns `None` if the fit is degenerate.
+pub fn fit_corner_aliased(freqs: &[f64], psd: &[f64], fs: f64) -> Option<f64> {
+    let dt = 1.0 / fs;
+    let (alpha, beta) = weighted_line(inverse_psd_points(freqs, psd, |f| {
+        (2.0 * std::f64::consts::PI * f * dt).cos()
+    }))?;
     let rho = -beta / alpha; // = 2c/(1+c²)
     if !(rho > 0.0 && rho < 1.0) {
         return None;
@@ -94,29 +108,10 @@ pub fn fit_corner_aliased(freqs: &[f64], psd: &[f64], fs: f64) -> Option<f64> {
 }
 
 /// Corner frequency (Hz) from the continuous Lorentzian `A/(fc² + f²)`
-/// fitted the same way, ignoring aliasing — kept to show its bias.
+/// fitted the same way (`1/S` is linear in `f²`), ignoring aliasing — kept
+/// to show its bias.
 pub fn fit_corner_lorentzian(freqs: &[f64], psd: &[f64]) -> Option<f64> {
-    // 1/S = (fc² + f²)/A: linear in f².
-    let (mut sw, mut su, mut sy, mut suu, mut suy) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for (f, s) in freqs.iter().zip(psd) {
-        if *s <= 0.0 {
-            continue;
-        }
-        let u = f * f;
-        let y = 1.0 / s;
-        let w = s * s;
-        sw += w;
-        su += w * u;
-        sy += w * y;
-        suu += w * u * u;
-        suy += w * u * y;
-    }
-    let det = sw * suu - su * su;
-    if det == 0.0 {
-        return None;
-    }
-    let beta = (sw * suy - su * sy) / det;
-    let alpha = (sy - beta * su) / sw;
+    let (alpha, beta) = weighted_line(inverse_psd_points(freqs, psd, |f| f * f))?;
     let fc2 = alpha / beta;
     (fc2 > 0.0).then(|| fc2.sqrt())
 }

@@ -23,6 +23,9 @@ pub struct Flow<const D: usize> {
     pub evals: u64,
 }
 
+/// Lanes of the lockstep batch path.
+const LANES: usize = 4;
+
 fn check<const D: usize>(field: &'static str, x: &SVector<f64, D>) -> Result<()> {
     for v in x.iter() {
         finite(field, *v)?;
@@ -88,16 +91,42 @@ impl<const D: usize> Propagator<D> {
                 got: out.len(),
             });
         }
-        let mut evals = 0;
-        for (i, (o, d)) in offsets.iter().zip(out.iter_mut()).enumerate() {
-            let v = if velocities.len() == 1 {
+        let vel = |i: usize| {
+            if velocities.len() == 1 {
                 &velocities[0]
             } else {
                 &velocities[i]
+            }
+        };
+        let mut evals = 0;
+        let mut i = 0;
+        // Fixed-step methods: four lanes in lockstep (same bits, overlapped).
+        while i + LANES <= n {
+            let mut y0 = [Phase {
+                r: SVector::zeros(),
+                v: SVector::zeros(),
+            }; LANES];
+            for (l, y) in y0.iter_mut().enumerate() {
+                check("offset [m]", &offsets[i + l])?;
+                check("velocity [m/s]", vel(i + l))?;
+                *y = Phase {
+                    r: -offsets[i + l],
+                    v: *vel(i + l),
+                };
+            }
+            let Some((end, n_ev)) = self.phase_lanes(&y0) else {
+                break;
             };
-            let (disp, _, n) = self.flow(o, v)?;
-            *d = disp;
-            evals += n;
+            for l in 0..LANES {
+                out[i + l] = end[l].r - y0[l].r;
+            }
+            evals += n_ev;
+            i += LANES;
+        }
+        for j in i..n {
+            let (disp, _, n_ev) = self.flow(&offsets[j], vel(j))?;
+            out[j] = disp;
+            evals += n_ev;
         }
         Ok(evals)
     }

@@ -110,6 +110,38 @@ fn three_d_jacobian_is_symmetric_about_the_axis() {
 }
 
 #[test]
+fn lockstep_batches_of_fixed_step_methods_are_bit_identical_to_single_calls() {
+    for m in [
+        Method::PaperRk4,
+        Method::Rk4 { substeps: 8 },
+        Method::Rk8 { substeps: 4 },
+    ] {
+        let p = Propagator::new(paper_model(), m, DT).unwrap();
+        // 11 offsets: two lockstep groups of four and a remainder of three
+        let offsets: Vec<_> = (0..11)
+            .map(|i| Vector2::new(f64::from(i) * 97e-9 - 500e-9, 40e-9 * f64::from(i % 3)))
+            .collect();
+        let vels: Vec<_> = (0..11)
+            .map(|i| Vector2::new(0.01 * f64::from(i), -0.02))
+            .collect();
+        let mut out = vec![Vector2::zeros(); 11];
+        p.flow_batch(&offsets, &vels, &mut out).unwrap();
+        for ((o, v), d) in offsets.iter().zip(&vels).zip(&out) {
+            let single = p.flow(o, v).unwrap().0;
+            assert_eq!(d.x.to_bits(), single.x.to_bits(), "{m:?}");
+            assert_eq!(d.y.to_bits(), single.y.to_bits(), "{m:?}");
+        }
+        let mut bad = offsets.clone();
+        bad[5].x = f64::NAN;
+        let e = p.flow_batch(&bad, &vels, &mut out).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "offset [m] = NaN is out of range: allowed finite"
+        );
+    }
+}
+
+#[test]
 fn batch_matches_single_calls_and_checks_lengths() {
     let p = Propagator::new(paper_model(), Method::default(), DT).unwrap();
     let offsets: Vec<_> = (0..50)
@@ -157,6 +189,7 @@ proptest! {
         let e = |r: &Vector2<f64>, v: &Vector2<f64>| 0.5 * MASS * v.norm_squared() + model.well.potential(r);
         let e0 = e(&-o, &v0);
         let e1 = e(&(d - o), &v);
-        prop_assert!((e1 - e0).abs() < 1e-6 * DEPTH, "ΔE = {:e} J", e1 - e0);
+        // the default tolerance is rtol 1e-6 on the phase: energy to ~1e-6 P0
+        prop_assert!((e1 - e0).abs() < 1e-5 * DEPTH, "ΔE = {:e} J", e1 - e0);
     }
 }

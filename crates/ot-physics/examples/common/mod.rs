@@ -130,6 +130,33 @@ pub fn measure(
     })
 }
 
+/// Measure one of our fixed-step methods through `flow_batch` (lockstep
+/// lanes); the row's method name gets a ` batch` suffix.
+pub fn measure_batch(
+    p: &Problem,
+    method: Method,
+    setting: &str,
+    min_ms: f64,
+) -> Result<Row, PhysicsError> {
+    let prop = Propagator::new(p.model, method, paper::DT)?;
+    let offsets: Vec<Vector2<f64>> = p.starts.iter().map(|s| s.0).collect();
+    let vels: Vec<Vector2<f64>> = p.starts.iter().map(|s| s.1).collect();
+    let mut disp = vec![Vector2::zeros(); offsets.len()];
+    let evals = prop.flow_batch(&offsets, &vels, &mut disp)?;
+    let (max_err_nm, mean_err_nm) = errors(p, &disp);
+    let ns = time_per_call(p.starts.len(), min_ms, || {
+        let _ = black_box(prop.flow_batch(black_box(&offsets), &vels, &mut disp));
+    });
+    Ok(Row {
+        method: format!("{} batch", method.name()),
+        setting: setting.to_string(),
+        max_err_nm,
+        mean_err_nm,
+        ns_per_traj: ns,
+        evals_per_traj: evals as f64 / p.starts.len() as f64,
+    })
+}
+
 /// The settings swept for each of our methods.
 pub fn our_settings() -> Vec<(Method, String)> {
     use ot_physics::Composition::*;
@@ -267,4 +294,21 @@ pub fn cheapest_within<'a>(rows: &'a [Row], method: &str, target_nm: f64) -> Opt
     rows.iter()
         .filter(|r| r.method == method && r.max_err_nm <= target_nm)
         .min_by(|a, b| a.ns_per_traj.total_cmp(&b.ns_per_traj))
+}
+
+/// CPU time (ns) of one method family at exactly `target_nm` max error,
+/// interpolated linearly in log(time)–log(error) between the two settings
+/// that bracket it. `None` if no pair of settings brackets the target.
+pub fn time_at_error(rows: &[Row], method: &str, target_nm: f64) -> Option<f64> {
+    let mut pts: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.method == method && r.max_err_nm > 0.0)
+        .map(|r| (r.max_err_nm.ln(), r.ns_per_traj.ln()))
+        .collect();
+    pts.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let t = target_nm.ln();
+    pts.windows(2).find_map(|w| {
+        let ((e0, c0), (e1, c1)) = (w[0], w[1]);
+        (e0 >= t && t >= e1 && e0 > e1).then(|| (c0 + (c1 - c0) * (e0 - t) / (e0 - e1)).exp())
+    })
 }

@@ -4,8 +4,9 @@
 //! code; as tabulated in the ode_solvers crate). Statically sized stages, no
 //! allocation per step.
 
+use super::driver::{Trial, drive};
 use super::{AdaptiveStats, StepControl};
-use crate::error::{PhysicsError, Result};
+use crate::error::Result;
 use crate::state::{OdeState, OdeSystem, Tolerance};
 
 /// 3rd-order error weights (on stages 1, 9, 12).
@@ -143,27 +144,8 @@ pub fn dop853<S: OdeSystem>(
     h0: f64,
     ctl: &StepControl,
 ) -> Result<(S::State, AdaptiveStats)> {
-    let mut stats = AdaptiveStats::default();
-    let mut y = *y0;
-    let mut k1 = sys.rhs(&y);
-    stats.evals += 1;
-    let mut time = 0.0;
-    let mut h = h0.min(t);
-    let mut err_prev: f64 = 1e-4;
-    while time < t {
-        if stats.accepted + stats.rejected >= ctl.max_steps {
-            return Err(PhysicsError::Unsupported {
-                method: "dop853",
-                reason: "step limit reached before the end of the interval (stiff problem: use more substeps or an overdamped model)",
-            });
-        }
-        h = h.min(sys.max_step(&y));
-        let last = time + h >= t * (1.0 - 1e-14);
-        if last {
-            h = t - time;
-        }
-        let (y1, k) = stages(sys, &y, k1, h);
-        stats.evals += 11;
+    drive(sys, y0, t, h0, ctl, 8.0, "adaptive", |y, k1, h| {
+        let (y1, k) = stages(sys, y, *k1, h);
         let e5 = y.zero_like().combine(
             h,
             &[
@@ -177,32 +159,19 @@ pub fn dop853<S: OdeSystem>(
                 (-0.022355307863886294, &k[11]),
             ],
         );
-        // 3rd-order estimate: (y1 - y) - h (bhh1 k1 + bhh2 k9 + bhh3 k12)
+        // 3rd-order estimate: (y1 − y) − h (bhh1 k1 + bhh2 k9 + bhh3 k12)
         let e3 = y1
-            .combine(-1.0, &[(1.0, &y)])
+            .combine(-1.0, &[(1.0, y)])
             .combine(h, &[(-BHH[0], &k[0]), (-BHH[1], &k[8]), (-BHH[2], &k[11])]);
-        let r5 = S::State::error_ratio(&e5, &y, &y1, tol);
-        let r3 = S::State::error_ratio(&e3, &y, &y1, tol);
+        let r5 = S::State::error_ratio(&e5, y, &y1, tol);
+        let r3 = S::State::error_ratio(&e3, y, &y1, tol);
+        // Hairer's combination of the 5th- and 3rd-order estimates
         let deno = (r5 * r5 + 0.01 * r3 * r3).sqrt();
-        let ratio = if deno > 0.0 { r5 * r5 / deno } else { 0.0 };
-        if ratio <= 1.0 {
-            time = if last { t } else { time + h };
-            y = y1;
-            k1 = sys.rhs(&y);
-            stats.evals += 1;
-            stats.accepted += 1;
-            let fac = ctl.factor(ratio, err_prev, 8.0);
-            err_prev = ratio.max(1e-4);
-            h *= fac;
-        } else {
-            stats.rejected += 1;
-            let fac = if ratio.is_finite() {
-                ctl.factor(ratio, err_prev, 8.0).min(1.0)
-            } else {
-                0.1
-            };
-            h *= fac;
+        Trial {
+            y1,
+            ratio: if deno > 0.0 { r5 * r5 / deno } else { 0.0 },
+            k_end: None,
+            evals: 11,
         }
-    }
-    Ok((y, stats))
+    })
 }

@@ -1,14 +1,11 @@
 //! Dormand–Prince 5(4): embedded Runge–Kutta with error control
 //! (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.5), FSAL, PI step control.
 
+use super::driver::{Trial, drive};
 use super::{AdaptiveStats, StepControl};
-use crate::error::{PhysicsError, Result};
+use crate::error::Result;
 use crate::state::{OdeState, OdeSystem, Tolerance};
 
-const C2: f64 = 1.0 / 5.0;
-const C3: f64 = 3.0 / 10.0;
-const C4: f64 = 4.0 / 5.0;
-const C5: f64 = 8.0 / 9.0;
 const A21: f64 = 1.0 / 5.0;
 const A31: f64 = 3.0 / 40.0;
 const A32: f64 = 9.0 / 40.0;
@@ -49,26 +46,8 @@ pub fn dopri5<S: OdeSystem>(
     h0: f64,
     ctl: &StepControl,
 ) -> Result<(S::State, AdaptiveStats)> {
-    let _ = (C2, C3, C4, C5);
-    let mut stats = AdaptiveStats::default();
-    let mut y = *y0;
-    let mut k1 = sys.rhs(&y);
-    stats.evals += 1;
-    let mut time = 0.0;
-    let mut h = h0.min(t);
-    let mut err_prev: f64 = 1e-4;
-    while time < t {
-        if stats.accepted + stats.rejected >= ctl.max_steps {
-            return Err(PhysicsError::Unsupported {
-                method: "adaptive",
-                reason: "step limit reached before the end of the interval (stiff problem: use more substeps or an overdamped model)",
-            });
-        }
-        h = h.min(sys.max_step(&y));
-        let last = time + h >= t * (1.0 - 1e-14);
-        if last {
-            h = t - time;
-        }
+    drive(sys, y0, t, h0, ctl, 5.0, "dopri5", |y, k1, h| {
+        let k1 = *k1;
         let k2 = sys.rhs(&y.combine(h, &[(A21, &k1)]));
         let k3 = sys.rhs(&y.combine(h, &[(A31, &k1), (A32, &k2)]));
         let k4 = sys.rhs(&y.combine(h, &[(A41, &k1), (A42, &k2), (A43, &k3)]));
@@ -79,7 +58,6 @@ pub fn dopri5<S: OdeSystem>(
         ));
         let y1 = y.combine(h, &[(B1, &k1), (B3, &k3), (B4, &k4), (B5, &k5), (B6, &k6)]);
         let k7 = sys.rhs(&y1);
-        stats.evals += 6;
         let err = y.zero_like().combine(
             h,
             &[
@@ -91,24 +69,11 @@ pub fn dopri5<S: OdeSystem>(
                 (E7, &k7),
             ],
         );
-        let ratio = S::State::error_ratio(&err, &y, &y1, tol);
-        if ratio <= 1.0 {
-            time = if last { t } else { time + h };
-            y = y1;
-            k1 = k7;
-            stats.accepted += 1;
-            let fac = ctl.factor(ratio, err_prev, 5.0);
-            err_prev = ratio.max(1e-4);
-            h *= fac;
-        } else {
-            stats.rejected += 1;
-            let fac = if ratio.is_finite() {
-                ctl.factor(ratio, err_prev, 5.0).min(1.0)
-            } else {
-                0.1
-            };
-            h *= fac;
+        Trial {
+            y1,
+            ratio: S::State::error_ratio(&err, y, &y1, tol),
+            k_end: Some(k7),
+            evals: 6,
         }
-    }
-    Ok((y, stats))
+    })
 }

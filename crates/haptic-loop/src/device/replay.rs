@@ -1,0 +1,92 @@
+//! The replay device: plays back the device inputs of a recording, tick by tick.
+
+use super::{Buttons, DeviceError, DeviceSample, DeviceSpecs, HapticDevice, TickTime};
+use crate::record::messages::{Channel, DeviceInputMsg};
+use crate::record::{Recording, RecordingError};
+use crate::vec3::Vec3;
+
+/// Inputs of a recording played back as a device.
+#[derive(Clone, Debug)]
+pub struct ReplayDevice {
+    specs: DeviceSpecs,
+    samples: Vec<DeviceSample>,
+    missed: Vec<bool>,
+    forces_n: Vec<Vec3>,
+}
+
+impl ReplayDevice {
+    /// Reads the `/device/input` messages of `rec`; they must be ticks 0, 1, 2, … in order, at
+    /// log time `tick · period_ns`.
+    pub fn from_recording(
+        rec: &Recording,
+        specs: DeviceSpecs,
+        period_ns: u64,
+    ) -> Result<Self, RecordingError> {
+        let mut samples = Vec::new();
+        let mut missed = Vec::new();
+        for m in rec
+            .messages
+            .iter()
+            .filter(|m| m.channel == Channel::DeviceInput)
+        {
+            let bad = |detail: String| RecordingError::BadMessage {
+                topic: Channel::DeviceInput.topic().to_string(),
+                log_time_ns: m.log_time_ns,
+                detail,
+            };
+            let d = DeviceInputMsg::decode(&m.data).map_err(|e| bad(e.to_string()))?;
+            let n = samples.len() as u64;
+            if d.tick != n || m.log_time_ns != n.saturating_mul(period_ns) {
+                return Err(bad(format!(
+                    "expected tick {n} at {} ns, found tick {} at {} ns",
+                    n.saturating_mul(period_ns),
+                    d.tick,
+                    m.log_time_ns
+                )));
+            }
+            samples.push(DeviceSample {
+                position_m: d.position_m,
+                buttons: Buttons(d.buttons),
+            });
+            missed.push(d.deadline_missed);
+        }
+        Ok(ReplayDevice {
+            specs,
+            samples,
+            missed,
+            forces_n: Vec::new(),
+        })
+    }
+
+    /// Number of ticks recorded.
+    pub fn ticks(&self) -> u64 {
+        self.samples.len() as u64
+    }
+
+    /// Whether the deadline of `tick` was missed in the recorded session.
+    pub fn deadline_missed(&self, tick: u64) -> bool {
+        self.missed.get(tick as usize).copied().unwrap_or(false)
+    }
+
+    /// The forces commanded during the replay, N, one per tick.
+    pub fn forces_n(&self) -> &[Vec3] {
+        &self.forces_n
+    }
+}
+
+impl HapticDevice for ReplayDevice {
+    fn specs(&self) -> &DeviceSpecs {
+        &self.specs
+    }
+
+    fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
+        self.samples
+            .get(time.index as usize)
+            .copied()
+            .ok_or(DeviceError::EndOfRecording(time.index))
+    }
+
+    fn set_force(&mut self, force_n: Vec3) {
+        self.forces_n.push(force_n);
+    }
+}

@@ -1,0 +1,490 @@
+//! The fixed-tick haptic loop: device input → world cursor → scene → force → device.
+//!
+//! One call of [`HapticLoop::tick`] is one tick. The tick index is the only clock; nothing in
+//! here reads the wall clock. What the loop guarantees about the force it sends:
+//!
+//! - **mapping**: cursor = `origin + workspace_scale · p_device`; device force =
+//!   `force_scale · F_world` (scene file `[mapping]`);
+//! - **stiffness cap**: the scene is given the world-frame stiffness that maps to the device's
+//!   maximum (`k_max / (force_scale · workspace_scale)`) and reports the stiffness it rendered;
+//!   a scene exceeding it gets zero force and a `scene.stiffness_over_cap` event;
+//! - **soft engagement**: the force is multiplied by a smoothstep ramp `3x² − 2x³` over
+//!   `engage_s` at start and again after an invalid-input episode;
+//! - **clamp**: a force above the device maximum is scaled down to it, direction kept
+//!   (`force.clamped` event at the onset of each clamped episode, status bit every tick);
+//! - **invalid input** (non-finite position, outside the workspace sphere, unknown button
+//!   bits): zero force, the cursor held at the last valid position, `input.invalid` event;
+//! - **missed deadline** (real-time mode): zero force, `deadline.missed` event. The flag is an
+//!   input of the tick (logged with the device input), so replay reproduces it.
+//!
+//! The world force, the sent force and the status of every tick are returned in
+//! [`TickResult`]; the sent force is always finite and of norm ≤ the device maximum.
+
+use crate::device::{Buttons, DeviceSample, DeviceSpecs};
+use crate::scene::{Event, Scene, SceneInput, SceneOutput};
+use crate::vec3::{self, Vec3};
+
+/// Device ↔ world mapping.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mapping {
+    /// World metres per device metre.
+    pub workspace_scale: f64,
+    /// Device newtons per world newton.
+    pub force_scale: f64,
+    /// World point under the device origin, m.
+    pub origin_m: Vec3,
+}
+
+impl Mapping {
+    /// World position (m) of device position `p_m` (m).
+    pub fn to_world(&self, p_m: Vec3) -> Vec3 {
+        vec3::add(self.origin_m, vec3::scale(p_m, self.workspace_scale))
+    }
+}
+
+/// Everything the loop needs besides the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopConfig {
+    /// Tick rate, Hz.
+    pub rate_hz: u32,
+    /// Length of the soft-engagement ramp, ticks (0: none).
+    pub engage_ticks: u64,
+    /// Foxglove display channels are written every this many ticks.
+    pub display_every: u32,
+    /// Display metres per world metre (Foxglove channels only).
+    pub display_scale: f64,
+    /// Device ↔ world mapping.
+    pub mapping: Mapping,
+    /// The device's specifications.
+    pub specs: DeviceSpecs,
+}
+
+impl LoopConfig {
+    /// Tick length, s.
+    pub fn dt_s(&self) -> f64 {
+        1.0 / f64::from(self.rate_hz)
+    }
+
+    /// Tick length, ns (exact: validated to be whole).
+    pub fn period_ns(&self) -> u64 {
+        1_000_000_000 / u64::from(self.rate_hz)
+    }
+
+    /// The largest world-frame stiffness that renders within the device's stiffness limit, N/m.
+    pub fn world_stiffness_cap_n_per_m(&self) -> f64 {
+        self.specs.max_stiffness_n_per_m / (self.mapping.force_scale * self.mapping.workspace_scale)
+    }
+}
+
+/// Status bits of a tick (`TickResult::status`).
+pub mod status {
+    /// The force was scaled down to the device maximum.
+    pub const CLAMPED: u8 = 1;
+    /// The device input was invalid; zero force.
+    pub const INPUT_INVALID: u8 = 2;
+    /// The real-time deadline was missed; zero force.
+    pub const DEADLINE_MISSED: u8 = 4;
+    /// The scene rendered a stiffness above the cap; zero force.
+    pub const STIFFNESS_OVER_CAP: u8 = 8;
+    /// The scene returned a non-finite force; zero force.
+    pub const FORCE_INVALID: u8 = 16;
+}
+
+/// What one tick produced.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TickResult {
+    /// Tick index.
+    pub tick: u64,
+    /// Cursor given to the scene, world frame, m.
+    pub cursor_m: Vec3,
+    /// Buttons given to the scene.
+    pub buttons: Buttons,
+    /// Force the scene returned, world frame, N.
+    pub world_force_n: Vec3,
+    /// Force sent to the device, device frame, N (finite, norm ≤ device maximum).
+    pub device_force_n: Vec3,
+    /// Soft-engagement factor applied, 0–1.
+    pub engagement: f64,
+    /// Status bits, see [`status`].
+    pub status: u8,
+    /// Events of this tick: loop events, button events, scene events.
+    pub events: Vec<Event>,
+}
+
+/// The haptic loop around one scene.
+pub struct HapticLoop {
+    config: LoopConfig,
+    scene: Box<dyn Scene>,
+    next_tick: u64,
+    last_cursor_m: Vec3,
+    last_buttons: Buttons,
+    engage_start: u64,
+    input_invalid: bool,
+    clamping: bool,
+    out: SceneOutput,
+    result: TickResult,
+}
+
+/// Smoothstep `3x² − 2x³` on [0, 1].
+fn smoothstep(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+impl HapticLoop {
+    /// A loop around `scene` with `config`.
+    pub fn new(config: LoopConfig, scene: Box<dyn Scene>) -> Self {
+        let origin = config.mapping.origin_m;
+        HapticLoop {
+            config,
+            scene,
+            next_tick: 0,
+            last_cursor_m: origin,
+            last_buttons: Buttons(0),
+            engage_start: 0,
+            input_invalid: false,
+            clamping: false,
+            out: SceneOutput::default(),
+            result: TickResult::default(),
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &LoopConfig {
+        &self.config
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &dyn Scene {
+        self.scene.as_ref()
+    }
+
+    /// Index of the next tick.
+    pub fn next_tick(&self) -> u64 {
+        self.next_tick
+    }
+
+    /// Why a device sample is invalid, or `None` when it is valid.
+    pub fn check_sample(specs: &DeviceSpecs, s: &DeviceSample) -> Option<String> {
+        if !vec3::is_finite(s.position_m) {
+            return Some(format!("non-finite position {:?} m", s.position_m));
+        }
+        let r = vec3::norm(s.position_m);
+        if r > specs.workspace_radius_m {
+            return Some(format!(
+                "position {:?} m is {r} m from the origin, outside the {} m workspace",
+                s.position_m, specs.workspace_radius_m
+            ));
+        }
+        let extra = s.buttons.0 & !specs.button_mask();
+        if extra != 0 {
+            return Some(format!(
+                "button bits {extra:#x} do not exist on a {}",
+                specs.name
+            ));
+        }
+        None
+    }
+
+    /// Runs one tick with the device reading `sample`; `deadline_missed` forces zero force.
+    pub fn tick(&mut self, sample: DeviceSample, deadline_missed: bool) -> &TickResult {
+        let tick = self.next_tick;
+        self.next_tick += 1;
+        let r = &mut self.result;
+        r.tick = tick;
+        r.status = 0;
+        r.events.clear();
+
+        // 1. Input validation and mapping.
+        let problem = Self::check_sample(&self.config.specs, &sample);
+        let valid = problem.is_none();
+        if let Some(why) = problem {
+            r.status |= status::INPUT_INVALID;
+            if !self.input_invalid {
+                r.events.push(Event::new("input.invalid", why));
+            }
+            self.input_invalid = true;
+        } else {
+            if self.input_invalid {
+                r.events
+                    .push(Event::new("input.valid", "soft engagement restarts"));
+                self.engage_start = tick;
+            }
+            self.input_invalid = false;
+            self.last_cursor_m = self.config.mapping.to_world(sample.position_m);
+            let changed = sample.buttons.0 ^ self.last_buttons.0;
+            for (i, name) in self.config.specs.button_names.iter().enumerate() {
+                if changed & (1 << i) != 0 {
+                    let kind = if sample.buttons.pressed(i as u32) {
+                        "button.down"
+                    } else {
+                        "button.up"
+                    };
+                    r.events.push(Event::new(kind, *name));
+                }
+            }
+            self.last_buttons = sample.buttons;
+        }
+        r.cursor_m = self.last_cursor_m;
+        r.buttons = self.last_buttons;
+
+        // 2. The world.
+        self.out.clear();
+        let input = SceneInput {
+            tick,
+            dt_s: self.config.dt_s(),
+            cursor_m: r.cursor_m,
+            buttons: r.buttons,
+            input_valid: valid,
+        };
+        self.scene.step(&input, &mut self.out);
+        r.events.append(&mut self.out.events);
+        r.world_force_n = self.out.force_n;
+
+        // 3. Force to the device.
+        let cap = self.config.world_stiffness_cap_n_per_m();
+        let mut force_ok = valid;
+        if !vec3::is_finite(self.out.force_n) {
+            r.status |= status::FORCE_INVALID;
+            r.events.push(Event::new(
+                "force.invalid",
+                format!("scene force {:?} N is not finite", self.out.force_n),
+            ));
+            force_ok = false;
+        } else if self.out.stiffness_n_per_m > cap * (1.0 + 1e-12) {
+            r.status |= status::STIFFNESS_OVER_CAP;
+            r.events.push(Event::new(
+                "scene.stiffness_over_cap",
+                format!(
+                    "scene rendered {} N/m, the cap is {cap} N/m",
+                    self.out.stiffness_n_per_m
+                ),
+            ));
+            force_ok = false;
+        }
+        r.engagement = if self.config.engage_ticks == 0 {
+            1.0
+        } else {
+            smoothstep((tick - self.engage_start) as f64 / self.config.engage_ticks as f64)
+        };
+        let mut f = if force_ok {
+            vec3::scale(
+                self.out.force_n,
+                self.config.mapping.force_scale * r.engagement,
+            )
+        } else {
+            [0.0; 3]
+        };
+        if !vec3::is_finite(f) {
+            // Finite world force times a finite scale can still overflow.
+            r.status |= status::FORCE_INVALID;
+            r.events
+                .push(Event::new("force.invalid", "mapped force overflows"));
+            f = [0.0; 3];
+        }
+        let max = self.config.specs.max_force_n;
+        let mag = vec3::norm(f);
+        if mag > max {
+            r.status |= status::CLAMPED;
+            if !self.clamping {
+                r.events.push(Event::new(
+                    "force.clamped",
+                    format!("requested {mag} N, rendering {max} N"),
+                ));
+            }
+            self.clamping = true;
+            f = vec3::scale(f, max / mag);
+            while vec3::norm(f) > max {
+                f = vec3::scale(f, 1.0 - f64::EPSILON);
+            }
+        } else {
+            self.clamping = false;
+        }
+        r.device_force_n = f;
+        if deadline_missed {
+            self.mark_deadline_missed();
+        }
+        &self.result
+    }
+
+    /// Marks the last tick's deadline as missed: zero force, status bit, `deadline.missed`
+    /// event. Exactly what `tick(sample, true)` does; the loop's own state is not affected, so a
+    /// real-time run that decides after computing and a replay that knows beforehand agree.
+    pub fn mark_deadline_missed(&mut self) {
+        let r = &mut self.result;
+        if r.status & status::DEADLINE_MISSED == 0 {
+            r.status |= status::DEADLINE_MISSED;
+            r.events
+                .push(Event::new("deadline.missed", "zero force sent this tick"));
+            r.device_force_n = [0.0; 3];
+        }
+    }
+
+    /// The result of the last tick.
+    pub fn last_result(&self) -> &TickResult {
+        &self.result
+    }
+
+    /// Appends the scene's state fields to `out`.
+    pub fn scene_state(&self, out: &mut Vec<f64>) {
+        self.scene.state(out);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::device::FALCON;
+    use crate::scene::load_scene;
+
+    const WALL: &str = r#"
+[scene]
+name = "w"
+kind = "wall"
+[loop]
+engage_s = 0.0
+[wall]
+normal = [0.0, 0.0, 1.0]
+stiffness_n_per_m = 5000.0
+"#;
+
+    fn looped(text: &str) -> HapticLoop {
+        let s = load_scene(text, None).unwrap();
+        HapticLoop::new(s.config, s.scene)
+    }
+
+    fn at(z: f64) -> DeviceSample {
+        DeviceSample {
+            position_m: [0.0, 0.0, z],
+            buttons: Buttons(0),
+        }
+    }
+
+    #[test]
+    fn stiffness_is_capped_and_force_clamped_along_its_direction() {
+        let mut l = looped(WALL);
+        // 1 mm deep: the 5000 N/m wall is capped at the Falcon's 3000 N/m -> 3 N.
+        let r = l.tick(at(-0.001), false).clone();
+        assert!((r.device_force_n[2] - 3.0).abs() < 1e-12);
+        assert_eq!(r.status, 0);
+        // 2 mm -> 6 N; felt stiffness ΔF/Δx = 3000 N/m exactly (to rounding).
+        let f2 = l.tick(at(-0.002), false).device_force_n[2];
+        assert!(((f2 - r.device_force_n[2]) / 0.001 - 3000.0).abs() < 1e-6);
+        // 5 mm -> 15 N requested, clamped to 8 N, still along +z.
+        let r = l.tick(at(-0.005), false).clone();
+        assert_eq!(r.status, status::CLAMPED);
+        assert!(vec3::norm(r.device_force_n) <= FALCON.max_force_n);
+        assert!((r.device_force_n[2] - 8.0).abs() < 1e-12);
+        assert_eq!(r.events[0].name, "force.clamped");
+        // The clamp event fires once per episode.
+        assert!(l.tick(at(-0.006), false).events.is_empty());
+    }
+
+    #[test]
+    fn invalid_input_gives_zero_force_and_holds_the_cursor() {
+        let mut l = looped(WALL);
+        l.tick(at(-0.001), false);
+        let r = l
+            .tick(
+                DeviceSample {
+                    position_m: [f64::NAN, 0.0, 0.0],
+                    buttons: Buttons(0),
+                },
+                false,
+            )
+            .clone();
+        assert_eq!(r.device_force_n, [0.0; 3]);
+        assert_eq!(r.status, status::INPUT_INVALID);
+        assert_eq!(r.cursor_m, [0.0, 0.0, -0.001]);
+        assert_eq!(r.events[0].name, "input.invalid");
+        let r = l.tick(at(0.05), false).clone();
+        assert_eq!(r.device_force_n, [0.0; 3]);
+        assert!(r.events.is_empty(), "one event per episode");
+        let r = l
+            .tick(
+                DeviceSample {
+                    position_m: [0.0; 3],
+                    buttons: Buttons(1 << 7),
+                },
+                false,
+            )
+            .clone();
+        assert_eq!(r.status, status::INPUT_INVALID);
+        let r = l.tick(at(-0.001), false).clone();
+        assert_eq!(r.events[0].name, "input.valid");
+    }
+
+    #[test]
+    fn soft_engagement_ramps_with_smoothstep() {
+        let mut l = looped(&WALL.replace("engage_s = 0.0", "engage_s = 0.1"));
+        let f: Vec<f64> = (0..120)
+            .map(|_| l.tick(at(-0.0005), false).device_force_n[2])
+            .collect();
+        assert_eq!(f[0], 0.0);
+        assert!((f[50] - 1.5 * 0.5).abs() < 1e-12, "half way: half force");
+        assert!(f.windows(2).all(|w| w[1] >= w[0]));
+        assert_eq!(f[100], 1.5);
+        assert_eq!(f[119], 1.5);
+    }
+
+    #[test]
+    fn missed_deadline_sends_zero_force_and_buttons_raise_events() {
+        let mut l = looped(WALL);
+        let r = l
+            .tick(
+                DeviceSample {
+                    position_m: [0.0, 0.0, -0.001],
+                    buttons: Buttons(0b101),
+                },
+                true,
+            )
+            .clone();
+        assert_eq!(r.device_force_n, [0.0; 3]);
+        assert!((r.world_force_n[2] - 3.0).abs() < 1e-12);
+        assert_eq!(r.status, status::DEADLINE_MISSED);
+        let names: Vec<_> = r
+            .events
+            .iter()
+            .map(|e| (e.name.as_str(), e.detail.as_str()))
+            .collect();
+        assert_eq!(names[0], ("button.down", "centre"));
+        assert_eq!(names[1], ("button.down", "minus"));
+        assert_eq!(names.last().unwrap().0, "deadline.missed");
+    }
+
+    use proptest::prelude::*;
+
+    fn coord() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            -0.05f64..0.05,
+            Just(f64::NAN),
+            Just(f64::INFINITY),
+            Just(-1e300),
+            Just(1e300)
+        ]
+    }
+
+    proptest! {
+        /// Whatever the device reports, the force sent is finite, within the device maximum,
+        /// and zero whenever the input is invalid.
+        #[test]
+        fn sent_force_is_always_finite_and_bounded(
+            samples in proptest::collection::vec(((coord(), coord(), coord()), 0u32..64), 1..200),
+            k in 1.0f64..1e9,
+        ) {
+            let text = WALL.replace("5000.0", &format!("{k:?}"));
+            let mut l = looped(&text);
+            for ((x, y, z), b) in samples {
+                let s = DeviceSample { position_m: [x, y, z], buttons: Buttons(b) };
+                let invalid = HapticLoop::check_sample(&FALCON, &s).is_some();
+                let r = l.tick(s, false);
+                prop_assert!(vec3::is_finite(r.device_force_n));
+                prop_assert!(vec3::norm(r.device_force_n) <= FALCON.max_force_n);
+                if invalid {
+                    prop_assert_eq!(r.device_force_n, [0.0; 3]);
+                    prop_assert!(r.status & status::INPUT_INVALID != 0);
+                }
+            }
+        }
+    }
+}

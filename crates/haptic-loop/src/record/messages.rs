@@ -1,0 +1,468 @@
+//! The recording's channels, their schemas (ROS 2 `.msg` text, CDR encoding) and the typed
+//! messages with their encoders and decoders.
+
+use super::cdr::{CdrError, CdrReader, CdrWriter};
+use crate::vec3::Vec3;
+
+/// Format version written in the scene description; bumped on any layout change.
+pub const FORMAT_VERSION: &str = "nanohaptics-recording/1";
+
+/// The channels of a recording.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Channel {
+    /// `/scene/description`, once at tick 0.
+    Description,
+    /// `/device/input`, every tick (an input of replay).
+    DeviceInput,
+    /// `/world/state`, every tick.
+    State,
+    /// `/haptic/force`, every tick.
+    Force,
+    /// `/events`, on ticks with events.
+    Events,
+    /// `/loop/timing`, every tick (wall-clock measurements, not verified).
+    Timing,
+    /// `/foxglove/scene` (`foxglove.SceneUpdate`), at display rate.
+    FoxgloveScene,
+    /// `/foxglove/tf` (`foxglove.FrameTransform`), at display rate.
+    FoxgloveTf,
+    /// `/foxglove/log` (`foxglove.Log`), on ticks with events.
+    FoxgloveLog,
+}
+
+impl Channel {
+    /// Every channel, in registration order.
+    pub const ALL: [Channel; 9] = [
+        Channel::Description,
+        Channel::DeviceInput,
+        Channel::State,
+        Channel::Force,
+        Channel::Events,
+        Channel::Timing,
+        Channel::FoxgloveScene,
+        Channel::FoxgloveTf,
+        Channel::FoxgloveLog,
+    ];
+
+    /// MCAP topic.
+    pub fn topic(self) -> &'static str {
+        match self {
+            Channel::Description => "/scene/description",
+            Channel::DeviceInput => "/device/input",
+            Channel::State => "/world/state",
+            Channel::Force => "/haptic/force",
+            Channel::Events => "/events",
+            Channel::Timing => "/loop/timing",
+            Channel::FoxgloveScene => "/foxglove/scene",
+            Channel::FoxgloveTf => "/foxglove/tf",
+            Channel::FoxgloveLog => "/foxglove/log",
+        }
+    }
+
+    /// The channel with this topic.
+    pub fn from_topic(topic: &str) -> Option<Channel> {
+        Channel::ALL.into_iter().find(|c| c.topic() == topic)
+    }
+
+    /// True for outputs that replay recomputes and compares bit for bit.
+    pub fn verified(self) -> bool {
+        !matches!(
+            self,
+            Channel::Description | Channel::DeviceInput | Channel::Timing
+        )
+    }
+}
+
+/// Schema of `/device/input`.
+pub const DEVICE_INPUT_SCHEMA: (&str, &str) = (
+    "nanohaptics_msgs/msg/DeviceInput",
+    "# Device reading of one tick (device frame) and the real-time deadline flag.\n\
+     uint64 tick\n\
+     float64[3] position_m\n\
+     uint32 buttons\n\
+     bool deadline_missed\n",
+);
+
+/// Schema of `/haptic/force`.
+pub const FORCE_SCHEMA: (&str, &str) = (
+    "nanohaptics_msgs/msg/Force",
+    "# Force of one tick: the scene's (world frame) and the one sent (device frame).\n\
+     uint64 tick\n\
+     float64[3] world_force_n\n\
+     float64[3] device_force_n\n\
+     float64 engagement\n\
+     # bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid\n\
+     uint8 status\n",
+);
+
+/// Schema of `/events`.
+pub const EVENTS_SCHEMA: (&str, &str) = (
+    "nanohaptics_msgs/msg/Events",
+    "# Events raised during one tick, in order.\n\
+     uint64 tick\n\
+     string[] names\n\
+     string[] details\n",
+);
+
+/// Schema of `/loop/timing`.
+pub const TIMING_SCHEMA: (&str, &str) = (
+    "nanohaptics_msgs/msg/Timing",
+    "# Wall-clock measurements of one tick (not reproducible, not verified by replay).\n\
+     uint64 tick\n\
+     int64 start_late_ns\n\
+     uint64 compute_ns\n",
+);
+
+/// Schema of `/scene/description`.
+pub const DESCRIPTION_SCHEMA: (&str, &str) = (
+    "nanohaptics_msgs/msg/SceneDescription",
+    "# The session: everything replay needs besides the per-tick inputs.\n\
+     string format\n\
+     string scene_name\n\
+     string scene_kind\n\
+     string scene_toml\n\
+     string device_model\n\
+     uint32 rate_hz\n\
+     string mode\n\
+     string script_name\n\
+     string script_toml\n\
+     string operator\n\
+     string[] state_fields\n",
+);
+
+/// Schema name and text of `/world/state` for a scene kind and its state fields.
+pub fn state_schema(kind: &str, fields: &[String]) -> (String, String) {
+    let mut camel = String::new();
+    for part in kind.split('_') {
+        let mut c = part.chars();
+        if let Some(f) = c.next() {
+            camel.extend(f.to_uppercase());
+            camel.push_str(c.as_str());
+        }
+    }
+    let mut text = String::from(
+        "# World state after one tick; cursor in the world frame.\n\
+         uint64 tick\n\
+         float64[3] cursor_m\n\
+         uint32 buttons\n",
+    );
+    for f in fields {
+        text.push_str("float64 ");
+        text.push_str(f);
+        text.push('\n');
+    }
+    (format!("nanohaptics_msgs/msg/{camel}State"), text)
+}
+
+/// True when `name` is a valid ROS 2 field name (lower snake case, starts with a letter, no
+/// double or trailing underscore) and not one of the fixed state fields.
+pub fn valid_field_name(name: &str) -> bool {
+    let b = name.as_bytes();
+    !b.is_empty()
+        && b[0].is_ascii_lowercase()
+        && b.iter()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == b'_')
+        && !name.contains("__")
+        && !name.ends_with('_')
+        && !["tick", "cursor_m", "buttons"].contains(&name)
+}
+
+/// `/device/input`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeviceInputMsg {
+    /// Tick index.
+    pub tick: u64,
+    /// Stylus position, m, device frame (raw, possibly invalid).
+    pub position_m: Vec3,
+    /// Button bits (raw).
+    pub buttons: u32,
+    /// The real-time deadline of this tick was missed (zero force was sent).
+    pub deadline_missed: bool,
+}
+
+impl DeviceInputMsg {
+    /// Encodes to CDR.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        w.u64(self.tick)
+            .f64s(&self.position_m)
+            .u32(self.buttons)
+            .bool(self.deadline_missed);
+        w.finish()
+    }
+
+    /// Decodes from CDR.
+    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let m = DeviceInputMsg {
+            tick: r.u64()?,
+            position_m: r.vec3()?,
+            buttons: r.u32()?,
+            deadline_missed: r.bool()?,
+        };
+        r.end()?;
+        Ok(m)
+    }
+}
+
+/// `/haptic/force`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForceMsg {
+    /// Tick index.
+    pub tick: u64,
+    /// Scene force, world frame, N.
+    pub world_force_n: Vec3,
+    /// Force sent, device frame, N.
+    pub device_force_n: Vec3,
+    /// Soft-engagement factor.
+    pub engagement: f64,
+    /// Status bits (see `haptic::status`).
+    pub status: u8,
+}
+
+impl ForceMsg {
+    /// Encodes to CDR.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        w.u64(self.tick)
+            .f64s(&self.world_force_n)
+            .f64s(&self.device_force_n)
+            .f64(self.engagement)
+            .u8(self.status);
+        w.finish()
+    }
+
+    /// Decodes from CDR.
+    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let m = ForceMsg {
+            tick: r.u64()?,
+            world_force_n: r.vec3()?,
+            device_force_n: r.vec3()?,
+            engagement: r.f64()?,
+            status: r.u8()?,
+        };
+        r.end()?;
+        Ok(m)
+    }
+}
+
+/// `/world/state`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateMsg {
+    /// Tick index.
+    pub tick: u64,
+    /// Cursor, world frame, m.
+    pub cursor_m: Vec3,
+    /// Buttons given to the scene.
+    pub buttons: u32,
+    /// The scene's state fields, in the order of the description's `state_fields`.
+    pub values: Vec<f64>,
+}
+
+impl StateMsg {
+    /// Encodes to CDR.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        w.u64(self.tick)
+            .f64s(&self.cursor_m)
+            .u32(self.buttons)
+            .f64s(&self.values);
+        w.finish()
+    }
+
+    /// Decodes from CDR with `n` scene fields.
+    pub fn decode(b: &[u8], n: usize) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let tick = r.u64()?;
+        let cursor_m = r.vec3()?;
+        let buttons = r.u32()?;
+        let values = (0..n).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
+        r.end()?;
+        Ok(StateMsg {
+            tick,
+            cursor_m,
+            buttons,
+            values,
+        })
+    }
+}
+
+/// `/events`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EventsMsg {
+    /// Tick index.
+    pub tick: u64,
+    /// Event names.
+    pub names: Vec<String>,
+    /// Event details (same length as `names`).
+    pub details: Vec<String>,
+}
+
+impl EventsMsg {
+    /// Encodes `events` of `tick` to CDR.
+    pub fn encode(tick: u64, events: &[crate::scene::Event]) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        w.u64(tick)
+            .strings(events.iter().map(|e| e.name.as_str()))
+            .strings(events.iter().map(|e| e.detail.as_str()));
+        w.finish()
+    }
+
+    /// Decodes from CDR.
+    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let m = EventsMsg {
+            tick: r.u64()?,
+            names: r.strings()?,
+            details: r.strings()?,
+        };
+        r.end()?;
+        Ok(m)
+    }
+}
+
+/// `/loop/timing`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimingMsg {
+    /// Tick index.
+    pub tick: u64,
+    /// Start lateness against the real-time schedule, ns (0 in batch mode).
+    pub start_late_ns: i64,
+    /// Work of the tick, ns.
+    pub compute_ns: u64,
+}
+
+impl TimingMsg {
+    /// Encodes to CDR.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        w.u64(self.tick)
+            .i64(self.start_late_ns)
+            .u64(self.compute_ns);
+        w.finish()
+    }
+
+    /// Decodes from CDR.
+    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let m = TimingMsg {
+            tick: r.u64()?,
+            start_late_ns: r.i64()?,
+            compute_ns: r.u64()?,
+        };
+        r.end()?;
+        Ok(m)
+    }
+}
+
+/// `/scene/description`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct DescriptionMsg {
+    /// [`FORMAT_VERSION`].
+    pub format: String,
+    /// Scene name.
+    pub scene_name: String,
+    /// Scene kind.
+    pub scene_kind: String,
+    /// The scene file's text.
+    pub scene_toml: String,
+    /// Device model used (may override the scene file's).
+    pub device_model: String,
+    /// Tick rate, Hz.
+    pub rate_hz: u32,
+    /// `batch` or `realtime`.
+    pub mode: String,
+    /// Script name (information only).
+    pub script_name: String,
+    /// Script text (information only: replay uses the logged inputs).
+    pub script_toml: String,
+    /// Operator (`rigid` or the hand parameters; information only).
+    pub operator: String,
+    /// Names of the scene's state fields.
+    pub state_fields: Vec<String>,
+}
+
+impl DescriptionMsg {
+    /// Encodes to CDR.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        w.string(&self.format)
+            .string(&self.scene_name)
+            .string(&self.scene_kind)
+            .string(&self.scene_toml)
+            .string(&self.device_model)
+            .u32(self.rate_hz)
+            .string(&self.mode)
+            .string(&self.script_name)
+            .string(&self.script_toml)
+            .string(&self.operator)
+            .strings(self.state_fields.iter().map(|s| s.as_str()));
+        w.finish()
+    }
+
+    /// Decodes from CDR.
+    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let m = DescriptionMsg {
+            format: r.string()?,
+            scene_name: r.string()?,
+            scene_kind: r.string()?,
+            scene_toml: r.string()?,
+            device_model: r.string()?,
+            rate_hz: r.u32()?,
+            mode: r.string()?,
+            script_name: r.string()?,
+            script_toml: r.string()?,
+            operator: r.string()?,
+            state_fields: r.strings()?,
+        };
+        r.end()?;
+        Ok(m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_roundtrip() {
+        let f = ForceMsg {
+            tick: 9,
+            world_force_n: [1.0, -0.0, f64::MIN_POSITIVE],
+            device_force_n: [0.1, 0.2, 0.3],
+            engagement: 0.5,
+            status: 5,
+        };
+        assert_eq!(ForceMsg::decode(&f.encode()), Ok(f));
+        let i = DeviceInputMsg {
+            tick: 1,
+            position_m: [f64::NAN, 0.0, 1.0],
+            buttons: 3,
+            deadline_missed: true,
+        };
+        let d = DeviceInputMsg::decode(&i.encode()).unwrap();
+        assert!(d.position_m[0].is_nan() && d.buttons == 3 && d.deadline_missed);
+        let s = StateMsg {
+            tick: 2,
+            cursor_m: [1.0, 2.0, 3.0],
+            buttons: 1,
+            values: vec![4.0, 5.0],
+        };
+        assert_eq!(StateMsg::decode(&s.encode(), 2), Ok(s.clone()));
+        assert!(StateMsg::decode(&s.encode(), 3).is_err());
+        assert!(StateMsg::decode(&s.encode(), 1).is_err());
+    }
+
+    #[test]
+    fn state_schema_is_ros2_msg_text() {
+        let (name, text) = state_schema("optical_tweezers", &["x_m".into(), "vx_m_per_s".into()]);
+        assert_eq!(name, "nanohaptics_msgs/msg/OpticalTweezersState");
+        assert!(text.ends_with("uint32 buttons\nfloat64 x_m\nfloat64 vx_m_per_s\n"));
+        assert!(valid_field_name("penetration_m"));
+        for bad in ["", "X", "a__b", "a_", "1a", "tick", "a-b"] {
+            assert!(!valid_field_name(bad), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,345 @@
+//! The MCAP writer thread.
+//!
+//! The tick appends its encoded messages to a shared queue with `try_lock` (if the writer
+//! happens to hold the lock, the tick keeps them in a local buffer and hands them over on a
+//! later tick): the tick never waits and never wakes another thread (a wake-up can make the
+//! scheduler preempt the waker). The writer thread polls the queue every 2 ms, swaps it out and
+//! writes the messages into zstd-compressed chunks. Every second
+//! of session time the thread closes the chunk and flushes it to the file, so a crash loses at
+//! most the last second. The thread compresses single-threaded (`compression_threads(0)`) to
+//! leave the other core to the loop.
+
+use super::messages::{self, Channel, DescriptionMsg};
+use super::{OutMsg, TickMessages, foxglove_out};
+use foxglove::schemas::{FrameTransform, Log, SceneUpdate};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, mpsc};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// How often the writer thread drains the queue.
+const POLL: Duration = Duration::from_millis(2);
+
+struct Shared {
+    queue: Mutex<Vec<Cmd>>,
+    done: AtomicBool,
+    failed: AtomicBool,
+}
+
+/// Errors while recording.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum RecordError {
+    /// The file could not be created or written.
+    #[error("recording {path}: {message}")]
+    Io {
+        /// Path of the recording.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// The writer thread stopped (after an earlier error) or panicked.
+    #[error("the recording writer stopped: {0}")]
+    WriterStopped(String),
+}
+
+/// What the writer needs before the first tick.
+#[derive(Clone, Debug)]
+pub struct RecorderSetup {
+    /// The scene description (written once at tick 0).
+    pub description: DescriptionMsg,
+    /// Flush a chunk to the file every this many ns of session time (crash loss bound).
+    pub flush_every_ns: u64,
+}
+
+/// What the writer thread did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct WriteSummary {
+    /// Messages written.
+    pub messages: u64,
+    /// File size, bytes.
+    pub bytes: u64,
+    /// Chunks flushed to the file.
+    pub flushes: u64,
+    /// Largest number of ticks waiting in the queue.
+    pub max_queue_ticks: usize,
+}
+
+enum Cmd {
+    Tick(TickMessages),
+    Metadata(String, BTreeMap<String, String>),
+}
+
+/// Handle to the writer thread.
+pub struct Recorder {
+    shared: Arc<Shared>,
+    local: Vec<Cmd>,
+    handle: Option<JoinHandle<Result<WriteSummary, RecordError>>>,
+    max_queued: usize,
+    path: String,
+}
+
+type McapWriter = mcap::Writer<BufWriter<File>>;
+
+fn io_err(path: &str, e: impl std::fmt::Display) -> RecordError {
+    RecordError::Io {
+        path: path.to_string(),
+        message: e.to_string(),
+    }
+}
+
+fn open(
+    path: &str,
+    setup: &RecorderSetup,
+) -> Result<(McapWriter, BTreeMap<Channel, u16>), RecordError> {
+    let file = File::create(path).map_err(|e| io_err(path, e))?;
+    let opts = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .compression_threads(0)
+        .chunk_size(Some(8 << 20))
+        .profile("")
+        .library(concat!(
+            "nanohaptics haptic-loop ",
+            env!("CARGO_PKG_VERSION")
+        ));
+    let mut w = opts
+        .create(BufWriter::with_capacity(1 << 20, file))
+        .map_err(|e| io_err(path, e))?;
+    let d = &setup.description;
+    let (state_name, state_text) = messages::state_schema(&d.scene_kind, &d.state_fields);
+    let mut ids = BTreeMap::new();
+    let meta = BTreeMap::new();
+    for ch in Channel::ALL {
+        let (name, enc, data): (String, String, Vec<u8>) = match ch {
+            Channel::Description => s(messages::DESCRIPTION_SCHEMA),
+            Channel::DeviceInput => s(messages::DEVICE_INPUT_SCHEMA),
+            Channel::State => (
+                state_name.clone(),
+                "ros2msg".into(),
+                state_text.clone().into_bytes(),
+            ),
+            Channel::Force => s(messages::FORCE_SCHEMA),
+            Channel::Events => s(messages::EVENTS_SCHEMA),
+            Channel::Timing => s(messages::TIMING_SCHEMA),
+            Channel::FoxgloveScene => foxglove_out::schema::<SceneUpdate>(),
+            Channel::FoxgloveTf => foxglove_out::schema::<FrameTransform>(),
+            Channel::FoxgloveLog => foxglove_out::schema::<Log>(),
+        };
+        let msg_enc = if enc == "protobuf" { "protobuf" } else { "cdr" };
+        let sid = w
+            .add_schema(&name, &enc, &data)
+            .map_err(|e| io_err(path, e))?;
+        let cid = w
+            .add_channel(sid, ch.topic(), msg_enc, &meta)
+            .map_err(|e| io_err(path, e))?;
+        ids.insert(ch, cid);
+    }
+    Ok((w, ids))
+}
+
+fn s((name, text): (&str, &str)) -> (String, String, Vec<u8>) {
+    (
+        name.to_string(),
+        "ros2msg".to_string(),
+        text.as_bytes().to_vec(),
+    )
+}
+
+fn write_msgs(
+    w: &mut McapWriter,
+    ids: &BTreeMap<Channel, u16>,
+    seq: &mut u32,
+    log_time: u64,
+    msgs: &[OutMsg],
+    path: &str,
+) -> Result<u64, RecordError> {
+    for m in msgs {
+        let channel_id = ids[&m.channel];
+        *seq = seq.wrapping_add(1);
+        let header = mcap::records::MessageHeader {
+            channel_id,
+            sequence: *seq,
+            log_time,
+            publish_time: log_time,
+        };
+        w.write_to_known_channel(&header, &m.data)
+            .map_err(|e| io_err(path, e))?;
+    }
+    Ok(msgs.len() as u64)
+}
+
+fn run_thread(
+    path: String,
+    setup: RecorderSetup,
+    shared: Arc<Shared>,
+    ready: mpsc::Sender<Result<(), RecordError>>,
+) -> Result<WriteSummary, RecordError> {
+    let res = write_all(&path, &setup, &shared, ready);
+    if res.is_err() {
+        shared.failed.store(true, Ordering::Release);
+    }
+    res
+}
+
+fn write_all(
+    path: &str,
+    setup: &RecorderSetup,
+    shared: &Shared,
+    ready: mpsc::Sender<Result<(), RecordError>>,
+) -> Result<WriteSummary, RecordError> {
+    let (mut w, ids) = match open(path, setup) {
+        Ok(x) => {
+            let _ = ready.send(Ok(()));
+            x
+        }
+        Err(e) => {
+            let _ = ready.send(Err(e.clone()));
+            return Err(e);
+        }
+    };
+    let mut sum = WriteSummary::default();
+    let mut seq = 0u32;
+    let desc = OutMsg {
+        channel: Channel::Description,
+        data: setup.description.encode(),
+    };
+    sum.messages += write_msgs(&mut w, &ids, &mut seq, 0, &[desc], path)?;
+    w.flush().map_err(|e| io_err(path, e))?;
+    let mut next_flush = setup.flush_every_ns;
+    let mut batch: Vec<Cmd> = Vec::new();
+    loop {
+        // Read the flag before draining: whatever was queued before `done` is then drained.
+        let done = shared.done.load(Ordering::Acquire);
+        {
+            let mut q = shared
+                .queue
+                .lock()
+                .map_err(|_| RecordError::WriterStopped("queue lock poisoned".into()))?;
+            std::mem::swap(&mut *q, &mut batch);
+        }
+        for cmd in batch.drain(..) {
+            match cmd {
+                Cmd::Tick(t) => {
+                    if t.log_time_ns >= next_flush {
+                        // Close the chunk of the previous second and push it to the OS.
+                        w.flush().map_err(|e| io_err(path, e))?;
+                        sum.flushes += 1;
+                        while next_flush <= t.log_time_ns {
+                            next_flush += setup.flush_every_ns;
+                        }
+                    }
+                    sum.messages +=
+                        write_msgs(&mut w, &ids, &mut seq, t.log_time_ns, &t.msgs, path)?;
+                }
+                Cmd::Metadata(name, metadata) => {
+                    w.write_metadata(&mcap::records::Metadata { name, metadata })
+                        .map_err(|e| io_err(path, e))?;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+        std::thread::sleep(POLL);
+    }
+    w.finish().map_err(|e| io_err(path, e))?;
+    drop(w);
+    sum.bytes = std::fs::metadata(path).map_err(|e| io_err(path, e))?.len();
+    Ok(sum)
+}
+
+impl Recorder {
+    /// Creates the file and starts the writer thread.
+    pub fn create(path: &Path, setup: RecorderSetup) -> Result<Recorder, RecordError> {
+        let path_s = path.display().to_string();
+        let (ready_tx, ready_rx) = mpsc::channel();
+        let shared = Arc::new(Shared {
+            queue: Mutex::new(Vec::with_capacity(4096)),
+            done: AtomicBool::new(false),
+            failed: AtomicBool::new(false),
+        });
+        let s2 = shared.clone();
+        let p2 = path_s.clone();
+        let handle = std::thread::Builder::new()
+            .name("mcap-writer".into())
+            .spawn(move || run_thread(p2, setup, s2, ready_tx))
+            .map_err(|e| io_err(&path_s, e))?;
+        match ready_rx.recv() {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(e),
+            Err(_) => return Err(RecordError::WriterStopped("writer thread died".into())),
+        }
+        Ok(Recorder {
+            shared,
+            local: Vec::with_capacity(64),
+            handle: Some(handle),
+            max_queued: 0,
+            path: path_s,
+        })
+    }
+
+    fn hand_over(&mut self) {
+        if let Ok(mut q) = self.shared.queue.try_lock() {
+            q.append(&mut self.local);
+            self.max_queued = self.max_queued.max(q.len());
+        }
+    }
+
+    /// Queues a tick's messages for the writer thread (never blocks, never wakes a thread).
+    pub fn write(&mut self, t: TickMessages) -> Result<(), RecordError> {
+        if self.shared.failed.load(Ordering::Acquire) {
+            return Err(RecordError::WriterStopped(format!(
+                "{}: the writer failed (its error is returned by finish)",
+                self.path
+            )));
+        }
+        self.local.push(Cmd::Tick(t));
+        self.hand_over();
+        Ok(())
+    }
+
+    /// Queues a metadata record (e.g. the session summary).
+    pub fn metadata(&mut self, name: &str, m: BTreeMap<String, String>) -> Result<(), RecordError> {
+        self.local.push(Cmd::Metadata(name.to_string(), m));
+        self.hand_over();
+        Ok(())
+    }
+
+    /// Hands over what is left, waits for the thread to write the summary and returns what it
+    /// did (or the first error it met).
+    pub fn finish(mut self) -> Result<WriteSummary, RecordError> {
+        {
+            let mut q = self
+                .shared
+                .queue
+                .lock()
+                .map_err(|_| RecordError::WriterStopped("queue lock poisoned".into()))?;
+            q.append(&mut self.local);
+        }
+        self.shared.done.store(true, Ordering::Release);
+        let h = self
+            .handle
+            .take()
+            .ok_or_else(|| RecordError::WriterStopped("already finished".into()))?;
+        let mut sum = h
+            .join()
+            .map_err(|_| RecordError::WriterStopped("writer thread panicked".into()))??;
+        sum.max_queue_ticks = self.max_queued;
+        Ok(sum)
+    }
+}
+
+impl Drop for Recorder {
+    fn drop(&mut self) {
+        if let Ok(mut q) = self.shared.queue.lock() {
+            q.append(&mut self.local);
+        }
+        self.shared.done.store(true, Ordering::Release);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}

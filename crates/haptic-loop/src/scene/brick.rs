@@ -1,0 +1,253 @@
+//! The macro world (crate `brickworld`) as a scene: bricks under gravity on rapier, a
+//! god-object cursor, grab / carry / rotate / throw, blueprint score.
+//!
+//! A thin adapter. `[brickworld.params]` is the world's own [`brickworld::Params`] table
+//! (every field has a default). The device limits handed to the world are the device's,
+//! mapped to the world (`k_max / (force_scale · workspace_scale)`, `F_max / force_scale`), so the
+//! world's proxy stiffness is checked against the real device. Buttons: Falcon centre → grab,
+//! plus / minus / forward → turn about x / y / z; Touch button1 → grab, button2 → turn about z.
+//! The world's `dt_s` must equal the loop's tick.
+
+use super::file::{SceneError, out_of_range};
+use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
+use crate::vec3::Vec3;
+use brickworld::{Buttons as BrickButtons, CursorInput, DeviceLimits, Params, World};
+use serde::Deserialize;
+
+/// `[brickworld]`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BrickSection {
+    /// The world's parameters (defaults for what is left out).
+    #[serde(default)]
+    pub params: Params,
+    /// Half side of the drawn ground square, m (the physical ground is 100 m wide).
+    #[serde(default = "default_ground")]
+    pub draw_ground_half_m: f64,
+}
+
+fn default_ground() -> f64 {
+    1.0
+}
+
+/// The brick-world scene.
+pub struct BrickScene {
+    world: World,
+    /// Bit of the device button for centre, x, y, z turns (`None`: the device has none).
+    bits: [Option<u32>; 4],
+    last_input: Option<CursorInput>,
+    rejected: bool,
+    force_n: Vec3,
+    penetration_m: f64,
+    ground_half_m: f64,
+}
+
+impl BrickScene {
+    /// Builds the scene: `cap_n_per_m` and `max_force_world_n` are the device limits mapped to
+    /// the world, `dt_s` the tick, `buttons` the device's button names.
+    pub fn new(
+        s: BrickSection,
+        cap_n_per_m: f64,
+        max_force_world_n: f64,
+        dt_s: f64,
+        buttons: &[&str],
+    ) -> Result<Self, SceneError> {
+        if s.params.dt_s != dt_s {
+            return Err(out_of_range(
+                "brickworld.params.dt_s",
+                s.params.dt_s,
+                format!("{dt_s} s, the loop's tick (1 / loop.rate_hz)"),
+            ));
+        }
+        super::file::check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;
+        let limits = DeviceLimits {
+            max_stiffness_n_m: cap_n_per_m,
+            max_force_n: max_force_world_n,
+        };
+        let world = World::new(s.params, limits)
+            .map_err(|e| SceneError::Parse(format!("brickworld.params: {e}")))?;
+        let find = |names: &[&str]| {
+            names
+                .iter()
+                .find_map(|n| buttons.iter().position(|b| b == n).map(|i| i as u32))
+        };
+        Ok(BrickScene {
+            world,
+            bits: [
+                find(&["centre", "button1"]),
+                find(&["plus"]),
+                find(&["minus"]),
+                find(&["forward", "button2"]),
+            ],
+            last_input: None,
+            rejected: false,
+            force_n: [0.0; 3],
+            penetration_m: 0.0,
+            ground_half_m: s.draw_ground_half_m,
+        })
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+}
+
+fn event_name(e: &brickworld::Event) -> &'static str {
+    use brickworld::Event as E;
+    match e {
+        E::Spawned { .. } => "brick.spawned",
+        E::Grabbed { .. } => "brick.grabbed",
+        E::GrabMissed => "brick.grab_missed",
+        E::Released { .. } => "brick.released",
+        E::Thrown { .. } => "brick.thrown",
+        E::Rotated { .. } => "brick.rotated",
+        E::RotationBlocked { .. } => "brick.rotation_blocked",
+        E::TouchBegan { .. } => "brick.touch_began",
+        E::TouchEnded { .. } => "brick.touch_ended",
+        E::SlotFilled { .. } => "brick.slot_filled",
+        E::SlotVacated { .. } => "brick.slot_vacated",
+    }
+}
+
+impl Scene for BrickScene {
+    fn kind(&self) -> &'static str {
+        "brickworld"
+    }
+
+    fn state_fields(&self) -> Vec<String> {
+        [
+            "proxy_x_m",
+            "proxy_y_m",
+            "proxy_z_m",
+            "holding",
+            "bricks",
+            "awake_bricks",
+            "slots_filled",
+            "proxy_penetration_m",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    }
+
+    fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
+        let pressed = |bit: Option<u32>| bit.is_some_and(|b| input.buttons.pressed(b));
+        let buttons = BrickButtons {
+            center: pressed(self.bits[0]),
+            rotate_x: pressed(self.bits[1]),
+            rotate_y: pressed(self.bits[2]),
+            rotate_z: pressed(self.bits[3]),
+        };
+        let cursor_input = match self.world.input(input.cursor_m, buttons) {
+            Ok(i) => {
+                self.rejected = false;
+                Some(i)
+            }
+            Err(e) => {
+                if !self.rejected {
+                    out.events
+                        .push(Event::new("brick.input_rejected", e.to_string()));
+                }
+                self.rejected = true;
+                // Time goes on: step with the last accepted input (the cursor held there).
+                self.last_input
+            }
+        };
+        let Some(ci) = cursor_input else {
+            return;
+        };
+        self.last_input = Some(ci);
+        let r = self.world.step(&ci);
+        for e in &r.events {
+            out.events.push(Event::new(event_name(e), format!("{e:?}")));
+        }
+        self.force_n = if self.rejected { [0.0; 3] } else { r.force_n };
+        self.penetration_m = r.proxy_penetration_m;
+        out.force_n = self.force_n;
+        out.stiffness_n_per_m = r.stiffness_n_m;
+    }
+
+    fn state(&self, out: &mut Vec<f64>) {
+        let p = self.world.proxy_position_m();
+        out.extend_from_slice(&p);
+        out.push(f64::from(u8::from(self.world.held_brick().is_some())));
+        out.push(self.world.brick_count() as f64);
+        out.push(self.world.awake_brick_count() as f64);
+        out.push(self.world.score().filled as f64);
+        out.push(self.penetration_m);
+    }
+
+    fn draw(&self, out: &mut Vec<Primitive>) {
+        let g = self.ground_half_m;
+        out.push(Primitive::Box {
+            center_m: [0.0, 0.0, -0.01],
+            half_extents_m: [g, g, 0.01],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            color: Rgba([0.3, 0.6, 0.25, 1.0]),
+        });
+        for o in self.world.obstacles() {
+            out.push(Primitive::Box {
+                center_m: o.position_m,
+                half_extents_m: o.half_extents_m,
+                rotation: o.orientation_xyzw,
+                color: Rgba([0.5, 0.5, 0.5, 1.0]),
+            });
+        }
+        let h = self.world.params().brick_half_extents_m;
+        for s in self.world.slots().filter(|s| s.filled_by.is_none()) {
+            out.push(Primitive::Box {
+                center_m: s.position_m,
+                half_extents_m: h,
+                rotation: s.orientation_xyzw,
+                color: Rgba([0.4, 0.6, 1.0, 0.3]),
+            });
+        }
+        for b in self.world.bricks() {
+            out.push(Primitive::Box {
+                center_m: b.position_m,
+                half_extents_m: b.half_extents_m,
+                rotation: b.orientation_xyzw,
+                color: if b.held {
+                    Rgba([0.85, 0.35, 0.2, 1.0])
+                } else {
+                    Rgba([0.7, 0.25, 0.15, 1.0])
+                },
+            });
+        }
+        if let Some(z) = &self.world.params().loading_zone {
+            let (a, b) = (z.min_m, z.max_m);
+            out.push(Primitive::Polyline {
+                points_m: vec![
+                    [a[0], a[1], 0.001],
+                    [b[0], a[1], 0.001],
+                    [b[0], b[1], 0.001],
+                    [a[0], b[1], 0.001],
+                ],
+                closed: true,
+                color: Rgba([1.0, 0.85, 0.2, 1.0]),
+            });
+        }
+        let p = self.world.proxy_position_m();
+        out.push(Primitive::Sphere {
+            center_m: p,
+            radius_m: self.world.params().proxy_radius_m.max(0.01),
+            color: Rgba([0.2, 0.5, 0.95, 1.0]),
+        });
+        let f = self.force_n;
+        if f.iter().any(|c| *c != 0.0) {
+            // Arrow length: 1 cm per newton of world force (drawing only).
+            out.push(Primitive::Arrow {
+                from_m: p,
+                to_m: [p[0] + 0.01 * f[0], p[1] + 0.01 * f[1], p[2] + 0.01 * f[2]],
+                color: Rgba([1.0, 0.9, 0.1, 1.0]),
+            });
+        }
+        let s = self.world.score();
+        out.push(Primitive::Label {
+            position_m: [0.0, -0.6, 0.0],
+            text: format!("blueprint {}/{}", s.filled, s.total),
+            color: Rgba([1.0, 1.0, 1.0, 1.0]),
+        });
+    }
+}

@@ -1,0 +1,156 @@
+//! The scene interface every world plugs into, the drawable primitives, scene files, and the
+//! stiff-wall calibration scene.
+//!
+//! A scene receives the cursor (world frame, m) and the buttons once per tick and answers with
+//! the force on the cursor (world frame, N), events, and on request its state (named f64
+//! fields) and the primitives a renderer draws.
+
+pub mod brick;
+pub mod file;
+pub mod nano;
+pub mod optical;
+pub mod wall;
+
+use crate::device::Buttons;
+use crate::vec3::Vec3;
+
+pub use file::{SceneError, SceneFile, load_scene};
+
+/// What the loop tells the scene each tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneInput {
+    /// Tick index (the only clock).
+    pub tick: u64,
+    /// Tick length, s.
+    pub dt_s: f64,
+    /// Cursor position, world frame, m.
+    pub cursor_m: Vec3,
+    /// Button state of the device.
+    pub buttons: Buttons,
+    /// False when the device input was invalid this tick: the cursor is then the last valid one.
+    pub input_valid: bool,
+}
+
+/// An event raised during a tick (logged, shown in Foxglove as a log line).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Event {
+    /// Dotted event name, e.g. `wall.contact_begin`.
+    pub name: String,
+    /// Human-readable detail (may be empty).
+    pub detail: String,
+}
+
+impl Event {
+    /// A new event.
+    pub fn new(name: impl Into<String>, detail: impl Into<String>) -> Self {
+        Event {
+            name: name.into(),
+            detail: detail.into(),
+        }
+    }
+}
+
+/// What a scene answers each tick.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneOutput {
+    /// Force on the cursor, world frame, N.
+    pub force_n: Vec3,
+    /// Local stiffness of the rendered force field this tick, world frame, N/m (0 when no spring
+    /// acts). The loop checks it against the cap it gave the scene.
+    pub stiffness_n_per_m: f64,
+    /// Events raised this tick, in order.
+    pub events: Vec<Event>,
+}
+
+impl SceneOutput {
+    /// Clears the output for reuse.
+    pub fn clear(&mut self) {
+        self.force_n = [0.0; 3];
+        self.stiffness_n_per_m = 0.0;
+        self.events.clear();
+    }
+}
+
+/// An RGBA colour, each channel in 0–1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rgba(pub [f64; 4]);
+
+/// A drawable primitive, world frame, metres.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Primitive {
+    /// A sphere.
+    Sphere {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Radius, m.
+        radius_m: f64,
+        /// Colour.
+        color: Rgba,
+    },
+    /// A box rotated by a unit quaternion `[x, y, z, w]`.
+    Box {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Half extents along the box axes, m.
+        half_extents_m: Vec3,
+        /// Orientation as a unit quaternion `[x, y, z, w]`.
+        rotation: [f64; 4],
+        /// Colour.
+        color: Rgba,
+    },
+    /// An ellipse in a plane of constant z (e.g. the beam's cross-section).
+    Ellipse {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Semi-axes along x and y, m.
+        semi_axes_m: [f64; 2],
+        /// Colour.
+        color: Rgba,
+    },
+    /// A polyline, closed into a loop when `closed`.
+    Polyline {
+        /// Vertices, m.
+        points_m: Vec<Vec3>,
+        /// Join the last vertex to the first.
+        closed: bool,
+        /// Colour.
+        color: Rgba,
+    },
+    /// An arrow from `from_m` to `to_m`.
+    Arrow {
+        /// Tail, m.
+        from_m: Vec3,
+        /// Head, m.
+        to_m: Vec3,
+        /// Colour.
+        color: Rgba,
+    },
+    /// A text label.
+    Label {
+        /// Anchor, m.
+        position_m: Vec3,
+        /// Text.
+        text: String,
+        /// Colour.
+        color: Rgba,
+    },
+}
+
+/// A world as the haptic loop sees it.
+///
+/// Implementations hold their world's parameters and state; `step` advances by one tick of
+/// `input.dt_s`. It must be deterministic: same inputs, same bits.
+pub trait Scene {
+    /// Short scene kind name, e.g. `wall`.
+    fn kind(&self) -> &'static str;
+    /// Names of the state fields, in the order [`Scene::state`] writes them (lower snake case,
+    /// with the unit as suffix, e.g. `penetration_m`).
+    fn state_fields(&self) -> Vec<String>;
+    /// Advances one tick and writes the force on the cursor and the events into `out` (which
+    /// the caller has cleared).
+    fn step(&mut self, input: &SceneInput, out: &mut SceneOutput);
+    /// Appends the state fields (after the last step) to `out`.
+    fn state(&self, out: &mut Vec<f64>);
+    /// Appends the primitives to draw the current state to `out`.
+    fn draw(&self, out: &mut Vec<Primitive>);
+}

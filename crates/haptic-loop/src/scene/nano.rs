@@ -1,0 +1,316 @@
+//! The nano world (crate `nanoworld`) as a scene: AFM tip on the cursor, van der Waals
+//! attraction, snap-to-contact, tenfold pull-off, atom transfer, house blueprint.
+//!
+//! A thin adapter: the world's own [`nanoworld::Params`] come from the scene file (a preset or
+//! a full table), the world is created at the first tick with the tip at the cursor, and each
+//! tick calls [`nanoworld::World::step`]. Its typed events become `nano.*` events (detail:
+//! the event's fields).
+//!
+//! Stiffness: the stiffest spring the world renders (the largest game-mode adhesion `k`, or
+//! the physical-mode cantilever `k_c`) must map within the device's limit; the scene file is
+//! refused otherwise (lower `mapping.force_scale` or `mapping.workspace_scale`). Each tick the
+//! scene reports the adhesion `k` of the anchored contact (game mode) or `k_c` (physical).
+
+use super::file::{SceneError, out_of_range};
+use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
+use crate::vec3::Vec3;
+use nalgebra::Vector3;
+use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};
+use serde::Deserialize;
+
+/// `[nanoworld]`: a preset or a full parameter table.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct NanoSection {
+    /// `game` (the paper's laws) or `physical` (real constants).
+    #[serde(default)]
+    pub preset: Option<String>,
+    /// Full world parameters (instead of a preset).
+    #[serde(default)]
+    pub params: Option<Params>,
+    /// Substrate atoms are drawn within this distance of the tip, m (default 1.5 nm).
+    #[serde(default = "default_draw_radius")]
+    pub draw_radius_m: f64,
+}
+
+fn default_draw_radius() -> f64 {
+    1.5e-9
+}
+
+/// The nano-world scene.
+pub struct NanoScene {
+    params: Params,
+    world: Option<World>,
+    dt_s: f64,
+    draw_radius_m: f64,
+    saturated: bool,
+    force_n: Vec3,
+}
+
+fn max_render_stiffness(p: &Params) -> (String, f64) {
+    match &p.interaction {
+        Interaction::Game(g) => {
+            let pairs = [
+                ("tip_substrate", g.pairs.tip_substrate.stiffness_n_per_m),
+                ("tip_atom", g.pairs.tip_atom.stiffness_n_per_m),
+                ("atom_atom", g.pairs.atom_atom.stiffness_n_per_m),
+                ("atom_substrate", g.pairs.atom_substrate.stiffness_n_per_m),
+            ];
+            let (name, k) =
+                pairs.iter().fold(
+                    ("tip_substrate", 0.0),
+                    |a, b| if b.1 > a.1 { *b } else { a },
+                );
+            (
+                format!("nanoworld.params.interaction.game.pairs.{name}.stiffness_n_per_m"),
+                k,
+            )
+        }
+        Interaction::Physical(ph) => (
+            "nanoworld.params.interaction.physical.cantilever_stiffness_n_per_m".to_string(),
+            ph.cantilever_stiffness_n_per_m,
+        ),
+    }
+}
+
+impl NanoScene {
+    /// Builds the scene from its section, the world stiffness cap (N/m) and the tick (s).
+    pub fn new(s: NanoSection, cap_n_per_m: f64, dt_s: f64) -> Result<Self, SceneError> {
+        let params = match (&s.preset, s.params) {
+            (Some(name), None) => match name.as_str() {
+                "game" => Params::game_default(),
+                "physical" => Params::physical_default(),
+                other => {
+                    return Err(out_of_range(
+                        "nanoworld.preset",
+                        format!("\"{other}\""),
+                        "\"game\" or \"physical\"",
+                    ));
+                }
+            },
+            (None, Some(p)) => p,
+            _ => {
+                return Err(out_of_range(
+                    "nanoworld",
+                    "a table with both or neither of `preset` and `params`",
+                    "exactly one of `preset` or `[nanoworld.params]`",
+                ));
+            }
+        };
+        params
+            .validate()
+            .map_err(|e| SceneError::Parse(format!("nanoworld.params: {e}")))?;
+        let (field, k) = max_render_stiffness(&params);
+        if k > cap_n_per_m {
+            return Err(out_of_range(
+                &field,
+                k,
+                format!(
+                    "≤ {cap_n_per_m} N/m, the device's stiffness limit mapped to the world \
+                     (lower mapping.force_scale or mapping.workspace_scale)"
+                ),
+            ));
+        }
+        super::file::check_positive("nanoworld.draw_radius_m", s.draw_radius_m, 1e-6)?;
+        Ok(NanoScene {
+            params,
+            world: None,
+            dt_s,
+            draw_radius_m: s.draw_radius_m,
+            saturated: false,
+            force_n: [0.0; 3],
+        })
+    }
+
+    /// The world (after the first tick).
+    pub fn world(&self) -> Option<&World> {
+        self.world.as_ref()
+    }
+}
+
+fn v(p: Vector3<f64>) -> Vec3 {
+    [p.x, p.y, p.z]
+}
+
+fn event_name(e: &nanoworld::Event) -> &'static str {
+    use nanoworld::Event as E;
+    match e {
+        E::AtomSpawned { .. } => "nano.atom_spawned",
+        E::Snap { .. } => "nano.snap",
+        E::AtomAttached { .. } => "nano.atom_attached",
+        E::PullOff { .. } => "nano.pull_off",
+        E::AtomTransferred { .. } => "nano.atom_transferred",
+        E::AtomPickedUp { .. } => "nano.atom_picked_up",
+        E::SlotFilled { .. } => "nano.slot_filled",
+        E::SlotEmptied { .. } => "nano.slot_emptied",
+        E::HouseComplete => "nano.house_complete",
+    }
+}
+
+impl Scene for NanoScene {
+    fn kind(&self) -> &'static str {
+        "nanoworld"
+    }
+
+    fn state_fields(&self) -> Vec<String> {
+        [
+            "tip_x_m",
+            "tip_y_m",
+            "tip_z_m",
+            "anchored",
+            "carried_atoms",
+            "movable_atoms",
+            "house_score",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    }
+
+    fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
+        let cursor = Vector3::new(input.cursor_m[0], input.cursor_m[1], input.cursor_m[2]);
+        if self.world.is_none() {
+            match World::new(self.params.clone(), cursor) {
+                Ok(w) => self.world = Some(w),
+                Err(e) => {
+                    out.events.push(Event::new("nano.error", e.to_string()));
+                    return;
+                }
+            }
+        }
+        let Some(world) = self.world.as_mut() else {
+            return;
+        };
+        match world.step(&TipInput { position_m: cursor }, self.dt_s) {
+            Ok(r) => {
+                for e in &r.events {
+                    out.events.push(Event::new(event_name(e), format!("{e:?}")));
+                }
+                if r.saturated && !self.saturated {
+                    out.events.push(Event::new(
+                        "nano.saturated",
+                        format!(
+                            "world force {:e} N scaled to max_force_n",
+                            r.unlimited_force_n.norm()
+                        ),
+                    ));
+                }
+                self.saturated = r.saturated;
+                self.force_n = v(r.force_n);
+            }
+            Err(e) => {
+                out.events
+                    .push(Event::new("nano.step_error", e.to_string()));
+                self.force_n = [0.0; 3];
+            }
+        }
+        out.force_n = self.force_n;
+        out.stiffness_n_per_m = match (&self.params.interaction, world.tip_contact()) {
+            (Interaction::Physical(p), _) => p.cantilever_stiffness_n_per_m,
+            (Interaction::Game(_), TipContact::Anchored(a)) => {
+                world.laws().get(a.pair).stiffness_n_per_m
+            }
+            (Interaction::Game(_), TipContact::Free) => 0.0,
+        };
+    }
+
+    fn state(&self, out: &mut Vec<f64>) {
+        match &self.world {
+            Some(w) => {
+                let t = w.tip_position_m();
+                out.extend_from_slice(&[t.x, t.y, t.z]);
+                out.push(f64::from(u8::from(matches!(
+                    w.tip_contact(),
+                    TipContact::Anchored(_)
+                ))));
+                out.push(w.carried().len() as f64);
+                out.push(w.atoms().len() as f64);
+                out.push(w.house().score() as f64);
+            }
+            None => out.extend_from_slice(&[0.0; 7]),
+        }
+    }
+
+    fn draw(&self, out: &mut Vec<Primitive>) {
+        let Some(w) = &self.world else {
+            return;
+        };
+        let teal = Rgba([0.0, 0.55, 0.55, 1.0]);
+        let orange = Rgba([1.0, 0.55, 0.1, 1.0]);
+        let tip = w.tip_position_m();
+        // The substrate as a slab, and its atoms near the tip.
+        let s = &self.params.substrate;
+        let (lx, ly) = (s.nx as f64 * s.spacing_m, s.ny as f64 * s.spacing_m);
+        out.push(Primitive::Box {
+            center_m: [
+                0.5 * (lx - s.spacing_m),
+                0.5 * (ly - s.spacing_m),
+                -s.atom_radius_m,
+            ],
+            half_extents_m: [0.5 * lx, 0.5 * ly, 0.5 * s.atom_radius_m],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            color: Rgba([0.0, 0.35, 0.35, 0.6]),
+        });
+        let near = Vector3::new(tip.x, tip.y, 0.0);
+        w.substrate()
+            .for_each_within(&near, self.draw_radius_m, |_, q| {
+                out.push(Primitive::Sphere {
+                    center_m: v(*q),
+                    radius_m: s.atom_radius_m,
+                    color: teal,
+                });
+            });
+        for b in w.bodies().filter(|b| b.kind != BodyKind::Substrate) {
+            let color = match b.kind {
+                BodyKind::Tip => Rgba([0.75, 0.75, 0.8, 1.0]),
+                _ => orange,
+            };
+            out.push(Primitive::Sphere {
+                center_m: v(b.position_m),
+                radius_m: b.radius_m,
+                color,
+            });
+        }
+        if let Some(h) = &self.params.house {
+            for (k, slot) in h.slots_m.iter().enumerate() {
+                let filled = w.house().filled().get(k).is_some_and(Option::is_some);
+                if !filled {
+                    out.push(Primitive::Sphere {
+                        center_m: *slot,
+                        radius_m: self.params.atoms.radius_m,
+                        color: Rgba([1.0, 1.0, 1.0, 0.25]),
+                    });
+                }
+            }
+        }
+        if let Some(z) = &self.params.loading_zone {
+            let (a, b) = (z.min_xy_m, z.max_xy_m);
+            out.push(Primitive::Polyline {
+                points_m: vec![
+                    [a[0], a[1], 0.0],
+                    [b[0], a[1], 0.0],
+                    [b[0], b[1], 0.0],
+                    [a[0], b[1], 0.0],
+                ],
+                closed: true,
+                color: Rgba([1.0, 0.8, 0.2, 1.0]),
+            });
+        }
+        let f = self.force_n;
+        let fmag = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+        if fmag > 0.0 {
+            // Arrow length: 1 nm per nN (drawing only).
+            let tip_v = v(tip);
+            out.push(Primitive::Arrow {
+                from_m: tip_v,
+                to_m: [tip_v[0] + f[0], tip_v[1] + f[1], tip_v[2] + f[2]],
+                color: Rgba([1.0, 0.9, 0.1, 1.0]),
+            });
+        }
+        out.push(Primitive::Label {
+            position_m: [0.5 * lx, -0.1 * ly, 0.0],
+            text: format!("house {}/{}", w.house().score(), w.house().slots_m().len()),
+            color: Rgba([1.0, 1.0, 1.0, 1.0]),
+        });
+    }
+}

@@ -1,0 +1,371 @@
+//! The optical-tweezers steering scene (Lee, Lyons & LeBrun, §2.4 and §3.3): a 1 µm particle
+//! in an elliptic Gaussian trap, a cursor sphere on the stylus, grab by touching the particle
+//! and pressing the button, steering through `ot-envelope`'s controller, release on button up.
+//!
+//! Each haptic tick advances the particle by `dt_us` of particle time (the paper's control
+//! cycle). While grabbed, the controller computes this tick's working envelope from the
+//! particle's current velocity, clips the command (cursor − particle) to it, places the trap so
+//! that the particle makes the allowed displacement, and returns the spring force `−k·excess`
+//! felt on the stylus (when `feedback` is on). The particle is then moved by the trap's flow
+//! map (not by the command), so what the recording shows is the physics, not the wish. Not
+//! grabbed, the particle evolves in the last trap. The paper's viscous simplification (the
+//! velocity kept to a fraction each cycle) is `velocity_retain` (1: none).
+
+use super::file::{SceneError, check_positive, check_range};
+use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
+use crate::vec3::Vec3;
+use nalgebra::Vector2;
+use ot_envelope::ClipMode;
+use ot_envelope::steer::{Controller, ParticleState, SteerParams};
+use ot_physics::{Method, Propagator, TrapModel};
+use serde::Deserialize;
+
+type V2 = Vector2<f64>;
+
+/// `[optical_tweezers]`: what a human types, with units in the names.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OtParams {
+    /// Well depth P0, nJ (paper: 1e-6).
+    pub depth_nj: f64,
+    /// Beam waist a along x, nm (paper: 600).
+    pub waist_x_nm: f64,
+    /// Beam waist b along y, nm (paper: 300).
+    pub waist_y_nm: f64,
+    /// Particle mass, g (paper: 1e-12).
+    pub mass_g: f64,
+    /// Particle time per haptic tick, µs (paper: 1).
+    pub dt_us: f64,
+    /// RK4 substeps of the tick map (8: within 0.21 nm of converged dynamics).
+    #[serde(default = "default_substeps")]
+    pub rk4_substeps: u32,
+    /// Particle diameter, µm (paper: 1).
+    pub particle_diameter_um: f64,
+    /// Cursor sphere radius, nm.
+    pub cursor_radius_nm: f64,
+    /// Spring stiffness on the excess, world frame, N/m.
+    pub stiffness_n_per_m: f64,
+    /// Force feedback on the stylus (the paper's experiment switches it off).
+    #[serde(default = "yes")]
+    pub feedback: bool,
+    /// Clipping rule: "radial" (the paper's) or "nearest".
+    #[serde(default)]
+    pub clip: ClipMode,
+    /// Fraction of the velocity kept after each tick (paper §3.3: 0.1; 1: no damping).
+    #[serde(default = "one")]
+    pub velocity_retain: f64,
+    /// Drawing scale of the working envelope around the particle (paper: 100).
+    #[serde(default = "hundred")]
+    pub envelope_draw_scale: f64,
+    /// Particle (and trap) start, µm.
+    #[serde(default)]
+    pub start_um: [f64; 2],
+    /// Geometric tolerance of the working envelope, nm (default: `ot_envelope::DEFAULT_TOL`).
+    #[serde(default)]
+    pub envelope_tol_nm: Option<f64>,
+}
+
+fn default_substeps() -> u32 {
+    8
+}
+fn yes() -> bool {
+    true
+}
+fn one() -> f64 {
+    1.0
+}
+fn hundred() -> f64 {
+    100.0
+}
+
+/// The optical-tweezers scene.
+pub struct OpticalScene {
+    p: OtParams,
+    prop: Propagator<2>,
+    controller: Controller,
+    waists_m: [f64; 2],
+    particle_r_m: f64,
+    cursor_r_m: f64,
+    position: V2,
+    velocity: V2,
+    trap: V2,
+    cursor: V2,
+    grabbed: bool,
+    button_was: bool,
+    excess: V2,
+    force: V2,
+    envelope: Vec<V2>,
+    clipping: bool,
+}
+
+impl OpticalScene {
+    /// Builds the scene; `cap_n_per_m` is the world stiffness cap.
+    pub fn new(p: OtParams, cap_n_per_m: f64) -> Result<Self, SceneError> {
+        check_positive("optical_tweezers.depth_nj", p.depth_nj, 1e3)?;
+        check_positive("optical_tweezers.waist_x_nm", p.waist_x_nm, 1e6)?;
+        check_positive("optical_tweezers.waist_y_nm", p.waist_y_nm, 1e6)?;
+        check_positive("optical_tweezers.mass_g", p.mass_g, 1.0)?;
+        check_positive("optical_tweezers.dt_us", p.dt_us, 1e6)?;
+        check_range(
+            "optical_tweezers.rk4_substeps",
+            f64::from(p.rk4_substeps),
+            1.0,
+            1000.0,
+        )?;
+        check_positive(
+            "optical_tweezers.particle_diameter_um",
+            p.particle_diameter_um,
+            1e3,
+        )?;
+        check_positive("optical_tweezers.cursor_radius_nm", p.cursor_radius_nm, 1e6)?;
+        check_positive(
+            "optical_tweezers.stiffness_n_per_m",
+            p.stiffness_n_per_m,
+            cap_n_per_m,
+        )
+        .map_err(|_| {
+            super::file::out_of_range(
+                "optical_tweezers.stiffness_n_per_m",
+                p.stiffness_n_per_m,
+                format!(
+                    "0 < stiffness ≤ {cap_n_per_m} N/m, the device's limit mapped to the world"
+                ),
+            )
+        })?;
+        check_range(
+            "optical_tweezers.velocity_retain",
+            p.velocity_retain,
+            0.0,
+            1.0,
+        )?;
+        check_positive(
+            "optical_tweezers.envelope_draw_scale",
+            p.envelope_draw_scale,
+            1e6,
+        )?;
+        let tol = match p.envelope_tol_nm {
+            Some(t) => {
+                check_positive("optical_tweezers.envelope_tol_nm", t, 1e3)?;
+                t * 1e-9
+            }
+            None => ot_envelope::DEFAULT_TOL,
+        };
+        for (k, c) in p.start_um.iter().enumerate() {
+            check_range(&format!("optical_tweezers.start_um[{k}]"), *c, -1e6, 1e6)?;
+        }
+        let waists_m = [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9];
+        let model = TrapModel::builder(p.depth_nj * 1e-9, waists_m)
+            .mass(p.mass_g * 1e-3)
+            .build()
+            .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
+        let prop = Propagator::new(
+            model,
+            Method::Rk4 {
+                substeps: p.rk4_substeps,
+            },
+            p.dt_us * 1e-6,
+        )
+        .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
+        let controller = Controller::new(SteerParams {
+            stiffness: p.stiffness_n_per_m,
+            mode: p.clip,
+            tol,
+            margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
+        })
+        .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
+        let start = V2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
+        Ok(OpticalScene {
+            particle_r_m: 0.5 * p.particle_diameter_um * 1e-6,
+            cursor_r_m: p.cursor_radius_nm * 1e-9,
+            p,
+            prop,
+            controller,
+            waists_m,
+            position: start,
+            velocity: V2::zeros(),
+            trap: start,
+            cursor: start,
+            grabbed: false,
+            button_was: false,
+            excess: V2::zeros(),
+            force: V2::zeros(),
+            envelope: Vec::new(),
+            clipping: false,
+        })
+    }
+
+    /// Advances the particle in the trap at `self.trap` for one tick.
+    fn advance(&mut self) -> Result<(), String> {
+        let offset = self.trap - self.position;
+        let (d, v, _) = self
+            .prop
+            .flow(&offset, &self.velocity)
+            .map_err(|e| e.to_string())?;
+        self.position += d;
+        self.velocity = v * self.p.velocity_retain;
+        Ok(())
+    }
+}
+
+impl Scene for OpticalScene {
+    fn kind(&self) -> &'static str {
+        "optical_tweezers"
+    }
+
+    fn state_fields(&self) -> Vec<String> {
+        [
+            "particle_x_m",
+            "particle_y_m",
+            "particle_vx_m_per_s",
+            "particle_vy_m_per_s",
+            "trap_x_m",
+            "trap_y_m",
+            "grabbed",
+            "excess_m",
+            "lag_m",
+            "envelope_vertices",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    }
+
+    fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
+        self.cursor = V2::new(input.cursor_m[0], input.cursor_m[1]);
+        let button = input.buttons.pressed(0);
+        if button && !self.button_was && !self.grabbed {
+            let gap = (self.cursor - self.position).norm();
+            if gap <= self.particle_r_m + self.cursor_r_m {
+                self.grabbed = true;
+                self.controller.reset();
+                out.events.push(Event::new(
+                    "ot.grab",
+                    format!("cursor {gap:e} m from the particle centre"),
+                ));
+            } else {
+                out.events.push(Event::new(
+                    "ot.grab_missed",
+                    format!("cursor {gap:e} m from the particle centre"),
+                ));
+            }
+        }
+        if !button && self.grabbed {
+            self.grabbed = false;
+            out.events.push(Event::new("ot.release", ""));
+        }
+        self.button_was = button;
+        self.excess = V2::zeros();
+        self.force = V2::zeros();
+        if self.grabbed {
+            let state = ParticleState {
+                position: self.position,
+                velocity: self.velocity,
+            };
+            match self.controller.step(&self.prop, &state, &self.cursor) {
+                Ok(s) => {
+                    self.trap = s.trap;
+                    self.excess = s.excess;
+                    if self.p.feedback {
+                        self.force = s.force;
+                    }
+                    self.envelope = s.envelope.polygon;
+                }
+                Err(e) => {
+                    out.events
+                        .push(Event::new("ot.controller_error", e.to_string()));
+                }
+            }
+        } else {
+            self.envelope.clear();
+        }
+        let clipping = self.excess.norm() > 0.0;
+        if clipping && !self.clipping {
+            out.events.push(Event::new(
+                "ot.clipped",
+                "command outside the working envelope",
+            ));
+        }
+        self.clipping = clipping;
+        if let Err(e) = self.advance() {
+            out.events.push(Event::new("ot.physics_error", e));
+        }
+        out.force_n = [self.force.x, self.force.y, 0.0];
+        out.stiffness_n_per_m = if self.grabbed && self.p.feedback {
+            self.p.stiffness_n_per_m
+        } else {
+            0.0
+        };
+    }
+
+    fn state(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(&[
+            self.position.x,
+            self.position.y,
+            self.velocity.x,
+            self.velocity.y,
+            self.trap.x,
+            self.trap.y,
+            f64::from(u8::from(self.grabbed)),
+            self.excess.norm(),
+            (self.cursor - self.position).norm(),
+            self.envelope.len() as f64,
+        ]);
+    }
+
+    fn draw(&self, out: &mut Vec<Primitive>) {
+        let p = [self.position.x, self.position.y, 0.0];
+        out.push(Primitive::Ellipse {
+            center_m: [self.trap.x, self.trap.y, -self.particle_r_m],
+            semi_axes_m: self.waists_m,
+            color: Rgba([0.3, 0.8, 0.3, 0.4]),
+        });
+        out.push(Primitive::Sphere {
+            center_m: p,
+            radius_m: self.particle_r_m,
+            color: if self.grabbed {
+                Rgba([0.95, 0.6, 0.2, 1.0])
+            } else {
+                Rgba([0.8, 0.8, 0.85, 1.0])
+            },
+        });
+        out.push(Primitive::Sphere {
+            center_m: [self.cursor.x, self.cursor.y, 0.0],
+            radius_m: self.cursor_r_m,
+            color: Rgba([0.2, 0.5, 0.95, 1.0]),
+        });
+        if !self.envelope.is_empty() {
+            let s = self.p.envelope_draw_scale;
+            out.push(Primitive::Polyline {
+                points_m: self
+                    .envelope
+                    .iter()
+                    .map(|q| [p[0] + s * q.x, p[1] + s * q.y, 0.0])
+                    .collect(),
+                closed: true,
+                color: Rgba([0.9, 0.2, 0.2, 1.0]),
+            });
+        }
+        if self.force.norm() > 0.0 {
+            // Arrow: 1 µm per µN of world force (drawing only).
+            let tip: Vec3 = [p[0] + self.force.x, p[1] + self.force.y, 0.0];
+            out.push(Primitive::Arrow {
+                from_m: [self.cursor.x, self.cursor.y, 0.0],
+                to_m: [
+                    self.cursor.x + (tip[0] - p[0]),
+                    self.cursor.y + (tip[1] - p[1]),
+                    0.0,
+                ],
+                color: Rgba([1.0, 0.9, 0.1, 1.0]),
+            });
+        }
+        out.push(Primitive::Label {
+            position_m: [p[0], p[1] - 2.0 * self.particle_r_m, 0.0],
+            text: format!(
+                "WE ×{} · feedback {}",
+                self.p.envelope_draw_scale,
+                if self.p.feedback { "on" } else { "off" }
+            ),
+            color: Rgba([1.0, 1.0, 1.0, 1.0]),
+        });
+    }
+}

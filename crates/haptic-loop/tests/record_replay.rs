@@ -1,0 +1,296 @@
+//! Recording and bit-exact replay: round trips, determinism, divergence reports, damaged files,
+//! and the golden recordings under `recordings/`.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use haptic_loop::record::messages::{Channel, DeviceInputMsg, ForceMsg};
+use haptic_loop::record::{RecordingError, read_recording, read_recording_file};
+use haptic_loop::replay::verify;
+use haptic_loop::session::{
+    OperatorChoice, SceneSource, SessionArrays, SessionOptions, read_arrays, run_session,
+};
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("haptic-loop-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn wall_opts(out: Option<PathBuf>) -> SessionOptions {
+    let mut o =
+        SessionOptions::new(SceneSource::from_path(&root().join("scenes/wall.toml")).unwrap());
+    o.out = out;
+    o
+}
+
+#[test]
+fn recording_replays_bit_exactly_and_reads_back_the_same_arrays() {
+    let p = tmp("wall.mcap");
+    let report = run_session(&wall_opts(Some(p.clone())), &mut |_, _| {}).unwrap();
+    let rec = read_recording_file(&p, false).unwrap();
+    let v = verify(&rec).unwrap();
+    assert!(v.ok(), "{:?}", v.divergence);
+    assert_eq!(v.ticks, 4000);
+    // state + force every tick, Foxglove scene + tf at 50 Hz, events and their log lines.
+    let events = report.arrays.events.len() as u64;
+    let event_ticks = rec
+        .messages
+        .iter()
+        .filter(|m| m.channel == Channel::Events)
+        .count() as u64;
+    assert_eq!(
+        v.messages_compared,
+        2 * 4000 + 2 * 200 + event_ticks + events
+    );
+    let back = read_arrays(&p, false).unwrap();
+    assert_eq!(back, report.arrays);
+    // The physics the recording shows: the wall is capped at the Falcon's 3000 N/m, the force
+    // is clamped at 8 N along +z, and the Foxglove channels use the foxglove schemas.
+    let k = back.state_column("stiffness_n_per_m").unwrap();
+    assert!(k.iter().all(|&k| k == 3000.0));
+    let peak = back.device_force_n.iter().map(|f| f[2]).fold(0.0, f64::max);
+    assert_eq!(peak, 8.0);
+    assert!(back.events.iter().any(|e| e.1 == "force.clamped"));
+    assert!(back.events.iter().any(|e| e.1 == "wall.stiffness_capped"));
+    let schemas: Vec<_> = rec.channels.iter().map(|c| c.1.as_str()).collect();
+    for s in [
+        "foxglove.SceneUpdate",
+        "foxglove.FrameTransform",
+        "foxglove.Log",
+    ] {
+        assert!(schemas.contains(&s), "{s} missing from {schemas:?}");
+    }
+}
+
+#[test]
+fn force_feedback_changes_the_simulated_hand_but_not_a_rigid_one() {
+    let mut rigid = wall_opts(None);
+    rigid.operator = OperatorChoice::Rigid;
+    let r = run_session(&rigid, &mut |_, _| {}).unwrap().arrays;
+    let h = run_session(&wall_opts(None), &mut |_, _| {})
+        .unwrap()
+        .arrays;
+    // At the deepest scripted point (t = 2.6 s, z = −35 mm) the rigid stylus is at the script;
+    // the hand is held up by the wall near k_hand·(z_i − z) = k_wall·d (capped/clamped force).
+    let t = 2600;
+    assert!((r.device_position_m[t][2] + 0.035).abs() < 1e-12);
+    let z = h.device_position_m[t][2];
+    assert!(z > -0.0085 && z < -0.005, "hand z = {z}");
+    // Equilibrium check: the spring pull of the hand balances the (clamped) wall force.
+    let f = h.device_force_n[t][2];
+    let pull = 300.0 * (z + 0.035);
+    assert!((pull - f).abs() < 0.2, "pull {pull} N vs wall {f} N");
+}
+
+#[test]
+fn same_inputs_same_bits_across_runs() {
+    let a = tmp("det-a.mcap");
+    let b = tmp("det-b.mcap");
+    run_session(&wall_opts(Some(a.clone())), &mut |_, _| {}).unwrap();
+    run_session(&wall_opts(Some(b.clone())), &mut |_, _| {}).unwrap();
+    let ra = read_recording_file(&a, false).unwrap();
+    let rb = read_recording_file(&b, false).unwrap();
+    let outputs = |r: &haptic_loop::record::Recording| {
+        r.messages
+            .iter()
+            .filter(|m| m.channel != Channel::Timing)
+            .map(|m| (m.channel, m.log_time_ns, m.data.clone()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(outputs(&ra), outputs(&rb));
+}
+
+#[test]
+fn divergence_names_the_first_tick_and_channel() {
+    let p = tmp("div.mcap");
+    run_session(&wall_opts(Some(p.clone())), &mut |_, _| {}).unwrap();
+    let rec = read_recording_file(&p, false).unwrap();
+
+    // A tampered force at tick 1234.
+    let mut bad = rec.clone();
+    let m = bad
+        .messages
+        .iter_mut()
+        .find(|m| m.channel == Channel::Force && m.log_time_ns == 1_234_000_000)
+        .unwrap();
+    let mut f = ForceMsg::decode(&m.data).unwrap();
+    f.device_force_n[2] = f64::from_bits(f.device_force_n[2].to_bits() ^ 1);
+    m.data = f.encode();
+    let d = verify(&bad).unwrap().divergence.unwrap();
+    assert_eq!((d.tick, d.channel.as_str()), (1234, "/haptic/force"));
+    assert!(d.detail.starts_with("recorded world"), "{}", d.detail);
+
+    // A recorded deadline miss at tick 900 that the recorded outputs do not show.
+    let mut bad = rec.clone();
+    let m = bad
+        .messages
+        .iter_mut()
+        .find(|m| m.channel == Channel::DeviceInput && m.log_time_ns == 900_000_000)
+        .unwrap();
+    let mut i = DeviceInputMsg::decode(&m.data).unwrap();
+    i.deadline_missed = true;
+    m.data = i.encode();
+    let d = verify(&bad).unwrap().divergence.unwrap();
+    assert_eq!((d.tick, d.channel.as_str()), (900, "/haptic/force"));
+
+    // A scene edited after recording: the wall's damping doubled. Nothing differs until the
+    // first tick of contact, where the damping term first acts on the force.
+    let a = SessionArrays::from_recording(&rec).unwrap();
+    let contact = a.state_column("in_contact").unwrap();
+    let first = contact.iter().position(|&c| c == 1.0).unwrap() as u64;
+    let mut bad = rec.clone();
+    bad.description.scene_toml = bad
+        .description
+        .scene_toml
+        .replace("damping_n_s_per_m = 1.0", "damping_n_s_per_m = 2.0");
+    let d = verify(&bad).unwrap().divergence.unwrap();
+    assert_eq!((d.tick, d.channel.as_str()), (first, "/haptic/force"));
+    // The wall moved by 1 mm: the drawn scene differs from tick 0.
+    let mut bad = rec.clone();
+    bad.description.scene_toml = bad.description.scene_toml.replace(
+        "point_m = [0.0, 0.0, -0.005]",
+        "point_m = [0.0, 0.0, -0.006]",
+    );
+    let d = verify(&bad).unwrap().divergence.unwrap();
+    assert_eq!((d.tick, d.channel.as_str()), (0, "/foxglove/scene"));
+    // A dropped events message.
+    let mut bad = rec.clone();
+    let k = bad
+        .messages
+        .iter()
+        .position(|m| m.channel == Channel::Events)
+        .unwrap();
+    let t = bad.messages[k].log_time_ns / 1_000_000;
+    bad.messages.remove(k);
+    let d = verify(&bad).unwrap().divergence.unwrap();
+    assert_eq!(d.tick, t);
+    assert_eq!(d.detail, "replay produced a message that was not recorded");
+}
+
+#[test]
+fn damaged_files_give_clear_errors() {
+    let p = tmp("dmg.mcap");
+    run_session(&wall_opts(Some(p.clone())), &mut |_, _| {}).unwrap();
+    let bytes = std::fs::read(&p).unwrap();
+
+    assert_eq!(
+        read_recording(b"hello, world", false).unwrap_err(),
+        RecordingError::NotMcap
+    );
+
+    // Truncated mid-file: an error that says how much is readable; salvage replays that part.
+    let cut = &bytes[..bytes.len() * 2 / 3];
+    match read_recording(cut, false).unwrap_err() {
+        RecordingError::Truncated { ticks, .. } => assert!((1000..4000).contains(&ticks)),
+        e => panic!("expected Truncated, got {e}"),
+    }
+    let part = read_recording(cut, true).unwrap();
+    assert!(part.truncated.is_some());
+    let v = verify(&part).unwrap();
+    assert!(v.ok(), "{:?}", v.divergence);
+    // Chunks are flushed every second of session time, so the salvaged ticks are whole seconds.
+    assert_eq!(v.ticks % 1000, 0);
+
+    // A flipped byte inside a compressed chunk: the chunk CRC catches it.
+    let mut flipped = bytes.clone();
+    let mid = bytes.len() / 2;
+    flipped[mid] ^= 0x40;
+    let e = read_recording(&flipped, false).unwrap_err();
+    assert!(matches!(e, RecordingError::Corrupt(_)), "{e}");
+    assert!(e.to_string().starts_with("corrupt recording: "), "{e}");
+}
+
+#[test]
+fn golden_recordings_replay_bit_exactly() {
+    let dir = root().join("recordings");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "mcap") {
+            let rec = read_recording_file(&p, false).unwrap();
+            let v = verify(&rec).unwrap();
+            assert!(v.ok(), "{}: {:?}", p.display(), v.divergence);
+            assert!(v.ticks > 0);
+            let a = SessionArrays::from_recording(&rec).unwrap();
+            assert_eq!(a.tick.len() as u64, v.ticks);
+            n += 1;
+        }
+    }
+    assert!(n >= 1, "no golden recordings in {}", dir.display());
+}
+
+#[test]
+fn realtime_session_replays_exactly_including_its_missed_deadlines() {
+    let p = tmp("rt.mcap");
+    let mut o = wall_opts(Some(p.clone()));
+    o.realtime = true;
+    o.seconds = Some(0.5);
+    let report = run_session(&o, &mut |_, _| {}).unwrap();
+    let a = &report.arrays;
+    assert_eq!(a.tick.len(), 500);
+    assert_eq!(a.start_late_ns.len(), 500);
+    assert!(a.start_late_ns.iter().all(|&l| l >= 0));
+    // Whatever the machine did, each missed deadline is logged as an input, flagged in the
+    // status, and sent zero force; replay reproduces the session bit for bit.
+    let missed: Vec<usize> = (0..500).filter(|&i| a.deadline_missed[i]).collect();
+    assert_eq!(missed.len() as u64, report.stats.missed);
+    for &i in &missed {
+        assert!(a.status[i] & 4 != 0);
+        assert_eq!(a.device_force_n[i], [0.0; 3]);
+    }
+    assert_eq!(
+        a.status.iter().filter(|s| **s & 4 != 0).count(),
+        missed.len()
+    );
+    let v = verify(&read_recording_file(&p, false).unwrap()).unwrap();
+    assert!(v.ok(), "{:?}", v.divergence);
+}
+
+#[test]
+fn touch_device_caps_at_its_own_limits() {
+    let mut o = wall_opts(None);
+    o.device = Some(haptic_loop::DeviceModel::Touch);
+    o.operator = OperatorChoice::Rigid;
+    o.script = Some(
+        "[script]\nname = 'ramp'\n[[waypoint]]\nt_s = 0.0\nposition_mm = [0.0, 0.0, 0.0]\n\
+         [[waypoint]]\nt_s = 2.0\nposition_mm = [0.0, 0.0, -30.0]\n"
+            .to_string(),
+    );
+    let a = run_session(&o, &mut |_, _| {}).unwrap().arrays;
+    assert!(
+        a.state_column("stiffness_n_per_m")
+            .unwrap()
+            .iter()
+            .all(|&k| k == 400.0)
+    );
+    let peak = a
+        .device_force_n
+        .iter()
+        .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
+        .fold(0.0, f64::max);
+    assert_eq!(peak, 3.3);
+    // Buttons of the Falcon script do not exist on a Touch: the script is refused by name.
+    let e = haptic_loop::device::Script::from_toml(
+        &std::fs::read_to_string(root().join("scenes/wall.script.toml")).unwrap(),
+        haptic_loop::DeviceModel::Touch.specs(),
+    );
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "script: `button[0].name`: device `touch` has no button `centre` (allowed: button1, \
+         button2)"
+    );
+}
+
+#[test]
+fn an_unwritable_recording_path_is_a_typed_error() {
+    let o = wall_opts(Some(PathBuf::from("/nonexistent-dir/x.mcap")));
+    let e = run_session(&o, &mut |_, _| {}).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "recording /nonexistent-dir/x.mcap: No such file or directory (os error 2)"
+    );
+}

@@ -1,0 +1,83 @@
+//! Command clipping at the working envelope (paper §2.4, Fig. 1).
+
+use crate::envelope::Envelope;
+use crate::error::{EnvelopeError, Result, finite_vec};
+use crate::geometry::{contains, first_crossing, nearest_on_boundary};
+use nalgebra::Vector2;
+
+type V2 = Vector2<f64>;
+
+/// How a command outside the envelope is cut back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ClipMode {
+    /// Along the segment from the anchor (zero displacement, or the free
+    /// drift when zero is unreachable) to the command, stop at the first
+    /// envelope crossing: the paper's rule.
+    #[default]
+    Radial,
+    /// The nearest point of the envelope boundary.
+    Nearest,
+}
+
+impl ClipMode {
+    /// Parse `"radial"` or `"nearest"`.
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "radial" => Ok(Self::Radial),
+            "nearest" => Ok(Self::Nearest),
+            _ => Err(EnvelopeError::OutOfRange {
+                field: "mode (\"radial\" or \"nearest\")",
+                value: f64::NAN,
+                allowed: "\"radial\" | \"nearest\"",
+            }),
+        }
+    }
+}
+
+/// A clipped command.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clipped {
+    /// The displacement actually possible (m).
+    pub allowed: V2,
+    /// `command − allowed` (m): zero inside the envelope.
+    pub excess: V2,
+}
+
+/// Clip `command` (displacement, m) to the envelope `we`.
+pub fn clip_command(we: &Envelope, command: &V2, mode: ClipMode) -> Result<Clipped> {
+    finite_vec("command [m]", command.as_slice())?;
+    let poly = &we.polygon;
+    if poly.len() < 3 {
+        return Err(EnvelopeError::OutOfRange {
+            field: "envelope.polygon (vertices)",
+            value: poly.len() as f64,
+            allowed: ">= 3",
+        });
+    }
+    if contains(poly, command) {
+        return Ok(Clipped {
+            allowed: *command,
+            excess: V2::zeros(),
+        });
+    }
+    let nearest = || nearest_on_boundary(poly, command).0;
+    let allowed = match mode {
+        ClipMode::Nearest => nearest(),
+        ClipMode::Radial => {
+            let anchor = [V2::zeros(), we.free_displacement]
+                .into_iter()
+                .find(|a| contains(poly, a));
+            match anchor
+                .and_then(|a| first_crossing(poly, &a, command).map(|t| a + (command - a) * t))
+            {
+                Some(p) => p,
+                None => nearest(),
+            }
+        }
+    };
+    Ok(Clipped {
+        allowed,
+        excess: command - allowed,
+    })
+}
