@@ -6,8 +6,12 @@
 //! nanohaptics replay REC.mcap [--verify] [--salvage] [--json]
 //! nanohaptics info REC.mcap [--salvage] [--json]
 //! nanohaptics demo [--scenes DIR] [--out DIR] [--json]
+//! nanohaptics render REC.mcap --out DIR [--every N] [--width W] [--gif FILE] [--view V]
+//! nanohaptics render SCENE.toml --out FILE.png [--width W] [--view V]
 //! ```
 //! Exit status: 0 success, 1 error (bad input, unreadable file), 2 replay diverged.
+
+mod render_cmd;
 
 use clap::{Parser, Subcommand};
 use haptic_loop::device::{DeviceModel, OperatorParams};
@@ -38,6 +42,8 @@ struct Cli {
 enum Cmd {
     /// Run a scene with a script (batch by default) and optionally record it.
     Run(RunArgs),
+    /// Draw a recording (PNG frames, animated GIF) or a scene's initial state (PNG).
+    Render(render_cmd::RenderArgs),
     /// Recompute a recording from its inputs and compare every output bit for bit.
     Replay {
         /// Recording (MCAP).
@@ -388,9 +394,13 @@ fn cmd_demo(scenes: &Path, out: &Path, json: bool) -> Result<ExitCode, String> {
         let r = read_recording_file(&rec, false).map_err(|e| format!("{}: {e}", rec.display()))?;
         let v = verify(&r).map_err(|e| e.to_string())?;
         all_ok &= v.ok();
+        let png = out.join(format!("{stem}.png"));
+        render_cmd::final_picture(&rec, &png, 800)
+            .map_err(|e| format!("{}: {e}", png.display()))?;
         let mut j = summary_json(&report);
         j["recording"] = serde_json::json!(rec.display().to_string());
         j["replay_verified"] = serde_json::json!(v.ok());
+        j["picture"] = serde_json::json!(png.display().to_string());
         j["divergence"] = serde_json::json!(v.divergence);
         if !json {
             print_summary(&report);
@@ -399,6 +409,7 @@ fn cmd_demo(scenes: &Path, out: &Path, json: bool) -> Result<ExitCode, String> {
                 rec.display(),
                 if v.ok() { "bit-exact" } else { "DIVERGED" }
             );
+            println!("  -> {}", png.display());
         }
         rows.push(j);
     }
@@ -429,6 +440,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let res = match cli.cmd {
         Cmd::Run(args) => cmd_run(args),
+        Cmd::Render(args) => render_cmd::cmd(&args),
         Cmd::Replay {
             rec,
             verify,

@@ -144,6 +144,7 @@ fn demo_runs_every_scene_and_verifies() {
     assert!(!scenes.is_empty());
     for s in scenes {
         assert!(Path::new(s["recording"].as_str().unwrap()).exists());
+        assert!(Path::new(s["picture"].as_str().unwrap()).exists());
     }
 }
 

@@ -1,0 +1,588 @@
+//! `nanohaptics render`: PNG frames and an animated GIF of a recording (recomputed from its
+//! logged inputs, as `replay` does), or one picture of a scene's initial state; drawn by the
+//! `render` crate. Also the one-picture-per-recording step of `demo`.
+
+use std::path::{Path, PathBuf};
+
+use haptic_loop::device::{DeviceError, DeviceModel, HapticDevice, ReplayDevice, TickTime};
+use haptic_loop::record::{RecordingError, read_recording_file};
+use haptic_loop::scene::{Primitive as ScenePrimitive, SceneError, load_scene};
+use haptic_loop::{HapticLoop, LoopConfig, Scene};
+use render::{Camera, Frame, GifWriter, Image, Palette, Primitive, RenderError, Rgba, Style, View};
+
+/// Arguments of `nanohaptics render`.
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// A recording (`.mcap`) or a scene file (`.toml`).
+    pub input: PathBuf,
+    /// For a recording: the folder for the PNG frames; for a scene: the PNG file.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Draw every N-th tick of a recording (default: tick rate / 30, i.e. 30 frames per second
+    /// of session).
+    #[arg(long)]
+    pub every: Option<u64>,
+    /// Image width, px (height is 3/4 of it). Allowed: 64–4096.
+    #[arg(long, default_value_t = 640)]
+    pub width: u32,
+    /// Also write the frames of a recording as an animated GIF.
+    #[arg(long)]
+    pub gif: Option<PathBuf>,
+    /// Camera: top, side or oblique (default: top for a flat world, oblique otherwise).
+    #[arg(long)]
+    pub view: Option<String>,
+}
+
+/// Why `render` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderCmdError {
+    /// A command-line value out of its range.
+    #[error("--{flag} = {value} is out of range: allowed {allowed}")]
+    Arg {
+        /// The flag, without dashes.
+        flag: &'static str,
+        /// The value given.
+        value: String,
+        /// The allowed range.
+        allowed: String,
+    },
+    /// The input is neither `.mcap` nor `.toml`.
+    #[error("{0}: expected a recording (.mcap) or a scene file (.toml)")]
+    InputKind(PathBuf),
+    /// Reading or writing a file.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        source: std::io::Error,
+    },
+    /// The recording.
+    #[error(transparent)]
+    Recording(#[from] RecordingError),
+    /// The scene.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The device.
+    #[error(transparent)]
+    Device(#[from] DeviceError),
+    /// Drawing.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+}
+
+/// The renderer's primitive for a scene primitive (same variants, fields and units).
+pub fn to_render(p: &ScenePrimitive) -> Primitive {
+    match p {
+        ScenePrimitive::Sphere {
+            center_m,
+            radius_m,
+            color,
+        } => Primitive::Sphere {
+            center_m: *center_m,
+            radius_m: *radius_m,
+            color: Rgba(color.0),
+        },
+        ScenePrimitive::Box {
+            center_m,
+            half_extents_m,
+            rotation,
+            color,
+        } => Primitive::Box {
+            center_m: *center_m,
+            half_extents_m: *half_extents_m,
+            rotation: *rotation,
+            color: Rgba(color.0),
+        },
+        ScenePrimitive::Ellipse {
+            center_m,
+            semi_axes_m,
+            color,
+        } => Primitive::Ellipse {
+            center_m: *center_m,
+            semi_axes_m: *semi_axes_m,
+            color: Rgba(color.0),
+        },
+        ScenePrimitive::Polyline {
+            points_m,
+            closed,
+            color,
+        } => Primitive::Polyline {
+            points_m: points_m.clone(),
+            closed: *closed,
+            color: Rgba(color.0),
+        },
+        ScenePrimitive::Arrow {
+            from_m,
+            to_m,
+            color,
+        } => Primitive::Arrow {
+            from_m: *from_m,
+            to_m: *to_m,
+            color: Rgba(color.0),
+        },
+        ScenePrimitive::Label {
+            position_m,
+            text,
+            color,
+        } => Primitive::Label {
+            position_m: *position_m,
+            text: text.clone(),
+            color: Rgba(color.0),
+        },
+    }
+}
+
+/// Text and scale bar colour, light on the dark background the scenes' colours are chosen for
+/// (they are shared with the Foxglove channels).
+const INK: Rgba = Rgba([0.9, 0.9, 0.9, 1.0]);
+
+fn style() -> Style {
+    Style {
+        background: Rgba([0.12, 0.13, 0.15, 1.0]),
+        ..Style::default()
+    }
+}
+
+/// A camera that holds the scene's first picture and every `extra` point (the cursor's world
+/// positions over a recording, so the cursor never leaves the image); top view for a flat
+/// world unless `view` says otherwise.
+fn camera_for(
+    prims: &[Primitive],
+    extra: &[[f64; 3]],
+    view: Option<View>,
+    width: u32,
+) -> Result<Camera, RenderError> {
+    let (mut lo, mut hi) = render::bounds(prims)
+        .or_else(|| extra.first().map(|p| (*p, *p)))
+        .unwrap_or(([0.0; 3], [0.0; 3]));
+    for p in extra {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    // room around the cursor path for what the cursor carries (a particle, a brick)
+    if !extra.is_empty() {
+        let pad = 0.08 * (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
+        for i in 0..3 {
+            lo[i] -= pad;
+            hi[i] += pad;
+        }
+    }
+    let flat = (hi[2] - lo[2]) < 0.05 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let view = view.unwrap_or(if flat {
+        View::Top
+    } else {
+        View::oblique_default()
+    });
+    Camera::fit(view, lo, hi, width, width * 3 / 4, 0.04)
+}
+
+/// World positions of the cursor over a recording, read from its device inputs (no physics).
+fn cursor_path(
+    rec: &haptic_loop::record::Recording,
+    config: &LoopConfig,
+) -> Result<Vec<[f64; 3]>, RenderCmdError> {
+    let mut dev = ReplayDevice::from_recording(rec, config.specs.clone(), config.period_ns())?;
+    let mut out = Vec::with_capacity(dev.ticks() as usize);
+    for n in 0..dev.ticks() {
+        let s = dev.sample(TickTime::new(n, config.rate_hz))?;
+        out.push(config.mapping.to_world(s.position_m));
+    }
+    Ok(out)
+}
+
+fn draw(
+    frame: &mut Frame,
+    scene: &dyn Scene,
+    prims: &mut Vec<ScenePrimitive>,
+    title: &str,
+) -> Result<(), RenderError> {
+    prims.clear();
+    scene.draw(prims);
+    frame.clear();
+    for p in prims.iter() {
+        frame.push(to_render(p))?;
+    }
+    frame.scale_bar(None, INK)?;
+    frame.title(title, INK)
+}
+
+fn parse_view(v: &Option<String>) -> Result<Option<View>, RenderError> {
+    v.as_deref().map(str::parse).transpose()
+}
+
+fn check_width(width: u32) -> Result<(), RenderCmdError> {
+    if !(64..=4096).contains(&width) {
+        return Err(RenderCmdError::Arg {
+            flag: "width",
+            value: width.to_string(),
+            allowed: "64–4096 px".into(),
+        });
+    }
+    Ok(())
+}
+
+/// What `render` wrote.
+#[derive(Debug, serde::Serialize)]
+pub struct RenderSummary {
+    /// Pictures written.
+    pub frames: u64,
+    /// Ticks recomputed.
+    pub ticks: u64,
+    /// GIF size, bytes (0 without `--gif`).
+    pub gif_bytes: u64,
+}
+
+/// Runs `nanohaptics render`.
+pub fn run(args: &RenderArgs) -> Result<RenderSummary, RenderCmdError> {
+    check_width(args.width)?;
+    let view = parse_view(&args.view)?;
+    match args.input.extension().and_then(|e| e.to_str()) {
+        Some("toml") => {
+            scene_picture(&args.input, &args.out, view, args.width)?;
+            Ok(RenderSummary {
+                frames: 1,
+                ticks: 0,
+                gif_bytes: 0,
+            })
+        }
+        Some("mcap") => recording_frames(args, view),
+        _ => Err(RenderCmdError::InputKind(args.input.clone())),
+    }
+}
+
+/// Draws a scene file's initial state into a PNG.
+pub fn scene_picture(
+    scene_path: &Path,
+    out: &Path,
+    view: Option<View>,
+    width: u32,
+) -> Result<(), RenderCmdError> {
+    let text = std::fs::read_to_string(scene_path).map_err(|source| RenderCmdError::Io {
+        path: scene_path.to_path_buf(),
+        source,
+    })?;
+    let loaded = load_scene(&text, None)?;
+    let mut prims = Vec::new();
+    loaded.scene.draw(&mut prims);
+    let rp: Vec<Primitive> = prims.iter().map(to_render).collect();
+    let cam = camera_for(&rp, &[], view, width)?;
+    let mut frame = Frame::new(cam, style())?;
+    draw(
+        &mut frame,
+        loaded.scene.as_ref(),
+        &mut prims,
+        &format!("{} (initial state)", loaded.scene.kind()),
+    )?;
+    frame.finish()?.save_png(out)?;
+    Ok(())
+}
+
+/// Recomputes a recording from its inputs and draws every `every`-th tick into
+/// `out/frame_NNNNN.png` (and a GIF when asked).
+fn recording_frames(
+    args: &RenderArgs,
+    view: Option<View>,
+) -> Result<RenderSummary, RenderCmdError> {
+    let rec = read_recording_file(&args.input, false)?;
+    let d = &rec.description;
+    let model = DeviceModel::from_name(&d.device_model)?;
+    let loaded = load_scene(&d.scene_toml, Some(model))?;
+    let config = loaded.config.clone();
+    let rate = u64::from(config.rate_hz);
+    let every = args.every.unwrap_or((rate / 30).max(1));
+    let min_every = rate.div_ceil(50).max(1);
+    if every == 0 || (args.gif.is_some() && every < min_every) {
+        return Err(RenderCmdError::Arg {
+            flag: "every",
+            value: every.to_string(),
+            allowed: if args.gif.is_some() {
+                format!("{min_every} or more ticks (a GIF plays at most 50 frames/s)")
+            } else {
+                "1 or more ticks".into()
+            },
+        });
+    }
+    std::fs::create_dir_all(&args.out).map_err(|source| RenderCmdError::Io {
+        path: args.out.clone(),
+        source,
+    })?;
+    let path = cursor_path(&rec, &config)?;
+    let mut dev = ReplayDevice::from_recording(&rec, config.specs.clone(), config.period_ns())?;
+    let ticks = dev.ticks();
+    let kind = loaded.scene.kind();
+    let mut lp = HapticLoop::new(config.clone(), loaded.scene);
+    let mut prims = Vec::new();
+    let mut frame: Option<Frame> = None;
+    let mut img: Option<Image> = None;
+    let mut gif: Option<GifWriter<std::io::BufWriter<std::fs::File>>> = None;
+    let mut frames = 0u64;
+    for n in 0..ticks {
+        let sample = dev.sample(TickTime::new(n, config.rate_hz))?;
+        lp.tick(sample, dev.deadline_missed(n));
+        dev.set_force(lp.last_result().device_force_n);
+        if n % every != 0 {
+            continue;
+        }
+        let title = format!("{kind}  t = {:.3} s", n as f64 / rate as f64);
+        if frame.is_none() {
+            prims.clear();
+            lp.scene().draw(&mut prims);
+            let rp: Vec<Primitive> = prims.iter().map(to_render).collect();
+            let cam = camera_for(&rp, &path, view, args.width)?;
+            frame = Some(Frame::new(cam, style())?);
+            img = Some(Image::new(cam.width_px(), cam.height_px())?);
+        }
+        let (Some(f), Some(im)) = (frame.as_mut(), img.as_mut()) else {
+            continue;
+        };
+        draw(f, lp.scene(), &mut prims, &title)?;
+        f.draw_into(im)?;
+        im.save_png(args.out.join(format!("frame_{frames:05}.png")))?;
+        if let Some(path) = &args.gif {
+            if gif.is_none() {
+                let file = std::fs::File::create(path).map_err(|source| RenderCmdError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+                // palette from the first frame; the writer switches when new colours appear
+                let pal = Palette::from_images(&[im], 255)?;
+                let fps = rate as f64 / every as f64;
+                gif = Some(GifWriter::new(
+                    std::io::BufWriter::new(file),
+                    im.width(),
+                    im.height(),
+                    fps,
+                    pal,
+                )?);
+            }
+            if let Some(g) = gif.as_mut() {
+                g.add_frame(im)?;
+            }
+        }
+        frames += 1;
+    }
+    let mut gif_bytes = 0;
+    if let (Some(g), Some(path)) = (gif, &args.gif) {
+        let mut w = g.finish()?;
+        std::io::Write::flush(&mut w).map_err(|source| RenderCmdError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        drop(w);
+        gif_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    }
+    Ok(RenderSummary {
+        frames,
+        ticks,
+        gif_bytes,
+    })
+}
+
+/// Recomputes a recording and draws its last tick into a PNG (the `demo` picture of a scene).
+pub fn final_picture(rec_path: &Path, out: &Path, width: u32) -> Result<(), RenderCmdError> {
+    check_width(width)?;
+    let rec = read_recording_file(rec_path, false)?;
+    let d = &rec.description;
+    let model = DeviceModel::from_name(&d.device_model)?;
+    let loaded = load_scene(&d.scene_toml, Some(model))?;
+    let config = loaded.config.clone();
+    let mut dev = ReplayDevice::from_recording(&rec, config.specs.clone(), config.period_ns())?;
+    let ticks = dev.ticks();
+    let kind = loaded.scene.kind();
+    let mut lp = HapticLoop::new(config.clone(), loaded.scene);
+    let mut prims = Vec::new();
+    lp.scene().draw(&mut prims);
+    let first: Vec<Primitive> = prims.iter().map(to_render).collect();
+    for n in 0..ticks {
+        let sample = dev.sample(TickTime::new(n, config.rate_hz))?;
+        lp.tick(sample, dev.deadline_missed(n));
+        dev.set_force(lp.last_result().device_force_n);
+    }
+    let cam = camera_for(&first, &cursor_path(&rec, &config)?, None, width)?;
+    let mut frame = Frame::new(cam, style())?;
+    let t = ticks as f64 / f64::from(config.rate_hz);
+    draw(
+        &mut frame,
+        lp.scene(),
+        &mut prims,
+        &format!("{kind}  t = {t:.3} s (end of recording)"),
+    )?;
+    frame.finish()?.save_png(out)?;
+    Ok(())
+}
+
+/// `nanohaptics render` as the program runs it: prints what was written.
+pub fn cmd(args: &RenderArgs) -> Result<std::process::ExitCode, String> {
+    let s = run(args).map_err(|e| e.to_string())?;
+    if s.ticks == 0 {
+        println!("{} -> {}", args.input.display(), args.out.display());
+    } else {
+        println!(
+            "{}: {} ticks recomputed, {} frames -> {}{}",
+            args.input.display(),
+            s.ticks,
+            s.frames,
+            args.out.display(),
+            match &args.gif {
+                Some(g) => format!(", GIF {} ({} bytes)", g.display(), s.gif_bytes),
+                None => String::new(),
+            }
+        );
+    }
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic_loop::scene::Rgba as SceneRgba;
+
+    fn root() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    }
+
+    #[test]
+    fn every_scene_primitive_maps_to_the_same_render_primitive() {
+        let c = SceneRgba([0.1, 0.2, 0.3, 0.4]);
+        let rc = Rgba([0.1, 0.2, 0.3, 0.4]);
+        let cases = vec![
+            (
+                ScenePrimitive::Sphere {
+                    center_m: [1.0, 2.0, 3.0],
+                    radius_m: 0.5,
+                    color: c,
+                },
+                Primitive::Sphere {
+                    center_m: [1.0, 2.0, 3.0],
+                    radius_m: 0.5,
+                    color: rc,
+                },
+            ),
+            (
+                ScenePrimitive::Box {
+                    center_m: [1.0, 0.0, 0.0],
+                    half_extents_m: [0.1, 0.2, 0.3],
+                    rotation: [0.0, 0.0, 0.6, 0.8],
+                    color: c,
+                },
+                Primitive::Box {
+                    center_m: [1.0, 0.0, 0.0],
+                    half_extents_m: [0.1, 0.2, 0.3],
+                    rotation: [0.0, 0.0, 0.6, 0.8],
+                    color: rc,
+                },
+            ),
+            (
+                ScenePrimitive::Ellipse {
+                    center_m: [0.0; 3],
+                    semi_axes_m: [6e-7, 3e-7],
+                    color: c,
+                },
+                Primitive::Ellipse {
+                    center_m: [0.0; 3],
+                    semi_axes_m: [6e-7, 3e-7],
+                    color: rc,
+                },
+            ),
+            (
+                ScenePrimitive::Polyline {
+                    points_m: vec![[0.0; 3], [1.0; 3]],
+                    closed: true,
+                    color: c,
+                },
+                Primitive::Polyline {
+                    points_m: vec![[0.0; 3], [1.0; 3]],
+                    closed: true,
+                    color: rc,
+                },
+            ),
+            (
+                ScenePrimitive::Arrow {
+                    from_m: [0.0; 3],
+                    to_m: [1.0, 0.0, 0.0],
+                    color: c,
+                },
+                Primitive::Arrow {
+                    from_m: [0.0; 3],
+                    to_m: [1.0, 0.0, 0.0],
+                    color: rc,
+                },
+            ),
+            (
+                ScenePrimitive::Label {
+                    position_m: [0.0; 3],
+                    text: "x".into(),
+                    color: c,
+                },
+                Primitive::Label {
+                    position_m: [0.0; 3],
+                    text: "x".into(),
+                    color: rc,
+                },
+            ),
+        ];
+        for (a, b) in cases {
+            assert_eq!(to_render(&a), b);
+        }
+    }
+
+    #[test]
+    fn golden_recording_becomes_frames_and_a_gif() {
+        let dir = std::env::temp_dir().join(format!("nanohaptics-render-{}", std::process::id()));
+        let gif_path = dir.join("ot.gif");
+        let args = RenderArgs {
+            input: root().join("recordings/optical_tweezers.mcap"),
+            out: dir.join("frames"),
+            every: Some(100),
+            width: 320,
+            gif: Some(gif_path.clone()),
+            view: None,
+        };
+        let s = run(&args).expect("render");
+        // ticks 0, 100, …: one frame per started 100 ticks
+        assert_eq!(s.frames, s.ticks.div_ceil(100));
+        let pngs = std::fs::read_dir(dir.join("frames"))
+            .expect("frames")
+            .count() as u64;
+        assert_eq!(pngs, s.frames);
+        let mut opts = gif::DecodeOptions::new();
+        opts.set_color_output(gif::ColorOutput::Indexed);
+        let bytes = std::fs::read(&gif_path).expect("gif");
+        let mut dec = opts.read_info(bytes.as_slice()).expect("gif header");
+        assert_eq!((dec.width(), dec.height()), (320, 240));
+        let mut n = 0u64;
+        let mut cs = 0u64;
+        while let Some(f) = dec.read_next_frame().expect("frame") {
+            n += 1;
+            cs += u64::from(f.delay);
+        }
+        assert_eq!(n, s.frames);
+        // 100 ticks at 1 kHz = 10 cs per frame
+        assert_eq!(cs, 10 * s.frames);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_gif_faster_than_50_fps_is_refused() {
+        let args = RenderArgs {
+            input: root().join("recordings/optical_tweezers.mcap"),
+            out: std::env::temp_dir().join("nanohaptics-render-refused"),
+            every: Some(10),
+            width: 320,
+            gif: Some(std::env::temp_dir().join("nanohaptics-render-refused.gif")),
+            view: None,
+        };
+        let e = run(&args).unwrap_err().to_string();
+        assert!(
+            e.starts_with("--every = 10 is out of range: allowed 20 or more ticks"),
+            "{e}"
+        );
+        let e = run(&RenderArgs { width: 10, ..args })
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "--width = 10 is out of range: allowed 64–4096 px");
+    }
+}

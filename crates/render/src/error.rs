@@ -1,0 +1,92 @@
+//! The renderer's error type.
+
+use thiserror::Error;
+
+/// Why a camera, a primitive, an image or a GIF could not be made.
+///
+/// Every variant names the offending field and, where there is one, the allowed range.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum RenderError {
+    /// A number is NaN or infinite.
+    #[error("{field} must be finite, got {value}")]
+    NotFinite {
+        /// Dotted name of the field, e.g. `sphere.center_m[1]`.
+        field: String,
+        /// The value given.
+        value: f64,
+    },
+    /// A number lies outside its allowed range.
+    #[error("{field} = {value} is out of range: allowed {allowed}")]
+    OutOfRange {
+        /// Dotted name of the field.
+        field: String,
+        /// The value given.
+        value: f64,
+        /// The allowed range, written out, e.g. `(0, 50] frames/s`.
+        allowed: &'static str,
+    },
+    /// A name that is not one of the allowed ones.
+    #[error("{field} = {got:?} is not known: allowed {allowed}")]
+    UnknownName {
+        /// Name of the field, e.g. `view`.
+        field: String,
+        /// The name given.
+        got: String,
+        /// The allowed names.
+        allowed: &'static str,
+    },
+    /// An image size the renderer cannot make.
+    #[error("image size {width_px}x{height_px} px is out of range: allowed 1..={max} px per side")]
+    ImageSize {
+        /// Width asked for, px.
+        width_px: u32,
+        /// Height asked for, px.
+        height_px: u32,
+        /// Largest side allowed, px.
+        max: u32,
+    },
+    /// An image does not have the size expected (the GIF's, or the camera's).
+    #[error("image is {got_width}x{got_height} px, expected {width}x{height} px")]
+    FrameSize {
+        /// Expected width, px.
+        width: u32,
+        /// Expected height, px.
+        height: u32,
+        /// Width given, px.
+        got_width: u32,
+        /// Height given, px.
+        got_height: u32,
+    },
+    /// A palette was asked for from no pixels.
+    #[error("palette needs at least one image with at least one pixel")]
+    EmptyPalette,
+    /// The embedded font could not be parsed (a build problem, not an input problem).
+    #[error("embedded font could not be parsed")]
+    Font,
+    /// PNG encoding or file writing failed.
+    #[error("PNG: {0}")]
+    Png(String),
+    /// GIF encoding or writing failed.
+    #[error("GIF: {0}")]
+    Gif(String),
+}
+
+/// Checks that `value` is finite.
+pub(crate) fn finite(field: impl FnOnce() -> String, value: f64) -> Result<f64, RenderError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(RenderError::NotFinite {
+            field: field(),
+            value,
+        })
+    }
+}
+
+/// Checks that every component of a point is finite.
+pub(crate) fn finite3(field: &str, p: [f64; 3]) -> Result<(), RenderError> {
+    for (i, v) in p.iter().enumerate() {
+        finite(|| format!("{field}[{i}]"), *v)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,422 @@
+//! A frame: primitives added in world coordinates, drawn back to front with shading into an
+//! [`Image`].
+
+use crate::camera::Camera;
+use crate::draw::{box_corners, normq};
+use crate::error::{RenderError, finite, finite3};
+use crate::image::Image;
+use crate::math::{Vec3, add, axes, scale, sub};
+use crate::order::{Item, Shape, back_to_front};
+use crate::primitive::{Primitive, Rgba};
+
+/// How a frame looks apart from its primitives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Style {
+    /// Background colour.
+    pub background: Rgba,
+    /// Width of polylines, arrow shafts and outlines, px.
+    pub line_width_px: f32,
+    /// Label text size, px per em.
+    pub font_size_px: f32,
+    /// Length of an arrow head, px (shortened to 40 % of a short arrow).
+    pub arrow_head_px: f32,
+    /// Share of a lit face's brightness that does not depend on the light direction, 0–1.
+    pub ambient: f64,
+}
+
+impl Default for Style {
+    fn default() -> Style {
+        Style {
+            background: Rgba::from_u8(250, 250, 247),
+            line_width_px: 2.0,
+            font_size_px: 14.0,
+            arrow_head_px: 12.0,
+            ambient: 0.45,
+        }
+    }
+}
+
+impl Style {
+    fn validate(&self) -> Result<(), RenderError> {
+        self.background.validate("style.background")?;
+        let pos = |field: &str, v: f32, max: f32| -> Result<(), RenderError> {
+            finite(|| field.to_string(), f64::from(v))?;
+            if !(v > 0.0 && v <= max) {
+                return Err(RenderError::OutOfRange {
+                    field: field.to_string(),
+                    value: f64::from(v),
+                    allowed: "(0, 200] px",
+                });
+            }
+            Ok(())
+        };
+        pos("style.line_width_px", self.line_width_px, 200.0)?;
+        pos("style.font_size_px", self.font_size_px, 200.0)?;
+        pos("style.arrow_head_px", self.arrow_head_px, 200.0)?;
+        finite(|| "style.ambient".into(), self.ambient)?;
+        if !(0.0..=1.0).contains(&self.ambient) {
+            return Err(RenderError::OutOfRange {
+                field: "style.ambient".into(),
+                value: self.ambient,
+                allowed: "[0, 1]",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A scale bar in the bottom-left corner.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ScaleBar {
+    pub(crate) length_m: f64,
+    pub(crate) color: Rgba,
+}
+
+/// One picture being composed: a camera, a style and the primitives added so far.
+///
+/// Solids (spheres, cursors, boxes, ellipses) are drawn back to front in an exact order for
+/// disjoint convex bodies (see the `order` module); polylines, arrows and slots are drawn over
+/// them in the order added; labels, the title and the scale bar go on top.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub(crate) camera: Camera,
+    pub(crate) style: Style,
+    items: Vec<Primitive>,
+    scale_bar: Option<ScaleBar>,
+    title: Option<(String, Rgba)>,
+}
+
+/// Picks a length of 1, 2 or 5 × 10^k m whose bar is at most `max_px` long.
+pub fn nice_length_m(pixels_per_m: f64, max_px: f64) -> f64 {
+    let target = max_px / pixels_per_m;
+    let p = 10f64.powf(target.log10().floor());
+    for m in [5.0, 2.0, 1.0] {
+        if m * p <= target {
+            return m * p;
+        }
+    }
+    p
+}
+
+/// Writes a length in metres with an SI prefix, e.g. `2 µm`, `100 nm`, `5 cm`.
+pub fn format_length(length_m: f64) -> String {
+    let units = [
+        (1.0, "m"),
+        (1e-2, "cm"),
+        (1e-3, "mm"),
+        (1e-6, "µm"),
+        (1e-9, "nm"),
+        (1e-12, "pm"),
+    ];
+    let a = length_m.abs();
+    let (k, u) = units
+        .iter()
+        .find(|(k, _)| a >= *k * 0.999_999)
+        .copied()
+        .unwrap_or((1e-12, "pm"));
+    let v = length_m / k;
+    if (v - v.round()).abs() < 1e-6 * v.abs().max(1.0) {
+        format!("{} {u}", v.round())
+    } else {
+        format!("{v:.3} {u}")
+    }
+}
+
+impl Frame {
+    /// An empty frame.
+    pub fn new(camera: Camera, style: Style) -> Result<Frame, RenderError> {
+        style.validate()?;
+        Ok(Frame {
+            camera,
+            style,
+            items: Vec::new(),
+            scale_bar: None,
+            title: None,
+        })
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The style.
+    pub fn style(&self) -> &Style {
+        &self.style
+    }
+
+    /// The primitives added so far.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.items
+    }
+
+    /// Removes every primitive, the title and the scale bar (keeps camera and style).
+    pub fn clear(&mut self) {
+        self.items.clear();
+        self.scale_bar = None;
+        self.title = None;
+    }
+
+    /// Adds a primitive after checking its numbers ([`Primitive::validate`]).
+    pub fn push(&mut self, p: Primitive) -> Result<(), RenderError> {
+        p.validate()?;
+        self.items.push(p);
+        Ok(())
+    }
+
+    /// Adds a closed loop through `points_m` drawn `factor` times larger about `about_m` (m):
+    /// point p is drawn at `about + factor · (p − about)`. This is how the working envelope,
+    /// a region a few nm across around a µm particle, is drawn ×100 as in the optical-tweezers
+    /// paper. `factor` must be finite and > 0.
+    pub fn scaled_loop(
+        &mut self,
+        points_m: &[Vec3],
+        about_m: Vec3,
+        factor: f64,
+        color: Rgba,
+    ) -> Result<(), RenderError> {
+        finite3("scaled_loop.about_m", about_m)?;
+        finite(|| "scaled_loop.factor".into(), factor)?;
+        if factor <= 0.0 {
+            return Err(RenderError::OutOfRange {
+                field: "scaled_loop.factor".into(),
+                value: factor,
+                allowed: "(0, inf)",
+            });
+        }
+        let points_m = points_m
+            .iter()
+            .map(|p| add(about_m, scale(sub(*p, about_m), factor)))
+            .collect();
+        self.push(Primitive::Polyline {
+            points_m,
+            closed: true,
+            color,
+        })
+    }
+
+    /// Shows a scale bar in the bottom-left corner, `length_m` long (m, > 0), or when `None` the
+    /// longest 1-2-5 length that fits a fifth of the image width. In an oblique view the bar
+    /// measures lengths in planes facing the camera.
+    pub fn scale_bar(&mut self, length_m: Option<f64>, color: Rgba) -> Result<(), RenderError> {
+        color.validate("scale_bar.color")?;
+        let length_m = match length_m {
+            Some(l) => {
+                finite(|| "scale_bar.length_m".into(), l)?;
+                if l <= 0.0 {
+                    return Err(RenderError::OutOfRange {
+                        field: "scale_bar.length_m".into(),
+                        value: l,
+                        allowed: "(0, inf) m",
+                    });
+                }
+                l
+            }
+            None => nice_length_m(
+                self.camera.pixels_per_m(),
+                f64::from(self.camera.width_px()) / 5.0,
+            ),
+        };
+        self.scale_bar = Some(ScaleBar { length_m, color });
+        Ok(())
+    }
+
+    /// The scale bar's length, m, if one is shown.
+    pub fn scale_bar_length_m(&self) -> Option<f64> {
+        self.scale_bar.map(|s| s.length_m)
+    }
+
+    /// Shows `text` in the top-left corner.
+    pub fn title(&mut self, text: impl Into<String>, color: Rgba) -> Result<(), RenderError> {
+        color.validate("title.color")?;
+        self.title = Some((text.into(), color));
+        Ok(())
+    }
+
+    /// Draws the frame into a new image.
+    pub fn finish(&self) -> Result<Image, RenderError> {
+        let mut img = Image::new(self.camera.width_px(), self.camera.height_px())?;
+        self.draw_into(&mut img)?;
+        Ok(img)
+    }
+
+    /// Draws the frame into `img` (which must have the camera's size), overwriting it.
+    pub fn draw_into(&self, img: &mut Image) -> Result<(), RenderError> {
+        let (w, h) = (self.camera.width_px(), self.camera.height_px());
+        if img.width() != w || img.height() != h {
+            return Err(RenderError::FrameSize {
+                width: w,
+                height: h,
+                got_width: img.width(),
+                got_height: img.height(),
+            });
+        }
+        let pm = &mut img.pixmap;
+        pm.fill(self.style.background.skia());
+        let mut solids = Vec::new();
+        let mut solid_idx = Vec::new();
+        for (i, p) in self.items.iter().enumerate() {
+            if let Some(it) = self.solid_item(p) {
+                solids.push(it);
+                solid_idx.push(i);
+            }
+        }
+        for k in back_to_front(&solids, self.camera.forward()) {
+            self.draw_solid(pm, &self.items[solid_idx[k]]);
+        }
+        for p in &self.items {
+            match p {
+                Primitive::Polyline {
+                    points_m,
+                    closed,
+                    color,
+                } => self.draw_polyline(pm, points_m, *closed, *color),
+                Primitive::Arrow {
+                    from_m,
+                    to_m,
+                    color,
+                } => self.draw_arrow(pm, *from_m, *to_m, *color),
+                Primitive::Slot {
+                    center_m,
+                    half_extents_m,
+                    rotation,
+                    color,
+                } => self.draw_slot(pm, *center_m, *half_extents_m, *rotation, *color),
+                _ => {}
+            }
+        }
+        for p in &self.items {
+            if let Primitive::Label {
+                position_m,
+                text,
+                color,
+            } = p
+            {
+                let q = self.camera.project(*position_m);
+                self.draw_text(
+                    pm,
+                    text,
+                    q.x_px as f32 + 4.0,
+                    q.y_px as f32 - 4.0,
+                    *color,
+                    0.0,
+                )?;
+            }
+        }
+        if let Some((t, c)) = &self.title {
+            let size = self.style.font_size_px;
+            self.draw_text(pm, t, 10.0, 10.0 + size, *c, 0.0)?;
+        }
+        if let Some(sb) = self.scale_bar {
+            self.draw_scale_bar(pm, sb)?;
+        }
+        Ok(())
+    }
+
+    fn solid_item(&self, p: &Primitive) -> Option<Item> {
+        let cam = &self.camera;
+        let s = cam.pixels_per_m();
+        match p {
+            Primitive::Sphere {
+                center_m, radius_m, ..
+            }
+            | Primitive::Cursor {
+                center_m, radius_m, ..
+            } => {
+                let q = cam.project(*center_m);
+                let r = radius_m * s;
+                Some(Item {
+                    shape: Shape::Sphere {
+                        c: *center_m,
+                        r: *radius_m,
+                    },
+                    depth: q.depth_m,
+                    flat: false,
+                    rect: [q.x_px - r, q.y_px - r, q.x_px + r, q.y_px + r],
+                })
+            }
+            Primitive::Box {
+                center_m,
+                half_extents_m,
+                rotation,
+                ..
+            } => {
+                let ax = axes(normq(*rotation));
+                let rect = rect_of(
+                    box_corners(*center_m, ax, *half_extents_m)
+                        .iter()
+                        .map(|c| cam.project(*c)),
+                );
+                Some(Item {
+                    shape: Shape::Obb {
+                        c: *center_m,
+                        axes: ax,
+                        half: *half_extents_m,
+                    },
+                    depth: cam.project(*center_m).depth_m,
+                    flat: false,
+                    rect,
+                })
+            }
+            Primitive::Ellipse {
+                center_m,
+                semi_axes_m,
+                ..
+            } => {
+                let ax = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                let half = [semi_axes_m[0], semi_axes_m[1], 0.0];
+                let rect = rect_of(
+                    box_corners(*center_m, ax, half)
+                        .iter()
+                        .map(|c| cam.project(*c)),
+                );
+                Some(Item {
+                    shape: Shape::Obb {
+                        c: *center_m,
+                        axes: ax,
+                        half,
+                    },
+                    depth: cam.project(*center_m).depth_m,
+                    flat: true,
+                    rect,
+                })
+            }
+            _ => None,
+        }
+    }
+}
+
+fn rect_of(it: impl Iterator<Item = crate::camera::Projected>) -> [f64; 4] {
+    let mut r = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for q in it {
+        r[0] = r[0].min(q.x_px);
+        r[1] = r[1].min(q.y_px);
+        r[2] = r[2].max(q.x_px);
+        r[3] = r[3].max(q.y_px);
+    }
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nice_lengths_and_their_labels() {
+        // 1e6 px/m, at most 130 px: 100 µm fits (100 px), 200 µm does not
+        assert!((nice_length_m(1e6, 130.0) - 1e-4).abs() < 1e-18);
+        assert!((nice_length_m(1e8, 130.0) - 1e-6).abs() < 1e-18);
+        assert!((nice_length_m(1e8, 250.0) - 2e-6).abs() < 1e-18);
+        assert!((nice_length_m(1e8, 600.0) - 5e-6).abs() < 1e-18);
+        assert_eq!(format_length(2e-6), "2 µm");
+        assert_eq!(format_length(1e-7), "100 nm");
+        assert_eq!(format_length(0.05), "5 cm");
+        assert_eq!(format_length(3.0), "3 m");
+        assert_eq!(format_length(1.5e-6), "1.500 µm");
+    }
+}

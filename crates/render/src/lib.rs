@@ -1,0 +1,56 @@
+//! Headless CPU renderer for nanohaptics: pictures and animations of every world without a
+//! GPU, a window or a browser.
+//!
+//! **What it is for.** Drawing a world's primitives — spheres, boxes, the beam ellipse, the
+//! haptic cursor, force arrows, polylines and loops such as the working envelope (drawn ×N
+//! about a point), blueprint slots, text labels and a scale bar — given in world coordinates
+//! (metres, z up), through an orthographic [`Camera`] (top, side or oblique 3D view), with
+//! anti-aliasing (tiny-skia), light shading so solids read as solid, and an exact back-to-front
+//! order for disjoint convex bodies. A [`Frame`] becomes an [`Image`] (RGBA, PNG); a
+//! [`GifWriter`] turns a sequence of images into an animated GIF at a given frame rate.
+//!
+//! **What it is not.** It knows nothing of worlds, scenes, recordings or the command line:
+//! `haptic-loop` adapts its `scene::Primitive` (whose variants and fields [`Primitive`]
+//! mirrors) and owns MCAP reading and the `nanohaptics render` command. No perspective, no
+//! lighting model beyond one directional light with ambient, no interpenetrating solids (they
+//! are ordered by centre depth).
+//!
+//! ```
+//! use render::{Camera, Frame, Primitive, Rgba, Style, View};
+//! let cam = Camera::new(View::Top, [0.0; 3], 1e8, 320, 240)?; // 1 px = 10 nm
+//! let mut f = Frame::new(cam, Style::default())?;
+//! f.push(Primitive::Sphere {
+//!     center_m: [0.0; 3],
+//!     radius_m: 0.5e-6,
+//!     color: Rgba::from_u8(200, 60, 40),
+//! })?;
+//! f.scale_bar(None, Rgba::from_u8(0, 0, 0))?;
+//! let img = f.finish()?;
+//! let [r, g, b, _] = img.pixel(160, 120).expect("inside");
+//! assert!(r > g && r > b); // the particle is where it should be
+//! # Ok::<(), render::RenderError>(())
+//! ```
+
+pub mod camera;
+mod draw;
+pub mod error;
+pub mod frame;
+pub mod gif;
+pub mod image;
+mod math;
+mod order;
+pub mod primitive;
+mod text;
+
+pub use camera::{Camera, MAX_SIDE_PX, Projected, View, bounds};
+pub use error::RenderError;
+pub use frame::{Frame, Style, format_length, nice_length_m};
+pub use gif::{BAD_PIXEL_ERROR, BAD_PIXEL_SHARE, GifWriter, Palette, frame_delays_cs};
+pub use image::Image;
+pub use math::Vec3;
+pub use primitive::{Primitive, Rgba};
+
+/// The user guide's examples (`docs/render.md`), compiled and run as doc-tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/render.md")]
+pub struct UserGuide;

@@ -1,0 +1,323 @@
+//! What can be drawn: the primitives, world frame, metres.
+//!
+//! The first six variants mirror `haptic_loop::scene::Primitive` field for field (same names,
+//! same units, `[f64; 3]` points, `[x, y, z, w]` quaternions, RGBA in 0–1), so an adapter is a
+//! one-to-one `match`. [`Primitive::Cursor`] and [`Primitive::Slot`] are extras for the
+//! haptic cursor and blueprint slots.
+
+use crate::error::{RenderError, finite, finite3};
+use crate::math::Vec3;
+
+/// An RGBA colour, each channel in 0–1 (straight, not premultiplied alpha).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rgba(pub [f64; 4]);
+
+impl Rgba {
+    /// An opaque colour from 8-bit sRGB channels.
+    pub fn from_u8(r: u8, g: u8, b: u8) -> Rgba {
+        Rgba([
+            f64::from(r) / 255.0,
+            f64::from(g) / 255.0,
+            f64::from(b) / 255.0,
+            1.0,
+        ])
+    }
+
+    /// The same colour with alpha `a` (0–1).
+    pub fn with_alpha(self, a: f64) -> Rgba {
+        let [r, g, b, _] = self.0;
+        Rgba([r, g, b, a])
+    }
+
+    /// The colour as 8-bit straight RGBA (each channel rounded).
+    pub fn to_u8(self) -> [u8; 4] {
+        self.0.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
+    }
+
+    /// Multiplies the RGB channels by `k` (≥ 0, results capped at 1); alpha unchanged.
+    pub(crate) fn times(self, k: f64) -> Rgba {
+        let [r, g, b, a] = self.0;
+        Rgba([(r * k).min(1.0), (g * k).min(1.0), (b * k).min(1.0), a])
+    }
+
+    /// Mixes the RGB channels toward white by `t` (0 = unchanged, 1 = white).
+    pub(crate) fn toward_white(self, t: f64) -> Rgba {
+        let [r, g, b, a] = self.0;
+        Rgba([r + (1.0 - r) * t, g + (1.0 - g) * t, b + (1.0 - b) * t, a])
+    }
+
+    pub(crate) fn skia(self) -> tiny_skia::Color {
+        let [r, g, b, a] = self.0.map(|c| c.clamp(0.0, 1.0) as f32);
+        tiny_skia::Color::from_rgba(r, g, b, a).unwrap_or(tiny_skia::Color::BLACK)
+    }
+
+    pub(crate) fn validate(self, field: &str) -> Result<(), RenderError> {
+        for (i, c) in self.0.iter().enumerate() {
+            finite(|| format!("{field}[{i}]"), *c)?;
+            if !(0.0..=1.0).contains(c) {
+                return Err(RenderError::OutOfRange {
+                    field: format!("{field}[{i}]"),
+                    value: *c,
+                    allowed: "[0, 1]",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A drawable primitive, world frame, metres.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Primitive {
+    /// A shaded sphere.
+    Sphere {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Radius, m (> 0).
+        radius_m: f64,
+        /// Colour.
+        color: Rgba,
+    },
+    /// A shaded box rotated by a unit quaternion `[x, y, z, w]`.
+    Box {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Half extents along the box axes, m (each ≥ 0).
+        half_extents_m: Vec3,
+        /// Orientation as a unit quaternion `[x, y, z, w]` (normalised when drawn).
+        rotation: [f64; 4],
+        /// Colour.
+        color: Rgba,
+    },
+    /// A filled, outlined ellipse in a plane of constant z (e.g. the beam's cross-section).
+    Ellipse {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Semi-axes along x and y, m (each ≥ 0).
+        semi_axes_m: [f64; 2],
+        /// Colour (the fill uses a third of its alpha, the outline all of it).
+        color: Rgba,
+    },
+    /// A polyline, closed into a loop when `closed`; drawn over the solids.
+    Polyline {
+        /// Vertices, m.
+        points_m: Vec<Vec3>,
+        /// Join the last vertex to the first.
+        closed: bool,
+        /// Colour.
+        color: Rgba,
+    },
+    /// An arrow from `from_m` to `to_m` (e.g. a force drawn at some m/N scale); drawn over the
+    /// solids.
+    Arrow {
+        /// Tail, m.
+        from_m: Vec3,
+        /// Head, m.
+        to_m: Vec3,
+        /// Colour.
+        color: Rgba,
+    },
+    /// A text label whose baseline starts a few pixels right of and above its anchor; drawn
+    /// last.
+    Label {
+        /// Anchor, m.
+        position_m: Vec3,
+        /// Text.
+        text: String,
+        /// Colour.
+        color: Rgba,
+    },
+    /// The haptic cursor: a see-through sphere with an outline and a cross-hair at its centre.
+    Cursor {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Radius, m (> 0).
+        radius_m: f64,
+        /// Colour (the body uses its alpha, the outline and cross-hair are opaque).
+        color: Rgba,
+    },
+    /// A blueprint slot: the dashed edges of a box where a brick should go; drawn over the
+    /// solids.
+    Slot {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Half extents along the box axes, m (each ≥ 0).
+        half_extents_m: Vec3,
+        /// Orientation as a unit quaternion `[x, y, z, w]`.
+        rotation: [f64; 4],
+        /// Colour.
+        color: Rgba,
+    },
+}
+
+fn positive(field: &str, v: f64, allow_zero: bool) -> Result<(), RenderError> {
+    finite(|| field.to_string(), v)?;
+    if v < 0.0 || (!allow_zero && v == 0.0) {
+        return Err(RenderError::OutOfRange {
+            field: field.to_string(),
+            value: v,
+            allowed: if allow_zero {
+                "[0, inf) m"
+            } else {
+                "(0, inf) m"
+            },
+        });
+    }
+    Ok(())
+}
+
+fn quaternion(field: &str, q: [f64; 4]) -> Result<(), RenderError> {
+    for (i, v) in q.iter().enumerate() {
+        finite(|| format!("{field}[{i}]"), *v)?;
+    }
+    let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if !(0.5..=2.0).contains(&n) {
+        return Err(RenderError::OutOfRange {
+            field: format!("{field} (norm)"),
+            value: n,
+            allowed: "[0.5, 2] (a unit quaternion [x, y, z, w], normalised when drawn)",
+        });
+    }
+    Ok(())
+}
+
+impl Primitive {
+    /// Short name of the variant, used in error field names (`sphere`, `box`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Primitive::Sphere { .. } => "sphere",
+            Primitive::Box { .. } => "box",
+            Primitive::Ellipse { .. } => "ellipse",
+            Primitive::Polyline { .. } => "polyline",
+            Primitive::Arrow { .. } => "arrow",
+            Primitive::Label { .. } => "label",
+            Primitive::Cursor { .. } => "cursor",
+            Primitive::Slot { .. } => "slot",
+        }
+    }
+
+    /// Checks every number: finite points, positive sizes, colours in 0–1, quaternions near
+    /// unit length.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let k = self.kind();
+        let f = |name: &str| format!("{k}.{name}");
+        match self {
+            Primitive::Sphere {
+                center_m,
+                radius_m,
+                color,
+            }
+            | Primitive::Cursor {
+                center_m,
+                radius_m,
+                color,
+            } => {
+                finite3(&f("center_m"), *center_m)?;
+                positive(&f("radius_m"), *radius_m, false)?;
+                color.validate(&f("color"))
+            }
+            Primitive::Box {
+                center_m,
+                half_extents_m,
+                rotation,
+                color,
+            }
+            | Primitive::Slot {
+                center_m,
+                half_extents_m,
+                rotation,
+                color,
+            } => {
+                finite3(&f("center_m"), *center_m)?;
+                for (i, h) in half_extents_m.iter().enumerate() {
+                    positive(&format!("{k}.half_extents_m[{i}]"), *h, true)?;
+                }
+                quaternion(&f("rotation"), *rotation)?;
+                color.validate(&f("color"))
+            }
+            Primitive::Ellipse {
+                center_m,
+                semi_axes_m,
+                color,
+            } => {
+                finite3(&f("center_m"), *center_m)?;
+                for (i, h) in semi_axes_m.iter().enumerate() {
+                    positive(&format!("{k}.semi_axes_m[{i}]"), *h, true)?;
+                }
+                color.validate(&f("color"))
+            }
+            Primitive::Polyline {
+                points_m, color, ..
+            } => {
+                for (i, p) in points_m.iter().enumerate() {
+                    finite3(&format!("{k}.points_m[{i}]"), *p)?;
+                }
+                color.validate(&f("color"))
+            }
+            Primitive::Arrow {
+                from_m,
+                to_m,
+                color,
+            } => {
+                finite3(&f("from_m"), *from_m)?;
+                finite3(&f("to_m"), *to_m)?;
+                color.validate(&f("color"))
+            }
+            Primitive::Label {
+                position_m, color, ..
+            } => {
+                finite3(&f("position_m"), *position_m)?;
+                color.validate(&f("color"))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_names_field_and_range() {
+        let p = Primitive::Sphere {
+            center_m: [0.0, 0.0, 0.0],
+            radius_m: 0.0,
+            color: Rgba([1.0, 0.0, 0.0, 1.0]),
+        };
+        assert_eq!(
+            p.validate().unwrap_err().to_string(),
+            "sphere.radius_m = 0 is out of range: allowed (0, inf) m"
+        );
+        let p = Primitive::Arrow {
+            from_m: [0.0; 3],
+            to_m: [0.0, f64::INFINITY, 0.0],
+            color: Rgba([1.0, 0.0, 0.0, 1.0]),
+        };
+        assert_eq!(
+            p.validate().unwrap_err().to_string(),
+            "arrow.to_m[1] must be finite, got inf"
+        );
+        let p = Primitive::Box {
+            center_m: [0.0; 3],
+            half_extents_m: [1.0; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            color: Rgba([1.5, 0.0, 0.0, 1.0]),
+        };
+        assert_eq!(
+            p.validate().unwrap_err().to_string(),
+            "box.color[0] = 1.5 is out of range: allowed [0, 1]"
+        );
+        let p = Primitive::Slot {
+            center_m: [0.0; 3],
+            half_extents_m: [1.0; 3],
+            rotation: [0.0; 4],
+            color: Rgba([1.0, 0.0, 0.0, 1.0]),
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .starts_with("slot.rotation (norm) = 0 is out of range")
+        );
+    }
+}
