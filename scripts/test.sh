@@ -21,9 +21,12 @@ if [ -d crates/ot-py ]; then
   rm -rf .venv
   python3 -m venv .venv
   .venv/bin/pip install --quiet --upgrade pip
-  .venv/bin/pip install --quiet "maturin>=1.8,<2" "pytest>=8" "numpy>=1.26"
-  .venv/bin/maturin build --release --manifest-path crates/ot-py/Cargo.toml --out target/wheels --interpreter .venv/bin/python
-  .venv/bin/pip install --quiet --force-reinstall --no-deps target/wheels/nanohaptics-*.whl
+  # maturin >= 1.9.4 sets PYO3_BUILD_EXTENSION_MODULE (pyo3 0.30 has no
+  # extension-module feature): the wheel then does not link libpython.
+  .venv/bin/pip install --quiet "maturin>=1.9.4,<2" "pytest>=8" "numpy>=1.26"
+  rm -rf target/wheels-test
+  .venv/bin/maturin build --release --manifest-path crates/ot-py/Cargo.toml --out target/wheels-test --interpreter .venv/bin/python
+  .venv/bin/pip install --quiet --force-reinstall --no-deps target/wheels-test/nanohaptics-*.whl
   step "pytest"
   .venv/bin/python -m pytest -q tests/python
 fi
