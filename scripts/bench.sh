@@ -4,10 +4,15 @@
 # writes docs/bench/<crate>.md, then the
 # sections are assembled in a fixed order. A Python venv with scipy (the
 # ot-physics peer) is created in .venv-bench on first use.
+# `scripts/bench.sh --assemble` only re-assembles BENCHMARKS.md from the
+# existing docs/bench/*.md sections.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if [ ! -x .venv-bench/bin/python ]; then
+assemble_only=0
+[ "${1:-}" = "--assemble" ] && assemble_only=1
+
+if [ "$assemble_only" = 0 ] && [ ! -x .venv-bench/bin/python ]; then
   echo "==> creating .venv-bench (numpy, scipy)"
   python3 -m venv .venv-bench
   .venv-bench/bin/pip install --quiet --upgrade pip
@@ -17,11 +22,15 @@ export NANOHAPTICS_PYTHON="$PWD/.venv-bench/bin/python"
 
 order=(ot-physics ot-envelope haptic-loop brickworld nanoworld render)
 for crate in "${order[@]}"; do
-  if [ -f "crates/$crate/examples/bench_report.rs" ]; then
+  if [ "$assemble_only" = 0 ] && [ -f "crates/$crate/examples/bench_report.rs" ]; then
     echo "==> $crate-report"
     cargo run --release -q -p "$crate" --example "$crate-report" > /dev/null
   fi
 done
+if [ "$assemble_only" = 0 ]; then
+  echo "==> ot-envelope figures (paper Figs. 2, 3, 4, 7, 8)"
+  cargo run --release -q -p ot-envelope --example figures > /dev/null
+fi
 
 {
   echo "# Benchmarks"
@@ -32,7 +41,8 @@ done
   echo
   for crate in "${order[@]}"; do
     if [ -f "docs/bench/$crate.md" ]; then
-      cat "docs/bench/$crate.md"
+      # section images are relative to docs/bench/; BENCHMARKS.md sits at the root
+      sed "s#](../figures/#](docs/figures/#g" "docs/bench/$crate.md"
       echo
     fi
   done
