@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use haptic_loop::device::{DeviceError, DeviceModel, HapticDevice, ReplayDevice, TickTime};
 use haptic_loop::record::{RecordingError, read_recording_file};
-use haptic_loop::scene::{Primitive as ScenePrimitive, SceneError, load_scene};
+use haptic_loop::scene::{SceneError, load_scene};
 use haptic_loop::{HapticLoop, LoopConfig, Scene};
 use render::{Camera, Frame, GifWriter, Image, Palette, Primitive, RenderError, Rgba, Style, View};
 
@@ -69,68 +69,6 @@ pub enum RenderCmdError {
     /// Drawing.
     #[error(transparent)]
     Render(#[from] RenderError),
-}
-
-/// The renderer's primitive for a scene primitive (same variants, fields and units).
-pub fn to_render(p: &ScenePrimitive) -> Primitive {
-    match p {
-        ScenePrimitive::Sphere {
-            center_m,
-            radius_m,
-            color,
-        } => Primitive::Sphere {
-            center_m: *center_m,
-            radius_m: *radius_m,
-            color: Rgba(color.0),
-        },
-        ScenePrimitive::Box {
-            center_m,
-            half_extents_m,
-            rotation,
-            color,
-        } => Primitive::Box {
-            center_m: *center_m,
-            half_extents_m: *half_extents_m,
-            rotation: *rotation,
-            color: Rgba(color.0),
-        },
-        ScenePrimitive::Ellipse {
-            center_m,
-            semi_axes_m,
-            color,
-        } => Primitive::Ellipse {
-            center_m: *center_m,
-            semi_axes_m: *semi_axes_m,
-            color: Rgba(color.0),
-        },
-        ScenePrimitive::Polyline {
-            points_m,
-            closed,
-            color,
-        } => Primitive::Polyline {
-            points_m: points_m.clone(),
-            closed: *closed,
-            color: Rgba(color.0),
-        },
-        ScenePrimitive::Arrow {
-            from_m,
-            to_m,
-            color,
-        } => Primitive::Arrow {
-            from_m: *from_m,
-            to_m: *to_m,
-            color: Rgba(color.0),
-        },
-        ScenePrimitive::Label {
-            position_m,
-            text,
-            color,
-        } => Primitive::Label {
-            position_m: *position_m,
-            text: text.clone(),
-            color: Rgba(color.0),
-        },
-    }
 }
 
 /// Text and scale bar colour, light on the dark background the scenes' colours are chosen for
@@ -196,14 +134,14 @@ fn cursor_path(
 fn draw(
     frame: &mut Frame,
     scene: &dyn Scene,
-    prims: &mut Vec<ScenePrimitive>,
+    prims: &mut Vec<Primitive>,
     title: &str,
 ) -> Result<(), RenderError> {
     prims.clear();
     scene.draw(prims);
     frame.clear();
     for p in prims.iter() {
-        frame.push(to_render(p))?;
+        frame.push(p.clone())?;
     }
     frame.scale_bar(None, INK)?;
     frame.title(title, INK)
@@ -267,7 +205,7 @@ pub fn scene_picture(
     let loaded = load_scene(&text, None)?;
     let mut prims = Vec::new();
     loaded.scene.draw(&mut prims);
-    let rp: Vec<Primitive> = prims.iter().map(to_render).collect();
+    let rp: Vec<Primitive> = prims.clone();
     let cam = camera_for(&rp, &[], view, width)?;
     let mut frame = Frame::new(cam, style())?;
     draw(
@@ -330,7 +268,7 @@ fn recording_frames(
         if frame.is_none() {
             prims.clear();
             lp.scene().draw(&mut prims);
-            let rp: Vec<Primitive> = prims.iter().map(to_render).collect();
+            let rp: Vec<Primitive> = prims.clone();
             let cam = camera_for(&rp, &path, view, args.width)?;
             frame = Some(Frame::new(cam, style())?);
             img = Some(Image::new(cam.width_px(), cam.height_px())?);
@@ -395,7 +333,7 @@ pub fn final_picture(rec_path: &Path, out: &Path, width: u32) -> Result<(), Rend
     let mut lp = HapticLoop::new(config.clone(), loaded.scene);
     let mut prims = Vec::new();
     lp.scene().draw(&mut prims);
-    let first: Vec<Primitive> = prims.iter().map(to_render).collect();
+    let first: Vec<Primitive> = prims.clone();
     for n in 0..ticks {
         let sample = dev.sample(TickTime::new(n, config.rate_hz))?;
         lp.tick(sample, dev.deadline_missed(n));
@@ -438,95 +376,9 @@ pub fn cmd(args: &RenderArgs) -> Result<std::process::ExitCode, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use haptic_loop::scene::Rgba as SceneRgba;
 
     fn root() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-    }
-
-    #[test]
-    fn every_scene_primitive_maps_to_the_same_render_primitive() {
-        let c = SceneRgba([0.1, 0.2, 0.3, 0.4]);
-        let rc = Rgba([0.1, 0.2, 0.3, 0.4]);
-        let cases = vec![
-            (
-                ScenePrimitive::Sphere {
-                    center_m: [1.0, 2.0, 3.0],
-                    radius_m: 0.5,
-                    color: c,
-                },
-                Primitive::Sphere {
-                    center_m: [1.0, 2.0, 3.0],
-                    radius_m: 0.5,
-                    color: rc,
-                },
-            ),
-            (
-                ScenePrimitive::Box {
-                    center_m: [1.0, 0.0, 0.0],
-                    half_extents_m: [0.1, 0.2, 0.3],
-                    rotation: [0.0, 0.0, 0.6, 0.8],
-                    color: c,
-                },
-                Primitive::Box {
-                    center_m: [1.0, 0.0, 0.0],
-                    half_extents_m: [0.1, 0.2, 0.3],
-                    rotation: [0.0, 0.0, 0.6, 0.8],
-                    color: rc,
-                },
-            ),
-            (
-                ScenePrimitive::Ellipse {
-                    center_m: [0.0; 3],
-                    semi_axes_m: [6e-7, 3e-7],
-                    color: c,
-                },
-                Primitive::Ellipse {
-                    center_m: [0.0; 3],
-                    semi_axes_m: [6e-7, 3e-7],
-                    color: rc,
-                },
-            ),
-            (
-                ScenePrimitive::Polyline {
-                    points_m: vec![[0.0; 3], [1.0; 3]],
-                    closed: true,
-                    color: c,
-                },
-                Primitive::Polyline {
-                    points_m: vec![[0.0; 3], [1.0; 3]],
-                    closed: true,
-                    color: rc,
-                },
-            ),
-            (
-                ScenePrimitive::Arrow {
-                    from_m: [0.0; 3],
-                    to_m: [1.0, 0.0, 0.0],
-                    color: c,
-                },
-                Primitive::Arrow {
-                    from_m: [0.0; 3],
-                    to_m: [1.0, 0.0, 0.0],
-                    color: rc,
-                },
-            ),
-            (
-                ScenePrimitive::Label {
-                    position_m: [0.0; 3],
-                    text: "x".into(),
-                    color: c,
-                },
-                Primitive::Label {
-                    position_m: [0.0; 3],
-                    text: "x".into(),
-                    color: rc,
-                },
-            ),
-        ];
-        for (a, b) in cases {
-            assert_eq!(to_render(&a), b);
-        }
     }
 
     #[test]

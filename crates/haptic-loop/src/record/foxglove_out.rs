@@ -92,7 +92,14 @@ pub fn scene_update(prims: &[Primitive], scale: f64, time_ns: u64) -> SceneUpdat
     };
     for p in prims {
         match p {
+            // Foxglove has no cursor or dashed-slot primitive: a cursor is
+            // drawn as its sphere, a blueprint slot as its box.
             Primitive::Sphere {
+                center_m,
+                radius_m,
+                color: c,
+            }
+            | Primitive::Cursor {
                 center_m,
                 radius_m,
                 color: c,
@@ -102,6 +109,12 @@ pub fn scene_update(prims: &[Primitive], scale: f64, time_ns: u64) -> SceneUpdat
                 color: Some(color(*c)),
             }),
             Primitive::Box {
+                center_m,
+                half_extents_m,
+                rotation,
+                color: c,
+            }
+            | Primitive::Slot {
                 center_m,
                 half_extents_m,
                 rotation,

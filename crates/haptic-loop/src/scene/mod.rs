@@ -71,70 +71,10 @@ impl SceneOutput {
     }
 }
 
-/// An RGBA colour, each channel in 0–1.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Rgba(pub [f64; 4]);
-
-/// A drawable primitive, world frame, metres.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Primitive {
-    /// A sphere.
-    Sphere {
-        /// Centre, m.
-        center_m: Vec3,
-        /// Radius, m.
-        radius_m: f64,
-        /// Colour.
-        color: Rgba,
-    },
-    /// A box rotated by a unit quaternion `[x, y, z, w]`.
-    Box {
-        /// Centre, m.
-        center_m: Vec3,
-        /// Half extents along the box axes, m.
-        half_extents_m: Vec3,
-        /// Orientation as a unit quaternion `[x, y, z, w]`.
-        rotation: [f64; 4],
-        /// Colour.
-        color: Rgba,
-    },
-    /// An ellipse in a plane of constant z (e.g. the beam's cross-section).
-    Ellipse {
-        /// Centre, m.
-        center_m: Vec3,
-        /// Semi-axes along x and y, m.
-        semi_axes_m: [f64; 2],
-        /// Colour.
-        color: Rgba,
-    },
-    /// A polyline, closed into a loop when `closed`.
-    Polyline {
-        /// Vertices, m.
-        points_m: Vec<Vec3>,
-        /// Join the last vertex to the first.
-        closed: bool,
-        /// Colour.
-        color: Rgba,
-    },
-    /// An arrow from `from_m` to `to_m`.
-    Arrow {
-        /// Tail, m.
-        from_m: Vec3,
-        /// Head, m.
-        to_m: Vec3,
-        /// Colour.
-        color: Rgba,
-    },
-    /// A text label.
-    Label {
-        /// Anchor, m.
-        position_m: Vec3,
-        /// Text.
-        text: String,
-        /// Colour.
-        color: Rgba,
-    },
-}
+/// Drawable primitives and colours are the renderer's own types (world
+/// frame, metres; RGBA in 0–1), so a scene's drawing goes to the renderer
+/// and to the Foxglove channels without conversion.
+pub use render::{Primitive, Rgba};
 
 /// A world as the haptic loop sees it.
 ///
