@@ -16,11 +16,19 @@
 //!   bits): zero force, the cursor held at the last valid position, `input.invalid` event;
 //! - **missed deadline** (real-time mode): zero force, `deadline.missed` event. The flag is an
 //!   input of the tick (logged with the device input), so replay reproduces it.
+//! - **watchdog** (a bridged device whose samples stop): the sample's age in ticks is an input of
+//!   the tick. While it is within `watchdog_grace_ticks` the force is untouched; then the force
+//!   ramps linearly to zero, reaching zero `watchdog_timeout_ticks` after the last sample
+//!   (default 2 ms grace, 10 ms timeout). Events: `device.sample_late` at the first stale tick of
+//!   an episode, `device.lost` when the force reaches zero, `device.resumed` on the next fresh
+//!   sample; after a loss, soft engagement restarts.
+//! - **local stiffness**: the device also gets the 3×3 stiffness of the rendered field (scaled
+//!   by mapping, engagement, watchdog and clamp), so a driver may render between packets.
 //!
 //! The world force, the sent force and the status of every tick are returned in
 //! [`TickResult`]; the sent force is always finite and of norm ≤ the device maximum.
 
-use crate::device::{Buttons, DeviceSample, DeviceSpecs};
+use crate::device::{Buttons, DeviceSample, DeviceSpecs, ForceCommand};
 use crate::scene::{Event, Scene, SceneInput, SceneOutput};
 use crate::vec3::{self, Vec3};
 
@@ -57,6 +65,10 @@ pub struct LoopConfig {
     pub mapping: Mapping,
     /// The device's specifications.
     pub specs: DeviceSpecs,
+    /// Ticks a stale device sample is tolerated at full force.
+    pub watchdog_grace_ticks: u32,
+    /// Ticks after the last fresh sample at which the force has ramped to zero (> grace).
+    pub watchdog_timeout_ticks: u32,
 }
 
 impl LoopConfig {
@@ -88,6 +100,8 @@ pub mod status {
     pub const STIFFNESS_OVER_CAP: u8 = 8;
     /// The scene returned a non-finite force; zero force.
     pub const FORCE_INVALID: u8 = 16;
+    /// The device sample was stale beyond the grace time: the watchdog reduced the force.
+    pub const WATCHDOG: u8 = 32;
 }
 
 /// What one tick produced.
@@ -105,6 +119,10 @@ pub struct TickResult {
     pub device_force_n: Vec3,
     /// Soft-engagement factor applied, 0–1.
     pub engagement: f64,
+    /// Watchdog factor applied, 0–1 (1 while device samples are fresh).
+    pub watchdog: f64,
+    /// Local stiffness sent with the force, N/m, device frame, row-major 3×3.
+    pub device_stiffness_n_per_m: [f64; 9],
     /// Status bits, see [`status`].
     pub status: u8,
     /// Events of this tick: loop events, button events, scene events.
@@ -121,8 +139,33 @@ pub struct HapticLoop {
     engage_start: u64,
     input_invalid: bool,
     clamping: bool,
+    link_lost: bool,
     out: SceneOutput,
     result: TickResult,
+}
+
+/// `k a aᵀ` for a unit axis `a`, `k I` without one (row-major).
+fn stiffness_matrix(k: f64, axis: Option<Vec3>) -> [f64; 9] {
+    let mut m = [0.0; 9];
+    if k == 0.0 {
+        return m;
+    }
+    match axis {
+        Some(a) if vec3::is_finite(a) && vec3::norm(a) > 0.0 => {
+            let a = vec3::scale(a, 1.0 / vec3::norm(a));
+            for i in 0..3 {
+                for j in 0..3 {
+                    m[3 * i + j] = k * a[i] * a[j];
+                }
+            }
+        }
+        _ => {
+            m[0] = k;
+            m[4] = k;
+            m[8] = k;
+        }
+    }
+    m
 }
 
 /// Smoothstep `3x² − 2x³` on [0, 1].
@@ -144,6 +187,7 @@ impl HapticLoop {
             engage_start: 0,
             input_invalid: false,
             clamping: false,
+            link_lost: false,
             out: SceneOutput::default(),
             result: TickResult::default(),
         }
@@ -164,16 +208,42 @@ impl HapticLoop {
         self.next_tick
     }
 
+    /// The config's watchdog factor for a sample `age_ticks` old: 1 within the grace, then a
+    /// linear ramp reaching 0 at the timeout.
+    pub fn watchdog_factor(&self, age_ticks: u32) -> f64 {
+        let c = &self.config;
+        if age_ticks <= c.watchdog_grace_ticks {
+            1.0
+        } else if age_ticks >= c.watchdog_timeout_ticks {
+            0.0
+        } else {
+            f64::from(c.watchdog_timeout_ticks - age_ticks)
+                / f64::from(c.watchdog_timeout_ticks - c.watchdog_grace_ticks)
+        }
+    }
+
+    /// The command for the device after the last tick.
+    pub fn command(&self, seq: u64) -> ForceCommand {
+        ForceCommand {
+            tick: self.result.tick,
+            seq,
+            force_n: self.result.device_force_n,
+            stiffness_n_per_m: self.result.device_stiffness_n_per_m,
+            status: self.result.status,
+        }
+    }
+
     /// Why a device sample is invalid, or `None` when it is valid.
     pub fn check_sample(specs: &DeviceSpecs, s: &DeviceSample) -> Option<String> {
+        let [x, y, z] = s.position_m;
         if !vec3::is_finite(s.position_m) {
-            return Some(format!("non-finite position {:?} m", s.position_m));
+            return Some(format!("non-finite position ({x}, {y}, {z}) m"));
         }
         let r = vec3::norm(s.position_m);
-        if r > specs.workspace_radius_m {
+        if r.is_nan() || r > specs.workspace_radius_m {
             return Some(format!(
-                "position {:?} m is {r} m from the origin, outside the {} m workspace",
-                s.position_m, specs.workspace_radius_m
+                "position ({x}, {y}, {z}) m is {r} m from the origin, outside the {} m workspace",
+                specs.workspace_radius_m
             ));
         }
         let extra = s.buttons.0 & !specs.button_mask();
@@ -190,6 +260,7 @@ impl HapticLoop {
     pub fn tick(&mut self, sample: DeviceSample, deadline_missed: bool) -> &TickResult {
         let tick = self.next_tick;
         self.next_tick += 1;
+        let watchdog = self.watchdog_factor(sample.age_ticks);
         let r = &mut self.result;
         r.tick = tick;
         r.status = 0;
@@ -220,13 +291,39 @@ impl HapticLoop {
                     } else {
                         "button.up"
                     };
-                    r.events.push(Event::new(kind, *name));
+                    r.events.push(Event::new(kind, name.as_ref()));
                 }
             }
             self.last_buttons = sample.buttons;
         }
         r.cursor_m = self.last_cursor_m;
         r.buttons = self.last_buttons;
+
+        // 1b. Watchdog on the sample's age.
+        let age = sample.age_ticks;
+        if age == 1 {
+            r.events
+                .push(Event::new("device.sample_late", "no new device sample this tick"));
+        }
+        if watchdog == 0.0 && !self.link_lost {
+            self.link_lost = true;
+            r.events.push(Event::new(
+                "device.lost",
+                format!("no device sample for {age} ticks: force ramped to zero"),
+            ));
+        }
+        if age == 0 && self.link_lost {
+            self.link_lost = false;
+            r.events.push(Event::new(
+                "device.resumed",
+                "device samples resumed: soft engagement restarts",
+            ));
+            self.engage_start = tick;
+        }
+        if watchdog < 1.0 {
+            r.status |= status::WATCHDOG;
+        }
+        r.watchdog = watchdog;
 
         // 2. The world.
         self.out.clear();
@@ -267,11 +364,9 @@ impl HapticLoop {
         } else {
             smoothstep((tick - self.engage_start) as f64 / self.config.engage_ticks as f64)
         };
+        let gain = self.config.mapping.force_scale * r.engagement * r.watchdog;
         let mut f = if force_ok {
-            vec3::scale(
-                self.out.force_n,
-                self.config.mapping.force_scale * r.engagement,
-            )
+            vec3::scale(self.out.force_n, gain)
         } else {
             [0.0; 3]
         };
@@ -284,7 +379,15 @@ impl HapticLoop {
         }
         let max = self.config.specs.max_force_n;
         let mag = vec3::norm(f);
+        let mut k_gain = if force_ok && vec3::is_finite(f) {
+            self.out.stiffness_n_per_m * gain * self.config.mapping.workspace_scale
+        } else {
+            0.0
+        };
         if mag > max {
+            // On the saturated part of the field the force no longer grows: scale the local
+            // stiffness with the force.
+            k_gain *= max / mag;
             r.status |= status::CLAMPED;
             if !self.clamping {
                 r.events.push(Event::new(
@@ -301,6 +404,10 @@ impl HapticLoop {
             self.clamping = false;
         }
         r.device_force_n = f;
+        r.device_stiffness_n_per_m = stiffness_matrix(
+            if k_gain.is_finite() { k_gain } else { 0.0 },
+            self.out.stiffness_axis,
+        );
         if deadline_missed {
             self.mark_deadline_missed();
         }
@@ -317,6 +424,7 @@ impl HapticLoop {
             r.events
                 .push(Event::new("deadline.missed", "zero force sent this tick"));
             r.device_force_n = [0.0; 3];
+            r.device_stiffness_n_per_m = [0.0; 9];
         }
     }
 
@@ -354,10 +462,7 @@ stiffness_n_per_m = 5000.0
     }
 
     fn at(z: f64) -> DeviceSample {
-        DeviceSample {
-            position_m: [0.0, 0.0, z],
-            buttons: Buttons(0),
-        }
+        DeviceSample::new([0.0, 0.0, z], Buttons(0))
     }
 
     #[test]
@@ -386,10 +491,7 @@ stiffness_n_per_m = 5000.0
         l.tick(at(-0.001), false);
         let r = l
             .tick(
-                DeviceSample {
-                    position_m: [f64::NAN, 0.0, 0.0],
-                    buttons: Buttons(0),
-                },
+                DeviceSample::new([f64::NAN, 0.0, 0.0], Buttons(0)),
                 false,
             )
             .clone();
@@ -402,10 +504,7 @@ stiffness_n_per_m = 5000.0
         assert!(r.events.is_empty(), "one event per episode");
         let r = l
             .tick(
-                DeviceSample {
-                    position_m: [0.0; 3],
-                    buttons: Buttons(1 << 7),
-                },
+                DeviceSample::new([0.0; 3], Buttons(1 << 7)),
                 false,
             )
             .clone();
@@ -432,10 +531,7 @@ stiffness_n_per_m = 5000.0
         let mut l = looped(WALL);
         let r = l
             .tick(
-                DeviceSample {
-                    position_m: [0.0, 0.0, -0.001],
-                    buttons: Buttons(0b101),
-                },
+                DeviceSample::new([0.0, 0.0, -0.001], Buttons(0b101)),
                 true,
             )
             .clone();
@@ -475,7 +571,7 @@ stiffness_n_per_m = 5000.0
             let text = WALL.replace("5000.0", &format!("{k:?}"));
             let mut l = looped(&text);
             for ((x, y, z), b) in samples {
-                let s = DeviceSample { position_m: [x, y, z], buttons: Buttons(b) };
+                let s = DeviceSample::new([x, y, z], Buttons(b));
                 let invalid = HapticLoop::check_sample(&FALCON, &s).is_some();
                 let r = l.tick(s, false);
                 prop_assert!(vec3::is_finite(r.device_force_n));

@@ -17,18 +17,27 @@
 //! - **Recording and replay** ([`record`], [`replay`]): every tick into MCAP from a writer
 //!   thread (so writing never stalls a tick), and a replay that recomputes every output from the
 //!   logged inputs alone and compares bit for bit.
+//! - **The runner** ([`runner`]): one loop for every way a session is driven — a device source
+//!   (script, simulated hand, replay, a device in another process over the UDP [`bridge`]), a
+//!   pacing policy (batch, real time, the device's clock) and sinks (the MCAP recorder, the
+//!   per-tick [`arrays`], the replay verifier, the frame renderer, the [`live`] Foxglove view).
 //! - **Sessions** ([`session`]): "run a scene with a script and get per-tick arrays back" and
 //!   "read a recording into arrays", the API the Python wheel wraps.
 //!
 //! What it is not: it holds no world physics (the worlds live in their own crates and are
-//! adapted by a thin scene), no GPU renderer and no driver for real hardware (a real device
-//! would implement [`device::HapticDevice`]).
+//! adapted by a thin scene), no GPU renderer and no driver for real hardware: a real device's
+//! driver runs in its own process and speaks the bridge protocol (the wheel's
+//! `nanohaptics.bridge` has adapters for the Touch and Force Dimension / Falcon SDKs).
 
+pub mod arrays;
+pub mod bridge;
 pub mod device;
 pub mod haptic;
+pub mod live;
 pub mod pacing;
 pub mod record;
 pub mod replay;
+pub mod runner;
 pub mod scene;
 pub mod session;
 pub mod vec3;

@@ -1,8 +1,12 @@
 //! `nanohaptics`: run scenes headless, record them to MCAP, replay and verify recordings.
 //!
 //! ```text
-//! nanohaptics run SCENE [--script S] [--operator rigid|hand|hand:key=value,...] [--device M]
-//!                 [--seconds T] [--out REC.mcap] [--realtime] [--json]
+//! nanohaptics run SCENE [--script S] [--operator rigid|hand|hand:key=value,...]
+//!                 [--device falcon|touch|udp:HOST:PORT] [--seconds T] [--out REC.mcap]
+//!                 [--realtime] [--live ws:HOST:PORT] [--json]
+//! nanohaptics fake-device udp:HOST:PORT [--script S] [--hand|--hand key=value,...|--rigid]
+//!                 [--model M] [--loss P] [--jitter-ms J] [--latency-ms L] [--seed N]
+//!                 [--seconds T] [--outage START:SECONDS] [--json]
 //! nanohaptics replay REC.mcap [--verify] [--salvage] [--json]
 //! nanohaptics info REC.mcap [--salvage] [--json]
 //! nanohaptics demo [--scenes DIR] [--out DIR] [--json]
@@ -14,7 +18,9 @@
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
+use haptic_loop::bridge::BridgeConfig;
 use haptic_loop::device::{DeviceModel, OperatorParams};
+use haptic_loop::live::LiveConfig;
 use haptic_loop::record::messages::Channel;
 use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
@@ -69,6 +75,9 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// A stand-in haptic device process: plays a script over the UDP bridge to `nanohaptics run
+    /// --device udp:HOST:PORT`, with injectable loss, jitter, latency and an outage.
+    FakeDevice(FakeArgs),
     /// Run every scene with its default script, record, verify, and summarise.
     Demo {
         /// Folder of scene files.
@@ -94,9 +103,21 @@ struct RunArgs {
     /// parameters) or `hand:mass_kg=0.3,stiffness_n_per_m=300,damping_n_s_per_m=12`.
     #[arg(long, default_value = "hand")]
     operator: String,
-    /// Device model overriding the scene's: falcon or touch.
+    /// Device: a model overriding the scene's (falcon, touch), or a device in another process
+    /// over the UDP bridge, `udp:HOST:PORT` (listen there; waits for its hello; always real
+    /// time; see docs/device-bridge.md).
     #[arg(long)]
     device: Option<String>,
+    /// Serve a live Foxglove view at `ws:HOST:PORT` while the session runs (open
+    /// ws://HOST:PORT in Foxglove; layout in docs/foxglove/).
+    #[arg(long)]
+    live: Option<String>,
+    /// Rate of the live 3D scene, Hz (default 50).
+    #[arg(long, default_value_t = 50)]
+    live_hz: u32,
+    /// How long to wait for a bridged device's hello, s.
+    #[arg(long, default_value_t = 120.0)]
+    wait_s: f64,
     /// Session length, s (default: the script's duration).
     #[arg(long)]
     seconds: Option<f64>,
@@ -109,6 +130,135 @@ struct RunArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
+}
+
+#[derive(clap::Args)]
+struct FakeArgs {
+    /// The simulator's bridge address, `udp:HOST:PORT`.
+    target: String,
+    /// Script file (TOML) the stylus plays (default: the built-in wall-press script).
+    #[arg(long)]
+    script: Option<PathBuf>,
+    /// `hand` (default: a simulated hand pushed by the force), `rigid`, or
+    /// `hand:mass_kg=0.3,stiffness_n_per_m=300,...`.
+    #[arg(long, default_value = "hand")]
+    operator: String,
+    /// Device model announced in the hello: falcon or touch.
+    #[arg(long, default_value = "falcon")]
+    model: String,
+    /// Probability that a sample is lost, 0–1.
+    #[arg(long, default_value_t = 0.0)]
+    loss: f64,
+    /// Extra delay of each sample, uniform in 0–J ms (samples may overtake each other).
+    #[arg(long, default_value_t = 0.0)]
+    jitter_ms: f64,
+    /// Fixed delay of each sample, ms.
+    #[arg(long, default_value_t = 0.0)]
+    latency_ms: f64,
+    /// Seed of the loss and jitter draws.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// How long to play, s (default: the script's duration).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Go silent from START s for SECONDS s, then come back (`--outage 1.0:0.05`).
+    #[arg(long)]
+    outage: Option<String>,
+    /// How long to wait for the simulator's welcome, s.
+    #[arg(long, default_value_t = 30.0)]
+    wait_s: f64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The default script of `fake-device`: press the wall scene's surface, as its own script does.
+const FAKE_SCRIPT: &str = include_str!("../../../scenes/wall.script.toml");
+
+fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
+    use haptic_loop::bridge::fake::{FakeConfig, run_fake};
+    let target = a
+        .target
+        .strip_prefix("udp:")
+        .and_then(|t| t.parse().ok())
+        .ok_or_else(|| {
+            format!(
+                "fake-device `{}`: expected udp:HOST:PORT, e.g. udp:127.0.0.1:9870",
+                a.target
+            )
+        })?;
+    let model = DeviceModel::from_name(&a.model).map_err(|e| format!("--model: {e}"))?;
+    let text = match &a.script {
+        Some(p) => std::fs::read_to_string(p)
+            .map_err(|e| format!("--script: cannot read {}: {e}", p.display()))?,
+        None => FAKE_SCRIPT.to_string(),
+    };
+    let script = haptic_loop::device::Script::from_toml(&text, model.specs())
+        .map_err(|e| format!("--script: {e}"))?;
+    let hand = match parse_operator(&a.operator)? {
+        OperatorChoice::Rigid => None,
+        OperatorChoice::Hand(p) => Some(p),
+        OperatorChoice::ScriptHand => Some(script.operator.unwrap_or_default()),
+    };
+    let check = |flag: &str, v: f64, lo: f64, hi: f64| {
+        if v.is_finite() && (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("--{flag} = {v} is out of range (allowed: {lo}–{hi})"))
+        }
+    };
+    let loss = check("loss", a.loss, 0.0, 1.0)?;
+    let jitter = check("jitter-ms", a.jitter_ms, 0.0, 1000.0)?;
+    let latency = check("latency-ms", a.latency_ms, 0.0, 1000.0)?;
+    let outage = a
+        .outage
+        .as_deref()
+        .map(|o| {
+            let bad = || format!("--outage `{o}`: expected START:SECONDS, e.g. 1.0:0.05");
+            let (s, d) = o.split_once(':').ok_or_else(bad)?;
+            let s: f64 = s.parse().map_err(|_| bad())?;
+            let d: f64 = d.parse().map_err(|_| bad())?;
+            Ok::<_, String>((check("outage start", s, 0.0, 3600.0)?, check("outage seconds", d, 0.0, 3600.0)?))
+        })
+        .transpose()?;
+    if let Some(s) = a.seconds {
+        check("seconds", s, 1e-3, 3600.0)?;
+    }
+    let cfg = FakeConfig {
+        target,
+        model,
+        script,
+        hand,
+        loss,
+        jitter_s: jitter * 1e-3,
+        latency_s: latency * 1e-3,
+        seed: a.seed,
+        seconds: a.seconds,
+        outage,
+        wait_s: check("wait-s", a.wait_s, 0.0, 86400.0)?,
+        bye: true,
+    };
+    if !a.json {
+        eprintln!("fake-device: saying hello to {target} ...");
+    }
+    let r = run_fake(&cfg, None).map_err(|e| e.to_string())?;
+    if a.json {
+        println!("{}", serde_json::json!(r));
+    } else {
+        println!(
+            "fake-device: {} periods, {} samples sent, {} dropped (loss), {} silent (outage), {} replies",
+            r.ticks, r.sent, r.dropped, r.silent, r.replies
+        );
+        println!(
+            "  round trip p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; peak force {:.3} N (within limits: {})",
+            r.round_trip.p50_ns as f64 / 1e3,
+            r.round_trip.p99_ns as f64 / 1e3,
+            r.round_trip.max_ns as f64 / 1e3,
+            r.max_force_n,
+            if r.forces_within_limits { "yes" } else { "NO" }
+        );
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn parse_operator(s: &str) -> Result<OperatorChoice, String> {
@@ -148,6 +298,11 @@ fn summary_json(r: &SessionReport) -> serde_json::Value {
         "events": a.events.len(),
         "tick_stats": r.stats,
         "written": r.written,
+        "end": r.end,
+        "device_link": r.description.device_link,
+        "link": r.link.iter().map(|(k, v)| (k.to_string(), *v)).collect::<BTreeMap<String, u64>>(),
+        "watchdog_ticks": a.status.iter().filter(|s| **s & 32 != 0).count(),
+        "live": r.live,
     })
 }
 
@@ -177,6 +332,16 @@ fn print_summary(r: &SessionReport) {
         s.jitter.p99_ns as f64 / 1e3,
         s.missed
     );
+    if !r.link.is_empty() {
+        let parts: Vec<String> = r.link.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        println!("  device link: {}", parts.join(", "));
+    }
+    if let Some(l) = &r.live {
+        println!(
+            "  live view: {} scenes, {} states, {} log lines published, {} dropped",
+            l.scenes, l.states, l.logs, l.dropped
+        );
+    }
     if let Some(w) = &r.written {
         println!(
             "  recorded {} messages, {} bytes ({:.0} bytes per minute)",
@@ -203,6 +368,9 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
         script,
         operator,
         device,
+        live,
+        live_hz,
+        wait_s,
         seconds,
         out,
         realtime,
@@ -210,11 +378,36 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
     } = args;
     let mut opts = SessionOptions::new(SceneSource::from_path(&scene).map_err(|e| e.to_string())?);
     opts.operator = parse_operator(&operator)?;
-    opts.device = device
-        .as_deref()
-        .map(DeviceModel::from_name)
-        .transpose()
-        .map_err(|e| e.to_string())?;
+    match device.as_deref() {
+        Some(d) if d.starts_with("udp:") => {
+            let mut b = BridgeConfig::parse(d).map_err(|e| e.to_string())?;
+            if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
+                return Err(format!("--wait-s = {wait_s} is out of range (allowed: 0–86400)"));
+            }
+            b.wait_s = wait_s;
+            if !json {
+                eprintln!("waiting for a device on udp:{} (nanohaptics fake-device udp:{} in another terminal) ...", b.bind, b.bind);
+            }
+            opts.bridge = Some(b);
+        }
+        Some(d) => {
+            opts.device = Some(DeviceModel::from_name(d).map_err(|e| {
+                format!("--device: {e}; or udp:HOST:PORT for a device in another process")
+            })?);
+        }
+        None => {}
+    }
+    if let Some(l) = live.as_deref() {
+        let mut c = LiveConfig::parse(l).map_err(|e| e.to_string())?;
+        if !(1..=1000).contains(&live_hz) {
+            return Err(format!("--live-hz = {live_hz} is out of range (allowed: 1–1000)"));
+        }
+        c.display_hz = live_hz;
+        if !json {
+            eprintln!("live view on ws://{} (Foxglove: Open connection → Foxglove WebSocket)", c.bind);
+        }
+        opts.live = Some(c);
+    }
     opts.script = script
         .as_deref()
         .map(|p| {
@@ -449,6 +642,7 @@ fn main() -> ExitCode {
         } => cmd_replay(&rec, verify, salvage, json),
         Cmd::Info { rec, salvage, json } => cmd_info(&rec, salvage, json),
         Cmd::Demo { scenes, out, json } => cmd_demo(&scenes, &out, json),
+        Cmd::FakeDevice(a) => cmd_fake(a),
     };
     match res {
         Ok(code) => code,

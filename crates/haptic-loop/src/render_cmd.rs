@@ -4,9 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use haptic_loop::device::{DeviceError, DeviceModel, HapticDevice, ReplayDevice, TickTime};
+use haptic_loop::device::{DeviceError, HapticDevice, ReplayDevice, TickTime};
 use haptic_loop::record::{RecordingError, read_recording_file};
-use haptic_loop::scene::{SceneError, load_scene};
+use haptic_loop::runner::{Pacing, Runner, Sink, TickView};
+use haptic_loop::scene::{SceneError, load_scene, load_scene_for};
+use haptic_loop::session::SessionError;
 use haptic_loop::{HapticLoop, LoopConfig, Scene};
 use render::{Camera, Frame, GifWriter, Image, Palette, Primitive, RenderError, Rgba, Style, View};
 
@@ -69,6 +71,9 @@ pub enum RenderCmdError {
     /// Drawing.
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// Replaying the recording.
+    #[error("replay: {0}")]
+    Session(String),
 }
 
 /// Text and scale bar colour, light on the dark background the scenes' colours are chosen for
@@ -218,6 +223,100 @@ pub fn scene_picture(
     Ok(())
 }
 
+/// The frame renderer as a sink of the runner: draws every `every`-th tick into
+/// `out/frame_NNNNN.png` and, when asked, an animated GIF.
+struct FramesSink<'a> {
+    args: &'a RenderArgs,
+    view: Option<View>,
+    every: u64,
+    rate: u64,
+    kind: &'static str,
+    path: Vec<[f64; 3]>,
+    prims: Vec<Primitive>,
+    frame: Option<Frame>,
+    img: Option<Image>,
+    gif: Option<GifWriter<std::io::BufWriter<std::fs::File>>>,
+    frames: u64,
+}
+
+impl FramesSink<'_> {
+    fn draw_tick(&mut self, n: u64, scene: &dyn Scene) -> Result<(), RenderCmdError> {
+        let title = format!("{}  t = {:.3} s", self.kind, n as f64 / self.rate as f64);
+        if self.frame.is_none() {
+            self.prims.clear();
+            scene.draw(&mut self.prims);
+            let cam = camera_for(&self.prims, &self.path, self.view, self.args.width)?;
+            self.frame = Some(Frame::new(cam, style())?);
+            self.img = Some(Image::new(cam.width_px(), cam.height_px())?);
+        }
+        let (Some(f), Some(im)) = (self.frame.as_mut(), self.img.as_mut()) else {
+            return Ok(());
+        };
+        draw(f, scene, &mut self.prims, &title)?;
+        f.draw_into(im)?;
+        im.save_png(self.args.out.join(format!("frame_{:05}.png", self.frames)))?;
+        if let Some(path) = &self.args.gif {
+            if self.gif.is_none() {
+                let file = std::fs::File::create(path).map_err(|source| RenderCmdError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+                // palette from the first frame; the writer switches when new colours appear
+                let pal = Palette::from_images(&[im], 255)?;
+                let fps = self.rate as f64 / self.every as f64;
+                self.gif = Some(GifWriter::new(
+                    std::io::BufWriter::new(file),
+                    im.width(),
+                    im.height(),
+                    fps,
+                    pal,
+                )?);
+            }
+            if let Some(g) = self.gif.as_mut() {
+                g.add_frame(im)?;
+            }
+        }
+        self.frames += 1;
+        Ok(())
+    }
+}
+
+impl Sink for FramesSink<'_> {
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+        let n = t.result.tick;
+        if n % self.every != 0 {
+            return Ok(());
+        }
+        self.draw_tick(n, t.lp.scene())
+            .map_err(|e| SessionError::Option(e.to_string()))
+    }
+}
+
+/// Replays a recording through the runner with `sinks` and returns the loop at its end.
+fn replay_into(
+    rec: &haptic_loop::record::Recording,
+    sinks: Vec<&mut dyn Sink>,
+) -> Result<(HapticLoop, u64), RenderCmdError> {
+    let d = &rec.description;
+    let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
+    let config = loaded.config.clone();
+    let mut dev = ReplayDevice::from_recording(rec, config.specs.clone(), config.period_ns())?;
+    let ticks = dev.ticks();
+    let flags = dev.deadline_flags();
+    let mut lp = HapticLoop::new(config, loaded.scene);
+    Runner::new(sinks)
+        .run(
+            &mut lp,
+            &mut dev,
+            d,
+            Some(ticks),
+            Pacing::Recorded(flags),
+            &mut |_, _| {},
+        )
+        .map_err(|e| RenderCmdError::Session(e.to_string()))?;
+    Ok((lp, ticks))
+}
+
 /// Recomputes a recording from its inputs and draws every `every`-th tick into
 /// `out/frame_NNNNN.png` (and a GIF when asked).
 fn recording_frames(
@@ -226,8 +325,7 @@ fn recording_frames(
 ) -> Result<RenderSummary, RenderCmdError> {
     let rec = read_recording_file(&args.input, false)?;
     let d = &rec.description;
-    let model = DeviceModel::from_name(&d.device_model)?;
-    let loaded = load_scene(&d.scene_toml, Some(model))?;
+    let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
     let config = loaded.config.clone();
     let rate = u64::from(config.rate_hz);
     let every = args.every.unwrap_or((rate / 30).max(1));
@@ -247,63 +345,23 @@ fn recording_frames(
         path: args.out.clone(),
         source,
     })?;
-    let path = cursor_path(&rec, &config)?;
-    let mut dev = ReplayDevice::from_recording(&rec, config.specs.clone(), config.period_ns())?;
-    let ticks = dev.ticks();
-    let kind = loaded.scene.kind();
-    let mut lp = HapticLoop::new(config.clone(), loaded.scene);
-    let mut prims = Vec::new();
-    let mut frame: Option<Frame> = None;
-    let mut img: Option<Image> = None;
-    let mut gif: Option<GifWriter<std::io::BufWriter<std::fs::File>>> = None;
-    let mut frames = 0u64;
-    for n in 0..ticks {
-        let sample = dev.sample(TickTime::new(n, config.rate_hz))?;
-        lp.tick(sample, dev.deadline_missed(n));
-        dev.set_force(lp.last_result().device_force_n);
-        if n % every != 0 {
-            continue;
-        }
-        let title = format!("{kind}  t = {:.3} s", n as f64 / rate as f64);
-        if frame.is_none() {
-            prims.clear();
-            lp.scene().draw(&mut prims);
-            let rp: Vec<Primitive> = prims.clone();
-            let cam = camera_for(&rp, &path, view, args.width)?;
-            frame = Some(Frame::new(cam, style())?);
-            img = Some(Image::new(cam.width_px(), cam.height_px())?);
-        }
-        let (Some(f), Some(im)) = (frame.as_mut(), img.as_mut()) else {
-            continue;
-        };
-        draw(f, lp.scene(), &mut prims, &title)?;
-        f.draw_into(im)?;
-        im.save_png(args.out.join(format!("frame_{frames:05}.png")))?;
-        if let Some(path) = &args.gif {
-            if gif.is_none() {
-                let file = std::fs::File::create(path).map_err(|source| RenderCmdError::Io {
-                    path: path.clone(),
-                    source,
-                })?;
-                // palette from the first frame; the writer switches when new colours appear
-                let pal = Palette::from_images(&[im], 255)?;
-                let fps = rate as f64 / every as f64;
-                gif = Some(GifWriter::new(
-                    std::io::BufWriter::new(file),
-                    im.width(),
-                    im.height(),
-                    fps,
-                    pal,
-                )?);
-            }
-            if let Some(g) = gif.as_mut() {
-                g.add_frame(im)?;
-            }
-        }
-        frames += 1;
-    }
+    let mut sink = FramesSink {
+        args,
+        view,
+        every,
+        rate,
+        kind: loaded.scene.kind(),
+        path: cursor_path(&rec, &config)?,
+        prims: Vec::new(),
+        frame: None,
+        img: None,
+        gif: None,
+        frames: 0,
+    };
+    let (_, ticks) = replay_into(&rec, vec![&mut sink])?;
+    let frames = sink.frames;
     let mut gif_bytes = 0;
-    if let (Some(g), Some(path)) = (gif, &args.gif) {
+    if let (Some(g), Some(path)) = (sink.gif.take(), &args.gif) {
         let mut w = g.finish()?;
         std::io::Write::flush(&mut w).map_err(|source| RenderCmdError::Io {
             path: path.clone(),
@@ -324,21 +382,13 @@ pub fn final_picture(rec_path: &Path, out: &Path, width: u32) -> Result<(), Rend
     check_width(width)?;
     let rec = read_recording_file(rec_path, false)?;
     let d = &rec.description;
-    let model = DeviceModel::from_name(&d.device_model)?;
-    let loaded = load_scene(&d.scene_toml, Some(model))?;
+    let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
     let config = loaded.config.clone();
-    let mut dev = ReplayDevice::from_recording(&rec, config.specs.clone(), config.period_ns())?;
-    let ticks = dev.ticks();
     let kind = loaded.scene.kind();
-    let mut lp = HapticLoop::new(config.clone(), loaded.scene);
     let mut prims = Vec::new();
-    lp.scene().draw(&mut prims);
+    loaded.scene.draw(&mut prims);
     let first: Vec<Primitive> = prims.clone();
-    for n in 0..ticks {
-        let sample = dev.sample(TickTime::new(n, config.rate_hz))?;
-        lp.tick(sample, dev.deadline_missed(n));
-        dev.set_force(lp.last_result().device_force_n);
-    }
+    let (lp, ticks) = replay_into(&rec, Vec::new())?;
     let cam = camera_for(&first, &cursor_path(&rec, &config)?, None, width)?;
     let mut frame = Frame::new(cam, style())?;
     let t = ticks as f64 / f64::from(config.rate_hz);

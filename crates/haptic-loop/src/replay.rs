@@ -1,16 +1,18 @@
 //! Replay and bit-exact verification of a recording.
 //!
-//! The scene is rebuilt from the description (scene text and device model), the device inputs
-//! and deadline flags are played back through a [`ReplayDevice`], and every verified output
-//! message (state, force, events, Foxglove channels) is recomputed and compared byte for byte
-//! with the recorded one. The first difference names its tick and channel.
+//! The scene is rebuilt from the description (scene text and the device's specifications), the
+//! device inputs, sample ages and deadline flags are played back through a [`ReplayDevice`] by
+//! the [runner](crate::runner), and the verifier sink recomputes every verified output message
+//! (state, force, events, Foxglove channels) and compares it byte for byte with the recorded
+//! one. The first difference names its tick and channel.
 
-use crate::device::{DeviceModel, HapticDevice, ReplayDevice};
+use crate::device::ReplayDevice;
 use crate::haptic::HapticLoop;
 use crate::record::messages::{Channel, ForceMsg, StateMsg};
-use crate::record::{Recording, RecordingError, TickMessages};
-use crate::scene::load_scene;
-use crate::session::{Pacing, SessionError, drive};
+use crate::record::{OutMsg, Recording, RecordingError, TickEncoder};
+use crate::runner::{Pacing, Runner, SessionInfo, Sink, TickView};
+use crate::scene::load_scene_for;
+use crate::session::SessionError;
 
 /// The first difference between a recording and its replay.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -41,18 +43,27 @@ impl VerifyReport {
     }
 }
 
+fn fmt3(v: [f64; 3]) -> String {
+    format!("({}, {}, {})", v[0], v[1], v[2])
+}
+
+fn fmt_list(v: &[f64]) -> String {
+    let parts: Vec<String> = v.iter().map(|x| x.to_string()).collect();
+    format!("[{}]", parts.join(", "))
+}
+
 fn describe(channel: Channel, rec: &[u8], rep: &[u8], n_fields: usize) -> String {
     match channel {
         Channel::Force => {
             if let (Ok(a), Ok(b)) = (ForceMsg::decode(rec), ForceMsg::decode(rep)) {
                 return format!(
-                    "recorded world {:?} N, device {:?} N, status {}; replayed world {:?} N, \
-                     device {:?} N, status {}",
-                    a.world_force_n,
-                    a.device_force_n,
+                    "recorded world {} N, device {} N, status {}; replayed world {} N, \
+                     device {} N, status {}",
+                    fmt3(a.world_force_n),
+                    fmt3(a.device_force_n),
                     a.status,
-                    b.world_force_n,
-                    b.device_force_n,
+                    fmt3(b.world_force_n),
+                    fmt3(b.device_force_n),
                     b.status
                 );
             }
@@ -63,8 +74,11 @@ fn describe(channel: Channel, rec: &[u8], rep: &[u8], n_fields: usize) -> String
                 StateMsg::decode(rep, n_fields),
             ) {
                 return format!(
-                    "recorded cursor {:?} m, state {:?}; replayed cursor {:?} m, state {:?}",
-                    a.cursor_m, a.values, b.cursor_m, b.values
+                    "recorded cursor {} m, state {}; replayed cursor {} m, state {}",
+                    fmt3(a.cursor_m),
+                    fmt_list(&a.values),
+                    fmt3(b.cursor_m),
+                    fmt_list(&b.values)
                 );
             }
         }
@@ -82,11 +96,84 @@ fn describe(channel: Channel, rec: &[u8], rep: &[u8], n_fields: usize) -> String
     )
 }
 
+/// The verifier as a sink: encodes each replayed tick exactly as the recorder did and compares.
+pub struct VerifySink<'r> {
+    expected: Vec<Vec<(Channel, &'r [u8])>>,
+    n_fields: usize,
+    enc: Option<TickEncoder>,
+    msgs: Vec<OutMsg>,
+    /// Output messages compared.
+    pub compared: u64,
+    /// The first divergence.
+    pub divergence: Option<Divergence>,
+}
+
+impl Sink for VerifySink<'_> {
+    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
+        self.enc = Some(TickEncoder::new(lp, info.description.start_time_ns));
+        Ok(())
+    }
+
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+        let Some(enc) = self.enc.as_mut() else {
+            return Ok(());
+        };
+        if self.divergence.is_some() {
+            return Ok(());
+        }
+        self.msgs.clear();
+        enc.outputs(t.result, t.lp, &mut self.msgs);
+        let tick = t.result.tick;
+        let Some(want) = self.expected.get(tick as usize) else {
+            return Ok(());
+        };
+        for ch in Channel::ALL.into_iter().filter(|c| c.verified()) {
+            let w = want.iter().filter(|m| m.0 == ch).map(|m| m.1);
+            let mut g = self
+                .msgs
+                .iter()
+                .filter(|m| m.channel == ch)
+                .map(|m| m.data.as_slice());
+            let mut detail = None;
+            let mut nw = 0;
+            for a in w {
+                nw += 1;
+                match g.next() {
+                    Some(b) => {
+                        self.compared += 1;
+                        if a != b {
+                            detail = Some(describe(ch, a, b, self.n_fields));
+                            break;
+                        }
+                    }
+                    None => {
+                        detail = Some("recorded a message that replay did not produce".into());
+                        break;
+                    }
+                }
+            }
+            if detail.is_none() && g.next().is_some() {
+                detail = Some("replay produced a message that was not recorded".into());
+            }
+            let _ = nw;
+            if let Some(detail) = detail {
+                self.divergence = Some(Divergence {
+                    tick,
+                    channel: ch.topic().to_string(),
+                    detail,
+                });
+                break;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Replays `rec` from its inputs and compares every verified output bit for bit.
 pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
     let d = &rec.description;
-    let model = DeviceModel::from_name(&d.device_model)?;
-    let loaded = load_scene(&d.scene_toml, Some(model))?;
+    let specs = d.device_specs();
+    let loaded = load_scene_for(&d.scene_toml, specs.clone())?;
     let period = loaded.config.period_ns();
     if loaded.config.rate_hz != d.rate_hz {
         return Err(SessionError::Recording(RecordingError::BadMessage {
@@ -107,20 +194,21 @@ pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
                 tick: 0,
                 channel: Channel::State.topic().into(),
                 detail: format!(
-                    "recorded state fields {:?}, the scene now has {:?}",
-                    d.state_fields,
-                    loaded.scene.state_fields()
+                    "recorded state fields {}, the scene now has {}",
+                    d.state_fields.join(", "),
+                    loaded.scene.state_fields().join(", ")
                 ),
             }),
         });
     }
-    let mut dev = ReplayDevice::from_recording(rec, loaded.config.specs.clone(), period)?;
+    let mut dev = ReplayDevice::from_recording(rec, specs, period)?;
     let ticks = dev.ticks();
     // Expected outputs, grouped by tick, in file order.
     let mut expected: Vec<Vec<(Channel, &[u8])>> = vec![Vec::new(); ticks as usize];
     for m in rec.messages.iter().filter(|m| m.channel.verified()) {
-        let t = m.log_time_ns / period;
-        if m.log_time_ns % period != 0 || t >= ticks {
+        let rel = m.log_time_ns.checked_sub(d.start_time_ns);
+        let t = rel.map_or(u64::MAX, |r| r / period);
+        if rel.is_none_or(|r| r % period != 0) || t >= ticks {
             return Err(SessionError::Recording(RecordingError::BadMessage {
                 topic: m.channel.topic().into(),
                 log_time_ns: m.log_time_ns,
@@ -129,61 +217,27 @@ pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
         }
         expected[t as usize].push((m.channel, m.data.as_slice()));
     }
-    let flags: Vec<bool> = (0..ticks).map(|t| dev.deadline_missed(t)).collect();
-    let missed = |t: u64| flags.get(t as usize).copied().unwrap_or(false);
+    let flags = dev.deadline_flags();
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
-    let mut compared = 0u64;
-    let mut divergence: Option<Divergence> = None;
-    let mut sink = |t: TickMessages| -> Result<(), SessionError> {
-        if divergence.is_some() {
-            return Ok(());
-        }
-        let want = &expected[t.tick as usize];
-        for ch in Channel::ALL.into_iter().filter(|c| c.verified()) {
-            let w: Vec<&[u8]> = want.iter().filter(|m| m.0 == ch).map(|m| m.1).collect();
-            let g: Vec<&[u8]> = t
-                .msgs
-                .iter()
-                .filter(|m| m.channel == ch)
-                .map(|m| m.data.as_slice())
-                .collect();
-            let mut detail = None;
-            for (a, b) in w.iter().zip(&g) {
-                compared += 1;
-                if a != b {
-                    detail = Some(describe(ch, a, b, n_fields));
-                    break;
-                }
-            }
-            if detail.is_none() && w.len() != g.len() {
-                detail = Some(if w.len() < g.len() {
-                    "replay produced a message that was not recorded".to_string()
-                } else {
-                    "recorded a message that replay did not produce".to_string()
-                });
-            }
-            if let Some(detail) = detail {
-                divergence = Some(Divergence {
-                    tick: t.tick,
-                    channel: ch.topic().to_string(),
-                    detail,
-                });
-                break;
-            }
-        }
-        Ok(())
+    let mut sink = VerifySink {
+        expected,
+        n_fields,
+        enc: None,
+        msgs: Vec::with_capacity(8),
+        compared: 0,
+        divergence: None,
     };
-    drive(
+    Runner::new(vec![&mut sink]).run(
         &mut lp,
-        &mut dev as &mut dyn HapticDevice,
-        ticks,
-        Pacing::Recorded(&missed),
-        &mut sink,
+        &mut dev,
+        d,
+        Some(ticks),
+        Pacing::Recorded(flags),
         &mut |_, _| {},
     )?;
     Ok(VerifyReport {
         ticks,
-        messages_compared: compared,
-        divergence,
+        messages_compared: sink.compared,
+        divergence: sink.divergence,
     })
 }

@@ -8,27 +8,33 @@
 pub mod operator;
 pub mod replay;
 pub mod script;
+pub mod source;
 
 use crate::vec3::Vec3;
 use serde::{Deserialize, Serialize};
 
 pub use operator::{OperatorParams, SimulatedOperator};
+use std::borrow::Cow;
 pub use replay::ReplayDevice;
 pub use script::{Script, ScriptError, ScriptedDevice};
 
 /// Specifications of a haptic device (what it can sense and render).
+///
+/// The shipped models are constants ([`FALCON`], [`TOUCH`]); a device bridged from another
+/// process announces its own at run time (see `docs/device-bridge.md`), hence the owned-or-static
+/// strings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DeviceSpecs {
     /// Model name as written in scene files and recordings.
-    pub name: &'static str,
+    pub name: Cow<'static, str>,
     /// Largest force the device renders, N (the force vector is scaled down to this norm).
     pub max_force_n: f64,
     /// Largest stable stiffness at a 1 kHz servo rate, N/m.
     pub max_stiffness_n_per_m: f64,
     /// Radius of the sphere, centred on the device origin, that the stylus can reach, m.
     pub workspace_radius_m: f64,
-    /// Button names, bit `i` of [`Buttons`] is `button_names[i]`.
-    pub button_names: &'static [&'static str],
+    /// Button names, bit `i` of [`Buttons`] is `button_names[i]` (at most 32).
+    pub button_names: Cow<'static, [Cow<'static, str>]>,
 }
 
 /// The device models this crate ships specifications for.
@@ -44,20 +50,25 @@ pub enum DeviceModel {
 
 /// Novint Falcon specifications.
 pub const FALCON: DeviceSpecs = DeviceSpecs {
-    name: "falcon",
+    name: Cow::Borrowed("falcon"),
     max_force_n: 8.0,
     max_stiffness_n_per_m: 3000.0,
     workspace_radius_m: 0.04,
-    button_names: &["centre", "plus", "minus", "forward"],
+    button_names: Cow::Borrowed(&[
+        Cow::Borrowed("centre"),
+        Cow::Borrowed("plus"),
+        Cow::Borrowed("minus"),
+        Cow::Borrowed("forward"),
+    ]),
 };
 
 /// Touch / Omni class specifications (conservative end of the published ranges).
 pub const TOUCH: DeviceSpecs = DeviceSpecs {
-    name: "touch",
+    name: Cow::Borrowed("touch"),
     max_force_n: 3.3,
     max_stiffness_n_per_m: 400.0,
     workspace_radius_m: 0.075,
-    button_names: &["button1", "button2"],
+    button_names: Cow::Borrowed(&[Cow::Borrowed("button1"), Cow::Borrowed("button2")]),
 };
 
 impl DeviceModel {
@@ -71,7 +82,10 @@ impl DeviceModel {
 
     /// Model name as written in scene files ("falcon", "touch").
     pub fn name(self) -> &'static str {
-        self.specs().name
+        match self {
+            DeviceModel::Falcon => "falcon",
+            DeviceModel::Touch => "touch",
+        }
     }
 
     /// Parses a model name; the error lists the allowed names.
@@ -92,10 +106,59 @@ impl DeviceSpecs {
             .position(|b| *b == name)
             .map(|i| i as u32)
             .ok_or_else(|| DeviceError::UnknownButton {
-                device: self.name,
+                device: self.name.to_string(),
                 name: name.to_string(),
                 allowed: self.button_names.join(", "),
             })
+    }
+
+    /// Button names as plain string slices.
+    pub fn button_strs(&self) -> Vec<&str> {
+        self.button_names.iter().map(|b| b.as_ref()).collect()
+    }
+
+    /// Checks specifications announced by a device (e.g. over the bridge): every number finite
+    /// and in range, at most 32 buttons, names of 1–32 printable ASCII characters.
+    pub fn validate(&self) -> Result<(), DeviceError> {
+        let range = |field: &'static str, v: f64, lo: f64, hi: f64| {
+            if v.is_finite() && v > lo && v <= hi {
+                Ok(())
+            } else {
+                Err(DeviceError::BadSpec {
+                    field,
+                    value: format!("{v}"),
+                    allowed: format!("{lo} < {field} ≤ {hi}"),
+                })
+            }
+        };
+        range("max_force_n", self.max_force_n, 0.0, 1e3)?;
+        range("max_stiffness_n_per_m", self.max_stiffness_n_per_m, 0.0, 1e6)?;
+        range("workspace_radius_m", self.workspace_radius_m, 0.0, 10.0)?;
+        let name_ok = |s: &str| {
+            (1..=32).contains(&s.len()) && s.bytes().all(|b| b.is_ascii_graphic() || b == b' ')
+        };
+        if !name_ok(&self.name) {
+            return Err(DeviceError::BadSpec {
+                field: "name",
+                value: format!("\"{}\"", self.name.escape_default()),
+                allowed: "1–32 printable ASCII characters".into(),
+            });
+        }
+        if self.button_names.len() > 32 {
+            return Err(DeviceError::BadSpec {
+                field: "button_names",
+                value: format!("{} buttons", self.button_names.len()),
+                allowed: "at most 32 buttons".into(),
+            });
+        }
+        if let Some(b) = self.button_names.iter().find(|b| !name_ok(b)) {
+            return Err(DeviceError::BadSpec {
+                field: "button_names",
+                value: format!("\"{}\"", b.escape_default()),
+                allowed: "1–32 printable ASCII characters per name".into(),
+            });
+        }
+        Ok(())
     }
 
     /// Bitmask of the buttons this device has.
@@ -139,6 +202,42 @@ pub struct DeviceSample {
     pub position_m: Vec3,
     /// Button state.
     pub buttons: Buttons,
+    /// The device's own sequence number of this reading (0 for headless devices, which number
+    /// nothing). Information only: the physics never reads it.
+    pub seq: u64,
+    /// Ticks since this reading arrived: 0 for a fresh reading; n > 0 when no new reading came
+    /// for n ticks and the last one is repeated (a bridged device whose packets stopped). The
+    /// loop's watchdog ramps the force down from it, so it is an input of the tick and recorded.
+    pub age_ticks: u32,
+}
+
+impl DeviceSample {
+    /// A fresh reading (age 0, sequence number 0).
+    pub fn new(position_m: Vec3, buttons: Buttons) -> Self {
+        DeviceSample {
+            position_m,
+            buttons,
+            seq: 0,
+            age_ticks: 0,
+        }
+    }
+}
+
+/// What the loop commands the device until the next tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ForceCommand {
+    /// The tick this command answers.
+    pub tick: u64,
+    /// The device's sequence number of the reading this command answers.
+    pub seq: u64,
+    /// Force, N, device frame (finite, norm ≤ the device maximum).
+    pub force_n: Vec3,
+    /// Local stiffness of the rendered force field, N/m, device frame, row-major 3×3
+    /// (`F(p + dp) ≈ F(p) − K dp`), already scaled by engagement, watchdog and clamp, so a
+    /// driver may render between packets at its own rate.
+    pub stiffness_n_per_m: [f64; 9],
+    /// Status bits of the tick (see `haptic::status`).
+    pub status: u8,
 }
 
 /// The time of a tick as the devices see it (tick index is time).
@@ -173,7 +272,7 @@ pub enum DeviceError {
     #[error("device `{device}` has no button `{name}` (allowed: {allowed})")]
     UnknownButton {
         /// Device model name.
-        device: &'static str,
+        device: String,
         /// The name asked for.
         name: String,
         /// The device's button names.
@@ -190,19 +289,49 @@ pub enum DeviceError {
     /// A replay device ran past the end of its recording.
     #[error("the recording has no device input for tick {0}")]
     EndOfRecording(u64),
+    /// Specifications announced by a device out of range.
+    #[error("device specs: `{field}` = {value} is out of range (allowed: {allowed})")]
+    BadSpec {
+        /// Field name.
+        field: &'static str,
+        /// The value announced.
+        value: String,
+        /// The allowed range.
+        allowed: String,
+    },
+    /// The device ended the session (a bridged device said goodbye): not an error of the run.
+    #[error("the device ended the session")]
+    Ended,
+    /// The device's transport failed (socket error, device gone for good).
+    #[error("device link: {0}")]
+    Link(String),
 }
 
 /// The generic haptic device (after CHAI3D's `cGenericHapticDevice`).
 ///
-/// The loop calls [`HapticDevice::sample`] once per tick, in tick order, then
-/// [`HapticDevice::set_force`] with the force to render until the next tick.
+/// The runner calls [`HapticDevice::open`] once, then per tick [`HapticDevice::sample`] (in
+/// tick order) and [`HapticDevice::set_force`] with the command to render until the next tick,
+/// and [`HapticDevice::close`] at the end (also after an error).
 pub trait HapticDevice {
-    /// The device's specifications.
+    /// The device's specifications (a bridged device's are known after `open`).
     fn specs(&self) -> &DeviceSpecs;
+    /// Connects to the device (waits for a bridged device's hello). Headless devices: nothing.
+    fn open(&mut self) -> Result<(), DeviceError> {
+        Ok(())
+    }
     /// Reads position (m) and buttons for tick `time`.
     fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError>;
-    /// Commands the force (N, device frame) rendered until the next tick.
-    fn set_force(&mut self, force_n: Vec3);
+    /// Commands the force (N, device frame) and local stiffness rendered until the next tick.
+    fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError>;
+    /// Releases the device (a bridged device is told the session ended; zero force).
+    fn close(&mut self) -> Result<(), DeviceError> {
+        Ok(())
+    }
+    /// Counters of the device's link (packets received, dropped, ...); empty for headless
+    /// devices.
+    fn link_counters(&self) -> Vec<(&'static str, u64)> {
+        Vec::new()
+    }
 }
 
 #[cfg(test)]

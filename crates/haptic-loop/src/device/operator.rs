@@ -16,7 +16,7 @@
 //! sphere (its outward velocity is removed at the boundary), as a real linkage cannot.
 
 use super::script::{Script, ScriptError};
-use super::{DeviceError, DeviceSample, DeviceSpecs, HapticDevice, TickTime};
+use super::{DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime};
 use crate::vec3::{self, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -189,21 +189,19 @@ impl HapticDevice for SimulatedOperator {
             self.step(time);
         }
         self.next_tick += 1;
-        Ok(DeviceSample {
-            position_m: self.position_m,
-            buttons: self.script.buttons(self.intent_time_s),
-        })
+        Ok(DeviceSample::new(self.position_m, self.script.buttons(self.intent_time_s)))
     }
 
-    fn set_force(&mut self, force_n: Vec3) {
-        self.force_n = force_n;
+    fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
+        self.force_n = cmd.force_n;
+        Ok(())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::FALCON;
+    use crate::device::{FALCON, ForceCommand};
 
     fn hold_script() -> Script {
         Script::from_toml(
@@ -220,7 +218,7 @@ mod tests {
         let mut last = [0.0; 3];
         for n in 0..5000 {
             last = op.sample(TickTime::new(n, 1000)).unwrap().position_m;
-            op.set_force([3.0, 0.0, 0.0]);
+            op.set_force(&ForceCommand { force_n: [3.0, 0.0, 0.0], ..Default::default() }).unwrap();
         }
         assert!((last[0] - 0.01).abs() < 1e-6, "x = {}", last[0]);
     }
@@ -258,7 +256,7 @@ mod tests {
         for n in 0..2000 {
             let p = op.sample(TickTime::new(n, 1000)).unwrap().position_m;
             assert!(vec3::norm(p) <= FALCON.workspace_radius_m * (1.0 + 1e-15));
-            op.set_force([8.0, 8.0, 0.0]);
+            op.set_force(&ForceCommand { force_n: [8.0, 8.0, 0.0], ..Default::default() }).unwrap();
         }
         assert!(matches!(
             op.sample(TickTime::new(7, 1000)),
@@ -295,8 +293,8 @@ mod tests {
         for n in 0..1001 {
             op.sample(TickTime::new(n, 1000)).unwrap();
             free.sample(TickTime::new(n, 1000)).unwrap();
-            op.set_force([0.0, 2.0, 0.0]);
-            free.set_force([0.0, 2.0, 0.0]);
+            op.set_force(&ForceCommand { force_n: [0.0, 2.0, 0.0], ..Default::default() }).unwrap();
+            free.set_force(&ForceCommand { force_n: [0.0, 2.0, 0.0], ..Default::default() }).unwrap();
         }
         // 1000 steps of 1 ms at rate 1 / (1 + 2/2): the plan is at 0.5 s, the free one at 1 s.
         assert!(

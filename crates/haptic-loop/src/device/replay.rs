@@ -1,6 +1,8 @@
 //! The replay device: plays back the device inputs of a recording, tick by tick.
 
-use super::{Buttons, DeviceError, DeviceSample, DeviceSpecs, HapticDevice, TickTime};
+use super::{
+    Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
+};
 use crate::record::messages::{Channel, DeviceInputMsg};
 use crate::record::{Recording, RecordingError};
 use crate::vec3::Vec3;
@@ -16,12 +18,13 @@ pub struct ReplayDevice {
 
 impl ReplayDevice {
     /// Reads the `/device/input` messages of `rec`; they must be ticks 0, 1, 2, … in order, at
-    /// log time `tick · period_ns`.
+    /// log time `start + tick · period_ns` (start: the description's `start_time_ns`).
     pub fn from_recording(
         rec: &Recording,
         specs: DeviceSpecs,
         period_ns: u64,
     ) -> Result<Self, RecordingError> {
+        let start = rec.description.start_time_ns;
         let mut samples = Vec::new();
         let mut missed = Vec::new();
         for m in rec
@@ -36,17 +39,18 @@ impl ReplayDevice {
             };
             let d = DeviceInputMsg::decode(&m.data).map_err(|e| bad(e.to_string()))?;
             let n = samples.len() as u64;
-            if d.tick != n || m.log_time_ns != n.saturating_mul(period_ns) {
+            let at = start.saturating_add(n.saturating_mul(period_ns));
+            if d.tick != n || m.log_time_ns != at {
                 return Err(bad(format!(
-                    "expected tick {n} at {} ns, found tick {} at {} ns",
-                    n.saturating_mul(period_ns),
-                    d.tick,
-                    m.log_time_ns
+                    "expected tick {n} at {at} ns, found tick {} at {} ns",
+                    d.tick, m.log_time_ns
                 )));
             }
             samples.push(DeviceSample {
                 position_m: d.position_m,
                 buttons: Buttons(d.buttons),
+                seq: d.seq,
+                age_ticks: d.age_ticks,
             });
             missed.push(d.deadline_missed);
         }
@@ -68,6 +72,11 @@ impl ReplayDevice {
         self.missed.get(tick as usize).copied().unwrap_or(false)
     }
 
+    /// The recorded deadline flags, one per tick.
+    pub fn deadline_flags(&self) -> Vec<bool> {
+        self.missed.clone()
+    }
+
     /// The forces commanded during the replay, N, one per tick.
     pub fn forces_n(&self) -> &[Vec3] {
         &self.forces_n
@@ -86,7 +95,8 @@ impl HapticDevice for ReplayDevice {
             .ok_or(DeviceError::EndOfRecording(time.index))
     }
 
-    fn set_force(&mut self, force_n: Vec3) {
-        self.forces_n.push(force_n);
+    fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
+        self.forces_n.push(cmd.force_n);
+        Ok(())
     }
 }

@@ -25,7 +25,9 @@
 //! down = true
 //! ```
 
-use super::{Buttons, DeviceError, DeviceSample, DeviceSpecs, HapticDevice, TickTime};
+use super::{
+    Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
+};
 use crate::device::operator::OperatorParams;
 use crate::vec3::{self, Vec3};
 use serde::Deserialize;
@@ -353,14 +355,12 @@ impl HapticDevice for ScriptedDevice {
     }
 
     fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
-        Ok(DeviceSample {
-            position_m: self.script.position(time.time_s),
-            buttons: self.script.buttons(time.time_s),
-        })
+        Ok(DeviceSample::new(self.script.position(time.time_s), self.script.buttons(time.time_s)))
     }
 
-    fn set_force(&mut self, force_n: Vec3) {
-        self.last_force_n = force_n;
+    fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
+        self.last_force_n = cmd.force_n;
+        Ok(())
     }
 }
 

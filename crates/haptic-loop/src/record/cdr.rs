@@ -24,6 +24,12 @@ pub enum CdrError {
     /// Bytes left after the last field.
     #[error("{0} bytes left after the last field")]
     Trailing(usize),
+    /// A recording of another format version.
+    #[error(
+        "recorded with format {0}; this build reads {fmt} (re-record the session, or replay it with the build that wrote it)",
+        fmt = super::messages::FORMAT_VERSION
+    )]
+    Format(String),
 }
 
 const HEADER: [u8; 4] = [0x00, 0x01, 0x00, 0x00];

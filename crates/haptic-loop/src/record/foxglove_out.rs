@@ -82,15 +82,37 @@ fn quat_x_to(d: Vec3) -> Quaternion {
     }
 }
 
-/// Builds a `foxglove.SceneUpdate` holding every primitive as one entity `scene`.
-pub fn scene_update(prims: &[Primitive], scale: f64, time_ns: u64) -> SceneUpdate {
-    let mut e = SceneEntity {
-        timestamp: Some(timestamp(time_ns)),
-        frame_id: WORLD_FRAME.to_string(),
-        id: "scene".to_string(),
-        ..Default::default()
+/// Entity id of a primitive: its kind and its index among the primitives of that kind in
+/// drawing order (`sphere_0`, `box_3`, `cursor_0`, `polyline_0`), stable while the scene draws
+/// the same bodies in the same order.
+fn entity_id(p: &Primitive, counts: &mut [u32; 8]) -> String {
+    let (k, name) = match p {
+        Primitive::Sphere { .. } => (0, "sphere"),
+        Primitive::Cursor { .. } => (1, "cursor"),
+        Primitive::Box { .. } => (2, "box"),
+        Primitive::Slot { .. } => (3, "slot"),
+        Primitive::Ellipse { .. } => (4, "ellipse"),
+        Primitive::Polyline { .. } => (5, "polyline"),
+        Primitive::Arrow { .. } => (6, "arrow"),
+        Primitive::Label { .. } => (7, "label"),
     };
+    let n = counts[k];
+    counts[k] += 1;
+    format!("{name}_{n}")
+}
+
+/// Builds a `foxglove.SceneUpdate` with one entity per primitive (each body can be selected and
+/// hidden in Foxglove's 3D panel).
+pub fn scene_update(prims: &[Primitive], scale: f64, time_ns: u64) -> SceneUpdate {
+    let mut entities = Vec::with_capacity(prims.len());
+    let mut counts = [0u32; 8];
     for p in prims {
+        let mut e = SceneEntity {
+            timestamp: Some(timestamp(time_ns)),
+            frame_id: WORLD_FRAME.to_string(),
+            id: entity_id(p, &mut counts),
+            ..Default::default()
+        };
         match p {
             // Foxglove has no cursor or dashed-slot primitive: a cursor is
             // drawn as its sphere, a blueprint slot as its box.
@@ -208,10 +230,11 @@ pub fn scene_update(prims: &[Primitive], scale: f64, time_ns: u64) -> SceneUpdat
                 text: text.clone(),
             }),
         }
+        entities.push(e);
     }
     SceneUpdate {
         deletions: Vec::new(),
-        entities: vec![e],
+        entities,
     }
 }
 
@@ -235,6 +258,8 @@ pub fn event_log(ev: &Event, time_ns: u64) -> Log {
             | "force.invalid"
             | "deadline.missed"
             | "scene.stiffness_over_cap"
+            | "device.sample_late"
+            | "device.lost"
     );
     Log {
         timestamp: Some(timestamp(time_ns)),

@@ -5,7 +5,7 @@ use super::cdr::{CdrError, CdrReader, CdrWriter};
 use crate::vec3::Vec3;
 
 /// Format version written in the scene description; bumped on any layout change.
-pub const FORMAT_VERSION: &str = "nanohaptics-recording/1";
+pub const FORMAT_VERSION: &str = "nanohaptics-recording/2";
 
 /// The channels of a recording.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -80,7 +80,11 @@ pub const DEVICE_INPUT_SCHEMA: (&str, &str) = (
      uint64 tick\n\
      float64[3] position_m\n\
      uint32 buttons\n\
-     bool deadline_missed\n",
+     bool deadline_missed\n\
+     # the device's sequence number of this reading (information only)\n\
+     uint64 seq\n\
+     # ticks since the reading arrived (0: fresh; the watchdog ramps the force down from it)\n\
+     uint32 age_ticks\n",
 );
 
 /// Schema of `/haptic/force`.
@@ -91,8 +95,13 @@ pub const FORCE_SCHEMA: (&str, &str) = (
      float64[3] world_force_n\n\
      float64[3] device_force_n\n\
      float64 engagement\n\
-     # bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid\n\
-     uint8 status\n",
+     # bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid,\n\
+     # 32 watchdog\n\
+     uint8 status\n\
+     # watchdog factor applied to the force (1: device samples fresh)\n\
+     float64 watchdog\n\
+     # local stiffness sent with the force, N/m, device frame, row-major 3x3\n\
+     float64[9] device_stiffness_n_per_m\n",
 );
 
 /// Schema of `/events`.
@@ -127,7 +136,15 @@ pub const DESCRIPTION_SCHEMA: (&str, &str) = (
      string script_name\n\
      string script_toml\n\
      string operator\n\
-     string[] state_fields\n",
+     string[] state_fields\n\
+     # wall-clock start of the session, ns since the Unix epoch (log times are start + tick time)\n\
+     uint64 start_time_ns\n\
+     # how the device was connected: script, hand, replay, udp:HOST:PORT, python\n\
+     string device_link\n\
+     float64 device_max_force_n\n\
+     float64 device_max_stiffness_n_per_m\n\
+     float64 device_workspace_radius_m\n\
+     string[] device_buttons\n",
 );
 
 /// Schema name and text of `/world/state` for a scene kind and its state fields.
@@ -178,6 +195,10 @@ pub struct DeviceInputMsg {
     pub buttons: u32,
     /// The real-time deadline of this tick was missed (zero force was sent).
     pub deadline_missed: bool,
+    /// The device's sequence number of the reading.
+    pub seq: u64,
+    /// Ticks since the reading arrived (0: fresh).
+    pub age_ticks: u32,
 }
 
 impl DeviceInputMsg {
@@ -187,7 +208,9 @@ impl DeviceInputMsg {
         w.u64(self.tick)
             .f64s(&self.position_m)
             .u32(self.buttons)
-            .bool(self.deadline_missed);
+            .bool(self.deadline_missed)
+            .u64(self.seq)
+            .u32(self.age_ticks);
         w.finish()
     }
 
@@ -199,6 +222,8 @@ impl DeviceInputMsg {
             position_m: r.vec3()?,
             buttons: r.u32()?,
             deadline_missed: r.bool()?,
+            seq: r.u64()?,
+            age_ticks: r.u32()?,
         };
         r.end()?;
         Ok(m)
@@ -218,6 +243,10 @@ pub struct ForceMsg {
     pub engagement: f64,
     /// Status bits (see `haptic::status`).
     pub status: u8,
+    /// Watchdog factor.
+    pub watchdog: f64,
+    /// Local stiffness sent, N/m, device frame, row-major 3×3.
+    pub device_stiffness_n_per_m: [f64; 9],
 }
 
 impl ForceMsg {
@@ -228,7 +257,9 @@ impl ForceMsg {
             .f64s(&self.world_force_n)
             .f64s(&self.device_force_n)
             .f64(self.engagement)
-            .u8(self.status);
+            .u8(self.status)
+            .f64(self.watchdog)
+            .f64s(&self.device_stiffness_n_per_m);
         w.finish()
     }
 
@@ -241,6 +272,14 @@ impl ForceMsg {
             device_force_n: r.vec3()?,
             engagement: r.f64()?,
             status: r.u8()?,
+            watchdog: r.f64()?,
+            device_stiffness_n_per_m: {
+                let mut k = [0.0; 9];
+                for v in &mut k {
+                    *v = r.f64()?;
+                }
+                k
+            },
         };
         r.end()?;
         Ok(m)
@@ -381,6 +420,37 @@ pub struct DescriptionMsg {
     pub operator: String,
     /// Names of the scene's state fields.
     pub state_fields: Vec<String>,
+    /// Wall-clock start of the session, ns since the Unix epoch (information; log times and
+    /// Foxglove timestamps are `start_time_ns + tick · period`).
+    pub start_time_ns: u64,
+    /// How the device was connected (`script`, `hand`, `udp:HOST:PORT`, `python`).
+    pub device_link: String,
+    /// The device's maximum force, N.
+    pub device_max_force_n: f64,
+    /// The device's maximum stiffness, N/m.
+    pub device_max_stiffness_n_per_m: f64,
+    /// The device's workspace radius, m.
+    pub device_workspace_radius_m: f64,
+    /// The device's button names.
+    pub device_buttons: Vec<String>,
+}
+
+impl DescriptionMsg {
+    /// The device specifications this session ran with.
+    pub fn device_specs(&self) -> crate::device::DeviceSpecs {
+        crate::device::DeviceSpecs {
+            name: self.device_model.clone().into(),
+            max_force_n: self.device_max_force_n,
+            max_stiffness_n_per_m: self.device_max_stiffness_n_per_m,
+            workspace_radius_m: self.device_workspace_radius_m,
+            button_names: self
+                .device_buttons
+                .iter()
+                .map(|b| std::borrow::Cow::Owned(b.clone()))
+                .collect::<Vec<_>>()
+                .into(),
+        }
+    }
 }
 
 impl DescriptionMsg {
@@ -397,15 +467,26 @@ impl DescriptionMsg {
             .string(&self.script_name)
             .string(&self.script_toml)
             .string(&self.operator)
-            .strings(self.state_fields.iter().map(|s| s.as_str()));
+            .strings(self.state_fields.iter().map(|s| s.as_str()))
+            .u64(self.start_time_ns)
+            .string(&self.device_link)
+            .f64(self.device_max_force_n)
+            .f64(self.device_max_stiffness_n_per_m)
+            .f64(self.device_workspace_radius_m)
+            .strings(self.device_buttons.iter().map(|s| s.as_str()));
         w.finish()
     }
 
-    /// Decodes from CDR.
+    /// Decodes from CDR. A recording of another format version is refused with
+    /// [`CdrError::Format`] naming the version it was recorded with.
     pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
         let mut r = CdrReader::new(b)?;
+        let format = r.string()?;
+        if format != FORMAT_VERSION {
+            return Err(CdrError::Format(format));
+        }
         let m = DescriptionMsg {
-            format: r.string()?,
+            format,
             scene_name: r.string()?,
             scene_kind: r.string()?,
             scene_toml: r.string()?,
@@ -416,6 +497,12 @@ impl DescriptionMsg {
             script_toml: r.string()?,
             operator: r.string()?,
             state_fields: r.strings()?,
+            start_time_ns: r.u64()?,
+            device_link: r.string()?,
+            device_max_force_n: r.f64()?,
+            device_max_stiffness_n_per_m: r.f64()?,
+            device_workspace_radius_m: r.f64()?,
+            device_buttons: r.strings()?,
         };
         r.end()?;
         Ok(m)
@@ -434,6 +521,8 @@ mod tests {
             device_force_n: [0.1, 0.2, 0.3],
             engagement: 0.5,
             status: 5,
+            watchdog: 0.25,
+            device_stiffness_n_per_m: [1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.0],
         };
         assert_eq!(ForceMsg::decode(&f.encode()), Ok(f));
         let i = DeviceInputMsg {
@@ -441,9 +530,12 @@ mod tests {
             position_m: [f64::NAN, 0.0, 1.0],
             buttons: 3,
             deadline_missed: true,
+            seq: 77,
+            age_ticks: 4,
         };
         let d = DeviceInputMsg::decode(&i.encode()).unwrap();
         assert!(d.position_m[0].is_nan() && d.buttons == 3 && d.deadline_missed);
+        assert_eq!((d.seq, d.age_ticks), (77, 4));
         let s = StateMsg {
             tick: 2,
             cursor_m: [1.0, 2.0, 3.0],

@@ -7,6 +7,7 @@ pub mod cdr;
 pub mod foxglove_out;
 pub mod messages;
 pub mod reader;
+pub mod sink;
 pub mod writer;
 
 use crate::device::DeviceSample;
@@ -31,7 +32,7 @@ pub struct OutMsg {
 pub struct TickMessages {
     /// Tick index.
     pub tick: u64,
-    /// Log time, ns from the session start (`tick · period`).
+    /// Log time, ns since the Unix epoch (`start + tick · period`).
     pub log_time_ns: u64,
     /// The messages, in the order they are written.
     pub msgs: Vec<OutMsg>,
@@ -41,6 +42,7 @@ pub struct TickMessages {
 /// compares exactly what was written).
 #[derive(Debug)]
 pub struct TickEncoder {
+    start_ns: u64,
     period_ns: u64,
     display_every: u64,
     display_scale: f64,
@@ -49,10 +51,12 @@ pub struct TickEncoder {
 }
 
 impl TickEncoder {
-    /// An encoder for the loop `l`.
-    pub fn new(l: &HapticLoop) -> Self {
+    /// An encoder for the loop `l` of a session that started at `start_ns` (ns since the Unix
+    /// epoch; log times are `start_ns + tick · period`).
+    pub fn new(l: &HapticLoop, start_ns: u64) -> Self {
         let c = l.config();
         TickEncoder {
+            start_ns,
             period_ns: c.period_ns(),
             display_every: u64::from(c.display_every),
             display_scale: c.display_scale,
@@ -61,9 +65,10 @@ impl TickEncoder {
         }
     }
 
-    /// Log time of tick `tick`, ns.
+    /// Log time of tick `tick`, ns since the Unix epoch.
     pub fn log_time_ns(&self, tick: u64) -> u64 {
-        tick.saturating_mul(self.period_ns)
+        self.start_ns
+            .saturating_add(tick.saturating_mul(self.period_ns))
     }
 
     /// The `/device/input` message of a tick.
@@ -75,6 +80,8 @@ impl TickEncoder {
                 position_m: sample.position_m,
                 buttons: sample.buttons.0,
                 deadline_missed,
+                seq: sample.seq,
+                age_ticks: sample.age_ticks,
             }
             .encode(),
         }
@@ -117,6 +124,8 @@ impl TickEncoder {
                 device_force_n: r.device_force_n,
                 engagement: r.engagement,
                 status: r.status,
+                watchdog: r.watchdog,
+                device_stiffness_n_per_m: r.device_stiffness_n_per_m,
             }
             .encode(),
         });

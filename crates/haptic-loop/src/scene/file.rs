@@ -18,6 +18,8 @@
 //! [loop]
 //! rate_hz = 1000                       # tick rate; 10^9 / rate_hz must be whole nanoseconds
 //! engage_s = 0.25                      # soft-engagement ramp at start
+//! watchdog_grace_s = 0.002             # a bridged device's sample may be this late at full force
+//! watchdog_timeout_s = 0.010           # ... and the force is zero this long after the last one
 //!
 //! [display]
 //! rate_hz = 50                         # Foxglove channels; must divide the tick rate
@@ -176,6 +178,11 @@ pub struct LoopSection {
     pub rate_hz: u32,
     /// Soft-engagement ramp at start (and after invalid input), s. Allowed: 0–10.
     pub engage_s: f64,
+    /// How long a bridged device's last sample is used at full force, s. Allowed: 0–0.1.
+    pub watchdog_grace_s: f64,
+    /// Time after the last sample at which the force has ramped to zero, s. Allowed: more than
+    /// `watchdog_grace_s` plus one tick, at most 1.
+    pub watchdog_timeout_s: f64,
 }
 
 impl Default for LoopSection {
@@ -183,6 +190,8 @@ impl Default for LoopSection {
         LoopSection {
             rate_hz: 1000,
             engage_s: 0.25,
+            watchdog_grace_s: 0.002,
+            watchdog_timeout_s: 0.010,
         }
     }
 }
@@ -250,6 +259,12 @@ impl SceneFile {
 
     /// Builds the loop configuration for device `model`, checking every common field.
     pub fn loop_config(&self, model: DeviceModel) -> Result<LoopConfig, SceneError> {
+        self.loop_config_for(model.specs().clone())
+    }
+
+    /// Builds the loop configuration for a device with `specs` (e.g. announced by a bridged
+    /// device), checking every common field.
+    pub fn loop_config_for(&self, specs: DeviceSpecs) -> Result<LoopConfig, SceneError> {
         let m = &self.mapping;
         check_range("mapping.workspace_scale", m.workspace_scale, 1e-12, 1e3)?;
         check_range("mapping.force_scale", m.force_scale, 1e-6, 1e18)?;
@@ -265,6 +280,12 @@ impl SceneFile {
             ));
         }
         check_range("loop.engage_s", l.engage_s, 0.0, 10.0)?;
+        check_range("loop.watchdog_grace_s", l.watchdog_grace_s, 0.0, 0.1)?;
+        let rate = f64::from(l.rate_hz);
+        let grace_ticks = (l.watchdog_grace_s * rate).round();
+        let min_timeout = (grace_ticks + 1.0) / rate;
+        check_range("loop.watchdog_timeout_s", l.watchdog_timeout_s, min_timeout, 1.0)?;
+        let timeout_ticks = (l.watchdog_timeout_s * rate).round().max(grace_ticks + 1.0);
         let d = &self.display;
         if d.rate_hz == 0 || d.rate_hz > l.rate_hz || l.rate_hz % d.rate_hz != 0 {
             return Err(out_of_range(
@@ -274,7 +295,6 @@ impl SceneFile {
             ));
         }
         check_range("display.scale", d.scale, 1e-3, 1e12)?;
-        let specs: DeviceSpecs = model.specs().clone();
         Ok(LoopConfig {
             rate_hz: l.rate_hz,
             engage_ticks: (l.engage_s * f64::from(l.rate_hz)).round() as u64,
@@ -286,6 +306,8 @@ impl SceneFile {
                 origin_m: m.origin_m,
             },
             specs,
+            watchdog_grace_ticks: grace_ticks as u32,
+            watchdog_timeout_ticks: timeout_ticks as u32,
         })
     }
 }
@@ -304,7 +326,18 @@ pub struct LoadedScene {
 pub fn load_scene(text: &str, device: Option<DeviceModel>) -> Result<LoadedScene, SceneError> {
     let file = SceneFile::parse(text)?;
     let model = device.unwrap_or(file.device.model);
-    let config = file.loop_config(model)?;
+    let specs = model.specs().clone();
+    build(file, specs)
+}
+
+/// Parses, validates and builds a scene for a device with `specs` (a bridged device announces
+/// its own; the file's `[device] model` is then ignored).
+pub fn load_scene_for(text: &str, specs: DeviceSpecs) -> Result<LoadedScene, SceneError> {
+    build(SceneFile::parse(text)?, specs)
+}
+
+fn build(file: SceneFile, specs: DeviceSpecs) -> Result<LoadedScene, SceneError> {
+    let config = file.loop_config_for(specs)?;
     let cap = config.world_stiffness_cap_n_per_m();
     let dt = 1.0 / f64::from(config.rate_hz);
     let missing = |kind: &str| SceneError::Kind {
@@ -338,7 +371,7 @@ pub fn load_scene(text: &str, device: Option<DeviceModel>) -> Result<LoadedScene
                 cap,
                 fmax,
                 dt,
-                config.specs.button_names,
+                &config.specs.button_strs(),
             )?)
         }
         other => {

@@ -14,7 +14,7 @@ pub mod wall;
 use crate::device::Buttons;
 use crate::vec3::Vec3;
 
-pub use file::{SceneError, SceneFile, load_scene};
+pub use file::{SceneError, SceneFile, load_scene, load_scene_for};
 
 /// What the loop tells the scene each tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,6 +58,9 @@ pub struct SceneOutput {
     /// Local stiffness of the rendered force field this tick, world frame, N/m (0 when no spring
     /// acts). The loop checks it against the cap it gave the scene.
     pub stiffness_n_per_m: f64,
+    /// Unit vector along which `stiffness_n_per_m` acts (a plane constraint such as a wall:
+    /// `K = k a aᵀ`); `None`: isotropic (`K = k I`, a spring to a proxy point).
+    pub stiffness_axis: Option<Vec3>,
     /// Events raised this tick, in order.
     pub events: Vec<Event>,
 }
@@ -67,6 +70,7 @@ impl SceneOutput {
     pub fn clear(&mut self) {
         self.force_n = [0.0; 3];
         self.stiffness_n_per_m = 0.0;
+        self.stiffness_axis = None;
         self.events.clear();
     }
 }

@@ -163,6 +163,7 @@ impl Scene for WallScene {
             let mag = (self.stiffness * d - self.damping * v_n).max(0.0);
             self.force_n = vec3::scale(self.normal, mag);
             out.stiffness_n_per_m = self.stiffness;
+            out.stiffness_axis = Some(self.normal);
         } else {
             self.force_n = [0.0; 3];
         }

@@ -1,0 +1,271 @@
+//! A stand-in device process (`nanohaptics fake-device`): plays a script, rigidly or through
+//! the simulated hand, over the bridge, with injectable loss, jitter, latency and an outage;
+//! measures the round trip of every answered sample.
+//!
+//! The device runs its own servo clock at the session's tick rate (from the welcome). Each
+//! period it reads its (simulated) stylus, sends a sample, and renders the last force that came
+//! back. A receiver thread timestamps each reply on arrival, so the round trip is measured from
+//! the send of a sample to the arrival of its answer.
+
+use super::protocol::{Packet, Sample};
+use crate::device::script::Script;
+use crate::device::{
+    DeviceError, DeviceModel, ForceCommand, HapticDevice, OperatorParams, ScriptedDevice,
+    SimulatedOperator, TickTime,
+};
+use crate::pacing::{Pacer, Percentiles};
+use crate::vec3;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::BTreeMap;
+use std::net::{SocketAddr, UdpSocket};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// What the fake device does.
+#[derive(Clone, Debug)]
+pub struct FakeConfig {
+    /// The simulator's bridge address.
+    pub target: SocketAddr,
+    /// The device model it pretends to be (its specifications go in the hello).
+    pub model: DeviceModel,
+    /// The stylus motion.
+    pub script: Script,
+    /// A simulated hand pushed by the rendered force (`None`: a rigid stylus).
+    pub hand: Option<OperatorParams>,
+    /// Probability that a sample is lost, 0–1.
+    pub loss: f64,
+    /// Extra delay of each sample, uniform in 0–`jitter_s`, s (samples may overtake each other).
+    pub jitter_s: f64,
+    /// Fixed delay of each sample, s.
+    pub latency_s: f64,
+    /// Seed of the loss and jitter draws.
+    pub seed: u64,
+    /// How long to play, s (default: the script's duration).
+    pub seconds: Option<f64>,
+    /// The device goes silent from `.0` s for `.1` s (vanishes and comes back).
+    pub outage: Option<(f64, f64)>,
+    /// How long to wait for the welcome, s.
+    pub wait_s: f64,
+    /// Say goodbye at the end (the session then ends too).
+    pub bye: bool,
+}
+
+/// What the fake device measured.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FakeReport {
+    /// Servo periods played.
+    pub ticks: u64,
+    /// Samples sent.
+    pub sent: u64,
+    /// Samples dropped on purpose (`loss`).
+    pub dropped: u64,
+    /// Samples not sent during the outage.
+    pub silent: u64,
+    /// Force packets received.
+    pub replies: u64,
+    /// Round trip from sending a sample to receiving its answer, ns.
+    pub round_trip: Percentiles,
+    /// Largest force received, N.
+    pub max_force_n: f64,
+    /// Force received after the outage began, as (ms after the last sample sent, N), one entry
+    /// per reply until it reached zero.
+    pub outage_force: Vec<(f64, f64)>,
+    /// Whether every force received was finite and within the device's maximum.
+    pub forces_within_limits: bool,
+}
+
+struct Reply {
+    seq: u64,
+    at: Instant,
+    force_n: [f64; 3],
+}
+
+/// Runs the fake device to the end; `stop` ends it early.
+pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeReport, DeviceError> {
+    let specs = cfg.model.specs().clone();
+    let link = |what: &str, e: std::io::Error| DeviceError::Link(format!("{what}: {e}"));
+    let bind: SocketAddr = if cfg.target.is_ipv4() {
+        "0.0.0.0:0"
+    } else {
+        "[::]:0"
+    }
+    .parse()
+    .map_err(|_| DeviceError::Link("bad local address".into()))?;
+    let socket = UdpSocket::bind(bind).map_err(|e| link("cannot bind", e))?;
+    socket
+        .set_read_timeout(Some(Duration::from_millis(50)))
+        .map_err(|e| link("cannot configure the socket", e))?;
+    // 1. Hello until welcome.
+    let hello = Packet::Hello {
+        rate_hz: 1000,
+        specs: specs.clone(),
+    }
+    .encode();
+    let deadline = Instant::now() + Duration::from_secs_f64(cfg.wait_s.max(0.0));
+    let mut buf = [0u8; 2048];
+    let rate_hz = loop {
+        if Instant::now() > deadline || stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            return Err(DeviceError::Link(format!(
+                "no welcome from {} within {} s",
+                cfg.target, cfg.wait_s
+            )));
+        }
+        // ICMP "unreachable" before the simulator binds: retry.
+        let _ = socket.send_to(&hello, cfg.target);
+        if let Ok((n, from)) = socket.recv_from(&mut buf) {
+            if from == cfg.target {
+                if let Ok(Packet::Welcome { rate_hz, .. }) = Packet::decode(&buf[..n]) {
+                    break rate_hz;
+                }
+            }
+        }
+    };
+    if !(100..=10_000).contains(&rate_hz) {
+        return Err(DeviceError::Link(format!(
+            "the simulator asked for {rate_hz} Hz (this fake device plays 100–10000 Hz)"
+        )));
+    }
+    // 2. A receiver thread timestamps each reply.
+    let replies: Arc<Mutex<Vec<Reply>>> = Arc::new(Mutex::new(Vec::with_capacity(1024)));
+    let done = Arc::new(AtomicBool::new(false));
+    let rx = socket.try_clone().map_err(|e| link("cannot clone the socket", e))?;
+    let (r2, d2, target) = (replies.clone(), done.clone(), cfg.target);
+    let thread = std::thread::Builder::new()
+        .name("fake-rx".into())
+        .spawn(move || {
+            let mut buf = [0u8; 2048];
+            while !d2.load(Ordering::Relaxed) {
+                if let Ok((n, from)) = rx.recv_from(&mut buf) {
+                    let at = Instant::now();
+                    if from != target {
+                        continue;
+                    }
+                    match Packet::decode(&buf[..n]) {
+                        Ok(Packet::Force(f)) => {
+                            if let Ok(mut v) = r2.lock() {
+                                v.push(Reply {
+                                    seq: f.seq,
+                                    at,
+                                    force_n: f.force_n,
+                                });
+                            }
+                        }
+                        Ok(Packet::Bye { .. }) => {
+                            d2.store(true, Ordering::Relaxed);
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        })
+        .map_err(|e| link("cannot start the receiver", e))?;
+    // 3. The servo loop.
+    let mut dev: Box<dyn HapticDevice> = match cfg.hand {
+        Some(p) => Box::new(SimulatedOperator::new(cfg.script.clone(), specs.clone(), p)),
+        None => Box::new(ScriptedDevice::new(cfg.script.clone(), specs.clone())),
+    };
+    let seconds = cfg.seconds.unwrap_or(cfg.script.duration_s);
+    let ticks = (seconds * f64::from(rate_hz)).round().max(0.0) as u64;
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let pacer = Pacer::new(1_000_000_000 / u64::from(rate_hz));
+    let start = Instant::now();
+    let mut pending: BTreeMap<(u64, u64), Vec<u8>> = BTreeMap::new();
+    let mut sent_at: BTreeMap<u64, Instant> = BTreeMap::new();
+    let mut rtt = Vec::with_capacity(ticks as usize);
+    let mut rep = FakeReport {
+        forces_within_limits: true,
+        ..Default::default()
+    };
+    let mut last_sent: Option<Instant> = None;
+    let mut outage_begun = false;
+    let mut force = [0.0; 3];
+    for k in 0..ticks {
+        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) || done.load(Ordering::Relaxed) {
+            break;
+        }
+        pacer.wait_for(k);
+        rep.ticks += 1;
+        let t = TickTime::new(k, rate_hz);
+        dev.set_force(&ForceCommand {
+            force_n: force,
+            ..Default::default()
+        })?;
+        let s = dev.sample(t)?;
+        let silent = cfg
+            .outage
+            .is_some_and(|(a, d)| t.time_s >= a && t.time_s < a + d);
+        if silent {
+            rep.silent += 1;
+            outage_begun = true;
+        } else if cfg.loss > 0.0 && rng.random::<f64>() < cfg.loss {
+            rep.dropped += 1;
+        } else {
+            let delay = cfg.latency_s
+                + if cfg.jitter_s > 0.0 {
+                    rng.random::<f64>() * cfg.jitter_s
+                } else {
+                    0.0
+                };
+            let pkt = Packet::Sample(Sample {
+                seq: k,
+                device_time_ns: start.elapsed().as_nanos() as u64,
+                position_m: s.position_m,
+                buttons: s.buttons.0,
+            })
+            .encode();
+            let due = start.elapsed().as_nanos() as u64 + (delay * 1e9) as u64;
+            pending.insert((due, k), pkt);
+        }
+        // Send what is due (in due order: jitter may reorder samples).
+        let now_ns = start.elapsed().as_nanos() as u64;
+        while let Some(entry) = pending.first_entry() {
+            if entry.key().0 > now_ns {
+                break;
+            }
+            let ((_, seq), pkt) = entry.remove_entry();
+            let at = Instant::now();
+            if socket.send_to(&pkt, cfg.target).is_ok() {
+                rep.sent += 1;
+                sent_at.insert(seq, at);
+                last_sent = Some(at);
+            }
+        }
+        // Replies that arrived since the last period.
+        let got: Vec<Reply> = replies
+            .lock()
+            .map(|mut v| std::mem::take(&mut *v))
+            .unwrap_or_default();
+        for r in got {
+            rep.replies += 1;
+            let mag = vec3::norm(r.force_n);
+            if !vec3::is_finite(r.force_n) || mag > specs.max_force_n {
+                rep.forces_within_limits = false;
+            }
+            rep.max_force_n = rep.max_force_n.max(mag);
+            if let Some(t0) = sent_at.remove(&r.seq) {
+                rtt.push(r.at.duration_since(t0).as_nanos() as u64);
+            }
+            if outage_begun && rep.outage_force.last().is_none_or(|l| l.1 > 0.0) {
+                if let Some(ls) = last_sent {
+                    let ms = r.at.saturating_duration_since(ls).as_secs_f64() * 1e3;
+                    rep.outage_force.push((ms, mag));
+                }
+            }
+            force = r.force_n;
+        }
+        // Forget sends never answered (lost replies) after a second.
+        if sent_at.len() > 4 * rate_hz as usize {
+            let keep = sent_at.split_off(&k.saturating_sub(u64::from(rate_hz)));
+            sent_at = keep;
+        }
+    }
+    if cfg.bye {
+        let _ = socket.send_to(&Packet::Bye { reason: 0 }.encode(), cfg.target);
+    }
+    done.store(true, Ordering::Relaxed);
+    let _ = thread.join();
+    rep.round_trip = Percentiles::of(&rtt);
+    Ok(rep)
+}

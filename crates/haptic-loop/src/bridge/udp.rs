@@ -1,0 +1,417 @@
+//! The simulator's side of the bridge: a [`HapticDevice`] whose readings arrive over UDP.
+//!
+//! A receiver thread blocks on the socket, checks every datagram (magic, version, type, length,
+//! sender, sequence number) and queues fresh samples; the tick waits on a condition variable
+//! for the next sample, so a tick starts as soon as its sample arrives (the device's samples
+//! are the clock). When no sample comes within 1.5 periods of the last tick, the tick runs on
+//! the last sample with its age in ticks, and the loop's watchdog ramps the force down from
+//! that age. Every fault is counted, never fatal: duplicates, reordered and malformed packets,
+//! oversized datagrams, packets from a stranger, gaps in the sequence.
+
+use super::protocol::{ForceReply, Packet, Sample};
+use crate::device::{
+    Buttons, DeviceError, DeviceSample, DeviceSpecs, FALCON, ForceCommand, HapticDevice, TickTime,
+};
+use std::collections::VecDeque;
+use std::net::{SocketAddr, UdpSocket};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Where and how the simulator listens for a device.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BridgeConfig {
+    /// Address to bind (default loopback: `127.0.0.1:PORT`).
+    pub bind: SocketAddr,
+    /// How long to wait for the device's hello (and its first sample), s.
+    pub wait_s: f64,
+    /// The session's tick rate, Hz (sent in the welcome).
+    pub rate_hz: u32,
+    /// Scene name (sent in the welcome).
+    pub scene: String,
+    /// Session start, ns since the Unix epoch (sent in the welcome).
+    pub start_time_ns: u64,
+}
+
+impl BridgeConfig {
+    /// Parses `udp:HOST:PORT` (the `--device` option).
+    pub fn parse(spec: &str) -> Result<Self, DeviceError> {
+        let addr = spec.strip_prefix("udp:").ok_or_else(|| {
+            DeviceError::Link(format!(
+                "--device `{spec}`: expected udp:HOST:PORT, e.g. udp:127.0.0.1:9870"
+            ))
+        })?;
+        let bind: SocketAddr = addr.parse().map_err(|_| {
+            DeviceError::Link(format!(
+                "--device `{spec}`: `{addr}` is not an IP address and port (e.g. 127.0.0.1:9870)"
+            ))
+        })?;
+        Ok(BridgeConfig {
+            bind,
+            wait_s: 120.0,
+            rate_hz: 1000,
+            scene: String::new(),
+            start_time_ns: 0,
+        })
+    }
+}
+
+/// Counters of the link, in the order they are reported.
+#[derive(Clone, Copy, Debug, Default)]
+struct Counters {
+    received: u64,
+    duplicate: u64,
+    reordered: u64,
+    gap_lost: u64,
+    malformed: u64,
+    oversized: u64,
+    stranger: u64,
+    superseded: u64,
+    hellos: u64,
+    send_errors: u64,
+    stale_ticks: u64,
+}
+
+#[derive(Default)]
+struct State {
+    peer: Option<SocketAddr>,
+    specs: Option<DeviceSpecs>,
+    last_seq: Option<u64>,
+    queue: VecDeque<Sample>,
+    ended: bool,
+    error: Option<String>,
+    c: Counters,
+}
+
+struct Shared {
+    state: Mutex<State>,
+    arrived: Condvar,
+    stop: AtomicBool,
+}
+
+/// A device in another process, over UDP.
+pub struct UdpDevice {
+    config: BridgeConfig,
+    specs: DeviceSpecs,
+    socket: Option<UdpSocket>,
+    shared: Arc<Shared>,
+    thread: Option<JoinHandle<()>>,
+    last: Option<Sample>,
+    age: u32,
+    prev_start: Option<Instant>,
+    peer: Option<SocketAddr>,
+}
+
+/// Most samples waiting for a tick; older ones are dropped (counted as superseded) so latency
+/// cannot build up.
+const QUEUE: usize = 4;
+
+impl UdpDevice {
+    /// A bridged device; nothing is bound before [`HapticDevice::open`].
+    pub fn new(config: BridgeConfig) -> Self {
+        UdpDevice {
+            config,
+            specs: FALCON,
+            socket: None,
+            shared: Arc::new(Shared {
+                state: Mutex::new(State::default()),
+                arrived: Condvar::new(),
+                stop: AtomicBool::new(false),
+            }),
+            thread: None,
+            last: None,
+            age: 0,
+            prev_start: None,
+            peer: None,
+        }
+    }
+
+    /// The address the socket is bound to (after `open`).
+    pub fn local_addr(&self) -> Option<SocketAddr> {
+        self.socket.as_ref().and_then(|s| s.local_addr().ok())
+    }
+
+    fn lock(&self) -> Result<std::sync::MutexGuard<'_, State>, DeviceError> {
+        self.shared
+            .state
+            .lock()
+            .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))
+    }
+
+    fn welcome(&self) -> Vec<u8> {
+        Packet::Welcome {
+            rate_hz: self.config.rate_hz,
+            start_time_ns: self.config.start_time_ns,
+            scene: self.config.scene.clone(),
+        }
+        .encode()
+    }
+}
+
+fn receive(socket: UdpSocket, shared: Arc<Shared>, welcome: Vec<u8>) {
+    let mut buf = vec![0u8; 2048];
+    while !shared.stop.load(Ordering::Relaxed) {
+        let (n, from) = match socket.recv_from(&mut buf) {
+            Ok(x) => x,
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                continue;
+            }
+            Err(e) => {
+                // ICMP "port unreachable" from a vanished device surfaces here on some systems.
+                if e.kind() == std::io::ErrorKind::ConnectionRefused {
+                    continue;
+                }
+                if let Ok(mut st) = shared.state.lock() {
+                    st.error = Some(e.to_string());
+                }
+                shared.arrived.notify_all();
+                return;
+            }
+        };
+        let packet = Packet::decode(&buf[..n]);
+        let Ok(mut st) = shared.state.lock() else {
+            return;
+        };
+        match packet {
+            Err(super::protocol::ProtocolError::Oversized(_)) => st.c.oversized += 1,
+            Err(_) => st.c.malformed += 1,
+            Ok(Packet::Hello { specs, .. }) => {
+                // A first hello, a repeated one, or a device that restarted: welcome it and
+                // accept its new numbering. Its limits cannot change during a session.
+                if st.specs.as_ref().is_some_and(|s| *s != specs) {
+                    st.c.stranger += 1;
+                } else {
+                    st.c.hellos += 1;
+                    st.specs = Some(specs);
+                    st.peer = Some(from);
+                    st.last_seq = None;
+                    let _ = socket.send_to(&welcome, from);
+                    drop(st);
+                    shared.arrived.notify_all();
+                    continue;
+                }
+            }
+            Ok(Packet::Sample(s)) if st.peer == Some(from) => match st.last_seq {
+                Some(l) if s.seq == l => st.c.duplicate += 1,
+                Some(l) if s.seq < l => st.c.reordered += 1,
+                last => {
+                    if let Some(l) = last {
+                        st.c.gap_lost += s.seq - l - 1;
+                    }
+                    st.last_seq = Some(s.seq);
+                    st.c.received += 1;
+                    if st.queue.len() >= QUEUE {
+                        st.queue.pop_front();
+                        st.c.superseded += 1;
+                    }
+                    st.queue.push_back(s);
+                    drop(st);
+                    shared.arrived.notify_all();
+                    continue;
+                }
+            },
+            Ok(Packet::Bye { .. }) if st.peer == Some(from) => {
+                st.ended = true;
+                drop(st);
+                shared.arrived.notify_all();
+                continue;
+            }
+            Ok(Packet::Sample(_) | Packet::Bye { .. }) => st.c.stranger += 1,
+            // Packets only the simulator sends.
+            Ok(Packet::Welcome { .. } | Packet::Force(_)) => st.c.malformed += 1,
+        }
+    }
+}
+
+impl HapticDevice for UdpDevice {
+    fn specs(&self) -> &DeviceSpecs {
+        &self.specs
+    }
+
+    fn open(&mut self) -> Result<(), DeviceError> {
+        let link = |what: &str, e: std::io::Error| {
+            DeviceError::Link(format!("{what} {}: {e}", self.config.bind))
+        };
+        let socket = UdpSocket::bind(self.config.bind).map_err(|e| link("cannot bind", e))?;
+        // The receiver wakes at least every 100 ms to notice the end of the session.
+        socket
+            .set_read_timeout(Some(Duration::from_millis(100)))
+            .map_err(|e| link("cannot configure", e))?;
+        let rx = socket.try_clone().map_err(|e| link("cannot clone", e))?;
+        let shared = self.shared.clone();
+        let welcome = self.welcome();
+        self.thread = Some(
+            std::thread::Builder::new()
+                .name("bridge-rx".into())
+                .spawn(move || receive(rx, shared, welcome))
+                .map_err(|e| link("cannot start the receiver for", e))?,
+        );
+        self.socket = Some(socket);
+        let deadline = Instant::now() + Duration::from_secs_f64(self.config.wait_s.max(0.0));
+        let mut st = self.lock()?;
+        while st.specs.is_none() {
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(DeviceError::Link(format!(
+                    "no device said hello on udp:{} within {} s",
+                    self.config.bind, self.config.wait_s
+                )));
+            }
+            st = self
+                .shared
+                .arrived
+                .wait_timeout(st, deadline - now)
+                .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))?
+                .0;
+        }
+        let specs = st.specs.clone();
+        drop(st);
+        if let Some(s) = specs {
+            self.specs = s;
+        }
+        Ok(())
+    }
+
+    fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
+        let period = Duration::from_secs_f64(time.dt_s);
+        // The first tick waits for the first sample; later ones at most 1.5 periods after the
+        // previous tick (one period once the link is already stale).
+        let deadline = match self.prev_start {
+            None => Instant::now() + Duration::from_secs_f64(self.config.wait_s.max(0.0)),
+            Some(p) if self.age == 0 => p + period + period / 2,
+            Some(p) => p + period,
+        };
+        let earliest = self.prev_start.map(|p| p + period / 2);
+        let shared = self.shared.clone();
+        let mut st = shared
+            .state
+            .lock()
+            .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))?;
+        loop {
+            if let Some(e) = st.error.take() {
+                return Err(DeviceError::Link(format!("receiving: {e}")));
+            }
+            let now = Instant::now();
+            let early = earliest.is_some_and(|e| now < e);
+            if !st.queue.is_empty() && !early {
+                break;
+            }
+            if st.ended && st.queue.is_empty() {
+                return Err(DeviceError::Ended);
+            }
+            if now >= deadline {
+                break;
+            }
+            let until = match earliest {
+                Some(e) if early && !st.queue.is_empty() => e,
+                _ => deadline,
+            };
+            st = shared
+                .arrived
+                .wait_timeout(st, until.saturating_duration_since(now))
+                .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))?
+                .0;
+        }
+        self.peer = st.peer;
+        let fresh = st.queue.pop_front();
+        if fresh.is_none() {
+            st.c.stale_ticks += 1;
+        }
+        drop(st);
+        self.prev_start = Some(Instant::now());
+        match fresh {
+            Some(s) => {
+                self.last = Some(s);
+                self.age = 0;
+            }
+            None if self.last.is_none() => {
+                return Err(DeviceError::Link(format!(
+                    "no sample from the device within {} s of its hello",
+                    self.config.wait_s
+                )));
+            }
+            None => self.age = self.age.saturating_add(1),
+        }
+        let s = self.last.unwrap_or(Sample {
+            seq: 0,
+            device_time_ns: 0,
+            position_m: [0.0; 3],
+            buttons: 0,
+        });
+        Ok(DeviceSample {
+            position_m: s.position_m,
+            buttons: Buttons(s.buttons),
+            seq: s.seq,
+            age_ticks: self.age,
+        })
+    }
+
+    fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
+        if let (Some(sock), Some(peer)) = (&self.socket, self.peer) {
+            let p = Packet::Force(ForceReply {
+                seq: cmd.seq,
+                tick: cmd.tick,
+                force_n: cmd.force_n,
+                stiffness_n_per_m: cmd.stiffness_n_per_m,
+                status: cmd.status,
+            });
+            if sock.send_to(&p.encode(), peer).is_err() {
+                if let Ok(mut st) = self.shared.state.lock() {
+                    st.c.send_errors += 1;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn close(&mut self) -> Result<(), DeviceError> {
+        if let (Some(sock), Some(peer)) = (&self.socket, self.peer) {
+            let zero = Packet::Force(ForceReply {
+                seq: self.last.map_or(0, |s| s.seq),
+                tick: u64::MAX,
+                force_n: [0.0; 3],
+                stiffness_n_per_m: [0.0; 9],
+                status: 0,
+            });
+            let _ = sock.send_to(&zero.encode(), peer);
+            let _ = sock.send_to(&Packet::Bye { reason: 0 }.encode(), peer);
+        }
+        self.shared.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+        Ok(())
+    }
+
+    fn link_counters(&self) -> Vec<(&'static str, u64)> {
+        let c = self.shared.state.lock().map(|s| s.c).unwrap_or_default();
+        vec![
+            ("received", c.received),
+            ("duplicate", c.duplicate),
+            ("reordered", c.reordered),
+            ("lost_in_transit", c.gap_lost),
+            ("malformed", c.malformed),
+            ("oversized", c.oversized),
+            ("stranger", c.stranger),
+            ("superseded", c.superseded),
+            ("hellos", c.hellos),
+            ("send_errors", c.send_errors),
+            ("stale_ticks", c.stale_ticks),
+        ]
+    }
+}
+
+impl Drop for UdpDevice {
+    fn drop(&mut self) {
+        self.shared.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}

@@ -1,0 +1,349 @@
+//! The live view: a Foxglove WebSocket server (the `foxglove` crate's `websocket` feature) that
+//! publishes a running session, as a sink of the runner.
+//!
+//! The servo tick never waits on it. At plot rate (default 200 Hz) the tick copies a small
+//! snapshot (cursor, forces, factors, status) and, at display rate (default 50 Hz), the scene's
+//! primitives, into a local buffer that it hands to a publisher thread with `try_lock` (never
+//! blocking, never waking a thread). The publisher thread wakes every 5 ms, turns the snapshots
+//! into Foxglove messages and logs them to the server's channels:
+//!
+//! | topic             | schema                     | rate          |
+//! |-------------------|----------------------------|---------------|
+//! | `/foxglove/scene` | `foxglove.SceneUpdate`     | display rate  |
+//! | `/foxglove/tf`    | `foxglove.FrameTransform`  | display rate  |
+//! | `/foxglove/log`   | `foxglove.Log`             | on events     |
+//! | `/live/state`     | `nanohaptics.LiveState` (JSON) | plot rate |
+//!
+//! Timestamps are the session's start (wall clock, from the description) plus the tick time,
+//! so Foxglove shows the real date. When the publisher falls behind, the oldest snapshots are
+//! dropped and counted (`dropped` in `/live/state` and in the summary).
+
+use crate::haptic::HapticLoop;
+use crate::pacing::TickStats;
+use crate::record::foxglove_out;
+use crate::runner::{SessionInfo, Sink, TickView};
+use crate::scene::{Event, Primitive};
+use crate::session::SessionError;
+use crate::vec3::Vec3;
+use foxglove::schemas::{FrameTransform, Log, SceneUpdate};
+use foxglove::{Context, PartialMetadata, RawChannel, Schema, WebSocketServerHandle};
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// Where the live view listens and how often it publishes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LiveConfig {
+    /// Address of the WebSocket server (default loopback).
+    pub bind: SocketAddr,
+    /// Rate of the 3D scene, Hz (≤ the tick rate; the nearest divisor of it is used).
+    pub display_hz: u32,
+    /// Rate of the per-tick state for plots, Hz (same rule).
+    pub plot_hz: u32,
+}
+
+impl LiveConfig {
+    /// Parses `ws:HOST:PORT` (the `--live` option), with the default rates (50 Hz scene, 200 Hz
+    /// plots).
+    pub fn parse(spec: &str) -> Result<Self, SessionError> {
+        let addr = spec.strip_prefix("ws:").ok_or_else(|| {
+            SessionError::Option(format!(
+                "--live `{spec}`: expected ws:HOST:PORT, e.g. ws:127.0.0.1:8765"
+            ))
+        })?;
+        let bind = addr.parse().map_err(|_| {
+            SessionError::Option(format!(
+                "--live `{spec}`: `{addr}` is not an IP address and port (e.g. 127.0.0.1:8765)"
+            ))
+        })?;
+        Ok(LiveConfig {
+            bind,
+            display_hz: 50,
+            plot_hz: 200,
+        })
+    }
+}
+
+/// What the live view did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LiveSummary {
+    /// Scene updates published.
+    pub scenes: u64,
+    /// State snapshots published.
+    pub states: u64,
+    /// Log lines published.
+    pub logs: u64,
+    /// Snapshots dropped because the publisher fell behind.
+    pub dropped: u64,
+    /// Clients connected at the end.
+    pub clients_at_end: usize,
+}
+
+struct Snapshot {
+    tick: u64,
+    cursor_m: Vec3,
+    world_force_n: Vec3,
+    device_force_n: Vec3,
+    engagement: f64,
+    watchdog: f64,
+    status: u8,
+    age_ticks: u32,
+    prims: Option<Vec<Primitive>>,
+    events: Vec<Event>,
+}
+
+struct Shared {
+    queue: Mutex<Vec<Snapshot>>,
+    done: AtomicBool,
+    dropped: AtomicU64,
+    scenes: AtomicU64,
+    states: AtomicU64,
+    logs: AtomicU64,
+}
+
+/// Most snapshots waiting for the publisher; beyond, the oldest are dropped.
+const CAP: usize = 2048;
+
+/// The live Foxglove view of a session.
+pub struct LiveSink {
+    config: LiveConfig,
+    server: Option<WebSocketServerHandle>,
+    ctx: Arc<Context>,
+    shared: Arc<Shared>,
+    local: Vec<Snapshot>,
+    thread: Option<JoinHandle<()>>,
+    display_every: u64,
+    plot_every: u64,
+}
+
+impl LiveSink {
+    /// Starts the WebSocket server (clients may connect before the first tick).
+    pub fn new(config: LiveConfig) -> Result<Self, SessionError> {
+        let ctx = Context::new();
+        let server = ctx
+            .websocket_server()
+            .name("nanohaptics")
+            .bind(config.bind.ip().to_string(), config.bind.port())
+            .start_blocking()
+            .map_err(|e| SessionError::Live(format!("cannot serve on ws:{}: {e}", config.bind)))?;
+        Ok(LiveSink {
+            config,
+            server: Some(server),
+            ctx,
+            shared: Arc::new(Shared {
+                queue: Mutex::new(Vec::with_capacity(CAP)),
+                done: AtomicBool::new(false),
+                dropped: AtomicU64::new(0),
+                scenes: AtomicU64::new(0),
+                states: AtomicU64::new(0),
+                logs: AtomicU64::new(0),
+            }),
+            local: Vec::with_capacity(64),
+            thread: None,
+            display_every: 1,
+            plot_every: 1,
+        })
+    }
+
+    /// The port the server listens on (useful with port 0).
+    pub fn port(&self) -> Option<u16> {
+        self.server.as_ref().map(|s| s.port())
+    }
+
+    /// What was published so far.
+    pub fn summary(&self) -> LiveSummary {
+        let s = &self.shared;
+        LiveSummary {
+            scenes: s.scenes.load(Ordering::Relaxed),
+            states: s.states.load(Ordering::Relaxed),
+            logs: s.logs.load(Ordering::Relaxed),
+            dropped: s.dropped.load(Ordering::Relaxed),
+            clients_at_end: self.server.as_ref().map_or(0, |h| h.client_count()),
+        }
+    }
+
+    fn hand_over(&mut self) {
+        if let Ok(mut q) = self.shared.queue.try_lock() {
+            q.append(&mut self.local);
+            if q.len() > CAP {
+                let extra = q.len() - CAP;
+                q.drain(..extra);
+                self.shared
+                    .dropped
+                    .fetch_add(extra as u64, Ordering::Relaxed);
+            }
+        } else if self.local.len() > CAP {
+            let extra = self.local.len() - CAP;
+            self.local.drain(..extra);
+            self.shared
+                .dropped
+                .fetch_add(extra as u64, Ordering::Relaxed);
+        }
+    }
+}
+
+/// Tick-rate divisor nearest to `rate / hz` (at least 1).
+fn every(rate_hz: u32, hz: u32) -> u64 {
+    u64::from((rate_hz / hz.clamp(1, rate_hz.max(1))).max(1))
+}
+
+/// JSON schema of `/live/state`.
+const STATE_SCHEMA: &str = r#"{"type":"object","properties":{
+"tick":{"type":"integer"},"time_s":{"type":"number"},
+"cursor_m":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}},
+"world_force_n":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}},
+"device_force_n":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}},
+"device_force_norm_n":{"type":"number"},"engagement":{"type":"number"},"watchdog":{"type":"number"},
+"status":{"type":"integer"},"sample_age_ticks":{"type":"integer"},"dropped":{"type":"integer"}}}"#;
+
+fn xyz(v: Vec3) -> serde_json::Value {
+    serde_json::json!({"x": v[0], "y": v[1], "z": v[2]})
+}
+
+struct Channels {
+    scene: foxglove::Channel<SceneUpdate>,
+    tf: foxglove::Channel<FrameTransform>,
+    log: foxglove::Channel<Log>,
+    state: Arc<RawChannel>,
+}
+
+fn publish(
+    shared: Arc<Shared>,
+    ch: Channels,
+    start_ns: u64,
+    period_ns: u64,
+    rate_hz: u32,
+    scale: f64,
+) {
+    let mut batch = Vec::with_capacity(CAP);
+    loop {
+        let done = shared.done.load(Ordering::Acquire);
+        if let Ok(mut q) = shared.queue.lock() {
+            std::mem::swap(&mut *q, &mut batch);
+        }
+        for s in batch.drain(..) {
+            let t_ns = start_ns.saturating_add(s.tick.saturating_mul(period_ns));
+            let meta = PartialMetadata::with_log_time(t_ns);
+            if let Some(prims) = &s.prims {
+                let u = foxglove_out::scene_update(prims, scale, t_ns);
+                ch.scene.log_with_meta(&u, meta);
+                let tf = foxglove_out::cursor_transform(s.cursor_m, scale, t_ns);
+                ch.tf.log_with_meta(&tf, meta);
+                shared.scenes.fetch_add(1, Ordering::Relaxed);
+            }
+            for e in &s.events {
+                ch.log
+                    .log_with_meta(&foxglove_out::event_log(e, t_ns), meta);
+                shared.logs.fetch_add(1, Ordering::Relaxed);
+            }
+            let j = serde_json::json!({
+                "tick": s.tick,
+                "time_s": s.tick as f64 / f64::from(rate_hz),
+                "cursor_m": xyz(s.cursor_m),
+                "world_force_n": xyz(s.world_force_n),
+                "device_force_n": xyz(s.device_force_n),
+                "device_force_norm_n": crate::vec3::norm(s.device_force_n),
+                "engagement": s.engagement,
+                "watchdog": s.watchdog,
+                "status": s.status,
+                "sample_age_ticks": s.age_ticks,
+                "dropped": shared.dropped.load(Ordering::Relaxed),
+            });
+            ch.state.log_with_meta(j.to_string().as_bytes(), meta);
+            shared.states.fetch_add(1, Ordering::Relaxed);
+        }
+        if done {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+impl Sink for LiveSink {
+    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
+        let c = info.config;
+        self.display_every = every(c.rate_hz, self.config.display_hz);
+        self.plot_every = every(c.rate_hz, self.config.plot_hz);
+        let ctx = &self.ctx;
+        let state = ctx
+            .channel_builder("/live/state")
+            .message_encoding("json")
+            .schema(Schema::new(
+                "nanohaptics.LiveState",
+                "jsonschema",
+                STATE_SCHEMA.as_bytes().to_vec(),
+            ))
+            .build_raw()
+            .map_err(|e| SessionError::Live(e.to_string()))?;
+        let ch = Channels {
+            scene: ctx.channel_builder("/foxglove/scene").build(),
+            tf: ctx.channel_builder("/foxglove/tf").build(),
+            log: ctx.channel_builder("/foxglove/log").build(),
+            state,
+        };
+        let shared = self.shared.clone();
+        let start_ns = info.description.start_time_ns;
+        let (period, rate, scale) = (c.period_ns(), c.rate_hz, c.display_scale);
+        let _ = lp;
+        self.thread = Some(
+            std::thread::Builder::new()
+                .name("live-view".into())
+                .spawn(move || publish(shared, ch, start_ns, period, rate, scale))
+                .map_err(|e| SessionError::Live(e.to_string()))?,
+        );
+        Ok(())
+    }
+
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+        let r = t.result;
+        let display = r.tick % self.display_every == 0;
+        if r.tick % self.plot_every != 0 && !display && r.events.is_empty() {
+            return Ok(());
+        }
+        let prims = display.then(|| {
+            let mut p = Vec::new();
+            t.lp.scene().draw(&mut p);
+            p
+        });
+        self.local.push(Snapshot {
+            tick: r.tick,
+            cursor_m: r.cursor_m,
+            world_force_n: r.world_force_n,
+            device_force_n: r.device_force_n,
+            engagement: r.engagement,
+            watchdog: r.watchdog,
+            status: r.status,
+            age_ticks: t.sample.age_ticks,
+            prims,
+            events: r.events.clone(),
+        });
+        self.hand_over();
+        Ok(())
+    }
+
+    fn finish(&mut self, _stats: &TickStats, _link: &[(&'static str, u64)]) -> Result<(), SessionError> {
+        if let Ok(mut q) = self.shared.queue.lock() {
+            q.append(&mut self.local);
+        }
+        self.shared.done.store(true, Ordering::Release);
+        if let Some(t) = self.thread.take() {
+            t.join()
+                .map_err(|_| SessionError::Live("the publisher thread panicked".into()))?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for LiveSink {
+    fn drop(&mut self) {
+        self.shared.done.store(true, Ordering::Release);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+        if let Some(s) = self.server.take() {
+            drop(s.stop());
+        }
+    }
+}

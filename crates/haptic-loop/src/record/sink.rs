@@ -1,0 +1,98 @@
+//! The MCAP recorder as a sink of the runner: encodes each tick's messages and hands them to
+//! the writer thread (never blocking the tick).
+
+use super::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
+use crate::haptic::HapticLoop;
+use crate::pacing::TickStats;
+use crate::runner::{SessionInfo, Sink, TickView};
+use crate::session::SessionError;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Records a session to an MCAP file.
+pub struct RecorderSink {
+    path: PathBuf,
+    recorder: Option<Recorder>,
+    enc: Option<TickEncoder>,
+    mode: String,
+    summary: Option<WriteSummary>,
+}
+
+impl RecorderSink {
+    /// A recorder that will create `path` when the session starts.
+    pub fn new(path: PathBuf) -> Self {
+        RecorderSink {
+            path,
+            recorder: None,
+            enc: None,
+            mode: String::new(),
+            summary: None,
+        }
+    }
+
+    /// What the writer did (after the session finished).
+    pub fn summary(&self) -> Option<&WriteSummary> {
+        self.summary.as_ref()
+    }
+}
+
+/// Metadata record `session` of a recording: the tick statistics and the mode.
+pub fn stats_metadata(stats: &TickStats, mode: &str) -> BTreeMap<String, String> {
+    let mut m = BTreeMap::new();
+    m.insert("mode".into(), mode.into());
+    m.insert("ticks".into(), stats.ticks.to_string());
+    m.insert("compute_p50_ns".into(), stats.compute.p50_ns.to_string());
+    m.insert("compute_p99_ns".into(), stats.compute.p99_ns.to_string());
+    m.insert("compute_max_ns".into(), stats.compute.max_ns.to_string());
+    m.insert("jitter_p99_ns".into(), stats.jitter.p99_ns.to_string());
+    m.insert("jitter_max_ns".into(), stats.jitter.max_ns.to_string());
+    m.insert("missed_deadlines".into(), stats.missed.to_string());
+    m.insert("wall_s".into(), format!("{:.6}", stats.wall_s));
+    m
+}
+
+impl Sink for RecorderSink {
+    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
+        self.recorder = Some(Recorder::create(
+            &self.path,
+            RecorderSetup {
+                description: info.description.clone(),
+                flush_every_ns: 1_000_000_000,
+            },
+        )?);
+        self.enc = Some(TickEncoder::new(lp, info.description.start_time_ns));
+        self.mode = info.description.mode.clone();
+        Ok(())
+    }
+
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+        let (Some(rec), Some(enc)) = (self.recorder.as_mut(), self.enc.as_mut()) else {
+            return Ok(());
+        };
+        let n = t.result.tick;
+        let mut msgs = Vec::with_capacity(8);
+        msgs.push(TickEncoder::input(n, &t.sample, t.deadline_missed));
+        enc.outputs(t.result, t.lp, &mut msgs);
+        msgs.push(TickEncoder::timing(n, t.start_late_ns, t.compute_ns));
+        rec.write(TickMessages {
+            tick: n,
+            log_time_ns: enc.log_time_ns(n),
+            msgs,
+        })?;
+        Ok(())
+    }
+
+    fn finish(&mut self, stats: &TickStats, link: &[(&'static str, u64)]) -> Result<(), SessionError> {
+        if let Some(mut rec) = self.recorder.take() {
+            rec.metadata("session", stats_metadata(stats, &self.mode))?;
+            if !link.is_empty() {
+                rec.metadata(
+                    "device_link",
+                    link.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
+                )?;
+            }
+            self.summary = Some(rec.finish()?);
+        }
+        Ok(())
+    }
+}

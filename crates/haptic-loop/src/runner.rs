@@ -1,0 +1,225 @@
+//! The one runner: a haptic loop, a device source, a pacing policy and a list of sinks.
+//!
+//! ```text
+//! device source ──sample──▶ HapticLoop::tick ──TickView──▶ sinks
+//!  (script, hand, replay,     (fixed dt, clamp,            (MCAP recorder, per-tick arrays,
+//!   UDP bridge, Python)        stiffness cap, watchdog)     replay verifier, frames, live view)
+//! ```
+//!
+//! Every way a session is driven goes through [`Runner::run`] (or, one tick at a time from
+//! Python, through [`deliver`]): `nanohaptics run`, `replay --verify`, `render`, `demo`, the
+//! wheel's `run_scene` and `Session`. A sink sees each tick once, after the force was sent to the
+//! device, and must not block: the recorder and the live view hand their data to threads of
+//! their own.
+//!
+//! Adding a sink is one new file implementing [`Sink`] and one line where the session builds
+//! its list of sinks (`session::run_session`).
+
+use crate::device::{DeviceError, DeviceSample, HapticDevice, TickTime};
+use crate::haptic::{HapticLoop, LoopConfig, TickResult};
+use crate::pacing::{Pacer, Percentiles, TickStats};
+use crate::record::messages::DescriptionMsg;
+use crate::session::SessionError;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// One tick as the sinks see it.
+pub struct TickView<'a> {
+    /// The device reading the tick ran on (the tick's recorded input).
+    pub sample: DeviceSample,
+    /// Whether the tick's real-time deadline was missed (zero force was sent); an input too.
+    pub deadline_missed: bool,
+    /// What the tick produced.
+    pub result: &'a TickResult,
+    /// The loop after the tick (scene state and drawing).
+    pub lp: &'a HapticLoop,
+    /// Start lateness against the schedule, ns (0 in batch mode; wall clock, not reproducible).
+    pub start_late_ns: i64,
+    /// Work of the tick from reading the device to sending the force, ns (wall clock).
+    pub compute_ns: u64,
+}
+
+/// What a sink learns before the first tick.
+pub struct SessionInfo<'a> {
+    /// The session's description (as recorded).
+    pub description: &'a DescriptionMsg,
+    /// The loop's configuration.
+    pub config: &'a LoopConfig,
+    /// Number of ticks planned (`None`: until the device ends the session).
+    pub ticks: Option<u64>,
+}
+
+/// A consumer of ticks.
+pub trait Sink {
+    /// Called once before the first tick.
+    fn start(&mut self, _info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SessionError> {
+        Ok(())
+    }
+    /// Called once per tick, after the force was sent; must not block.
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError>;
+    /// Called once after the last tick with the session's statistics and the device's link
+    /// counters (empty for headless devices).
+    fn finish(&mut self, _stats: &TickStats, _link: &[(&'static str, u64)]) -> Result<(), SessionError> {
+        Ok(())
+    }
+}
+
+/// How ticks are paced and where the deadline flag comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pacing {
+    /// As fast as possible; no deadline.
+    Batch,
+    /// Tick `n` starts at `start + n · period` by the wall clock; a tick whose force is ready
+    /// after the start of the next one sends zero force (`deadline.missed`).
+    Realtime,
+    /// The device's samples are the clock (a bridged device: `sample` returns when a reading
+    /// arrives or the watchdog's wait expires); the deadline is one period after the tick starts.
+    DeviceClock,
+    /// Deadline flags read from a recording (replay).
+    Recorded(Vec<bool>),
+}
+
+/// How a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EndReason {
+    /// The planned number of ticks ran.
+    Completed,
+    /// The device ended the session (a bridged device said goodbye).
+    DeviceEnded,
+    /// The stop flag was raised (Ctrl-C, Python interrupt).
+    Stopped,
+}
+
+/// Runs ticks of a loop against a device and hands each to the sinks.
+pub struct Runner<'s> {
+    sinks: Vec<&'s mut dyn Sink>,
+    stop: Option<&'s AtomicBool>,
+}
+
+/// Hands one tick to every sink, in order.
+pub fn deliver(sinks: &mut [&mut dyn Sink], view: &TickView<'_>) -> Result<(), SessionError> {
+    for s in sinks.iter_mut() {
+        s.tick(view)?;
+    }
+    Ok(())
+}
+
+impl<'s> Runner<'s> {
+    /// A runner handing ticks to `sinks`, in order.
+    pub fn new(sinks: Vec<&'s mut dyn Sink>) -> Self {
+        Runner { sinks, stop: None }
+    }
+
+    /// Stops the run cleanly (after the current tick) when `flag` becomes true.
+    pub fn stop_on(mut self, flag: &'s AtomicBool) -> Self {
+        self.stop = Some(flag);
+        self
+    }
+
+    /// Runs `ticks` ticks (`None`: until the device ends the session) of `lp` with `dev`
+    /// (opened by the caller); `progress` is called every 100 ticks with (done, planned or 0).
+    /// The sinks' `start` is called first and their `finish` last (also when the run stops).
+    pub fn run(
+        &mut self,
+        lp: &mut HapticLoop,
+        dev: &mut dyn HapticDevice,
+        description: &DescriptionMsg,
+        ticks: Option<u64>,
+        pacing: Pacing,
+        progress: &mut dyn FnMut(u64, u64),
+    ) -> Result<(TickStats, EndReason), SessionError> {
+        let info = SessionInfo {
+            description,
+            config: lp.config(),
+            ticks,
+        };
+        for s in self.sinks.iter_mut() {
+            s.start(&info, lp)?;
+        }
+        let rate = lp.config().rate_hz;
+        let period_ns = lp.config().period_ns();
+        let cap = ticks.unwrap_or(0) as usize;
+        let mut compute = Vec::with_capacity(cap.min(1 << 24));
+        let timed = !matches!(pacing, Pacing::Batch | Pacing::Recorded(_));
+        let mut jitter = Vec::with_capacity(if timed { cap.min(1 << 24) } else { 0 });
+        let mut missed_count = 0;
+        let start = Instant::now();
+        let pacer = matches!(pacing, Pacing::Realtime).then(|| Pacer::new(period_ns));
+        let mut prev_start: Option<Instant> = None;
+        let mut end = EndReason::Completed;
+        let mut n = 0u64;
+        while ticks.is_none_or(|t| n < t) {
+            if self.stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
+                end = EndReason::Stopped;
+                break;
+            }
+            let late = match &pacer {
+                Some(p) => p.wait_for(n),
+                None => 0,
+            };
+            let sample = match dev.sample(TickTime::new(n, rate)) {
+                Ok(s) => s,
+                Err(DeviceError::Ended) => {
+                    end = EndReason::DeviceEnded;
+                    break;
+                }
+                Err(e) => return Err(e.into()),
+            };
+            // The tick starts when its sample is in hand (for a device clock, when it arrived).
+            let t0 = Instant::now();
+            let late = match (&pacing, prev_start) {
+                (Pacing::DeviceClock, Some(p)) => {
+                    t0.duration_since(p).as_nanos() as i64 - period_ns as i64
+                }
+                _ => late,
+            };
+            prev_start = Some(t0);
+            let recorded_missed = match &pacing {
+                Pacing::Recorded(flags) => flags.get(n as usize).copied().unwrap_or(false),
+                _ => false,
+            };
+            lp.tick(sample, recorded_missed);
+            let missed = match &pacing {
+                Pacing::Realtime => pacer.as_ref().is_some_and(|p| p.deadline_passed(n)),
+                Pacing::DeviceClock => t0.elapsed().as_nanos() as u64 > period_ns,
+                _ => recorded_missed,
+            };
+            if missed && !recorded_missed {
+                lp.mark_deadline_missed();
+            }
+            dev.set_force(&lp.command(sample.seq))?;
+            let compute_ns = t0.elapsed().as_nanos() as u64;
+            missed_count += u64::from(missed);
+            let view = TickView {
+                sample,
+                deadline_missed: missed,
+                result: lp.last_result(),
+                lp,
+                start_late_ns: late,
+                compute_ns,
+            };
+            deliver(&mut self.sinks, &view)?;
+            // The hand-off to the sinks belongs to the tick's cost.
+            compute.push(t0.elapsed().as_nanos() as u64);
+            if timed && n > 0 {
+                jitter.push(late.unsigned_abs());
+            }
+            n += 1;
+            if n % 100 == 0 || ticks == Some(n) {
+                progress(n, ticks.unwrap_or(0));
+            }
+        }
+        let stats = TickStats {
+            ticks: n,
+            compute: Percentiles::of(&compute),
+            jitter: Percentiles::of(&jitter),
+            missed: missed_count,
+            wall_s: start.elapsed().as_secs_f64(),
+        };
+        let link = dev.link_counters();
+        for s in self.sinks.iter_mut() {
+            s.finish(&stats, &link)?;
+        }
+        Ok((stats, end))
+    }
+}
