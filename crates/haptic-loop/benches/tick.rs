@@ -20,26 +20,17 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             n += 1;
             let z = -0.004 + 0.002 * ((n % 100) as f64 / 100.0);
-            let r = lp.tick(
-                DeviceSample {
-                    position_m: [0.001, 0.0, z],
-                    buttons: Buttons(1),
-                },
-                false,
-            );
+            let r = lp.tick(DeviceSample::new([0.001, 0.0, z], Buttons(1)), false);
             black_box(r.device_force_n)
         })
     });
     let s = load_scene(SCENE, None).unwrap();
     let mut lp = HapticLoop::new(s.config, s.scene);
-    let mut enc = TickEncoder::new(&lp);
+    let mut enc = TickEncoder::new(&lp, 0);
     let mut msgs = Vec::with_capacity(16);
     c.bench_function("wall tick + encode all channels", |b| {
         b.iter(|| {
-            let sample = DeviceSample {
-                position_m: [0.001, 0.0, -0.004],
-                buttons: Buttons(0),
-            };
+            let sample = DeviceSample::new([0.001, 0.0, -0.004], Buttons(0));
             lp.tick(sample, false);
             msgs.clear();
             msgs.push(TickEncoder::input(lp.next_tick() - 1, &sample, false));
@@ -53,6 +44,8 @@ fn bench(c: &mut Criterion) {
         device_force_n: [0.1, 0.2, 0.3],
         engagement: 1.0,
         status: 0,
+        watchdog: 1.0,
+        device_stiffness_n_per_m: [0.0; 9],
     };
     c.bench_function("CDR encode force message", |b| {
         b.iter(|| black_box(f.encode()))

@@ -185,7 +185,6 @@ impl SessionArrays {
     }
 }
 
-
 impl Sink for SessionArrays {
     fn start(&mut self, info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SessionError> {
         self.rate_hz = info.config.rate_hz;

@@ -302,8 +302,10 @@ impl HapticLoop {
         // 1b. Watchdog on the sample's age.
         let age = sample.age_ticks;
         if age == 1 {
-            r.events
-                .push(Event::new("device.sample_late", "no new device sample this tick"));
+            r.events.push(Event::new(
+                "device.sample_late",
+                "no new device sample this tick",
+            ));
         }
         if watchdog == 0.0 && !self.link_lost {
             self.link_lost = true;
@@ -490,10 +492,7 @@ stiffness_n_per_m = 5000.0
         let mut l = looped(WALL);
         l.tick(at(-0.001), false);
         let r = l
-            .tick(
-                DeviceSample::new([f64::NAN, 0.0, 0.0], Buttons(0)),
-                false,
-            )
+            .tick(DeviceSample::new([f64::NAN, 0.0, 0.0], Buttons(0)), false)
             .clone();
         assert_eq!(r.device_force_n, [0.0; 3]);
         assert_eq!(r.status, status::INPUT_INVALID);
@@ -503,10 +502,7 @@ stiffness_n_per_m = 5000.0
         assert_eq!(r.device_force_n, [0.0; 3]);
         assert!(r.events.is_empty(), "one event per episode");
         let r = l
-            .tick(
-                DeviceSample::new([0.0; 3], Buttons(1 << 7)),
-                false,
-            )
+            .tick(DeviceSample::new([0.0; 3], Buttons(1 << 7)), false)
             .clone();
         assert_eq!(r.status, status::INPUT_INVALID);
         let r = l.tick(at(-0.001), false).clone();
@@ -530,10 +526,7 @@ stiffness_n_per_m = 5000.0
     fn missed_deadline_sends_zero_force_and_buttons_raise_events() {
         let mut l = looped(WALL);
         let r = l
-            .tick(
-                DeviceSample::new([0.0, 0.0, -0.001], Buttons(0b101)),
-                true,
-            )
+            .tick(DeviceSample::new([0.0, 0.0, -0.001], Buttons(0b101)), true)
             .clone();
         assert_eq!(r.device_force_n, [0.0; 3]);
         assert!((r.world_force_n[2] - 3.0).abs() < 1e-12);

@@ -323,7 +323,11 @@ impl Sink for LiveSink {
         Ok(())
     }
 
-    fn finish(&mut self, _stats: &TickStats, _link: &[(&'static str, u64)]) -> Result<(), SessionError> {
+    fn finish(
+        &mut self,
+        _stats: &TickStats,
+        _link: &[(&'static str, u64)],
+    ) -> Result<(), SessionError> {
         if let Ok(mut q) = self.shared.queue.lock() {
             q.append(&mut self.local);
         }

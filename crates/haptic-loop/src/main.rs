@@ -204,7 +204,9 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
         if v.is_finite() && (lo..=hi).contains(&v) {
             Ok(v)
         } else {
-            Err(format!("--{flag} = {v} is out of range (allowed: {lo}–{hi})"))
+            Err(format!(
+                "--{flag} = {v} is out of range (allowed: {lo}–{hi})"
+            ))
         }
     };
     let loss = check("loss", a.loss, 0.0, 1.0)?;
@@ -218,7 +220,10 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
             let (s, d) = o.split_once(':').ok_or_else(bad)?;
             let s: f64 = s.parse().map_err(|_| bad())?;
             let d: f64 = d.parse().map_err(|_| bad())?;
-            Ok::<_, String>((check("outage start", s, 0.0, 3600.0)?, check("outage seconds", d, 0.0, 3600.0)?))
+            Ok::<_, String>((
+                check("outage start", s, 0.0, 3600.0)?,
+                check("outage seconds", d, 0.0, 3600.0)?,
+            ))
         })
         .transpose()?;
     if let Some(s) = a.seconds {
@@ -382,11 +387,16 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
         Some(d) if d.starts_with("udp:") => {
             let mut b = BridgeConfig::parse(d).map_err(|e| e.to_string())?;
             if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
-                return Err(format!("--wait-s = {wait_s} is out of range (allowed: 0–86400)"));
+                return Err(format!(
+                    "--wait-s = {wait_s} is out of range (allowed: 0–86400)"
+                ));
             }
             b.wait_s = wait_s;
             if !json {
-                eprintln!("waiting for a device on udp:{} (nanohaptics fake-device udp:{} in another terminal) ...", b.bind, b.bind);
+                eprintln!(
+                    "waiting for a device on udp:{} (nanohaptics fake-device udp:{} in another terminal) ...",
+                    b.bind, b.bind
+                );
             }
             opts.bridge = Some(b);
         }
@@ -400,11 +410,16 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
     if let Some(l) = live.as_deref() {
         let mut c = LiveConfig::parse(l).map_err(|e| e.to_string())?;
         if !(1..=1000).contains(&live_hz) {
-            return Err(format!("--live-hz = {live_hz} is out of range (allowed: 1–1000)"));
+            return Err(format!(
+                "--live-hz = {live_hz} is out of range (allowed: 1–1000)"
+            ));
         }
         c.display_hz = live_hz;
         if !json {
-            eprintln!("live view on ws://{} (Foxglove: Open connection → Foxglove WebSocket)", c.bind);
+            eprintln!(
+                "live view on ws://{} (Foxglove: Open connection → Foxglove WebSocket)",
+                c.bind
+            );
         }
         opts.live = Some(c);
     }

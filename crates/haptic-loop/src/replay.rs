@@ -135,9 +135,7 @@ impl Sink for VerifySink<'_> {
                 .filter(|m| m.channel == ch)
                 .map(|m| m.data.as_slice());
             let mut detail = None;
-            let mut nw = 0;
             for a in w {
-                nw += 1;
                 match g.next() {
                     Some(b) => {
                         self.compared += 1;
@@ -155,7 +153,6 @@ impl Sink for VerifySink<'_> {
             if detail.is_none() && g.next().is_some() {
                 detail = Some("replay produced a message that was not recorded".into());
             }
-            let _ = nw;
             if let Some(detail) = detail {
                 self.divergence = Some(Divergence {
                     tick,

@@ -59,7 +59,11 @@ pub trait Sink {
     fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError>;
     /// Called once after the last tick with the session's statistics and the device's link
     /// counters (empty for headless devices).
-    fn finish(&mut self, _stats: &TickStats, _link: &[(&'static str, u64)]) -> Result<(), SessionError> {
+    fn finish(
+        &mut self,
+        _stats: &TickStats,
+        _link: &[(&'static str, u64)],
+    ) -> Result<(), SessionError> {
         Ok(())
     }
 }

@@ -137,6 +137,9 @@ pub struct SessionOptions {
     pub live: Option<LiveConfig>,
     /// Keep the per-tick arrays (default true; long live sessions may turn them off).
     pub arrays: bool,
+    /// Session start written in the description, ns since the Unix epoch (`None`: the wall
+    /// clock now). Pin it to make a batch recording byte-identical across runs.
+    pub start_time_ns: Option<u64>,
 }
 
 impl SessionOptions {
@@ -154,6 +157,7 @@ impl SessionOptions {
             out: None,
             live: None,
             arrays: true,
+            start_time_ns: None,
         }
     }
 }
@@ -302,7 +306,7 @@ fn run_with_device(
         script_toml,
         operator: source.describe(),
         state_fields: fields.clone(),
-        start_time_ns: now_unix_ns(),
+        start_time_ns: opts.start_time_ns.unwrap_or_else(now_unix_ns),
         device_link: source.link_name(),
         device_max_force_n: specs.max_force_n,
         device_max_stiffness_n_per_m: specs.max_stiffness_n_per_m,

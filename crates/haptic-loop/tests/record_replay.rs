@@ -90,8 +90,14 @@ fn force_feedback_changes_the_simulated_hand_but_not_a_rigid_one() {
 fn same_inputs_same_bits_across_runs() {
     let a = tmp("det-a.mcap");
     let b = tmp("det-b.mcap");
-    run_session(&wall_opts(Some(a.clone())), &mut |_, _| {}).unwrap();
-    run_session(&wall_opts(Some(b.clone())), &mut |_, _| {}).unwrap();
+    // The session's start (wall clock) is part of the recording: pin it.
+    let pinned = |p: &PathBuf| {
+        let mut o = wall_opts(Some(p.clone()));
+        o.start_time_ns = Some(1_795_000_000_000_000_000);
+        o
+    };
+    run_session(&pinned(&a), &mut |_, _| {}).unwrap();
+    run_session(&pinned(&b), &mut |_, _| {}).unwrap();
     let ra = read_recording_file(&a, false).unwrap();
     let rb = read_recording_file(&b, false).unwrap();
     let outputs = |r: &haptic_loop::record::Recording| {
@@ -109,13 +115,14 @@ fn divergence_names_the_first_tick_and_channel() {
     let p = tmp("div.mcap");
     run_session(&wall_opts(Some(p.clone())), &mut |_, _| {}).unwrap();
     let rec = read_recording_file(&p, false).unwrap();
+    let t0 = rec.description.start_time_ns;
 
     // A tampered force at tick 1234.
     let mut bad = rec.clone();
     let m = bad
         .messages
         .iter_mut()
-        .find(|m| m.channel == Channel::Force && m.log_time_ns == 1_234_000_000)
+        .find(|m| m.channel == Channel::Force && m.log_time_ns == t0 + 1_234_000_000)
         .unwrap();
     let mut f = ForceMsg::decode(&m.data).unwrap();
     f.device_force_n[2] = f64::from_bits(f.device_force_n[2].to_bits() ^ 1);
@@ -129,7 +136,7 @@ fn divergence_names_the_first_tick_and_channel() {
     let m = bad
         .messages
         .iter_mut()
-        .find(|m| m.channel == Channel::DeviceInput && m.log_time_ns == 900_000_000)
+        .find(|m| m.channel == Channel::DeviceInput && m.log_time_ns == t0 + 900_000_000)
         .unwrap();
     let mut i = DeviceInputMsg::decode(&m.data).unwrap();
     i.deadline_missed = true;
@@ -164,7 +171,7 @@ fn divergence_names_the_first_tick_and_channel() {
         .iter()
         .position(|m| m.channel == Channel::Events)
         .unwrap();
-    let t = bad.messages[k].log_time_ns / 1_000_000;
+    let t = (bad.messages[k].log_time_ns - t0) / 1_000_000;
     bad.messages.remove(k);
     let d = verify(&bad).unwrap().divergence.unwrap();
     assert_eq!(d.tick, t);

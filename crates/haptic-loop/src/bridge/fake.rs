@@ -130,7 +130,9 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     // 2. A receiver thread timestamps each reply.
     let replies: Arc<Mutex<Vec<Reply>>> = Arc::new(Mutex::new(Vec::with_capacity(1024)));
     let done = Arc::new(AtomicBool::new(false));
-    let rx = socket.try_clone().map_err(|e| link("cannot clone the socket", e))?;
+    let rx = socket
+        .try_clone()
+        .map_err(|e| link("cannot clone the socket", e))?;
     let (r2, d2, target) = (replies.clone(), done.clone(), cfg.target);
     let thread = std::thread::Builder::new()
         .name("fake-rx".into())

@@ -307,7 +307,9 @@ impl Packet {
             }
             5 => {
                 fixed("bye", BYE_LEN)?;
-                Ok(Packet::Bye { reason: r.u8("bye")? })
+                Ok(Packet::Bye {
+                    reason: r.u8("bye")?,
+                })
             }
             t => Err(ProtocolError::Type(t)),
         }
@@ -426,10 +428,16 @@ mod tests {
         })
         .encode();
         let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
-        assert_eq!(e(&good[..51]), "sample packet of 51 bytes is too short (needs 52)");
+        assert_eq!(
+            e(&good[..51]),
+            "sample packet of 51 bytes is too short (needs 52)"
+        );
         let mut long = good.clone();
         long.push(0);
-        assert_eq!(e(&long), "sample packet of 53 bytes is too long (expected 52)");
+        assert_eq!(
+            e(&long),
+            "sample packet of 53 bytes is too long (expected 52)"
+        );
         assert_eq!(
             e(&vec![0; MAX_PACKET + 1]),
             "datagram of 1201 bytes is over the 1200-byte limit"

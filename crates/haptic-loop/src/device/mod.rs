@@ -14,9 +14,9 @@ use crate::vec3::Vec3;
 use serde::{Deserialize, Serialize};
 
 pub use operator::{OperatorParams, SimulatedOperator};
-use std::borrow::Cow;
 pub use replay::ReplayDevice;
 pub use script::{Script, ScriptError, ScriptedDevice};
+use std::borrow::Cow;
 
 /// Specifications of a haptic device (what it can sense and render).
 ///
@@ -132,7 +132,12 @@ impl DeviceSpecs {
             }
         };
         range("max_force_n", self.max_force_n, 0.0, 1e3)?;
-        range("max_stiffness_n_per_m", self.max_stiffness_n_per_m, 0.0, 1e6)?;
+        range(
+            "max_stiffness_n_per_m",
+            self.max_stiffness_n_per_m,
+            0.0,
+            1e6,
+        )?;
         range("workspace_radius_m", self.workspace_radius_m, 0.0, 10.0)?;
         let name_ok = |s: &str| {
             (1..=32).contains(&s.len()) && s.bytes().all(|b| b.is_ascii_graphic() || b == b' ')

@@ -189,7 +189,10 @@ impl HapticDevice for SimulatedOperator {
             self.step(time);
         }
         self.next_tick += 1;
-        Ok(DeviceSample::new(self.position_m, self.script.buttons(self.intent_time_s)))
+        Ok(DeviceSample::new(
+            self.position_m,
+            self.script.buttons(self.intent_time_s),
+        ))
     }
 
     fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
@@ -218,7 +221,11 @@ mod tests {
         let mut last = [0.0; 3];
         for n in 0..5000 {
             last = op.sample(TickTime::new(n, 1000)).unwrap().position_m;
-            op.set_force(&ForceCommand { force_n: [3.0, 0.0, 0.0], ..Default::default() }).unwrap();
+            op.set_force(&ForceCommand {
+                force_n: [3.0, 0.0, 0.0],
+                ..Default::default()
+            })
+            .unwrap();
         }
         assert!((last[0] - 0.01).abs() < 1e-6, "x = {}", last[0]);
     }
@@ -256,7 +263,11 @@ mod tests {
         for n in 0..2000 {
             let p = op.sample(TickTime::new(n, 1000)).unwrap().position_m;
             assert!(vec3::norm(p) <= FALCON.workspace_radius_m * (1.0 + 1e-15));
-            op.set_force(&ForceCommand { force_n: [8.0, 8.0, 0.0], ..Default::default() }).unwrap();
+            op.set_force(&ForceCommand {
+                force_n: [8.0, 8.0, 0.0],
+                ..Default::default()
+            })
+            .unwrap();
         }
         assert!(matches!(
             op.sample(TickTime::new(7, 1000)),
@@ -293,8 +304,16 @@ mod tests {
         for n in 0..1001 {
             op.sample(TickTime::new(n, 1000)).unwrap();
             free.sample(TickTime::new(n, 1000)).unwrap();
-            op.set_force(&ForceCommand { force_n: [0.0, 2.0, 0.0], ..Default::default() }).unwrap();
-            free.set_force(&ForceCommand { force_n: [0.0, 2.0, 0.0], ..Default::default() }).unwrap();
+            op.set_force(&ForceCommand {
+                force_n: [0.0, 2.0, 0.0],
+                ..Default::default()
+            })
+            .unwrap();
+            free.set_force(&ForceCommand {
+                force_n: [0.0, 2.0, 0.0],
+                ..Default::default()
+            })
+            .unwrap();
         }
         // 1000 steps of 1 ms at rate 1 / (1 + 2/2): the plan is at 0.5 s, the free one at 1 s.
         assert!(

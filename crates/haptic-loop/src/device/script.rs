@@ -355,7 +355,10 @@ impl HapticDevice for ScriptedDevice {
     }
 
     fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
-        Ok(DeviceSample::new(self.script.position(time.time_s), self.script.buttons(time.time_s)))
+        Ok(DeviceSample::new(
+            self.script.position(time.time_s),
+            self.script.buttons(time.time_s),
+        ))
     }
 
     fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {

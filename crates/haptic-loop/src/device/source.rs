@@ -1,9 +1,9 @@
 //! The device sources a session can be driven by, registered in one place: adding a device is
 //! one new file implementing [`HapticDevice`](super::HapticDevice) and one arm here.
 
+use super::SimulatedOperator;
 use super::script::Script;
 use super::{DeviceError, DeviceModel, HapticDevice, OperatorParams, ScriptedDevice};
-use super::SimulatedOperator;
 use crate::bridge::{BridgeConfig, UdpDevice};
 
 /// Which device drives a session.
@@ -45,7 +45,11 @@ pub fn open_device(
     source: &DeviceSource,
     script: Option<&Script>,
 ) -> Result<Box<dyn HapticDevice>, DeviceError> {
-    let need = || script.cloned().ok_or(DeviceError::Link("no script for a scripted device".into()));
+    let need = || {
+        script
+            .cloned()
+            .ok_or(DeviceError::Link("no script for a scripted device".into()))
+    };
     Ok(match source {
         DeviceSource::Script(m) => Box::new(ScriptedDevice::new(need()?, m.specs().clone())),
         DeviceSource::Hand(m, p) => {

@@ -82,13 +82,19 @@ impl Sink for RecorderSink {
         Ok(())
     }
 
-    fn finish(&mut self, stats: &TickStats, link: &[(&'static str, u64)]) -> Result<(), SessionError> {
+    fn finish(
+        &mut self,
+        stats: &TickStats,
+        link: &[(&'static str, u64)],
+    ) -> Result<(), SessionError> {
         if let Some(mut rec) = self.recorder.take() {
             rec.metadata("session", stats_metadata(stats, &self.mode))?;
             if !link.is_empty() {
                 rec.metadata(
                     "device_link",
-                    link.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
+                    link.iter()
+                        .map(|(k, v)| (k.to_string(), v.to_string()))
+                        .collect(),
                 )?;
             }
             self.summary = Some(rec.finish()?);

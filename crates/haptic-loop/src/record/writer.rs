@@ -208,7 +208,10 @@ fn write_all(
     };
     sum.messages += write_msgs(&mut w, &ids, &mut seq, 0, &[desc], path)?;
     w.flush().map_err(|e| io_err(path, e))?;
-    let mut next_flush = setup.flush_every_ns;
+    let mut next_flush = setup
+        .description
+        .start_time_ns
+        .saturating_add(setup.flush_every_ns);
     let mut batch: Vec<Cmd> = Vec::new();
     loop {
         // Read the flag before draining: whatever was queued before `done` is then drained.

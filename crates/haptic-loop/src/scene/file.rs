@@ -284,7 +284,12 @@ impl SceneFile {
         let rate = f64::from(l.rate_hz);
         let grace_ticks = (l.watchdog_grace_s * rate).round();
         let min_timeout = (grace_ticks + 1.0) / rate;
-        check_range("loop.watchdog_timeout_s", l.watchdog_timeout_s, min_timeout, 1.0)?;
+        check_range(
+            "loop.watchdog_timeout_s",
+            l.watchdog_timeout_s,
+            min_timeout,
+            1.0,
+        )?;
         let timeout_ticks = (l.watchdog_timeout_s * rate).round().max(grace_ticks + 1.0);
         let d = &self.display;
         if d.rate_hz == 0 || d.rate_hz > l.rate_hz || l.rate_hz % d.rate_hz != 0 {
