@@ -1,0 +1,313 @@
+//! The device bridge end to end on loopback: a session waits for a device process (here the
+//! fake device, or a hand-written client), runs against it, records every received sample as
+//! the tick's input, and replays bit for bit; faults are counted, never fatal; the watchdog
+//! ramps the force to zero within 10 ms of the last sample and engages softly again.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use haptic_loop::bridge::BridgeConfig;
+use haptic_loop::bridge::fake::{FakeConfig, FakeReport, run_fake};
+use haptic_loop::bridge::protocol::{Packet, Sample};
+use haptic_loop::device::{DeviceModel, FALCON, Script};
+use haptic_loop::haptic::status;
+use haptic_loop::record::read_recording_file;
+use haptic_loop::replay::verify;
+use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
+use haptic_loop::vec3;
+use std::net::{SocketAddr, UdpSocket};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("haptic-loop-bridge-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+/// A free loopback UDP port.
+fn free_port() -> SocketAddr {
+    let s = UdpSocket::bind("127.0.0.1:0").unwrap();
+    s.local_addr().unwrap()
+}
+
+fn bridged(addr: SocketAddr, out: &Path) -> SessionOptions {
+    let mut o =
+        SessionOptions::new(SceneSource::from_path(&root().join("scenes/wall.toml")).unwrap());
+    let mut b = BridgeConfig::parse(&format!("udp:{addr}")).unwrap();
+    b.wait_s = 20.0;
+    o.bridge = Some(b);
+    o.out = Some(out.to_path_buf());
+    o
+}
+
+fn fake(addr: SocketAddr) -> FakeConfig {
+    let text = std::fs::read_to_string(root().join("scenes/wall.script.toml")).unwrap();
+    FakeConfig {
+        target: addr,
+        model: DeviceModel::Falcon,
+        script: Script::from_toml(&text, &FALCON).unwrap(),
+        hand: None,
+        loss: 0.0,
+        jitter_s: 0.0,
+        latency_s: 0.0,
+        seed: 1,
+        seconds: Some(3.0),
+        outage: None,
+        wait_s: 20.0,
+        bye: true,
+    }
+}
+
+/// Runs a bridged session in a thread and `device` in this one.
+fn session_with(
+    opts: SessionOptions,
+    device: impl FnOnce() -> FakeReport,
+) -> (SessionReport, FakeReport) {
+    let h = std::thread::spawn(move || run_session(&opts, &mut |_, _| {}));
+    let f = device();
+    (h.join().unwrap().unwrap(), f)
+}
+
+fn counter(r: &SessionReport, name: &str) -> u64 {
+    r.link.iter().find(|(k, _)| *k == name).unwrap().1
+}
+
+fn assert_replays(out: &Path) {
+    let rec = read_recording_file(out, false).unwrap();
+    let v = verify(&rec).unwrap();
+    assert!(v.ok(), "{:?}", v.divergence);
+    assert_eq!(rec.description.device_link.split(':').next(), Some("udp"));
+}
+
+#[test]
+fn five_percent_loss_and_2_ms_jitter_are_survived_and_replay_bit_for_bit() {
+    let addr = free_port();
+    let out = tmp("lossy.mcap");
+    let mut f = fake(addr);
+    f.loss = 0.05;
+    f.jitter_s = 0.002;
+    f.seconds = Some(2.0);
+    let (r, dev) = session_with(bridged(addr, &out), move || run_fake(&f, None).unwrap());
+    assert_eq!(r.end, "device_ended");
+    // Loopback loses nothing: every sample sent arrived, in order or not.
+    assert_eq!(
+        counter(&r, "received") + counter(&r, "reordered") + counter(&r, "duplicate"),
+        dev.sent
+    );
+    assert!(dev.dropped > 40 && dev.dropped < 200, "{}", dev.dropped);
+    assert!(
+        counter(&r, "reordered") > 0,
+        "2 ms of jitter at 1 kHz reorders samples"
+    );
+    // Every tick's input is recorded with its age; stale ticks are the ones the link counted.
+    let a = &r.arrays;
+    let stale = a.device_age_ticks.iter().filter(|&&g| g > 0).count() as u64;
+    assert_eq!(stale, counter(&r, "stale_ticks"));
+    assert!(a.events.iter().any(|e| e.1 == "device.sample_late"));
+    for (f, s) in a.device_force_n.iter().zip(&a.status) {
+        assert!(vec3::is_finite(*f) && vec3::norm(*f) <= FALCON.max_force_n);
+        if s & status::WATCHDOG != 0 {
+            assert!(vec3::norm(*f) < FALCON.max_force_n);
+        }
+    }
+    assert!(dev.forces_within_limits && dev.replies > 0);
+    assert_replays(&out);
+}
+
+#[test]
+fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_return() {
+    let addr = free_port();
+    let out = tmp("outage.mcap");
+    let mut f = fake(addr);
+    // Pressing into the wall (z ≈ −7 mm, 2 mm deep at 3000 N/m ≈ 6 N) when the device goes
+    // silent for 100 ms.
+    f.outage = Some((2.0, 0.1));
+    f.seconds = Some(2.5);
+    let (r, dev) = session_with(bridged(addr, &out), move || run_fake(&f, None).unwrap());
+    let a = &r.arrays;
+    let first = a.device_age_ticks.iter().position(|&g| g >= 50).unwrap();
+    let last_fresh = (0..first)
+        .rev()
+        .find(|&i| a.device_age_ticks[i] == 0)
+        .unwrap();
+    let f0 = vec3::norm(a.device_force_n[last_fresh]);
+    assert!(f0 > 4.0, "in contact when the device vanished: {f0} N");
+    // Full force through the 2 ms grace, then a linear ramp, zero from 10 ms on.
+    for k in 1..=30 {
+        let i = last_fresh + k;
+        let f = vec3::norm(a.device_force_n[i]);
+        assert_eq!(a.device_age_ticks[i], k as u32);
+        let expected = if k <= 2 {
+            1.0
+        } else {
+            (10.0 - k as f64).max(0.0) / 8.0
+        };
+        assert_eq!(a.watchdog[i], expected, "age {k}");
+        if k >= 10 {
+            assert_eq!(f, 0.0, "age {k} ms: {f} N");
+            assert_eq!(a.device_stiffness_n_per_m[i], [0.0; 9]);
+        }
+    }
+    let lost = a.events.iter().find(|e| e.1 == "device.lost").unwrap();
+    assert_eq!(lost.0, (last_fresh + 10) as u64);
+    // It comes back: soft engagement restarts from zero.
+    let back = a.events.iter().find(|e| e.1 == "device.resumed").unwrap();
+    let b = back.0 as usize;
+    assert_eq!(a.device_age_ticks[b], 0);
+    assert_eq!(a.engagement[b], 0.0);
+    assert!(a.engagement[b + 100] > 0.0 && a.engagement[b + 100] < 1.0);
+    assert!(dev.silent >= 99);
+    assert_replays(&out);
+}
+
+/// A hand-written client sends every kind of bad packet between good ones, waiting for each
+/// answer so the counts are exact.
+#[test]
+fn duplicate_reordered_malformed_oversized_and_stranger_packets_are_counted_and_dropped() {
+    let addr = free_port();
+    let out = tmp("faults.mcap");
+    let mut opts = bridged(addr, &out);
+    opts.seconds = Some(10.0);
+    let client = move || {
+        let s = UdpSocket::bind("127.0.0.1:0").unwrap();
+        s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
+        let hello = Packet::Hello {
+            rate_hz: 1000,
+            specs: FALCON,
+        }
+        .encode();
+        let mut buf = [0u8; 2048];
+        loop {
+            s.send_to(&hello, addr).unwrap();
+            if let Ok((n, _)) = s.recv_from(&mut buf) {
+                if matches!(Packet::decode(&buf[..n]), Ok(Packet::Welcome { .. })) {
+                    break;
+                }
+            }
+        }
+        s.set_read_timeout(Some(Duration::from_millis(200)))
+            .unwrap();
+        let sample = |seq: u64, z: f64| {
+            Packet::Sample(Sample {
+                seq,
+                device_time_ns: seq * 1_000_000,
+                position_m: [0.0, 0.0, z],
+                buttons: 0,
+            })
+            .encode()
+        };
+        let mut replies = Vec::new();
+        let mut send = |b: &[u8], answered: bool| {
+            s.send_to(b, addr).unwrap();
+            if answered {
+                // The answer to this sample (stale ticks may answer the previous one first).
+                loop {
+                    let (n, _) = s.recv_from(&mut buf).unwrap();
+                    if let Ok(Packet::Force(f)) = Packet::decode(&buf[..n]) {
+                        replies.push(f);
+                        if f.seq
+                            == Packet::decode(b).map_or(0, |p| match p {
+                                Packet::Sample(x) => x.seq,
+                                _ => 0,
+                            })
+                        {
+                            break;
+                        }
+                    }
+                }
+            } else {
+                std::thread::sleep(Duration::from_millis(3));
+            }
+        };
+        send(&sample(0, 0.0), true);
+        send(&sample(0, 0.0), false); // duplicate
+        send(&sample(2, 0.0), true); // seq 1 lost in transit
+        send(&sample(1, 0.0), false); // reordered
+        send(b"hello world, not a packet", false); // malformed (magic)
+        let mut v = sample(3, 0.0);
+        v[4] = 7;
+        send(&v, false); // malformed (version)
+        send(&sample(3, 0.0)[..40], false); // malformed (too short)
+        send(&vec![0u8; 1500], false); // oversized
+        let stranger = UdpSocket::bind("127.0.0.1:0").unwrap();
+        stranger.send_to(&sample(9, 0.0), addr).unwrap(); // not the device
+        std::thread::sleep(Duration::from_millis(3));
+        send(&sample(3, f64::NAN), true); // a valid packet with an invalid reading
+        send(&sample(4, -0.006), true); // 1 mm into the wall
+        s.send_to(&Packet::Bye { reason: 0 }.encode(), addr)
+            .unwrap();
+        replies
+    };
+    let h = std::thread::spawn(move || run_session(&opts, &mut |_, _| {}));
+    let replies = client();
+    let r = h.join().unwrap().unwrap();
+    assert_eq!(r.end, "device_ended");
+    for (name, n) in [
+        ("received", 4),
+        ("duplicate", 1),
+        ("reordered", 1),
+        ("lost_in_transit", 1),
+        ("malformed", 3),
+        ("oversized", 1),
+        ("stranger", 1),
+        ("hellos", 1),
+    ] {
+        assert_eq!(counter(&r, name), n, "{name}");
+    }
+    let nan = replies.iter().find(|f| f.seq == 3).unwrap();
+    assert_eq!(nan.force_n, [0.0; 3]);
+    assert_ne!(nan.status & status::INPUT_INVALID, 0);
+    let last = replies.last().unwrap();
+    assert_eq!(last.seq, 4);
+    assert!(last.force_n.iter().all(|f| f.is_finite()));
+    assert_replays(&out);
+}
+
+#[test]
+fn a_device_process_that_restarts_is_welcomed_again() {
+    let addr = free_port();
+    let out = tmp("restart.mcap");
+    let mut first = fake(addr);
+    first.seconds = Some(0.5);
+    first.bye = false;
+    let mut second = fake(addr);
+    second.seconds = Some(0.5);
+    let (r, dev) = session_with(bridged(addr, &out), move || {
+        let a = run_fake(&first, None).unwrap();
+        std::thread::sleep(Duration::from_millis(30));
+        let b = run_fake(&second, None).unwrap();
+        FakeReport {
+            sent: a.sent + b.sent,
+            ..b
+        }
+    });
+    assert_eq!(counter(&r, "hellos"), 2);
+    assert_eq!(counter(&r, "received"), dev.sent);
+    // The 30 ms gap is longer than the watchdog's 10 ms: the link was lost and resumed.
+    assert!(r.arrays.events.iter().any(|e| e.1 == "device.lost"));
+    assert!(r.arrays.events.iter().any(|e| e.1 == "device.resumed"));
+    assert_replays(&out);
+}
+
+#[test]
+fn no_device_is_a_clear_error_after_the_wait() {
+    let addr = free_port();
+    let mut o = bridged(addr, &tmp("none.mcap"));
+    if let Some(b) = o.bridge.as_mut() {
+        b.wait_s = 0.2;
+    }
+    let e = run_session(&o, &mut |_, _| {}).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!("device: device link: no device said hello on udp:{addr} within 0.2 s")
+    );
+    assert_eq!(
+        BridgeConfig::parse("udp:localhost")
+            .unwrap_err()
+            .to_string(),
+        "device link: --device `udp:localhost`: `localhost` is not an IP address and port (e.g. 127.0.0.1:9870)"
+    );
+}
