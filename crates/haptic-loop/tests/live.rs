@@ -1,0 +1,114 @@
+//! The live view: a Foxglove WebSocket client (the `foxglove.sdk.v1` subprotocol) connects to a
+//! running session and receives the 3D scene (one entity per body, real timestamps), the cursor
+//! frame and the plotted state.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use foxglove::Decode;
+use foxglove::schemas::SceneUpdate;
+use haptic_loop::live::LiveConfig;
+use haptic_loop::session::{SceneSource, SessionOptions, run_session};
+use std::collections::BTreeMap;
+use std::net::TcpListener;
+use std::path::Path;
+use std::time::{Duration, Instant};
+use tungstenite::client::IntoClientRequest;
+use tungstenite::{Message, connect};
+
+#[test]
+fn a_foxglove_client_receives_the_scene_while_the_session_runs() {
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut o =
+        SessionOptions::new(SceneSource::from_path(&root.join("scenes/wall.toml")).unwrap());
+    o.realtime = true;
+    o.seconds = Some(3.0);
+    o.live = Some(LiveConfig::parse(&format!("ws:127.0.0.1:{port}")).unwrap());
+    let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}).unwrap());
+
+    // Connect (the server starts before the first tick).
+    let t0 = Instant::now();
+    let mut ws = loop {
+        let mut req = format!("ws://127.0.0.1:{port}")
+            .into_client_request()
+            .unwrap();
+        req.headers_mut()
+            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+        match connect(req) {
+            Ok((ws, _)) => break ws,
+            Err(_) if t0.elapsed() < Duration::from_secs(10) => {
+                std::thread::sleep(Duration::from_millis(20))
+            }
+            Err(e) => panic!("cannot connect: {e}"),
+        }
+    };
+    // Channel advertisements (JSON text), then subscribe by topic.
+    let mut channels: BTreeMap<String, u64> = BTreeMap::new();
+    while channels.len() < 4 {
+        if let Message::Text(t) = ws.read().unwrap() {
+            let j: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
+            if j["op"] == "advertise" {
+                for c in j["channels"].as_array().unwrap() {
+                    channels.insert(
+                        c["topic"].as_str().unwrap().to_string(),
+                        c["id"].as_u64().unwrap(),
+                    );
+                }
+            }
+        }
+    }
+    for t in [
+        "/foxglove/scene",
+        "/foxglove/tf",
+        "/foxglove/log",
+        "/live/state",
+    ] {
+        assert!(channels.contains_key(t), "{t} not advertised: {channels:?}");
+    }
+    let subs: Vec<_> = ["/foxglove/scene", "/live/state"]
+        .iter()
+        .enumerate()
+        .map(|(i, t)| serde_json::json!({"id": i as u32 + 1, "channelId": channels[*t]}))
+        .collect();
+    ws.send(Message::text(
+        serde_json::json!({"op": "subscribe", "subscriptions": subs}).to_string(),
+    ))
+    .unwrap();
+    let (mut scene, mut state) = (None, None);
+    while scene.is_none() || state.is_none() {
+        if let Message::Binary(b) = ws.read().unwrap() {
+            // opcode 1: message data = subscription u32, log time u64, payload
+            assert_eq!(b[0], 1);
+            let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
+            let log_time = u64::from_le_bytes(b[5..13].try_into().unwrap());
+            let payload = b[13..].to_vec();
+            match sub {
+                1 => scene = Some((log_time, SceneUpdate::decode(payload.as_slice()).unwrap())),
+                _ => state = Some(serde_json::from_slice::<serde_json::Value>(&payload).unwrap()),
+            }
+        }
+    }
+    let (log_time, scene) = scene.unwrap();
+    // Timestamps are the session's real start plus tick time (after 2024-01-01), not 1970.
+    assert!(log_time > 1_704_067_200_000_000_000, "{log_time}");
+    let ts = scene.entities[0].timestamp.unwrap();
+    assert_eq!(
+        u64::from(ts.sec()) * 1_000_000_000 + u64::from(ts.nsec()),
+        log_time
+    );
+    // One entity per body: the wall (a box), the cursor (a sphere) and its label apart.
+    let ids: Vec<&str> = scene.entities.iter().map(|e| e.id.as_str()).collect();
+    assert_eq!(ids, ["box_0", "sphere_0", "label_0"]);
+    assert_eq!(scene.entities[1].spheres.len(), 1);
+    let state = state.unwrap();
+    assert!(state["device_force_norm_n"].as_f64().unwrap() >= 0.0);
+    assert!(state["tick"].as_u64().is_some());
+    drop(ws);
+    let r = session.join().unwrap();
+    let live = r.live.unwrap();
+    assert!(live.scenes >= 100, "{live:?}");
+    assert_eq!(live.dropped, 0);
+}
