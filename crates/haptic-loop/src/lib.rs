@@ -40,6 +40,7 @@ pub mod replay;
 pub mod runner;
 pub mod scene;
 pub mod session;
+pub mod stepper;
 pub mod vec3;
 
 pub use device::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};

@@ -1,0 +1,207 @@
+//! A session driven one tick at a time from outside (a Python driver, a notebook, a test), as
+//! `mujoco.mj_step` is: the caller hands in each device reading and gets the force back. The
+//! same sinks as every other session (recorder, per-tick arrays) see each tick, so a stepped
+//! session records and replays bit for bit like any other.
+//!
+//! ```
+//! use haptic_loop::stepper::{Stepper, StepperOptions};
+//! use haptic_loop::session::SceneSource;
+//! use haptic_loop::{Buttons, DeviceSample};
+//! let scene = SceneSource::from_path("../../scenes/wall.toml".as_ref()).unwrap();
+//! let mut s = Stepper::new(StepperOptions::new(scene)).unwrap();
+//! for k in 0..500 {
+//!     let z = -0.001 * k as f64 / 100.0; // press 5 mm down over 0.5 s
+//!     let f = s.tick(DeviceSample::new([0.0, 0.0, z], Buttons(0))).unwrap().device_force_n;
+//!     assert!(f[2] >= 0.0);
+//! }
+//! let report = s.finish().unwrap();
+//! assert_eq!(report.arrays.tick.len(), 500);
+//! ```
+
+use crate::arrays::SessionArrays;
+use crate::device::{DeviceModel, DeviceSample, ForceCommand};
+use crate::haptic::{HapticLoop, TickResult};
+use crate::pacing::{Percentiles, TickStats};
+use crate::record::WriteSummary;
+use crate::record::messages::{self, DescriptionMsg};
+use crate::record::sink::RecorderSink;
+use crate::runner::{SessionInfo, Sink, TickView, deliver};
+use crate::scene::{SceneFile, load_scene};
+use crate::session::{SceneSource, SessionError, now_unix_ns};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Options of a stepped session.
+#[derive(Clone, Debug)]
+pub struct StepperOptions {
+    /// The scene.
+    pub scene: SceneSource,
+    /// Device model overriding the scene file's.
+    pub device: Option<DeviceModel>,
+    /// Record to this MCAP file.
+    pub out: Option<PathBuf>,
+    /// Keep the per-tick arrays.
+    pub arrays: bool,
+    /// Session start, ns since the Unix epoch (`None`: now).
+    pub start_time_ns: Option<u64>,
+    /// How the caller is connected, as written in the recording (`python`).
+    pub link: String,
+}
+
+impl StepperOptions {
+    /// A stepped session of `scene` keeping arrays, not recorded.
+    pub fn new(scene: SceneSource) -> Self {
+        StepperOptions {
+            scene,
+            device: None,
+            out: None,
+            arrays: true,
+            start_time_ns: None,
+            link: "python".into(),
+        }
+    }
+}
+
+/// What a stepped session produced.
+#[derive(Debug)]
+pub struct StepperReport {
+    /// The session's description (as recorded).
+    pub description: DescriptionMsg,
+    /// Per-tick arrays (empty when turned off).
+    pub arrays: SessionArrays,
+    /// Tick-time statistics (work of each `tick` call).
+    pub stats: TickStats,
+    /// What the writer did, when recording.
+    pub written: Option<WriteSummary>,
+}
+
+/// A session stepped by its caller.
+pub struct Stepper {
+    lp: HapticLoop,
+    description: DescriptionMsg,
+    arrays: Option<SessionArrays>,
+    recorder: Option<RecorderSink>,
+    compute: Vec<u64>,
+    started: Instant,
+}
+
+impl Stepper {
+    /// Builds the scene and starts the sinks (the recording file is created now).
+    pub fn new(opts: StepperOptions) -> Result<Self, SessionError> {
+        let file = SceneFile::parse(&opts.scene.text)?;
+        let model = opts.device.unwrap_or(file.device.model);
+        let loaded = load_scene(&opts.scene.text, Some(model))?;
+        let specs = loaded.config.specs.clone();
+        let fields = loaded.scene.state_fields();
+        if let Some(bad) = fields.iter().find(|f| !messages::valid_field_name(f)) {
+            return Err(SessionError::StateField(bad.clone()));
+        }
+        let rate = loaded.config.rate_hz;
+        let description = DescriptionMsg {
+            format: messages::FORMAT_VERSION.to_string(),
+            scene_name: loaded.file.scene.name.clone(),
+            scene_kind: loaded.scene.kind().to_string(),
+            scene_toml: opts.scene.text.clone(),
+            device_model: specs.name.to_string(),
+            rate_hz: rate,
+            mode: "stepped".into(),
+            script_name: String::new(),
+            script_toml: String::new(),
+            operator: opts.link.clone(),
+            state_fields: fields.clone(),
+            start_time_ns: opts.start_time_ns.unwrap_or_else(now_unix_ns),
+            device_link: opts.link.clone(),
+            device_max_force_n: specs.max_force_n,
+            device_max_stiffness_n_per_m: specs.max_stiffness_n_per_m,
+            device_workspace_radius_m: specs.workspace_radius_m,
+            device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
+        };
+        let lp = HapticLoop::new(loaded.config, loaded.scene);
+        let mut arrays = opts.arrays.then(|| SessionArrays::new(rate, fields));
+        let mut recorder = opts.out.clone().map(RecorderSink::new);
+        let info = SessionInfo {
+            description: &description,
+            config: lp.config(),
+            ticks: None,
+        };
+        if let Some(a) = arrays.as_mut() {
+            a.start(&info, &lp)?;
+        }
+        if let Some(r) = recorder.as_mut() {
+            r.start(&info, &lp)?;
+        }
+        Ok(Stepper {
+            lp,
+            description,
+            arrays,
+            recorder,
+            compute: Vec::new(),
+            started: Instant::now(),
+        })
+    }
+
+    /// Runs one tick on `sample` and hands it to the sinks.
+    pub fn tick(&mut self, sample: DeviceSample) -> Result<&TickResult, SessionError> {
+        let t0 = Instant::now();
+        self.lp.tick(sample, false);
+        let compute_ns = t0.elapsed().as_nanos() as u64;
+        let view = TickView {
+            sample,
+            deadline_missed: false,
+            result: self.lp.last_result(),
+            lp: &self.lp,
+            start_late_ns: 0,
+            compute_ns,
+        };
+        let mut sinks: Vec<&mut dyn Sink> = Vec::with_capacity(2);
+        if let Some(a) = self.arrays.as_mut() {
+            sinks.push(a);
+        }
+        if let Some(r) = self.recorder.as_mut() {
+            sinks.push(r);
+        }
+        deliver(&mut sinks, &view)?;
+        self.compute.push(t0.elapsed().as_nanos() as u64);
+        Ok(self.lp.last_result())
+    }
+
+    /// The command for the device after the last tick (force, local stiffness, status).
+    pub fn command(&self) -> ForceCommand {
+        self.lp.command(0)
+    }
+
+    /// The loop (configuration, scene state, drawing).
+    pub fn haptic_loop(&self) -> &HapticLoop {
+        &self.lp
+    }
+
+    /// The session's description.
+    pub fn description(&self) -> &DescriptionMsg {
+        &self.description
+    }
+
+    /// Per-tick arrays so far (`None` when turned off).
+    pub fn arrays(&self) -> Option<&SessionArrays> {
+        self.arrays.as_ref()
+    }
+
+    /// Ends the session: closes the recording and returns what it produced.
+    pub fn finish(mut self) -> Result<StepperReport, SessionError> {
+        let stats = TickStats {
+            ticks: self.lp.next_tick(),
+            compute: Percentiles::of(&self.compute),
+            jitter: Percentiles::default(),
+            missed: 0,
+            wall_s: self.started.elapsed().as_secs_f64(),
+        };
+        if let Some(r) = self.recorder.as_mut() {
+            r.finish(&stats, &[])?;
+        }
+        Ok(StepperReport {
+            description: self.description,
+            arrays: self.arrays.unwrap_or_default(),
+            stats,
+            written: self.recorder.and_then(|r| r.summary().cloned()),
+        })
+    }
+}
