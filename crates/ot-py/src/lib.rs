@@ -22,6 +22,7 @@ pub mod brick;
 mod convert;
 pub mod envelope;
 mod json;
+pub mod live;
 pub mod nano;
 mod params_dict;
 pub mod session;
@@ -49,6 +50,7 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(envelope::working_envelope_3d, m)?)?;
     m.add_function(wrap_pyfunction!(session::run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(session::read_recording, m)?)?;
+    m.add_class::<live::Session>()?;
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

@@ -19,7 +19,7 @@ use crate::json::{from_py, to_py};
 
 /// File errors as `OSError`, everything else (bad scene, script, options,
 /// corrupt recording) as `ValueError`, with the crate's text.
-fn session_error(e: SessionError) -> PyErr {
+pub(crate) fn session_error(e: SessionError) -> PyErr {
     match e {
         SessionError::Io { .. } | SessionError::Recording(RecordingError::Io { .. }) => {
             PyOSError::new_err(e.to_string())
@@ -28,13 +28,13 @@ fn session_error(e: SessionError) -> PyErr {
     }
 }
 
-fn path_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<PathBuf> {
+pub(crate) fn path_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<PathBuf> {
     obj.extract::<PathBuf>()
         .map_err(|_| PyValueError::new_err(format!("{name}: expected a path (str or os.PathLike)")))
 }
 
 /// Per-tick arrays as a dict of numpy arrays.
-fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let time = a.time_s();
     let n = a.tick.len();
@@ -61,6 +61,19 @@ fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<Bound<'py, P
     d.set_item("world_force_n", array2_flat(py, v3(a.world_force_n), 3)?)?;
     d.set_item("device_force_n", array2_flat(py, v3(a.device_force_n), 3)?)?;
     d.set_item("engagement", PyArray1::from_vec(py, a.engagement))?;
+    d.set_item("watchdog", PyArray1::from_vec(py, a.watchdog))?;
+    let k: Vec<f64> = a.device_stiffness_n_per_m.into_iter().flatten().collect();
+    let rows = k.len() / 9;
+    d.set_item(
+        "device_stiffness_n_per_m",
+        PyArray1::from_vec(py, k).reshape([rows, 3, 3])?,
+    )?;
+    let seq: Vec<i64> = a.device_seq.iter().map(|&s| s as i64).collect();
+    d.set_item("device_seq", PyArray1::from_vec(py, seq))?;
+    d.set_item(
+        "device_age_ticks",
+        PyArray1::from_vec(py, a.device_age_ticks),
+    )?;
     d.set_item("status", PyArray1::from_vec(py, a.status))?;
     let ev = PyList::empty(py);
     for (t, name, detail) in a.events {
