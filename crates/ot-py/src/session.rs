@@ -2,6 +2,7 @@
 //! get per-tick arrays back; read an MCAP recording into the same arrays.
 
 use haptic_loop::DeviceModel;
+use haptic_loop::bridge::BridgeConfig;
 use haptic_loop::device::OperatorParams;
 use haptic_loop::record::RecordingError;
 use haptic_loop::session::{
@@ -103,18 +104,28 @@ fn operator_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OperatorChoice> 
     Ok(OperatorChoice::Hand(from_py(obj, "operator")?))
 }
 
-fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<DeviceModel>> {
+/// The `device` argument: a model name, or `udp:HOST:PORT` for a device in another process.
+enum DeviceArg {
+    Model(Option<DeviceModel>),
+    Bridge(BridgeConfig),
+}
+
+fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceArg> {
+    let allowed = "allowed \"falcon\", \"touch\" or \"udp:HOST:PORT\"";
     match obj {
-        None => Ok(None),
+        None => Ok(DeviceArg::Model(None)),
         Some(o) => {
-            let name: String = o.extract().map_err(|_| {
-                PyValueError::new_err("device: allowed \"falcon\" or \"touch\"".to_string())
-            })?;
+            let name: String = o
+                .extract()
+                .map_err(|_| PyValueError::new_err(format!("device: {allowed}")))?;
             match name.as_str() {
-                "falcon" => Ok(Some(DeviceModel::Falcon)),
-                "touch" => Ok(Some(DeviceModel::Touch)),
+                "falcon" => Ok(DeviceArg::Model(Some(DeviceModel::Falcon))),
+                "touch" => Ok(DeviceArg::Model(Some(DeviceModel::Touch))),
+                udp if udp.starts_with("udp:") => BridgeConfig::parse(udp)
+                    .map(DeviceArg::Bridge)
+                    .map_err(|e| PyValueError::new_err(format!("device = {udp:?}: {e}"))),
                 other => Err(PyValueError::new_err(format!(
-                    "device = {other:?}: allowed \"falcon\" or \"touch\""
+                    "device = {other:?}: {allowed}"
                 ))),
             }
         }
@@ -135,8 +146,12 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<DeviceModel
 ///         parameters, pushed by the rendered force) or a dict of hand
 ///         parameters (mass_kg, stiffness_n_per_m, damping_n_s_per_m,
 ///         yield_force_n).
-///     device: None (the scene's), "falcon" or "touch".
+///     device: None (the scene's), "falcon", "touch", or "udp:HOST:PORT":
+///         wait there for a device in another process (see
+///         ``nanohaptics.bridge``) and run in real time against it until it
+///         says goodbye or ``seconds`` pass.
 ///     out: path of an MCAP recording to write, or None.
+///     wait_s: how long to wait for a bridged device's hello, s.
 ///
 /// Returns:
 ///     dict: "rate_hz", "state_fields" (names of the state columns), per-tick
@@ -148,7 +163,8 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<DeviceModel
 ///     "start_late_ns", "events" [(tick, name, detail)], and "stats" (tick
 ///     timing). The GIL is released while the session runs.
 #[pyfunction]
-#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments
+#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None, wait_s=120.0))]
 pub fn run_scene<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -157,7 +173,13 @@ pub fn run_scene<'py>(
     operator: Option<&Bound<'py, PyAny>>,
     device: Option<&Bound<'py, PyAny>>,
     out: Option<&Bound<'py, PyAny>>,
+    wait_s: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
+        return Err(PyValueError::new_err(format!(
+            "wait_s = {wait_s}: allowed 0–86400 s"
+        )));
+    }
     let scene_path = path_arg(scene, "scene")?;
     let source = SceneSource::from_path(&scene_path).map_err(session_error)?;
     let mut opts = SessionOptions::new(source);
@@ -169,7 +191,13 @@ pub fn run_scene<'py>(
     }
     opts.seconds = seconds;
     opts.operator = operator_from_py(operator)?;
-    opts.device = device_from_py(device)?;
+    match device_from_py(device)? {
+        DeviceArg::Model(m) => opts.device = m,
+        DeviceArg::Bridge(mut b) => {
+            b.wait_s = wait_s;
+            opts.bridge = Some(b);
+        }
+    }
     opts.out = match out {
         Some(o) => Some(path_arg(o, "out")?),
         None => None,
@@ -178,8 +206,12 @@ pub fn run_scene<'py>(
         .detach(|| run_session(&opts, &mut |_, _| {}))
         .map_err(session_error)?;
     let stats = to_py(py, &report.stats)?;
+    let link: std::collections::BTreeMap<&str, u64> = report.link.iter().copied().collect();
+    let link = to_py(py, &link)?;
     let d = arrays_to_py(py, report.arrays)?;
     d.set_item("stats", stats)?;
+    d.set_item("link", link)?;
+    d.set_item("end", report.end)?;
     Ok(d)
 }
 

@@ -1,0 +1,425 @@
+"""A device in this process, a simulator in another: the nanohaptics device bridge.
+
+The simulator (``nanohaptics run SCENE --device udp:HOST:PORT``, or
+``nanohaptics.run_scene(SCENE, device="udp:HOST:PORT")``) listens on UDP; a
+device process says hello with its specifications, then sends one sample per
+servo period and gets a force (N) and a local stiffness (N/m, 3×3) back for
+each. The byte layout is in ``docs/device-bridge.md``; this module is its
+Python client, plus adapters for real devices through their Python SDKs:
+
+* :class:`TouchDevice` — 3D Systems Touch / Phantom Omni through
+  ``pyOpenHaptics`` (OpenHaptics HD API);
+* :class:`ForceDimensionDevice` — Force Dimension devices and the Novint
+  Falcon through ``forcedimension_core`` (Force Dimension SDK).
+
+The SDKs are imported only when an adapter is created. Every adapter renders,
+between packets and at its own servo rate, ``F = F0 − K (p − p0)`` from the
+last answer (the force F0 computed at p0 and the stiffness K), and zero force
+once answers stop for longer than ``hold_s`` (the simulator's watchdog does
+the same on its side).
+
+Units: metres, newtons, N/m, seconds, in the device frame.
+"""
+
+from __future__ import annotations
+
+import math
+import socket
+import struct
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import List, Optional, Sequence, Tuple
+
+__all__ = [
+    "MAGIC",
+    "VERSION",
+    "Specs",
+    "ForceReply",
+    "BridgeClient",
+    "Device",
+    "TouchDevice",
+    "ForceDimensionDevice",
+    "encode_hello",
+    "encode_sample",
+    "decode",
+    "run",
+]
+
+MAGIC = b"NHDB"
+VERSION = 1
+HELLO, WELCOME, SAMPLE, FORCE, BYE = 1, 2, 3, 4, 5
+_HEADER = struct.Struct("<4sBBH")  # magic, version, type, reserved
+_SAMPLE = struct.Struct("<QQdddI")  # seq, device time ns, x, y, z, buttons
+_FORCE = struct.Struct("<QQ3d9dB")  # seq answered, tick, force, stiffness, status
+
+
+@dataclass
+class Specs:
+    """What a device announces in its hello."""
+
+    name: str
+    max_force_n: float
+    max_stiffness_n_per_m: float
+    workspace_radius_m: float
+    buttons: List[str] = field(default_factory=list)
+    rate_hz: int = 1000
+
+
+@dataclass
+class ForceReply:
+    """The simulator's answer to one sample."""
+
+    seq: int
+    tick: int
+    force_n: Tuple[float, float, float]
+    stiffness_n_per_m: Tuple[float, ...]  # 9 values, row-major 3x3
+    status: int
+    received_at: float = 0.0  # time.perf_counter() on arrival, s
+
+
+def _string(s: str) -> bytes:
+    b = s.encode("utf-8")[:255]
+    return bytes([len(b)]) + b
+
+
+def encode_hello(specs: Specs) -> bytes:
+    """The hello datagram of a device with ``specs``."""
+    body = struct.pack(
+        "<Iddd",
+        specs.rate_hz,
+        specs.max_force_n,
+        specs.max_stiffness_n_per_m,
+        specs.workspace_radius_m,
+    )
+    body += _string(specs.name) + bytes([len(specs.buttons)])
+    body += b"".join(_string(b) for b in specs.buttons)
+    return _HEADER.pack(MAGIC, VERSION, HELLO, 0) + body
+
+
+def encode_sample(seq: int, device_time_ns: int, position_m: Sequence[float], buttons: int) -> bytes:
+    """A sample datagram: position in metres (device frame), button bits."""
+    x, y, z = (float(v) for v in position_m)
+    return _HEADER.pack(MAGIC, VERSION, SAMPLE, 0) + _SAMPLE.pack(
+        seq, device_time_ns, x, y, z, buttons
+    )
+
+
+def encode_bye(reason: int = 0) -> bytes:
+    """A goodbye datagram (0: end of session, 1: error)."""
+    return _HEADER.pack(MAGIC, VERSION, BYE, 0) + bytes([reason])
+
+
+def decode(data: bytes):
+    """Decode a datagram from the simulator: ``("welcome", dict)``,
+    ``("force", ForceReply)`` or ``("bye", reason)``. Raises ValueError
+    naming what is wrong for anything else."""
+    if len(data) < _HEADER.size:
+        raise ValueError(f"packet of {len(data)} bytes is shorter than the 8-byte header")
+    magic, version, kind, _ = _HEADER.unpack_from(data)
+    if magic != MAGIC:
+        raise ValueError(f"bad magic {magic!r} (expected b'NHDB')")
+    if version != VERSION:
+        raise ValueError(f"protocol version {version} (this client speaks {VERSION})")
+    body = data[_HEADER.size:]
+    if kind == WELCOME:
+        if len(body) < 13:
+            raise ValueError("welcome packet too short")
+        rate, start = struct.unpack_from("<IQ", body)
+        n = body[12]
+        return "welcome", {
+            "rate_hz": rate,
+            "start_time_ns": start,
+            "scene": body[13:13 + n].decode("utf-8", "replace"),
+        }
+    if kind == FORCE:
+        if len(body) != _FORCE.size:
+            raise ValueError(f"force packet of {len(data)} bytes (expected {8 + _FORCE.size})")
+        v = _FORCE.unpack(body)
+        return "force", ForceReply(v[0], v[1], tuple(v[2:5]), tuple(v[5:14]), v[14])
+    if kind == BYE:
+        return "bye", body[0] if body else 0
+    raise ValueError(f"unexpected packet type {kind}")
+
+
+class BridgeClient:
+    """The device side of the bridge over one UDP socket.
+
+    >>> c = BridgeClient(("127.0.0.1", 9870), Specs("falcon", 8.0, 3000.0, 0.04,
+    ...                  ["centre", "plus", "minus", "forward"]))      # doctest: +SKIP
+    >>> c.connect()   # hello until welcome                            # doctest: +SKIP
+    >>> c.send(position_m=(0, 0, 0), buttons=0)                        # doctest: +SKIP
+    >>> reply = c.receive(timeout_s=0.002)                             # doctest: +SKIP
+    """
+
+    def __init__(self, address: Tuple[str, int], specs: Specs):
+        self.address = (socket.gethostbyname(address[0]), int(address[1]))
+        self.specs = specs
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind(("0.0.0.0", 0))
+        self.seq = 0
+        self.welcome: Optional[dict] = None
+        self.ended = False
+        self._t0 = time.perf_counter_ns()
+
+    def connect(self, timeout_s: float = 30.0) -> dict:
+        """Say hello every 50 ms until the simulator welcomes this device;
+        returns the welcome (rate_hz, start_time_ns, scene)."""
+        hello = encode_hello(self.specs)
+        deadline = time.monotonic() + timeout_s
+        self.sock.settimeout(0.05)
+        while time.monotonic() < deadline:
+            try:
+                self.sock.sendto(hello, self.address)
+                data, src = self.sock.recvfrom(2048)
+            except (socket.timeout, ConnectionRefusedError):
+                continue
+            if src != self.address:
+                continue
+            kind, value = decode(data)
+            if kind == "welcome":
+                self.welcome = value
+                return value
+        raise TimeoutError(f"no welcome from udp:{self.address[0]}:{self.address[1]} within {timeout_s} s")
+
+    def send(self, position_m: Sequence[float], buttons: int = 0) -> int:
+        """Send one sample; returns its sequence number."""
+        seq = self.seq
+        self.seq += 1
+        t = time.perf_counter_ns() - self._t0
+        self.sock.sendto(encode_sample(seq, t, position_m, buttons), self.address)
+        return seq
+
+    def receive(self, timeout_s: float) -> Optional[ForceReply]:
+        """The next force packet, or None after ``timeout_s``; a goodbye from
+        the simulator sets ``ended``."""
+        self.sock.settimeout(max(timeout_s, 1e-6))
+        while True:
+            try:
+                data, src = self.sock.recvfrom(2048)
+            except (socket.timeout, ConnectionRefusedError):
+                return None
+            at = time.perf_counter()
+            if src != self.address:
+                continue
+            try:
+                kind, value = decode(data)
+            except ValueError:
+                continue
+            if kind == "force":
+                value.received_at = at
+                return value
+            if kind == "bye":
+                self.ended = True
+                return None
+
+    def close(self) -> None:
+        """Say goodbye (the simulator ends the session) and close the socket."""
+        try:
+            self.sock.sendto(encode_bye(0), self.address)
+        finally:
+            self.sock.close()
+
+    def __enter__(self) -> "BridgeClient":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class Device:
+    """What :func:`run` needs of a device. Subclass and implement
+    ``specs``, ``read`` and ``render`` (and ``close`` if the device must be
+    released)."""
+
+    def specs(self) -> Specs:
+        raise NotImplementedError
+
+    def read(self) -> Tuple[Tuple[float, float, float], int]:
+        """Stylus position (m, device frame) and button bits."""
+        raise NotImplementedError
+
+    def render(self, reply: Optional[ForceReply], position_m: Sequence[float]) -> None:
+        """Render the answer (None: no answer, render zero force)."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        pass
+
+
+def local_force(reply: Optional[ForceReply], p0: Sequence[float], p: Sequence[float],
+                max_force_n: float) -> Tuple[float, float, float]:
+    """``F0 − K (p − p0)`` from an answer computed at ``p0``, scaled down to
+    ``max_force_n``; zero without an answer or on non-finite input."""
+    if reply is None:
+        return (0.0, 0.0, 0.0)
+    d = [p[i] - p0[i] for i in range(3)]
+    k = reply.stiffness_n_per_m
+    f = [reply.force_n[i] - sum(k[3 * i + j] * d[j] for j in range(3)) for i in range(3)]
+    if not all(math.isfinite(v) for v in f):
+        return (0.0, 0.0, 0.0)
+    n = math.sqrt(sum(v * v for v in f))
+    if n > max_force_n > 0:
+        f = [v * max_force_n / n for v in f]
+    return (f[0], f[1], f[2])
+
+
+def _percentile(values: List[float], q: float) -> float:
+    if not values:
+        return 0.0
+    v = sorted(values)
+    return v[min(len(v) - 1, max(0, math.ceil(q * len(v)) - 1))]
+
+
+def run(device: Device, address: Tuple[str, int], *, seconds: Optional[float] = None,
+        connect_timeout_s: float = 30.0, stop: Optional[threading.Event] = None) -> dict:
+    """Drive a simulator session with ``device`` until ``seconds`` pass, the
+    simulator says goodbye or ``stop`` is set: each servo period read the
+    device, send the sample, wait up to one period for its answer and render
+    it. Returns counts and the round-trip percentiles (s)."""
+    specs = device.specs()
+    client = BridgeClient(address, specs)
+    rtts: List[float] = []
+    sent = answered = 0
+    try:
+        welcome = client.connect(connect_timeout_s)
+        period = 1.0 / welcome["rate_hz"]
+        t_end = None if seconds is None else time.perf_counter() + seconds
+        next_t = time.perf_counter()
+        last: Optional[ForceReply] = None
+        last_p0 = (0.0, 0.0, 0.0)
+        while not client.ended and not (stop is not None and stop.is_set()):
+            now = time.perf_counter()
+            if t_end is not None and now >= t_end:
+                break
+            p, b = device.read()
+            t_send = time.perf_counter()
+            seq = client.send(p, b)
+            sent += 1
+            reply = client.receive(period)
+            while reply is not None and reply.seq < seq:
+                reply = client.receive(max(0.0, t_send + period - time.perf_counter()))
+            if reply is not None and reply.seq == seq:
+                answered += 1
+                rtts.append(reply.received_at - t_send)
+                last, last_p0 = reply, p
+            device.render(last, last_p0)
+            next_t += period
+            delay = next_t - time.perf_counter()
+            if delay > 0:
+                time.sleep(delay)
+            else:
+                next_t = time.perf_counter()
+    finally:
+        device.render(None, (0.0, 0.0, 0.0))
+        client.close()
+        device.close()
+    return {
+        "sent": sent,
+        "answered": answered,
+        "round_trip_p50_s": _percentile(rtts, 0.5),
+        "round_trip_p99_s": _percentile(rtts, 0.99),
+    }
+
+
+class TouchDevice(Device):
+    """A 3D Systems Touch (Phantom Omni class) through ``pyOpenHaptics``.
+
+    OpenHaptics reports millimetres in its own frame; this adapter reports
+    metres. A servo callback of the HD scheduler (1 kHz) renders the local
+    force ``F0 − K (p − p0)`` of the last answer between packets.
+    """
+
+    def __init__(self, device_name: str = "Default Device", *, hold_s: float = 0.01,
+                 max_force_n: float = 3.3, max_stiffness_n_per_m: float = 400.0,
+                 workspace_radius_m: float = 0.075):
+        try:
+            import pyOpenHaptics.hd as hd
+            from pyOpenHaptics.hd_callback import hd_callback
+            from pyOpenHaptics.hd_device import HapticDevice
+        except ImportError as e:  # pragma: no cover - depends on the machine
+            raise ImportError(
+                "TouchDevice needs pyOpenHaptics and the OpenHaptics runtime: "
+                "pip install pyOpenHaptics (see docs/device-bridge.md)"
+            ) from e
+        self._hd = hd
+        self._lock = threading.Lock()
+        self._position = (0.0, 0.0, 0.0)
+        self._buttons = 0
+        self._reply: Optional[ForceReply] = None
+        self._p0 = (0.0, 0.0, 0.0)
+        self._reply_at = 0.0
+        self.hold_s = hold_s
+        self._specs = Specs("touch", max_force_n, max_stiffness_n_per_m, workspace_radius_m,
+                            ["button1", "button2"])
+
+        @hd_callback
+        def servo():
+            t = hd.get_transform()
+            p = (t[3][0] * 1e-3, t[3][1] * 1e-3, t[3][2] * 1e-3)
+            b = int(hd.get_buttons())
+            with self._lock:
+                self._position, self._buttons = p, b
+                fresh = time.perf_counter() - self._reply_at <= self.hold_s
+                f = local_force(self._reply if fresh else None, self._p0, p, self._specs.max_force_n)
+            hd.set_force(list(f))
+
+        self._device = HapticDevice(callback=servo, device_name=device_name, scheduler_type="async")
+
+    def specs(self) -> Specs:
+        return self._specs
+
+    def read(self):
+        with self._lock:
+            return self._position, self._buttons
+
+    def render(self, reply, position_m):
+        with self._lock:
+            self._reply, self._p0 = reply, tuple(position_m)
+            self._reply_at = time.perf_counter() if reply is not None else 0.0
+
+    def close(self) -> None:
+        self._device.close()
+
+
+class ForceDimensionDevice(Device):
+    """A Force Dimension device (delta, omega, sigma, lambda) or a Novint
+    Falcon through ``forcedimension_core`` (the Force Dimension SDK, which
+    drives the Falcon too). Positions are already in metres."""
+
+    def __init__(self, device_id: Optional[int] = None, *, name: Optional[str] = None,
+                 max_force_n: Optional[float] = None, max_stiffness_n_per_m: float = 3000.0,
+                 workspace_radius_m: float = 0.04, buttons: Sequence[str] = ("centre", "plus", "minus", "forward")):
+        try:
+            from forcedimension_core import dhd
+        except ImportError as e:  # pragma: no cover - depends on the machine
+            raise ImportError(
+                "ForceDimensionDevice needs forcedimension_core and the Force Dimension SDK: "
+                "pip install forcedimension-core (see docs/device-bridge.md)"
+            ) from e
+        self._dhd = dhd
+        self._id = dhd.open() if device_id is None else dhd.openID(device_id)
+        if self._id == -1:
+            raise ConnectionError(f"no Force Dimension device: {dhd.errorGetLastStr()}")
+        dhd.enableForce(True, ID=self._id)
+        sdk_max = dhd.getMaxForce(ID=self._id)
+        fmax = max_force_n if max_force_n is not None else (sdk_max if sdk_max and sdk_max > 0 else 8.0)
+        self._specs = Specs(name or (dhd.getSystemName(ID=self._id) or "forcedimension")[:32],
+                            float(fmax), max_stiffness_n_per_m, workspace_radius_m, list(buttons))
+        self._pos = [0.0, 0.0, 0.0]
+
+    def specs(self) -> Specs:
+        return self._specs
+
+    def read(self):
+        if self._dhd.getPosition(out=self._pos, ID=self._id) == -1:
+            raise IOError(f"getPosition: {self._dhd.errorGetLastStr()}")
+        return (self._pos[0], self._pos[1], self._pos[2]), int(self._dhd.getButtonMask(ID=self._id))
+
+    def render(self, reply, position_m):
+        f = local_force(reply, position_m, tuple(self._pos), self._specs.max_force_n)
+        self._dhd.setForce(list(f), ID=self._id)
+
+    def close(self) -> None:
+        self._dhd.setForce([0.0, 0.0, 0.0], ID=self._id)
+        self._dhd.close(ID=self._id)
