@@ -186,6 +186,10 @@ impl SessionArrays {
 }
 
 impl Sink for SessionArrays {
+    fn name(&self) -> &'static str {
+        "arrays"
+    }
+
     fn start(&mut self, info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SessionError> {
         self.rate_hz = info.config.rate_hz;
         self.state_fields = info.description.state_fields.clone();

@@ -17,9 +17,11 @@
 //! - **missed deadline** (real-time mode): zero force, `deadline.missed` event. The flag is an
 //!   input of the tick (logged with the device input), so replay reproduces it.
 //! - **watchdog** (a bridged device whose samples stop): the sample's age in ticks is an input of
-//!   the tick. While it is within `watchdog_grace_ticks` the force is untouched; then the force
-//!   ramps linearly to zero, reaching zero `watchdog_timeout_ticks` after the last sample
-//!   (default 2 ms grace, 10 ms timeout). Events: `device.sample_late` at the first stale tick of
+//!   the tick (a stale tick of age `a` runs `a + 0.5` periods after the last sample). While the
+//!   age is within `watchdog_grace_ticks` the force is untouched; then it ramps linearly to zero,
+//!   zero from age `watchdog_timeout_ticks` on (defaults at 1 kHz: full force through 1.5 ms,
+//!   zero from 9.5 ms after the last sample: `[loop] watchdog_grace_s = 0.002`,
+//!   `watchdog_timeout_s = 0.010`). Events: `device.sample_late` at the first stale tick of
 //!   an episode, `device.lost` when the force reaches zero, `device.resumed` on the next fresh
 //!   sample; after a loss, soft engagement restarts.
 //! - **local stiffness**: the device also gets the 3×3 stiffness of the rendered field (scaled

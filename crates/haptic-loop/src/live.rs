@@ -262,6 +262,10 @@ fn publish(
 }
 
 impl Sink for LiveSink {
+    fn name(&self) -> &'static str {
+        "live"
+    }
+
     fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
         let c = info.config;
         self.display_every = every(c.rate_hz, self.config.display_hz);

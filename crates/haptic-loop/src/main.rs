@@ -308,6 +308,7 @@ fn summary_json(r: &SessionReport) -> serde_json::Value {
         "link": r.link.iter().map(|(k, v)| (k.to_string(), *v)).collect::<BTreeMap<String, u64>>(),
         "watchdog_ticks": a.status.iter().filter(|s| **s & 32 != 0).count(),
         "live": r.live,
+        "sinks": r.sinks,
     })
 }
 
@@ -337,6 +338,14 @@ fn print_summary(r: &SessionReport) {
         s.jitter.p99_ns as f64 / 1e3,
         s.missed
     );
+    if !r.sinks.is_empty() {
+        let parts: Vec<String> = r
+            .sinks
+            .iter()
+            .map(|t| format!("{} {:.1} µs", t.sink, t.tick.p99_ns as f64 / 1e3))
+            .collect();
+        println!("  sink time per tick, p99: {}", parts.join(", "));
+    }
     if !r.link.is_empty() {
         let parts: Vec<String> = r.link.iter().map(|(k, v)| format!("{k} {v}")).collect();
         println!("  device link: {}", parts.join(", "));

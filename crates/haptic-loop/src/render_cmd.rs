@@ -282,6 +282,10 @@ impl FramesSink<'_> {
 }
 
 impl Sink for FramesSink<'_> {
+    fn name(&self) -> &'static str {
+        "frames"
+    }
+
     fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
         let n = t.result.tick;
         if n % self.every != 0 {

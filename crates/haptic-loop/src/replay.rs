@@ -109,6 +109,10 @@ pub struct VerifySink<'r> {
 }
 
 impl Sink for VerifySink<'_> {
+    fn name(&self) -> &'static str {
+        "verifier"
+    }
+
     fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
         self.enc = Some(TickEncoder::new(lp, info.description.start_time_ns));
         Ok(())

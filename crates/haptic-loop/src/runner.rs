@@ -51,6 +51,8 @@ pub struct SessionInfo<'a> {
 
 /// A consumer of ticks.
 pub trait Sink {
+    /// Short name for reports (`recorder`, `arrays`, `live`, ...).
+    fn name(&self) -> &'static str;
     /// Called once before the first tick.
     fn start(&mut self, _info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SessionError> {
         Ok(())
@@ -98,6 +100,16 @@ pub enum EndReason {
 pub struct Runner<'s> {
     sinks: Vec<&'s mut dyn Sink>,
     stop: Option<&'s AtomicBool>,
+    sink_ns: Vec<Vec<u64>>,
+}
+
+/// Time each sink took per tick (its `tick` call), ns.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SinkTime {
+    /// The sink's name.
+    pub sink: &'static str,
+    /// Percentiles of its per-tick time, ns.
+    pub tick: Percentiles,
 }
 
 /// Hands one tick to every sink, in order.
@@ -111,7 +123,12 @@ pub fn deliver(sinks: &mut [&mut dyn Sink], view: &TickView<'_>) -> Result<(), S
 impl<'s> Runner<'s> {
     /// A runner handing ticks to `sinks`, in order.
     pub fn new(sinks: Vec<&'s mut dyn Sink>) -> Self {
-        Runner { sinks, stop: None }
+        let n = sinks.len();
+        Runner {
+            sinks,
+            stop: None,
+            sink_ns: vec![Vec::new(); n],
+        }
     }
 
     /// Stops the run cleanly (after the current tick) when `flag` becomes true.
@@ -202,7 +219,11 @@ impl<'s> Runner<'s> {
                 start_late_ns: late,
                 compute_ns,
             };
-            deliver(&mut self.sinks, &view)?;
+            for (s, times) in self.sinks.iter_mut().zip(self.sink_ns.iter_mut()) {
+                let t = Instant::now();
+                s.tick(&view)?;
+                times.push(t.elapsed().as_nanos() as u64);
+            }
             // The hand-off to the sinks belongs to the tick's cost.
             compute.push(t0.elapsed().as_nanos() as u64);
             if timed && n > 0 {
@@ -225,5 +246,17 @@ impl<'s> Runner<'s> {
             s.finish(&stats, &link)?;
         }
         Ok((stats, end))
+    }
+
+    /// How long each sink took per tick in the last run (the servo tick pays for it).
+    pub fn sink_times(&self) -> Vec<SinkTime> {
+        self.sinks
+            .iter()
+            .zip(&self.sink_ns)
+            .map(|(s, t)| SinkTime {
+                sink: s.name(),
+                tick: Percentiles::of(t),
+            })
+            .collect()
     }
 }

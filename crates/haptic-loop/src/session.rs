@@ -179,6 +179,8 @@ pub struct SessionReport {
     pub link: Vec<(&'static str, u64)>,
     /// What the live view published, when serving one.
     pub live: Option<crate::live::LiveSummary>,
+    /// Time each sink took per tick, ns.
+    pub sinks: Vec<crate::runner::SinkTime>,
 }
 
 /// Reads the script text for a local device: the given one or the scene's default script.
@@ -342,6 +344,8 @@ fn run_with_device(
         runner = runner.stop_on(f);
     }
     let (stats, end) = runner.run(&mut lp, dev, &description, ticks, pacing, progress)?;
+    let sink_times = runner.sink_times();
+    drop(runner);
     if stats.ticks == 0 {
         return Err(SessionError::Option(
             "the session ended before its first tick (no device sample arrived)".into(),
@@ -359,6 +363,7 @@ fn run_with_device(
         },
         link: dev.link_counters(),
         live: live.map(|l| l.summary()),
+        sinks: sink_times,
     })
 }
 

@@ -135,24 +135,25 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
         .unwrap();
     let f0 = vec3::norm(a.device_force_n[last_fresh]);
     assert!(f0 > 4.0, "in contact when the device vanished: {f0} N");
-    // Full force through the 2 ms grace, then a linear ramp, zero from 10 ms on.
+    // Full force through the grace (the tick of age 1 runs 1.5 ms after the last sample), then
+    // a linear ramp, zero from age 9 (9.5 ms) on: within the 10 ms timeout.
     for k in 1..=30 {
         let i = last_fresh + k;
         let f = vec3::norm(a.device_force_n[i]);
         assert_eq!(a.device_age_ticks[i], k as u32);
-        let expected = if k <= 2 {
+        let expected = if k <= 1 {
             1.0
         } else {
-            (10.0 - k as f64).max(0.0) / 8.0
+            (9.0 - k as f64).max(0.0) / 8.0
         };
         assert_eq!(a.watchdog[i], expected, "age {k}");
-        if k >= 10 {
+        if k >= 9 {
             assert_eq!(f, 0.0, "age {k} ms: {f} N");
             assert_eq!(a.device_stiffness_n_per_m[i], [0.0; 9]);
         }
     }
     let lost = a.events.iter().find(|e| e.1 == "device.lost").unwrap();
-    assert_eq!(lost.0, (last_fresh + 10) as u64);
+    assert_eq!(lost.0, (last_fresh + 9) as u64);
     // It comes back: soft engagement restarts from zero.
     let back = a.events.iter().find(|e| e.1 == "device.resumed").unwrap();
     let b = back.0 as usize;

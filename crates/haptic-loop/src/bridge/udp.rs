@@ -100,6 +100,7 @@ pub struct UdpDevice {
     last: Option<Sample>,
     age: u32,
     prev_start: Option<Instant>,
+    fresh_start: Option<Instant>,
     peer: Option<SocketAddr>,
 }
 
@@ -123,6 +124,7 @@ impl UdpDevice {
             last: None,
             age: 0,
             prev_start: None,
+            fresh_start: None,
             peer: None,
         }
     }
@@ -281,11 +283,11 @@ impl HapticDevice for UdpDevice {
     fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
         let period = Duration::from_secs_f64(time.dt_s);
         // The first tick waits for the first sample; later ones at most 1.5 periods after the
-        // previous tick (one period once the link is already stale).
-        let deadline = match self.prev_start {
+        // last fresh one, and stale ticks follow on an absolute schedule: the tick of age a runs
+        // (a + 0.5) periods after the last sample arrived, so the watchdog's age is wall time.
+        let deadline = match self.fresh_start {
             None => Instant::now() + Duration::from_secs_f64(self.config.wait_s.max(0.0)),
-            Some(p) if self.age == 0 => p + period + period / 2,
-            Some(p) => p + period,
+            Some(f) => f + period.mul_f64(f64::from(self.age) + 1.5),
         };
         let earliest = self.prev_start.map(|p| p + period / 2);
         let shared = self.shared.clone();
@@ -324,11 +326,13 @@ impl HapticDevice for UdpDevice {
             st.c.stale_ticks += 1;
         }
         drop(st);
-        self.prev_start = Some(Instant::now());
+        let now = Instant::now();
+        self.prev_start = Some(now);
         match fresh {
             Some(s) => {
                 self.last = Some(s);
                 self.age = 0;
+                self.fresh_start = Some(now);
             }
             None if self.last.is_none() => {
                 return Err(DeviceError::Link(format!(

@@ -52,6 +52,10 @@ pub fn stats_metadata(stats: &TickStats, mode: &str) -> BTreeMap<String, String>
 }
 
 impl Sink for RecorderSink {
+    fn name(&self) -> &'static str {
+        "recorder"
+    }
+
     fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
         self.recorder = Some(Recorder::create(
             &self.path,

@@ -281,16 +281,21 @@ impl SceneFile {
         }
         check_range("loop.engage_s", l.engage_s, 0.0, 10.0)?;
         check_range("loop.watchdog_grace_s", l.watchdog_grace_s, 0.0, 0.1)?;
+        // A stale tick of age a runs (a + 0.5) periods after the last sample: the grace covers
+        // the ages whose tick is within watchdog_grace_s, and the force is zero from the first
+        // age whose tick is within watchdog_timeout_s of the last sample.
         let rate = f64::from(l.rate_hz);
-        let grace_ticks = (l.watchdog_grace_s * rate).round();
-        let min_timeout = (grace_ticks + 1.0) / rate;
+        let grace_ticks = (l.watchdog_grace_s * rate - 0.5).floor().max(0.0);
+        let min_timeout = (grace_ticks + 1.5) / rate;
         check_range(
             "loop.watchdog_timeout_s",
             l.watchdog_timeout_s,
             min_timeout,
             1.0,
         )?;
-        let timeout_ticks = (l.watchdog_timeout_s * rate).round().max(grace_ticks + 1.0);
+        let timeout_ticks = (l.watchdog_timeout_s * rate - 0.5)
+            .floor()
+            .max(grace_ticks + 1.0);
         let d = &self.display;
         if d.rate_hz == 0 || d.rate_hz > l.rate_hz || l.rate_hz % d.rate_hz != 0 {
             return Err(out_of_range(
@@ -435,6 +440,20 @@ stiffness_n_per_m = 2000.0
             err(&format!("{WALL}[mapping]\nforce_scale = -1.0\n")),
             "scene: `mapping.force_scale` = -1 is out of range (allowed: 1e-6 ≤ \
              mapping.force_scale ≤ 1e18)"
+        );
+        assert_eq!(
+            err(&format!("{WALL}[loop]\nwatchdog_timeout_s = 0.001\n")),
+            "scene: `loop.watchdog_timeout_s` = 0.001 is out of range (allowed: 0.0025 ≤ \
+             loop.watchdog_timeout_s ≤ 1)"
+        );
+        let s = load_scene(&format!("{WALL}[loop]\nrate_hz = 10000\n"), None).unwrap();
+        // At 10 kHz: full force through age 19 (1.95 ms), zero from age 99 (9.95 ms).
+        assert_eq!(
+            (
+                s.config.watchdog_grace_ticks,
+                s.config.watchdog_timeout_ticks
+            ),
+            (19, 99)
         );
         assert_eq!(
             err(&format!("{WALL}[display]\nrate_hz = 30\n")),
