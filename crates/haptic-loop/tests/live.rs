@@ -112,3 +112,51 @@ fn a_foxglove_client_receives_the_scene_while_the_session_runs() {
     assert!(live.scenes >= 100, "{live:?}");
     assert_eq!(live.dropped, 0);
 }
+
+/// The shipped Foxglove layout names only topics and fields the live view publishes.
+#[test]
+fn the_shipped_foxglove_layout_uses_only_published_topics_and_fields() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let text = std::fs::read_to_string(root.join("docs/foxglove/nanohaptics-live.json")).unwrap();
+    let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let topics = ["/foxglove/scene", "/foxglove/tf", "/foxglove/log", "/live/state"];
+    let fields = [
+        "tick",
+        "time_s",
+        "cursor_m",
+        "world_force_n",
+        "device_force_n",
+        "device_force_norm_n",
+        "engagement",
+        "watchdog",
+        "status",
+        "sample_age_ticks",
+        "dropped",
+    ];
+    let mut checked = 0;
+    for (id, panel) in j["configById"].as_object().unwrap() {
+        if let Some(t) = panel["topics"].as_object() {
+            for k in t.keys() {
+                assert!(topics.contains(&k.as_str()), "{id}: {k}");
+                checked += 1;
+            }
+        }
+        if let Some(t) = panel["topicToRender"].as_str() {
+            assert_eq!(t, "/foxglove/log", "{id}");
+            checked += 1;
+        }
+        for p in panel["paths"].as_array().into_iter().flatten() {
+            let v = p["value"].as_str().unwrap();
+            let rest = v.strip_prefix("/live/state.").unwrap_or_else(|| panic!("{id}: {v}"));
+            let field = rest.split('.').next().unwrap();
+            assert!(fields.contains(&field), "{id}: {v}");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 11, "{checked}");
+    // Every panel of the configuration is placed in the layout tree.
+    let layout = j["layout"].to_string();
+    for id in j["configById"].as_object().unwrap().keys() {
+        assert!(layout.contains(id.as_str()), "{id} not in the layout");
+    }
+}
