@@ -5,6 +5,7 @@ naming the argument and its allowed range.
 """
 
 import os
+from types import ModuleType
 from typing import Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -369,14 +370,69 @@ def run_scene(
     script: Optional[PathLike] = None,
     seconds: Optional[float] = None,
     operator: Union[Literal["script", "rigid", "hand"], dict, None] = None,
-    device: Optional[Literal["falcon", "touch"]] = None,
+    device: Union[Literal["falcon", "touch"], str, None] = None,
     out: Optional[PathLike] = None,
+    wait_s: float = 120.0,
 ) -> dict:
-    """Run a scene in batch mode with a script; per-tick arrays: tick, time_s,
-    device_position_m (T, 3), device_buttons, deadline_missed, cursor_m (T, 3),
-    state (T, F) with state_fields, world_force_n (T, 3), device_force_n (T, 3),
-    engagement, status, compute_ns, start_late_ns, events [(tick, name, detail)],
-    rate_hz, stats. Optionally records to `out` (MCAP)."""
+    """Run a scene in batch mode with a script, or in real time against a
+    device in another process (device="udp:HOST:PORT", see nanohaptics.bridge;
+    wait_s: how long to wait for its hello). Per-tick arrays: tick, time_s,
+    device_position_m (T, 3), device_buttons, device_seq, device_age_ticks,
+    deadline_missed, cursor_m (T, 3), state (T, F) with state_fields,
+    world_force_n (T, 3), device_force_n (T, 3), device_stiffness_n_per_m
+    (T, 3, 3), engagement, watchdog, status, compute_ns, start_late_ns,
+    events [(tick, name, detail)], rate_hz, stats (tick timing, "link"
+    counters, "end", per-sink "sinks" timing). Optionally records to `out`."""
 
 def read_recording(path: PathLike, *, salvage: bool = False) -> dict:
     """An MCAP recording as the arrays of run_scene (without stats)."""
+
+class Session:
+    """The haptic loop stepped one tick at a time from Python, with the same
+    recorder and per-tick arrays as every session (replays bit for bit).
+
+    device: None (the scene's), "falcon" or "touch"; out: MCAP path or None.
+    """
+
+    def __init__(
+        self,
+        scene: PathLike,
+        *,
+        device: Optional[Literal["falcon", "touch"]] = None,
+        out: Optional[PathLike] = None,
+        arrays: bool = True,
+    ) -> None: ...
+    def tick(self, position: ArrayLike, buttons: Union[int, Sequence[str], None] = None) -> F64Array:
+        """One tick with the device at `position` (3,) m; returns the force (3,) N."""
+    @property
+    def stiffness(self) -> F64Array:
+        """Local stiffness sent with the last force, (3, 3) N/m."""
+    @property
+    def status(self) -> int:
+        """Status bits of the last tick (1 clamped, 2 input invalid, ..., 32 watchdog)."""
+    @property
+    def events(self) -> list:
+        """Events of the last tick: [(name, detail)]."""
+    @property
+    def cursor(self) -> F64Array:
+        """Cursor of the last tick, (3,) m, world frame."""
+    @property
+    def state(self) -> dict:
+        """The scene's state fields after the last tick."""
+    @property
+    def tick_index(self) -> int:
+        """Index of the next tick."""
+    @property
+    def rate_hz(self) -> int:
+        """Tick rate, Hz."""
+    @property
+    def device(self) -> dict:
+        """The device's specifications (name, max_force_n, max_stiffness_n_per_m,
+        workspace_radius_m, buttons)."""
+    def close(self) -> dict:
+        """End the session; the per-tick arrays of run_scene with stats."""
+
+bridge: ModuleType
+"""The device bridge: protocol client (BridgeClient, run) and adapters for a
+Touch (pyOpenHaptics) and Force Dimension devices / the Falcon
+(forcedimension_core). See docs/device-bridge.md."""

@@ -90,7 +90,7 @@ def test_session_errors(tmp_path):
         (lambda: nh.run_scene(SCENES / "wall.toml", operator="robot"),
          'operator = "robot": allowed "script", "rigid", "hand" or a dict of hand parameters'),
         (lambda: nh.run_scene(SCENES / "wall.toml", device="phantom"),
-         'device = "phantom": allowed "falcon" or "touch"'),
+         'device = "phantom": allowed "falcon", "touch" or "udp:HOST:PORT"'),
         (lambda: nh.run_scene(42), "scene: expected a path (str or os.PathLike)"),
     ]
     for fn, msg in cases:

@@ -119,7 +119,12 @@ fn the_shipped_foxglove_layout_uses_only_published_topics_and_fields() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let text = std::fs::read_to_string(root.join("docs/foxglove/nanohaptics-live.json")).unwrap();
     let j: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let topics = ["/foxglove/scene", "/foxglove/tf", "/foxglove/log", "/live/state"];
+    let topics = [
+        "/foxglove/scene",
+        "/foxglove/tf",
+        "/foxglove/log",
+        "/live/state",
+    ];
     let fields = [
         "tick",
         "time_s",
@@ -147,7 +152,9 @@ fn the_shipped_foxglove_layout_uses_only_published_topics_and_fields() {
         }
         for p in panel["paths"].as_array().into_iter().flatten() {
             let v = p["value"].as_str().unwrap();
-            let rest = v.strip_prefix("/live/state.").unwrap_or_else(|| panic!("{id}: {v}"));
+            let rest = v
+                .strip_prefix("/live/state.")
+                .unwrap_or_else(|| panic!("{id}: {v}"));
             let field = rest.split('.').next().unwrap();
             assert!(fields.contains(&field), "{id}: {v}");
             checked += 1;

@@ -51,6 +51,19 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(session::run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(session::read_recording, m)?)?;
     m.add_class::<live::Session>()?;
+    // The device bridge's client and the device adapters are Python (they import the devices'
+    // Python SDKs); the source ships inside the extension and becomes `nanohaptics.bridge`.
+    let py = m.py();
+    let bridge = PyModule::from_code(
+        py,
+        pyo3::ffi::c_str!(include_str!("../python/nanohaptics/bridge.py")),
+        c"nanohaptics/bridge.py",
+        c"nanohaptics.bridge",
+    )?;
+    m.add_submodule(&bridge)?;
+    py.import("sys")?
+        .getattr("modules")?
+        .set_item("nanohaptics.bridge", &bridge)?;
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

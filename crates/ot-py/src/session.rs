@@ -207,11 +207,11 @@ pub fn run_scene<'py>(
         .map_err(session_error)?;
     let stats = to_py(py, &report.stats)?;
     let link: std::collections::BTreeMap<&str, u64> = report.link.iter().copied().collect();
-    let link = to_py(py, &link)?;
+    stats.set_item("link", to_py(py, &link)?)?;
+    stats.set_item("end", report.end)?;
+    stats.set_item("sinks", to_py(py, &report.sinks)?)?;
     let d = arrays_to_py(py, report.arrays)?;
     d.set_item("stats", stats)?;
-    d.set_item("link", link)?;
-    d.set_item("end", report.end)?;
     Ok(d)
 }
 

@@ -358,11 +358,11 @@ class TouchDevice(Device):
             t = hd.get_transform()
             p = (t[3][0] * 1e-3, t[3][1] * 1e-3, t[3][2] * 1e-3)
             b = int(hd.get_buttons())
-            with self._lock:
+            with self._lock:  # held while rendering: a newer answer never races an older force
                 self._position, self._buttons = p, b
                 fresh = time.perf_counter() - self._reply_at <= self.hold_s
                 f = local_force(self._reply if fresh else None, self._p0, p, self._specs.max_force_n)
-            hd.set_force(list(f))
+                hd.set_force(list(f))
 
         self._device = HapticDevice(callback=servo, device_name=device_name, scheduler_type="async")
 
@@ -379,6 +379,9 @@ class TouchDevice(Device):
             self._reply_at = time.perf_counter() if reply is not None else 0.0
 
     def close(self) -> None:
+        with self._lock:
+            self._reply, self._reply_at = None, 0.0
+        time.sleep(0.003)  # a few servo periods of zero force before the scheduler stops
         self._device.close()
 
 
