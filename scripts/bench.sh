@@ -20,7 +20,7 @@ if [ "$assemble_only" = 0 ] && [ ! -x .venv-bench/bin/python ]; then
 fi
 export NANOHAPTICS_PYTHON="$PWD/.venv-bench/bin/python"
 
-order=(ot-physics ot-envelope haptic-loop brickworld nanoworld render)
+order=(ot-physics ot-envelope haptic-loop haptic-loop-live brickworld nanoworld render)
 for crate in "${order[@]}"; do
   if [ "$assemble_only" = 0 ] && [ -f "crates/$crate/examples/bench_report.rs" ]; then
     echo "==> $crate-report"
@@ -28,6 +28,8 @@ for crate in "${order[@]}"; do
   fi
 done
 if [ "$assemble_only" = 0 ]; then
+  echo "==> haptic-loop-live-report (4 real-time sessions, about 3.5 minutes)"
+  cargo run --release -q -p haptic-loop --example haptic-loop-live-report -- --out docs/bench/haptic-loop-live.md > /dev/null
   echo "==> ot-envelope figures (paper Figs. 2, 3, 4, 7, 8)"
   cargo run --release -q -p ot-envelope --example figures > /dev/null
 fi

@@ -140,8 +140,8 @@ struct FakeArgs {
     #[arg(long)]
     script: Option<PathBuf>,
     /// `hand` (default: a simulated hand pushed by the force), `rigid`, or
-    /// `hand:mass_kg=0.3,stiffness_n_per_m=300,...`.
-    #[arg(long, default_value = "hand")]
+    /// `hand:mass_kg=0.3,stiffness_n_per_m=300,...` (also spelled `--hand`).
+    #[arg(long, alias = "hand", default_value = "hand")]
     operator: String,
     /// Device model announced in the hello: falcon or touch.
     #[arg(long, default_value = "falcon")]

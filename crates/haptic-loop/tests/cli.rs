@@ -187,3 +187,61 @@ fn sigkill_mid_session_loses_at_most_the_last_second() {
     );
     assert!(v.ticks as f64 <= elapsed * 1000.0);
 }
+
+/// The scene: one terminal runs a bridged, live, recorded session; another runs the
+/// fake device with 5% loss; the recording verifies.
+#[test]
+fn a_bridged_live_session_against_fake_device_replays_bit_for_bit() {
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let ws = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let rec = tmp("live.mcap");
+    let sim = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args([
+            "run",
+            "scenes/wall.toml",
+            "--device",
+            &format!("udp:127.0.0.1:{port}"),
+            "--realtime",
+            "--live",
+            &format!("ws:127.0.0.1:{ws}"),
+            "--out",
+            rec.to_str().unwrap(),
+            "--wait-s",
+            "30",
+            "--json",
+        ])
+        .current_dir(root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let dev = nh(&[
+        "fake-device",
+        &format!("udp:127.0.0.1:{port}"),
+        "--loss",
+        "0.05",
+        "--seconds",
+        "2",
+        "--json",
+    ]);
+    let d = json(&dev);
+    let s = json(&sim.wait_with_output().unwrap());
+    assert_eq!(s["end"], "device_ended");
+    assert_eq!(s["device_link"], format!("udp:127.0.0.1:{port}"));
+    let sent = d["sent"].as_u64().unwrap();
+    assert_eq!(s["link"]["received"].as_u64().unwrap(), sent);
+    assert!(d["dropped"].as_u64().unwrap() > 30, "{d}");
+    assert!(s["live"]["scenes"].as_u64().unwrap() >= 90, "{s}");
+    assert_eq!(d["forces_within_limits"], true);
+    let o = nh(&["replay", rec.to_str().unwrap(), "--verify"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("identical bit for bit"));
+}
