@@ -31,6 +31,7 @@
 
 pub mod arrays;
 pub mod bridge;
+pub mod builtin;
 pub mod device;
 pub mod haptic;
 pub mod live;

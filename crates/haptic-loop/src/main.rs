@@ -75,14 +75,22 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// List the built-in scenes, or `scenes export DIR` to write editable copies.
+    Scenes {
+        /// `export` to write the scenes and their scripts.
+        action: Option<String>,
+        /// Folder for `export`.
+        dir: Option<PathBuf>,
+    },
     /// A stand-in haptic device process: plays a script over the UDP bridge to `nanohaptics run
     /// --device udp:HOST:PORT`, with injectable loss, jitter, latency and an outage.
     FakeDevice(FakeArgs),
     /// Run every scene with its default script, record, verify, and summarise.
     Demo {
-        /// Folder of scene files.
-        #[arg(long, default_value = "scenes")]
-        scenes: PathBuf,
+        /// Folder of scene files (default: `./scenes` if it exists, else the built-in scenes,
+        /// which `scenes export DIR` writes out for editing).
+        #[arg(long)]
+        scenes: Option<PathBuf>,
         /// Folder for the recordings.
         #[arg(long, default_value = "target/demo")]
         out: PathBuf,
@@ -390,7 +398,7 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
         realtime,
         json,
     } = args;
-    let mut opts = SessionOptions::new(SceneSource::from_path(&scene).map_err(|e| e.to_string())?);
+    let mut opts = SessionOptions::new(SceneSource::resolve(&scene).map_err(|e| e.to_string())?);
     opts.operator = parse_operator(&operator)?;
     match device.as_deref() {
         Some(d) if d.starts_with("udp:") => {
@@ -571,19 +579,57 @@ fn cmd_info(rec: &Path, salvage: bool, json: bool) -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn cmd_demo(scenes: &Path, out: &Path, json: bool) -> Result<ExitCode, String> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(scenes)
-        .map_err(|e| format!("cannot list {}: {e}", scenes.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension().is_some_and(|x| x == "toml")
-                && !p.to_string_lossy().ends_with(".script.toml")
-        })
-        .collect();
-    files.sort();
-    if files.is_empty() {
-        return Err(format!("no scene files (*.toml) in {}", scenes.display()));
+fn cmd_scenes(action: Option<&str>, dir: Option<&Path>) -> Result<ExitCode, String> {
+    match (action, dir) {
+        (None, _) => {
+            for b in haptic_loop::builtin::SCENES {
+                let name = haptic_loop::scene::SceneFile::parse(b.scene)
+                    .map(|f| f.scene.name)
+                    .unwrap_or_default();
+                println!("{:<18} {name} (script: {})", b.name, b.script_file);
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        (Some("export"), Some(d)) => {
+            let files = haptic_loop::builtin::export(d)?;
+            for f in &files {
+                println!("{}", f.display());
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        (Some("export"), None) => {
+            Err("scenes export: give the folder, e.g. `nanohaptics scenes export my-scenes`".into())
+        }
+        (Some(other), _) => Err(format!("scenes `{other}`: the only action is `export DIR`")),
     }
+}
+
+fn cmd_demo(scenes: Option<&Path>, out: &Path, json: bool) -> Result<ExitCode, String> {
+    // Scene files on disk (`--scenes`, or `./scenes` when it exists: files on disk override),
+    // or else the built-in scenes.
+    let local = Path::new("scenes");
+    let scenes = scenes.or_else(|| local.is_dir().then_some(local));
+    let files: Vec<PathBuf> = match scenes {
+        Some(dir) => {
+            let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+                .map_err(|e| format!("cannot list {}: {e}", dir.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.extension().is_some_and(|x| x == "toml")
+                        && !p.to_string_lossy().ends_with(".script.toml")
+                })
+                .collect();
+            files.sort();
+            if files.is_empty() {
+                return Err(format!("no scene files (*.toml) in {}", dir.display()));
+            }
+            files
+        }
+        None => haptic_loop::builtin::SCENES
+            .iter()
+            .map(|b| PathBuf::from(b.name))
+            .collect(),
+    };
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let mut rows = Vec::new();
     let mut all_ok = true;
@@ -593,9 +639,11 @@ fn cmd_demo(scenes: &Path, out: &Path, json: bool) -> Result<ExitCode, String> {
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default();
         let rec = out.join(format!("{stem}.mcap"));
-        let mut opts = SessionOptions::new(
-            SceneSource::from_path(f).map_err(|e: SessionError| e.to_string())?,
-        );
+        let source = match scenes {
+            Some(_) => SceneSource::from_path(f),
+            None => SceneSource::resolve(f),
+        };
+        let mut opts = SessionOptions::new(source.map_err(|e: SessionError| e.to_string())?);
         opts.out = Some(rec.clone());
         let pb = (!json).then(|| progress_bar(0, &stem));
         let report = run_session(&opts, &mut |done, total| {
@@ -665,7 +713,8 @@ fn main() -> ExitCode {
             json,
         } => cmd_replay(&rec, verify, salvage, json),
         Cmd::Info { rec, salvage, json } => cmd_info(&rec, salvage, json),
-        Cmd::Demo { scenes, out, json } => cmd_demo(&scenes, &out, json),
+        Cmd::Demo { scenes, out, json } => cmd_demo(scenes.as_deref(), &out, json),
+        Cmd::Scenes { action, dir } => cmd_scenes(action.as_deref(), dir.as_deref()),
         Cmd::FakeDevice(a) => cmd_fake(a),
     };
     match res {

@@ -80,6 +80,9 @@ pub struct SceneSource {
     pub text: String,
     /// Folder for relative paths in the file.
     pub dir: Option<PathBuf>,
+    /// Scripts that come with the scene (a built-in scene's default script), file name → text;
+    /// consulted before the disk.
+    pub scripts: Vec<(String, String)>,
 }
 
 fn read(path: &Path) -> Result<String, SessionError> {
@@ -95,7 +98,38 @@ impl SceneSource {
         Ok(SceneSource {
             text: read(path)?,
             dir: path.parent().map(Path::to_path_buf),
+            scripts: Vec::new(),
         })
+    }
+
+    /// A scene file on disk, or else a built-in scene by name (`wall`, `wall.toml`): files on
+    /// disk override the built-ins, so this works from any directory.
+    pub fn resolve(arg: &Path) -> Result<Self, SessionError> {
+        if arg.exists() {
+            return Self::from_path(arg);
+        }
+        // `wall`, `wall.toml` or `scenes/wall.toml` (the repository's path, from anywhere).
+        let parent_ok = arg
+            .parent()
+            .is_none_or(|p| p.as_os_str().is_empty() || p == Path::new("scenes"));
+        let name = arg
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        match crate::builtin::find(&name) {
+            Some(b) if parent_ok => Ok(SceneSource {
+                text: b.scene.to_string(),
+                dir: None,
+                scripts: vec![(b.script_file.to_string(), b.script.to_string())],
+            }),
+            _ => Err(SessionError::Io {
+                path: arg.display().to_string(),
+                message: format!(
+                    "no such file, and not a built-in scene (built-in: {}; `nanohaptics scenes export DIR` writes editable copies)",
+                    crate::builtin::names()
+                ),
+            }),
+        }
     }
 }
 
@@ -193,6 +227,9 @@ fn script_text(opts: &SessionOptions, file: &SceneFile) -> Result<String, Sessio
                 .default_script
                 .as_ref()
                 .ok_or(SessionError::NoScript)?;
+            if let Some((_, text)) = opts.scene.scripts.iter().find(|(n, _)| n == rel) {
+                return Ok(text.clone());
+            }
             let p = match &opts.scene.dir {
                 Some(d) => d.join(rel),
                 None => PathBuf::from(rel),

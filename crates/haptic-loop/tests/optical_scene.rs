@@ -103,7 +103,11 @@ fn feedback_keeps_the_cursor_near_the_particle() {
         } else {
             text.replace("feedback = true", "feedback = false")
         };
-        let mut o = SessionOptions::new(SceneSource { text: t, dir: None });
+        let mut o = SessionOptions::new(SceneSource {
+            text: t,
+            dir: None,
+            scripts: Vec::new(),
+        });
         o.script = Some(drag.to_string());
         o.operator = OperatorChoice::Hand(op);
         let a = run_session(&o, &mut |_, _| {}).unwrap().arrays;

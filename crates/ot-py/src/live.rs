@@ -97,7 +97,7 @@ impl Session {
         out: Option<&Bound<'_, PyAny>>,
         arrays: bool,
     ) -> PyResult<Self> {
-        let source = SceneSource::from_path(&path_arg(scene, "scene")?).map_err(session_error)?;
+        let source = SceneSource::resolve(&path_arg(scene, "scene")?).map_err(session_error)?;
         let mut o = StepperOptions::new(source);
         o.device = match device {
             None => None,

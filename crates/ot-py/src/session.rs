@@ -181,7 +181,7 @@ pub fn run_scene<'py>(
         )));
     }
     let scene_path = path_arg(scene, "scene")?;
-    let source = SceneSource::from_path(&scene_path).map_err(session_error)?;
+    let source = SceneSource::resolve(&scene_path).map_err(session_error)?;
     let mut opts = SessionOptions::new(source);
     if let Some(s) = script {
         let p = path_arg(s, "script")?;
