@@ -245,3 +245,52 @@ fn a_bridged_live_session_against_fake_device_replays_bit_for_bit() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
     assert!(String::from_utf8_lossy(&o.stdout).contains("identical bit for bit"));
 }
+
+/// From a folder with no scenes: built-in scenes by name, `scenes export`, and the exported
+/// copy (a file on disk) overriding the built-in.
+#[test]
+fn builtin_scenes_work_from_any_directory_and_exported_copies_override_them() {
+    let dir = tmp("elsewhere");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap()
+    };
+    let j = json(&run(&["run", "wall", "--seconds", "0.2", "--json"]));
+    assert_eq!(j["ticks"], 200);
+    let j = json(&run(&[
+        "run",
+        "scenes/wall.toml",
+        "--seconds",
+        "0.2",
+        "--json",
+    ]));
+    assert_eq!(j["scene"], "stiff wall (calibration)");
+    let o = run(&["scenes", "export", "mine"]);
+    assert!(o.status.success());
+    assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 8);
+    let edited = std::fs::read_to_string(dir.join("mine/wall.toml"))
+        .unwrap()
+        .replace("name = \"stiff wall (calibration)\"", "name = \"my wall\"");
+    std::fs::write(dir.join("mine/wall.toml"), edited).unwrap();
+    let j = json(&run(&[
+        "run",
+        "mine/wall.toml",
+        "--seconds",
+        "0.2",
+        "--json",
+    ]));
+    assert_eq!(j["scene"], "my wall");
+    let o = run(&["scenes", "export", "mine"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("exists: not overwriting it"));
+    let o = run(&["run", "moon"]);
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: cannot read moon: no such file, and not a built-in scene (built-in: brickworld, \
+         nanoworld, optical_tweezers, wall; `nanohaptics scenes export DIR` writes editable copies)"
+    );
+}
