@@ -48,8 +48,8 @@ pub mod state;
 pub mod well;
 
 pub use error::{PhysicsError, Result};
-pub use flow::Flow;
-pub use integrate::{Composition, DEFAULT_RTOL, Method, Propagator};
+pub use flow::{Flow, OffsetFlow};
+pub use integrate::{Composition, DEFAULT_RTOL, DEFAULT_TOL_M, Method, Propagator};
 pub use model::{BOLTZMANN, TrapBuilder, TrapModel};
-pub use state::{Phase, PhaseVar};
+pub use state::{Phase, PhaseSens, PhaseVar};
 pub use well::{GaussianWell, Well2, Well3};
