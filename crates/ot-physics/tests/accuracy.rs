@@ -136,3 +136,47 @@ fn the_old_default_missed_the_promise() {
     assert!(e > 1e-11, "{e:e}");
 }
 
+
+#[test]
+fn error_budget_chooses_the_cheapest_map_within_tolerance_and_it_holds_off_the_probes() {
+    use ot_physics::budget::{choose_tick_map, converged};
+    // the scene's tick (0.2 µs) and the paper's (1 µs), budget 0.01 nm
+    for (dt, v_max) in [(0.2e-6, 0.1), (1e-6, 0.1)] {
+        let (p, c) = choose_tick_map(paper_model(), dt, 1e-11, v_max).unwrap();
+        eprintln!("dt {dt:e}: {c}");
+        assert!(c.error_m * 2.0 <= 1e-11 && c.probes == 4 * 81);
+        // off-probe check: a denser, shifted lattice against the reference
+        let r = converged(paper_model(), dt).unwrap();
+        let mut worst: f64 = 0.0;
+        for v in [Vector2::zeros(), Vector2::new(0.07, -0.07)] {
+            for i in 0..25 {
+                for j in 0..25 {
+                    let o = Vector2::new(
+                        -1.8e-6 + 3.6e-6 * (f64::from(i) + 0.37) / 25.0,
+                        -0.9e-6 + 1.8e-6 * (f64::from(j) + 0.61) / 25.0,
+                    );
+                    worst = worst.max((p.flow(&o, &v).unwrap().0 - r.flow(&o, &v).unwrap().0).norm());
+                }
+            }
+        }
+        assert!(worst <= 1e-11, "dt {dt:e}: {worst:e} m off the probes");
+        // the next cheaper candidate fails the budget: the choice is minimal
+        if let Method::Rk4 { substeps } = c.method {
+            if substeps > 1 {
+                let (_, cheaper) =
+                    choose_tick_map(paper_model(), dt, 2.0 * c.error_m * 0.999, v_max).unwrap();
+                assert!(cheaper.evals_per_flow >= c.evals_per_flow);
+            }
+        }
+    }
+    // a loose budget takes a single step; a tight one more substeps
+    let (_, loose) = choose_tick_map(paper_model(), 0.2e-6, 1e-7, 0.1).unwrap();
+    let (_, tight) = choose_tick_map(paper_model(), 0.2e-6, 1e-13, 0.1).unwrap();
+    assert!(loose.evals_per_flow < tight.evals_per_flow);
+    assert_eq!(
+        choose_tick_map(paper_model(), 0.2e-6, -1.0, 0.1)
+            .unwrap_err()
+            .to_string(),
+        "tick map tolerance [m] = -1e0 is out of range: allowed finite and > 0"
+    );
+}
