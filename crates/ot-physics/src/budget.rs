@@ -124,6 +124,38 @@ fn probes(model: &TrapModel<2>, dt: f64, v_max: f64) -> Vec<(Vector2<f64>, Vecto
     out
 }
 
+/// Measure a given fixed-step `method`'s displacement error (m) against
+/// converged dynamics at the same probes [`choose_tick_map`] uses (start
+/// speeds up to `v_max`, m/s), and report it as a [`MapChoice`] with
+/// `tol_m` = the measured error (a map fixed by hand has no budget).
+pub fn measure(model: TrapModel<2>, method: Method, dt: f64, v_max: f64) -> Result<MapChoice> {
+    if !(v_max.is_finite() && v_max >= 0.0) {
+        return Err(PhysicsError::OutOfRange {
+            field: "v_max [m/s]",
+            value: v_max,
+            allowed: "finite and >= 0",
+        });
+    }
+    let reference = converged(model, dt)?;
+    let p = Propagator::new(model, method, dt)?;
+    let probes = probes(&model, dt, v_max);
+    let mut worst: f64 = 0.0;
+    let mut evals = 0;
+    for (o, v) in &probes {
+        let (d, _, e) = p.flow(o, v)?;
+        evals = e;
+        worst = worst.max((d - reference.flow(o, v)?.0).norm());
+    }
+    Ok(MapChoice {
+        method,
+        error_m: worst,
+        tol_m: worst,
+        evals_per_flow: evals,
+        probes: probes.len(),
+        v_max,
+    })
+}
+
 /// Choose the cheapest fixed-step tick map (RK4 or DOP853's 8th-order
 /// formula, `n` equal substeps) whose displacement is within `tol_m` (m) of
 /// converged dynamics for start speeds up to `v_max` (m/s), measured at
