@@ -138,7 +138,7 @@ fn main() -> Result<(), BoxError> {
     if let Some(which) = flag("--only") {
         let t = if which == "old" { &old } else { &text };
         let r = session(t, seconds, false, &which)?;
-        println!("{which}: {} ticks", r.stats.ticks);
+        println!("{which}: {} ticks, {} events", r.stats.ticks, r.arrays.events.len());
         return Ok(());
     }
     let rounds: usize = flag("--rounds").map_or(Ok(1), |s| s.parse())?;
@@ -158,6 +158,12 @@ fn main() -> Result<(), BoxError> {
                 us(s.compute.max_ns),
                 load().split(' ').next().unwrap_or("?")
             );
+            let mut slow: Vec<(u64, usize)> =
+                r.arrays.compute_ns.iter().copied().enumerate().map(|(i, t)| (t, i)).collect();
+            slow.sort_unstable_by(|a, b| b.cmp(a));
+            let slow: Vec<String> =
+                slow.iter().take(5).map(|(t, i)| format!("tick {i}: {:.0} µs", us(*t))).collect();
+            println!("|   slowest: {} | | | | | |", slow.join(", "));
             if name.starts_with("new") {
                 last_new = Some(r);
             }
