@@ -143,19 +143,36 @@ fn main() -> Result<(), BoxError> {
     }
     let rounds: usize = flag("--rounds").map_or(Ok(1), |s| s.parse())?;
     println!("load before: {}", load());
-    println!("| settings | ticks | p50 µs | p99 µs | max µs | load (1 min) |");
-    println!("|---|---|---|---|---|---|");
+    println!(
+        "| settings | ticks | p50 µs | p99 µs | max µs | grabbed ticks | grabbed p50 µs | grabbed p99 µs | grabbed max µs | load (1 min) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     let mut last_new = None;
     for _ in 0..rounds {
         for (name, t) in [("old: RK4×8, full build every tick", &old), ("new: budget map, warm start", &text)] {
             let r = session(t, seconds, false, "bench")?;
             let s = &r.stats;
+            let g = r.arrays.state_column("grabbed").ok_or("no grabbed column")?;
+            let mut gt: Vec<u64> = r
+                .arrays
+                .compute_ns
+                .iter()
+                .zip(&g)
+                .filter(|(_, g)| **g == 1.0)
+                .map(|(t, _)| *t)
+                .collect();
+            gt.sort_unstable();
+            let pct = |q: f64| gt.get(((gt.len() as f64 * q).ceil() as usize).saturating_sub(1)).map_or(0.0, |t| us(*t));
             println!(
-                "| {name} | {} | {:.1} | {:.1} | {:.1} | {} |",
+                "| {name} | {} | {:.1} | {:.1} | {:.1} | {} | {:.1} | {:.1} | {:.1} | {} |",
                 s.ticks,
                 us(s.compute.p50_ns),
                 us(s.compute.p99_ns),
                 us(s.compute.max_ns),
+                gt.len(),
+                pct(0.5),
+                pct(0.99),
+                pct(1.0),
                 load().split(' ').next().unwrap_or("?")
             );
             let mut slow: Vec<(u64, usize)> =
@@ -163,7 +180,7 @@ fn main() -> Result<(), BoxError> {
             slow.sort_unstable_by(|a, b| b.cmp(a));
             let slow: Vec<String> =
                 slow.iter().take(5).map(|(t, i)| format!("tick {i}: {:.0} µs", us(*t))).collect();
-            println!("|   slowest: {} | | | | | |", slow.join(", "));
+            println!("|   slowest: {} | | | | | | | | | |", slow.join(", "));
             if name.starts_with("new") {
                 last_new = Some(r);
             }

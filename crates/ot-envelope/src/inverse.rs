@@ -131,6 +131,9 @@ pub(crate) struct Newton<'p> {
     pub region: OffsetRegion,
     /// Residual tolerance (m).
     pub residual: f64,
+    /// Extra steps once the residual is met (2 where distinct roots must be
+    /// told apart, 0 for a single continued root).
+    pub polish: u8,
 }
 
 impl Newton<'_> {
@@ -152,13 +155,13 @@ impl Newton<'_> {
         *evals += f.evals;
         let (mut r, mut j) = (f.displacement - target, f.d_offset);
         let mut rn = r.norm();
-        let mut polish = 0;
+        let mut polish = 0u8;
         for _ in 0..40 {
             if rn <= self.residual {
                 // two more steps while they still gain: converged roots agree
                 // to rounding, so distinct roots are told apart reliably
                 polish += 1;
-                if polish > 2 {
+                if polish > self.polish {
                     break;
                 }
             }
@@ -231,6 +234,7 @@ pub fn solve_trap(prop: &Propagator<2>, v0: &V2, target: &V2) -> Result<Solution
         w: solver.w,
         region: solver.map.region,
         residual: DEFAULT_RESIDUAL,
+        polish: 2,
     };
     let mut found: Vec<V2> = Vec::new();
     let mut evals = 0;
@@ -341,6 +345,7 @@ impl<'a> TrapSolver<'a> {
             w: self.w,
             region: self.map.region,
             residual: self.residual,
+            polish: 2,
         };
         nw.run(start, target, evals, known, &self.map.h)
     }

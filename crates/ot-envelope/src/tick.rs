@@ -13,7 +13,7 @@
 use crate::clip::clip_to_polygon;
 use crate::envelope::envelope_and_folds;
 use crate::error::{Result, finite_vec, positive};
-use crate::geometry::nearest_on_boundary;
+use crate::geometry::{closest_on_segment, nearest_on_boundary};
 use crate::inverse::{Choice, DEFAULT_RESIDUAL, Newton, TrapSolver};
 use crate::region::{OffsetRegion, free_drift};
 use crate::sample::{SampledMap, coarse_companion};
@@ -113,6 +113,25 @@ pub struct TickOutput {
     pub rebuilt: bool,
 }
 
+/// Edges examined on each side of a fold point's vertex by the warm check.
+const VERIFY_WINDOW: usize = 12;
+
+/// Distance (m) from `p` to the polygon edges within [`VERIFY_WINDOW`]
+/// edges of vertex `v` (the whole polygon when it is small).
+fn window_distance(poly: &[V2], v: usize, p: &V2) -> f64 {
+    let n = poly.len();
+    if n <= 2 * VERIFY_WINDOW + 2 {
+        return nearest_on_boundary(poly, p).1;
+    }
+    let mut best = f64::INFINITY;
+    for k in 0..2 * VERIFY_WINDOW {
+        let i = (v + n - VERIFY_WINDOW + k) % n;
+        let q = closest_on_segment(&poly[i], &poly[(i + 1) % n], p);
+        best = best.min((q - p).norm());
+    }
+    best
+}
+
 /// The warm-started steering controller: settings, the last full build
 /// (velocity, polygon, fold points, sampled map) and reused buffers.
 #[derive(Debug, Clone)]
@@ -127,10 +146,12 @@ pub struct TickController {
     /// Fold points (offset, displacement; m) whose images are vertices of
     /// the base polygon.
     base_folds: Vec<(V2, V2)>,
+    /// The base polygon vertex index of each of `base_folds`.
+    base_fold_vertex: Vec<usize>,
     /// Every fold point of the last build (scratch).
     all_folds: Vec<(V2, V2)>,
-    /// Sorted bit keys of the base polygon's vertices (scratch).
-    keys: Vec<(u64, u64)>,
+    /// Sorted bit keys of the base polygon's vertices with their indices (scratch).
+    keys: Vec<((u64, u64), usize)>,
     /// The last build's sampled map (for the full solve).
     map: Option<SampledMap>,
     /// This tick's envelope polygon (m).
@@ -152,6 +173,7 @@ impl TickController {
             base_valid: false,
             base_poly: Vec::new(),
             base_folds: Vec::new(),
+            base_fold_vertex: Vec::new(),
             all_folds: Vec::new(),
             keys: Vec::new(),
             map: None,
@@ -190,17 +212,20 @@ impl TickController {
         self.base_free = env.free_displacement;
         self.base_v0 = *v0;
         self.keys.clear();
-        self.keys
-            .extend(self.base_poly.iter().map(|p| (p.x.to_bits(), p.y.to_bits())));
+        self.keys.extend(
+            self.base_poly
+                .iter()
+                .enumerate()
+                .map(|(i, p)| ((p.x.to_bits(), p.y.to_bits()), i)),
+        );
         self.keys.sort_unstable();
         self.base_folds.clear();
+        self.base_fold_vertex.clear();
         for f in &self.all_folds {
-            if self
-                .keys
-                .binary_search(&(f.1.x.to_bits(), f.1.y.to_bits()))
-                .is_ok()
-            {
+            let key = (f.1.x.to_bits(), f.1.y.to_bits());
+            if let Ok(k) = self.keys.binary_search_by(|e| e.0.cmp(&key)) {
                 self.base_folds.push(*f);
+                self.base_fold_vertex.push(self.keys[k].1);
             }
         }
         self.poly.clear();
@@ -228,9 +253,12 @@ impl TickController {
         let n = self.base_folds.len();
         let k = self.params.verify_points.min(n);
         for i in 0..k {
-            let (o, _) = self.base_folds[(self.verify_next + i * n / k) % n];
+            let j = (self.verify_next + i * n / k) % n;
+            let (o, _) = self.base_folds[j];
             let (d, _, _) = prop.flow(&o, v0)?;
-            if nearest_on_boundary(&self.poly, &d).1 > self.params.verify_tol {
+            // distance to the polygon edges around the fold's own vertex: at
+            // least the distance to the whole boundary, so never laxer
+            if window_distance(&self.poly, self.base_fold_vertex[j], &d) > self.params.verify_tol {
                 self.stats.verify_failures += 1;
                 return Ok(false);
             }
@@ -299,6 +327,8 @@ impl TickController {
             w: prop.model().well.waists(),
             region,
             residual: DEFAULT_RESIDUAL,
+            // one root continued: no extra steps past the residual
+            polish: 0,
         };
         let prev = self.prev_trap.map(|t| t - particle.position);
         let shift = free - self.base_free;

@@ -138,3 +138,70 @@ fn bad_tick_settings_are_typed_errors() {
         "verify_points = 0e0 is out of range: allowed 1 ..= 64"
     );
 }
+
+#[test]
+fn without_a_previous_trap_a_clipped_target_is_solved_from_the_fold_points() {
+    // After a drag, the hand lets go and grabs again (no previous trap):
+    // the clipped command is solved by Newton from the nearest fold points,
+    // with no grid solve, and the tick map reaches it.
+    let prop = scene_tick();
+    let mut c = TickController::new(params(true)).unwrap();
+    let mut last = ParticleState {
+        position: V2::zeros(),
+        velocity: V2::zeros(),
+    };
+    drag(&prop, &mut c, 300, 2e-6, 2e-9, |_, o, _, s| {
+        let (d, v, _) = prop.flow(&(o.trap - s.position), &s.velocity).unwrap();
+        last = ParticleState {
+            position: s.position + d,
+            velocity: v * 0.1,
+        };
+    });
+    let before = c.stats();
+    c.reset();
+    let far = last.position + V2::new(0.0, 3e-6);
+    let out = c.step(&prop, &last, &far).unwrap();
+    let after = c.stats();
+    assert_eq!(out.choice, ot_envelope::inverse::Choice::FoldSeeded, "{after:?}");
+    assert!(!out.rebuilt && after.full_solves == before.full_solves);
+    assert!(out.excess.norm() > 1e-6, "the command was clipped");
+    let (d, _, _) = prop.flow(&(out.trap - last.position), &last.velocity).unwrap();
+    assert!((d - out.allowed).norm() < 1e-11);
+}
+
+#[test]
+fn a_velocity_jump_fails_the_fold_check_and_rebuilds() {
+    // With the velocity threshold out of the way, only the fold check guards
+    // the translation: changes of 10 and 30 nm/µs pass it and the translated
+    // envelope is within 0.1 nm of converged dynamics; jumps of 100 and
+    // 300 nm/µs fail it and rebuild.
+    let prop = scene_tick();
+    let truth = converged(*prop.model(), prop.dt()).unwrap();
+    let mut p = params(true);
+    p.warm_dv = 10.0;
+    let at = |v: V2| ParticleState {
+        position: V2::zeros(),
+        velocity: v,
+    };
+    let cursor = V2::new(10e-9, 0.0);
+    for (dv, warm) in [(0.01, true), (0.03, true), (0.1, false), (0.3, false)] {
+        let mut c = TickController::new(p).unwrap();
+        assert!(c.step(&prop, &at(V2::zeros()), &cursor).unwrap().rebuilt);
+        let out = c.step(&prop, &at(V2::new(0.0, dv)), &cursor).unwrap();
+        let st = c.stats();
+        assert_eq!(out.rebuilt, !warm, "dv {dv}: {st:?}");
+        assert_eq!(st.verify_failures, u64::from(!warm));
+        let reference = working_envelope_with(
+            &truth,
+            &V2::new(0.0, dv),
+            &EnvelopeOptions {
+                tol: 0.02e-9,
+                coarse_grid: false,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let h = hausdorff(c.envelope(), &reference.polygon, 0.05e-9);
+        assert!(h <= 0.1e-9, "dv {dv}: {h:e} m");
+    }
+}
