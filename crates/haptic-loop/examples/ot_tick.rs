@@ -20,8 +20,8 @@ use ot_envelope::geometry::hausdorff;
 use ot_envelope::steer::{ParticleState, SteerParams};
 use ot_envelope::tick::{TickController, TickParams};
 use ot_envelope::{EnvelopeOptions, working_envelope_with};
-use ot_physics::budget::{choose_tick_map, converged};
 use ot_physics::TrapModel;
+use ot_physics::budget::{choose_tick_map, converged};
 use std::path::{Path, PathBuf};
 
 type BoxError = Box<dyn std::error::Error>;
@@ -59,21 +59,32 @@ fn us(ns: u64) -> f64 {
 }
 
 fn load() -> String {
-    std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string()
+    std::fs::read_to_string("/proc/loadavg")
+        .unwrap_or_default()
+        .trim()
+        .to_string()
 }
 
 /// Replays the new session's steering from its recorded states and measures the envelope's
 /// Hausdorff distance from converged dynamics every `every` grabbed ticks.
 fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String, BoxError> {
     let file = SceneFile::parse(text)?;
-    let p = file.optical_tweezers.clone().ok_or("not an optical scene")?;
-    let model = TrapModel::builder(p.depth_nj * 1e-9, [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9])
-        .mass(p.mass_g * 1e-3)
-        .build()?;
+    let p = file
+        .optical_tweezers
+        .clone()
+        .ok_or("not an optical scene")?;
+    let model = TrapModel::builder(
+        p.depth_nj * 1e-9,
+        [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
+    )
+    .mass(p.mass_g * 1e-3)
+    .build()?;
     let dt = p.dt_us * 1e-6;
     let (prop, _) = choose_tick_map(model, dt, p.tick_map_tol_nm.unwrap_or(0.01) * 1e-9, 0.1)?;
     let truth = converged(model, dt)?;
-    let tol = p.envelope_tol_nm.map_or(ot_envelope::DEFAULT_TOL, |t| t * 1e-9);
+    let tol = p
+        .envelope_tol_nm
+        .map_or(ot_envelope::DEFAULT_TOL, |t| t * 1e-9);
     let mut c = TickController::new(TickParams::new(SteerParams {
         stiffness: p.stiffness_n_per_m,
         mode: p.clip,
@@ -82,7 +93,12 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
     }))?;
     let a = &r.arrays;
     let col = |n: &str| a.state_column(n).ok_or(format!("no column {n}"));
-    let (px, py, vx, vy) = (col("particle_x_m")?, col("particle_y_m")?, col("particle_vx_m_per_s")?, col("particle_vy_m_per_s")?);
+    let (px, py, vx, vy) = (
+        col("particle_x_m")?,
+        col("particle_y_m")?,
+        col("particle_vx_m_per_s")?,
+        col("particle_vy_m_per_s")?,
+    );
     let (tx, ty, g) = (col("trap_x_m")?, col("trap_y_m")?, col("grabbed")?);
     let start = Vector2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
     let (mut worst, mut worst_cold, mut n, mut grabbed, mut mismatch) = (0.0f64, 0.0f64, 0, 0, 0);
@@ -94,7 +110,10 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
             c.reset();
         }
         let s = if i == 0 {
-            ParticleState { position: start, velocity: Vector2::zeros() }
+            ParticleState {
+                position: start,
+                velocity: Vector2::zeros(),
+            }
         } else {
             ParticleState {
                 position: Vector2::new(px[i - 1], py[i - 1]),
@@ -111,9 +130,20 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
             let reference = working_envelope_with(
                 &truth,
                 &s.velocity,
-                &EnvelopeOptions { tol: 0.02e-9, coarse_grid: false, ..Default::default() },
+                &EnvelopeOptions {
+                    tol: 0.02e-9,
+                    coarse_grid: false,
+                    ..Default::default()
+                },
             )?;
-            let cold = working_envelope_with(&prop, &s.velocity, &EnvelopeOptions { tol, ..Default::default() })?;
+            let cold = working_envelope_with(
+                &prop,
+                &s.velocity,
+                &EnvelopeOptions {
+                    tol,
+                    ..Default::default()
+                },
+            )?;
             worst = worst.max(hausdorff(c.envelope(), &reference.polygon, 0.05e-9));
             worst_cold = worst_cold.max(hausdorff(&cold.polygon, &reference.polygon, 0.05e-9));
             n += 1;
@@ -131,14 +161,23 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
 
 fn main() -> Result<(), BoxError> {
     let args: Vec<String> = std::env::args().collect();
-    let flag = |f: &str| args.iter().position(|a| a == f).and_then(|i| args.get(i + 1)).cloned();
+    let flag = |f: &str| {
+        args.iter()
+            .position(|a| a == f)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
     let text = std::fs::read_to_string(root().join("scenes/optical_tweezers.toml"))?;
     let old = old_text(&text);
     let seconds: f64 = flag("--seconds").map_or(Ok(60.0), |s| s.parse())?;
     if let Some(which) = flag("--only") {
         let t = if which == "old" { &old } else { &text };
         let r = session(t, seconds, false, &which)?;
-        println!("{which}: {} ticks, {} events", r.stats.ticks, r.arrays.events.len());
+        println!(
+            "{which}: {} ticks, {} events",
+            r.stats.ticks,
+            r.arrays.events.len()
+        );
         return Ok(());
     }
     let rounds: usize = flag("--rounds").map_or(Ok(1), |s| s.parse())?;
@@ -149,10 +188,16 @@ fn main() -> Result<(), BoxError> {
     println!("|---|---|---|---|---|---|---|---|---|---|");
     let mut last_new = None;
     for _ in 0..rounds {
-        for (name, t) in [("old: RK4×8, full build every tick", &old), ("new: budget map, warm start", &text)] {
+        for (name, t) in [
+            ("old: RK4×8, full build every tick", &old),
+            ("new: budget map, warm start", &text),
+        ] {
             let r = session(t, seconds, false, "bench")?;
             let s = &r.stats;
-            let g = r.arrays.state_column("grabbed").ok_or("no grabbed column")?;
+            let g = r
+                .arrays
+                .state_column("grabbed")
+                .ok_or("no grabbed column")?;
             let mut gt: Vec<u64> = r
                 .arrays
                 .compute_ns
@@ -162,7 +207,10 @@ fn main() -> Result<(), BoxError> {
                 .map(|(t, _)| *t)
                 .collect();
             gt.sort_unstable();
-            let pct = |q: f64| gt.get(((gt.len() as f64 * q).ceil() as usize).saturating_sub(1)).map_or(0.0, |t| us(*t));
+            let pct = |q: f64| {
+                gt.get(((gt.len() as f64 * q).ceil() as usize).saturating_sub(1))
+                    .map_or(0.0, |t| us(*t))
+            };
             println!(
                 "| {name} | {} | {:.1} | {:.1} | {:.1} | {} | {:.1} | {:.1} | {:.1} | {} |",
                 s.ticks,
@@ -175,11 +223,20 @@ fn main() -> Result<(), BoxError> {
                 pct(1.0),
                 load().split(' ').next().unwrap_or("?")
             );
-            let mut slow: Vec<(u64, usize)> =
-                r.arrays.compute_ns.iter().copied().enumerate().map(|(i, t)| (t, i)).collect();
+            let mut slow: Vec<(u64, usize)> = r
+                .arrays
+                .compute_ns
+                .iter()
+                .copied()
+                .enumerate()
+                .map(|(i, t)| (t, i))
+                .collect();
             slow.sort_unstable_by(|a, b| b.cmp(a));
-            let slow: Vec<String> =
-                slow.iter().take(5).map(|(t, i)| format!("tick {i}: {:.0} µs", us(*t))).collect();
+            let slow: Vec<String> = slow
+                .iter()
+                .take(5)
+                .map(|(t, i)| format!("tick {i}: {:.0} µs", us(*t)))
+                .collect();
             println!("|   slowest: {} | | | | | | | | | |", slow.join(", "));
             if name.starts_with("new") {
                 last_new = Some(r);
@@ -187,10 +244,16 @@ fn main() -> Result<(), BoxError> {
         }
     }
     if let Some(r) = &last_new {
-        for e in r.arrays.events.iter().filter(|e| e.1 == "ot.tick_map").take(1) {
+        for e in r
+            .arrays
+            .events
+            .iter()
+            .filter(|e| e.1 == "ot.tick_map")
+            .take(1)
+        {
             println!("{}", e.2);
         }
-        println!("{}", hausdorff_check(&text, r, 250)?);
+        println!("{}", hausdorff_check(&text, r, 50)?);
     }
     if args.iter().any(|a| a == "--realtime") {
         let t10 = std::fs::read_to_string(root().join("scenes/optical_tweezers_10khz.toml"))?;

@@ -70,9 +70,7 @@ pub fn clip_to_polygon(poly: &[V2], free: &V2, command: &V2, mode: ClipMode) -> 
     let allowed = match mode {
         ClipMode::Nearest => nearest(),
         ClipMode::Radial => {
-            let anchor = [V2::zeros(), *free]
-                .into_iter()
-                .find(|a| contains(poly, a));
+            let anchor = [V2::zeros(), *free].into_iter().find(|a| contains(poly, a));
             match anchor
                 .and_then(|a| first_crossing(poly, &a, command).map(|t| a + (command - a) * t))
             {

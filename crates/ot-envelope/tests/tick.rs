@@ -85,7 +85,10 @@ fn warm_envelope_stays_within_a_tenth_of_a_nanometre_of_converged_dynamics() {
         });
     }
     let st = c.stats();
-    eprintln!("worst Hausdorff {:.3e} m over {checked} warm ticks; {st:?}", worst);
+    eprintln!(
+        "worst Hausdorff {:.3e} m over {checked} warm ticks; {st:?}",
+        worst
+    );
     assert!(checked >= 10);
     // issue 13's target: ≤ 0.1 nm from converged dynamics at every tick
     assert!(worst <= 0.1e-9, "{worst:e} m");
@@ -118,7 +121,11 @@ fn warm_and_cold_ticks_reach_the_same_targets_and_replay_bit_exactly() {
     // solver's residual, warm or cold
     for (o, _, s) in w1.iter().chain(&cold) {
         let (d, _, _) = prop.flow(&(o.trap - s.position), &s.velocity).unwrap();
-        assert!((d - o.allowed).norm() < 1e-11, "{:e}", (d - o.allowed).norm());
+        assert!(
+            (d - o.allowed).norm() < 1e-11,
+            "{:e}",
+            (d - o.allowed).norm()
+        );
     }
     eprintln!("warm {s1:?}\ncold {sc:?}");
 }
@@ -162,10 +169,16 @@ fn without_a_previous_trap_a_clipped_target_is_solved_from_the_fold_points() {
     let far = last.position + V2::new(0.0, 3e-6);
     let out = c.step(&prop, &last, &far).unwrap();
     let after = c.stats();
-    assert_eq!(out.choice, ot_envelope::inverse::Choice::FoldSeeded, "{after:?}");
+    assert_eq!(
+        out.choice,
+        ot_envelope::inverse::Choice::FoldSeeded,
+        "{after:?}"
+    );
     assert!(!out.rebuilt && after.full_solves == before.full_solves);
     assert!(out.excess.norm() > 1e-6, "the command was clipped");
-    let (d, _, _) = prop.flow(&(out.trap - last.position), &last.velocity).unwrap();
+    let (d, _, _) = prop
+        .flow(&(out.trap - last.position), &last.velocity)
+        .unwrap();
     assert!((d - out.allowed).norm() < 1e-11);
 }
 

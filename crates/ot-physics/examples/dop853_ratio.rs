@@ -31,16 +31,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let p = Problem::paper(21)?;
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     println!("load: {}", load.trim());
-    println!("| run | ours (setting) | ours ns/traj | ours max err nm | Dop853 (rtol) | Dop853 ns/traj | Dop853 max err nm | ratio |");
+    println!(
+        "| run | ours (setting) | ours ns/traj | ours max err nm | Dop853 (rtol) | Dop853 ns/traj | Dop853 max err nm | ratio |"
+    );
     println!("|---|---|---|---|---|---|---|---|");
     for run in 1..=runs {
         let mut ours = Vec::new();
         for k in 6..=10 {
             let rtol = 10f64.powi(-k);
-            ours.push(measure(&p, Method::Adaptive { rtol }, &format!("adaptive rtol 1e-{k}"), 20.0)?);
+            ours.push(measure(
+                &p,
+                Method::Adaptive { rtol },
+                &format!("adaptive rtol 1e-{k}"),
+                20.0,
+            )?);
         }
         for n in 1..=8 {
-            ours.push(measure(&p, Method::Rk8 { substeps: n }, &format!("rk8 ×{n}"), 20.0)?);
+            ours.push(measure(
+                &p,
+                Method::Rk8 { substeps: n },
+                &format!("rk8 ×{n}"),
+                20.0,
+            )?);
         }
         let mut theirs = Vec::new();
         for k in 6..=11 {

@@ -85,7 +85,11 @@ fn worst(f: &Family, method: Method) -> (f64, String) {
                 if e > worst.0 {
                     worst = (
                         e,
-                        format!("dt {dt:e} s, v0 {:?} m/s, offset {:?} m", v.as_slice(), o.as_slice()),
+                        format!(
+                            "dt {dt:e} s, v0 {:?} m/s, offset {:?} m",
+                            v.as_slice(),
+                            o.as_slice()
+                        ),
                     );
                 }
             }
@@ -136,7 +140,6 @@ fn the_old_default_missed_the_promise() {
     assert!(e > 1e-11, "{e:e}");
 }
 
-
 #[test]
 fn error_budget_chooses_the_cheapest_map_within_tolerance_and_it_holds_off_the_probes() {
     use ot_physics::budget::{choose_tick_map, converged};
@@ -155,7 +158,8 @@ fn error_budget_chooses_the_cheapest_map_within_tolerance_and_it_holds_off_the_p
                         -1.8e-6 + 3.6e-6 * (f64::from(i) + 0.37) / 25.0,
                         -0.9e-6 + 1.8e-6 * (f64::from(j) + 0.61) / 25.0,
                     );
-                    worst = worst.max((p.flow(&o, &v).unwrap().0 - r.flow(&o, &v).unwrap().0).norm());
+                    worst =
+                        worst.max((p.flow(&o, &v).unwrap().0 - r.flow(&o, &v).unwrap().0).norm());
                 }
             }
         }

@@ -190,7 +190,8 @@ impl OpticalScene {
             .build()
             .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
         let dt_s = p.dt_us * 1e-6;
-        let physics = |e: ot_physics::PhysicsError| SceneError::Parse(format!("optical_tweezers: {e}"));
+        let physics =
+            |e: ot_physics::PhysicsError| SceneError::Parse(format!("optical_tweezers: {e}"));
         let (prop, report) = match p.rk4_substeps {
             Some(n) => {
                 let method = Method::Rk4 { substeps: n };
@@ -199,7 +200,8 @@ impl OpticalScene {
                 (prop, format!("fixed by rk4_substeps: {m}"))
             }
             None => {
-                let (prop, c) = choose_tick_map(model, dt_s, map_tol_m, map_speed).map_err(physics)?;
+                let (prop, c) =
+                    choose_tick_map(model, dt_s, map_tol_m, map_speed).map_err(physics)?;
                 (prop, format!("chosen from tick_map_tol_nm: {c}"))
             }
         };
@@ -325,8 +327,7 @@ impl Scene for OpticalScene {
                     }
                     // reuse the buffer: no allocation once it has grown
                     self.envelope.clear();
-                    self.envelope
-                        .extend_from_slice(self.controller.envelope());
+                    self.envelope.extend_from_slice(self.controller.envelope());
                 }
                 Err(e) => {
                     out.events
