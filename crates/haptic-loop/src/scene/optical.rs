@@ -428,3 +428,95 @@ impl Scene for OpticalScene {
         });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use crate::scene::SceneFile;
+
+    fn params(extra: &str) -> OtParams {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/optical_tweezers.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let text = text.replace("tick_map_tol_nm = 0.01", extra);
+        SceneFile::parse(&text)
+            .unwrap()
+            .optical_tweezers
+            .expect("optical scene")
+    }
+
+    fn first_events(p: OtParams) -> Vec<Event> {
+        let mut s = OpticalScene::new(p, 3.0).unwrap();
+        let mut out = SceneOutput::default();
+        let input = SceneInput {
+            tick: 0,
+            dt_s: 1e-3,
+            cursor_m: [0.0; 3],
+            buttons: crate::device::Buttons(0),
+            input_valid: true,
+        };
+        s.step(&input, &mut out);
+        out.events
+    }
+
+    #[test]
+    fn the_tick_map_choice_is_reported_once() {
+        let ev = first_events(params("tick_map_tol_nm = 0.01"));
+        assert_eq!(ev.len(), 1);
+        assert_eq!(ev[0].name, "ot.tick_map");
+        assert!(
+            ev[0]
+                .detail
+                .starts_with("chosen from tick_map_tol_nm: tick map rk4×2: "),
+            "{}",
+            ev[0].detail
+        );
+        let fixed = first_events(params("rk4_substeps = 8"));
+        assert!(
+            fixed[0]
+                .detail
+                .starts_with("fixed by rk4_substeps: tick map rk4×8: "),
+            "{}",
+            fixed[0].detail
+        );
+    }
+
+    #[test]
+    fn the_10_khz_scene_loads_with_an_exact_period() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/optical_tweezers_10khz.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let loaded = crate::scene::load_scene(&text, None).unwrap();
+        assert_eq!(loaded.config.rate_hz, 10_000);
+        assert_eq!(loaded.config.period_ns(), 100_000);
+        assert_eq!(loaded.scene.kind(), "optical_tweezers");
+    }
+
+    #[test]
+    fn budget_fields_are_validated_with_their_range() {
+        let err = |extra: &str| match OpticalScene::new(params(extra), 3.0) {
+            Ok(_) => panic!("accepted {extra}"),
+            Err(e) => e.to_string(),
+        };
+        assert_eq!(
+            err("tick_map_tol_nm = 0.0"),
+            "scene: `optical_tweezers.tick_map_tol_nm` = 0 is out of range (allowed: 1e-4 ≤ \
+             optical_tweezers.tick_map_tol_nm ≤ 100)"
+        );
+        assert_eq!(
+            err("tick_map_speed_m_per_s = -1.0"),
+            "scene: `optical_tweezers.tick_map_speed_m_per_s` = -1 is out of range (allowed: 0 ≤ \
+             optical_tweezers.tick_map_speed_m_per_s ≤ 1000)"
+        );
+        assert_eq!(
+            err("rk4_substeps = 0"),
+            "scene: `optical_tweezers.rk4_substeps` = 0 is out of range (allowed: 1 ≤ \
+             optical_tweezers.rk4_substeps ≤ 1000)"
+        );
+    }
+}
