@@ -160,7 +160,8 @@ def solve_trap(
 ) -> F64Array:
     """(M, 2) trap offsets (m, trap centre relative to the particle) that move a
     particle of velocity (2,) m/s by target (2,) m in dt s; (0, 2) if none in the
-    search region (3 waists around the free drift). Default tick: rk4 x 8."""
+    search region (3 waists around the free drift). Default tick: rk4 x 8 seeds
+    Newton; every offset is polished under the true dynamics (within 0.01 nm)."""
 
 def working_envelope(
     trap: GaussianTrap,

@@ -45,8 +45,9 @@ def test_every_solution_reaches_the_target(paper, v0):
     target = np.array([300 * NM, 0.0])
     offsets = nh.solve_trap(paper, v0, DT, target)
     assert offsets.shape == (2, 2)  # the paper's Fig. 7: two trap positions
-    d = paper.displacement(offsets, v0, DT, **TICK)
-    assert np.max(np.abs(d - target)) <= 1e-3 * NM
+    # solve_trap answers for the true dynamics (issue 13): converged reference, 0.01 nm
+    d = paper.displacement(offsets, v0, DT, rtol=1e-13)
+    assert np.max(np.abs(d - target)) <= 1e-2 * NM
     assert not np.allclose(offsets[0], offsets[1])
     if v0 == (0.0, 0.0):
         assert np.all(offsets[:, 1] == 0.0)  # symmetric well, target on the axis

@@ -125,14 +125,14 @@ impl TrapSolver<'_> {
     ) -> Result<Bounded> {
         let l = self.w.min();
         let mut o = *start;
-        let f = self.prop.flow_jacobian(&o, &self.map.v0)?;
+        let f = self.prop.flow_offset_jacobian(&o, &self.map.v0)?;
         let (mut r, mut j) = ((f.displacement - target) / l, f.d_offset);
         let mut trust = 0.25; // waists (of the smallest axis)
         for _ in 0..40 {
             let delta = disc_step(&j, &r, &((o - c) / l), radius / l, trust)?;
             let pred = (r + j * delta).norm_squared();
             let cand = o + delta * l;
-            let fc = self.prop.flow_jacobian(&cand, &self.map.v0)?;
+            let fc = self.prop.flow_offset_jacobian(&cand, &self.map.v0)?;
             let rc = (fc.displacement - target) / l;
             let actual = r.norm_squared() - rc.norm_squared();
             let predicted = r.norm_squared() - pred;

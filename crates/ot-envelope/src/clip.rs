@@ -46,8 +46,13 @@ pub struct Clipped {
 
 /// Clip `command` (displacement, m) to the envelope `we`.
 pub fn clip_command(we: &Envelope, command: &V2, mode: ClipMode) -> Result<Clipped> {
+    clip_to_polygon(&we.polygon, &we.free_displacement, command, mode)
+}
+
+/// [`clip_command`] on a bare polygon (m, counter-clockwise) with the free
+/// drift `free` (m) as the second radial anchor. Allocates nothing.
+pub fn clip_to_polygon(poly: &[V2], free: &V2, command: &V2, mode: ClipMode) -> Result<Clipped> {
     finite_vec("command [m]", command.as_slice())?;
-    let poly = &we.polygon;
     if poly.len() < 3 {
         return Err(EnvelopeError::OutOfRange {
             field: "envelope.polygon (vertices)",
@@ -65,9 +70,7 @@ pub fn clip_command(we: &Envelope, command: &V2, mode: ClipMode) -> Result<Clipp
     let allowed = match mode {
         ClipMode::Nearest => nearest(),
         ClipMode::Radial => {
-            let anchor = [V2::zeros(), we.free_displacement]
-                .into_iter()
-                .find(|a| contains(poly, a));
+            let anchor = [V2::zeros(), *free].into_iter().find(|a| contains(poly, a));
             match anchor
                 .and_then(|a| first_crossing(poly, &a, command).map(|t| a + (command - a) * t))
             {

@@ -125,8 +125,25 @@ pub fn working_envelope_with(
 /// Build the envelope from an already sampled map (the haptic loop reuses the
 /// map for the inverse solver). `tol` in m.
 pub fn envelope_from_map(prop: &Propagator<2>, map: &SampledMap, tol: f64) -> Result<Envelope> {
+    envelope_and_folds(prop, map, tol, None)
+}
+
+/// [`envelope_from_map`] that also returns, in `folds`, every traced fold
+/// point as (offset, displacement) (m): the warm-started tick verifies them.
+pub(crate) fn envelope_and_folds(
+    prop: &Propagator<2>,
+    map: &SampledMap,
+    tol: f64,
+    folds: Option<&mut Vec<(V2, V2)>>,
+) -> Result<Envelope> {
     let tol = positive("tol [m]", tol)?;
     let mut traced = trace(prop, map, tol)?;
+    if let Some(f) = folds {
+        f.clear();
+        for c in traced.curves.iter().filter(|c| c.edge_dir.is_none()) {
+            f.extend(c.pts.iter().map(|p| (p.o, p.d)));
+        }
+    }
     let lines = hermite_polylines(&traced.curves, tol, &mut traced.edge_only);
     let (fold_curves, edge_only) = (traced.fold_curves, &traced.edge_only);
     let scale = map
@@ -135,7 +152,23 @@ pub fn envelope_from_map(prop: &Propagator<2>, map: &SampledMap, tol: f64) -> Re
         .map(|d| (d - map.disp[0]).norm())
         .fold(0.0, f64::max)
         .max(tol);
-    let polygon = outer_boundary(&lines, 1e-9 * scale);
+    let snap = 1e-9 * scale;
+    // The region edge's image (last line) is usually a small tangle near the
+    // free drift, deep inside the envelope: when its bounding box lies inside
+    // the outer boundary of the fold images alone (corners inside, no
+    // boundary edge through the box), it cannot change the outer boundary and
+    // its thousands of segment pairs are never tested.
+    let polygon = match lines.split_last() {
+        Some((edge, folds)) if !folds.is_empty() => {
+            let inner = outer_boundary(folds, snap);
+            if inner.len() >= 3 && geometry::box_inside(&inner, &geometry::bbox(&edge.0)) {
+                inner
+            } else {
+                outer_boundary(&lines, snap)
+            }
+        }
+        _ => outer_boundary(&lines, snap),
+    };
     let touches_region_edge = polygon
         .iter()
         .any(|p| edge_only.contains(&(p.x.to_bits(), p.y.to_bits())));

@@ -29,8 +29,8 @@ pub(crate) struct Traced {
 /// A point of an image curve: offset (m), displacement (m), Jacobian.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct CurvePoint {
-    o: V2,
-    d: V2,
+    pub(crate) o: V2,
+    pub(crate) d: V2,
     j: Matrix2<f64>,
 }
 
@@ -61,7 +61,7 @@ struct Ctx<'a> {
 
 impl Ctx<'_> {
     fn eval(&mut self, o: &V2) -> Result<CurvePoint> {
-        let f = self.prop.flow_jacobian(o, &self.v0)?;
+        let f = self.prop.flow_offset_jacobian(o, &self.v0)?;
         self.evals += f.evals;
         Ok(CurvePoint {
             o: *o,
@@ -140,11 +140,11 @@ impl Ctx<'_> {
 
 /// One image curve under construction.
 pub(crate) struct Curve {
-    pts: Vec<CurvePoint>,
+    pub(crate) pts: Vec<CurvePoint>,
     closed: bool,
     /// `Some(dir)` for a region edge walked along `dir` (tangent = J·dir at
     /// every point); `None` for a fold curve.
-    edge_dir: Option<Vec<V2>>,
+    pub(crate) edge_dir: Option<Vec<V2>>,
 }
 
 fn tangents(c: &Curve, k: usize, chord: &V2) -> (V2, V2) {

@@ -254,6 +254,56 @@ pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
     out
 }
 
+/// Bounding box `(lo, hi)` of a point set (m); `(+∞, −∞)` when empty.
+pub fn bbox(points: &[V2]) -> (V2, V2) {
+    let mut lo = V2::repeat(f64::INFINITY);
+    let mut hi = V2::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (lo, hi)
+}
+
+/// Whether segment `[a, b]` meets the closed box `(lo, hi)` (Liang–Barsky).
+pub fn segment_meets_box(a: &V2, b: &V2, lo: &V2, hi: &V2) -> bool {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for i in 0..2 {
+        if d[i] == 0.0 {
+            if a[i] < lo[i] || a[i] > hi[i] {
+                return false;
+            }
+        } else {
+            let (mut u, mut v) = ((lo[i] - a[i]) / d[i], (hi[i] - a[i]) / d[i]);
+            if u > v {
+                std::mem::swap(&mut u, &mut v);
+            }
+            t0 = t0.max(u);
+            t1 = t1.min(v);
+            if t0 > t1 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Whether the box `(lo, hi)` lies strictly inside the closed polygon: its
+/// four corners inside and no polygon edge meeting it. False for an empty box.
+pub fn box_inside(poly: &[V2], b: &(V2, V2)) -> bool {
+    let (lo, hi) = b;
+    if !(lo.x <= hi.x && lo.y <= hi.y) {
+        return false;
+    }
+    let corners = [*lo, V2::new(hi.x, lo.y), *hi, V2::new(lo.x, hi.y)];
+    if !corners.iter().all(|c| contains(poly, c)) {
+        return false;
+    }
+    let n = poly.len();
+    (0..n).all(|i| !segment_meets_box(&poly[i], &poly[(i + 1) % n], lo, hi))
+}
+
 /// Signed area (positive when counter-clockwise), in the points' unit squared.
 pub fn signed_area(poly: &[V2]) -> f64 {
     let n = poly.len();

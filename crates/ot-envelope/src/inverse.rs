@@ -79,6 +79,9 @@ pub enum Choice {
     Continued,
     /// The solution with the smallest trap move among all found.
     SmallestMove,
+    /// Newton seeded from a fold point of the (warm-started) envelope whose
+    /// image is near the target (no grid needed).
+    FoldSeeded,
 }
 
 /// Counters of one solve.
@@ -92,25 +95,168 @@ pub struct SolveStats {
     pub evals: u64,
 }
 
+/// Per cell: the grown image box (m) and its margin (m).
+#[derive(Debug, Clone, Default)]
+struct CellBoxes {
+    boxes: Vec<(V2, V2)>,
+    margins: Vec<f64>,
+}
+
 /// The inverse solver of one tick (one propagator, one velocity): holds the
 /// sampled map, answers many targets.
 #[derive(Debug, Clone)]
 pub struct TrapSolver<'a> {
     pub(crate) prop: &'a Propagator<2>,
     pub(crate) map: SampledMap,
-    /// Per cell: box of its corner images grown by the nonlinearity margin (m).
-    boxes: Vec<(V2, V2)>,
-    /// Per cell: the nonlinearity margin (m).
-    margins: Vec<f64>,
+    /// Per cell: box of its corner images grown by the nonlinearity margin
+    /// (m) and that margin (m); built on the first full solve only
+    /// (continuation never needs them).
+    boxes: std::cell::OnceCell<CellBoxes>,
     /// Residual tolerance (m).
     pub residual: f64,
     pub(crate) w: V2,
 }
 
+/// Damped Newton on one tick map for one velocity, independent of any
+/// sampled map (the warm-started tick uses it without a grid).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Newton<'p> {
+    /// The tick map.
+    pub prop: &'p Propagator<2>,
+    /// Start velocity (m/s).
+    pub v0: V2,
+    /// Waists (m): steps are limited to half a waist in these units.
+    pub w: V2,
+    /// The offsets searched (m); iterates far outside give up.
+    pub region: OffsetRegion,
+    /// Residual tolerance (m).
+    pub residual: f64,
+    /// Extra steps once the residual is met (2 where distinct roots must be
+    /// told apart, 0 for a single continued root).
+    pub polish: u8,
+}
+
+impl Newton<'_> {
+    /// Newton from `start` (m) towards `target` (m), damped, with steps of
+    /// at most half a waist; gives up when the iterate comes within 1/20 of
+    /// `cell` (m, per axis) of one of the `known` roots. `Some((offset,
+    /// residual))` when the residual falls below the tolerance inside the
+    /// region.
+    pub(crate) fn run(
+        &self,
+        start: &V2,
+        target: &V2,
+        evals: &mut u64,
+        known: &[(V2, bool)],
+        cell: &V2,
+    ) -> Result<Option<(V2, f64)>> {
+        let mut o = *start;
+        let f = self.prop.flow_offset_jacobian(&o, &self.v0)?;
+        *evals += f.evals;
+        let (mut r, mut j) = (f.displacement - target, f.d_offset);
+        let mut rn = r.norm();
+        let mut polish = 0u8;
+        for _ in 0..40 {
+            if rn <= self.residual {
+                // two more steps while they still gain: converged roots agree
+                // to rounding, so distinct roots are told apart reliably
+                polish += 1;
+                if polish > self.polish {
+                    break;
+                }
+            }
+            let step = match j.try_inverse() {
+                Some(inv) => -(inv * r),
+                None => -(j.transpose() * r) / (j.norm_squared() + f64::MIN_POSITIVE),
+            };
+            let zs = step.component_div(&self.w).norm();
+            let mut step = if zs > 0.5 { step * (0.5 / zs) } else { step };
+            let mut accepted = false;
+            for _ in 0..6 {
+                let cand = o + step;
+                let f = self.prop.flow_offset_jacobian(&cand, &self.v0)?;
+                *evals += f.evals;
+                let rc = f.displacement - target;
+                if rc.norm() < rn {
+                    (o, r, j, rn) = (cand, rc, f.d_offset, rc.norm());
+                    accepted = true;
+                    break;
+                }
+                step *= 0.5;
+            }
+            if !accepted {
+                if rn <= self.residual {
+                    break;
+                }
+                return Ok(None);
+            }
+            if rn > self.residual
+                && known
+                    .iter()
+                    .any(|(k, _)| (o - k).component_div(cell).amax() < 0.05)
+            {
+                return Ok(None);
+            }
+            // Leave early when the iterate has wandered far outside the region.
+            let out = (o - self.region.centre())
+                .component_div(&(self.region.hi - self.region.lo))
+                .amax();
+            if out > 1.0 {
+                return Ok(None);
+            }
+        }
+        Ok((rn <= self.residual && self.region.contains(&o)).then_some((o, rn)))
+    }
+}
+
 /// Every offset in the default region (3 waists around the drift path) that
-/// moves a particle of velocity `v0` (m/s) by `target` (m) in `prop`'s tick.
+/// moves a particle of velocity `v0` (m/s) by `target` (m) in one tick of
+/// `prop`'s model and Δt, **under the true dynamics**: `prop`'s map samples
+/// the region and seeds Newton, then every root is polished with the
+/// default method ([`ot_physics::Method::default`], within
+/// [`ot_physics::DEFAULT_TOL_M`] = 0.01 nm of converged dynamics) to a
+/// residual of [`DEFAULT_RESIDUAL`]. So each returned offset reproduces the
+/// target within 0.011 nm of converged dynamics whatever `prop`'s own error
+/// (RK4×8 at Δt = 1 µs is 0.21 nm off). A root of `prop`'s map whose polish
+/// leaves the region is dropped. For the roots of `prop`'s own map, use
+/// [`TrapSolver::solve`].
 pub fn solve_trap(prop: &Propagator<2>, v0: &V2, target: &V2) -> Result<Solutions> {
-    Ok(TrapSolver::new(prop, v0, None, None)?.solve(target)?.0)
+    let solver = TrapSolver::new(prop, v0, None, None)?;
+    let (sol, _) = solver.solve(target)?;
+    if matches!(prop.method(), ot_physics::Method::Adaptive { rtol } if rtol <= ot_physics::DEFAULT_RTOL)
+    {
+        return Ok(sol);
+    }
+    let truth = Propagator::new(*prop.model(), ot_physics::Method::default(), prop.dt())?;
+    let nw = Newton {
+        prop: &truth,
+        v0: *v0,
+        w: solver.w,
+        region: solver.map.region,
+        residual: DEFAULT_RESIDUAL,
+        polish: 2,
+    };
+    let mut found: Vec<V2> = Vec::new();
+    let mut evals = 0;
+    for o in sol.offsets() {
+        if let Some((p, _)) = nw.run(o, target, &mut evals, &[], &solver.map.h)? {
+            let zp = p.component_div(&solver.w);
+            if !found
+                .iter()
+                .any(|f| (f.component_div(&solver.w) - zp).norm() < DEDUP_WAISTS)
+            {
+                found.push(p);
+            }
+        }
+    }
+    found.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    Ok(if found.is_empty() {
+        Solutions::None {
+            region: solver.map.region,
+        }
+    } else {
+        Solutions::Found(found)
+    })
 }
 
 impl<'a> TrapSolver<'a> {
@@ -130,39 +276,46 @@ impl<'a> TrapSolver<'a> {
         Ok(Self::from_map(prop, map))
     }
 
-    /// Reuse a sampled map (the envelope's, in the haptic loop).
+    /// Reuse a sampled map (the envelope's, in the haptic loop). Cheap: the
+    /// per-cell boxes of the full solve are built lazily, on its first call.
     pub fn from_map(prop: &'a Propagator<2>, map: SampledMap) -> Self {
-        let [nx, ny] = map.n;
-        let mut boxes = Vec::with_capacity((nx - 1) * (ny - 1));
-        let mut margins = Vec::with_capacity((nx - 1) * (ny - 1));
-        for i in 0..nx - 1 {
-            for j in 0..ny - 1 {
-                let c = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
-                let (mut lo, mut hi) = (map.disp[map.idx(i, j)], map.disp[map.idx(i, j)]);
-                let mut nl: f64 = 0.0;
-                for k in 0..4 {
-                    let (a, b) = (c[k], c[(k + 1) % 4]);
-                    let (ia, ib) = (map.idx(a.0, a.1), map.idx(b.0, b.1));
-                    lo = lo.inf(&map.disp[ib]);
-                    hi = hi.sup(&map.disp[ib]);
-                    let step = map.offset(b.0, b.1) - map.offset(a.0, a.1);
-                    let e1 = map.disp[ib] - map.disp[ia] - map.jac[ia] * step;
-                    let e2 = map.disp[ia] - map.disp[ib] + map.jac[ib] * step;
-                    nl = nl.max(e1.amax()).max(e2.amax());
-                }
-                let g = NL_SAFETY * nl + map.interior_error + 1e-12;
-                boxes.push((lo - V2::repeat(g), hi + V2::repeat(g)));
-                margins.push(g);
-            }
-        }
         Self {
             prop,
             map,
-            boxes,
-            margins,
+            boxes: std::cell::OnceCell::new(),
             residual: DEFAULT_RESIDUAL,
             w: prop.model().well.waists(),
         }
+    }
+
+    fn cell_boxes(&self) -> &CellBoxes {
+        self.boxes.get_or_init(|| {
+            let map = &self.map;
+            let [nx, ny] = map.n;
+            let mut boxes = Vec::with_capacity((nx - 1) * (ny - 1));
+            let mut margins = Vec::with_capacity((nx - 1) * (ny - 1));
+            for i in 0..nx - 1 {
+                for j in 0..ny - 1 {
+                    let c = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+                    let (mut lo, mut hi) = (map.disp[map.idx(i, j)], map.disp[map.idx(i, j)]);
+                    let mut nl: f64 = 0.0;
+                    for k in 0..4 {
+                        let (a, b) = (c[k], c[(k + 1) % 4]);
+                        let (ia, ib) = (map.idx(a.0, a.1), map.idx(b.0, b.1));
+                        lo = lo.inf(&map.disp[ib]);
+                        hi = hi.sup(&map.disp[ib]);
+                        let step = map.offset(b.0, b.1) - map.offset(a.0, a.1);
+                        let e1 = map.disp[ib] - map.disp[ia] - map.jac[ia] * step;
+                        let e2 = map.disp[ia] - map.disp[ib] + map.jac[ib] * step;
+                        nl = nl.max(e1.amax()).max(e2.amax());
+                    }
+                    let g = NL_SAFETY * nl + map.interior_error + 1e-12;
+                    boxes.push((lo - V2::repeat(g), hi + V2::repeat(g)));
+                    margins.push(g);
+                }
+            }
+            CellBoxes { boxes, margins }
+        })
     }
 
     /// The sampled map.
@@ -186,62 +339,15 @@ impl<'a> TrapSolver<'a> {
         evals: &mut u64,
         known: &[(V2, bool)],
     ) -> Result<Option<(V2, f64)>> {
-        let mut o = *start;
-        let f = self.prop.flow_jacobian(&o, &self.map.v0)?;
-        *evals += f.evals;
-        let (mut r, mut j) = (f.displacement - target, f.d_offset);
-        let mut rn = r.norm();
-        let mut polish = 0;
-        for _ in 0..40 {
-            if rn <= self.residual {
-                // two more steps while they still gain: converged roots agree
-                // to rounding, so distinct roots are told apart reliably
-                polish += 1;
-                if polish > 2 {
-                    break;
-                }
-            }
-            let step = match j.try_inverse() {
-                Some(inv) => -(inv * r),
-                None => -(j.transpose() * r) / (j.norm_squared() + f64::MIN_POSITIVE),
-            };
-            let zs = step.component_div(&self.w).norm();
-            let mut step = if zs > 0.5 { step * (0.5 / zs) } else { step };
-            let mut accepted = false;
-            for _ in 0..6 {
-                let cand = o + step;
-                let f = self.prop.flow_jacobian(&cand, &self.map.v0)?;
-                *evals += f.evals;
-                let rc = f.displacement - target;
-                if rc.norm() < rn {
-                    (o, r, j, rn) = (cand, rc, f.d_offset, rc.norm());
-                    accepted = true;
-                    break;
-                }
-                step *= 0.5;
-            }
-            if !accepted {
-                if rn <= self.residual {
-                    break;
-                }
-                return Ok(None);
-            }
-            if rn > self.residual
-                && known
-                    .iter()
-                    .any(|(k, _)| (o - k).component_div(&self.map.h).amax() < 0.05)
-            {
-                return Ok(None);
-            }
-            // Leave early when the iterate has wandered far outside the region.
-            let out = (o - self.map.region.centre())
-                .component_div(&(self.map.region.hi - self.map.region.lo))
-                .amax();
-            if out > 1.0 {
-                return Ok(None);
-            }
-        }
-        Ok((rn <= self.residual && self.map.region.contains(&o)).then_some((o, rn)))
+        let nw = Newton {
+            prop: self.prop,
+            v0: self.map.v0,
+            w: self.w,
+            region: self.map.region,
+            residual: self.residual,
+            polish: 2,
+        };
+        nw.run(start, target, evals, known, &self.map.h)
     }
 
     fn scaled(&self, o: &V2) -> V2 {
@@ -252,16 +358,17 @@ impl<'a> TrapSolver<'a> {
     pub fn solve(&self, target: &V2) -> Result<(Solutions, SolveStats)> {
         finite_vec("target [m]", target.as_slice())?;
         let [nx, ny] = self.map.n;
+        let cells = self.cell_boxes();
         let mut stats = SolveStats::default();
         // candidate cells, best first (smallest image distance of a corner)
         let mut cand: Vec<(f64, usize, usize)> = Vec::new();
         for i in 0..nx - 1 {
             for j in 0..ny - 1 {
-                let (lo, hi) = self.boxes[i * (ny - 1) + j];
+                let (lo, hi) = cells.boxes[i * (ny - 1) + j];
                 if target.x >= lo.x && target.x <= hi.x && target.y >= lo.y && target.y <= hi.y && {
                     let d = |a: usize, b: usize| self.map.disp[self.map.idx(a, b)];
                     let (p00, p10, p11, p01) = (d(i, j), d(i + 1, j), d(i + 1, j + 1), d(i, j + 1));
-                    let m = self.margins[i * (ny - 1) + j];
+                    let m = cells.margins[i * (ny - 1) + j];
                     tri_dist(&p00, &p10, &p11, target) <= m
                         || tri_dist(&p00, &p11, &p01, target) <= m
                         || tri_dist(&p00, &p10, &p01, target) <= m
@@ -329,7 +436,7 @@ impl<'a> TrapSolver<'a> {
                     {
                         let det = self
                             .prop
-                            .flow_jacobian(&o, &self.map.v0)?
+                            .flow_offset_jacobian(&o, &self.map.v0)?
                             .d_offset
                             .determinant();
                         found.push((o, det >= 0.0));

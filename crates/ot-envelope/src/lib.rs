@@ -12,6 +12,9 @@
 //!   (radially, as in the paper, or to the nearest point) and the excess;
 //! * [`steer::Controller`]: the pure per-tick steering law — cursor command in,
 //!   new trap position and the reaction force of a spring on the excess out;
+//! * [`tick::TickController`]: the same law warm-started from the previous
+//!   tick's envelope (translate, check fold points, rebuild on failure),
+//!   allocation-free in steady state — the haptic loop's tick;
 //! * [`paper`]: the paper's own method (grid of targets, marching-squares
 //!   seeds, Newton, subdivision, contour), kept as the benchmark baseline.
 //!
@@ -52,9 +55,10 @@ pub mod reference;
 pub mod region;
 pub mod sample;
 pub mod steer;
+pub mod tick;
 
 pub use bounded::{Bounded, SteeringRange};
-pub use clip::{ClipMode, Clipped, clip_command};
+pub use clip::{ClipMode, Clipped, clip_command, clip_to_polygon};
 pub use envelope::{
     DEFAULT_TOL, Envelope, EnvelopeOptions, envelope_from_map, working_envelope,
     working_envelope_with,
@@ -63,3 +67,4 @@ pub use error::{EnvelopeError, Result};
 pub use inverse::{Solutions, solve_trap};
 pub use region::OffsetRegion;
 pub use sample::SampledMap;
+pub use tick::{TickController, TickOutput, TickParams, TickStats};

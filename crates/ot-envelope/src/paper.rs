@@ -49,7 +49,7 @@ fn newton(
 ) -> Result<Option<V2>> {
     let mut o = start;
     for _ in 0..20 {
-        let f = prop.flow_jacobian(&o, v0)?;
+        let f = prop.flow_offset_jacobian(&o, v0)?;
         *evals += f.evals;
         let r = f.displacement - target;
         if r.norm() <= 1e-12 {

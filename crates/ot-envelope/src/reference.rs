@@ -148,7 +148,7 @@ impl Reference {
         let mut best = (self.images[k] - p).norm();
         let mut mu = 1e-3;
         for _ in 0..30 {
-            let f = prop.flow_jacobian(&o, &self.v0)?;
+            let f = prop.flow_offset_jacobian(&o, &self.v0)?;
             let r = f.displacement - p;
             best = best.min(r.norm());
             let j = f.d_offset;

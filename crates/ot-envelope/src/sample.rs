@@ -5,7 +5,7 @@
 use crate::error::{EnvelopeError, Result, finite_vec, positive};
 use crate::region::OffsetRegion;
 use nalgebra::{Matrix2, Vector2};
-use ot_physics::{Flow, Propagator};
+use ot_physics::{OffsetFlow, Propagator};
 
 /// Largest grid the sampler accepts (vertices).
 pub const MAX_VERTICES: usize = 4_000_000;
@@ -141,7 +141,7 @@ impl SampledMap {
                 let o = region.lo + Vector2::new(h.x * i as f64, h.y * j as f64);
                 let edge = i == 0 || j == 0 || i + 1 == n[0] || j + 1 == n[1];
                 let p = if edge { prop } else { coarse.unwrap_or(prop) };
-                let f: Flow<2> = p.flow_jacobian(&o, v0)?;
+                let f: OffsetFlow<2> = p.flow_offset_jacobian(&o, v0)?;
                 disp.push(f.displacement);
                 jac.push(f.d_offset);
                 evals += f.evals;

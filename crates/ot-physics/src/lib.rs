@@ -16,6 +16,8 @@
 //! * the flow map of a tick ([`Propagator::flow`],
 //!   [`Propagator::flow_jacobian`]): displacement after Δt for a trap offset
 //!   and its exact derivatives from the variational equations;
+//! * [`budget`]: the cheapest fixed-step tick map within a stated error (m)
+//!   of converged dynamics, chosen and reported ([`choose_tick_map`]);
 //! * [`langevin`]: thermal noise (BAOAB; overdamped exact-OU local
 //!   linearisation) with seeded, reproducible random numbers;
 //! * [`analysis`]: variance, autocorrelation and corner-frequency fits.
@@ -36,6 +38,7 @@
 //! ```
 
 pub mod analysis;
+pub mod budget;
 pub mod dynamics;
 pub mod error;
 pub mod fastexp;
@@ -47,9 +50,10 @@ pub mod paper;
 pub mod state;
 pub mod well;
 
+pub use budget::{MapChoice, choose_tick_map};
 pub use error::{PhysicsError, Result};
-pub use flow::Flow;
-pub use integrate::{Composition, DEFAULT_RTOL, Method, Propagator};
+pub use flow::{Flow, OffsetFlow};
+pub use integrate::{Composition, DEFAULT_RTOL, DEFAULT_TOL_M, Method, Propagator};
 pub use model::{BOLTZMANN, TrapBuilder, TrapModel};
-pub use state::{Phase, PhaseVar};
+pub use state::{Phase, PhaseSens, PhaseVar};
 pub use well::{GaussianWell, Well2, Well3};

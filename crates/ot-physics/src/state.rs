@@ -65,6 +65,72 @@ pub struct PhaseVar<const D: usize> {
     pub jvv: SMatrix<f64, D, D>,
 }
 
+/// Phase plus its sensitivity to the initial position only: the two `D×D`
+/// blocks `∂r/∂r0` and `∂v/∂r0` (dimensionless, 1/s). What the envelope and
+/// the inverse solver need (∂/∂offset = −∂/∂r0): half the variational work of
+/// [`PhaseVar`], which also carries `∂/∂v0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhaseSens<const D: usize> {
+    /// The phase itself.
+    pub p: Phase<D>,
+    /// `∂r/∂r0` (dimensionless).
+    pub jrr: SMatrix<f64, D, D>,
+    /// `∂v/∂r0` (1/s).
+    pub jvr: SMatrix<f64, D, D>,
+}
+
+impl<const D: usize> PhaseSens<D> {
+    /// Start from `p` with `∂r/∂r0 = I`, `∂v/∂r0 = 0`.
+    pub fn identity(p: Phase<D>) -> Self {
+        Self {
+            p,
+            jrr: SMatrix::identity(),
+            jvr: SMatrix::zeros(),
+        }
+    }
+}
+
+impl<const D: usize> OdeState for PhaseSens<D> {
+    #[inline(always)]
+    fn zero_like(&self) -> Self {
+        Self {
+            p: self.p.zero_like(),
+            jrr: SMatrix::zeros(),
+            jvr: SMatrix::zeros(),
+        }
+    }
+    #[inline(always)]
+    fn combine(&self, h: f64, terms: &[(f64, &Self)]) -> Self {
+        let mut out = *self;
+        for (c, k) in terms {
+            let s = h * c;
+            out.p.r.axpy(s, &k.p.r, 1.0);
+            out.p.v.axpy(s, &k.p.v, 1.0);
+            out.jrr += k.jrr * s;
+            out.jvr += k.jvr * s;
+        }
+        out
+    }
+
+    /// As [`PhaseVar`]'s error control, on the two blocks carried.
+    #[inline]
+    fn error_ratio(err: &Self, y0: &Self, y1: &Self, tol: &Tolerance) -> f64 {
+        let w = tol.atol_v / tol.atol_r;
+        let block =
+            |e: &SMatrix<f64, D, D>, a: &SMatrix<f64, D, D>, b: &SMatrix<f64, D, D>, atol: f64| {
+                let mut worst: f64 = 0.0;
+                for i in 0..D * D {
+                    let sc = atol + tol.rtol * a[i].abs().max(b[i].abs());
+                    worst = worst.max((e[i] / sc).abs());
+                }
+                worst
+            };
+        Phase::error_ratio(&err.p, &y0.p, &y1.p, tol)
+            .max(block(&err.jrr, &y0.jrr, &y1.jrr, tol.rtol))
+            .max(block(&err.jvr, &y0.jvr, &y1.jvr, tol.rtol * w))
+    }
+}
+
 impl<const D: usize> PhaseVar<D> {
     /// Start from `p` with identity sensitivities.
     pub fn identity(p: Phase<D>) -> Self {

@@ -10,13 +10,21 @@
 //! map (not by the command), so what the recording shows is the physics, not the wish. Not
 //! grabbed, the particle evolves in the last trap. The paper's viscous simplification (the
 //! velocity kept to a fraction each cycle) is `velocity_retain` (1: none).
+//!
+//! The tick map is chosen from an error budget (`tick_map_tol_nm`, default 0.01 nm from
+//! converged dynamics, see `ot_physics::budget`) unless `rk4_substeps` fixes it; the choice and
+//! its measured error are reported by an `ot.tick_map` event on the first tick. The controller is
+//! `ot_envelope::TickController`: warm-started from the last full envelope build (translated by
+//! the change of free drift, checked at fold points), allocation-free in a steady-state tick.
 
 use super::file::{SceneError, check_positive, check_range};
 use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
 use crate::vec3::Vec3;
 use nalgebra::Vector2;
 use ot_envelope::ClipMode;
-use ot_envelope::steer::{Controller, ParticleState, SteerParams};
+use ot_envelope::steer::{ParticleState, SteerParams};
+use ot_envelope::tick::{TickController, TickParams};
+use ot_physics::budget::{choose_tick_map, measure};
 use ot_physics::{Method, Propagator, TrapModel};
 use serde::Deserialize;
 
@@ -36,9 +44,22 @@ pub struct OtParams {
     pub mass_g: f64,
     /// Particle time per haptic tick, µs (paper: 1).
     pub dt_us: f64,
-    /// RK4 substeps of the tick map (8: within 0.21 nm of converged dynamics).
-    #[serde(default = "default_substeps")]
-    pub rk4_substeps: u32,
+    /// RK4 substeps of the tick map, fixed by hand (1–1000); absent: the tick map is chosen
+    /// from `tick_map_tol_nm`.
+    #[serde(default)]
+    pub rk4_substeps: Option<u32>,
+    /// Error budget of the tick map, nm from converged dynamics (default 0.01); the cheapest
+    /// RK4/RK8 map within it is chosen (`ot_physics::budget::choose_tick_map`).
+    #[serde(default)]
+    pub tick_map_tol_nm: Option<f64>,
+    /// Largest particle speed the tick map's budget is checked for, m/s (default 0.1, the
+    /// paper's 100 nm/µs).
+    #[serde(default)]
+    pub tick_map_speed_m_per_s: Option<f64>,
+    /// Warm-start the working envelope from the last full build (default true; false rebuilds
+    /// it every tick).
+    #[serde(default = "yes")]
+    pub warm_start: bool,
     /// Particle diameter, µm (paper: 1).
     pub particle_diameter_um: f64,
     /// Cursor sphere radius, nm.
@@ -65,9 +86,6 @@ pub struct OtParams {
     pub envelope_tol_nm: Option<f64>,
 }
 
-fn default_substeps() -> u32 {
-    8
-}
 fn yes() -> bool {
     true
 }
@@ -82,7 +100,9 @@ fn hundred() -> f64 {
 pub struct OpticalScene {
     p: OtParams,
     prop: Propagator<2>,
-    controller: Controller,
+    controller: TickController,
+    /// The tick map's report, sent as an `ot.tick_map` event on the first tick.
+    tick_map_report: Option<String>,
     waists_m: [f64; 2],
     particle_r_m: f64,
     cursor_r_m: f64,
@@ -106,12 +126,23 @@ impl OpticalScene {
         check_positive("optical_tweezers.waist_y_nm", p.waist_y_nm, 1e6)?;
         check_positive("optical_tweezers.mass_g", p.mass_g, 1.0)?;
         check_positive("optical_tweezers.dt_us", p.dt_us, 1e6)?;
-        check_range(
-            "optical_tweezers.rk4_substeps",
-            f64::from(p.rk4_substeps),
-            1.0,
-            1000.0,
-        )?;
+        if let Some(n) = p.rk4_substeps {
+            check_range("optical_tweezers.rk4_substeps", f64::from(n), 1.0, 1000.0)?;
+        }
+        let map_tol_m = match p.tick_map_tol_nm {
+            Some(t) => {
+                check_range("optical_tweezers.tick_map_tol_nm", t, 1e-4, 100.0)?;
+                t * 1e-9
+            }
+            None => ot_physics::DEFAULT_TOL_M,
+        };
+        let map_speed = match p.tick_map_speed_m_per_s {
+            Some(v) => {
+                check_range("optical_tweezers.tick_map_speed_m_per_s", v, 0.0, 1e3)?;
+                v
+            }
+            None => 0.1,
+        };
         check_positive(
             "optical_tweezers.particle_diameter_um",
             p.particle_diameter_um,
@@ -158,21 +189,31 @@ impl OpticalScene {
             .mass(p.mass_g * 1e-3)
             .build()
             .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
-        let prop = Propagator::new(
-            model,
-            Method::Rk4 {
-                substeps: p.rk4_substeps,
-            },
-            p.dt_us * 1e-6,
-        )
-        .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
-        let controller = Controller::new(SteerParams {
+        let dt_s = p.dt_us * 1e-6;
+        let physics =
+            |e: ot_physics::PhysicsError| SceneError::Parse(format!("optical_tweezers: {e}"));
+        let (prop, report) = match p.rk4_substeps {
+            Some(n) => {
+                let method = Method::Rk4 { substeps: n };
+                let m = measure(model, method, dt_s, map_speed).map_err(physics)?;
+                let prop = Propagator::new(model, method, dt_s).map_err(physics)?;
+                (prop, format!("fixed by rk4_substeps: {m}"))
+            }
+            None => {
+                let (prop, c) =
+                    choose_tick_map(model, dt_s, map_tol_m, map_speed).map_err(physics)?;
+                (prop, format!("chosen from tick_map_tol_nm: {c}"))
+            }
+        };
+        let mut tick = TickParams::new(SteerParams {
             stiffness: p.stiffness_n_per_m,
             mode: p.clip,
             tol,
             margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
-        })
-        .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
+        });
+        tick.warm_start = p.warm_start;
+        let controller = TickController::new(tick)
+            .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
         let start = V2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
         Ok(OpticalScene {
             particle_r_m: 0.5 * p.particle_diameter_um * 1e-6,
@@ -180,6 +221,7 @@ impl OpticalScene {
             p,
             prop,
             controller,
+            tick_map_report: Some(report),
             waists_m,
             position: start,
             velocity: V2::zeros(),
@@ -207,6 +249,18 @@ impl OpticalScene {
     }
 }
 
+impl OpticalScene {
+    /// The steering counters so far (rebuilds, warm ticks, solves).
+    pub fn tick_stats(&self) -> ot_envelope::TickStats {
+        self.controller.stats()
+    }
+
+    /// The tick map in use.
+    pub fn tick_map(&self) -> &Propagator<2> {
+        &self.prop
+    }
+}
+
 impl Scene for OpticalScene {
     fn kind(&self) -> &'static str {
         "optical_tweezers"
@@ -231,6 +285,9 @@ impl Scene for OpticalScene {
     }
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
+        if let Some(r) = self.tick_map_report.take() {
+            out.events.push(Event::new("ot.tick_map", r));
+        }
         self.cursor = V2::new(input.cursor_m[0], input.cursor_m[1]);
         let button = input.buttons.pressed(0);
         if button && !self.button_was && !self.grabbed {
@@ -268,7 +325,9 @@ impl Scene for OpticalScene {
                     if self.p.feedback {
                         self.force = s.force;
                     }
-                    self.envelope = s.envelope.polygon;
+                    // reuse the buffer: no allocation once it has grown
+                    self.envelope.clear();
+                    self.envelope.extend_from_slice(self.controller.envelope());
                 }
                 Err(e) => {
                     out.events
@@ -367,5 +426,97 @@ impl Scene for OpticalScene {
             ),
             color: Rgba([1.0, 1.0, 1.0, 1.0]),
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use crate::scene::SceneFile;
+
+    fn params(extra: &str) -> OtParams {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/optical_tweezers.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let text = text.replace("tick_map_tol_nm = 0.01", extra);
+        SceneFile::parse(&text)
+            .unwrap()
+            .optical_tweezers
+            .expect("optical scene")
+    }
+
+    fn first_events(p: OtParams) -> Vec<Event> {
+        let mut s = OpticalScene::new(p, 3.0).unwrap();
+        let mut out = SceneOutput::default();
+        let input = SceneInput {
+            tick: 0,
+            dt_s: 1e-3,
+            cursor_m: [0.0; 3],
+            buttons: crate::device::Buttons(0),
+            input_valid: true,
+        };
+        s.step(&input, &mut out);
+        out.events
+    }
+
+    #[test]
+    fn the_tick_map_choice_is_reported_once() {
+        let ev = first_events(params("tick_map_tol_nm = 0.01"));
+        assert_eq!(ev.len(), 1);
+        assert_eq!(ev[0].name, "ot.tick_map");
+        assert!(
+            ev[0]
+                .detail
+                .starts_with("chosen from tick_map_tol_nm: tick map rk4×2: "),
+            "{}",
+            ev[0].detail
+        );
+        let fixed = first_events(params("rk4_substeps = 8"));
+        assert!(
+            fixed[0]
+                .detail
+                .starts_with("fixed by rk4_substeps: tick map rk4×8: "),
+            "{}",
+            fixed[0].detail
+        );
+    }
+
+    #[test]
+    fn the_10_khz_scene_loads_with_an_exact_period() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/optical_tweezers_10khz.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let loaded = crate::scene::load_scene(&text, None).unwrap();
+        assert_eq!(loaded.config.rate_hz, 10_000);
+        assert_eq!(loaded.config.period_ns(), 100_000);
+        assert_eq!(loaded.scene.kind(), "optical_tweezers");
+    }
+
+    #[test]
+    fn budget_fields_are_validated_with_their_range() {
+        let err = |extra: &str| match OpticalScene::new(params(extra), 3.0) {
+            Ok(_) => panic!("accepted {extra}"),
+            Err(e) => e.to_string(),
+        };
+        assert_eq!(
+            err("tick_map_tol_nm = 0.0"),
+            "scene: `optical_tweezers.tick_map_tol_nm` = 0 is out of range (allowed: 1e-4 ≤ \
+             optical_tweezers.tick_map_tol_nm ≤ 100)"
+        );
+        assert_eq!(
+            err("tick_map_speed_m_per_s = -1.0"),
+            "scene: `optical_tweezers.tick_map_speed_m_per_s` = -1 is out of range (allowed: 0 ≤ \
+             optical_tweezers.tick_map_speed_m_per_s ≤ 1000)"
+        );
+        assert_eq!(
+            err("rk4_substeps = 0"),
+            "scene: `optical_tweezers.rk4_substeps` = 0 is out of range (allowed: 1 ≤ \
+             optical_tweezers.rk4_substeps ≤ 1000)"
+        );
     }
 }

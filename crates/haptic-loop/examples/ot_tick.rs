@@ -1,0 +1,275 @@
+//! Issue 13's measurements of the optical-tweezers tick, old settings against new in one run:
+//!
+//! * a 60 s session of `scenes/optical_tweezers.toml` with logging on, batch pacing, once with
+//!   the old settings (RK4×8 tick map, a full envelope build every tick) and once with the new
+//!   defaults (error-budget tick map, warm start), alternating `--rounds` times: tick compute
+//!   p50/p99/max;
+//! * the envelope's Hausdorff distance from converged dynamics at sampled ticks of the new
+//!   session, reconstructed from the recorded particle states (the reconstruction is checked
+//!   bit for bit against the recorded trap);
+//! * `--realtime`: `scenes/optical_tweezers_10khz.toml` paced in real time for 60 s: missed
+//!   deadlines;
+//! * `--only old|new --seconds S`: one session and nothing else (for `valgrind --tool=callgrind`).
+//!
+//! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
+
+use haptic_loop::scene::SceneFile;
+use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
+use nalgebra::Vector2;
+use ot_envelope::geometry::hausdorff;
+use ot_envelope::steer::{ParticleState, SteerParams};
+use ot_envelope::tick::{TickController, TickParams};
+use ot_envelope::{EnvelopeOptions, working_envelope_with};
+use ot_physics::TrapModel;
+use ot_physics::budget::{choose_tick_map, converged};
+use std::path::{Path, PathBuf};
+
+type BoxError = Box<dyn std::error::Error>;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn old_text(text: &str) -> String {
+    text.replace(
+        "tick_map_tol_nm = 0.01",
+        "rk4_substeps = 8\ntick_map_tol_nm_unused = 0",
+    )
+    .replace("tick_map_tol_nm_unused = 0", "")
+    .replace("warm_start = true", "warm_start = false")
+}
+
+fn session(text: &str, seconds: f64, realtime: bool, tag: &str) -> Result<SessionReport, BoxError> {
+    let mut o = SessionOptions::new(SceneSource {
+        text: text.to_string(),
+        dir: Some(root().join("scenes")),
+    });
+    o.seconds = Some(seconds);
+    o.realtime = realtime;
+    o.out = Some(std::env::temp_dir().join(format!("ot_tick_{tag}_{}.mcap", std::process::id())));
+    let r = run_session(&o, &mut |_, _| {})?;
+    if let Some(p) = &o.out {
+        let _ = std::fs::remove_file(p);
+    }
+    Ok(r)
+}
+
+fn us(ns: u64) -> f64 {
+    ns as f64 / 1e3
+}
+
+fn load() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .unwrap_or_default()
+        .trim()
+        .to_string()
+}
+
+/// Replays the new session's steering from its recorded states and measures the envelope's
+/// Hausdorff distance from converged dynamics every `every` grabbed ticks.
+fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String, BoxError> {
+    let file = SceneFile::parse(text)?;
+    let p = file
+        .optical_tweezers
+        .clone()
+        .ok_or("not an optical scene")?;
+    let model = TrapModel::builder(
+        p.depth_nj * 1e-9,
+        [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
+    )
+    .mass(p.mass_g * 1e-3)
+    .build()?;
+    let dt = p.dt_us * 1e-6;
+    let (prop, _) = choose_tick_map(model, dt, p.tick_map_tol_nm.unwrap_or(0.01) * 1e-9, 0.1)?;
+    let truth = converged(model, dt)?;
+    let tol = p
+        .envelope_tol_nm
+        .map_or(ot_envelope::DEFAULT_TOL, |t| t * 1e-9);
+    let mut c = TickController::new(TickParams::new(SteerParams {
+        stiffness: p.stiffness_n_per_m,
+        mode: p.clip,
+        tol,
+        margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
+    }))?;
+    let a = &r.arrays;
+    let col = |n: &str| a.state_column(n).ok_or(format!("no column {n}"));
+    let (px, py, vx, vy) = (
+        col("particle_x_m")?,
+        col("particle_y_m")?,
+        col("particle_vx_m_per_s")?,
+        col("particle_vy_m_per_s")?,
+    );
+    let (tx, ty, g) = (col("trap_x_m")?, col("trap_y_m")?, col("grabbed")?);
+    let start = Vector2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
+    let (mut worst, mut worst_cold, mut n, mut grabbed, mut mismatch) = (0.0f64, 0.0f64, 0, 0, 0);
+    for i in 0..a.tick.len() {
+        if g[i] != 1.0 {
+            continue;
+        }
+        if i == 0 || g[i - 1] != 1.0 {
+            c.reset();
+        }
+        let s = if i == 0 {
+            ParticleState {
+                position: start,
+                velocity: Vector2::zeros(),
+            }
+        } else {
+            ParticleState {
+                position: Vector2::new(px[i - 1], py[i - 1]),
+                velocity: Vector2::new(vx[i - 1], vy[i - 1]),
+            }
+        };
+        let cur = a.cursor_m[i];
+        let out = c.step(&prop, &s, &Vector2::new(cur[0], cur[1]))?;
+        if out.trap.x.to_bits() != tx[i].to_bits() || out.trap.y.to_bits() != ty[i].to_bits() {
+            mismatch += 1;
+        }
+        grabbed += 1;
+        if grabbed % every == 0 {
+            let reference = working_envelope_with(
+                &truth,
+                &s.velocity,
+                &EnvelopeOptions {
+                    tol: 0.02e-9,
+                    coarse_grid: false,
+                    ..Default::default()
+                },
+            )?;
+            let cold = working_envelope_with(
+                &prop,
+                &s.velocity,
+                &EnvelopeOptions {
+                    tol,
+                    ..Default::default()
+                },
+            )?;
+            worst = worst.max(hausdorff(c.envelope(), &reference.polygon, 0.05e-9));
+            worst_cold = worst_cold.max(hausdorff(&cold.polygon, &reference.polygon, 0.05e-9));
+            n += 1;
+        }
+    }
+    Ok(format!(
+        "envelope Hausdorff from converged dynamics (tol 0.02 nm reference), {n} of {grabbed} grabbed ticks: \
+         tick envelope (warm or rebuilt) {:.3} nm, a full rebuild at the same tick {:.3} nm; \
+         reconstruction mismatches with the recorded trap: {mismatch}; {:?}",
+        worst * 1e9,
+        worst_cold * 1e9,
+        c.stats()
+    ))
+}
+
+fn main() -> Result<(), BoxError> {
+    let args: Vec<String> = std::env::args().collect();
+    let flag = |f: &str| {
+        args.iter()
+            .position(|a| a == f)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    let text = std::fs::read_to_string(root().join("scenes/optical_tweezers.toml"))?;
+    let old = old_text(&text);
+    let seconds: f64 = flag("--seconds").map_or(Ok(60.0), |s| s.parse())?;
+    if let Some(which) = flag("--only") {
+        let t = if which == "old" { &old } else { &text };
+        let r = session(t, seconds, false, &which)?;
+        println!(
+            "{which}: {} ticks, {} events",
+            r.stats.ticks,
+            r.arrays.events.len()
+        );
+        return Ok(());
+    }
+    let rounds: usize = flag("--rounds").map_or(Ok(1), |s| s.parse())?;
+    println!("load before: {}", load());
+    println!(
+        "| settings | ticks | p50 µs | p99 µs | max µs | grabbed ticks | grabbed p50 µs | grabbed p99 µs | grabbed max µs | load (1 min) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let mut last_new = None;
+    for _ in 0..rounds {
+        for (name, t) in [
+            ("old: RK4×8, full build every tick", &old),
+            ("new: budget map, warm start", &text),
+        ] {
+            let r = session(t, seconds, false, "bench")?;
+            let s = &r.stats;
+            let g = r
+                .arrays
+                .state_column("grabbed")
+                .ok_or("no grabbed column")?;
+            let mut gt: Vec<u64> = r
+                .arrays
+                .compute_ns
+                .iter()
+                .zip(&g)
+                .filter(|(_, g)| **g == 1.0)
+                .map(|(t, _)| *t)
+                .collect();
+            gt.sort_unstable();
+            let pct = |q: f64| {
+                gt.get(((gt.len() as f64 * q).ceil() as usize).saturating_sub(1))
+                    .map_or(0.0, |t| us(*t))
+            };
+            println!(
+                "| {name} | {} | {:.1} | {:.1} | {:.1} | {} | {:.1} | {:.1} | {:.1} | {} |",
+                s.ticks,
+                us(s.compute.p50_ns),
+                us(s.compute.p99_ns),
+                us(s.compute.max_ns),
+                gt.len(),
+                pct(0.5),
+                pct(0.99),
+                pct(1.0),
+                load().split(' ').next().unwrap_or("?")
+            );
+            let mut slow: Vec<(u64, usize)> = r
+                .arrays
+                .compute_ns
+                .iter()
+                .copied()
+                .enumerate()
+                .map(|(i, t)| (t, i))
+                .collect();
+            slow.sort_unstable_by(|a, b| b.cmp(a));
+            let slow: Vec<String> = slow
+                .iter()
+                .take(5)
+                .map(|(t, i)| format!("tick {i}: {:.0} µs", us(*t)))
+                .collect();
+            println!("|   slowest: {} | | | | | | | | | |", slow.join(", "));
+            if name.starts_with("new") {
+                last_new = Some(r);
+            }
+        }
+    }
+    if let Some(r) = &last_new {
+        for e in r
+            .arrays
+            .events
+            .iter()
+            .filter(|e| e.1 == "ot.tick_map")
+            .take(1)
+        {
+            println!("{}", e.2);
+        }
+        println!("{}", hausdorff_check(&text, r, 50)?);
+    }
+    if args.iter().any(|a| a == "--realtime") {
+        let t10 = std::fs::read_to_string(root().join("scenes/optical_tweezers_10khz.toml"))?;
+        let r = session(&t10, seconds, true, "rt10k")?;
+        let s = &r.stats;
+        println!(
+            "10 kHz real time, {seconds} s: {} ticks, compute p50 {:.1} µs p99 {:.1} µs max {:.1} µs, \
+             jitter p99 {:.1} µs, missed deadlines {} (load {})",
+            s.ticks,
+            us(s.compute.p50_ns),
+            us(s.compute.p99_ns),
+            us(s.compute.max_ns),
+            us(s.jitter.p99_ns),
+            s.missed,
+            load()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,396 @@
+//! The steering tick of the optical-tweezers scene, warm-started: the
+//! working envelope of the previous full build is translated by the change
+//! of the free drift, a few of its fold points are re-mapped and checked
+//! against it, and the clipped target is solved by Newton continued from the
+//! previous trap or seeded from the fold points. The full build (grid, fold
+//! tracing, outer boundary) runs only when the velocity has moved more than
+//! [`TickParams::warm_dv`] from the build's, when a check fails, or when no
+//! seed converges. A warm tick allocates nothing once the buffers have grown.
+//!
+//! Everything the warm start depends on is deterministic state (the tick
+//! inputs seen so far): same inputs, same bits, on replay too.
+
+use crate::clip::clip_to_polygon;
+use crate::envelope::envelope_and_folds;
+use crate::error::{Result, finite_vec, positive};
+use crate::geometry::{closest_on_segment, nearest_on_boundary};
+use crate::inverse::{Choice, DEFAULT_RESIDUAL, Newton, TrapSolver};
+use crate::region::{OffsetRegion, free_drift};
+use crate::sample::{SampledMap, coarse_companion};
+use crate::steer::{ParticleState, SteerParams};
+use nalgebra::Vector2;
+use ot_physics::Propagator;
+
+type V2 = Vector2<f64>;
+
+/// Default velocity change (m/s) before a rebuild: 10 nm/µs.
+pub const DEFAULT_WARM_DV: f64 = 0.01;
+/// Default distance (m) a re-mapped fold point may lie from the translated
+/// envelope: 0.1 nm.
+pub const DEFAULT_VERIFY_TOL: f64 = 1e-10;
+/// Default fold points re-mapped per warm tick.
+pub const DEFAULT_VERIFY_POINTS: usize = 3;
+/// Fold points tried as Newton seeds when continuation fails.
+const FOLD_SEEDS: usize = 3;
+
+/// Settings of the warm-started tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TickParams {
+    /// Spring, clipping rule, envelope tolerance and region margin.
+    pub steer: SteerParams,
+    /// Whether to warm start (false: a full build every tick, the old way).
+    pub warm_start: bool,
+    /// Largest velocity change from the last full build (m/s, > 0).
+    pub warm_dv: f64,
+    /// Largest distance of a re-mapped fold point from the translated
+    /// envelope (m, > 0).
+    pub verify_tol: f64,
+    /// Fold points re-mapped per warm tick (≥ 1).
+    pub verify_points: usize,
+}
+
+impl TickParams {
+    /// Default warm-start settings around `steer`.
+    pub fn new(steer: SteerParams) -> Self {
+        Self {
+            steer,
+            warm_start: true,
+            warm_dv: DEFAULT_WARM_DV,
+            verify_tol: DEFAULT_VERIFY_TOL,
+            verify_points: DEFAULT_VERIFY_POINTS,
+        }
+    }
+
+    /// Check every field.
+    pub fn validate(&self) -> Result<()> {
+        self.steer.validate()?;
+        positive("warm_dv [m/s]", self.warm_dv)?;
+        positive("verify_tol [m]", self.verify_tol)?;
+        if !(1..=64).contains(&self.verify_points) {
+            return Err(crate::error::EnvelopeError::OutOfRange {
+                field: "verify_points",
+                value: self.verify_points as f64,
+                allowed: "1 ..= 64",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Counters of a steering session (deterministic: part of the state).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TickStats {
+    /// Ticks stepped.
+    pub ticks: u64,
+    /// Full envelope builds.
+    pub rebuilds: u64,
+    /// Of which forced by a failed fold check.
+    pub verify_failures: u64,
+    /// Ticks solved by Newton continued from the previous trap.
+    pub continued: u64,
+    /// Ticks solved by Newton from a fold point.
+    pub fold_seeded: u64,
+    /// Ticks that needed the full grid solve.
+    pub full_solves: u64,
+    /// Ticks with no solution at all (trap parked at the region's corner).
+    pub parked: u64,
+}
+
+/// One tick's decision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TickOutput {
+    /// Where to put the trap centre for this tick (world, m).
+    pub trap: V2,
+    /// Displacement the particle will make (m): the clipped command.
+    pub allowed: V2,
+    /// `command − allowed` (m).
+    pub excess: V2,
+    /// Reaction force on the stylus, `−k · excess` (N).
+    pub force: V2,
+    /// How the trap offset was chosen.
+    pub choice: Choice,
+    /// Whether the envelope was fully rebuilt this tick.
+    pub rebuilt: bool,
+}
+
+/// Edges examined on each side of a fold point's vertex by the warm check.
+const VERIFY_WINDOW: usize = 12;
+
+/// Distance (m) from `p` to the polygon edges within [`VERIFY_WINDOW`]
+/// edges of vertex `v` (the whole polygon when it is small).
+fn window_distance(poly: &[V2], v: usize, p: &V2) -> f64 {
+    let n = poly.len();
+    if n <= 2 * VERIFY_WINDOW + 2 {
+        return nearest_on_boundary(poly, p).1;
+    }
+    let mut best = f64::INFINITY;
+    for k in 0..2 * VERIFY_WINDOW {
+        let i = (v + n - VERIFY_WINDOW + k) % n;
+        let q = closest_on_segment(&poly[i], &poly[(i + 1) % n], p);
+        best = best.min((q - p).norm());
+    }
+    best
+}
+
+/// The warm-started steering controller: settings, the last full build
+/// (velocity, polygon, fold points, sampled map) and reused buffers.
+#[derive(Debug, Clone)]
+pub struct TickController {
+    params: TickParams,
+    prev_trap: Option<V2>,
+    /// Velocity (m/s) and free drift (m) of the last full build.
+    base_v0: V2,
+    base_free: V2,
+    base_valid: bool,
+    base_poly: Vec<V2>,
+    /// Fold points (offset, displacement; m) whose images are vertices of
+    /// the base polygon.
+    base_folds: Vec<(V2, V2)>,
+    /// The base polygon vertex index of each of `base_folds`.
+    base_fold_vertex: Vec<usize>,
+    /// Every fold point of the last build (scratch).
+    all_folds: Vec<(V2, V2)>,
+    /// Sorted bit keys of the base polygon's vertices with their indices (scratch).
+    keys: Vec<((u64, u64), usize)>,
+    /// The last build's sampled map (for the full solve).
+    map: Option<SampledMap>,
+    /// This tick's envelope polygon (m).
+    poly: Vec<V2>,
+    /// Rotating start of the fold points checked.
+    verify_next: usize,
+    stats: TickStats,
+}
+
+impl TickController {
+    /// A controller with validated settings and no history.
+    pub fn new(params: TickParams) -> Result<Self> {
+        params.validate()?;
+        Ok(Self {
+            params,
+            prev_trap: None,
+            base_v0: V2::zeros(),
+            base_free: V2::zeros(),
+            base_valid: false,
+            base_poly: Vec::new(),
+            base_folds: Vec::new(),
+            base_fold_vertex: Vec::new(),
+            all_folds: Vec::new(),
+            keys: Vec::new(),
+            map: None,
+            poly: Vec::new(),
+            verify_next: 0,
+            stats: TickStats::default(),
+        })
+    }
+
+    /// Forget the previous trap position (on grab); the last build stays.
+    pub fn reset(&mut self) {
+        self.prev_trap = None;
+    }
+
+    /// This tick's working envelope (m, counter-clockwise).
+    pub fn envelope(&self) -> &[V2] {
+        &self.poly
+    }
+
+    /// The counters so far.
+    pub fn stats(&self) -> TickStats {
+        self.stats
+    }
+
+    /// The settings.
+    pub fn params(&self) -> &TickParams {
+        &self.params
+    }
+
+    fn rebuild(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<()> {
+        let region = OffsetRegion::around_drift(prop, v0, self.params.steer.margin_waists)?;
+        let coarse = coarse_companion(prop, v0);
+        let map = SampledMap::build_with(prop, coarse.as_ref(), v0, &region, None)?;
+        let env = envelope_and_folds(prop, &map, self.params.steer.tol, Some(&mut self.all_folds))?;
+        self.base_poly = env.polygon;
+        self.base_free = env.free_displacement;
+        self.base_v0 = *v0;
+        self.keys.clear();
+        self.keys.extend(
+            self.base_poly
+                .iter()
+                .enumerate()
+                .map(|(i, p)| ((p.x.to_bits(), p.y.to_bits()), i)),
+        );
+        self.keys.sort_unstable();
+        self.base_folds.clear();
+        self.base_fold_vertex.clear();
+        for f in &self.all_folds {
+            let key = (f.1.x.to_bits(), f.1.y.to_bits());
+            if let Ok(k) = self.keys.binary_search_by(|e| e.0.cmp(&key)) {
+                self.base_folds.push(*f);
+                self.base_fold_vertex.push(self.keys[k].1);
+            }
+        }
+        self.poly.clear();
+        self.poly.extend_from_slice(&self.base_poly);
+        self.map = Some(map);
+        self.base_valid = true;
+        self.verify_next = 0;
+        self.stats.rebuilds += 1;
+        Ok(())
+    }
+
+    /// Translate the base envelope to `v0` and check it at a few fold
+    /// points; `false` when a check fails (or there is nothing to check).
+    fn warm(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<bool> {
+        if !self.params.warm_start
+            || !self.base_valid
+            || self.base_folds.is_empty()
+            || (v0 - self.base_v0).norm() > self.params.warm_dv
+        {
+            return Ok(false);
+        }
+        let shift = free_drift(prop.model(), v0, prop.dt()) - self.base_free;
+        self.poly.clear();
+        self.poly.extend(self.base_poly.iter().map(|p| p + shift));
+        let n = self.base_folds.len();
+        let k = self.params.verify_points.min(n);
+        for i in 0..k {
+            let j = (self.verify_next + i * n / k) % n;
+            let (o, _) = self.base_folds[j];
+            let (d, _, _) = prop.flow(&o, v0)?;
+            // distance to the polygon edges around the fold's own vertex: at
+            // least the distance to the whole boundary, so never laxer
+            if window_distance(&self.poly, self.base_fold_vertex[j], &d) > self.params.verify_tol {
+                self.stats.verify_failures += 1;
+                return Ok(false);
+            }
+        }
+        self.verify_next = (self.verify_next + 1) % n;
+        Ok(true)
+    }
+
+    /// Newton continued from `prev`, then from the fold points whose
+    /// translated images are nearest the target.
+    fn quick_solve(
+        &self,
+        nw: &Newton<'_>,
+        target: &V2,
+        prev: Option<&V2>,
+        shift: &V2,
+    ) -> Result<Option<(V2, Choice)>> {
+        let mut evals = 0;
+        if let Some(p) = prev
+            && let Some((o, _)) = nw.run(p, target, &mut evals, &[], &nw.w)?
+        {
+            return Ok(Some((o, Choice::Continued)));
+        }
+        let mut best = [(f64::INFINITY, usize::MAX); FOLD_SEEDS];
+        for (k, (_, d)) in self.base_folds.iter().enumerate() {
+            let dist = (d + shift - target).norm();
+            if dist < best[FOLD_SEEDS - 1].0 {
+                best[FOLD_SEEDS - 1] = (dist, k);
+                best.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            }
+        }
+        for &(_, k) in best.iter().filter(|b| b.1 != usize::MAX) {
+            let (o, _) = self.base_folds[k];
+            if let Some((o, _)) = nw.run(&o, target, &mut evals, &[], &nw.w)? {
+                return Ok(Some((o, Choice::FoldSeeded)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// One tick: the cursor commands the particle to `cursor` (world, m).
+    pub fn step(
+        &mut self,
+        prop: &Propagator<2>,
+        particle: &ParticleState,
+        cursor: &V2,
+    ) -> Result<TickOutput> {
+        finite_vec("particle.position [m]", particle.position.as_slice())?;
+        finite_vec("particle.velocity [m/s]", particle.velocity.as_slice())?;
+        finite_vec("cursor [m]", cursor.as_slice())?;
+        self.stats.ticks += 1;
+        let v0 = particle.velocity;
+        let mut rebuilt = false;
+        if !self.warm(prop, &v0)? {
+            self.rebuild(prop, &v0)?;
+            rebuilt = true;
+        }
+        let tol = self.params.steer.tol;
+        let free = free_drift(prop.model(), &v0, prop.dt());
+        let command = cursor - particle.position;
+        let clipped = clip_to_polygon(&self.poly, &free, &command, self.params.steer.mode)?;
+        let region = OffsetRegion::around_drift(prop, &v0, self.params.steer.margin_waists)?;
+        let nw = Newton {
+            prop,
+            v0,
+            w: prop.model().well.waists(),
+            region,
+            residual: DEFAULT_RESIDUAL,
+            // one root continued: no extra steps past the residual
+            polish: 0,
+        };
+        let prev = self.prev_trap.map(|t| t - particle.position);
+        let shift = free - self.base_free;
+        // The clipped point lies on the polygon, up to `tol` from the true
+        // boundary: pull it inward by 2 tol when it is not reachable.
+        let back = if clipped.excess.norm() > 0.0 {
+            clipped.excess / clipped.excess.norm() * (2.0 * tol)
+        } else {
+            V2::zeros()
+        };
+        let mut target = clipped.allowed;
+        let mut found = self.quick_solve(&nw, &target, prev.as_ref(), &shift)?;
+        if found.is_none() && back != V2::zeros() {
+            target = clipped.allowed - back;
+            found = self.quick_solve(&nw, &target, prev.as_ref(), &shift)?;
+        }
+        if found.is_none() {
+            // the full solve on a fresh grid
+            if !rebuilt {
+                self.rebuild(prop, &v0)?;
+                rebuilt = true;
+            }
+            self.stats.full_solves += 1;
+            if let Some(map) = self.map.take() {
+                let solver = TrapSolver::from_map(prop, map);
+                target = clipped.allowed;
+                found = solver.steer(&target, prev.as_ref())?;
+                if found.is_none() && back != V2::zeros() {
+                    target = clipped.allowed - back;
+                    found = solver.steer(&target, prev.as_ref())?;
+                }
+                self.map = Some(solver.map);
+            }
+        }
+        let (offset, choice) = match found {
+            Some(x) => x,
+            None => {
+                // Unreachable even after the pull-back (a boundary sliver
+                // thinner than the tolerance): park the trap at the region's
+                // corner, where the particle drifts almost freely, and report
+                // the displacement that really happens.
+                self.stats.parked += 1;
+                let o = region.hi;
+                target = prop.flow(&o, &v0)?.0;
+                (o, Choice::SmallestMove)
+            }
+        };
+        match choice {
+            Choice::Continued => self.stats.continued += 1,
+            Choice::FoldSeeded => self.stats.fold_seeded += 1,
+            Choice::SmallestMove => {}
+        }
+        let trap = particle.position + offset;
+        self.prev_trap = Some(trap);
+        let excess = command - target;
+        Ok(TickOutput {
+            trap,
+            allowed: target,
+            excess,
+            force: -excess * self.params.steer.stiffness,
+            choice,
+            rebuilt,
+        })
+    }
+}
