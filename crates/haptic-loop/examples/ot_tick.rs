@@ -43,6 +43,7 @@ fn session(text: &str, seconds: f64, realtime: bool, tag: &str) -> Result<Sessio
     let mut o = SessionOptions::new(SceneSource {
         text: text.to_string(),
         dir: Some(root().join("scenes")),
+        scripts: Vec::new(),
     });
     o.seconds = Some(seconds);
     o.realtime = realtime;

@@ -17,11 +17,14 @@ pub struct Builtin {
 
 macro_rules! builtin {
     ($name:literal) => {
+        builtin!($name, $name)
+    };
+    ($name:literal, $script:literal) => {
         Builtin {
             name: $name,
             scene: include_str!(concat!("../../../scenes/", $name, ".toml")),
-            script_file: concat!($name, ".script.toml"),
-            script: include_str!(concat!("../../../scenes/", $name, ".script.toml")),
+            script_file: concat!($script, ".script.toml"),
+            script: include_str!(concat!("../../../scenes/", $script, ".script.toml")),
         }
     };
 }
@@ -31,6 +34,7 @@ pub const SCENES: &[Builtin] = &[
     builtin!("brickworld"),
     builtin!("nanoworld"),
     builtin!("optical_tweezers"),
+    builtin!("optical_tweezers_10khz", "optical_tweezers"),
     builtin!("wall"),
 ];
 
@@ -56,6 +60,9 @@ pub fn export(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> 
             (b.script_file.to_string(), b.script),
         ] {
             let p = dir.join(file);
+            if written.contains(&p) {
+                continue; // a script shared by two scenes
+            }
             if p.exists() {
                 return Err(format!("{} exists: not overwriting it", p.display()));
             }
@@ -84,6 +91,9 @@ mod tests {
         }
         assert_eq!(find("wall.toml").map(|b| b.name), Some("wall"));
         assert!(find("moon").is_none());
-        assert_eq!(names(), "brickworld, nanoworld, optical_tweezers, wall");
+        assert_eq!(
+            names(),
+            "brickworld, nanoworld, optical_tweezers, optical_tweezers_10khz, wall"
+        );
     }
 }

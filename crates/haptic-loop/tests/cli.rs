@@ -271,7 +271,8 @@ fn builtin_scenes_work_from_any_directory_and_exported_copies_override_them() {
     assert_eq!(j["scene"], "stiff wall (calibration)");
     let o = run(&["scenes", "export", "mine"]);
     assert!(o.status.success());
-    assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 8);
+    // 5 scenes, 4 scripts (the 10 kHz scene shares the optical-tweezers script)
+    assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 9);
     let edited = std::fs::read_to_string(dir.join("mine/wall.toml"))
         .unwrap()
         .replace("name = \"stiff wall (calibration)\"", "name = \"my wall\"");
@@ -291,6 +292,7 @@ fn builtin_scenes_work_from_any_directory_and_exported_copies_override_them() {
     assert_eq!(
         String::from_utf8_lossy(&o.stderr).trim(),
         "error: cannot read moon: no such file, and not a built-in scene (built-in: brickworld, \
-         nanoworld, optical_tweezers, wall; `nanohaptics scenes export DIR` writes editable copies)"
+         nanoworld, optical_tweezers, optical_tweezers_10khz, wall; `nanohaptics scenes export \
+         DIR` writes editable copies)"
     );
 }
