@@ -96,7 +96,8 @@ pub enum Event {
         target: Target,
         /// The link that broke.
         broken: BrokenLink,
-        /// Pull along the contact normal at release (N).
+        /// Pull the bond resisted at release (N): the spring pull less any push into the
+        /// target, in any direction.
         pull_n: f64,
         /// Pull-off force of the broken link (N).
         pull_off_n: f64,
@@ -331,14 +332,15 @@ impl World {
     /// Advance one tick of length `dt_s` (s) with the cursor at `input`.
     pub fn step(&mut self, input: &TipInput, dt_s: f64) -> Result<StepReport, StepError> {
         for (k, v) in input.position_m.iter().enumerate() {
+            let axis = ['x', 'y', 'z'][k];
             if !v.is_finite() {
-                return Err(StepError::NonFinitePosition {
-                    axis: ['x', 'y', 'z'][k],
-                    value: *v,
-                });
+                return Err(StepError::NonFinitePosition { axis, value: *v });
+            }
+            if v.abs() > MAX_POSITION_M {
+                return Err(StepError::PositionOutOfRange { axis, value: *v });
             }
         }
-        if !(dt_s > 0.0 && dt_s <= 1.0) {
+        if !(MIN_DT_S..=1.0).contains(&dt_s) {
             return Err(StepError::BadDt(dt_s));
         }
         let mut events = Vec::new();
@@ -374,18 +376,35 @@ impl World {
             }
         };
         self.update_house(&mut events);
-        let max = self.params.max_force_n;
-        let norm = unlimited.norm();
-        let (force, saturated) = if norm > max {
-            (unlimited * (max / norm), true)
-        } else {
-            (unlimited, false)
-        };
+        let (force, saturated) = limit_force(unlimited, self.params.max_force_n);
         Ok(StepReport {
             force_n: force,
             unlimited_force_n: unlimited,
             saturated,
             events,
+        })
+    }
+
+    /// The attraction the tip assembly (the tip and what it carries) would feel with the tip
+    /// centre at `tip_m` (m), in N, from the pair laws alone: a probe that changes nothing — no
+    /// snap, no release, no tick. Game mode: the summed pair laws (what a free tip renders,
+    /// less weight and inertia). Physical mode: the Hamaker forces on the tip and its carried
+    /// particles (what the cantilever balances at equilibrium). Inside a snap gap the laws
+    /// hold their floor value, so the result is always finite.
+    pub fn force_at(&self, tip_m: Vector3<f64>) -> Result<Vector3<f64>, StepError> {
+        for (k, v) in tip_m.iter().enumerate() {
+            let axis = ['x', 'y', 'z'][k];
+            if !v.is_finite() {
+                return Err(StepError::NonFinitePosition { axis, value: *v });
+            }
+            if v.abs() > MAX_POSITION_M {
+                return Err(StepError::PositionOutOfRange { axis, value: *v });
+            }
+        }
+        Ok(if self.laws.physical {
+            self.force_jacobian(tip_m).0
+        } else {
+            self.assembly_force_game(tip_m)
         })
     }
 
@@ -555,6 +574,35 @@ impl World {
     /// Simulated time: the sum of all tick lengths (s).
     pub fn time_s(&self) -> f64 {
         self.time_s
+    }
+}
+
+/// Largest |coordinate| of a cursor position (m): a nano world is far smaller, and with every
+/// coordinate within 1 m every distance, force and norm the step computes stays finite.
+pub const MAX_POSITION_M: f64 = 1.0;
+
+/// Shortest tick (s): with positions within [`MAX_POSITION_M`] the inertial acceleration
+/// (a three-sample difference over dt²) stays below 4·10¹⁸ m/s², so the force stays finite.
+pub const MIN_DT_S: f64 = 1e-9;
+
+/// `f` scaled down to magnitude `max` (N) if larger, and whether it was. The norm is taken
+/// after dividing by the largest component, so it never overflows; an infinite component
+/// gives a force of magnitude `max` along it (flagged), never NaN.
+pub(crate) fn limit_force(f: Vector3<f64>, max: f64) -> (Vector3<f64>, bool) {
+    let big = f.amax();
+    if big == 0.0 || big.is_nan() {
+        return (Vector3::zeros(), big.is_nan());
+    }
+    let unit = if big.is_infinite() {
+        f.map(|v| if v.is_infinite() { v.signum() } else { 0.0 })
+    } else {
+        f / big
+    };
+    let n = unit.norm();
+    if big.is_infinite() || big * n > max {
+        (unit * (max / n), true)
+    } else {
+        (f, false)
     }
 }
 
