@@ -21,6 +21,32 @@ pub struct TipInput {
     pub position_m: Vector3<f64>,
 }
 
+impl TipInput {
+    /// Checks what [`World::step`] checks before it changes anything: every coordinate finite
+    /// and within ±[`MAX_POSITION_M`], and `dt_s` (s) in [[`MIN_DT_S`], 1]. Lets a batch be
+    /// checked in full before its first tick.
+    pub fn check(&self, dt_s: f64) -> Result<(), StepError> {
+        check_position(&self.position_m)?;
+        if !(MIN_DT_S..=1.0).contains(&dt_s) {
+            return Err(StepError::BadDt(dt_s));
+        }
+        Ok(())
+    }
+}
+
+fn check_position(p: &Vector3<f64>) -> Result<(), StepError> {
+    for (k, v) in p.iter().enumerate() {
+        let axis = ['x', 'y', 'z'][k];
+        if !v.is_finite() {
+            return Err(StepError::NonFinitePosition { axis, value: *v });
+        }
+        if v.abs() > MAX_POSITION_M {
+            return Err(StepError::PositionOutOfRange { axis, value: *v });
+        }
+    }
+    Ok(())
+}
+
 /// A body of the tip assembly: the tip itself or an atom it carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Member {
@@ -331,18 +357,7 @@ impl World {
 
     /// Advance one tick of length `dt_s` (s) with the cursor at `input`.
     pub fn step(&mut self, input: &TipInput, dt_s: f64) -> Result<StepReport, StepError> {
-        for (k, v) in input.position_m.iter().enumerate() {
-            let axis = ['x', 'y', 'z'][k];
-            if !v.is_finite() {
-                return Err(StepError::NonFinitePosition { axis, value: *v });
-            }
-            if v.abs() > MAX_POSITION_M {
-                return Err(StepError::PositionOutOfRange { axis, value: *v });
-            }
-        }
-        if !(MIN_DT_S..=1.0).contains(&dt_s) {
-            return Err(StepError::BadDt(dt_s));
-        }
+        input.check(dt_s)?;
         let mut events = Vec::new();
         self.tick += 1;
         self.time_s += dt_s;
@@ -392,15 +407,7 @@ impl World {
     /// particles (what the cantilever balances at equilibrium). Inside a snap gap the laws
     /// hold their floor value, so the result is always finite.
     pub fn force_at(&self, tip_m: Vector3<f64>) -> Result<Vector3<f64>, StepError> {
-        for (k, v) in tip_m.iter().enumerate() {
-            let axis = ['x', 'y', 'z'][k];
-            if !v.is_finite() {
-                return Err(StepError::NonFinitePosition { axis, value: *v });
-            }
-            if v.abs() > MAX_POSITION_M {
-                return Err(StepError::PositionOutOfRange { axis, value: *v });
-            }
-        }
+        check_position(&tip_m)?;
         Ok(if self.laws.physical {
             self.force_jacobian(tip_m).0
         } else {
