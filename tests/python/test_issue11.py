@@ -187,3 +187,16 @@ def test_long_batches_stop_on_ctrl_c():
     timer.cancel()
     assert elapsed < 10.0, elapsed
     assert 0 < bw.tick < 10_000_000 and bw.tick % 10_000 == 0, bw.tick
+
+
+def test_trap_waist_and_dt_never_give_nan():
+    with pytest.raises(ValueError) as e:
+        nh.GaussianTrap(1e-15, (1e-200, 3e-7), 1e-15)
+    assert str(e.value) == (
+        "waist[0] = 1e-200 is out of range: allowed a waist whose stiffness "
+        "2*ln2*depth/waist**2 is finite (m)"
+    )
+    trap = nh.paper_trap()
+    with pytest.raises(ValueError) as e:
+        trap.displacement([[1e-7, 0.0]], (0.0, 0.0), 1e300, method="rk4")
+    assert str(e.value).startswith("displacement[0] is not finite: dt = 1e300 s"), str(e.value)
