@@ -14,9 +14,7 @@ use crate::error::{InputError, ParamError, WorldError};
 use crate::estimator::MotionEstimator;
 use crate::impact::{IMPACT_MIN_SPEED_M_S, ImpactHook, is_support};
 use crate::input::{Buttons, CursorInput};
-use crate::params::{
-    AccelEstimator, BrickPlacement, BrickProps, DeviceLimits, Lo, Params, range,
-};
+use crate::params::{AccelEstimator, BrickPlacement, BrickProps, DeviceLimits, Lo, Params, range};
 use crate::proxy::{self, HeldShape};
 
 /// Identifier of a brick: its index in creation order (stable, never reused).
@@ -873,8 +871,7 @@ impl World {
                 centroid /= m.points.len() as f64;
                 // Approach of the contact as a whole (at its centroid): a rocking body's corners
                 // approach while its centroid does not, and that is no impact.
-                let fast =
-                    (vel(b1, centroid) - vel(b2, centroid)).dot(n) >= IMPACT_MIN_SPEED_M_S;
+                let fast = (vel(b1, centroid) - vel(b2, centroid)).dot(n) >= IMPACT_MIN_SPEED_M_S;
                 if fast {
                     for h in [b1, b2].into_iter().flatten() {
                         if central(h, centroid) && !seeds.contains(&h) {

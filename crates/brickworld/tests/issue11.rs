@@ -131,7 +131,9 @@ fn centred_flat_drop_onto_a_brick_stays_centred() {
         }
         let b = w.brick(BrickId(1)).unwrap().position_m;
         let off = b[0].hypot(b[1]);
-        println!("drop {drop} m: worst lateral speed {worst_v:.2e} m/s, rests {off:.2e} m off centre");
+        println!(
+            "drop {drop} m: worst lateral speed {worst_v:.2e} m/s, rests {off:.2e} m off centre"
+        );
         assert!(worst_v < 5e-3, "drop {drop}: lateral kick {worst_v} m/s");
         assert!(off < 1e-4, "drop {drop}: rests {off} m off centre");
     }

@@ -92,7 +92,10 @@ impl World {
             }
             let r = rm + rs + law.snap_gap_m;
             if let Some((s, j)) = self.sweep_substrate(p0, d, r) {
-                offer(s, sweep_candidate(m, Target::SubstrateAtom(j), pair, law.snap_gap_m));
+                offer(
+                    s,
+                    sweep_candidate(m, Target::SubstrateAtom(j), pair, law.snap_gap_m),
+                );
             }
         }
         best
@@ -129,7 +132,11 @@ impl World {
         // touches lies within r + h/2 of the window's middle.
         let len = d.norm();
         let cell = self.substrate.cell_m();
-        let h = if cell > r { (2.0 * (cell - r)).min(r) } else { r };
+        let h = if cell > r {
+            (2.0 * (cell - r)).min(r)
+        } else {
+            r
+        };
         let windows = (((t1 - t0) * len / h).ceil() as usize).max(1);
         let dt = (t1 - t0) / windows as f64;
         for w in 0..windows {

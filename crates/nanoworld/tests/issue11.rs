@@ -51,9 +51,12 @@ fn sideways_pull_releases_at_pull_off_over_k() {
     let mut released_at = None;
     for i in 1..20_000 {
         let dx = step * i as f64;
-        let r = w.step(&at(anchor.x + dx, anchor.y, anchor.z), 1e-3).expect("valid");
-        if let Some(Event::PullOff { pull_n, pull_off_n, .. }) =
-            r.events.iter().find(|e| matches!(e, Event::PullOff { .. }))
+        let r = w
+            .step(&at(anchor.x + dx, anchor.y, anchor.z), 1e-3)
+            .expect("valid");
+        if let Some(Event::PullOff {
+            pull_n, pull_off_n, ..
+        }) = r.events.iter().find(|e| matches!(e, Event::PullOff { .. }))
         {
             assert!(pull_n >= pull_off_n);
             released_at = Some(dx);
@@ -63,7 +66,11 @@ fn sideways_pull_releases_at_pull_off_over_k() {
     let _ = c;
     let dx = released_at.expect("a sideways pull of 40 nm never released the contact");
     let expected = law.pull_off_n / law.stiffness_n_per_m;
-    println!("released at {:.4} nm sideways, pull_off/k = {:.4} nm", dx * 1e9, expected * 1e9);
+    println!(
+        "released at {:.4} nm sideways, pull_off/k = {:.4} nm",
+        dx * 1e9,
+        expected * 1e9
+    );
     assert!(
         (dx - expected).abs() <= step,
         "released at {dx:e} m, expected {expected:e} m"
@@ -167,7 +174,11 @@ fn large_steps_do_not_tunnel_through_atoms() {
     w.step(&at(x + 3e-9, y, z), 1e-3).expect("valid");
     let events_ok = w.atoms()[0].is_carried()
         || matches!(w.tip_contact(), TipContact::Anchored(an) if an.target == Target::Atom(0));
-    assert!(events_ok, "tip passed through the atom: tip {:?}", w.tip_position_m());
+    assert!(
+        events_ok,
+        "tip passed through the atom: tip {:?}",
+        w.tip_position_m()
+    );
     assert!(w.tip_position_m().x < x - rt - ra + 1e-12 || w.atoms()[0].is_carried());
 }
 
@@ -190,7 +201,11 @@ fn absurd_cursor_positions_are_refused() {
         assert!(matches!(e, StepError::PositionOutOfRange { axis: 'x', .. }));
         // At the bound the force is finite and within the limit.
         let r = w.step(&at(1.0, 1.0, 1.0), 1e-3).expect("at the bound");
-        assert!(r.force_n.iter().all(|v| v.is_finite()), "{mode}: {:?}", r.force_n);
+        assert!(
+            r.force_n.iter().all(|v| v.is_finite()),
+            "{mode}: {:?}",
+            r.force_n
+        );
         assert!(r.force_n.norm() <= w.params().max_force_n * (1.0 + 1e-12));
         assert!(
             matches!(w.tip_contact(), TipContact::Free),

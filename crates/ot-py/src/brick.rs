@@ -3,7 +3,8 @@
 
 use brickworld::script::WallScript;
 use brickworld::{
-    BrickId, BrickPlacement, BrickProps, Buttons, CursorInput, DeviceLimits, Params, StepReport, World,
+    BrickId, BrickPlacement, BrickProps, Buttons, CursorInput, DeviceLimits, Params, StepReport,
+    World,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -173,7 +174,11 @@ fn ticks_to_py<'py>(
     let mut rot = Vec::with_capacity(ticks.len() * b * 4);
     for t in ticks {
         for k in 0..b {
-            let (p, q) = t.poses.get(k).copied().unwrap_or(([0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+            let (p, q) = t
+                .poses
+                .get(k)
+                .copied()
+                .unwrap_or(([0.0; 3], [0.0, 0.0, 0.0, 1.0]));
             pos.extend(p);
             rot.extend(q);
         }
