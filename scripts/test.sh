@@ -32,11 +32,11 @@ if [ -d crates/ot-py ]; then
     # The full check (a from-scratch release build of the workspace, many minutes): build the
     # sdist and pip-install it into a second fresh environment, then import it.
     step "sdist: build and pip install"
-    rm -rf target/sdist-test .venv-sdist
+    rm -rf target/sdist-test target/venv-sdist
     .venv/bin/maturin sdist --out target/sdist-test
-    python3 -m venv .venv-sdist
-    .venv-sdist/bin/pip install --quiet target/sdist-test/nanohaptics-*.tar.gz
-    .venv-sdist/bin/python -c "import nanohaptics as nh; print('sdist install:', nh.__version__, nh.__file__)"
+    python3 -m venv target/venv-sdist
+    target/venv-sdist/bin/pip install --quiet target/sdist-test/nanohaptics-*.tar.gz
+    target/venv-sdist/bin/python -c "import nanohaptics as nh; print('sdist install:', nh.__version__, nh.__file__)"
   fi
   step "pytest (includes the docs examples and the sdist contents check)"
   .venv/bin/python -m pytest -q tests/python
