@@ -202,8 +202,11 @@ const TAG_BRICK: u128 = 2 << 64;
 pub const SLEEP_SPEED_M_S: f64 = 2e-3;
 /// Net acceleration (m/s², farthest point) at or above which a slow brick is never put to sleep:
 /// over rapier's 0.5 s sleep window its velocity must change by less than this × the window.
-/// A brick sliding from rest on a ramp steeper than the friction angle by 0.01° accelerates at
-/// about 1.5e-3 m/s² and keeps sliding; resting bricks (solver noise around 1e-9 m/s²) sleep.
+/// A brick starting from rest on a ramp 0.01° steeper than the friction angle (μ = 0.6)
+/// accelerates at g·δ·(cos θ + μ sin θ) ≈ 2e-3 m/s² and keeps sliding; one with less net
+/// acceleration may sleep after moving under 0.5 mm in its first second. Resting bricks and
+/// stacks sleep (tests `resting_brick_and_brick_below_friction_angle_fall_asleep`,
+/// `stack_of_ten_bricks_stays_put_for_60_s`).
 pub const SLEEP_MAX_ACCEL_M_S2: f64 = 1e-3;
 
 #[derive(Debug, Clone, Copy)]
