@@ -56,16 +56,46 @@ fn slow_slide_is_not_frozen_by_sleep() {
     }
 }
 
-/// Item 1, the other half: bricks truly at rest still fall asleep (the cost benefit stays).
+/// Item 1, the other half: bricks truly at rest still fall asleep (the cost benefit stays):
+/// one resting on the ground, one dropped 0.2 m, and one held by static friction on a ramp
+/// 3° below its friction angle (which must not creep more than 1 mm either).
 #[test]
 fn resting_brick_and_brick_below_friction_angle_fall_asleep() {
     let mut p = bare();
     let h = p.brick_half_extents_m;
-    p.bricks = vec![at([0.0, 0.0, h[2]]), at([0.5, 0.0, h[2] + 0.2])];
+    let theta_deg = 0.6f64.atan().to_degrees() - 3.0;
+    let t = theta_deg.to_radians();
+    let ramp_half = [0.5, 0.3, 0.05];
+    let ramp_c = [1.0, 0.0, 0.5];
+    p.obstacles = vec![Obstacle {
+        center_m: ramp_c,
+        half_extents_m: ramp_half,
+        rotation_deg: [0.0, theta_deg, 0.0],
+    }];
+    let up = ramp_half[2] + h[2];
+    let on_ramp = [ramp_c[0] + up * t.sin(), 0.0, ramp_c[2] + up * t.cos()];
+    p.bricks = vec![
+        at([0.0, 0.0, h[2]]),
+        at([0.5, 0.0, h[2] + 0.2]),
+        brickworld::BrickPlacement {
+            center_m: on_ramp,
+            rotation_deg: [0.0, theta_deg, 0.0],
+        },
+    ];
     let mut w = world(p);
     for _ in 0..3000 {
         idle(&mut w, PARK);
     }
+    let b = w.brick(BrickId(2)).unwrap().position_m;
+    let crept: f64 = (0..3)
+        .map(|k| (b[k] - on_ramp[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    println!(
+        "ramp brick crept {crept:.2e} m; awake {}",
+        w.awake_brick_count()
+    );
+    assert!(crept < 1e-3, "crept {crept} m");
     assert_eq!(w.awake_brick_count(), 0, "resting bricks sleep within 3 s");
 }
 
