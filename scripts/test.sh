@@ -25,9 +25,20 @@ if [ -d crates/ot-py ]; then
   # extension-module feature): the wheel then does not link libpython.
   .venv/bin/pip install --quiet "maturin>=1.9.4,<2" "pytest>=8" "numpy>=1.26"
   rm -rf target/wheels-test
-  .venv/bin/maturin build --release --manifest-path crates/ot-py/Cargo.toml --out target/wheels-test --interpreter .venv/bin/python
-  .venv/bin/pip install --quiet --force-reinstall --no-deps target/wheels-test/nanohaptics-*.whl
-  step "pytest"
+  # pyproject.toml (at the workspace root) names crates/ot-py; the wheel is abi3 (CPython >= 3.9).
+  .venv/bin/maturin build --release --out target/wheels-test --interpreter .venv/bin/python
+  .venv/bin/pip install --quiet --force-reinstall --no-deps target/wheels-test/nanohaptics-*-abi3-*.whl
+  if [ "${NANOHAPTICS_SDIST_INSTALL:-0}" = 1 ]; then
+    # The full check (a from-scratch release build of the workspace, many minutes): build the
+    # sdist and pip-install it into a second fresh environment, then import it.
+    step "sdist: build and pip install"
+    rm -rf target/sdist-test target/venv-sdist
+    .venv/bin/maturin sdist --out target/sdist-test
+    python3 -m venv target/venv-sdist
+    target/venv-sdist/bin/pip install --quiet target/sdist-test/nanohaptics-*.tar.gz
+    target/venv-sdist/bin/python -c "import nanohaptics as nh; print('sdist install:', nh.__version__, nh.__file__)"
+  fi
+  step "pytest (includes the docs examples and the sdist contents check)"
   .venv/bin/python -m pytest -q tests/python
 fi
 step "all tests passed"

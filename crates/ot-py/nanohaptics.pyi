@@ -228,7 +228,11 @@ class NanoWorld:
         """One tick per row of (T, 3) cursor positions (m): {"force" (T, 3) N,
         "unlimited_force" (T, 3) N, "saturated" (T,) bool, "tip" (T, 3) m,
         "anchored" (T,) bool, "carried" (T,) int, "score" (T,) int,
-        "events": list[(tick, dict)]}. The GIL is released."""
+        "events": list[(tick, dict)]}. The GIL is released; Ctrl-C stops
+        the batch between chunks of 10 000 ticks."""
+    def force_at(self, position: ArrayLike) -> F64Array:
+        """(3,) N: the attraction the tip assembly would feel with the tip
+        centre at ``position`` (3,) m, without stepping (nothing snaps)."""
     def set_params(self, params: NanoParams) -> None:
         """Run-time change (strengths, masses, gravity, ...; not the geometry)."""
     def house_script(self, step_m: float = 2e-12) -> F64Array:
@@ -310,8 +314,18 @@ class BrickWorld:
     """
 
     def __init__(self, params: Optional[dict] = None, *, device: Union[str, dict, None] = None) -> None: ...
-    def add_brick(self, center_m: ArrayLike, rotation_deg: Optional[ArrayLike] = None) -> int:
-        """Add a brick (centre m, rotation vector in degrees); returns its id."""
+    def add_brick(
+        self,
+        center_m: ArrayLike,
+        rotation_deg: Optional[ArrayLike] = None,
+        *,
+        velocity_m_s: Optional[ArrayLike] = None,
+        mass_kg: Optional[float] = None,
+        friction: Optional[float] = None,
+        restitution: Optional[float] = None,
+    ) -> int:
+        """Add a brick (centre m, rotation vector in degrees, initial velocity
+        m/s, its own mass kg / friction / restitution); returns its id."""
     def step(self, position_m: ArrayLike, buttons: Buttons = None) -> dict:
         """One tick: {"tick", "force_n", "saturated", "spring_force_n",
         "stiffness_n_m", "weight_force_n", "inertia_force_n",
@@ -321,15 +335,18 @@ class BrickWorld:
         Per-tick arrays: force, spring_force, weight_force, inertia_force (T, 3) N,
         acceleration (T, 3) m/s², proxy, cursor (T, 3) m, buttons (T, 4) bool,
         saturated (T,), stiffness (T,) N/m, penetration (T,) m, held (T,) id or -1,
-        filled (T,) slots; events list[(tick, dict)]. GIL released."""
+        filled (T,) slots; brick_position_m (T, B, 3) m, brick_orientation_xyzw
+        (T, B, 4), brick_count (T,); events list[(tick, dict)]. GIL released;
+        Ctrl-C stops the batch between chunks of 10 000 ticks."""
     def run_wall_script(self, start_m: ArrayLike, max_ticks: int = 40000, settle_ticks: int = 1000) -> dict:
         """Run the scripted wall builder; same arrays as run()."""
     def brick(self, id: int) -> dict:
         """One brick: position_m, orientation_xyzw, half_extents_m, velocity_m_s, held, sleeping."""
     @property
     def bricks(self) -> dict:
-        """id (B,), position (B, 3) m, orientation (B, 4) xyzw, half_extents (B, 3) m,
-        velocity (B, 3) m/s, held (B,), sleeping (B,)."""
+        """Same keys as brick(): id (B,), position_m (B, 3) m, orientation_xyzw
+        (B, 4), half_extents_m (B, 3) m, velocity_m_s (B, 3) m/s, held (B,),
+        sleeping (B,)."""
     @property
     def proxy_position(self) -> F64Array: ...
     @property
@@ -346,7 +363,8 @@ class BrickWorld:
     @property
     def obstacles(self) -> list[dict]: ...
     @property
-    def awake_brick_count(self) -> int: ...
+    def awake_brick_count(self) -> int:
+        """Bricks the physics engine simulates now (a property, not a call)."""
     @property
     def params(self) -> dict: ...
     @property

@@ -150,8 +150,8 @@ def test_scripted_wall_fills_every_slot_and_replays_bit_for_bit():
     rb = b.run_wall_script((0.3, -0.4, 0.35))
     for k in ("force", "proxy", "cursor", "buttons", "held", "filled"):
         assert np.array_equal(ra[k], rb[k]), k
-    assert np.array_equal(a.bricks["position"], b.bricks["position"])
-    assert np.array_equal(a.bricks["orientation"], b.bricks["orientation"])
+    assert np.array_equal(a.bricks["position_m"], b.bricks["position_m"])
+    assert np.array_equal(a.bricks["orientation_xyzw"], b.bricks["orientation_xyzw"])
     # Replaying the recorded inputs through run() gives the same bits again.
     c = nh.BrickWorld(_wall_params())
     rc = c.run(ra["cursor"], ra["buttons"])

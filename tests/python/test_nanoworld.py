@@ -212,7 +212,7 @@ def test_step_and_curve_errors_name_the_argument():
     cases = [
         (lambda: nh.NanoWorld((0, 0)), "start: expected shape (3,), got (2,)"),
         (lambda: world.step((0, 0, float("nan"))), "position[2] = NaN is out of range: allowed finite (m)"),
-        (lambda: world.step((0, 0, 5e-9), dt_s=0.0), "dt_s = 0e0 is out of range: allowed 0 < dt_s <= 1 s"),
+        (lambda: world.step((0, 0, 5e-9), dt_s=0.0), "dt_s = 0e0 is out of range: allowed 1e-9 <= dt_s <= 1 s"),
         (lambda: world.run(np.zeros((4, 2))), "positions: expected shape (N, 3), got (4, 2)"),
         (
             lambda: nh.force_distance_curve(far_gap_m=2e-6),

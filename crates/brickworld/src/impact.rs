@@ -16,38 +16,63 @@
 //! keep their full four-point support.
 
 use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::{ContactModificationContext, PhysicsHooks};
+use rapier3d_f64::prelude::{
+    ContactModificationContext, PhysicsHooks, RigidBodyHandle, SolverContact,
+};
 
 /// Approach speed (m/s) below which a new contact is treated as a gentle placement, not an impact.
 pub const IMPACT_MIN_SPEED_M_S: f64 = 0.05;
 
-/// The hook; stateless.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct ImpactHook;
+/// The hook, with the bodies that take part in an impact this step.
+///
+/// A flat landing on a brick that rests on the ground (or on a stack) passes the impact down
+/// through the resting contacts below within the same step. Those contacts carry impulse, so
+/// the rule above leaves their four points to the sequential pass, which loads one corner
+/// first: the struck brick spins a little, friction turns the spin into a sideways slide, and
+/// the brick on top is kicked sideways (a centred 0.5 m drop was kicked at 0.06 m/s and came to
+/// rest 0.5 mm off centre, a 1.5 m drop 17 mm). So on an impact step every support manifold
+/// (normal within 45° of vertical) of a body in `impacted` is also merged to its centroid. A
+/// body is in `impacted` (see `World::impacted_bodies`) when the impact's load passes through
+/// its centre of mass — then the load has no moment and a support without lever arm is exact —
+/// and the rule follows such central supports down (and up) the stack. An off-centre load keeps
+/// every support point: its lever arms are physical (a brick landing across two others).
+#[derive(Debug, Default, Clone)]
+pub struct ImpactHook {
+    /// Bodies taking part in an impact on this step.
+    pub impacted: Vec<RigidBodyHandle>,
+}
 
 impl PhysicsHooks for ImpactHook {
     fn modify_solver_contacts(&self, ctx: &mut ContactModificationContext) {
         let bodies = ctx.bodies;
         let (rb1, rb2) = (ctx.rigid_body1, ctx.rigid_body2);
+        let in_impact = [rb1, rb2]
+            .into_iter()
+            .flatten()
+            .any(|h| self.impacted.contains(&h));
         let Some(m) = ctx.rigid_mut() else {
             return;
         };
         let n = m.solver_contacts.len();
-        if n < 2 || m.manifold.points.iter().any(|p| p.data.impulse != 0.0) {
+        if n < 2 {
+            return;
+        }
+        if in_impact && is_support(*m.normal) {
+            merge(m.solver_contacts);
+            return;
+        }
+        if m.manifold.points.iter().any(|p| p.data.impulse != 0.0) {
             return;
         }
         let inv = 1.0 / n as f64;
         let mut a1 = Vector::ZERO;
         let mut a2 = Vector::ZERO;
-        let mut dist = 0.0;
         for c in m.solver_contacts.iter() {
             a1 += c.anchor1;
             a2 += c.anchor2;
-            dist += c.dist;
         }
         a1 *= inv;
         a2 *= inv;
-        dist *= inv;
         let vel = |h: Option<rapier3d_f64::prelude::RigidBodyHandle>, p: Vector| {
             h.and_then(|h| bodies.get(h))
                 .map_or(Vector::ZERO, |rb| rb.velocity_at_point(p))
@@ -57,11 +82,33 @@ impl PhysicsHooks for ImpactHook {
         if approach < IMPACT_MIN_SPEED_M_S {
             return;
         }
-        let mut c0 = m.solver_contacts[0];
-        c0.anchor1 = a1;
-        c0.anchor2 = a2;
-        c0.dist = dist;
-        m.solver_contacts.truncate(1);
-        m.solver_contacts[0] = c0;
+        merge(m.solver_contacts);
     }
+}
+
+/// Whether a contact normal is within 45° of vertical: a support (a face resting on the one
+/// below), as opposed to a side contact.
+pub(crate) fn is_support(normal: Vector) -> bool {
+    normal.z.abs() >= std::f64::consts::FRAC_1_SQRT_2
+}
+
+/// Replaces the solver contacts by one at their centroid (mean anchors and distance).
+fn merge(contacts: &mut Vec<SolverContact>) {
+    let n = contacts.len();
+    if n < 2 {
+        return;
+    }
+    let inv = 1.0 / n as f64;
+    let mut c0 = contacts[0];
+    let (mut a1, mut a2, mut dist) = (Vector::ZERO, Vector::ZERO, 0.0);
+    for c in contacts.iter() {
+        a1 += c.anchor1;
+        a2 += c.anchor2;
+        dist += c.dist;
+    }
+    c0.anchor1 = a1 * inv;
+    c0.anchor2 = a2 * inv;
+    c0.dist = dist * inv;
+    contacts.truncate(1);
+    contacts[0] = c0;
 }

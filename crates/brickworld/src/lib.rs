@@ -41,7 +41,10 @@ pub use error::{InputError, ParamError, WorldError};
 pub use estimator::MotionEstimator;
 pub use input::{Buttons, CursorInput};
 pub use params::{
-    AccelEstimator, Blueprint, BrickPlacement, DeviceLimits, LoadingZone, Obstacle, Params,
-    ParamsFromTomlError,
+    AccelEstimator, Blueprint, BrickPlacement, BrickProps, DeviceLimits, LoadingZone, Obstacle,
+    Params, ParamsFromTomlError,
 };
-pub use world::{Axis, BoxView, BrickId, BrickView, Event, SlotView, StepReport, Touch, World};
+pub use world::{
+    Axis, BoxView, BrickId, BrickView, Event, SLEEP_MAX_ACCEL_M_S2, SLEEP_SPEED_M_S, SlotView,
+    StepReport, Touch, World,
+};

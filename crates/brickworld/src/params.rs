@@ -145,6 +145,22 @@ pub struct BrickPlacement {
     pub rotation_deg: [f64; 3],
 }
 
+/// Properties of one brick that may differ from the world's ([`crate::World::add_brick_with`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BrickProps {
+    /// Initial linear velocity, m/s. Each component in `[-100, 100]`.
+    pub velocity_m_s: [f64; 3],
+    /// Mass, kg in `[1e-3, 100]`; `None`: [`Params::brick_mass_kg`].
+    pub mass_kg: Option<f64>,
+    /// Friction coefficient in `[0, 10]`; `None`: [`Params::friction`]. A contact uses the
+    /// mean of its two bodies' coefficients (rapier's rule).
+    pub friction: Option<f64>,
+    /// Coefficient of restitution in `[0, 1]`; `None`: [`Params::restitution`]. A contact uses
+    /// the mean of its two bodies' coefficients.
+    pub restitution: Option<f64>,
+}
+
 /// A fixed box (table, ramp, wall).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

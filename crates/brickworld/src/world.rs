@@ -3,8 +3,8 @@
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::parry::shape::{Ball, Cuboid};
 use rapier3d_f64::prelude::{
-    ActiveHooks, ColliderBuilder, ColliderHandle, FrictionModel, PhysicsWorld, QueryFilter,
-    RigidBodyBuilder, RigidBodyHandle, RigidBodyType,
+    ActiveHooks, ColliderBuilder, ColliderHandle, FrictionModel, PairContacts, PhysicsWorld,
+    QueryFilter, RigidBodyBuilder, RigidBodyHandle, RigidBodyType,
 };
 
 use serde::Serialize;
@@ -12,9 +12,9 @@ use serde::Serialize;
 use crate::blueprint::{self, Score};
 use crate::error::{InputError, ParamError, WorldError};
 use crate::estimator::MotionEstimator;
-use crate::impact::ImpactHook;
+use crate::impact::{IMPACT_MIN_SPEED_M_S, ImpactHook, is_support};
 use crate::input::{Buttons, CursorInput};
-use crate::params::{AccelEstimator, BrickPlacement, DeviceLimits, Lo, Params, range};
+use crate::params::{AccelEstimator, BrickPlacement, BrickProps, DeviceLimits, Lo, Params, range};
 use crate::proxy::{self, HeldShape};
 
 /// Identifier of a brick: its index in creation order (stable, never reused).
@@ -181,6 +181,11 @@ pub struct SlotView {
     pub filled_by: Option<BrickId>,
 }
 
+/// Horizontal distance (m) from a body's centre of mass within which a support load counts as
+/// central (no moment), so that an impact may pass through the body's supports merged at their
+/// centroid (see [`crate::impact::ImpactHook`]).
+pub const CENTRAL_LOAD_M: f64 = 1e-3;
+
 /// Half-extent of the ground slab in x and y, m (the ground is a 100 m × 100 m slab whose top
 /// face is the plane z = 0).
 pub const GROUND_HALF_EXTENT_M: f64 = 50.0;
@@ -191,10 +196,26 @@ const TAG_GROUND: u128 = 0;
 const TAG_OBSTACLE: u128 = 1 << 64;
 const TAG_BRICK: u128 = 2 << 64;
 
+/// Speed (m/s, farthest point of the brick) below which a brick may start to count as resting;
+/// rapier's own threshold for the sleep timer (its default is 0.05 m/s, which freezes a brick
+/// gliding at 4 cm/s on frictionless ground).
+pub const SLEEP_SPEED_M_S: f64 = 2e-3;
+/// Net acceleration (m/s², farthest point) at or above which a slow brick is never put to sleep:
+/// over rapier's 0.5 s sleep window its velocity must change by less than this × the window.
+/// A brick starting from rest on a ramp 0.01° steeper than the friction angle (μ = 0.6)
+/// accelerates at g·δ·(cos θ + μ sin θ) ≈ 2e-3 m/s² and keeps sliding; one with less net
+/// acceleration may sleep after moving under 0.5 mm in its first second. Resting bricks and
+/// stacks sleep (tests `resting_brick_and_brick_below_friction_angle_fall_asleep`,
+/// `stack_of_ten_bricks_stays_put_for_60_s`).
+pub const SLEEP_MAX_ACCEL_M_S2: f64 = 1e-3;
+
 #[derive(Debug, Clone, Copy)]
 struct Brick {
     body: RigidBodyHandle,
     collider: ColliderHandle,
+    /// Linear and angular velocity when the brick last became slow (start of rapier's sleep
+    /// window), and the tick then.
+    slow_since: Option<(u64, Vector, Vector)>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -326,11 +347,15 @@ impl World {
     fn refresh_queries(&mut self) {
         let dt = self.phys.integration_parameters.dt;
         self.phys.integration_parameters.dt = 0.0;
-        self.phys.step_with_events(&ImpactHook, &());
+        self.phys.step_with_events(&ImpactHook::default(), &());
         self.phys.integration_parameters.dt = dt;
     }
 
     fn insert_brick(&mut self, placement: &BrickPlacement) -> BrickId {
+        self.insert_brick_with(placement, &BrickProps::default())
+    }
+
+    fn insert_brick_with(&mut self, placement: &BrickPlacement, props: &BrickProps) -> BrickId {
         let id = BrickId(self.bricks.len() as u32);
         let pose = Pose::from_parts(
             Vector::from_array(placement.center_m),
@@ -344,20 +369,37 @@ impl World {
         let h = self.params.brick_half_extents_m;
         let collider = self.phys.insert_collider(
             ColliderBuilder::cuboid(h[0], h[1], h[2])
-                .mass(self.params.brick_mass_kg)
-                .friction(self.params.friction)
-                .restitution(self.params.restitution)
+                .mass(props.mass_kg.unwrap_or(self.params.brick_mass_kg))
+                .friction(props.friction.unwrap_or(self.params.friction))
+                .restitution(props.restitution.unwrap_or(self.params.restitution))
                 .user_data(TAG_BRICK | id.0 as u128)
                 .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS),
             Some(body),
         );
-        self.bricks.push(Brick { body, collider });
+        if let Some(rb) = self.phys.bodies.get_mut(body) {
+            rb.activation_mut().normalized_linear_threshold = SLEEP_SPEED_M_S;
+            if props.velocity_m_s != [0.0; 3] {
+                rb.set_linvel(Vector::from_array(props.velocity_m_s), true);
+            }
+        }
+        self.bricks.push(Brick {
+            body,
+            collider,
+            slow_since: None,
+        });
         id
     }
 
     /// Adds a brick at `placement` (centre m, rotation vector deg). The pose is validated like
     /// [`Params::bricks`]; the count is limited by [`Params::max_bricks`].
     pub fn add_brick(&mut self, placement: BrickPlacement) -> Result<BrickId, WorldError> {
+        self.check_placement(&placement)?;
+        let id = self.insert_brick(&placement);
+        self.refresh_queries();
+        Ok(id)
+    }
+
+    fn check_placement(&self, placement: &BrickPlacement) -> Result<(), WorldError> {
         for i in 0..3 {
             range(
                 &format!("brick.center_m[{i}]"),
@@ -377,7 +419,36 @@ impl World {
                 max: self.params.max_bricks,
             });
         }
-        let id = self.insert_brick(&placement);
+        Ok(())
+    }
+
+    /// Adds a brick like [`World::add_brick`] with its own initial velocity, mass, friction and
+    /// restitution ([`BrickProps`]; `None` takes the world's value). The run-time switches
+    /// ([`World::set_friction`], ...) later set every brick, this one included.
+    pub fn add_brick_with(
+        &mut self,
+        placement: BrickPlacement,
+        props: BrickProps,
+    ) -> Result<BrickId, WorldError> {
+        for i in 0..3 {
+            range(
+                &format!("brick.velocity_m_s[{i}]"),
+                props.velocity_m_s[i],
+                Lo::Closed(-100.0),
+                100.0,
+            )?;
+        }
+        if let Some(m) = props.mass_kg {
+            range("brick.mass_kg", m, Lo::Closed(1e-3), 100.0)?;
+        }
+        if let Some(mu) = props.friction {
+            range("brick.friction", mu, Lo::Closed(0.0), 10.0)?;
+        }
+        if let Some(e) = props.restitution {
+            range("brick.restitution", e, Lo::Closed(0.0), 1.0)?;
+        }
+        self.check_placement(&placement)?;
+        let id = self.insert_brick_with(&placement, &props);
         self.refresh_queries();
         Ok(id)
     }
@@ -639,8 +710,35 @@ impl World {
             }
         }
 
-        // 3. Touch bookkeeping and the hand's push on dynamic bricks.
+        // 3. The force the device renders this tick: spring + weight + inertia, scaled down
+        //    to the device limit. The hand pushes the world with exactly the reaction of the
+        //    spring part of it (action = reaction at the coupling): a proxy pressed deep into a
+        //    brick pushes with at most the device's force, not with the stretched spring's.
         let spring = (self.proxy - c) * self.params.proxy_stiffness_n_m;
+        let m = self.params.brick_mass_kg;
+        let accel = Vector::from_array(self.motion.acceleration());
+        let (weight, inertia) = if self.held.is_some() {
+            let w = Vector::new(0.0, 0.0, -m * self.params.gravity_m_s2);
+            let i = if self.params.inertia {
+                -accel * m
+            } else {
+                Vector::ZERO
+            };
+            (w, i)
+        } else {
+            (Vector::ZERO, Vector::ZERO)
+        };
+        let total = spring + weight + inertia;
+        let mag = total.length();
+        let scale = if mag > self.device.max_force_n {
+            self.device.max_force_n / mag
+        } else {
+            1.0
+        };
+        let (force, saturated) = (total * scale, scale < 1.0);
+        let felt_spring = spring * scale;
+
+        // 4. Touch bookkeeping and the hand's push on dynamic bricks.
         let mut touching: Vec<Touch> = upd
             .contacts
             .iter()
@@ -674,13 +772,13 @@ impl World {
                 (rb.body_type() == RigidBodyType::Dynamic).then_some((body, ct.point))
             })
             .collect();
-        if !pushes.is_empty() && spring.length_squared() > 0.0 {
+        if !pushes.is_empty() && felt_spring.length_squared() > 0.0 {
             // The hand pushes with the reaction of the spring it feels, shared by the contacts,
             // at the contact points, as the impulse of that force over this tick. (A user force
             // at a point would be the natural call, but rapier 0.36 does not resist the torque
             // of user forces with contacts: 10 N pressed 5 cm off-centre launched a resting
             // 0.5 kg brick 0.45 m up. Velocity impulses are resisted correctly.)
-            let share = -spring * (self.params.dt_s / pushes.len() as f64);
+            let share = -felt_spring * (self.params.dt_s / pushes.len() as f64);
             for (body, point) in pushes {
                 if let Some(rb) = self.phys.bodies.get_mut(body) {
                     rb.apply_impulse_at_point(share, point, true);
@@ -688,36 +786,20 @@ impl World {
             }
         }
 
-        // 4. Loading zone.
+        // 5. Loading zone.
         self.loading_zone(c, &mut events);
 
-        // 5. Rigid-body physics.
-        self.phys.step_with_events(&ImpactHook, &());
+        // 6. Rigid-body physics (the sleep veto first: see `veto_sleep`).
+        self.veto_sleep();
+        let hook = ImpactHook {
+            impacted: self.impacted_bodies(),
+        };
+        self.phys.step_with_events(&hook, &());
 
-        // 6. Blueprint.
+        // 7. Blueprint.
         self.update_slots(&mut events);
 
-        // 7. Device force.
-        let m = self.params.brick_mass_kg;
-        let accel = Vector::from_array(self.motion.acceleration());
-        let (weight, inertia) = if self.held.is_some() {
-            let w = Vector::new(0.0, 0.0, -m * self.params.gravity_m_s2);
-            let i = if self.params.inertia {
-                -accel * m
-            } else {
-                Vector::ZERO
-            };
-            (w, i)
-        } else {
-            (Vector::ZERO, Vector::ZERO)
-        };
-        let total = spring + weight + inertia;
-        let mag = total.length();
-        let (force, saturated) = if mag > self.device.max_force_n {
-            (total * (self.device.max_force_n / mag), true)
-        } else {
-            (total, false)
-        };
+        // 8. Device force (computed in 3).
         let report = StepReport {
             tick: self.tick,
             force_n: arr(force),
@@ -736,6 +818,131 @@ impl World {
         };
         self.tick += 1;
         report
+    }
+
+    /// The bodies of an impact about to be solved (see [`ImpactHook`]): a body touched by a
+    /// support contact (within 45° of vertical) approaching faster than
+    /// [`IMPACT_MIN_SPEED_M_S`] at its centroid — a new contact, or a resting one that the body
+    /// above has just driven down — whose load passes through the body's centre of mass
+    /// (within [`CENTRAL_LOAD_M`]), and, through such central supports, the bodies below and
+    /// above it. An off-centre load keeps every support point: its lever arms are physical.
+    fn impacted_bodies(&self) -> Vec<RigidBodyHandle> {
+        let phys = &self.phys;
+        let body_of = |c: ColliderHandle| {
+            let h = phys.colliders.get(c)?.parent()?;
+            let rb = phys.bodies.get(h)?;
+            (rb.body_type() == RigidBodyType::Dynamic).then_some(h)
+        };
+        // Whether a load through `point` passes (within CENTRAL_LOAD_M) through the vertical of
+        // the body's centre of mass: then it has no moment and a centroid support is exact.
+        let central = |h: RigidBodyHandle, point: Vector| {
+            phys.bodies.get(h).is_some_and(|rb| {
+                let c = rb.center_of_mass();
+                (point.x - c.x).hypot(point.y - c.y) <= CENTRAL_LOAD_M
+            })
+        };
+        let mut seeds: Vec<RigidBodyHandle> = Vec::new();
+        // Supports between two bodies: (body, other, contact centroid), either way round.
+        let mut links: Vec<(RigidBodyHandle, RigidBodyHandle, Vector)> = Vec::new();
+        for pair in phys.narrow_phase.contact_pairs() {
+            let PairContacts::Rigid(rc) = &pair.contacts else {
+                continue;
+            };
+            let (b1, b2) = (body_of(pair.collider1), body_of(pair.collider2));
+            let (Some(c1), Some(c2)) = (
+                phys.colliders.get(pair.collider1),
+                phys.colliders.get(pair.collider2),
+            ) else {
+                continue;
+            };
+            if b1.is_none() && b2.is_none() {
+                continue;
+            }
+            let vel = |h: Option<RigidBodyHandle>, p: Vector| {
+                h.and_then(|h| phys.bodies.get(h))
+                    .map_or(Vector::ZERO, |rb| rb.velocity_at_point(p))
+            };
+            for m in &rc.manifolds {
+                if m.points.is_empty() || !is_support(m.data.normal) {
+                    continue;
+                }
+                let n = m.data.normal;
+                let mut centroid = Vector::ZERO;
+                for p in &m.points {
+                    centroid += (c1.position() * p.local_p1 + c2.position() * p.local_p2) * 0.5;
+                }
+                centroid /= m.points.len() as f64;
+                // Approach of the contact as a whole (at its centroid): a rocking body's corners
+                // approach while its centroid does not, and that is no impact.
+                let fast = (vel(b1, centroid) - vel(b2, centroid)).dot(n) >= IMPACT_MIN_SPEED_M_S;
+                if fast {
+                    for h in [b1, b2].into_iter().flatten() {
+                        if central(h, centroid) && !seeds.contains(&h) {
+                            seeds.push(h);
+                        }
+                    }
+                }
+                if let (Some(a), Some(b)) = (b1, b2) {
+                    links.push((a, b, centroid));
+                    links.push((b, a, centroid));
+                }
+            }
+        }
+        // Follow central supports through the stack.
+        loop {
+            let mut grew = false;
+            for (a, b, at) in &links {
+                if seeds.contains(a) && !seeds.contains(b) && central(*b, *at) {
+                    seeds.push(*b);
+                    grew = true;
+                }
+            }
+            if !grew {
+                return seeds;
+            }
+        }
+    }
+
+    /// The sleep policy: rapier puts a body to sleep once it has been slower than
+    /// [`SLEEP_SPEED_M_S`] for 0.5 s. That alone freezes a brick that starts sliding from rest
+    /// with a small net force (it stays slow for its first half second). So a slow brick is
+    /// allowed to fall asleep only if its velocity also stayed constant over that window (net
+    /// acceleration below [`SLEEP_MAX_ACCEL_M_S2`]): a brick under an unbalanced force is kept
+    /// awake, and sleep only skips bricks that are truly at rest.
+    fn veto_sleep(&mut self) {
+        if !self.params.sleeping {
+            return;
+        }
+        let dt = self.params.dt_s;
+        let tick = self.tick;
+        for b in &mut self.bricks {
+            let Some(rb) = self.phys.bodies.get_mut(b.body) else {
+                continue;
+            };
+            if rb.is_sleeping() || rb.body_type() != RigidBodyType::Dynamic {
+                b.slow_since = None;
+                continue;
+            }
+            let (v, w) = (rb.linvel(), rb.angvel());
+            let act = rb.activation();
+            let (timer, window) = (act.time_since_can_sleep, act.time_until_sleep);
+            let Some((t0, v0, w0)) = b.slow_since.filter(|_| timer > 0.0) else {
+                b.slow_since = Some((tick, v, w));
+                continue;
+            };
+            if timer + dt < window {
+                continue;
+            }
+            // Rapier would let it sleep this step: only if its velocity did not drift.
+            let elapsed = (tick - t0) as f64 * dt;
+            let reach = self.params.brick_half_extents_m;
+            let r = (reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]).sqrt();
+            let change = (v - v0).length() + (w - w0).length() * r;
+            if change >= SLEEP_MAX_ACCEL_M_S2 * elapsed.max(dt) {
+                rb.wake_up(true);
+                b.slow_since = Some((tick, v, w));
+            }
+        }
     }
 
     fn held_shape(&self) -> Option<HeldShape> {

@@ -6,8 +6,11 @@
 //!   the tip–atom pull-off, the atom jumps onto the tip; otherwise the tip anchors on it.
 //!   Substrate and uncarried atoms never move, so any other contact anchors the tip.
 //! - While anchored the tip is held; the device feels the adhesion spring
-//!   F = k·(anchor − cursor). The contact breaks when the pull along the contact normal
-//!   reaches the pull-off force of the weakest link of the chain
+//!   F = k·(anchor − cursor). The pull the bond resists is that spring's pull P =
+//!   k·(cursor − anchor) less any push into the target (the normal component
+//!   min(P·n, 0)·n, which the target's repulsion takes): P_bond = P − min(P·n, 0)·n, so a
+//!   sideways pull counts in full and a press counts not at all. The contact breaks when
+//!   |P_bond| reaches the pull-off force of the weakest link of the chain
 //!   tip → carried atoms → target → target's support; ties break nearest the tip.
 //! - Breaking tip→carried leaves the carried atoms bonded to the target (atom transfer);
 //!   breaking the target's support makes the target a carried atom (pick-up).
@@ -26,6 +29,13 @@ pub(crate) struct Candidate {
     pub gap: f64,
     /// Sort key: gap / snap gap (smaller snaps first).
     pub depth: f64,
+}
+
+/// The part of the spring pull `p` (N) that the bond resists: `p` less its compressive
+/// component along the contact normal `n` (unit, from target to member). Magnitude, N.
+pub(crate) fn bond_pull(p: Vector3<f64>, n: Vector3<f64>) -> f64 {
+    let along = p.dot(&n);
+    (p - along.min(0.0) * n).norm()
 }
 
 pub(crate) fn pair_of(member: Member, target: Target) -> PairKind {
@@ -140,7 +150,7 @@ impl World {
     /// Release the anchored tip if the pull reaches the weakest link's pull-off force.
     pub(crate) fn maybe_release(&mut self, a: &Anchor, events: &mut Vec<Event>) {
         let k = self.laws.get(a.pair).stiffness_n_per_m;
-        let pull = k * (self.cursor - a.tip_position_m).dot(&a.normal);
+        let pull = bond_pull(k * (self.cursor - a.tip_position_m), a.normal);
         let po = |p: PairKind| self.laws.get(p).pull_off_n;
         let mut links: Vec<(BrokenLink, f64)> = Vec::with_capacity(3);
         match a.member {

@@ -44,8 +44,17 @@ pub enum StepError {
         /// The offending value (m).
         value: f64,
     },
-    /// The tick length is not in (0, 1] s.
-    #[error("dt_s = {0:e} is out of range: allowed 0 < dt_s <= 1 s")]
+    /// A tip (cursor) position component is finite but farther than
+    /// [`crate::MAX_POSITION_M`] from the origin along its axis.
+    #[error("tip position {axis} = {value:e} is out of range: allowed |{axis}| <= 1 m")]
+    PositionOutOfRange {
+        /// `x`, `y` or `z`.
+        axis: char,
+        /// The offending value (m).
+        value: f64,
+    },
+    /// The tick length is not in [[`crate::MIN_DT_S`], 1] s.
+    #[error("dt_s = {0:e} is out of range: allowed 1e-9 <= dt_s <= 1 s")]
     BadDt(f64),
 }
 

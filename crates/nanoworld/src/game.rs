@@ -23,9 +23,22 @@ pub struct SubstrateForceCheck {
 
 impl World {
     pub(crate) fn free_game(&mut self, events: &mut Vec<Event>) {
-        self.place_tip(self.cursor);
+        // Sweep the tip's move of this tick: the first armed snap gap it enters stops it
+        // there, however long the move (no speed tunnels through an atom).
+        let from = self.tip;
+        let hit = self.sweep(from, self.cursor);
+        let stop = hit.map_or(self.cursor, |(t, _)| from + (self.cursor - from) * t);
+        self.place_tip(stop);
         self.rearm();
-        if let Some(c) = self.game_candidate() {
+        let candidate = match hit {
+            Some((_, mut c)) => {
+                let (gap, _) = self.gap_normal(c.member, c.target);
+                c.gap = gap;
+                Some(c)
+            }
+            None => self.game_candidate(),
+        };
+        if let Some(c) = candidate {
             match (c.member, c.target) {
                 (Member::Tip, Target::Atom(i))
                     if self.binding(i) < self.laws.get(PairKind::TipAtom).pull_off_n =>
@@ -35,6 +48,113 @@ impl World {
                 _ => self.anchor(c, events),
             }
         }
+    }
+
+    /// The first point of the straight move `from` → `to` of the tip centre (m) at which a
+    /// member of the tip assembly enters the snap gap of an armed target it was outside of:
+    /// the fraction t ∈ [0, 1] of the move and the contact. `None` if the move enters none.
+    /// Exact (ray against each target's snap sphere); the substrate is searched only along
+    /// the part of the move that passes within snap reach of its lattice.
+    fn sweep(&self, from: Vector3<f64>, to: Vector3<f64>) -> Option<(f64, Candidate)> {
+        let d = to - from;
+        if d == Vector3::zeros() {
+            return None;
+        }
+        let mut best: Option<(f64, Candidate)> = None;
+        let mut offer = |t: f64, c: Candidate| {
+            if best.as_ref().is_none_or(|b| t < b.0) {
+                best = Some((t, c));
+            }
+        };
+        let rs = self.substrate.radius_m();
+        let ra = self.params.atoms.radius_m;
+        for m in self.members() {
+            let (pm, rm) = self.member_pos_radius(m);
+            let p0 = pm + (from - self.tip);
+            for (i, a) in self.atoms.iter().enumerate() {
+                if a.is_carried() {
+                    continue;
+                }
+                let t = Target::Atom(i);
+                let pair = pair_of(m, t);
+                let law = self.laws.get(pair);
+                if !law.is_on() || self.is_disarmed(m, t) {
+                    continue;
+                }
+                if let Some(s) = ray_sphere(p0, d, a.position, rm + ra + law.snap_gap_m) {
+                    offer(s, sweep_candidate(m, t, pair, law.snap_gap_m));
+                }
+            }
+            let pair = pair_of(m, Target::SubstratePlane);
+            let law = self.laws.get(pair);
+            if !law.is_on() || self.is_disarmed(m, Target::SubstratePlane) {
+                continue;
+            }
+            let r = rm + rs + law.snap_gap_m;
+            if let Some((s, j)) = self.sweep_substrate(p0, d, r) {
+                offer(
+                    s,
+                    sweep_candidate(m, Target::SubstrateAtom(j), pair, law.snap_gap_m),
+                );
+            }
+        }
+        best
+    }
+
+    /// First fraction of the move `p0` → `p0 + d` (m) at which a sphere of radius `r` (m)
+    /// around the moving point touches a substrate atom centre, and that atom.
+    fn sweep_substrate(&self, p0: Vector3<f64>, d: Vector3<f64>, r: f64) -> Option<(f64, usize)> {
+        let sp = &self.params.substrate;
+        let hi = [
+            (sp.nx - 1) as f64 * sp.spacing_m + r,
+            (sp.ny - 1) as f64 * sp.spacing_m + r,
+            r,
+        ];
+        let lo = [-r, -r, -r];
+        // Clip the move to the box that holds every atom's snap sphere.
+        let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+        for k in 0..3 {
+            if d[k] == 0.0 {
+                if p0[k] < lo[k] || p0[k] > hi[k] {
+                    return None;
+                }
+            } else {
+                let a = (lo[k] - p0[k]) / d[k];
+                let b = (hi[k] - p0[k]) / d[k];
+                t0 = t0.max(a.min(b));
+                t1 = t1.min(a.max(b));
+            }
+        }
+        if t0 > t1 {
+            return None;
+        }
+        // Walk the clipped move in windows of length h; an atom whose sphere a window
+        // touches lies within r + h/2 of the window's middle.
+        let len = d.norm();
+        let cell = self.substrate.cell_m();
+        let h = if cell > r {
+            (2.0 * (cell - r)).min(r)
+        } else {
+            r
+        };
+        let windows = (((t1 - t0) * len / h).ceil() as usize).max(1);
+        let dt = (t1 - t0) / windows as f64;
+        for w in 0..windows {
+            let mid = p0 + d * (t0 + (w as f64 + 0.5) * dt);
+            let mut first: Option<(f64, usize)> = None;
+            self.substrate
+                .for_each_within(&mid, r + 0.5 * dt * len * (1.0 + 1e-9), |j, q| {
+                    if let Some(s) = ray_sphere(p0, d, *q, r)
+                        && first.is_none_or(|f| s < f.0)
+                    {
+                        first = Some((s, j));
+                    }
+                });
+            if first.is_some() {
+                return first;
+            }
+        }
+        None
     }
 
     /// Drop disarm entries whose gap has grown past the snap gap.
@@ -211,4 +331,33 @@ pub(crate) fn central(
         return Vector3::zeros();
     }
     d * (-f / r)
+}
+
+/// First t ∈ [0, 1] with |p0 + t·d − q| ≤ r, for a point starting outside the sphere and
+/// moving into it; `None` if it starts inside, moves away or misses.
+fn ray_sphere(p0: Vector3<f64>, d: Vector3<f64>, q: Vector3<f64>, r: f64) -> Option<f64> {
+    let w = p0 - q;
+    let c = w.norm_squared() - r * r;
+    let b = w.dot(&d);
+    if c <= 0.0 || b >= 0.0 {
+        return None;
+    }
+    let a = d.norm_squared();
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    // The smaller root, in the form that does not cancel: c / (−b + √disc).
+    let t = c / (-b + disc.sqrt());
+    (t <= 1.0).then_some(t)
+}
+
+fn sweep_candidate(member: Member, target: Target, pair: PairKind, snap_gap_m: f64) -> Candidate {
+    Candidate {
+        member,
+        target,
+        pair,
+        gap: snap_gap_m,
+        depth: 1.0,
+    }
 }

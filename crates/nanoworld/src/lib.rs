@@ -60,5 +60,6 @@ pub use script::{ScriptError, house_script, house_waypoints, polyline};
 pub use substrate::Substrate;
 pub use view::{BodyContact, BodyKind, BodyView};
 pub use world::{
-    Anchor, BrokenLink, Event, Member, MovableAtom, StepReport, Target, TipContact, TipInput, World,
+    Anchor, BrokenLink, Event, MAX_POSITION_M, MIN_DT_S, Member, MovableAtom, StepReport, Target,
+    TipContact, TipInput, World,
 };

@@ -151,7 +151,9 @@ pub struct GamePair {
     pub activation_gap_m: f64,
     /// Snap gap z_s (m): contact snaps inside it. Range (0, activation_gap_m).
     pub snap_gap_m: f64,
-    /// Adhesion stiffness k in F = k·z while in contact (N/m). Range (0, 1e6].
+    /// Adhesion stiffness k in F = k·z while in contact (N/m). Range (0, 1e6] and below
+    /// [`GamePair::max_stiffness_n_per_m`] = pull_off_ratio × snap force / snap gap, so that
+    /// the contact holds after it snaps (the approach–retract hysteresis).
     pub stiffness_n_per_m: f64,
 }
 
@@ -207,12 +209,36 @@ fn nonneg_up_to(field: &str, value: f64, max: f64) -> Result<(), ParamError> {
     })
 }
 
+/// `v` in `e` notation with at most 6 significant digits and no trailing zeros (`2e1`).
+fn short(v: f64) -> String {
+    let t = format!("{v:.5e}");
+    match t.split_once('e') {
+        Some((m, e)) if m.contains('.') => {
+            format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+        }
+        _ => t,
+    }
+}
+
 fn finite(field: &str, value: f64) -> Result<(), ParamError> {
     check(field, value, true, || "a finite number".to_string())
 }
 
 impl GamePair {
-    fn validate(&self, prefix: &str) -> Result<(), ParamError> {
+    /// Force at the snap gap (N): A·(1/z_s² − 1/w²).
+    pub fn snap_force_n(&self) -> f64 {
+        self.strength_n_m2 / (self.snap_gap_m * self.snap_gap_m)
+            - self.strength_n_m2 / (self.activation_gap_m * self.activation_gap_m)
+    }
+
+    /// Largest adhesion stiffness (N/m, exclusive) that keeps the hysteresis: a contact
+    /// snaps with the cursor one snap gap from the anchor, so the spring pulls k·z_s at once;
+    /// it must stay below the pull-off force `pull_off_ratio` × snap force.
+    pub fn max_stiffness_n_per_m(&self, pull_off_ratio: f64) -> f64 {
+        pull_off_ratio * self.snap_force_n() / self.snap_gap_m
+    }
+
+    fn validate(&self, prefix: &str, pull_off_ratio: f64) -> Result<(), ParamError> {
         nonneg_up_to(
             &format!("{prefix}.strength_n_m2"),
             self.strength_n_m2,
@@ -234,7 +260,23 @@ impl GamePair {
             &format!("{prefix}.stiffness_n_per_m"),
             self.stiffness_n_per_m,
             1e6,
-        )
+        )?;
+        if self.strength_n_m2 > 0.0 {
+            let bound = self.max_stiffness_n_per_m(pull_off_ratio);
+            check(
+                &format!("{prefix}.stiffness_n_per_m"),
+                self.stiffness_n_per_m,
+                self.stiffness_n_per_m < bound,
+                || {
+                    format!(
+                        "0 < value < pull_off_ratio * snap force / snap_gap_m = {} N/m \
+                         (stiffer contacts release on the tick after they snap)",
+                        short(bound)
+                    )
+                },
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -278,16 +320,16 @@ impl Params {
                 )?;
                 g.pairs
                     .tip_substrate
-                    .validate("interaction.game.pairs.tip_substrate")?;
+                    .validate("interaction.game.pairs.tip_substrate", g.pull_off_ratio)?;
                 g.pairs
                     .tip_atom
-                    .validate("interaction.game.pairs.tip_atom")?;
+                    .validate("interaction.game.pairs.tip_atom", g.pull_off_ratio)?;
                 g.pairs
                     .atom_atom
-                    .validate("interaction.game.pairs.atom_atom")?;
+                    .validate("interaction.game.pairs.atom_atom", g.pull_off_ratio)?;
                 g.pairs
                     .atom_substrate
-                    .validate("interaction.game.pairs.atom_substrate")?;
+                    .validate("interaction.game.pairs.atom_substrate", g.pull_off_ratio)?;
             }
             Interaction::Physical(p) => {
                 let h = &p.hamaker_j;

@@ -95,7 +95,7 @@ impl World {
 
     /// Force on the assembly (N), its Jacobian ∂F/∂x_tip (N/m), and the smallest
     /// (gap − contact gap) over all pairs (m), with the tip centre at `x`.
-    fn force_jacobian(&self, x: Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>, f64) {
+    pub(crate) fn force_jacobian(&self, x: Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>, f64) {
         let mut f = Vector3::zeros();
         let mut j = Matrix3::zeros();
         let mut margin = f64::INFINITY;

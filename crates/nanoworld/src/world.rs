@@ -21,6 +21,32 @@ pub struct TipInput {
     pub position_m: Vector3<f64>,
 }
 
+impl TipInput {
+    /// Checks what [`World::step`] checks before it changes anything: every coordinate finite
+    /// and within ±[`MAX_POSITION_M`], and `dt_s` (s) in [[`MIN_DT_S`], 1]. Lets a batch be
+    /// checked in full before its first tick.
+    pub fn check(&self, dt_s: f64) -> Result<(), StepError> {
+        check_position(&self.position_m)?;
+        if !(MIN_DT_S..=1.0).contains(&dt_s) {
+            return Err(StepError::BadDt(dt_s));
+        }
+        Ok(())
+    }
+}
+
+fn check_position(p: &Vector3<f64>) -> Result<(), StepError> {
+    for (k, v) in p.iter().enumerate() {
+        let axis = ['x', 'y', 'z'][k];
+        if !v.is_finite() {
+            return Err(StepError::NonFinitePosition { axis, value: *v });
+        }
+        if v.abs() > MAX_POSITION_M {
+            return Err(StepError::PositionOutOfRange { axis, value: *v });
+        }
+    }
+    Ok(())
+}
+
 /// A body of the tip assembly: the tip itself or an atom it carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Member {
@@ -96,7 +122,8 @@ pub enum Event {
         target: Target,
         /// The link that broke.
         broken: BrokenLink,
-        /// Pull along the contact normal at release (N).
+        /// Pull the bond resisted at release (N): the spring pull less any push into the
+        /// target, in any direction.
         pull_n: f64,
         /// Pull-off force of the broken link (N).
         pull_off_n: f64,
@@ -330,17 +357,7 @@ impl World {
 
     /// Advance one tick of length `dt_s` (s) with the cursor at `input`.
     pub fn step(&mut self, input: &TipInput, dt_s: f64) -> Result<StepReport, StepError> {
-        for (k, v) in input.position_m.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(StepError::NonFinitePosition {
-                    axis: ['x', 'y', 'z'][k],
-                    value: *v,
-                });
-            }
-        }
-        if !(dt_s > 0.0 && dt_s <= 1.0) {
-            return Err(StepError::BadDt(dt_s));
-        }
+        input.check(dt_s)?;
         let mut events = Vec::new();
         self.tick += 1;
         self.time_s += dt_s;
@@ -374,18 +391,27 @@ impl World {
             }
         };
         self.update_house(&mut events);
-        let max = self.params.max_force_n;
-        let norm = unlimited.norm();
-        let (force, saturated) = if norm > max {
-            (unlimited * (max / norm), true)
-        } else {
-            (unlimited, false)
-        };
+        let (force, saturated) = limit_force(unlimited, self.params.max_force_n);
         Ok(StepReport {
             force_n: force,
             unlimited_force_n: unlimited,
             saturated,
             events,
+        })
+    }
+
+    /// The attraction the tip assembly (the tip and what it carries) would feel with the tip
+    /// centre at `tip_m` (m), in N, from the pair laws alone: a probe that changes nothing — no
+    /// snap, no release, no tick. Game mode: the summed pair laws (what a free tip renders,
+    /// less weight and inertia). Physical mode: the Hamaker forces on the tip and its carried
+    /// particles (what the cantilever balances at equilibrium). Inside a snap gap the laws
+    /// hold their floor value, so the result is always finite.
+    pub fn force_at(&self, tip_m: Vector3<f64>) -> Result<Vector3<f64>, StepError> {
+        check_position(&tip_m)?;
+        Ok(if self.laws.physical {
+            self.force_jacobian(tip_m).0
+        } else {
+            self.assembly_force_game(tip_m)
         })
     }
 
@@ -555,6 +581,35 @@ impl World {
     /// Simulated time: the sum of all tick lengths (s).
     pub fn time_s(&self) -> f64 {
         self.time_s
+    }
+}
+
+/// Largest |coordinate| of a cursor position (m): a nano world is far smaller, and with every
+/// coordinate within 1 m every distance, force and norm the step computes stays finite.
+pub const MAX_POSITION_M: f64 = 1.0;
+
+/// Shortest tick (s): with positions within [`MAX_POSITION_M`] the inertial acceleration
+/// (a three-sample difference over dt²) stays below 4·10¹⁸ m/s², so the force stays finite.
+pub const MIN_DT_S: f64 = 1e-9;
+
+/// `f` scaled down to magnitude `max` (N) if larger, and whether it was. The norm is taken
+/// after dividing by the largest component, so it never overflows; an infinite component
+/// gives a force of magnitude `max` along it (flagged), never NaN.
+pub(crate) fn limit_force(f: Vector3<f64>, max: f64) -> (Vector3<f64>, bool) {
+    let big = f.amax();
+    if big == 0.0 || big.is_nan() {
+        return (Vector3::zeros(), big.is_nan());
+    }
+    let unit = if big.is_infinite() {
+        f.map(|v| if v.is_infinite() { v.signum() } else { 0.0 })
+    } else {
+        f / big
+    };
+    let n = unit.norm();
+    if big.is_infinite() || big * n > max {
+        (unit * (max / n), true)
+    } else {
+        (f, false)
     }
 }
 

@@ -123,7 +123,7 @@ fn bad_tick_input_is_a_typed_error() {
         .expect_err("dt");
     assert_eq!(
         e.to_string(),
-        "dt_s = 0e0 is out of range: allowed 0 < dt_s <= 1 s"
+        "dt_s = 0e0 is out of range: allowed 1e-9 <= dt_s <= 1 s"
     );
     // A rejected tick leaves the world untouched.
     assert_eq!(w.tick(), 0);

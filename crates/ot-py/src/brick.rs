@@ -3,14 +3,15 @@
 
 use brickworld::script::WallScript;
 use brickworld::{
-    BrickId, BrickPlacement, Buttons, CursorInput, DeviceLimits, Params, StepReport, World,
+    BrickId, BrickPlacement, BrickProps, Buttons, CursorInput, DeviceLimits, Params, StepReport,
+    World,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
-use crate::convert::{array2_flat, int_in, numbers, vector};
+use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, vector};
 use crate::json::{from_py, tagged_to_py, to_py};
 
 const BUTTON_KEYS: [&str; 4] = ["center", "rotate_x", "rotate_y", "rotate_z"];
@@ -70,7 +71,7 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceLimits> {
         return Ok(DeviceLimits::NOVINT_FALCON);
     };
     if let Ok(s) = obj.cast::<PyString>() {
-        return match s.to_str()? {
+        return match s.to_cow()?.as_ref() {
             "falcon" => Ok(DeviceLimits::NOVINT_FALCON),
             other => Err(PyValueError::new_err(format!(
                 "device = {other:?}: allowed \"falcon\" or a dict with max_stiffness_n_m and max_force_n"
@@ -102,6 +103,8 @@ struct Tick {
     proxy: [f64; 3],
     held: i64,
     filled: usize,
+    /// Every brick's centre (m) and orientation [x, y, z, w] after the tick, in id order.
+    poses: Vec<([f64; 3], [f64; 4])>,
 }
 
 /// Per-tick arrays of a batch, as a dict.
@@ -163,6 +166,33 @@ fn ticks_to_py<'py>(
         }
     }
     d.set_item("events", ev)?;
+    // Brick poses: (T, B, 3) and (T, B, 4) with B the brick count after the last tick; a
+    // brick that did not exist yet at a tick has position 0 and orientation [0, 0, 0, 1]
+    // there ("brick_count" (T,) says how many existed).
+    let b = ticks.last().map_or(0, |t| t.poses.len());
+    let mut pos = Vec::with_capacity(ticks.len() * b * 3);
+    let mut rot = Vec::with_capacity(ticks.len() * b * 4);
+    for t in ticks {
+        for k in 0..b {
+            let (p, q) = t
+                .poses
+                .get(k)
+                .copied()
+                .unwrap_or(([0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+            pos.extend(p);
+            rot.extend(q);
+        }
+    }
+    d.set_item(
+        "brick_position_m",
+        PyArray1::from_vec(py, pos).reshape([ticks.len(), b, 3])?,
+    )?;
+    d.set_item(
+        "brick_orientation_xyzw",
+        PyArray1::from_vec(py, rot).reshape([ticks.len(), b, 4])?,
+    )?;
+    let counts: Vec<i64> = ticks.iter().map(|t| t.poses.len() as i64).collect();
+    d.set_item("brick_count", PyArray1::from_vec(py, counts))?;
     Ok(d)
 }
 
@@ -172,6 +202,10 @@ fn record(world: &World, report: StepReport) -> Tick {
         proxy: world.proxy_position_m(),
         held: world.held_brick().map_or(-1, |b| i64::from(b.0)),
         filled: world.score().filled,
+        poses: world
+            .bricks()
+            .map(|b| (b.position_m, b.orientation_xyzw))
+            .collect(),
     }
 }
 
@@ -210,24 +244,44 @@ impl BrickWorld {
     }
 
     /// Add a brick with its centre at ``center_m`` (3,) (m), turned by the
-    /// rotation vector ``rotation_deg`` (axis · angle, degrees). Returns its id.
-    #[pyo3(signature = (center_m, rotation_deg=None))]
+    /// rotation vector ``rotation_deg`` (axis · angle, degrees), moving at
+    /// ``velocity_m_s`` (3,) (m/s, each in [-100, 100]), with its own
+    /// ``mass_kg`` ([1e-3, 100]), ``friction`` ([0, 10]) and ``restitution``
+    /// ([0, 1]); None takes the world's value (a contact uses the mean of
+    /// its two bodies' friction and restitution). Returns its id.
+    #[pyo3(signature = (center_m, rotation_deg=None, *, velocity_m_s=None, mass_kg=None, friction=None, restitution=None))]
     fn add_brick(
         &mut self,
         center_m: &Bound<'_, PyAny>,
         rotation_deg: Option<&Bound<'_, PyAny>>,
+        velocity_m_s: Option<&Bound<'_, PyAny>>,
+        mass_kg: Option<f64>,
+        friction: Option<f64>,
+        restitution: Option<f64>,
     ) -> PyResult<u32> {
         let c = vector::<3>(center_m, "center_m", "m")?;
         let r = match rotation_deg {
-            Some(r) => vector::<3>(r, "rotation_deg", "deg")?,
-            None => nalgebra::Vector3::zeros(),
+            Some(r) if !r.is_none() => vector::<3>(r, "rotation_deg", "deg")?,
+            _ => nalgebra::Vector3::zeros(),
+        };
+        let v = match velocity_m_s {
+            Some(v) if !v.is_none() => vector::<3>(v, "velocity_m_s", "m/s")?,
+            _ => nalgebra::Vector3::zeros(),
         };
         let id = self
             .world
-            .add_brick(BrickPlacement {
-                center_m: [c.x, c.y, c.z],
-                rotation_deg: [r.x, r.y, r.z],
-            })
+            .add_brick_with(
+                BrickPlacement {
+                    center_m: [c.x, c.y, c.z],
+                    rotation_deg: [r.x, r.y, r.z],
+                },
+                BrickProps {
+                    velocity_m_s: [v.x, v.y, v.z],
+                    mass_kg,
+                    friction,
+                    restitution,
+                },
+            )
             .map_err(err)?;
         Ok(id.0)
     }
@@ -273,7 +327,12 @@ impl BrickWorld {
     ///     (T, 3) m (after the tick), "cursor" (T, 3) m, "buttons" (T, 4)
     ///     bool, "saturated" (T,) bool, "stiffness" (T,) N/m, "penetration"
     ///     (T,) m, "held" (T,) int (brick id or -1), "filled" (T,) int
-    ///     (blueprint slots filled), and "events": list of (tick, dict).
+    ///     (blueprint slots filled), "brick_position_m" (T, B, 3) m and
+    ///     "brick_orientation_xyzw" (T, B, 4) after each tick (B: bricks
+    ///     after the last tick; a brick not yet spawned reads 0 and
+    ///     [0, 0, 0, 1]), "brick_count" (T,) int, and "events": list of
+    ///     (tick, dict). The GIL is released in chunks of 10 000 ticks;
+    ///     Ctrl-C (KeyboardInterrupt) stops the batch between chunks.
     #[pyo3(signature = (positions_m, buttons=None))]
     fn run<'py>(
         &mut self,
@@ -310,15 +369,18 @@ impl BrickWorld {
             );
         }
         let world = &mut self.world;
-        let ticks: Vec<Tick> = py.detach(|| {
-            inputs
-                .iter()
-                .map(|i| {
+        let mut ticks: Vec<Tick> = Vec::with_capacity(inputs.len());
+        // Chunks without the GIL; Ctrl-C is honoured between chunks (the world keeps the
+        // ticks already run).
+        for chunk in inputs.chunks(SIGNAL_CHUNK_TICKS) {
+            py.detach(|| {
+                for i in chunk {
                     let r = world.step(i);
-                    record(world, r)
-                })
-                .collect()
-        });
+                    ticks.push(record(world, r));
+                }
+            });
+            py.check_signals()?;
+        }
         ticks_to_py(py, &ticks, &inputs)
     }
 
@@ -345,30 +407,43 @@ impl BrickWorld {
             PyValueError::new_err("loading_zone is missing: the wall script fetches bricks from it")
         })?;
         let world = &mut self.world;
-        let (ticks, inputs) = py
-            .detach(|| {
-                let mut ticks = Vec::new();
-                let mut inputs = Vec::new();
-                while !script.done() && ticks.len() < max_ticks {
+        let mut ticks = Vec::new();
+        let mut inputs = Vec::new();
+        // Chunks without the GIL; Ctrl-C is honoured between chunks.
+        while !script.done() && ticks.len() < max_ticks {
+            let end = (ticks.len() + SIGNAL_CHUNK_TICKS).min(max_ticks);
+            py.detach(|| {
+                while !script.done() && ticks.len() < end {
                     let i = script.next_input(world)?;
                     let r = world.step(&i);
                     ticks.push(record(world, r));
                     inputs.push(i);
                 }
-                for _ in 0..settle_ticks {
+                Ok::<_, brickworld::InputError>(())
+            })
+            .map_err(err)?;
+            py.check_signals()?;
+        }
+        let mut left = settle_ticks;
+        while left > 0 {
+            let n = left.min(SIGNAL_CHUNK_TICKS);
+            py.detach(|| {
+                for _ in 0..n {
                     let r = world.step(&park);
                     ticks.push(record(world, r));
                     inputs.push(park);
                 }
-                Ok::<_, brickworld::InputError>((ticks, inputs))
-            })
-            .map_err(err)?;
+            });
+            left -= n;
+            py.check_signals()?;
+        }
         ticks_to_py(py, &ticks, &inputs)
     }
 
-    /// Every brick: {"id" (B,) int, "position" (B, 3) m, "orientation"
-    /// (B, 4) [x, y, z, w], "half_extents" (B, 3) m, "velocity" (B, 3) m/s,
-    /// "held" (B,) bool, "sleeping" (B,) bool}, in id order.
+    /// Every brick, with the same keys as :meth:`brick`: {"id" (B,) int,
+    /// "position_m" (B, 3) m, "orientation_xyzw" (B, 4) [x, y, z, w],
+    /// "half_extents_m" (B, 3) m, "velocity_m_s" (B, 3) m/s, "held" (B,)
+    /// bool, "sleeping" (B,) bool}, in id order.
     #[getter]
     fn bricks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let b: Vec<_> = self.world.bricks().collect();
@@ -378,17 +453,17 @@ impl BrickWorld {
         let f3 = |f: fn(&brickworld::BrickView) -> [f64; 3]| -> Vec<f64> {
             b.iter().flat_map(f).collect()
         };
-        d.set_item("position", array2_flat(py, f3(|v| v.position_m), 3)?)?;
+        d.set_item("position_m", array2_flat(py, f3(|v| v.position_m), 3)?)?;
         let q: Vec<f64> = b.iter().flat_map(|v| v.orientation_xyzw).collect();
         d.set_item(
-            "orientation",
+            "orientation_xyzw",
             PyArray1::from_vec(py, q).reshape([b.len(), 4])?,
         )?;
         d.set_item(
-            "half_extents",
+            "half_extents_m",
             array2_flat(py, f3(|v| v.half_extents_m), 3)?,
         )?;
-        d.set_item("velocity", array2_flat(py, f3(|v| v.velocity_m_s), 3)?)?;
+        d.set_item("velocity_m_s", array2_flat(py, f3(|v| v.velocity_m_s), 3)?)?;
         let held: Vec<bool> = b.iter().map(|v| v.held).collect();
         d.set_item("held", PyArray1::from_vec(py, held))?;
         let sl: Vec<bool> = b.iter().map(|v| v.sleeping).collect();

@@ -10,6 +10,10 @@ use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods}
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
+/// Ticks a batch call runs without the GIL before it checks for signals
+/// (Ctrl-C): about 10 ms to 1 s of work, so an interrupt is honoured promptly.
+pub(crate) const SIGNAL_CHUNK_TICKS: usize = 10_000;
+
 /// Raise a crate error as `ValueError` with its `Display` text (which names
 /// the field and the allowed range).
 pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {

@@ -1,9 +1,9 @@
 //! serde values to and from Python objects, for crates whose types derive
 //! `Serialize`/`Deserialize` (parameters, views, events).
 
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBool, PyDict, PyInt, PyList, PyString, PyTuple};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
@@ -47,16 +47,69 @@ pub(crate) fn to_py<'py, T: Serialize>(py: Python<'py>, t: &T) -> PyResult<Bound
     value_to_py(py, &v)
 }
 
-/// A Python dict (through `json.dumps`) as a deserialisable value; errors
-/// name the argument.
+/// A Python value (dicts, lists, tuples, numpy arrays, floats, ints, bools,
+/// strings) as a TOML value, keeping every float as it is — NaN and ±inf
+/// included, so that they reach the wrapped crate's validation, which names
+/// the field and its range. A `None` inside a dict means the key is absent.
+/// `path` names the value in errors (`params.substrate.nx`).
+fn py_to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
+    if obj.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyInt>() {
+        return obj.extract::<i64>().map(toml::Value::Integer).map_err(|_| {
+            PyValueError::new_err(format!(
+                "{path} = {obj} is out of range: allowed a 64-bit integer"
+            ))
+        });
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        return Ok(toml::Value::String(s.to_cow()?.into_owned()));
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut t = toml::Table::new();
+        for (k, v) in d.iter() {
+            let key: String = k.extract().map_err(|_| {
+                PyTypeError::new_err(format!("{path}: keys must be strings, got {k:?}"))
+            })?;
+            if v.is_none() {
+                continue;
+            }
+            let inner = py_to_toml(&v, &format!("{path}.{key}"))?;
+            t.insert(key, inner);
+        }
+        return Ok(toml::Value::Table(t));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        let mut out = Vec::new();
+        for (i, v) in obj.try_iter()?.enumerate() {
+            out.push(py_to_toml(&v?, &format!("{path}[{i}]"))?);
+        }
+        return Ok(toml::Value::Array(out));
+    }
+    if let Ok(x) = obj.extract::<f64>() {
+        return Ok(toml::Value::Float(x));
+    }
+    if obj.hasattr("tolist")? {
+        // numpy arrays and scalars.
+        return py_to_toml(&obj.call_method0("tolist")?, path);
+    }
+    Err(PyTypeError::new_err(format!(
+        "{path}: expected a number, bool, string, list or dict, got {}",
+        obj.get_type().name()?
+    )))
+}
+
+/// A Python dict as a deserialisable value, converted directly (no JSON text:
+/// NaN and inf survive to the crate's validation, which names the field).
+/// Errors name the argument and the key path; arrays with more elements than
+/// the field takes are refused.
 pub(crate) fn from_py<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<T> {
-    let json = obj
-        .py()
-        .import("json")?
-        .call_method1("dumps", (obj,))
-        .map_err(|e| PyValueError::new_err(format!("{name}: not JSON-serialisable ({e})")))?;
-    let text: String = json.extract()?;
-    serde_json::from_str::<T>(&text).map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
+    let v = py_to_toml(obj, name)?;
+    v.try_into::<T>().map_err(|e| {
+        let text = e.to_string().trim_end().replace('\n', " ");
+        PyValueError::new_err(format!("{name}: {text}"))
+    })
 }
 
 /// `CamelCase` to `snake_case`.

@@ -11,7 +11,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::convert::{array1, array2, int_in, rows, value_error, vector};
+use crate::convert::{SIGNAL_CHUNK_TICKS, array1, array2, int_in, rows, value_error, vector};
 use crate::params_dict::{params_from_py, params_to_py};
 
 fn pair_name(p: PairKind) -> &'static str {
@@ -154,8 +154,8 @@ impl NanoWorld {
         })
     }
 
-    /// Advance one tick of ``dt_s`` (s, 0 < dt_s <= 1) with the cursor at
-    /// ``position`` (3,) (m).
+    /// Advance one tick of ``dt_s`` (s, 1e-9 <= dt_s <= 1) with the cursor at
+    /// ``position`` (3,) (m, each coordinate within ±1 m).
     ///
     /// Returns:
     ///     dict with "force" (3,) N to send to the device (finite, within
@@ -187,8 +187,11 @@ impl NanoWorld {
     }
 
     /// Step once per row of ``positions`` (T, 3) cursor positions (m), each
-    /// tick ``dt_s`` (s). The GIL is released while the ticks run. All rows
-    /// are checked (finite) before the first tick.
+    /// tick ``dt_s`` (s). The GIL is released while the ticks run, in chunks
+    /// of 10 000 ticks; Ctrl-C (KeyboardInterrupt) stops the batch between
+    /// chunks, the world keeping the ticks already run. All rows are checked
+    /// (finite, within ±1 m; dt_s in [1e-9, 1]) before the first tick, so a
+    /// refused batch changes nothing; the refused row is named.
     ///
     /// Returns:
     ///     dict of per-tick arrays: "force" (T, 3) N, "unlimited_force"
@@ -205,13 +208,23 @@ impl NanoWorld {
         dt_s: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let path = rows::<3>(positions, "positions", "m")?;
+        // Every row is checked before the first tick: a refused batch changes nothing.
+        for (i, p) in path.iter().enumerate() {
+            TipInput { position_m: *p }
+                .check(dt_s)
+                .map_err(|e| value_error(format!("positions[{i}]: {e}")))?;
+        }
         let world = &mut self.world;
-        let records = py
-            .detach(|| {
-                let mut out = Vec::with_capacity(path.len());
-                for p in &path {
-                    let r = world.step(&TipInput { position_m: *p }, dt_s)?;
-                    out.push(TickRecord {
+        let mut records = Vec::with_capacity(path.len());
+        // Chunks of ticks without the GIL; Ctrl-C is honoured between chunks (the world
+        // keeps the ticks already run).
+        for (c, chunk) in path.chunks(SIGNAL_CHUNK_TICKS).enumerate() {
+            py.detach(|| {
+                for (k, p) in chunk.iter().enumerate() {
+                    let r = world
+                        .step(&TipInput { position_m: *p }, dt_s)
+                        .map_err(|e| (c * SIGNAL_CHUNK_TICKS + k, e))?;
+                    records.push(TickRecord {
                         force: r.force_n,
                         unlimited: r.unlimited_force_n,
                         saturated: r.saturated,
@@ -222,9 +235,11 @@ impl NanoWorld {
                         events: r.events,
                     });
                 }
-                Ok::<_, nanoworld::StepError>(out)
+                Ok::<_, (usize, nanoworld::StepError)>(())
             })
-            .map_err(value_error)?;
+            .map_err(|(i, e)| value_error(format!("positions[{i}]: {e}")))?;
+            py.check_signals()?;
+        }
         let d = PyDict::new(py);
         let v = |f: fn(&TickRecord) -> Vector3<f64>| -> Vec<Vector3<f64>> {
             records.iter().map(f).collect()
@@ -248,6 +263,22 @@ impl NanoWorld {
         }
         d.set_item("events", ev)?;
         Ok(d)
+    }
+
+    /// The attraction (3,) N the tip assembly would feel with the tip centre
+    /// at ``position`` (3,) (m), from the pair laws alone, without stepping:
+    /// nothing snaps or releases and the tick does not advance. Game mode:
+    /// the summed pair laws; physical mode: the Hamaker forces on the tip and
+    /// its carried particles. ValueError naming the axis if a coordinate is
+    /// not finite or beyond 1 m.
+    fn force_at<'py>(
+        &self,
+        py: Python<'py>,
+        position: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let p = vector::<3>(position, "position", "m")?;
+        let f = self.world.force_at(p).map_err(value_error)?;
+        Ok(array1(py, &f))
     }
 
     /// Replace the parameters at run time (same forms as the constructor's

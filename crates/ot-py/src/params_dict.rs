@@ -3,7 +3,8 @@
 //! The dict has exactly the layout of the scene's TOML table (field names
 //! with their units, `interaction = {"game": {...}}` or `{"physical": {...}}`),
 //! so `tomllib.load(f)` of a scene table can be passed as is. Reading goes
-//! through `json.dumps` and serde (`deny_unknown_fields`); writing mirrors the
+//! directly from the Python objects into serde (`deny_unknown_fields`; NaN and inf
+//! reach validation, which names the field); writing mirrors the
 //! struct field by field.
 
 use nanoworld::{
@@ -22,7 +23,7 @@ pub(crate) fn params_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Params>
         return Ok(Params::game_default());
     }
     if let Ok(s) = obj.cast::<PyString>() {
-        return match s.to_str()? {
+        return match s.to_cow()?.as_ref() {
             "game" => Ok(Params::game_default()),
             "physical" => Ok(Params::physical_default()),
             other => Err(PyValueError::new_err(format!(

@@ -92,7 +92,7 @@ fn operator_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OperatorChoice> 
         return Ok(OperatorChoice::ScriptHand);
     };
     if let Ok(s) = obj.cast::<PyString>() {
-        return match s.to_str()? {
+        return match s.to_cow()?.as_ref() {
             "script" => Ok(OperatorChoice::ScriptHand),
             "rigid" => Ok(OperatorChoice::Rigid),
             "hand" => Ok(OperatorChoice::Hand(OperatorParams::default())),

@@ -167,6 +167,12 @@ fn displacement_d<const D: usize>(
                 .map(|_| out)
         })
         .map_err(value_error)?;
+    if let Some(i) = out.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
+        return Err(PyValueError::new_err(format!(
+            "displacement[{i}] is not finite: dt = {dt:e} s is beyond what the integrator \
+             can follow for this model (use a shorter dt)"
+        )));
+    }
     Ok(array2(py, &out)?.unbind())
 }
 
@@ -389,6 +395,21 @@ impl GaussianTrap {
                 )
             }
         };
+        // ot-physics accepts any positive waist; one so small that the stiffness
+        // 2·ln2·P0/w² overflows would integrate to NaN. Refuse it here, by name, until the
+        // model's own validation bounds it.
+        let k = with_model!(&model, m => m.well.stiffness().as_slice().to_vec());
+        let names = ["waist[0]", "waist[1]", "axial_waist"];
+        let waists = [a, b, axial_waist.unwrap_or(1.0)];
+        for (i, ki) in k.iter().enumerate() {
+            if !ki.is_finite() {
+                return Err(PyValueError::new_err(format!(
+                    "{} = {:e} is out of range: allowed a waist whose stiffness \
+                     2*ln2*depth/waist**2 is finite (m)",
+                    names[i], waists[i]
+                )));
+            }
+        }
         Ok(Self {
             model,
             radius,

@@ -1,0 +1,211 @@
+//! Physics defects found by independent checks (issue 11, items 1–3): each test compares a
+//! figure with its analytic value.
+#![allow(clippy::unwrap_used)]
+
+mod common;
+use brickworld::{BrickId, Obstacle};
+use common::*;
+
+const PARK: [f64; 3] = [1.5, 1.5, 1.0];
+
+/// A brick starting from rest on a ramp of angle `theta_deg` (about y) with friction `mu`;
+/// returns its displacement along the ramp after `seconds` (m).
+fn slide(mu: f64, theta_deg: f64, seconds: f64) -> f64 {
+    let mut p = bare();
+    p.friction = mu;
+    p.restitution = 0.0;
+    let h = p.brick_half_extents_m;
+    let ramp_half = [1.0, 0.3, 0.05];
+    let ramp_c = [0.0, 0.0, 0.5];
+    p.obstacles = vec![Obstacle {
+        center_m: ramp_c,
+        half_extents_m: ramp_half,
+        rotation_deg: [0.0, theta_deg, 0.0],
+    }];
+    let t = theta_deg.to_radians();
+    let up = ramp_half[2] + h[2];
+    let c = [ramp_c[0] + up * t.sin(), 0.0, ramp_c[2] + up * t.cos()];
+    p.bricks = vec![brickworld::BrickPlacement {
+        center_m: c,
+        rotation_deg: [0.0, theta_deg, 0.0],
+    }];
+    let mut w = world(p);
+    let n = (seconds / w.params().dt_s).round() as usize;
+    for _ in 0..n {
+        idle(&mut w, PARK);
+    }
+    let b = w.brick(BrickId(0)).unwrap();
+    let d: f64 = (0..3).map(|k| (b.position_m[k] - c[k]).powi(2)).sum();
+    d.sqrt()
+}
+
+/// Item 1: sleeping never freezes a brick that slides with a small net acceleration. The
+/// distance after 2 s must be ½·g·(sin θ − μ cos θ)·t² within 3 %.
+#[test]
+fn slow_slide_is_not_frozen_by_sleep() {
+    for (mu, theta_deg) in [(0.6, 0.6f64.atan().to_degrees() + 1.0), (0.0, 1.0)] {
+        let t = 2.0;
+        let th = f64::to_radians(theta_deg);
+        let expected = 0.5 * 9.81 * (th.sin() - mu * th.cos()) * t * t;
+        let d = slide(mu, theta_deg, t);
+        println!("mu {mu}, θ {theta_deg:.3}°: slid {d:.4} m in {t} s, analytic {expected:.4} m");
+        assert!(
+            (d - expected).abs() < 0.03 * expected,
+            "mu {mu}, θ {theta_deg}°: slid {d} m, analytic {expected} m"
+        );
+    }
+}
+
+/// Item 1, the other half: bricks truly at rest still fall asleep (the cost benefit stays):
+/// one resting on the ground, one dropped 0.2 m, and one held by static friction on a ramp
+/// 3° below its friction angle (which must not creep more than 1 mm either).
+#[test]
+fn resting_brick_and_brick_below_friction_angle_fall_asleep() {
+    let mut p = bare();
+    let h = p.brick_half_extents_m;
+    let theta_deg = 0.6f64.atan().to_degrees() - 3.0;
+    let t = theta_deg.to_radians();
+    let ramp_half = [0.5, 0.3, 0.05];
+    let ramp_c = [1.0, 0.0, 0.5];
+    p.obstacles = vec![Obstacle {
+        center_m: ramp_c,
+        half_extents_m: ramp_half,
+        rotation_deg: [0.0, theta_deg, 0.0],
+    }];
+    let up = ramp_half[2] + h[2];
+    let on_ramp = [ramp_c[0] + up * t.sin(), 0.0, ramp_c[2] + up * t.cos()];
+    p.bricks = vec![
+        at([0.0, 0.0, h[2]]),
+        at([0.5, 0.0, h[2] + 0.2]),
+        brickworld::BrickPlacement {
+            center_m: on_ramp,
+            rotation_deg: [0.0, theta_deg, 0.0],
+        },
+    ];
+    let mut w = world(p);
+    for _ in 0..3000 {
+        idle(&mut w, PARK);
+    }
+    let b = w.brick(BrickId(2)).unwrap().position_m;
+    let crept: f64 = (0..3)
+        .map(|k| (b[k] - on_ramp[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    println!(
+        "ramp brick crept {crept:.2e} m; awake {}",
+        w.awake_brick_count()
+    );
+    assert!(crept < 1e-3, "crept {crept} m");
+    assert_eq!(w.awake_brick_count(), 0, "resting bricks sleep within 3 s");
+}
+
+/// Item 2: pressing straight down on the centre of a resting brick with the proxy 20 cm deep
+/// (a 600 N spring, far above the device's limit) must not move it sideways, and the push the
+/// world receives is the force the device renders (clamped to its limit).
+#[test]
+fn pressing_down_on_the_centre_does_not_walk_the_brick() {
+    let mut p = bare();
+    p.proxy_stiffness_n_m = 3000.0;
+    let h = p.brick_half_extents_m;
+    p.bricks = vec![at([0.0, 0.0, h[2]])];
+    let mut w = world(p);
+    for _ in 0..1000 {
+        idle(&mut w, [0.0, 0.0, 0.3]);
+    }
+    let start = w.brick(BrickId(0)).unwrap().position_m;
+    let top = start[2] + h[2];
+    let r = w.params().proxy_radius_m;
+    let max_f = w.device().max_force_n;
+    let mut worst_lateral = 0.0_f64;
+    let mut last = None;
+    for i in 0..4000 {
+        // Come down at 0.2 m/s, then hold the cursor 20 cm below the brick's top.
+        let z = (top + r + 0.05 - 2e-4 * i as f64).max(top + r - 0.2);
+        let rep = idle(&mut w, [0.0, 0.0, z]);
+        let b = w.brick(BrickId(0)).unwrap().position_m;
+        worst_lateral = worst_lateral.max((b[0] - start[0]).hypot(b[1] - start[1]));
+        last = Some(rep);
+    }
+    let rep = last.unwrap();
+    let fz = rep.force_n[2];
+    println!(
+        "lateral drift {worst_lateral:.2e} m over 3 s; device force {fz:.3} N (limit {max_f} N), spring {:.1} N",
+        rep.spring_force_n[2]
+    );
+    assert!(rep.saturated);
+    assert!((fz - max_f).abs() < 1e-9, "device force {fz}");
+    assert!(
+        worst_lateral < 1e-4,
+        "brick walked {worst_lateral} m sideways"
+    );
+    // Action = reaction: the brick is pushed into the ground by the device force, not by the
+    // 600 N spring: it sinks no deeper than under its own weight plus max_force_n.
+    let sink = start[2] - w.brick(BrickId(0)).unwrap().position_m[2];
+    assert!(sink < 1e-4, "brick pushed {sink} m into the ground");
+}
+
+/// Item 3: a brick dropped flat and centred onto another lands without a sideways kick and
+/// comes to rest centred.
+#[test]
+fn centred_flat_drop_onto_a_brick_stays_centred() {
+    for drop in [0.5, 1.0, 1.5] {
+        let mut p = bare();
+        let h = p.brick_half_extents_m;
+        p.bricks = vec![at([0.0, 0.0, h[2]]), at([0.0, 0.0, 3.0 * h[2] + drop])];
+        let mut w = world(p);
+        let mut worst_v = 0.0_f64;
+        for _ in 0..3000 {
+            idle(&mut w, PARK);
+            let b = w.brick(BrickId(1)).unwrap();
+            worst_v = worst_v.max(b.velocity_m_s[0].hypot(b.velocity_m_s[1]));
+        }
+        let b = w.brick(BrickId(1)).unwrap().position_m;
+        let off = b[0].hypot(b[1]);
+        println!(
+            "drop {drop} m: worst lateral speed {worst_v:.2e} m/s, rests {off:.2e} m off centre"
+        );
+        assert!(worst_v < 5e-3, "drop {drop}: lateral kick {worst_v} m/s");
+        assert!(off < 1e-4, "drop {drop}: rests {off} m off centre");
+    }
+}
+
+/// Item 15: a brick can start with its own velocity and friction. A brick launched at 1 m/s
+/// along the ground slides v² / (2 μ g); with the world's μ = 0.6 and the brick's μ = 0 the
+/// contact uses their mean, 0.3: 0.170 m. Its own mass is validated by name.
+#[test]
+fn brick_with_initial_velocity_and_own_friction_slides_v2_over_2_mu_g() {
+    let p = bare();
+    let h = p.brick_half_extents_m;
+    let mut w = world(p);
+    let id = w
+        .add_brick_with(
+            at([0.0, 0.0, h[2]]),
+            brickworld::BrickProps {
+                velocity_m_s: [1.0, 0.0, 0.0],
+                friction: Some(0.0),
+                mass_kg: Some(2.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    for _ in 0..1500 {
+        idle(&mut w, PARK);
+    }
+    let b = w.brick(id).unwrap();
+    let expected = 1.0 / (2.0 * 0.3 * 9.81);
+    println!("slid {:.4} m, analytic {expected:.4} m", b.position_m[0]);
+    assert!((b.position_m[0] - expected).abs() < 0.02 * expected);
+    let e = w
+        .add_brick_with(
+            at([0.5, 0.0, h[2]]),
+            brickworld::BrickProps {
+                mass_kg: Some(0.0),
+                ..Default::default()
+            },
+        )
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "parameter `brick.mass_kg` = 0 is out of range: allowed [0.001, 100]"
+    );
+}

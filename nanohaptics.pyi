@@ -1,0 +1,1 @@
+crates/ot-py/nanohaptics.pyi
