@@ -9,6 +9,7 @@
 //!   bit for bit against the recorded trap);
 //! * `--realtime`: `scenes/optical_tweezers_10khz.toml` paced in real time for 60 s: missed
 //!   deadlines;
+//! * `--hausdorff-every N`: check every N-th grabbed tick (default 50; 1 = every tick);
 //! * `--only old|new --seconds S`: one session and nothing else (for `valgrind --tool=callgrind`).
 //!
 //! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
@@ -253,7 +254,8 @@ fn main() -> Result<(), BoxError> {
         {
             println!("{}", e.2);
         }
-        println!("{}", hausdorff_check(&text, r, 50)?);
+        let every: usize = flag("--hausdorff-every").map_or(Ok(50), |s| s.parse())?;
+        println!("{}", hausdorff_check(&text, r, every.max(1))?);
     }
     if args.iter().any(|a| a == "--realtime") {
         let t10 = std::fs::read_to_string(root().join("scenes/optical_tweezers_10khz.toml"))?;
