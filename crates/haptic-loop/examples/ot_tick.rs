@@ -9,6 +9,7 @@
 //!   bit for bit against the recorded trap);
 //! * `--realtime`: `scenes/optical_tweezers_10khz.toml` paced in real time for 60 s: missed
 //!   deadlines;
+//! * `--hausdorff-every N`: check every N-th grabbed tick (default 50; 1 = every tick);
 //! * `--only old|new --seconds S`: one session and nothing else (for `valgrind --tool=callgrind`).
 //!
 //! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
@@ -70,6 +71,10 @@ fn load() -> String {
 /// Hausdorff distance from converged dynamics every `every` grabbed ticks.
 fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String, BoxError> {
     let file = SceneFile::parse(text)?;
+    let old = file
+        .optical_tweezers
+        .as_ref()
+        .is_some_and(|p| !p.warm_start);
     let p = file
         .optical_tweezers
         .clone()
@@ -81,17 +86,22 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
     .mass(p.mass_g * 1e-3)
     .build()?;
     let dt = p.dt_us * 1e-6;
-    let (prop, _) = choose_tick_map(model, dt, p.tick_map_tol_nm.unwrap_or(0.01) * 1e-9, 0.1)?;
+    let prop = match p.rk4_substeps {
+        Some(n) => ot_physics::Propagator::new(model, ot_physics::Method::Rk4 { substeps: n }, dt)?,
+        None => choose_tick_map(model, dt, p.tick_map_tol_nm.unwrap_or(0.01) * 1e-9, 0.1)?.0,
+    };
     let truth = converged(model, dt)?;
     let tol = p
         .envelope_tol_nm
         .map_or(ot_envelope::DEFAULT_TOL, |t| t * 1e-9);
-    let mut c = TickController::new(TickParams::new(SteerParams {
+    let mut tp = TickParams::new(SteerParams {
         stiffness: p.stiffness_n_per_m,
         mode: p.clip,
         tol,
         margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
-    }))?;
+    });
+    tp.warm_start = !old;
+    let mut c = TickController::new(tp)?;
     let a = &r.arrays;
     let col = |n: &str| a.state_column(n).ok_or(format!("no column {n}"));
     let (px, py, vx, vy) = (
@@ -188,6 +198,7 @@ fn main() -> Result<(), BoxError> {
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     let mut last_new = None;
+    let mut last_old = None;
     for _ in 0..rounds {
         for (name, t) in [
             ("old: RK4×8, full build every tick", &old),
@@ -241,6 +252,8 @@ fn main() -> Result<(), BoxError> {
             println!("|   slowest: {} | | | | | | | | | |", slow.join(", "));
             if name.starts_with("new") {
                 last_new = Some(r);
+            } else {
+                last_old = Some(r);
             }
         }
     }
@@ -254,7 +267,11 @@ fn main() -> Result<(), BoxError> {
         {
             println!("{}", e.2);
         }
-        println!("{}", hausdorff_check(&text, r, 50)?);
+        let every: usize = flag("--hausdorff-every").map_or(Ok(50), |s| s.parse())?;
+        println!("new: {}", hausdorff_check(&text, r, every.max(1))?);
+        if let Some(ro) = &last_old {
+            println!("old: {}", hausdorff_check(&old, ro, every.max(1))?);
+        }
     }
     if args.iter().any(|a| a == "--realtime") {
         let t10 = std::fs::read_to_string(root().join("scenes/optical_tweezers_10khz.toml"))?;
