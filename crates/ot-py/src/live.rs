@@ -75,7 +75,8 @@ fn buttons_arg(obj: Option<&Bound<'_, PyAny>>, names: &[String]) -> PyResult<u32
                 item.repr().map(|r| r.to_string()).unwrap_or_default()
             ))
         })?;
-        let n = name.to_str()?;
+        let n: String = name.extract()?;
+        let n = n.as_str();
         let i = names.iter().position(|b| b == n).ok_or_else(|| {
             PyValueError::new_err(format!(
                 "buttons: no button {n:?} on this device (allowed: {})",
