@@ -222,6 +222,8 @@ fn main() {
     writeln!(md).unwrap();
     writeln!(md, "{outage_line}").unwrap();
     writeln!(md).unwrap();
+    writeln!(md, "Reading the figures: *round trip* is measured by the device process, from sending a sample to receiving its answer; on the simulator's side a datagram wakes the bridge's receiver thread, which wakes the servo thread, which ticks and answers (two thread wake-ups, then a third in the device process). The tick's own work is a few microseconds (batch p99 in the haptic-loop section); in real time its p99 includes the answer's `send_to`, the recorder hand-off and cache misses after each idle wait. Both processes share 2 virtual cores with their receiver, writer and publisher threads, so the tails are wake-up latencies of a stock kernel (see `docs/device-bridge.md` on what an RT kernel and CPU isolation change). *Tick jitter* is |interval between tick starts − 1 ms|, the device's own pacing included. *Stale ticks* ran on the last sample (no new one within 1.5 periods); *watchdog ticks* are those past the 1.5 ms grace, where the force was reduced.").unwrap();
+    writeln!(md).unwrap();
     writeln!(md, "### Targets").unwrap();
     writeln!(md).unwrap();
     writeln!(md, "| target | measured | met |").unwrap();
