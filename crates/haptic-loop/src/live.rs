@@ -48,18 +48,8 @@ impl LiveConfig {
     /// Parses `ws:HOST:PORT`, or `ws:PORT` for loopback (the `--live` option), with the default
     /// rates (50 Hz scene, 200 Hz plots).
     pub fn parse(spec: &str) -> Result<Self, SessionError> {
-        let addr = spec.strip_prefix("ws:").ok_or_else(|| {
-            SessionError::Option(format!(
-                "--live `{spec}`: expected ws:HOST:PORT, e.g. ws:127.0.0.1:8765"
-            ))
-        })?;
-        let loopback = addr.parse::<u16>().ok().map(|p| format!("127.0.0.1:{p}"));
-        let addr = loopback.as_deref().unwrap_or(addr);
-        let bind = addr.parse().map_err(|_| {
-            SessionError::Option(format!(
-                "--live `{spec}`: `{addr}` is not an IP address and port (e.g. 127.0.0.1:8765)"
-            ))
-        })?;
+        let bind = crate::bridge::parse_endpoint(spec, "ws", "--live", "ws:127.0.0.1:8765")
+            .map_err(SessionError::Option)?;
         Ok(LiveConfig {
             bind,
             display_hz: 50,

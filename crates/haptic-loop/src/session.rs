@@ -333,25 +333,16 @@ fn run_with_device(
         Some((s, t)) => (s.name.clone(), t.clone()),
         None => (String::new(), String::new()),
     };
-    let description = DescriptionMsg {
-        format: messages::FORMAT_VERSION.to_string(),
-        scene_name: loaded.file.scene.name.clone(),
-        scene_kind: loaded.scene.kind().to_string(),
-        scene_toml: opts.scene.text.clone(),
-        device_model: specs.name.to_string(),
-        rate_hz: rate,
-        mode: mode.to_string(),
-        script_name,
-        script_toml,
-        operator: source.describe(),
-        state_fields: fields.clone(),
-        start_time_ns: opts.start_time_ns.unwrap_or_else(now_unix_ns),
-        device_link: source.link_name(),
-        device_max_force_n: specs.max_force_n,
-        device_max_stiffness_n_per_m: specs.max_stiffness_n_per_m,
-        device_workspace_radius_m: specs.workspace_radius_m,
-        device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
-    };
+    let mut description = DescriptionMsg::new(
+        &opts.scene.text,
+        &loaded,
+        mode,
+        &source.link_name(),
+        opts.start_time_ns.unwrap_or_else(now_unix_ns),
+    );
+    description.script_name = script_name;
+    description.script_toml = script_toml;
+    description.operator = source.describe();
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let mut arrays = SessionArrays::new(rate, fields);
     let mut recorder = opts.out.clone().map(RecorderSink::new);

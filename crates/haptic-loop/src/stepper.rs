@@ -91,31 +91,18 @@ impl Stepper {
         let file = SceneFile::parse(&opts.scene.text)?;
         let model = opts.device.unwrap_or(file.device.model);
         let loaded = load_scene(&opts.scene.text, Some(model))?;
-        let specs = loaded.config.specs.clone();
         let fields = loaded.scene.state_fields();
         if let Some(bad) = fields.iter().find(|f| !messages::valid_field_name(f)) {
             return Err(SessionError::StateField(bad.clone()));
         }
         let rate = loaded.config.rate_hz;
-        let description = DescriptionMsg {
-            format: messages::FORMAT_VERSION.to_string(),
-            scene_name: loaded.file.scene.name.clone(),
-            scene_kind: loaded.scene.kind().to_string(),
-            scene_toml: opts.scene.text.clone(),
-            device_model: specs.name.to_string(),
-            rate_hz: rate,
-            mode: "stepped".into(),
-            script_name: String::new(),
-            script_toml: String::new(),
-            operator: opts.link.clone(),
-            state_fields: fields.clone(),
-            start_time_ns: opts.start_time_ns.unwrap_or_else(now_unix_ns),
-            device_link: opts.link.clone(),
-            device_max_force_n: specs.max_force_n,
-            device_max_stiffness_n_per_m: specs.max_stiffness_n_per_m,
-            device_workspace_radius_m: specs.workspace_radius_m,
-            device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
-        };
+        let description = DescriptionMsg::new(
+            &opts.scene.text,
+            &loaded,
+            "stepped",
+            &opts.link,
+            opts.start_time_ns.unwrap_or_else(now_unix_ns),
+        );
         let lp = HapticLoop::new(loaded.config, loaded.scene);
         let mut arrays = opts.arrays.then(|| SessionArrays::new(rate, fields));
         let mut recorder = opts.out.clone().map(RecorderSink::new);

@@ -37,18 +37,8 @@ pub struct BridgeConfig {
 impl BridgeConfig {
     /// Parses `udp:HOST:PORT`, or `udp:PORT` for loopback (the `--device` option).
     pub fn parse(spec: &str) -> Result<Self, DeviceError> {
-        let addr = spec.strip_prefix("udp:").ok_or_else(|| {
-            DeviceError::Link(format!(
-                "--device `{spec}`: expected udp:HOST:PORT, e.g. udp:127.0.0.1:9870"
-            ))
-        })?;
-        let loopback = addr.parse::<u16>().ok().map(|p| format!("127.0.0.1:{p}"));
-        let addr = loopback.as_deref().unwrap_or(addr);
-        let bind: SocketAddr = addr.parse().map_err(|_| {
-            DeviceError::Link(format!(
-                "--device `{spec}`: `{addr}` is not an IP address and port (e.g. 127.0.0.1:9870)"
-            ))
-        })?;
+        let bind = super::parse_endpoint(spec, "udp", "--device", "udp:127.0.0.1:9870")
+            .map_err(DeviceError::Link)?;
         Ok(BridgeConfig {
             bind,
             wait_s: 120.0,
