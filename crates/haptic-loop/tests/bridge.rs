@@ -17,6 +17,14 @@ use std::net::{SocketAddr, UdpSocket};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+/// The real-time sessions of this file run one at a time (each is a simulator and a device
+/// pacing themselves by the wall clock; side by side on 2 cores they would starve each other).
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
@@ -84,6 +92,7 @@ fn assert_replays(out: &Path) {
 
 #[test]
 fn five_percent_loss_and_2_ms_jitter_are_survived_and_replay_bit_for_bit() {
+    let _serial = serial();
     let addr = free_port();
     let out = tmp("lossy.mcap");
     let mut f = fake(addr);
@@ -107,6 +116,18 @@ fn five_percent_loss_and_2_ms_jitter_are_survived_and_replay_bit_for_bit() {
     let stale = a.device_age_ticks.iter().filter(|&&g| g > 0).count() as u64;
     assert_eq!(stale, counter(&r, "stale_ticks"));
     assert!(a.events.iter().any(|e| e.1 == "device.sample_late"));
+    // The device's numbering is the clock: tick n stands for its sample first + n, and a tick's
+    // age is how many periods old its sample is; the world kept the device's time.
+    let first = a.device_seq[0];
+    for (n, (s, g)) in a.device_seq.iter().zip(&a.device_age_ticks).enumerate() {
+        assert_eq!(s + u64::from(*g), first + n as u64, "tick {n}");
+    }
+    let ticks = a.tick.len() as u64;
+    assert!(
+        ticks <= dev.ticks && ticks + 20 >= dev.ticks,
+        "{ticks} ticks, {} periods",
+        dev.ticks
+    );
     for (f, s) in a.device_force_n.iter().zip(&a.status) {
         assert!(vec3::is_finite(*f) && vec3::norm(*f) <= FALCON.max_force_n);
         if s & status::WATCHDOG != 0 {
@@ -119,6 +140,7 @@ fn five_percent_loss_and_2_ms_jitter_are_survived_and_replay_bit_for_bit() {
 
 #[test]
 fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_return() {
+    let _serial = serial();
     let addr = free_port();
     let out = tmp("outage.mcap");
     let mut f = fake(addr);
@@ -133,7 +155,7 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
         .rev()
         .find(|&i| a.device_age_ticks[i] == 0)
         .unwrap();
-    let f0 = vec3::norm(a.device_force_n[last_fresh]);
+    let f0 = vec3::norm(a.world_force_n[last_fresh]);
     assert!(f0 > 4.0, "in contact when the device vanished: {f0} N");
     // Full force through the grace (the tick of age 1 runs 1.5 ms after the last sample), then
     // a linear ramp, zero from age 9 (9.5 ms) on: within the 10 ms timeout.
@@ -152,10 +174,17 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
             assert_eq!(a.device_stiffness_n_per_m[i], [0.0; 9]);
         }
     }
-    let lost = a.events.iter().find(|e| e.1 == "device.lost").unwrap();
+    // (A loaded machine may lose the link briefly elsewhere too: look at this outage.)
+    let after = |name: &str| {
+        a.events
+            .iter()
+            .find(|e| e.1 == name && e.0 > last_fresh as u64)
+            .unwrap()
+    };
+    let lost = after("device.lost");
     assert_eq!(lost.0, (last_fresh + 9) as u64);
     // It comes back: soft engagement restarts from zero.
-    let back = a.events.iter().find(|e| e.1 == "device.resumed").unwrap();
+    let back = after("device.resumed");
     let b = back.0 as usize;
     assert_eq!(a.device_age_ticks[b], 0);
     assert_eq!(a.engagement[b], 0.0);
@@ -168,6 +197,7 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
 /// answer so the counts are exact.
 #[test]
 fn duplicate_reordered_malformed_oversized_and_stranger_packets_are_counted_and_dropped() {
+    let _serial = serial();
     let addr = free_port();
     let out = tmp("faults.mcap");
     let mut opts = bridged(addr, &out);
@@ -269,6 +299,7 @@ fn duplicate_reordered_malformed_oversized_and_stranger_packets_are_counted_and_
 
 #[test]
 fn a_device_process_that_restarts_is_welcomed_again() {
+    let _serial = serial();
     let addr = free_port();
     let out = tmp("restart.mcap");
     let mut first = fake(addr);
@@ -295,6 +326,7 @@ fn a_device_process_that_restarts_is_welcomed_again() {
 
 #[test]
 fn no_device_is_a_clear_error_after_the_wait() {
+    let _serial = serial();
     let addr = free_port();
     let mut o = bridged(addr, &tmp("none.mcap"));
     if let Some(b) = o.bridge.as_mut() {

@@ -2,10 +2,12 @@
 //!
 //! A receiver thread blocks on the socket, checks every datagram (magic, version, type, length,
 //! sender, sequence number) and queues fresh samples; the tick waits on a condition variable
-//! for the next sample, so a tick starts as soon as its sample arrives (the device's samples
-//! are the clock). When no sample comes within 1.5 periods of the last tick, the tick runs on
-//! the last sample with its age in ticks, and the loop's watchdog ramps the force down from
-//! that age. Every fault is counted, never fatal: duplicates, reordered and malformed packets,
+//! for its sample, so a tick starts as soon as its sample arrives. The device's sequence
+//! numbers are the clock: tick n stands for the device's sample `first + n`. When that sample
+//! has not come 0.5 period after its due time, the tick runs on the newest sample it has, with
+//! its age (how many device periods old it is), and the loop's watchdog ramps the force down
+//! from that age; a late sample is still used by the next tick. So the world advances exactly
+//! one tick per device period, whatever the network does. Every fault is counted, never fatal: duplicates, reordered and malformed packets,
 //! oversized datagrams, packets from a stranger, gaps in the sequence.
 
 use super::protocol::{ForceReply, Packet, Sample};
@@ -63,6 +65,7 @@ struct Counters {
     hellos: u64,
     send_errors: u64,
     stale_ticks: u64,
+    resync: u64,
 }
 
 #[derive(Default)]
@@ -70,6 +73,7 @@ struct State {
     peer: Option<SocketAddr>,
     specs: Option<DeviceSpecs>,
     last_seq: Option<u64>,
+    generation: u64,
     queue: VecDeque<Sample>,
     ended: bool,
     error: Option<String>,
@@ -90,15 +94,21 @@ pub struct UdpDevice {
     shared: Arc<Shared>,
     thread: Option<JoinHandle<()>>,
     last: Option<Sample>,
-    age: u32,
-    prev_start: Option<Instant>,
-    fresh_start: Option<Instant>,
+    /// The device sequence number the next tick stands for.
+    slot: Option<u64>,
+    /// When the last on-time sample arrived, and its slot.
+    anchor: Option<(Instant, u64)>,
+    generation: u64,
     peer: Option<SocketAddr>,
 }
 
 /// Most samples waiting for a tick; older ones are dropped (counted as superseded) so latency
 /// cannot build up.
 const QUEUE: usize = 4;
+
+/// A device sequence number this many samples ahead of the tick's slot resynchronises the
+/// slot instead of running that many stale ticks.
+const RESYNC: u64 = 1000;
 
 impl UdpDevice {
     /// A bridged device; nothing is bound before [`HapticDevice::open`].
@@ -114,9 +124,9 @@ impl UdpDevice {
             }),
             thread: None,
             last: None,
-            age: 0,
-            prev_start: None,
-            fresh_start: None,
+            slot: None,
+            anchor: None,
+            generation: 0,
             peer: None,
         }
     }
@@ -183,6 +193,11 @@ fn receive(socket: UdpSocket, shared: Arc<Shared>, welcome: Vec<u8>) {
                 } else {
                     st.c.hellos += 1;
                     st.specs = Some(specs);
+                    if st.peer != Some(from) || st.last_seq.is_some() {
+                        // A device that restarted: its old samples and numbering are gone.
+                        st.generation += 1;
+                        st.queue.clear();
+                    }
                     st.peer = Some(from);
                     st.last_seq = None;
                     let _ = socket.send_to(&welcome, from);
@@ -274,77 +289,95 @@ impl HapticDevice for UdpDevice {
 
     fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
         let period = Duration::from_secs_f64(time.dt_s);
-        // The first tick waits for the first sample; later ones at most 1.5 periods after the
-        // last fresh one, and stale ticks follow on an absolute schedule: the tick of age a runs
-        // (a + 0.5) periods after the last sample arrived, so the watchdog's age is wall time.
-        let deadline = match self.fresh_start {
-            None => Instant::now() + Duration::from_secs_f64(self.config.wait_s.max(0.0)),
-            Some(f) => f + period.mul_f64(f64::from(self.age) + 1.5),
-        };
-        let earliest = self.prev_start.map(|p| p + period / 2);
         let shared = self.shared.clone();
         let mut st = shared
             .state
             .lock()
             .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))?;
+        if st.generation != self.generation {
+            // A (re)started device numbers its samples afresh.
+            self.generation = st.generation;
+            self.slot = None;
+            self.anchor = None;
+        }
+        // The tick of slot k waits for the device's sample k; without it, it runs at
+        // (k − a + 0.5) periods after the arrival of the last on-time sample (slot a), so the
+        // stale ticks keep the device's clock and the sample's age is its lateness in periods.
+        let deadline = match (self.slot, self.anchor) {
+            (Some(k), Some((t, a))) => t + period.mul_f64(k.saturating_sub(a) as f64 + 0.5),
+            _ => Instant::now() + Duration::from_secs_f64(self.config.wait_s.max(0.0)),
+        };
         loop {
             if let Some(e) = st.error.take() {
                 return Err(DeviceError::Link(format!("receiving: {e}")));
             }
-            let now = Instant::now();
-            let early = earliest.is_some_and(|e| now < e);
-            if !st.queue.is_empty() && !early {
+            let ready = match self.slot {
+                None => !st.queue.is_empty(),
+                Some(k) => st.queue.back().is_some_and(|s| s.seq >= k),
+            };
+            if ready {
                 break;
             }
-            if st.ended && st.queue.is_empty() {
+            if st.ended {
                 return Err(DeviceError::Ended);
             }
+            let now = Instant::now();
             if now >= deadline {
                 break;
             }
-            let until = match earliest {
-                Some(e) if early && !st.queue.is_empty() => e,
-                _ => deadline,
-            };
             st = shared
                 .arrived
-                .wait_timeout(st, until.saturating_duration_since(now))
+                .wait_timeout(st, deadline - now)
                 .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))?
                 .0;
         }
         self.peer = st.peer;
-        let fresh = st.queue.pop_front();
-        if fresh.is_none() {
-            st.c.stale_ticks += 1;
+        let Some(k) = self.slot.or_else(|| st.queue.front().map(|s| s.seq)) else {
+            return Err(DeviceError::Link(format!(
+                "no sample from the device within {} s of its hello",
+                self.config.wait_s
+            )));
+        };
+        // A device clock far ahead of ours (a jump in its numbering): follow it.
+        let k = match st.queue.front().map(|f| f.seq) {
+            Some(f) if f > k.saturating_add(RESYNC) => {
+                st.c.resync += 1;
+                f
+            }
+            _ => k,
+        };
+        // The newest sample for this slot or an earlier one (late samples are superseded by
+        // newer ones; samples for later slots wait for their tick).
+        let mut used = None;
+        while st.queue.front().is_some_and(|s| s.seq <= k) {
+            if used.is_some() {
+                st.c.superseded += 1;
+            }
+            used = st.queue.pop_front();
         }
-        drop(st);
-        let now = Instant::now();
-        self.prev_start = Some(now);
-        match fresh {
-            Some(s) => {
-                self.last = Some(s);
-                self.age = 0;
-                self.fresh_start = Some(now);
-            }
-            None if self.last.is_none() => {
-                return Err(DeviceError::Link(format!(
-                    "no sample from the device within {} s of its hello",
-                    self.config.wait_s
-                )));
-            }
-            None => self.age = self.age.saturating_add(1),
+        if let Some(s) = used {
+            self.last = Some(s);
         }
         let s = self.last.unwrap_or(Sample {
-            seq: 0,
+            seq: k,
             device_time_ns: 0,
             position_m: [0.0; 3],
             buttons: 0,
         });
+        let age = u32::try_from(k.saturating_sub(s.seq)).unwrap_or(u32::MAX);
+        if age > 0 {
+            st.c.stale_ticks += 1;
+        }
+        drop(st);
+        if age == 0 {
+            self.anchor = Some((Instant::now(), k));
+        }
+        self.slot = Some(k + 1);
         Ok(DeviceSample {
             position_m: s.position_m,
             buttons: Buttons(s.buttons),
             seq: s.seq,
-            age_ticks: self.age,
+            age_ticks: age,
         })
     }
 
@@ -399,6 +432,7 @@ impl HapticDevice for UdpDevice {
             ("hellos", c.hellos),
             ("send_errors", c.send_errors),
             ("stale_ticks", c.stale_ticks),
+            ("resync", c.resync),
         ]
     }
 }
