@@ -213,7 +213,7 @@ fn main() {
                 ms <= 10.0,
             ));
             outage_line = format!(
-                "Device silent for 100 ms while pressing the wall with {f0:.2} N: the force sent reached 0 N at the stale tick of age {} (scheduled {}.5 ms after the last sample: full force through 1.5 ms, then a linear ramp); the device received its first zero-force packet {dev_zero:.2} ms after it sent its last sample (wall clock, including the loopback trip). On return: `device.resumed`, soft engagement from 0 over 0.25 s.",
+                "Device silent for 100 ms while pressing the wall with {f0:.2} N: the force sent reached 0 N at the stale tick of age {} (scheduled {}.5 ms after the last sample: full force through 2.5 ms, then a linear ramp); the device received its first zero-force packet {dev_zero:.2} ms after it sent its last sample (wall clock, including the loopback trip). On return: `device.resumed`, soft engagement from 0 over 0.25 s.",
                 zero_at - last_fresh,
                 zero_at - last_fresh
             );
@@ -222,7 +222,7 @@ fn main() {
     writeln!(md).unwrap();
     writeln!(md, "{outage_line}").unwrap();
     writeln!(md).unwrap();
-    writeln!(md, "Reading the figures: *round trip* is measured by the device process, from sending a sample to receiving its answer; on the simulator's side a datagram wakes the bridge's receiver thread, which wakes the servo thread, which ticks and answers (two thread wake-ups, then a third in the device process). The tick's own work is a few microseconds (batch p99 in the haptic-loop section); in real time its p99 includes the answer's `send_to`, the recorder hand-off and cache misses after each idle wait. Both processes share 2 virtual cores with their receiver, writer and publisher threads, so the tails are wake-up latencies of a stock kernel (see `docs/device-bridge.md` on what an RT kernel and CPU isolation change). *Tick jitter* is |interval between tick starts − 1 ms|, the device's own pacing included. *Stale ticks* ran on the last sample (no new one within 1.5 periods); *watchdog ticks* are those past the 1.5 ms grace, where the force was reduced.").unwrap();
+    writeln!(md, "Reading the figures: *round trip* is measured by the device process, from sending a sample to receiving its answer; on the simulator's side a datagram wakes the bridge's receiver thread, which wakes the servo thread, which ticks and answers (two thread wake-ups, then a third in the device process). The tick's own work is a few microseconds (batch p99 in the haptic-loop section); in real time its p99 includes the answer's `send_to`, the recorder hand-off and cache misses after each idle wait. Both processes share 2 virtual cores with their receiver, writer and publisher threads, so the tails are wake-up latencies of a stock kernel (see `docs/device-bridge.md` on what an RT kernel and CPU isolation change). *Tick jitter* is |interval between tick starts − 1 ms|, the device's own pacing included. *Stale ticks* ran on a sample older than their own (theirs had not arrived half a period after it was due); *watchdog ticks* are those past the 3 ms grace (age ≥ 3), where the force was reduced.").unwrap();
     writeln!(md).unwrap();
     writeln!(md, "### Targets").unwrap();
     writeln!(md).unwrap();

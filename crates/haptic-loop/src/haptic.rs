@@ -19,8 +19,8 @@
 //! - **watchdog** (a bridged device whose samples stop): the sample's age in ticks is an input of
 //!   the tick (a stale tick of age `a` runs `a + 0.5` periods after the last sample). While the
 //!   age is within `watchdog_grace_ticks` the force is untouched; then it ramps linearly to zero,
-//!   zero from age `watchdog_timeout_ticks` on (defaults at 1 kHz: full force through 1.5 ms,
-//!   zero from 9.5 ms after the last sample: `[loop] watchdog_grace_s = 0.002`,
+//!   zero from age `watchdog_timeout_ticks` on (defaults at 1 kHz: full force through 2.5 ms,
+//!   zero from 9.5 ms after the last sample: `[loop] watchdog_grace_s = 0.003`,
 //!   `watchdog_timeout_s = 0.010`). Events: `device.sample_late` at the first stale tick of
 //!   an episode, `device.lost` when the force reaches zero, `device.resumed` on the next fresh
 //!   sample; after a loss, soft engagement restarts.

@@ -157,16 +157,16 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
         .unwrap();
     let f0 = vec3::norm(a.world_force_n[last_fresh]);
     assert!(f0 > 4.0, "in contact when the device vanished: {f0} N");
-    // Full force through the grace (the tick of age 1 runs 1.5 ms after the last sample), then
-    // a linear ramp, zero from age 9 (9.5 ms) on: within the 10 ms timeout.
+    // Full force through the 3 ms grace (ages 1 and 2 run 1.5 and 2.5 ms after the last
+    // sample), then a linear ramp, zero from age 9 (9.5 ms) on: within the 10 ms timeout.
     for k in 1..=30 {
         let i = last_fresh + k;
         let f = vec3::norm(a.device_force_n[i]);
         assert_eq!(a.device_age_ticks[i], k as u32);
-        let expected = if k <= 1 {
+        let expected = if k <= 2 {
             1.0
         } else {
-            (9.0 - k as f64).max(0.0) / 8.0
+            (9.0 - k as f64).max(0.0) / 7.0
         };
         assert_eq!(a.watchdog[i], expected, "age {k}");
         if k >= 9 {

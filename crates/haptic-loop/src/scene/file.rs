@@ -18,7 +18,7 @@
 //! [loop]
 //! rate_hz = 1000                       # tick rate, 100..=20000 Hz; 10^9 / rate_hz whole ns
 //! engage_s = 0.25                      # soft-engagement ramp at start
-//! watchdog_grace_s = 0.002             # a bridged device's sample may be this late at full force
+//! watchdog_grace_s = 0.003             # a bridged device's sample may be this late at full force
 //! watchdog_timeout_s = 0.010           # ... and the force is zero this long after the last one
 //!
 //! [display]
@@ -190,7 +190,7 @@ impl Default for LoopSection {
         LoopSection {
             rate_hz: 1000,
             engage_s: 0.25,
-            watchdog_grace_s: 0.002,
+            watchdog_grace_s: 0.003,
             watchdog_timeout_s: 0.010,
         }
     }
@@ -457,17 +457,17 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&format!("{WALL}[loop]\nwatchdog_timeout_s = 0.001\n")),
-            "scene: `loop.watchdog_timeout_s` = 0.001 is out of range (allowed: 0.0025 ≤ \
+            "scene: `loop.watchdog_timeout_s` = 0.001 is out of range (allowed: 0.0035 ≤ \
              loop.watchdog_timeout_s ≤ 1)"
         );
         let s = load_scene(&format!("{WALL}[loop]\nrate_hz = 10000\n"), None).unwrap();
-        // At 10 kHz: full force through age 19 (1.95 ms), zero from age 99 (9.95 ms).
+        // At 10 kHz: full force through age 29 (2.95 ms), zero from age 99 (9.95 ms).
         assert_eq!(
             (
                 s.config.watchdog_grace_ticks,
                 s.config.watchdog_timeout_ticks
             ),
-            (19, 99)
+            (29, 99)
         );
         assert_eq!(
             err(&format!("{WALL}[display]\nrate_hz = 30\n")),
