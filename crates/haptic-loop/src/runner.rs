@@ -163,6 +163,11 @@ impl<'s> Runner<'s> {
         let mut compute = Vec::with_capacity(cap.min(1 << 24));
         let timed = !matches!(pacing, Pacing::Batch | Pacing::Recorded(_));
         let mut jitter = Vec::with_capacity(if timed { cap.min(1 << 24) } else { 0 });
+        // Per-sink timings grow with the run: reserve them up front so no tick reallocates.
+        for t in &mut self.sink_ns {
+            t.clear();
+            t.reserve(cap.min(1 << 24));
+        }
         let mut missed_count = 0;
         let start = Instant::now();
         let pacer = matches!(pacing, Pacing::Realtime).then(|| Pacer::new(period_ns));
