@@ -132,11 +132,10 @@ pub enum ProtocolError {
     Spec(String),
 }
 
-fn header(t: u8) -> Vec<u8> {
-    let mut v = Vec::with_capacity(128);
+fn header(v: &mut Vec<u8>, t: u8) {
+    v.clear();
     v.extend_from_slice(&MAGIC);
     v.extend_from_slice(&[VERSION, t, 0, 0]);
-    v
 }
 
 fn put_str(v: &mut Vec<u8>, s: &str) {
@@ -149,9 +148,17 @@ fn put_str(v: &mut Vec<u8>, s: &str) {
 impl Packet {
     /// Encodes to a datagram.
     pub fn encode(&self) -> Vec<u8> {
+        let mut v = Vec::with_capacity(128);
+        self.encode_into(&mut v);
+        v
+    }
+
+    /// Encodes into `v` (cleared first), reusing its allocation: the servo tick sends a force
+    /// packet every tick without allocating.
+    pub fn encode_into(&self, v: &mut Vec<u8>) {
         match self {
             Packet::Hello { rate_hz, specs } => {
-                let mut v = header(1);
+                header(v, 1);
                 v.extend_from_slice(&rate_hz.to_le_bytes());
                 for x in [
                     specs.max_force_n,
@@ -160,48 +167,43 @@ impl Packet {
                 ] {
                     v.extend_from_slice(&x.to_le_bytes());
                 }
-                put_str(&mut v, &specs.name);
+                put_str(v, &specs.name);
                 v.push(specs.button_names.len().min(255) as u8);
                 for b in specs.button_names.iter().take(255) {
-                    put_str(&mut v, b);
+                    put_str(v, b);
                 }
-                v
             }
             Packet::Welcome {
                 rate_hz,
                 start_time_ns,
                 scene,
             } => {
-                let mut v = header(2);
+                header(v, 2);
                 v.extend_from_slice(&rate_hz.to_le_bytes());
                 v.extend_from_slice(&start_time_ns.to_le_bytes());
-                put_str(&mut v, scene);
-                v
+                put_str(v, scene);
             }
             Packet::Sample(s) => {
-                let mut v = header(3);
+                header(v, 3);
                 v.extend_from_slice(&s.seq.to_le_bytes());
                 v.extend_from_slice(&s.device_time_ns.to_le_bytes());
                 for x in s.position_m {
                     v.extend_from_slice(&x.to_le_bytes());
                 }
                 v.extend_from_slice(&s.buttons.to_le_bytes());
-                v
             }
             Packet::Force(f) => {
-                let mut v = header(4);
+                header(v, 4);
                 v.extend_from_slice(&f.seq.to_le_bytes());
                 v.extend_from_slice(&f.tick.to_le_bytes());
                 for x in f.force_n.iter().chain(f.stiffness_n_per_m.iter()) {
                     v.extend_from_slice(&x.to_le_bytes());
                 }
                 v.push(f.status);
-                v
             }
             Packet::Bye { reason } => {
-                let mut v = header(5);
+                header(v, 5);
                 v.push(*reason);
-                v
             }
         }
     }

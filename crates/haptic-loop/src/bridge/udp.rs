@@ -100,6 +100,7 @@ pub struct UdpDevice {
     anchor: Option<(Instant, u64)>,
     generation: u64,
     peer: Option<SocketAddr>,
+    tx: Vec<u8>,
 }
 
 /// Most samples waiting for a tick; older ones are dropped (counted as superseded) so latency
@@ -128,6 +129,7 @@ impl UdpDevice {
             anchor: None,
             generation: 0,
             peer: None,
+            tx: Vec::with_capacity(super::protocol::FORCE_LEN),
         }
     }
 
@@ -390,7 +392,8 @@ impl HapticDevice for UdpDevice {
                 stiffness_n_per_m: cmd.stiffness_n_per_m,
                 status: cmd.status,
             });
-            if sock.send_to(&p.encode(), peer).is_err() {
+            p.encode_into(&mut self.tx);
+            if sock.send_to(&self.tx, peer).is_err() {
                 if let Ok(mut st) = self.shared.state.lock() {
                     st.c.send_errors += 1;
                 }
