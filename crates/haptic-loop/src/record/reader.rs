@@ -86,12 +86,54 @@ pub enum RecordingError {
     },
 }
 
+/// Largest uncompressed chunk accepted, bytes (the writer makes 8 MiB chunks).
+const MAX_CHUNK: u64 = 1 << 30;
+
+/// Walks the file's top-level records (opcode u8, length u64) and refuses a chunk whose
+/// announced uncompressed size is beyond any plausible bound before the MCAP reader allocates
+/// it: a damaged size field is an error naming the byte offset, never an abort. A length that
+/// runs past the end stops the walk (the reader then reports the truncation).
+fn check_chunk_sizes(buf: &[u8]) -> Result<(), RecordingError> {
+    let u64_at = |at: usize| -> Option<u64> {
+        buf.get(at..at + 8)
+            .map(|b| u64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]))
+    };
+    let mut at = 8usize;
+    while let (Some(&op), Some(len)) = (buf.get(at), u64_at(at + 1)) {
+        let body = at + 9;
+        let Some(end) = usize::try_from(len).ok().and_then(|l| body.checked_add(l)) else {
+            return Ok(());
+        };
+        if end > buf.len() {
+            return Ok(());
+        }
+        if op == 0x06 {
+            // Chunk: start u64, end u64, uncompressed size u64, crc u32, compression string,
+            // records length u64, records.
+            let size = u64_at(body + 16).unwrap_or(0);
+            let bound = MAX_CHUNK.min(len.saturating_mul(1000).saturating_add(1 << 20));
+            if size > bound {
+                return Err(RecordingError::Corrupt(format!(
+                    "chunk at byte {at}: uncompressed size {size} bytes is over the bound of \
+                     {bound} bytes for a {len}-byte chunk (a damaged size field)"
+                )));
+            }
+        }
+        if op == 0x02 {
+            return Ok(()); // footer
+        }
+        at = end;
+    }
+    Ok(())
+}
+
 /// Reads a recording from bytes. With `salvage`, a truncated file gives the complete part
 /// (and `truncated` says why it ends); without, it is an error.
 pub fn read_recording(buf: &[u8], salvage: bool) -> Result<Recording, RecordingError> {
     if buf.len() < 8 || &buf[..8] != mcap::MAGIC {
         return Err(RecordingError::NotMcap);
     }
+    check_chunk_sizes(buf)?;
     let flat = ChunkFlattener::new_with_options(buf, Options::ValidateChunkCrcs.into())
         .map_err(|e| RecordingError::Corrupt(e.to_string()))?;
     let mut topics: BTreeMap<u16, Option<Channel>> = BTreeMap::new();
