@@ -200,3 +200,39 @@ def test_trap_waist_and_dt_never_give_nan():
     with pytest.raises(ValueError) as e:
         trap.displacement([[1e-7, 0.0]], (0.0, 0.0), 1e300, method="rk4")
     assert str(e.value).startswith("displacement[0] is not finite: dt = 1e300 s"), str(e.value)
+
+
+# ---------------------------------------------------------------- item 20: long work stops on Ctrl-C
+
+
+def test_a_long_session_stops_on_ctrl_c_with_a_complete_recording(tmp_path):
+    out = tmp_path / "interrupted.mcap"
+    threading.Timer(0.5, _thread.interrupt_main).start()
+    t0 = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        nh.run_scene("wall", seconds=3600.0, out=str(out))
+    assert time.perf_counter() - t0 < 30.0
+    # The session ended after its current tick: the file is complete, not truncated.
+    a = nh.read_recording(str(out))
+    n = len(a["tick"])
+    assert 0 < n < 3_600_000
+    assert np.array_equal(a["tick"], np.arange(n))
+
+
+def test_a_house_script_step_too_small_for_memory_names_the_bound():
+    w = nh.NanoWorld(START)
+    with pytest.raises(ValueError) as e:
+        w.house_script(1e-15)
+    msg = str(e.value)
+    assert msg.startswith("step_m = 1e-15 is out of range for this house: the path is ")
+    assert msg.endswith("<= step_m <= 1e-6 m (at most 10000000 samples)")
+
+
+def test_tick_map_substeps_are_bounded_where_every_call_runs_hundreds_of_flows():
+    trap = nh.paper_trap()
+    with pytest.raises(ValueError) as e:
+        nh.working_envelope(trap, (0.0, 0.0), nh.PAPER_DT, substeps=10_000_000)
+    assert str(e.value) == "substeps = 10000000 is out of range: allowed 1 ..= 10000"
+    # One flow may take many more (displacement is one flow per offset).
+    d = trap.displacement([(0.0, 0.0)], (0.0, 0.0), nh.PAPER_DT, method="rk4", substeps=20_000)
+    assert np.all(np.isfinite(d))

@@ -35,6 +35,27 @@ pub enum ParamError {
     },
 }
 
+impl ParamError {
+    /// The dotted path of the offending field (as in the scene's `[brickworld.params]` table).
+    pub fn field(&self) -> &str {
+        match self {
+            ParamError::OutOfRange { field, .. }
+            | ParamError::CountOutOfRange { field, .. }
+            | ParamError::Inconsistent { field, .. } => field,
+        }
+    }
+}
+
+impl WorldError {
+    /// The dotted path of the offending parameter, when a parameter is what was refused.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            WorldError::Param(p) => Some(p.field()),
+            _ => None,
+        }
+    }
+}
+
 /// A cursor sample from a device or script cannot be used.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum InputError {

@@ -41,11 +41,9 @@ fn old_text(text: &str) -> String {
 }
 
 fn session(text: &str, seconds: f64, realtime: bool, tag: &str) -> Result<SessionReport, BoxError> {
-    let mut o = SessionOptions::new(SceneSource {
-        text: text.to_string(),
-        dir: Some(root().join("scenes")),
-        scripts: Vec::new(),
-    });
+    let mut src = SceneSource::from_text(text, "optical_tweezers.toml");
+    src.dir = Some(root().join("scenes"));
+    let mut o = SessionOptions::new(src);
     o.seconds = Some(seconds);
     o.realtime = realtime;
     o.out = Some(std::env::temp_dir().join(format!("ot_tick_{tag}_{}.mcap", std::process::id())));

@@ -42,6 +42,7 @@ pub mod runner;
 pub mod scene;
 pub mod session;
 pub mod stepper;
+pub mod textpos;
 pub mod vec3;
 
 pub use device::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};

@@ -26,12 +26,14 @@ use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions, SessionReport,
-    run_session,
+    run_session, run_session_until,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 #[derive(Parser)]
 #[command(
@@ -196,13 +198,23 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
             )
         })?;
     let model = DeviceModel::from_name(&a.model).map_err(|e| format!("--model: {e}"))?;
-    let text = match &a.script {
-        Some(p) => std::fs::read_to_string(p)
-            .map_err(|e| format!("--script: cannot read {}: {e}", p.display()))?,
-        None => FAKE_SCRIPT.to_string(),
+    let (text, origin) = match &a.script {
+        Some(p) => (
+            haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?,
+            p.display().to_string(),
+        ),
+        None => (
+            FAKE_SCRIPT.to_string(),
+            "built-in fake-device script".into(),
+        ),
     };
-    let script = haptic_loop::device::Script::from_toml(&text, model.specs())
-        .map_err(|e| format!("--script: {e}"))?;
+    let script = haptic_loop::device::Script::from_toml(&text, model.specs()).map_err(|e| {
+        let at = haptic_loop::session::Location {
+            file: origin,
+            at: e.position(&text),
+        };
+        format!("--script: {at}: {e}")
+    })?;
     let hand = match parse_operator(&a.operator)? {
         OperatorChoice::Rigid => None,
         OperatorChoice::Hand(p) => Some(p),
@@ -440,22 +452,26 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
         }
         opts.live = Some(c);
     }
-    opts.script = script
-        .as_deref()
-        .map(|p| {
-            std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))
-        })
-        .transpose()?;
+    if let Some(p) = script.as_deref() {
+        opts.script =
+            Some(haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?);
+        opts.script_origin = Some(p.display().to_string());
+    }
     opts.seconds = seconds;
     opts.realtime = realtime;
     opts.out = out;
     let pb = (!json).then(|| progress_bar(0, "run"));
-    let report = run_session(&opts, &mut |done, total| {
-        if let Some(pb) = &pb {
-            pb.set_length(total);
-            pb.set_position(done);
-        }
-    })
+    let stop = interrupt_flag()?;
+    let report = run_session_until(
+        &opts,
+        &mut |done, total| {
+            if let Some(pb) = &pb {
+                pb.set_length(total);
+                pb.set_position(done);
+            }
+        },
+        Some(&stop),
+    )
     .map_err(|e| e.to_string())?;
     if let Some(pb) = pb {
         pb.finish_and_clear();
@@ -465,7 +481,31 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
     } else {
         print_summary(&report);
     }
+    if report.end == "stopped" {
+        eprintln!(
+            "stopped by an interrupt after {} ticks{}",
+            report.stats.ticks,
+            match &opts.out {
+                Some(p) => format!("; {} holds them, complete and verifiable", p.display()),
+                None => String::new(),
+            }
+        );
+        return Ok(ExitCode::from(130));
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A flag raised by the first Ctrl-C (SIGINT) or SIGTERM: the session stops cleanly after
+/// the current tick and the recording is finished. A second one ends the program at once.
+fn interrupt_flag() -> Result<Arc<AtomicBool>, String> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let stop = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&stop))
+            .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&stop)))
+            .map_err(|e| format!("cannot watch for Ctrl-C: {e}"))?;
+    }
+    Ok(stop)
 }
 
 fn cmd_replay(rec: &Path, strict: bool, salvage: bool, json: bool) -> Result<ExitCode, String> {

@@ -17,7 +17,9 @@ use render::{Camera, Frame, GifWriter, Image, Palette, Primitive, RenderError, R
 pub struct RenderArgs {
     /// A recording (`.mcap`) or a scene file (`.toml`).
     pub input: PathBuf,
-    /// For a recording: the folder for the PNG frames; for a scene: the PNG file.
+    /// What to write, chosen by the name's extension: `NAME.png` one picture (a scene's
+    /// initial state, a recording's last tick); `NAME.gif` a recording as an animation; a
+    /// name without extension (or an existing folder) a recording's frames as PNG files.
     #[arg(long)]
     pub out: PathBuf,
     /// Draw every N-th tick of a recording (default: tick rate / 30, i.e. 30 frames per second
@@ -27,7 +29,7 @@ pub struct RenderArgs {
     /// Image width, px (height is 3/4 of it). Allowed: 64–4096.
     #[arg(long, default_value_t = 640)]
     pub width: u32,
-    /// Also write the frames of a recording as an animated GIF.
+    /// Also write the frames of a recording as an animated GIF (with `--out FOLDER`).
     #[arg(long)]
     pub gif: Option<PathBuf>,
     /// Camera: top, side or oblique (default: top for a flat world, oblique otherwise).
@@ -51,6 +53,16 @@ pub enum RenderCmdError {
     /// The input is neither `.mcap` nor `.toml`.
     #[error("{0}: expected a recording (.mcap) or a scene file (.toml)")]
     InputKind(PathBuf),
+    /// `--out` names something this input cannot become.
+    #[error("--out {out}: {problem} (allowed: {allowed})")]
+    OutKind {
+        /// The name given.
+        out: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+        /// What the input can become.
+        allowed: &'static str,
+    },
     /// Reading or writing a file.
     #[error("{path}: {source}")]
     Io {
@@ -74,6 +86,9 @@ pub enum RenderCmdError {
     /// Replaying the recording.
     #[error("replay: {0}")]
     Session(String),
+    /// The scene file, with where in it.
+    #[error(transparent)]
+    Input(#[from] haptic_loop::session::SessionError),
 }
 
 /// Text and scale bar colour, light on the dark background the scenes' colours are chosen for
@@ -176,24 +191,101 @@ pub struct RenderSummary {
     pub ticks: u64,
     /// GIF size, bytes (0 without `--gif`).
     pub gif_bytes: u64,
+    /// What was written, one line per file or folder.
+    pub written: Vec<String>,
+}
+
+/// What `--out` names, chosen by its extension.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// A folder of `frame_NNNNN.png` files (a recording).
+    Frames(PathBuf),
+    /// An animated GIF (a recording).
+    Gif(PathBuf),
+    /// One PNG picture: a scene's initial state, a recording's last tick.
+    Png(PathBuf),
+}
+
+const SCENE_OUTPUTS: &str = "NAME.png, the scene's initial state";
+const RECORDING_OUTPUTS: &str = "NAME.gif an animation, NAME.png the last tick, or a folder name without extension for PNG frames";
+
+/// Chooses the output from `out`'s extension for a recording (`recording`) or a scene file.
+pub fn output_for(recording: bool, out: &Path) -> Result<Output, RenderCmdError> {
+    let allowed = if recording {
+        RECORDING_OUTPUTS
+    } else {
+        SCENE_OUTPUTS
+    };
+    let refuse = |problem: String| RenderCmdError::OutKind {
+        out: out.to_path_buf(),
+        problem,
+        allowed,
+    };
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match (ext.as_deref(), recording) {
+        (Some("png"), _) => Ok(Output::Png(out.to_path_buf())),
+        (Some("gif"), true) => Ok(Output::Gif(out.to_path_buf())),
+        (Some("gif"), false) => Err(refuse(
+            "a scene file is one picture, not an animation".into(),
+        )),
+        (None, true) => Ok(Output::Frames(out.to_path_buf())),
+        _ if recording && out.is_dir() => Ok(Output::Frames(out.to_path_buf())),
+        (None, false) => Err(refuse("a scene file renders to one PNG picture".into())),
+        (Some(e), _) => Err(refuse(format!("cannot write .{e} files"))),
+    }
 }
 
 /// Runs `nanohaptics render`.
 pub fn run(args: &RenderArgs) -> Result<RenderSummary, RenderCmdError> {
     check_width(args.width)?;
     let view = parse_view(&args.view)?;
-    match args.input.extension().and_then(|e| e.to_str()) {
-        Some("toml") => {
-            scene_picture(&args.input, &args.out, view, args.width)?;
+    let recording = match args.input.extension().and_then(|e| e.to_str()) {
+        Some("toml") => false,
+        Some("mcap") => true,
+        _ => return Err(RenderCmdError::InputKind(args.input.clone())),
+    };
+    let output = output_for(recording, &args.out)?;
+    if args.gif.is_some() && !matches!(output, Output::Frames(_)) {
+        return Err(RenderCmdError::OutKind {
+            out: args.out.clone(),
+            problem: "--gif adds an animation to a folder of frames only".into(),
+            allowed: if recording {
+                RECORDING_OUTPUTS
+            } else {
+                SCENE_OUTPUTS
+            },
+        });
+    }
+    match output {
+        Output::Png(png) if !recording => {
+            scene_picture(&args.input, &png, view, args.width)?;
             Ok(RenderSummary {
                 frames: 1,
                 ticks: 0,
                 gif_bytes: 0,
+                written: vec![written_file("PNG picture (initial state)", &png)],
             })
         }
-        Some("mcap") => recording_frames(args, view),
-        _ => Err(RenderCmdError::InputKind(args.input.clone())),
+        Output::Png(png) => {
+            let ticks = final_picture_view(&args.input, &png, view, args.width)?;
+            Ok(RenderSummary {
+                frames: 1,
+                ticks,
+                gif_bytes: 0,
+                written: vec![written_file("PNG picture (last tick)", &png)],
+            })
+        }
+        Output::Frames(dir) => recording_frames(args, view, Some(dir), args.gif.clone()),
+        Output::Gif(gif) => recording_frames(args, view, None, Some(gif)),
     }
+}
+
+/// `what path (N bytes)`, for the summary.
+fn written_file(what: &str, path: &Path) -> String {
+    let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    format!("{what} {} ({bytes} bytes)", path.display())
 }
 
 /// Draws a scene file's initial state into a PNG.
@@ -203,11 +295,8 @@ pub fn scene_picture(
     view: Option<View>,
     width: u32,
 ) -> Result<(), RenderCmdError> {
-    let text = std::fs::read_to_string(scene_path).map_err(|source| RenderCmdError::Io {
-        path: scene_path.to_path_buf(),
-        source,
-    })?;
-    let loaded = load_scene(&text, None)?;
+    let source = haptic_loop::session::SceneSource::from_path(scene_path)?;
+    let loaded = load_scene(&source.text, None).map_err(|e| source.locate(e))?;
     let mut prims = Vec::new();
     loaded.scene.draw(&mut prims);
     let rp: Vec<Primitive> = prims.clone();
@@ -227,6 +316,8 @@ pub fn scene_picture(
 /// `out/frame_NNNNN.png` and, when asked, an animated GIF.
 struct FramesSink<'a> {
     args: &'a RenderArgs,
+    frames_dir: Option<PathBuf>,
+    gif_path: Option<PathBuf>,
     view: Option<View>,
     every: u64,
     rate: u64,
@@ -254,8 +345,10 @@ impl FramesSink<'_> {
         };
         draw(f, scene, &mut self.prims, &title)?;
         f.draw_into(im)?;
-        im.save_png(self.args.out.join(format!("frame_{:05}.png", self.frames)))?;
-        if let Some(path) = &self.args.gif {
+        if let Some(dir) = &self.frames_dir {
+            im.save_png(dir.join(format!("frame_{:05}.png", self.frames)))?;
+        }
+        if let Some(path) = &self.gif_path {
             if self.gif.is_none() {
                 let file = std::fs::File::create(path).map_err(|source| RenderCmdError::Io {
                     path: path.clone(),
@@ -322,10 +415,12 @@ fn replay_into(
 }
 
 /// Recomputes a recording from its inputs and draws every `every`-th tick into
-/// `out/frame_NNNNN.png` (and a GIF when asked).
+/// `frames_dir/frame_NNNNN.png` and/or the GIF `gif_path`.
 fn recording_frames(
     args: &RenderArgs,
     view: Option<View>,
+    frames_dir: Option<PathBuf>,
+    gif_path: Option<PathBuf>,
 ) -> Result<RenderSummary, RenderCmdError> {
     let rec = read_recording_file(&args.input, false)?;
     let d = &rec.description;
@@ -334,23 +429,27 @@ fn recording_frames(
     let rate = u64::from(config.rate_hz);
     let every = args.every.unwrap_or((rate / 30).max(1));
     let min_every = rate.div_ceil(50).max(1);
-    if every == 0 || (args.gif.is_some() && every < min_every) {
+    if every == 0 || (gif_path.is_some() && every < min_every) {
         return Err(RenderCmdError::Arg {
             flag: "every",
             value: every.to_string(),
-            allowed: if args.gif.is_some() {
+            allowed: if gif_path.is_some() {
                 format!("{min_every} or more ticks (a GIF plays at most 50 frames/s)")
             } else {
                 "1 or more ticks".into()
             },
         });
     }
-    std::fs::create_dir_all(&args.out).map_err(|source| RenderCmdError::Io {
-        path: args.out.clone(),
-        source,
-    })?;
+    if let Some(dir) = &frames_dir {
+        std::fs::create_dir_all(dir).map_err(|source| RenderCmdError::Io {
+            path: dir.clone(),
+            source,
+        })?;
+    }
     let mut sink = FramesSink {
         args,
+        frames_dir: frames_dir.clone(),
+        gif_path: gif_path.clone(),
         view,
         every,
         rate,
@@ -365,7 +464,11 @@ fn recording_frames(
     let (_, ticks) = replay_into(&rec, vec![&mut sink])?;
     let frames = sink.frames;
     let mut gif_bytes = 0;
-    if let (Some(g), Some(path)) = (sink.gif.take(), &args.gif) {
+    let mut written = Vec::new();
+    if let Some(dir) = &frames_dir {
+        written.push(format!("{frames} PNG frames in {}", dir.display()));
+    }
+    if let (Some(g), Some(path)) = (sink.gif.take(), &gif_path) {
         let mut w = g.finish()?;
         std::io::Write::flush(&mut w).map_err(|source| RenderCmdError::Io {
             path: path.clone(),
@@ -373,16 +476,31 @@ fn recording_frames(
         })?;
         drop(w);
         gif_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+        written.push(format!(
+            "GIF animation {} ({frames} frames, {gif_bytes} bytes)",
+            path.display()
+        ));
     }
     Ok(RenderSummary {
         frames,
         ticks,
         gif_bytes,
+        written,
     })
 }
 
 /// Recomputes a recording and draws its last tick into a PNG (the `demo` picture of a scene).
 pub fn final_picture(rec_path: &Path, out: &Path, width: u32) -> Result<(), RenderCmdError> {
+    final_picture_view(rec_path, out, None, width).map(|_| ())
+}
+
+/// [`final_picture`] with a camera choice; returns the ticks recomputed.
+fn final_picture_view(
+    rec_path: &Path,
+    out: &Path,
+    view: Option<View>,
+    width: u32,
+) -> Result<u64, RenderCmdError> {
     check_width(width)?;
     let rec = read_recording_file(rec_path, false)?;
     let d = &rec.description;
@@ -393,7 +511,7 @@ pub fn final_picture(rec_path: &Path, out: &Path, width: u32) -> Result<(), Rend
     loaded.scene.draw(&mut prims);
     let first: Vec<Primitive> = prims.clone();
     let (lp, ticks) = replay_into(&rec, Vec::new())?;
-    let cam = camera_for(&first, &cursor_path(&rec, &config)?, None, width)?;
+    let cam = camera_for(&first, &cursor_path(&rec, &config)?, view, width)?;
     let mut frame = Frame::new(cam, style())?;
     let t = ticks as f64 / f64::from(config.rate_hz);
     draw(
@@ -403,26 +521,17 @@ pub fn final_picture(rec_path: &Path, out: &Path, width: u32) -> Result<(), Rend
         &format!("{kind}  t = {t:.3} s (end of recording)"),
     )?;
     frame.finish()?.save_png(out)?;
-    Ok(())
+    Ok(ticks)
 }
 
 /// `nanohaptics render` as the program runs it: prints what was written.
 pub fn cmd(args: &RenderArgs) -> Result<std::process::ExitCode, String> {
     let s = run(args).map_err(|e| e.to_string())?;
-    if s.ticks == 0 {
-        println!("{} -> {}", args.input.display(), args.out.display());
-    } else {
-        println!(
-            "{}: {} ticks recomputed, {} frames -> {}{}",
-            args.input.display(),
-            s.ticks,
-            s.frames,
-            args.out.display(),
-            match &args.gif {
-                Some(g) => format!(", GIF {} ({} bytes)", g.display(), s.gif_bytes),
-                None => String::new(),
-            }
-        );
+    if s.ticks > 0 {
+        println!("{}: {} ticks recomputed", args.input.display(), s.ticks);
+    }
+    for w in &s.written {
+        println!("wrote {w}");
     }
     Ok(std::process::ExitCode::SUCCESS)
 }
@@ -490,5 +599,71 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert_eq!(e, "--width = 10 is out of range: allowed 64–4096 px");
+    }
+
+    #[test]
+    fn the_out_extension_chooses_the_format() {
+        let scene = |o: &str| output_for(false, Path::new(o)).map_err(|e| e.to_string());
+        let rec = |o: &str| output_for(true, Path::new(o)).map_err(|e| e.to_string());
+        assert_eq!(rec("a/wall.gif"), Ok(Output::Gif("a/wall.gif".into())));
+        assert_eq!(rec("wall.PNG"), Ok(Output::Png("wall.PNG".into())));
+        assert_eq!(rec("frames"), Ok(Output::Frames("frames".into())));
+        assert_eq!(scene("wall.png"), Ok(Output::Png("wall.png".into())));
+        assert_eq!(
+            scene("x.gif").unwrap_err(),
+            "--out x.gif: a scene file is one picture, not an animation \
+             (allowed: NAME.png, the scene's initial state)"
+        );
+        assert_eq!(
+            scene("pics").unwrap_err(),
+            "--out pics: a scene file renders to one PNG picture \
+             (allowed: NAME.png, the scene's initial state)"
+        );
+        assert_eq!(
+            rec("wall.jpg").unwrap_err(),
+            "--out wall.jpg: cannot write .jpg files (allowed: NAME.gif an animation, NAME.png \
+             the last tick, or a folder name without extension for PNG frames)"
+        );
+    }
+
+    #[test]
+    fn a_recording_becomes_the_file_its_name_says() {
+        let dir = std::env::temp_dir().join(format!("nanohaptics-out-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let base = RenderArgs {
+            input: root().join("recordings/wall.mcap"),
+            out: dir.join("wall.gif"),
+            every: Some(200),
+            width: 160,
+            gif: None,
+            view: None,
+        };
+        let s = run(&base).expect("gif");
+        let gif = std::fs::read(dir.join("wall.gif")).expect("gif written");
+        assert_eq!(&gif[..6], b"GIF89a");
+        assert_eq!(s.frames, s.ticks.div_ceil(200));
+        assert_eq!(s.written.len(), 1, "only the GIF: {:?}", s.written);
+        assert!(
+            s.written[0].starts_with("GIF animation"),
+            "{}",
+            s.written[0]
+        );
+        let png = dir.join("end.png");
+        let s = run(&RenderArgs {
+            out: png.clone(),
+            ..base
+        })
+        .expect("png");
+        let bytes = std::fs::read(&png).expect("png written");
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        assert!(png.is_file());
+        assert!(
+            s.written[0].starts_with("PNG picture (last tick)"),
+            "{}",
+            s.written[0]
+        );
+        // Only the two files: no folder of frames appeared.
+        assert_eq!(std::fs::read_dir(&dir).expect("dir").count(), 2);
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -24,6 +24,8 @@ use crate::record::writer::RecordError;
 use crate::record::{RecordingError, WriteSummary};
 use crate::runner::{EndReason, Pacing, Runner, Sink};
 use crate::scene::{SceneError, SceneFile, load_scene_for};
+pub use crate::textpos::Location;
+use crate::textpos::field_position;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -33,12 +35,44 @@ pub use crate::record::sink::stats_metadata;
 /// Errors of a session.
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
-    /// The scene file.
+    /// The scene (one without a file: the copy inside a recording, a built-in table).
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// The script.
+    /// The script (one without a file).
     #[error(transparent)]
     Script(#[from] ScriptError),
+    /// An error in a scene file, with where it is.
+    #[error("{at}: {error}")]
+    SceneFile {
+        /// File and, when known, line and column.
+        at: Location,
+        /// What is wrong.
+        error: Box<SceneError>,
+    },
+    /// An error in a script file, with where it is.
+    #[error("{at}: {error}")]
+    ScriptFile {
+        /// File and, when known, line and column.
+        at: Location,
+        /// What is wrong.
+        error: Box<ScriptError>,
+    },
+    /// The scene's default script cannot be read.
+    #[error(
+        "{at}: `scene.default_script` = \"{script}\": cannot read {path}: {message} (pass \
+         --script FILE, or keep the script next to the scene; `nanohaptics scenes export DIR` \
+         writes the built-in scenes with their scripts)"
+    )]
+    DefaultScript {
+        /// The scene file and the field's line and column.
+        at: Location,
+        /// The file name the scene gives.
+        script: String,
+        /// Where it was looked for.
+        path: String,
+        /// OS error.
+        message: String,
+    },
     /// The device.
     #[error("device: {0}")]
     Device(#[from] DeviceError),
@@ -62,6 +96,19 @@ pub enum SessionError {
     /// Session length out of range.
     #[error("session length {0} s is out of range (allowed: 0 < seconds ≤ 3600)")]
     Seconds(f64),
+    /// A session shorter than one tick.
+    #[error(
+        "session length {seconds} s is shorter than one tick ({} ms at {rate_hz} Hz): allowed \
+         {} ≤ seconds ≤ 3600",
+        1e3 / f64::from(*rate_hz),
+        0.5 / f64::from(*rate_hz)
+    )]
+    TooShort {
+        /// The length asked for, s.
+        seconds: f64,
+        /// The loop rate, Hz.
+        rate_hz: u32,
+    },
     /// A scene reported a state field name that cannot be a message field.
     #[error("scene state field `{0}` is not a lower-snake-case field name")]
     StateField(String),
@@ -78,6 +125,8 @@ pub enum SessionError {
 pub struct SceneSource {
     /// TOML text.
     pub text: String,
+    /// Where the text came from, as errors name it: the path, or `built-in NAME`.
+    pub origin: String,
     /// Folder for relative paths in the file.
     pub dir: Option<PathBuf>,
     /// Scripts that come with the scene (a built-in scene's default script), file name → text;
@@ -85,21 +134,66 @@ pub struct SceneSource {
     pub scripts: Vec<(String, String)>,
 }
 
-fn read(path: &Path) -> Result<String, SessionError> {
-    std::fs::read_to_string(path).map_err(|e| SessionError::Io {
+/// Reads a TOML text file; a recording or other binary file is named as such.
+pub fn read_toml_text(path: &Path) -> Result<String, SessionError> {
+    let io = |message: String| SessionError::Io {
         path: path.display().to_string(),
-        message: e.to_string(),
+        message,
+    };
+    let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
+    if bytes.starts_with(mcap::MAGIC) {
+        return Err(io(
+            "this is an MCAP recording, not a TOML file (recordings are for \
+             `nanohaptics replay`, `info` and `render`)"
+                .into(),
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let ok = e.utf8_error().valid_up_to();
+        let text = String::from_utf8_lossy(&e.as_bytes()[..ok]).into_owned();
+        let at = crate::textpos::position(&text, ok);
+        io(format!(
+            "not UTF-8 text: byte {ok} (line {}, column {}) is not valid UTF-8 (a TOML file is text)",
+            at.line, at.column
+        ))
     })
 }
 
 impl SceneSource {
+    /// A scene from its TOML text; `origin` names it in errors (a path, `built-in wall`).
+    pub fn from_text(text: impl Into<String>, origin: impl Into<String>) -> Self {
+        SceneSource {
+            text: text.into(),
+            origin: origin.into(),
+            dir: None,
+            scripts: Vec::new(),
+        }
+    }
+
     /// Reads a scene file.
     pub fn from_path(path: &Path) -> Result<Self, SessionError> {
         Ok(SceneSource {
-            text: read(path)?,
+            text: read_toml_text(path)?,
+            origin: path.display().to_string(),
             dir: path.parent().map(Path::to_path_buf),
             scripts: Vec::new(),
         })
+    }
+
+    /// `error`, located in this scene's text: `file:line:column: message`.
+    pub fn locate(&self, error: SceneError) -> SessionError {
+        SessionError::SceneFile {
+            at: Location {
+                file: self.origin.clone(),
+                at: error.position(&self.text),
+            },
+            error: Box::new(error),
+        }
+    }
+
+    /// Parses the scene's text, errors located.
+    pub fn parse(&self) -> Result<SceneFile, SessionError> {
+        SceneFile::parse(&self.text).map_err(|e| self.locate(e))
     }
 
     /// A scene file on disk, or else a built-in scene by name (`wall`, `wall.toml`): files on
@@ -119,6 +213,7 @@ impl SceneSource {
         match crate::builtin::find(&name) {
             Some(b) if parent_ok => Ok(SceneSource {
                 text: b.scene.to_string(),
+                origin: format!("built-in {}", b.name),
                 dir: None,
                 scripts: vec![(b.script_file.to_string(), b.script.to_string())],
             }),
@@ -152,6 +247,8 @@ pub struct SessionOptions {
     pub scene: SceneSource,
     /// Script text; `None`: the scene's default script (local devices only).
     pub script: Option<String>,
+    /// Where `script` came from, as errors name it (a path); `None`: `script`.
+    pub script_origin: Option<String>,
     /// Device model overriding the scene file's (local devices only: a bridged device announces
     /// its own specifications).
     pub device: Option<DeviceModel>,
@@ -183,6 +280,7 @@ impl SessionOptions {
         SessionOptions {
             scene,
             script: None,
+            script_origin: None,
             device: None,
             operator: OperatorChoice::ScriptHand,
             bridge: None,
@@ -217,26 +315,61 @@ pub struct SessionReport {
     pub sinks: Vec<crate::runner::SinkTime>,
 }
 
-/// Reads the script text for a local device: the given one or the scene's default script.
-fn script_text(opts: &SessionOptions, file: &SceneFile) -> Result<String, SessionError> {
-    match &opts.script {
-        Some(t) => Ok(t.clone()),
+/// Reads the script text for a local device (the given one or the scene's default script)
+/// and parses it; errors name the file, line and column.
+fn load_script(
+    opts: &SessionOptions,
+    file: &SceneFile,
+    specs: &crate::device::DeviceSpecs,
+) -> Result<(Script, String), SessionError> {
+    let (text, origin) = match &opts.script {
+        Some(t) => (
+            t.clone(),
+            opts.script_origin
+                .clone()
+                .unwrap_or_else(|| "script".into()),
+        ),
         None => {
             let rel = file
                 .scene
                 .default_script
                 .as_ref()
                 .ok_or(SessionError::NoScript)?;
-            if let Some((_, text)) = opts.scene.scripts.iter().find(|(n, _)| n == rel) {
-                return Ok(text.clone());
+            match opts.scene.scripts.iter().find(|(n, _)| n == rel) {
+                Some((name, text)) => (text.clone(), format!("built-in {name}")),
+                None => {
+                    let p = match &opts.scene.dir {
+                        Some(d) => d.join(rel),
+                        None => PathBuf::from(rel),
+                    };
+                    let text = match read_toml_text(&p) {
+                        Ok(t) => t,
+                        Err(SessionError::Io { path, message }) => {
+                            return Err(SessionError::DefaultScript {
+                                at: Location {
+                                    file: opts.scene.origin.clone(),
+                                    at: field_position(&opts.scene.text, "scene.default_script"),
+                                },
+                                script: rel.clone(),
+                                path,
+                                message,
+                            });
+                        }
+                        Err(e) => return Err(e),
+                    };
+                    (text, p.display().to_string())
+                }
             }
-            let p = match &opts.scene.dir {
-                Some(d) => d.join(rel),
-                None => PathBuf::from(rel),
-            };
-            read(&p)
         }
-    }
+    };
+    let script = Script::from_toml(&text, specs).map_err(|error| SessionError::ScriptFile {
+        at: Location {
+            at: error.position(&text),
+            file: origin,
+        },
+        error: Box::new(error),
+    })?;
+    Ok((script, text))
 }
 
 /// Wall-clock time now, ns since the Unix epoch (information only: it never reaches the
@@ -253,7 +386,11 @@ pub fn ticks_for(seconds: f64, rate_hz: u32) -> Result<u64, SessionError> {
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
         return Err(SessionError::Seconds(seconds));
     }
-    Ok((seconds * f64::from(rate_hz)).round() as u64)
+    let ticks = (seconds * f64::from(rate_hz)).round() as u64;
+    if ticks == 0 {
+        return Err(SessionError::TooShort { seconds, rate_hz });
+    }
+    Ok(ticks)
 }
 
 /// Runs a session (see the module example); `stop` ends it cleanly after the current tick.
@@ -262,14 +399,13 @@ pub fn run_session_until(
     progress: &mut dyn FnMut(u64, u64),
     stop: Option<&AtomicBool>,
 ) -> Result<SessionReport, SessionError> {
-    let file = SceneFile::parse(&opts.scene.text)?;
+    let file = opts.scene.parse()?;
     // 1. The device source: a script (rigid or through a simulated hand) or a bridged device.
     let (source, script) = match &opts.bridge {
         Some(b) => (DeviceSource::Udp(b.clone()), None),
         None => {
             let model = opts.device.unwrap_or(file.device.model);
-            let text = script_text(opts, &file)?;
-            let script = Script::from_toml(&text, model.specs())?;
+            let (script, text) = load_script(opts, &file, model.specs())?;
             let source = match &opts.operator {
                 OperatorChoice::Rigid => DeviceSource::Script(model),
                 OperatorChoice::Hand(p) => {
@@ -312,7 +448,8 @@ fn run_with_device(
 ) -> Result<SessionReport, SessionError> {
     dev.open()?;
     let specs = dev.specs().clone();
-    let loaded = load_scene_for(&opts.scene.text, specs.clone())?;
+    let loaded =
+        load_scene_for(&opts.scene.text, specs.clone()).map_err(|e| opts.scene.locate(e))?;
     let rate = loaded.config.rate_hz;
     let ticks = match (opts.seconds, &script) {
         (Some(s), _) => Some(ticks_for(s, rate)?),

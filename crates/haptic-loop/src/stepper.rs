@@ -26,7 +26,7 @@ use crate::record::WriteSummary;
 use crate::record::messages::{self, DescriptionMsg};
 use crate::record::sink::RecorderSink;
 use crate::runner::{SessionInfo, Sink, TickView, deliver};
-use crate::scene::{SceneFile, load_scene};
+use crate::scene::load_scene;
 use crate::session::{SceneSource, SessionError, now_unix_ns};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -88,9 +88,9 @@ pub struct Stepper {
 impl Stepper {
     /// Builds the scene and starts the sinks (the recording file is created now).
     pub fn new(opts: StepperOptions) -> Result<Self, SessionError> {
-        let file = SceneFile::parse(&opts.scene.text)?;
+        let file = opts.scene.parse()?;
         let model = opts.device.unwrap_or(file.device.model);
-        let loaded = load_scene(&opts.scene.text, Some(model))?;
+        let loaded = load_scene(&opts.scene.text, Some(model)).map_err(|e| opts.scene.locate(e))?;
         let fields = loaded.scene.state_fields();
         if let Some(bad) = fields.iter().find(|f| !messages::valid_field_name(f)) {
             return Err(SessionError::StateField(bad.clone()));

@@ -121,7 +121,11 @@ fn bad_input_is_an_error_naming_the_field() {
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(
         String::from_utf8_lossy(&o.stderr).trim(),
-        "error: scene: `loop.engage_s` = -1 is out of range (allowed: 0 ≤ loop.engage_s ≤ 10)"
+        format!(
+            "error: {}:6:10: scene: `loop.engage_s` = -1 is out of range (allowed: 0 ≤ \
+             loop.engage_s ≤ 10)",
+            scene.display()
+        )
     );
     let o = nh(&["run", "scenes/wall.toml", "--operator", "hand:mass_kg=-2"]);
     assert_eq!(
@@ -294,5 +298,169 @@ fn builtin_scenes_work_from_any_directory_and_exported_copies_override_them() {
         "error: cannot read moon: no such file, and not a built-in scene (built-in: brickworld, \
          nanoworld, optical_tweezers, optical_tweezers_10khz, wall; `nanohaptics scenes export \
          DIR` writes editable copies)"
+    );
+}
+
+/// Runs the program in `dir` and returns its error line (exit code 1 asserted).
+fn error_in(dir: &Path, args: &[&str]) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{args:?} should fail");
+    String::from_utf8_lossy(&o.stderr).trim().to_string()
+}
+
+#[test]
+fn file_errors_say_file_line_column_and_what_was_expected() {
+    let dir = tmp("located");
+    std::fs::create_dir_all(&dir).unwrap();
+    let w = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+    // TOML syntax: the reader's own position.
+    w("bad.toml", "garbage = [\n");
+    assert_eq!(
+        error_in(&dir, &["run", "bad.toml"]),
+        "error: bad.toml:1:12: scene: unclosed array, expected `]`"
+    );
+    // A range error: the field's value.
+    let wall = std::fs::read_to_string(root().join("scenes/wall.toml")).unwrap();
+    let line = wall
+        .lines()
+        .position(|l| l.starts_with("stiffness_n_per_m"))
+        .unwrap()
+        + 1;
+    w(
+        "w.toml",
+        &wall.replacen("stiffness_n_per_m = ", "stiffness_n_per_m = -", 1),
+    );
+    w(
+        "wall.script.toml",
+        &std::fs::read_to_string(root().join("scenes/wall.script.toml")).unwrap(),
+    );
+    assert_eq!(
+        error_in(&dir, &["run", "w.toml"]),
+        format!(
+            "error: w.toml:{line}:21: scene: `wall.stiffness_n_per_m` = -5000 is out of range \
+             (allowed: 0 < wall.stiffness_n_per_m ≤ 1e12)"
+        )
+    );
+    // A world's own parameter check, located in the world's table.
+    w(
+        "b.toml",
+        &std::fs::read_to_string(root().join("scenes/brickworld.toml"))
+            .unwrap()
+            .replacen(
+                "position_tolerance_m = 0.01",
+                "position_tolerance_m = -0.01",
+                1,
+            ),
+    );
+    let e = error_in(&dir, &["run", "b.toml", "--script", "wall.script.toml"]);
+    assert!(
+        e.starts_with("error: b.toml:")
+            && e.ends_with(
+                "scene: brickworld.params: parameter `blueprint.position_tolerance_m` = -0.01 \
+                 is out of range: allowed (0, 1]"
+            ),
+        "{e}"
+    );
+    // Scripts: unknown field, and a range error in the second waypoint.
+    w("s2.toml", "[script]\nname=\"x\"\nspeed=3\n");
+    assert_eq!(
+        error_in(&dir, &["run", "wall", "--script", "s2.toml"]),
+        "error: s2.toml:3:1: script: unknown field `speed`, expected one of `name`, \
+         `duration_s`, `operator`"
+    );
+    w(
+        "s3.toml",
+        "[script]\nname=\"x\"\n[[waypoint]]\nt_s=0.0\nposition_mm=[0.0,0.0,0.0]\n[[waypoint]]\n\
+         t_s=-0.8\nposition_mm=[0.0,0.0,0.0]\n",
+    );
+    assert_eq!(
+        error_in(&dir, &["run", "wall", "--script", "s3.toml"]),
+        "error: s3.toml:7:5: script: `waypoint[1].t_s` = -0.8 is out of range (allowed: 0 ≤ \
+         t_s ≤ 3600)"
+    );
+    // A recording or binary file given as a scene.
+    let wall_rec = root().join("recordings/wall.mcap");
+    assert_eq!(
+        error_in(&dir, &["run", wall_rec.to_str().unwrap()]),
+        format!(
+            "error: cannot read {}: this is an MCAP recording, not a TOML file (recordings are \
+             for `nanohaptics replay`, `info` and `render`)",
+            wall_rec.display()
+        )
+    );
+    std::fs::write(dir.join("bin.toml"), b"a = 1\n\xff\xfe").unwrap();
+    assert_eq!(
+        error_in(&dir, &["run", "bin.toml"]),
+        "error: cannot read bin.toml: not UTF-8 text: byte 6 (line 2, column 1) is not valid \
+         UTF-8 (a TOML file is text)"
+    );
+    // A scene copied without its default script.
+    std::fs::create_dir_all(dir.join("alone")).unwrap();
+    std::fs::write(dir.join("alone/wall.toml"), &wall).unwrap();
+    let line = wall
+        .lines()
+        .position(|l| l.starts_with("default_script"))
+        .unwrap()
+        + 1;
+    assert_eq!(
+        error_in(&dir, &["run", "alone/wall.toml"]),
+        format!(
+            "error: alone/wall.toml:{line}:18: `scene.default_script` = \"wall.script.toml\": \
+             cannot read alone/wall.script.toml: No such file or directory (os error 2) (pass \
+             --script FILE, or keep the script next to the scene; `nanohaptics scenes export \
+             DIR` writes the built-in scenes with their scripts)"
+        )
+    );
+}
+
+#[test]
+fn a_session_shorter_than_one_tick_is_refused() {
+    assert_eq!(
+        error_in(&root(), &["run", "wall", "--seconds", "0.0004"]),
+        "error: session length 0.0004 s is shorter than one tick (1 ms at 1000 Hz): allowed \
+         0.0005 ≤ seconds ≤ 3600"
+    );
+    // Half a tick rounds to one tick.
+    let run = json(&nh(&["run", "wall", "--seconds", "0.0005", "--json"]));
+    assert_eq!(run["ticks"], 1);
+}
+
+/// Long work can be interrupted: Ctrl-C (SIGINT) stops a session after the current tick, the
+/// recording is finished (not truncated) and verifies, and the exit code is 130.
+#[test]
+fn ctrl_c_stops_a_session_cleanly_with_a_complete_recording() {
+    let rec = tmp("interrupted.mcap");
+    let child = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args(["run", "wall", "--seconds", "3600", "--realtime", "--out"])
+        .arg(&rec)
+        .current_dir(root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let k = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(k.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130));
+    let r = haptic_loop::record::read_recording_file(&rec, false).expect("a complete file");
+    let v = haptic_loop::replay::verify(&r).unwrap();
+    assert!(v.ok());
+    assert!(v.ticks > 0 && v.ticks < 3_600_000, "{} ticks", v.ticks);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "stopped by an interrupt after {} ticks; {} holds them, complete and verifiable",
+            v.ticks,
+            rec.display()
+        )),
+        "{err}"
     );
 }

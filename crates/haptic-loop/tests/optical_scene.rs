@@ -103,11 +103,7 @@ fn feedback_keeps_the_cursor_near_the_particle() {
         } else {
             text.replace("feedback = true", "feedback = false")
         };
-        let mut o = SessionOptions::new(SceneSource {
-            text: t,
-            dir: None,
-            scripts: Vec::new(),
-        });
+        let mut o = SessionOptions::new(SceneSource::from_text(t, "optical_tweezers.toml"));
         o.script = Some(drag.to_string());
         o.operator = OperatorChoice::Hand(op);
         let a = run_session(&o, &mut |_, _| {}).unwrap().arrays;

@@ -24,6 +24,14 @@ pub enum ParamError {
 }
 
 impl ParamError {
+    /// The dotted path of the offending field (as in the scene's `[nanoworld.params]` table).
+    pub fn field(&self) -> &str {
+        match self {
+            ParamError::OutOfRange { field, .. } => field,
+            ParamError::NotChangeableAtRunTime { field } => field,
+        }
+    }
+
     pub(crate) fn range(field: impl Into<String>, value: f64, allowed: impl Into<String>) -> Self {
         Self::OutOfRange {
             field: field.into(),

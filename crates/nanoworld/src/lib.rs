@@ -56,7 +56,9 @@ pub use params::{
     AtomParams, GamePair, GameParams, HouseParams, Interaction, LoadingZone, MAX_MOVABLE_ATOMS,
     MAX_SUBSTRATE_ATOMS, Pairs, Params, PhysicalParams, SubstrateParams, TipParams,
 };
-pub use script::{ScriptError, house_script, house_waypoints, polyline};
+pub use script::{
+    MAX_SCRIPT_SAMPLES, ScriptError, house_script, house_waypoints, polyline, polyline_len,
+};
 pub use substrate::Substrate;
 pub use view::{BodyContact, BodyKind, BodyView};
 pub use world::{

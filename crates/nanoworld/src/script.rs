@@ -26,6 +26,35 @@ pub enum ScriptError {
     /// `step_m` is not a positive finite length.
     #[error("step_m = {0:e} is out of range: allowed 0 < step_m <= 1e-6 m")]
     BadStep(f64),
+    /// `step_m` is so small that the script would exceed [`MAX_SCRIPT_SAMPLES`].
+    #[error(
+        "step_m = {step_m:e} is out of range for this house: the path is {path_m:e} m long, \
+         so allowed {min_step_m:e} <= step_m <= 1e-6 m (at most {max} samples)",
+        max = MAX_SCRIPT_SAMPLES
+    )]
+    TooManySamples {
+        /// The step asked for, m.
+        step_m: f64,
+        /// The path's length, m.
+        path_m: f64,
+        /// The smallest step this path allows, m.
+        min_step_m: f64,
+    },
+}
+
+/// The most cursor samples a planned script may hold (10^7 samples, 240 MB: about 2.8 hours
+/// of a 1 kHz session).
+pub const MAX_SCRIPT_SAMPLES: usize = 10_000_000;
+
+/// How many samples [`polyline`] makes for `points` at `step_m` (without making them).
+pub fn polyline_len(points: &[Vector3<f64>], step_m: f64) -> f64 {
+    if points.is_empty() {
+        return 0.0;
+    }
+    1.0 + points
+        .windows(2)
+        .map(|w| ((w[1] - w[0]).norm() / step_m).ceil().max(1.0))
+        .sum::<f64>()
 }
 
 /// Cursor positions visiting `points` in order along straight lines, at most `step_m`
@@ -109,5 +138,16 @@ pub fn house_script(world: &World, step_m: f64) -> Result<Vec<TipInput>, ScriptE
     if !(step_m.is_finite() && step_m > 0.0 && step_m <= 1e-6) {
         return Err(ScriptError::BadStep(step_m));
     }
-    Ok(polyline(&house_waypoints(world)?, step_m))
+    let pts = house_waypoints(world)?;
+    if polyline_len(&pts, step_m) > MAX_SCRIPT_SAMPLES as f64 {
+        let path_m: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        // Each segment rounds up to whole steps: leave room for one extra sample per segment.
+        let min_step_m = path_m / (MAX_SCRIPT_SAMPLES - pts.len()) as f64;
+        return Err(ScriptError::TooManySamples {
+            step_m,
+            path_m,
+            min_step_m,
+        });
+    }
+    Ok(polyline(&pts, step_m))
 }

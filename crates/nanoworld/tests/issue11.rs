@@ -269,3 +269,29 @@ fn force_at_is_a_pure_probe() {
     assert_eq!(w.tick(), 1);
     assert!(w.force_at(Vector3::new(2.0, 0.0, 0.0)).is_err());
 }
+
+/// Item 20: a house script step so small that the script would not fit in memory is refused
+/// before anything is allocated, naming the smallest step this house allows; that step works.
+#[test]
+fn a_house_script_step_too_small_for_memory_is_refused_with_the_bound() {
+    let w = World::new(Params::game_default(), Vector3::new(4e-9, 4e-9, 4e-9)).expect("valid");
+    let e = nanoworld::house_script(&w, 1e-15).expect_err("1e-15 m steps");
+    let nanoworld::ScriptError::TooManySamples {
+        path_m, min_step_m, ..
+    } = e.clone()
+    else {
+        panic!("{e}");
+    };
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "step_m = 1e-15 is out of range for this house: the path is {path_m:e} m long, so \
+             allowed {min_step_m:e} <= step_m <= 1e-6 m (at most 10000000 samples)"
+        )
+    );
+    let pts = nanoworld::house_waypoints(&w).expect("plannable");
+    assert!(nanoworld::polyline_len(&pts, min_step_m) <= 1e7);
+    let s = nanoworld::house_script(&w, min_step_m).expect("the smallest step allowed");
+    assert!(s.len() <= nanoworld::MAX_SCRIPT_SAMPLES);
+    assert!(s.len() > 9_990_000, "{}", s.len());
+}

@@ -17,6 +17,11 @@ use crate::trap::{GaussianTrap, Model, check_overdamped_velocity, parse_method};
 /// 0.21 nm of converged dynamics at the paper's constants (ot-envelope guide).
 const DEFAULT_RK4_SUBSTEPS: i64 = 8;
 
+/// Most fixed-step substeps for a tick map: an envelope, inverse or steering call runs some
+/// hundreds of flows, so 10^4 RK4 substeps is already about 1 s of work (the error budget
+/// never asks for more than 512).
+const MAX_TICK_MAP_SUBSTEPS: i128 = 10_000;
+
 /// The tick map of a trap: its deterministic model, a method and Δt.
 fn tick<const D: usize>(
     py: Python<'_>,
@@ -31,7 +36,7 @@ fn tick<const D: usize>(
         None if method == "rk4" => Some(&default),
         s => s,
     };
-    let m = parse_method(method, rtol, substeps)?;
+    let m = parse_method(method, rtol, substeps, MAX_TICK_MAP_SUBSTEPS)?;
     Propagator::new(model, m, dt).map_err(value_error)
 }
 

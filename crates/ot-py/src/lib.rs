@@ -21,6 +21,7 @@
 pub mod brick;
 mod convert;
 pub mod envelope;
+mod interrupt;
 mod json;
 pub mod live;
 pub mod nano;

@@ -7,7 +7,7 @@ use haptic_loop::device::OperatorParams;
 use haptic_loop::record::RecordingError;
 use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions, read_arrays,
-    run_session,
+    run_session_until,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -22,9 +22,9 @@ use crate::json::{from_py, to_py};
 /// corrupt recording) as `ValueError`, with the crate's text.
 pub(crate) fn session_error(e: SessionError) -> PyErr {
     match e {
-        SessionError::Io { .. } | SessionError::Recording(RecordingError::Io { .. }) => {
-            PyOSError::new_err(e.to_string())
-        }
+        SessionError::Io { .. }
+        | SessionError::DefaultScript { .. }
+        | SessionError::Recording(RecordingError::Io { .. }) => PyOSError::new_err(e.to_string()),
         other => PyValueError::new_err(other.to_string()),
     }
 }
@@ -185,9 +185,8 @@ pub fn run_scene<'py>(
     let mut opts = SessionOptions::new(source);
     if let Some(s) = script {
         let p = path_arg(s, "script")?;
-        let text = std::fs::read_to_string(&p)
-            .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", p.display())))?;
-        opts.script = Some(text);
+        opts.script = Some(haptic_loop::session::read_toml_text(&p).map_err(session_error)?);
+        opts.script_origin = Some(p.display().to_string());
     }
     opts.seconds = seconds;
     opts.operator = operator_from_py(operator)?;
@@ -202,9 +201,12 @@ pub fn run_scene<'py>(
         Some(o) => Some(path_arg(o, "out")?),
         None => None,
     };
-    let report = py
-        .detach(|| run_session(&opts, &mut |_, _| {}))
-        .map_err(session_error)?;
+    // Ctrl-C stops the session after its current tick (the recording is finished and
+    // verifiable) and raises KeyboardInterrupt.
+    let report = crate::interrupt::interruptible(py, |stop| {
+        run_session_until(&opts, &mut |_, _| {}, Some(stop))
+    })?
+    .map_err(session_error)?;
     let stats = to_py(py, &report.stats)?;
     let link: std::collections::BTreeMap<&str, u64> = report.link.iter().copied().collect();
     stats.set_item("link", to_py(py, &link)?)?;

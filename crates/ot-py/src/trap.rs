@@ -99,16 +99,20 @@ impl GaussianTrap {
     }
 }
 
+/// Most fixed-step substeps for one flow (4e7 force evaluations with RK4, about 1 s).
+pub(crate) const MAX_FLOW_SUBSTEPS: i128 = 10_000_000;
+
 /// Parse an integration method with its options, rejecting options the
 /// method does not use (rather than ignoring them).
 pub(crate) fn parse_method(
     method: &str,
     rtol: Option<f64>,
     substeps: Option<&Bound<'_, PyAny>>,
+    max_substeps: i128,
 ) -> PyResult<Method> {
     let n = match substeps {
         None => None,
-        Some(obj) => Some(int_in(obj, "substeps", 1, 10_000_000)? as u32),
+        Some(obj) => Some(int_in(obj, "substeps", 1, max_substeps)? as u32),
     };
     let m = Method::from_name(method, rtol, n).map_err(value_error)?;
     let adaptive = matches!(m, Method::Adaptive { .. } | Method::Dopri5 { .. });
@@ -447,7 +451,7 @@ impl GaussianTrap {
         rtol: Option<f64>,
         substeps: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Py<PyArray2<f64>>> {
-        let method = parse_method(method, rtol, substeps)?;
+        let method = parse_method(method, rtol, substeps, MAX_FLOW_SUBSTEPS)?;
         with_model!(self.deterministic(), m => displacement_d(py, m, offsets, velocity, dt, method))
     }
 
@@ -470,7 +474,7 @@ impl GaussianTrap {
         rtol: Option<f64>,
         substeps: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let method = parse_method(method, rtol, substeps)?;
+        let method = parse_method(method, rtol, substeps, MAX_FLOW_SUBSTEPS)?;
         with_model!(self.deterministic(), m => flow_jacobian_d(py, m, offsets, velocity, dt, method))
     }
 
@@ -502,7 +506,7 @@ impl GaussianTrap {
         rtol: Option<f64>,
         substeps: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Py<PyTuple>> {
-        let method = parse_method(method, rtol, substeps)?;
+        let method = parse_method(method, rtol, substeps, MAX_FLOW_SUBSTEPS)?;
         let duration = positive(duration, "duration", "s")?;
         let samples = int_in(samples, "samples", 2, 10_000_000)? as usize;
         with_model!(self.deterministic(), m => trajectory_d(py, m, offset, velocity, duration, samples, method))

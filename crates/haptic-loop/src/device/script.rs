@@ -35,9 +35,17 @@ use serde::Deserialize;
 /// Errors in a script file; each names the field and the allowed range.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ScriptError {
-    /// The text is not valid TOML for a script (unknown field, wrong type, ...).
+    /// A value that cannot be read (an `--operator` override that is not `key=value`, ...).
     #[error("script: {0}")]
     Parse(String),
+    /// The text is not valid TOML for a script (unknown field, wrong type, ...).
+    #[error("script: {message}")]
+    Syntax {
+        /// What the TOML reader found wrong and what it expected.
+        message: String,
+        /// Byte offset in the text where it went wrong, when known.
+        offset: Option<usize>,
+    },
     /// A script needs at least one waypoint.
     #[error("script: `waypoint` must list at least one waypoint")]
     NoWaypoints,
@@ -59,6 +67,22 @@ pub enum ScriptError {
         /// The device error naming the allowed buttons.
         source: DeviceError,
     },
+}
+
+impl ScriptError {
+    /// Where in the script's `text` the error is: the TOML reader's position, or the named
+    /// field's value (`None` when neither is known).
+    pub fn position(&self, text: &str) -> Option<crate::textpos::Position> {
+        use crate::textpos::{field_position, position};
+        match self {
+            ScriptError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
+            ScriptError::OutOfRange { field, .. } | ScriptError::Button { field, .. } => {
+                field_position(text, field)
+            }
+            ScriptError::NoWaypoints => field_position(text, "script"),
+            ScriptError::Parse(_) => None,
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -165,7 +189,10 @@ impl Script {
     /// Parses and validates a script for a device with specs `specs`.
     pub fn from_toml(text: &str, specs: &DeviceSpecs) -> Result<Script, ScriptError> {
         let file: ScriptFile =
-            toml::from_str(text).map_err(|e| ScriptError::Parse(e.message().to_string()))?;
+            toml::from_str(text).map_err(|e: toml::de::Error| ScriptError::Syntax {
+                message: e.message().trim().to_string(),
+                offset: e.span().map(|s| s.start),
+            })?;
         if file.waypoint.is_empty() {
             return Err(ScriptError::NoWaypoints);
         }
@@ -442,7 +469,7 @@ down = false
         let bad = S.replace("[script]", "[script]\nspeed = 3");
         assert!(matches!(
             Script::from_toml(&bad, &FALCON),
-            Err(ScriptError::Parse(m)) if m.contains("unknown field `speed`")
+            Err(ScriptError::Syntax { message: m, .. }) if m.contains("unknown field `speed`")
         ));
         let bad = S.replace(
             "position_mm = [0.0, 0.0, 0.0]",

@@ -64,8 +64,11 @@ impl BrickScene {
             max_stiffness_n_m: cap_n_per_m,
             max_force_n: max_force_world_n,
         };
-        let world = World::new(s.params, limits)
-            .map_err(|e| SceneError::Parse(format!("brickworld.params: {e}")))?;
+        let world = World::new(s.params, limits).map_err(|e| SceneError::World {
+            section: "brickworld.params".into(),
+            field: Some(e.field().to_string()),
+            message: e.to_string(),
+        })?;
         let find = |names: &[&str]| {
             names
                 .iter()

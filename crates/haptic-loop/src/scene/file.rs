@@ -36,14 +36,30 @@ use super::optical::{OpticalScene, OtParams};
 use super::wall::{WallParams, WallScene};
 use crate::device::{DeviceModel, DeviceSpecs};
 use crate::haptic::{LoopConfig, Mapping};
+use crate::textpos::{Position, field_position, position};
 use serde::Deserialize;
 
 /// Errors in a scene file.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SceneError {
     /// Not valid TOML for a scene (unknown field, wrong type, missing field, ...).
-    #[error("scene: {0}")]
-    Parse(String),
+    #[error("scene: {message}")]
+    Syntax {
+        /// What the TOML reader found wrong and what it expected.
+        message: String,
+        /// Byte offset in the text where it went wrong, when known.
+        offset: Option<usize>,
+    },
+    /// A world refused its parameters.
+    #[error("scene: {section}: {message}")]
+    World {
+        /// The scene table the world reads, e.g. `nanoworld.params`.
+        section: String,
+        /// The offending field's dotted path inside `section`, when the world names one.
+        field: Option<String>,
+        /// The world's own message (names the field and the allowed range).
+        message: String,
+    },
     /// A number out of its allowed range.
     #[error("scene: `{field}` = {value} is out of range (allowed: {allowed})")]
     OutOfRange {
@@ -70,6 +86,23 @@ pub enum SceneError {
         /// OS error.
         message: String,
     },
+}
+
+impl SceneError {
+    /// Where in the scene's `text` the error is: the TOML reader's position, or the named
+    /// field's value (`None` when neither is known).
+    pub fn position(&self, text: &str) -> Option<Position> {
+        match self {
+            SceneError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
+            SceneError::OutOfRange { field, .. } => field_position(text, field),
+            SceneError::Kind { .. } => field_position(text, "scene.kind"),
+            SceneError::World { section, field, .. } => field
+                .as_ref()
+                .and_then(|f| field_position(text, &format!("{section}.{f}")))
+                .or_else(|| field_position(text, section)),
+            SceneError::Io { .. } => None,
+        }
+    }
 }
 
 /// Builds an out-of-range error.
@@ -254,7 +287,10 @@ pub const KINDS: &[&str] = &["wall", "nanoworld", "brickworld", "optical_tweezer
 impl SceneFile {
     /// Parses a scene file's text (no validation of ranges yet).
     pub fn parse(text: &str) -> Result<SceneFile, SceneError> {
-        toml::from_str(text).map_err(|e| SceneError::Parse(e.message().trim().to_string()))
+        toml::from_str(text).map_err(|e: toml::de::Error| SceneError::Syntax {
+            message: e.message().trim().to_string(),
+            offset: e.span().map(|s| s.start),
+        })
     }
 
     /// Builds the loop configuration for device `model`, checking every common field.

@@ -97,9 +97,11 @@ impl NanoScene {
                 ));
             }
         };
-        params
-            .validate()
-            .map_err(|e| SceneError::Parse(format!("nanoworld.params: {e}")))?;
+        params.validate().map_err(|e| SceneError::World {
+            section: "nanoworld.params".into(),
+            field: Some(e.field().to_string()),
+            message: e.to_string(),
+        })?;
         let (field, k) = max_render_stiffness(&params);
         if k > cap_n_per_m {
             return Err(out_of_range(

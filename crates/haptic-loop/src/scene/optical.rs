@@ -188,10 +188,9 @@ impl OpticalScene {
         let model = TrapModel::builder(p.depth_nj * 1e-9, waists_m)
             .mass(p.mass_g * 1e-3)
             .build()
-            .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
+            .map_err(ot_error)?;
         let dt_s = p.dt_us * 1e-6;
-        let physics =
-            |e: ot_physics::PhysicsError| SceneError::Parse(format!("optical_tweezers: {e}"));
+        let physics = ot_error::<ot_physics::PhysicsError>;
         let (prop, report) = match p.rk4_substeps {
             Some(n) => {
                 let method = Method::Rk4 { substeps: n };
@@ -212,8 +211,7 @@ impl OpticalScene {
             margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
         });
         tick.warm_start = p.warm_start;
-        let controller = TickController::new(tick)
-            .map_err(|e| SceneError::Parse(format!("optical_tweezers: {e}")))?;
+        let controller = TickController::new(tick).map_err(ot_error)?;
         let start = V2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
         Ok(OpticalScene {
             particle_r_m: 0.5 * p.particle_diameter_um * 1e-6,
@@ -426,6 +424,16 @@ impl Scene for OpticalScene {
             ),
             color: Rgba([1.0, 1.0, 1.0, 1.0]),
         });
+    }
+}
+
+/// An optical-tweezers model or steering error as a scene error (located at the
+/// `[optical_tweezers]` table: the model's field names are not the scene's).
+fn ot_error<E: std::fmt::Display>(e: E) -> SceneError {
+    SceneError::World {
+        section: "optical_tweezers".into(),
+        field: None,
+        message: e.to_string(),
     }
 }
 
