@@ -742,6 +742,13 @@ fn cmd_demo(scenes: Option<&Path>, out: &Path, json: bool) -> Result<ExitCode, S
 }
 
 fn main() -> ExitCode {
+    // A closed pipe (`nanohaptics info REC | head`) ends the program quietly with the shell's
+    // status 141, as for any Unix filter, instead of a panic on the next print.
+    let _ = signal_hook::flag::register_conditional_shutdown(
+        signal_hook::consts::SIGPIPE,
+        141,
+        Arc::new(AtomicBool::new(true)),
+    );
     let cli = Cli::parse();
     let res = match cli.cmd {
         Cmd::Run(args) => cmd_run(args),

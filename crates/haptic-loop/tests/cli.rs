@@ -464,3 +464,23 @@ fn ctrl_c_stops_a_session_cleanly_with_a_complete_recording() {
         "{err}"
     );
 }
+
+/// A reader that has closed the pipe (`nanohaptics scenes | head -0`) ends the program
+/// quietly with status 141, as any Unix filter, never with a panic message.
+#[test]
+fn a_closed_pipe_ends_the_program_quietly() {
+    for args in [&["scenes"][..], &["info", "recordings/wall.mcap"]] {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+            .args(args)
+            .current_dir(root())
+            .stdout(writer)
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(err, "", "{args:?}");
+        assert_eq!(o.status.code(), Some(141), "{args:?}");
+    }
+}

@@ -53,6 +53,9 @@ pub enum PhysicsError {
         /// The accepted names.
         allowed: &'static str,
     },
+    /// The work was stopped on request (see [`crate::cancel`]): Ctrl-C in the Python wheel.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// Result alias used across the crate.

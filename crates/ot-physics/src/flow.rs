@@ -57,6 +57,7 @@ impl<const D: usize> Propagator<D> {
         offset: &SVector<f64, D>,
         v0: &SVector<f64, D>,
     ) -> Result<(SVector<f64, D>, SVector<f64, D>, u64)> {
+        crate::cancel::check()?;
         check("offset [m]", offset)?;
         check("velocity [m/s]", v0)?;
         let y0 = Phase { r: -offset, v: *v0 };
@@ -66,6 +67,7 @@ impl<const D: usize> Propagator<D> {
 
     /// [`Propagator::flow`] plus the Jacobians from the variational equations.
     pub fn flow_jacobian(&self, offset: &SVector<f64, D>, v0: &SVector<f64, D>) -> Result<Flow<D>> {
+        crate::cancel::check()?;
         check("offset [m]", offset)?;
         check("velocity [m/s]", v0)?;
         let y0 = Phase { r: -offset, v: *v0 };
@@ -91,6 +93,7 @@ impl<const D: usize> Propagator<D> {
         offset: &SVector<f64, D>,
         v0: &SVector<f64, D>,
     ) -> Result<OffsetFlow<D>> {
+        crate::cancel::check()?;
         check("offset [m]", offset)?;
         check("velocity [m/s]", v0)?;
         let y0 = Phase { r: -offset, v: *v0 };
@@ -113,6 +116,7 @@ impl<const D: usize> Propagator<D> {
         velocities: &[SVector<f64, D>],
         out: &mut [SVector<f64, D>],
     ) -> Result<u64> {
+        crate::cancel::check()?;
         let n = offsets.len();
         if velocities.len() != 1 && velocities.len() != n {
             return Err(PhysicsError::Length {

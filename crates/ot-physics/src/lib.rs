@@ -39,6 +39,7 @@
 
 pub mod analysis;
 pub mod budget;
+pub mod cancel;
 pub mod dynamics;
 pub mod error;
 pub mod fastexp;

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
 use crate::convert::{array1, array2, int_in, value_error, vector};
+use crate::interrupt::interruptible_flows;
 use crate::trap::{GaussianTrap, Model, check_overdamped_velocity, parse_method};
 
 /// RK4 substeps used when `method="rk4"` and no `substeps` is given: within
@@ -90,9 +91,7 @@ pub fn solve_trap<'py>(
     let v0 = velocity2(&model, velocity)?;
     let target = vector::<2>(target, "target", "m")?;
     let prop = tick(py, model, dt, method, rtol, substeps)?;
-    let s = py
-        .detach(|| solve(&prop, &v0, &target))
-        .map_err(value_error)?;
+    let s = interruptible_flows(py, || solve(&prop, &v0, &target))?.map_err(value_error)?;
     array2(py, s.offsets())
 }
 
@@ -123,7 +122,7 @@ pub fn working_envelope<'py>(
     let model = planar(trap, "working_envelope")?;
     let v0 = velocity2(&model, velocity)?;
     let prop = tick(py, model, dt, method, rtol, substeps)?;
-    let e = py.detach(|| we(&prop, &v0, tol)).map_err(value_error)?;
+    let e = interruptible_flows(py, || we(&prop, &v0, tol))?.map_err(value_error)?;
     array2(py, &e.polygon)
 }
 
@@ -168,9 +167,10 @@ pub fn clip_command<'py>(
         }
     };
     let prop = tick(py, model, dt, method, rtol, substeps)?;
-    let c = py
-        .detach(|| we(&prop, &v0, tol).and_then(|e| clip(&e, &command, mode)))
-        .map_err(value_error)?;
+    let c = interruptible_flows(py, || {
+        we(&prop, &v0, tol).and_then(|e| clip(&e, &command, mode))
+    })?
+    .map_err(value_error)?;
     PyTuple::new(py, [array1(py, &c.allowed), array1(py, &c.excess)])
 }
 
@@ -214,8 +214,7 @@ pub fn working_envelope_3d<'py>(
         None => 4,
     };
     let prop = tick(py, model, dt, method, rtol, substeps)?;
-    let e = py
-        .detach(|| envelope3(&prop, &v, level, reach, step))
+    let e = interruptible_flows(py, || envelope3(&prop, &v, level, reach, step))?
         .map_err(value_error)?;
     let tri: Vec<i64> = e
         .mesh

@@ -3,7 +3,7 @@
 
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Condvar, Mutex, PoisonError};
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
 /// How often the waiting thread checks for signals.
@@ -15,9 +15,9 @@ const POLL: Duration = Duration::from_millis(50);
 /// raised once it has. Without a signal, returns what `work` returned.
 pub(crate) fn interruptible<T: Send>(
     py: Python<'_>,
-    work: impl FnOnce(&AtomicBool) -> T + Send,
+    work: impl FnOnce(&Arc<AtomicBool>) -> T + Send,
 ) -> PyResult<T> {
-    let stop = AtomicBool::new(false);
+    let stop = Arc::new(AtomicBool::new(false));
     let done = (Mutex::new(false), Condvar::new());
     std::thread::scope(|s| {
         let (stop_ref, done_ref) = (&stop, &done);
@@ -62,4 +62,13 @@ pub(crate) fn interruptible<T: Send>(
             None => Ok(out),
         }
     })
+}
+
+/// [`interruptible`] for optical-tweezers work made of many flows (envelopes, the inverse
+/// solver, steering): every flow checks the flag, so Ctrl-C ends the call within one flow.
+pub(crate) fn interruptible_flows<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    interruptible(py, |stop| ot_physics::cancel::watch(Arc::clone(stop), work))
 }

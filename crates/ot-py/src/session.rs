@@ -204,7 +204,7 @@ pub fn run_scene<'py>(
     // Ctrl-C stops the session after its current tick (the recording is finished and
     // verifiable) and raises KeyboardInterrupt.
     let report = crate::interrupt::interruptible(py, |stop| {
-        run_session_until(&opts, &mut |_, _| {}, Some(stop))
+        run_session_until(&opts, &mut |_, _| {}, Some(stop.as_ref()))
     })?
     .map_err(session_error)?;
     let stats = to_py(py, &report.stats)?;
