@@ -76,8 +76,14 @@ def test_operator_choices_change_the_motion():
     # Another device: the script's buttons are checked against it.
     with pytest.raises(ValueError) as e:
         nh.run_scene(SCENES / "wall.toml", device="touch")
+    # The error names the script file, line and column of the field.
+    line = next(
+        n for n, l in enumerate((SCENES / "wall.script.toml").read_text().splitlines(), 1)
+        if l.startswith("name = \"centre\"")
+    )
     assert str(e.value) == (
-        "script: `button[0].name`: device `touch` has no button `centre` (allowed: button1, button2)"
+        f"{SCENES / 'wall.script.toml'}:{line}:8: script: `button[0].name`: device `touch` has "
+        "no button `centre` (allowed: button1, button2)"
     )
 
 

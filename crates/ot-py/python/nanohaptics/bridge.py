@@ -309,7 +309,14 @@ def run(device: Device, address: Tuple[str, int], *, seconds: Optional[float] = 
             if delay > 0:
                 time.sleep(delay)
             else:
-                next_t = time.perf_counter()
+                # Late by one period or more: the device's clock has moved on. Skip the
+                # missed sequence numbers (the simulator counts them as a gap and has run
+                # those ticks on the last sample) so that sequence numbers keep the
+                # device's time: resetting the schedule instead would leave every later
+                # sample that many periods old, and the watchdog would fade the force out.
+                missed = int(-delay // period)
+                client.seq += missed
+                next_t += missed * period
     finally:
         device.render(None, (0.0, 0.0, 0.0))
         client.close()
