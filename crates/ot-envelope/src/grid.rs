@@ -17,8 +17,10 @@
 //!   envelope is built on each spacing of a ladder (1 … 0.1 waists) and
 //!   compared with the envelope of the same map on a 0.05-waist grid at
 //!   `tol/10`; the spacing chosen is the coarsest whose envelope, and that of
-//!   every finer spacing of the ladder, is within `tol/2` of it at every
-//!   velocity.
+//!   the next finer spacing of the ladder, is within `tol/2` of it at every
+//!   velocity (the finest when none is). The choice is remembered per
+//!   (model, map, Δt, tol, v_max) in the process, so a scene built twice
+//!   (replay, render) measures once.
 //!
 //! Together with the polygon's own tolerance these shares keep the envelope
 //! within its budget of the tick map's true reachable set; the tick map's own
@@ -150,20 +152,38 @@ fn build(
     .polygon)
 }
 
-/// The Hausdorff distance (m) of the envelope on each spacing of
+/// The Hausdorff distance (m) of the envelope on the spacings of
 /// [`CELL_LADDER`] from the reference grid's, worst over the velocities
-/// probed, for `prop` at tolerance `tol` (m) with region margin `margin`.
-pub fn ladder_errors(prop: &Propagator<2>, tol: f64, margin: f64, v_max: f64) -> Result<Vec<f64>> {
-    let mut worst = vec![0.0f64; CELL_LADDER.len()];
+/// probed, for `prop` at tolerance `tol` (m) with region margin `margin`,
+/// coarsest first, stopping after the first two consecutive spacings within
+/// `tol/2` (the rest are `None`). Boundaries are compared every `tol/8`.
+pub fn ladder_errors(
+    prop: &Propagator<2>,
+    tol: f64,
+    margin: f64,
+    v_max: f64,
+) -> Result<Vec<Option<f64>>> {
+    let mut cases = Vec::new();
     for v0 in velocities(v_max) {
         let region = OffsetRegion::around_drift(prop, &v0, margin)?;
         let reference = build(prop, &v0, &region, REFERENCE_CELL_WAISTS, tol / 10.0)?;
-        for (k, &cell) in CELL_LADDER.iter().enumerate() {
-            let poly = build(prop, &v0, &region, cell, tol)?;
-            worst[k] = worst[k].max(hausdorff(&poly, &reference, tol / 20.0));
+        cases.push((v0, region, reference));
+    }
+    let mut out = vec![None; CELL_LADDER.len()];
+    let mut passed = 0;
+    for (k, &cell) in CELL_LADDER.iter().enumerate() {
+        let mut worst: f64 = 0.0;
+        for (v0, region, reference) in &cases {
+            let poly = build(prop, v0, region, cell, tol)?;
+            worst = worst.max(hausdorff(&poly, reference, tol / 8.0));
+        }
+        out[k] = Some(worst);
+        passed = if worst <= tol / 2.0 { passed + 1 } else { 0 };
+        if passed == 2 {
+            break;
         }
     }
-    Ok(worst)
+    Ok(out)
 }
 
 /// Choose the region margin and the grid spacing of `prop`'s envelopes for
@@ -177,16 +197,55 @@ pub fn choose_grid(prop: &Propagator<2>, tol: f64, v_max: f64) -> Result<GridCho
             allowed: "finite and ≥ 0",
         });
     }
+    let key = cache_key(prop, tol, v_max);
+    if let Some(g) = CHOICES
+        .lock()
+        .ok()
+        .and_then(|c| c.iter().find(|(k, _)| *k == key).map(|(_, g)| *g))
+    {
+        return Ok(g);
+    }
+    let g = measure_choice(prop, tol, v_max)?;
+    if let Ok(mut c) = CHOICES.lock() {
+        c.push((key, g));
+    }
+    Ok(g)
+}
+
+/// Choices made so far in this process, by [`cache_key`].
+static CHOICES: std::sync::Mutex<Vec<(String, GridChoice)>> = std::sync::Mutex::new(Vec::new());
+
+/// Everything a choice depends on, exactly (bit patterns).
+fn cache_key(prop: &Propagator<2>, tol: f64, v_max: f64) -> String {
+    let m = prop.model();
+    let w = m.well.waists();
+    let bits = [
+        m.well.depth(),
+        w[0],
+        w[1],
+        m.mass.unwrap_or(f64::NAN),
+        m.drag.unwrap_or(f64::NAN),
+        m.kt.unwrap_or(f64::NAN),
+        m.external_force[0],
+        m.external_force[1],
+        prop.dt(),
+        tol,
+        v_max,
+    ]
+    .map(f64::to_bits);
+    format!("{:?} {bits:?}", prop.method())
+}
+
+fn measure_choice(prop: &Propagator<2>, tol: f64, v_max: f64) -> Result<GridChoice> {
     let (margin, region_bound) = region_margin(prop.model(), prop.dt(), tol)?;
     let errors = ladder_errors(prop, tol, margin, v_max)?;
-    // the coarsest spacing from which every finer one is within the share
+    // the coarsest spacing that, with the next finer one, is within the
+    // share; else the finest
     let share = tol / 2.0;
-    let mut k = CELL_LADDER.len() - 1;
-    if errors[k] <= share {
-        while k > 0 && errors[k - 1] <= share {
-            k -= 1;
-        }
-    }
+    let within = |k: usize| errors[k].is_some_and(|e| e <= share);
+    let k = (0..CELL_LADDER.len() - 1)
+        .find(|&k| within(k) && within(k + 1))
+        .unwrap_or(CELL_LADDER.len() - 1);
     let region = OffsetRegion::around_drift(prop, &V2::zeros(), margin)?;
     let w = prop.model().well.waists();
     let ext = region.hi - region.lo;
@@ -197,7 +256,7 @@ pub fn choose_grid(prop: &Propagator<2>, tol: f64, v_max: f64) -> Result<GridCho
         margin_waists: margin,
         region_bound_m: region_bound,
         cell_waists: CELL_LADDER[k],
-        grid_error_m: errors[k],
+        grid_error_m: errors[k].unwrap_or(f64::INFINITY),
         tol_m: tol,
         vertices,
         velocities: velocities(v_max).len(),
