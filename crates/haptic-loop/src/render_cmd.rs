@@ -145,8 +145,13 @@ fn draw(
 ) -> Result<(), RenderError> {
     prims.clear();
     scene.draw(prims);
+    draw_prims(frame, prims, title)
+}
+
+/// Draws `prims`, the scale bar and `title` into a cleared `frame`.
+fn draw_prims(frame: &mut Frame, prims: &[Primitive], title: &str) -> Result<(), RenderError> {
     frame.clear();
-    for p in prims.iter() {
+    for p in prims {
         frame.push(p.clone())?;
     }
     frame.scale_bar(None, INK)?;
@@ -246,14 +251,14 @@ struct FramesSink<'a> {
 
 impl FramesSink<'_> {
     fn draw_tick(&mut self, n: u64, scene: &dyn Scene) -> Result<(), RenderCmdError> {
-        self.draw_prims(n, |prims| {
+        self.draw_tick_with(n, |prims| {
             scene.draw(prims);
             Ok(())
         })
     }
 
     /// Draws tick `n` from the primitives `fill` appends.
-    fn draw_prims(
+    fn draw_tick_with(
         &mut self,
         n: u64,
         fill: impl FnOnce(&mut Vec<Primitive>) -> Result<(), RenderCmdError>,
@@ -269,12 +274,7 @@ impl FramesSink<'_> {
         let (Some(f), Some(im)) = (self.frame.as_mut(), self.img.as_mut()) else {
             return Ok(());
         };
-        f.clear();
-        for p in self.prims.iter() {
-            f.push(p.clone())?;
-        }
-        f.scale_bar(None, INK)?;
-        f.title(&title, INK)?;
+        draw_prims(f, &self.prims, &title)?;
         f.draw_into(im)?;
         im.save_png(self.args.out.join(format!("frame_{:05}.png", self.frames)))?;
         if let Some(path) = &self.args.gif {
@@ -428,6 +428,9 @@ fn recorded_picture(
     loaded: &haptic_loop::scene::file::LoadedScene,
     d: &haptic_loop::record::messages::DescriptionMsg,
 ) -> Option<RecordedPicture> {
+    if d.scene_kind != "optical_tweezers" {
+        return None;
+    }
     let pic = RecordedPicture::new(loaded.file.optical_tweezers.as_ref()?);
     pic.reads(&d.state_fields).then_some(pic)
 }
@@ -492,7 +495,7 @@ fn draw_recorded(
                         ]
                     })
                     .collect();
-                sink.draw_prims(s.tick, |prims| {
+                sink.draw_tick_with(s.tick, |prims| {
                     pic.draw(&s.values, s.cursor_m, f.world_force_n, envelope, prims)
                         .map_err(RenderCmdError::Session)
                 })?;
