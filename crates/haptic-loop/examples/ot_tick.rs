@@ -20,7 +20,7 @@ use nalgebra::Vector2;
 use ot_envelope::geometry::hausdorff;
 use ot_envelope::steer::{ParticleState, SteerParams};
 use ot_envelope::tick::{TickController, TickParams};
-use ot_envelope::{EnvelopeOptions, working_envelope_with};
+use ot_envelope::{EnvelopeOptions, OffsetRegion, working_envelope_with};
 use ot_physics::TrapModel;
 use ot_physics::budget::{choose_tick_map, converged};
 use std::path::{Path, PathBuf};
@@ -37,7 +37,10 @@ fn old_text(text: &str) -> String {
         "rk4_substeps = 8\ntick_map_tol_nm_unused = 0",
     )
     .replace("tick_map_tol_nm_unused = 0", "")
-    .replace("warm_start = true", "warm_start = false")
+    .replace(
+        "warm_start = true",
+        "warm_start = false\nenvelope_margin_waists = 3.0\nenvelope_cell_waists = 0.3",
+    )
 }
 
 fn session(text: &str, seconds: f64, realtime: bool, tag: &str) -> Result<SessionReport, BoxError> {
@@ -92,13 +95,22 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
     let tol = p
         .envelope_tol_nm
         .map_or(ot_envelope::DEFAULT_TOL, |t| t * 1e-9);
+    // the scene's region and grid: fixed by hand, or chosen from the tolerance
+    let (margin, cell) = match (p.envelope_margin_waists, p.envelope_cell_waists) {
+        (Some(m), Some(c)) => (m, c),
+        (m, c) => {
+            let g = ot_envelope::grid::choose_grid(&prop, tol, 0.1)?;
+            (m.unwrap_or(g.margin_waists), c.unwrap_or(g.cell_waists))
+        }
+    };
     let mut tp = TickParams::new(SteerParams {
         stiffness: p.stiffness_n_per_m,
         mode: p.clip,
         tol,
-        margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
+        margin_waists: margin,
     });
     tp.warm_start = !old;
+    tp.cell_waists = Some(cell);
     let mut c = TickController::new(tp)?;
     let a = &r.arrays;
     let col = |n: &str| a.state_column(n).ok_or(format!("no column {n}"));
@@ -136,12 +148,14 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
         }
         grabbed += 1;
         if grabbed % every == 0 {
+            // converged dynamics over a wider region than the scene's
             let reference = working_envelope_with(
                 &truth,
                 &s.velocity,
                 &EnvelopeOptions {
                     tol: 0.02e-9,
                     coarse_grid: false,
+                    region: Some(OffsetRegion::around_drift(&truth, &s.velocity, 4.5)?),
                     ..Default::default()
                 },
             )?;
@@ -150,6 +164,8 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
                 &s.velocity,
                 &EnvelopeOptions {
                     tol,
+                    cell_waists: Some(cell),
+                    region: Some(OffsetRegion::around_drift(&prop, &s.velocity, margin)?),
                     ..Default::default()
                 },
             )?;

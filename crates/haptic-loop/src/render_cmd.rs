@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use haptic_loop::device::{DeviceError, HapticDevice, ReplayDevice, TickTime};
 use haptic_loop::record::{RecordingError, read_recording_file};
 use haptic_loop::runner::{Pacing, Runner, Sink, TickView};
+use haptic_loop::scene::optical::RecordedPicture;
 use haptic_loop::scene::{SceneError, load_scene, load_scene_for};
 use haptic_loop::session::SessionError;
 use haptic_loop::{HapticLoop, LoopConfig, Scene};
@@ -159,8 +160,13 @@ fn draw(
 ) -> Result<(), RenderError> {
     prims.clear();
     scene.draw(prims);
+    draw_prims(frame, prims, title)
+}
+
+/// Draws `prims`, the scale bar and `title` into a cleared `frame`.
+fn draw_prims(frame: &mut Frame, prims: &[Primitive], title: &str) -> Result<(), RenderError> {
     frame.clear();
-    for p in prims.iter() {
+    for p in prims {
         frame.push(p.clone())?;
     }
     frame.scale_bar(None, INK)?;
@@ -187,8 +193,11 @@ fn check_width(width: u32) -> Result<(), RenderCmdError> {
 pub struct RenderSummary {
     /// Pictures written.
     pub frames: u64,
-    /// Ticks recomputed.
+    /// Ticks in the recording (recomputed, or read when drawn from the recorded state).
     pub ticks: u64,
+    /// Whether the frames were drawn from the recorded state (optical tweezers) instead of
+    /// recomputing the session.
+    pub from_recorded_state: bool,
     /// GIF size, bytes (0 without `--gif`).
     pub gif_bytes: u64,
     /// What was written, one line per file or folder.
@@ -264,6 +273,7 @@ pub fn run(args: &RenderArgs) -> Result<RenderSummary, RenderCmdError> {
             Ok(RenderSummary {
                 frames: 1,
                 ticks: 0,
+                from_recorded_state: false,
                 gif_bytes: 0,
                 written: vec![written_file("PNG picture (initial state)", &png)],
             })
@@ -273,12 +283,13 @@ pub fn run(args: &RenderArgs) -> Result<RenderSummary, RenderCmdError> {
             Ok(RenderSummary {
                 frames: 1,
                 ticks,
+                from_recorded_state: false,
                 gif_bytes: 0,
                 written: vec![written_file("PNG picture (last tick)", &png)],
             })
         }
-        Output::Frames(dir) => recording_frames(args, view, Some(dir), args.gif.clone()),
-        Output::Gif(gif) => recording_frames(args, view, None, Some(gif)),
+        Output::Frames(dir) => recording_frames(args, view, Some(dir), args.gif.clone(), false),
+        Output::Gif(gif) => recording_frames(args, view, None, Some(gif), false),
     }
 }
 
@@ -332,10 +343,22 @@ struct FramesSink<'a> {
 
 impl FramesSink<'_> {
     fn draw_tick(&mut self, n: u64, scene: &dyn Scene) -> Result<(), RenderCmdError> {
+        self.draw_tick_with(n, |prims| {
+            scene.draw(prims);
+            Ok(())
+        })
+    }
+
+    /// Draws tick `n` from the primitives `fill` appends.
+    fn draw_tick_with(
+        &mut self,
+        n: u64,
+        fill: impl FnOnce(&mut Vec<Primitive>) -> Result<(), RenderCmdError>,
+    ) -> Result<(), RenderCmdError> {
         let title = format!("{}  t = {:.3} s", self.kind, n as f64 / self.rate as f64);
+        self.prims.clear();
+        fill(&mut self.prims)?;
         if self.frame.is_none() {
-            self.prims.clear();
-            scene.draw(&mut self.prims);
             let cam = camera_for(&self.prims, &self.path, self.view, self.args.width)?;
             self.frame = Some(Frame::new(cam, style())?);
             self.img = Some(Image::new(cam.width_px(), cam.height_px())?);
@@ -343,7 +366,7 @@ impl FramesSink<'_> {
         let (Some(f), Some(im)) = (self.frame.as_mut(), self.img.as_mut()) else {
             return Ok(());
         };
-        draw(f, scene, &mut self.prims, &title)?;
+        draw_prims(f, &self.prims, &title)?;
         f.draw_into(im)?;
         if let Some(dir) = &self.frames_dir {
             im.save_png(dir.join(format!("frame_{:05}.png", self.frames)))?;
@@ -416,18 +439,30 @@ fn replay_into(
 
 /// Recomputes a recording from its inputs and draws every `every`-th tick into
 /// `frames_dir/frame_NNNNN.png` and/or the GIF `gif_path`.
+///
+/// An optical-tweezers recording is drawn from its recorded state instead (no physics) when
+/// `every` is a multiple of the display cadence (the default is) and `resimulate` is false.
 fn recording_frames(
     args: &RenderArgs,
     view: Option<View>,
     frames_dir: Option<PathBuf>,
     gif_path: Option<PathBuf>,
+    resimulate: bool,
 ) -> Result<RenderSummary, RenderCmdError> {
     let rec = read_recording_file(&args.input, false)?;
     let d = &rec.description;
     let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
     let config = loaded.config.clone();
     let rate = u64::from(config.rate_hz);
-    let every = args.every.unwrap_or((rate / 30).max(1));
+    let display_every = u64::from(config.display_every).max(1);
+    let picture = recorded_picture(&loaded, d);
+    let every = args.every.unwrap_or(match picture {
+        // the display tick nearest 30 frames per second of session
+        Some(_) => {
+            display_every * ((rate / 30) as f64 / display_every as f64).round().max(1.0) as u64
+        }
+        None => (rate / 30).max(1),
+    });
     let min_every = rate.div_ceil(50).max(1);
     if every == 0 || (gif_path.is_some() && every < min_every) {
         return Err(RenderCmdError::Arg {
@@ -461,7 +496,13 @@ fn recording_frames(
         gif: None,
         frames: 0,
     };
-    let (_, ticks) = replay_into(&rec, vec![&mut sink])?;
+    let from_recorded_state = picture.is_some() && every % display_every == 0 && !resimulate;
+    let ticks = match picture {
+        Some(pic) if from_recorded_state => {
+            draw_recorded(&rec, &pic, every, config.display_scale, &mut sink)?
+        }
+        _ => replay_into(&rec, vec![&mut sink])?.1,
+    };
     let frames = sink.frames;
     let mut gif_bytes = 0;
     let mut written = Vec::new();
@@ -484,9 +525,94 @@ fn recording_frames(
     Ok(RenderSummary {
         frames,
         ticks,
+        from_recorded_state,
         gif_bytes,
         written,
     })
+}
+
+/// The recorded-state drawer of an optical-tweezers recording whose state fields this build
+/// reads; `None` for other scenes (they are recomputed).
+fn recorded_picture(
+    loaded: &haptic_loop::scene::file::LoadedScene,
+    d: &haptic_loop::record::messages::DescriptionMsg,
+) -> Option<RecordedPicture> {
+    if d.scene_kind != "optical_tweezers" {
+        return None;
+    }
+    let pic = RecordedPicture::new(loaded.file.optical_tweezers.as_ref()?);
+    pic.reads(&d.state_fields).then_some(pic)
+}
+
+/// Draws every `every`-th tick of an optical-tweezers recording from its recorded state (no
+/// physics): `/world/state`, the scene force of `/haptic/force` and the envelope polyline of
+/// `/foxglove/scene` (written at display rate; `every` is a multiple of the display cadence).
+/// Returns the number of ticks in the recording.
+fn draw_recorded(
+    rec: &haptic_loop::record::Recording,
+    pic: &RecordedPicture,
+    every: u64,
+    display_scale: f64,
+    sink: &mut FramesSink<'_>,
+) -> Result<u64, RenderCmdError> {
+    use foxglove::Decode;
+    use haptic_loop::record::Channel;
+    use haptic_loop::record::messages::{ForceMsg, StateMsg};
+    let bad = |m: &haptic_loop::record::reader::RecordedMessage, detail: String| {
+        RenderCmdError::Recording(RecordingError::BadMessage {
+            topic: m.channel.topic().to_string(),
+            log_time_ns: m.log_time_ns,
+            detail,
+        })
+    };
+    let n_fields = rec.description.state_fields.len();
+    let mut state: Option<StateMsg> = None;
+    let mut force: Option<ForceMsg> = None;
+    let mut ticks = 0;
+    for m in &rec.messages {
+        match m.channel {
+            Channel::State => {
+                let s = StateMsg::decode(&m.data, n_fields).map_err(|e| bad(m, e.to_string()))?;
+                ticks = s.tick + 1;
+                state = Some(s);
+                force = None;
+            }
+            Channel::Force => {
+                force = Some(ForceMsg::decode(&m.data).map_err(|e| bad(m, e.to_string()))?);
+            }
+            Channel::FoxgloveScene => {
+                let (Some(s), Some(f)) = (&state, &force) else {
+                    continue;
+                };
+                if s.tick % every != 0 {
+                    continue;
+                }
+                let u = foxglove::schemas::SceneUpdate::decode(m.data.as_slice())
+                    .map_err(|e| bad(m, e.to_string()))?;
+                // the scene draws one polyline: the envelope around the particle
+                let envelope: Vec<[f64; 3]> = u
+                    .entities
+                    .iter()
+                    .filter(|e| e.id == "polyline_0")
+                    .flat_map(|e| e.lines.iter())
+                    .flat_map(|l| l.points.iter())
+                    .map(|q| {
+                        [
+                            q.x / display_scale,
+                            q.y / display_scale,
+                            q.z / display_scale,
+                        ]
+                    })
+                    .collect();
+                sink.draw_tick_with(s.tick, |prims| {
+                    pic.draw(&s.values, s.cursor_m, f.world_force_n, envelope, prims)
+                        .map_err(RenderCmdError::Session)
+                })?;
+            }
+            _ => {}
+        }
+    }
+    Ok(ticks)
 }
 
 /// Recomputes a recording and draws its last tick into a PNG (the `demo` picture of a scene).
@@ -528,7 +654,16 @@ fn final_picture_view(
 pub fn cmd(args: &RenderArgs) -> Result<std::process::ExitCode, String> {
     let s = run(args).map_err(|e| e.to_string())?;
     if s.ticks > 0 {
-        println!("{}: {} ticks recomputed", args.input.display(), s.ticks);
+        println!(
+            "{}: {} ticks {}",
+            args.input.display(),
+            s.ticks,
+            if s.from_recorded_state {
+                "drawn from the recorded state"
+            } else {
+                "recomputed"
+            }
+        );
     }
     for w in &s.written {
         println!("wrote {w}");
@@ -577,6 +712,47 @@ mod tests {
         assert_eq!(n, s.frames);
         // 100 ticks at 1 kHz = 10 cs per frame
         assert_eq!(cs, 10 * s.frames);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn optical_tweezers_frames_from_the_recorded_state_equal_the_recomputed_ones() {
+        let dir =
+            std::env::temp_dir().join(format!("nanohaptics-render-ot-{}", std::process::id()));
+        let args = |out: &str| RenderArgs {
+            input: root().join("recordings/optical_tweezers.mcap"),
+            out: dir.join(out),
+            every: Some(100),
+            width: 320,
+            gif: None,
+            view: None,
+        };
+        let (a, b) = (args("recorded"), args("recomputed"));
+        let recorded = recording_frames(&a, None, Some(a.out.clone()), None, false).expect("recorded state");
+        let recomputed = recording_frames(&b, None, Some(b.out.clone()), None, true).expect("recomputed");
+        assert!(recorded.from_recorded_state && !recomputed.from_recorded_state);
+        assert_eq!(recorded.ticks, recomputed.ticks);
+        assert_eq!(recorded.frames, recomputed.frames);
+        assert!(recorded.frames > 5);
+        for k in 0..recorded.frames {
+            let name = format!("frame_{k:05}.png");
+            let x = std::fs::read(a.out.join(&name)).expect("png");
+            let y = std::fs::read(b.out.join(&name)).expect("png");
+            assert!(x == y, "{name} differs");
+        }
+        // a cadence off the display ticks (every 20 at 1 kHz) is recomputed
+        let off = recording_frames(
+            &RenderArgs {
+                every: Some(30),
+                ..args("off")
+            },
+            None,
+            Some(dir.join("off")),
+            None,
+            false,
+        )
+        .expect("off-cadence");
+        assert!(!off.from_recorded_state);
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -49,6 +49,7 @@ pub mod envelope3;
 pub mod error;
 mod folds;
 pub mod geometry;
+pub mod grid;
 pub mod inverse;
 pub mod paper;
 pub mod reference;

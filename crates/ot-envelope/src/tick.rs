@@ -47,6 +47,10 @@ pub struct TickParams {
     pub verify_tol: f64,
     /// Fold points re-mapped per warm tick (≥ 1).
     pub verify_points: usize,
+    /// Grid spacing of a full build (waists per cell; `None`:
+    /// [`crate::sample::default_cell_waists`]); [`crate::grid::choose_grid`]
+    /// sizes it from the envelope tolerance.
+    pub cell_waists: Option<f64>,
 }
 
 impl TickParams {
@@ -58,6 +62,7 @@ impl TickParams {
             warm_dv: DEFAULT_WARM_DV,
             verify_tol: DEFAULT_VERIFY_TOL,
             verify_points: DEFAULT_VERIFY_POINTS,
+            cell_waists: None,
         }
     }
 
@@ -66,6 +71,9 @@ impl TickParams {
         self.steer.validate()?;
         positive("warm_dv [m/s]", self.warm_dv)?;
         positive("verify_tol [m]", self.verify_tol)?;
+        if let Some(c) = self.cell_waists {
+            positive("cell_waists [waists]", c)?;
+        }
         if !(1..=64).contains(&self.verify_points) {
             return Err(crate::error::EnvelopeError::OutOfRange {
                 field: "verify_points",
@@ -206,7 +214,8 @@ impl TickController {
     fn rebuild(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<()> {
         let region = OffsetRegion::around_drift(prop, v0, self.params.steer.margin_waists)?;
         let coarse = coarse_companion(prop, v0);
-        let map = SampledMap::build_with(prop, coarse.as_ref(), v0, &region, None)?;
+        let map =
+            SampledMap::build_with(prop, coarse.as_ref(), v0, &region, self.params.cell_waists)?;
         let env = envelope_and_folds(prop, &map, self.params.steer.tol, Some(&mut self.all_folds))?;
         self.base_poly = env.polygon;
         self.base_free = env.free_displacement;

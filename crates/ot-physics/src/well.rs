@@ -57,16 +57,20 @@ impl<const D: usize> GaussianWell<D> {
         -self.depth * self.envelope(r)
     }
 
-    /// `exp(-ln2 Σ r_i²/w_i²)`, in [0, 1].
+    /// `q = ln2 Σ r_i²/w_i²` (dimensionless), the Gaussian's exponent at `r` (m).
     #[inline(always)]
-    fn envelope(&self, r: &SVector<f64, D>) -> f64 {
-        let q: f64 = self
-            .k
+    pub fn exponent(&self, r: &SVector<f64, D>) -> f64 {
+        self.k
             .iter()
             .zip(&r.data.0[0])
             .map(|(k, x)| k * x * x)
-            .sum();
-        crate::fastexp::exp(-q)
+            .sum()
+    }
+
+    /// `exp(-ln2 Σ r_i²/w_i²)`, in [0, 1].
+    #[inline(always)]
+    fn envelope(&self, r: &SVector<f64, D>) -> f64 {
+        crate::fastexp::exp(-self.exponent(r))
     }
 
     /// Restoring force `-∇P` at `r` (N). Exactly zero (never NaN) where the

@@ -13,7 +13,10 @@
 //!
 //! The tick map is chosen from an error budget (`tick_map_tol_nm`, default 0.01 nm from
 //! converged dynamics, see `ot_physics::budget`) unless `rk4_substeps` fixes it; the choice and
-//! its measured error are reported by an `ot.tick_map` event on the first tick. The controller is
+//! its measured error are reported by an `ot.tick_map` event on the first tick. The envelope's
+//! offset region and grid spacing are sized from `envelope_tol_nm` and the tick
+//! (`ot_envelope::grid::choose_grid`) unless `envelope_margin_waists` / `envelope_cell_waists` fix
+//! them, reported by an `ot.envelope_grid` event on the first tick. The controller is
 //! `ot_envelope::TickController`: warm-started from the last full envelope build (translated by
 //! the change of free drift, checked at fold points), allocation-free in a steady-state tick.
 
@@ -22,6 +25,7 @@ use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
 use crate::vec3::Vec3;
 use nalgebra::Vector2;
 use ot_envelope::ClipMode;
+use ot_envelope::grid::choose_grid;
 use ot_envelope::steer::{ParticleState, SteerParams};
 use ot_envelope::tick::{TickController, TickParams};
 use ot_physics::budget::{choose_tick_map, measure};
@@ -84,6 +88,14 @@ pub struct OtParams {
     /// Geometric tolerance of the working envelope, nm (default: `ot_envelope::DEFAULT_TOL`).
     #[serde(default)]
     pub envelope_tol_nm: Option<f64>,
+    /// Grid spacing of a full envelope build, waists per cell, fixed by hand (0.01–2); absent:
+    /// chosen from `envelope_tol_nm` and the tick (`ot_envelope::grid::choose_grid`).
+    #[serde(default)]
+    pub envelope_cell_waists: Option<f64>,
+    /// Half-width of the envelope's offset region beyond the drift path, waists, fixed by hand
+    /// (1–10); absent: chosen from `envelope_tol_nm` and the tick.
+    #[serde(default)]
+    pub envelope_margin_waists: Option<f64>,
 }
 
 fn yes() -> bool {
@@ -103,7 +115,8 @@ pub struct OpticalScene {
     controller: TickController,
     /// The tick map's report, sent as an `ot.tick_map` event on the first tick.
     tick_map_report: Option<String>,
-    waists_m: [f64; 2],
+    /// The envelope grid's report, sent as an `ot.envelope_grid` event on the first tick.
+    grid_report: Option<String>,
     particle_r_m: f64,
     cursor_r_m: f64,
     position: V2,
@@ -204,13 +217,38 @@ impl OpticalScene {
                 (prop, format!("chosen from tick_map_tol_nm: {c}"))
             }
         };
+        if let Some(c) = p.envelope_cell_waists {
+            check_range("optical_tweezers.envelope_cell_waists", c, 0.01, 2.0)?;
+        }
+        if let Some(m) = p.envelope_margin_waists {
+            check_range("optical_tweezers.envelope_margin_waists", m, 1.0, 10.0)?;
+        }
+        let envelope = ot_error::<ot_envelope::EnvelopeError>;
+        let (margin, cell, grid_report) = match (p.envelope_margin_waists, p.envelope_cell_waists) {
+            (Some(m), Some(c)) => (
+                m,
+                c,
+                format!(
+                    "fixed by envelope_margin_waists and envelope_cell_waists: region {m} waists beyond the drift path, cell {c} waists"
+                ),
+            ),
+            (m, c) => {
+                let g = choose_grid(&prop, tol, map_speed).map_err(envelope)?;
+                (
+                    m.unwrap_or(g.margin_waists),
+                    c.unwrap_or(g.cell_waists),
+                    format!("chosen from envelope_tol_nm: {g}"),
+                )
+            }
+        };
         let mut tick = TickParams::new(SteerParams {
             stiffness: p.stiffness_n_per_m,
             mode: p.clip,
             tol,
-            margin_waists: ot_envelope::region::DEFAULT_MARGIN_WAISTS,
+            margin_waists: margin,
         });
         tick.warm_start = p.warm_start;
+        tick.cell_waists = Some(cell);
         let controller = TickController::new(tick).map_err(ot_error)?;
         let start = V2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
         Ok(OpticalScene {
@@ -220,7 +258,7 @@ impl OpticalScene {
             prop,
             controller,
             tick_map_report: Some(report),
-            waists_m,
+            grid_report: Some(grid_report),
             position: start,
             velocity: V2::zeros(),
             trap: start,
@@ -265,26 +303,15 @@ impl Scene for OpticalScene {
     }
 
     fn state_fields(&self) -> Vec<String> {
-        [
-            "particle_x_m",
-            "particle_y_m",
-            "particle_vx_m_per_s",
-            "particle_vy_m_per_s",
-            "trap_x_m",
-            "trap_y_m",
-            "grabbed",
-            "excess_m",
-            "lag_m",
-            "envelope_vertices",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        STATE_FIELDS.iter().map(|s| s.to_string()).collect()
     }
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         if let Some(r) = self.tick_map_report.take() {
             out.events.push(Event::new("ot.tick_map", r));
+        }
+        if let Some(r) = self.grid_report.take() {
+            out.events.push(Event::new("ot.envelope_grid", r));
         }
         self.cursor = V2::new(input.cursor_m[0], input.cursor_m[1]);
         let button = input.buttons.pressed(0);
@@ -370,46 +397,95 @@ impl Scene for OpticalScene {
     }
 
     fn draw(&self, out: &mut Vec<Primitive>) {
-        let p = [self.position.x, self.position.y, 0.0];
+        let p = self.position;
+        let s = self.p.envelope_draw_scale;
+        let envelope: Vec<Vec3> = self
+            .envelope
+            .iter()
+            .map(|q| [p.x + s * q.x, p.y + s * q.y, 0.0])
+            .collect();
+        Look::of(&self.p).draw(
+            &Shown {
+                position: self.position,
+                trap: self.trap,
+                cursor: self.cursor,
+                grabbed: self.grabbed,
+                force: self.force,
+            },
+            envelope,
+            out,
+        );
+    }
+}
+
+/// The parts of the picture that never change during a session: sizes, the envelope's drawing
+/// scale, the label.
+struct Look {
+    waists_m: [f64; 2],
+    particle_r_m: f64,
+    cursor_r_m: f64,
+    draw_scale: f64,
+    feedback: bool,
+}
+
+/// What one tick's picture shows (world frame, m; force N).
+struct Shown {
+    position: V2,
+    trap: V2,
+    cursor: V2,
+    grabbed: bool,
+    force: V2,
+}
+
+impl Look {
+    fn of(p: &OtParams) -> Self {
+        Look {
+            waists_m: [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
+            particle_r_m: 0.5 * p.particle_diameter_um * 1e-6,
+            cursor_r_m: p.cursor_radius_nm * 1e-9,
+            draw_scale: p.envelope_draw_scale,
+            feedback: p.feedback,
+        }
+    }
+
+    /// The scene's primitives: trap, particle, cursor, the envelope (already placed around the
+    /// particle and scaled for drawing; none when empty), the force arrow, the label.
+    fn draw(&self, t: &Shown, envelope: Vec<Vec3>, out: &mut Vec<Primitive>) {
+        let p = [t.position.x, t.position.y, 0.0];
         out.push(Primitive::Ellipse {
-            center_m: [self.trap.x, self.trap.y, -self.particle_r_m],
+            center_m: [t.trap.x, t.trap.y, -self.particle_r_m],
             semi_axes_m: self.waists_m,
             color: Rgba([0.3, 0.8, 0.3, 0.4]),
         });
         out.push(Primitive::Sphere {
             center_m: p,
             radius_m: self.particle_r_m,
-            color: if self.grabbed {
+            color: if t.grabbed {
                 Rgba([0.95, 0.6, 0.2, 1.0])
             } else {
                 Rgba([0.8, 0.8, 0.85, 1.0])
             },
         });
         out.push(Primitive::Sphere {
-            center_m: [self.cursor.x, self.cursor.y, 0.0],
+            center_m: [t.cursor.x, t.cursor.y, 0.0],
             radius_m: self.cursor_r_m,
             color: Rgba([0.2, 0.5, 0.95, 1.0]),
         });
-        if !self.envelope.is_empty() {
-            let s = self.p.envelope_draw_scale;
+        if !envelope.is_empty() {
             out.push(Primitive::Polyline {
-                points_m: self
-                    .envelope
-                    .iter()
-                    .map(|q| [p[0] + s * q.x, p[1] + s * q.y, 0.0])
-                    .collect(),
+                points_m: envelope,
                 closed: true,
                 color: Rgba([0.9, 0.2, 0.2, 1.0]),
             });
         }
-        if self.force.norm() > 0.0 {
+        if t.force.norm() > 0.0 {
             // Arrow: 1 µm per µN of world force (drawing only).
-            let tip: Vec3 = [p[0] + self.force.x, p[1] + self.force.y, 0.0];
+            let tip: Vec3 = [p[0] + t.force.x, p[1] + t.force.y, 0.0];
             out.push(Primitive::Arrow {
-                from_m: [self.cursor.x, self.cursor.y, 0.0],
+                from_m: [t.cursor.x, t.cursor.y, 0.0],
                 to_m: [
-                    self.cursor.x + (tip[0] - p[0]),
-                    self.cursor.y + (tip[1] - p[1]),
+                    t.cursor.x + (tip[0] - p[0]),
+                    t.cursor.y + (tip[1] - p[1]),
                     0.0,
                 ],
                 color: Rgba([1.0, 0.9, 0.1, 1.0]),
@@ -419,8 +495,8 @@ impl Scene for OpticalScene {
             position_m: [p[0], p[1] - 2.0 * self.particle_r_m, 0.0],
             text: format!(
                 "WE ×{} · feedback {}",
-                self.p.envelope_draw_scale,
-                if self.p.feedback { "on" } else { "off" }
+                self.draw_scale,
+                if self.feedback { "on" } else { "off" }
             ),
             color: Rgba([1.0, 1.0, 1.0, 1.0]),
         });
@@ -436,6 +512,76 @@ fn ot_error<E: std::fmt::Display>(e: E) -> SceneError {
         message: e.to_string(),
     }
 }
+
+/// Draws optical-tweezers ticks from a recording's state, without the physics (`nanohaptics
+/// render`): the `/world/state` fields, the cursor, the scene force of `/haptic/force` and the
+/// envelope polyline that `/foxglove/scene` holds at display rate are all the picture needs.
+/// At a display tick the primitives are those [`Scene::draw`] gives after that tick, to the
+/// rounding of the envelope's display scale.
+pub struct RecordedPicture {
+    look: Look,
+    fields: Vec<String>,
+}
+
+impl RecordedPicture {
+    /// The picture of a scene with parameters `p` (as recorded in the description's scene file).
+    pub fn new(p: &OtParams) -> Self {
+        RecordedPicture {
+            look: Look::of(p),
+            fields: STATE_FIELDS.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    /// Whether a recording's `state_fields` are the ones this build draws from.
+    pub fn reads(&self, state_fields: &[String]) -> bool {
+        self.fields == state_fields
+    }
+
+    /// Appends the primitives of one recorded tick to `out`: `fields` its `/world/state`
+    /// values, `cursor_m` its cursor (world, m), `world_force_n` the scene force (N),
+    /// `envelope_m` the envelope polyline of `/foxglove/scene` divided by the display scale
+    /// (world, m; empty when none was drawn). A state of the wrong length is an error naming
+    /// the field count.
+    pub fn draw(
+        &self,
+        fields: &[f64],
+        cursor_m: Vec3,
+        world_force_n: Vec3,
+        envelope_m: Vec<Vec3>,
+        out: &mut Vec<Primitive>,
+    ) -> Result<(), String> {
+        if fields.len() != self.fields.len() {
+            return Err(format!(
+                "optical_tweezers state has {} fields, expected {}",
+                fields.len(),
+                self.fields.len()
+            ));
+        }
+        let shown = Shown {
+            position: V2::new(fields[0], fields[1]),
+            trap: V2::new(fields[4], fields[5]),
+            cursor: V2::new(cursor_m[0], cursor_m[1]),
+            grabbed: fields[6] != 0.0,
+            force: V2::new(world_force_n[0], world_force_n[1]),
+        };
+        self.look.draw(&shown, envelope_m, out);
+        Ok(())
+    }
+}
+
+/// The state fields of the scene, in the order [`Scene::state`] writes them.
+const STATE_FIELDS: [&str; 10] = [
+    "particle_x_m",
+    "particle_y_m",
+    "particle_vx_m_per_s",
+    "particle_vy_m_per_s",
+    "trap_x_m",
+    "trap_y_m",
+    "grabbed",
+    "excess_m",
+    "lag_m",
+    "envelope_vertices",
+];
 
 #[cfg(test)]
 mod tests {
@@ -473,8 +619,16 @@ mod tests {
     #[test]
     fn the_tick_map_choice_is_reported_once() {
         let ev = first_events(params("tick_map_tol_nm = 0.01"));
-        assert_eq!(ev.len(), 1);
+        assert_eq!(ev.len(), 2);
         assert_eq!(ev[0].name, "ot.tick_map");
+        assert_eq!(ev[1].name, "ot.envelope_grid");
+        assert!(
+            ev[1]
+                .detail
+                .starts_with("chosen from envelope_tol_nm: envelope grid: region "),
+            "{}",
+            ev[1].detail
+        );
         assert!(
             ev[0]
                 .detail

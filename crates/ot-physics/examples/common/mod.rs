@@ -211,7 +211,7 @@ pub mod peer {
     use super::{Problem, Row, errors, time_per_call};
     use nalgebra::Vector2;
     // ode_solvers pins its own nalgebra: use its re-exported vector type.
-    use ode_solvers::{Dop853, OutputType, System, Vector4};
+    use ode_solvers::{Dop853, Dopri5, OutputType, System, Vector4};
     use ot_physics::paper;
     use std::hint::black_box;
 
@@ -253,6 +253,42 @@ pub mod peer {
         let stats = s.integrate().ok()?;
         let y = s.y_out().last()?;
         Some((Vector2::new(y[0] - y0[0], y[1] - y0[1]), stats.num_eval))
+    }
+
+    /// Displacement (nm) and evaluations of one trajectory with the peer's
+    /// Dopri5 (same tolerances and units as its Dop853).
+    fn solve_dopri5(o: &Vector2<f64>, v: &Vector2<f64>, rtol: f64) -> Option<(Vector2<f64>, u32)> {
+        let y0 = Vector4::new(-o.x * 1e9, -o.y * 1e9, v.x * 1e3, v.y * 1e3);
+        let mut s = Dopri5::new(eq(), 0.0, paper::DT * 1e6, 1.0, y0, rtol, rtol);
+        s.set_output(OutputType::Sparse);
+        let stats = s.integrate().ok()?;
+        let y = s.y_out().last()?;
+        Some((Vector2::new(y[0] - y0[0], y[1] - y0[1]), stats.num_eval))
+    }
+
+    /// Measure the peer's Dopri5 at tolerance `rtol` (= atol, nm and nm/µs).
+    pub fn measure_dopri5(p: &Problem, rtol: f64, min_ms: f64) -> Option<Row> {
+        let mut disp = Vec::with_capacity(p.starts.len());
+        let mut evals = 0u64;
+        for (o, v) in &p.starts {
+            let (d, n) = solve_dopri5(o, v, rtol)?;
+            disp.push(d * 1e-9);
+            evals += u64::from(n);
+        }
+        let (max_err_nm, mean_err_nm) = errors(p, &disp);
+        let ns = time_per_call(p.starts.len(), min_ms, || {
+            for (o, v) in &p.starts {
+                let _ = black_box(solve_dopri5(black_box(o), black_box(v), rtol));
+            }
+        });
+        Some(Row {
+            method: "ode_solvers Dopri5".to_string(),
+            setting: format!("tol={rtol:.0e}"),
+            max_err_nm,
+            mean_err_nm,
+            ns_per_traj: ns,
+            evals_per_traj: evals as f64 / p.starts.len() as f64,
+        })
     }
 
     /// One pass over the problem (for instruction counting).

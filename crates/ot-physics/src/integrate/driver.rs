@@ -4,6 +4,9 @@ use super::{AdaptiveStats, StepControl};
 use crate::error::{PhysicsError, Result};
 use crate::state::OdeSystem;
 
+/// `ln(1e-4)`, the floor of the remembered error ratio.
+const LN_1E_4: f64 = -9.210340371976184;
+
 /// Outcome of one trial step of an embedded pair.
 pub(crate) struct Trial<S> {
     /// The higher-order solution at the end of the step.
@@ -36,6 +39,16 @@ pub(crate) fn drive<S: OdeSystem>(
     let mut time = 0.0;
     let mut h = h0.min(t);
     let mut err_prev: f64 = 1e-4;
+    // PI control (beta > 0): ln(err_prev) kept, one exp per step
+    let pi = ctl.beta != 0.0;
+    let mut ln_prev = LN_1E_4;
+    let factor = |ratio: f64, err_prev: f64, ln_prev: f64| {
+        if pi && let Some(l) = super::ln_step(ratio) {
+            (ctl.factor_ln(l, ln_prev, q), l)
+        } else {
+            (ctl.factor(ratio, err_prev, q), 0.0)
+        }
+    };
     while time < t {
         if stats.accepted + stats.rejected >= ctl.max_steps {
             return Err(PhysicsError::Unsupported {
@@ -61,13 +74,17 @@ pub(crate) fn drive<S: OdeSystem>(
                 }
             };
             stats.accepted += 1;
-            let fac = ctl.factor(tr.ratio, err_prev, q);
+            let (fac, ln_err) = factor(tr.ratio, err_prev, ln_prev);
+            if pi {
+                // ln(max(ratio, 1e-4))
+                ln_prev = if tr.ratio >= 1e-4 { ln_err } else { LN_1E_4 };
+            }
             err_prev = tr.ratio.max(1e-4);
             h *= fac;
         } else {
             stats.rejected += 1;
             let fac = if tr.ratio.is_finite() {
-                ctl.factor(tr.ratio, err_prev, q).min(1.0)
+                factor(tr.ratio, err_prev, ln_prev).0.min(1.0)
             } else {
                 0.1
             };

@@ -219,6 +219,34 @@ impl StepControl {
     }
 }
 
+impl StepControl {
+    /// [`StepControl::factor`] from logarithms: `ln_err = ln(err)` (err > 0)
+    /// and `ln_prev = ln(prev)`, one `exp` instead of two powers; the PI
+    /// controller (`beta > 0`) keeps `ln(prev)` from the previous step.
+    #[inline]
+    pub(crate) fn factor_ln(&self, ln_err: f64, ln_prev: f64, q: f64) -> f64 {
+        let expo = 1.0 / q - 0.75 * self.beta;
+        let f = self.safety * crate::fastexp::exp(self.beta * ln_prev - expo * ln_err);
+        f.clamp(self.fac_min, self.fac_max)
+    }
+}
+
+/// `ln x` (x > 0, normal) to ~1e-7 absolute: the logarithm of
+/// [`pow_step`]; `None` where `x` is not a positive normal number.
+#[inline]
+pub(crate) fn ln_step(x: f64) -> Option<f64> {
+    if !(x.is_normal() && x > 0.0) {
+        return None;
+    }
+    let bits = x.to_bits();
+    let e = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    let s = (m - 1.0) / (m + 1.0);
+    let s2 = s * s;
+    let ln_m = 2.0 * s * (1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 / 9.0))));
+    Some(e as f64 * std::f64::consts::LN_2 + ln_m)
+}
+
 /// `x^p` for the step-size controller, to ~1e-6 relative (x > 0): a
 /// step-size factor needs no more, and libm's `powf` was a visible share of
 /// a short adaptive integration. `ln x = e·ln2 + 2·atanh((m−1)/(m+1))` with
@@ -250,6 +278,9 @@ pub struct Propagator<const D: usize> {
     dt: f64,
     tol: Tolerance,
     h0: f64,
+    /// `dopri5` with inertia: `(2 rtol^{1/5}, κ_max/m (1/s²), (γ/m)² (1/s²))`
+    /// for the first step from the local rate ([`Propagator::first_step`]).
+    first: Option<(f64, f64, f64)>,
     ctl: StepControl,
 }
 
@@ -296,6 +327,15 @@ impl<const D: usize> Propagator<D> {
         };
         // First trial step: the local error of order q at rate ω is ~ (ωh)^q.
         let h0 = (2.0 * rtol.powf(1.0 / q) / rate_or_dt).min(dt);
+        // dopri5 with inertia: the first step from the local rate
+        let first = match (method, model.mass) {
+            (Method::Dopri5 { rtol }, Some(m)) => Some((
+                6.0 * rtol.powf(0.2),
+                model.well.stiffness().max() / m,
+                model.drag.map_or(0.0, |g| (g / m) * (g / m)),
+            )),
+            _ => None,
+        };
         let mut ctl = StepControl::default();
         if matches!(method, Method::Adaptive { .. }) {
             ctl.beta = 0.0;
@@ -308,6 +348,7 @@ impl<const D: usize> Propagator<D> {
             dt,
             tol,
             h0,
+            first,
             ctl,
         })
     }
@@ -334,7 +375,8 @@ impl<const D: usize> Propagator<D> {
             Method::Rk4 { substeps } => (rk4(&sys, y0, dt, substeps), 4 * u64::from(substeps)),
             Method::Rk8 { substeps } => (rk8(&sys, y0, dt, substeps), 12 * u64::from(substeps)),
             Method::Dopri5 { .. } => {
-                let (y, s) = dopri5(&sys, y0, dt, &self.tol, self.h0, &self.ctl)?;
+                let h0 = self.first_step(y0);
+                let (y, s) = dopri5(&sys, y0, dt, &self.tol, h0, &self.ctl)?;
                 (y, s.evals)
             }
             Method::Adaptive { .. } => {
@@ -372,6 +414,39 @@ impl<const D: usize> Propagator<D> {
             *o = self.finish(*o, y0);
         }
         Some((out, evals * L as u64))
+    }
+
+    /// First trial step (s) of a `dopri5` propagation from `y0`:
+    /// `ωh = 6 rtol^{1/5}` (≈ 0.6 at rtol 1e-5, where the local error
+    /// `(ωh)^6/6!` is within an order of magnitude of rtol), with ω the larger
+    /// of the well's local rate at the start and at the end of the candidate
+    /// step along the start velocity — `ω² ≤ (κ_max/m) e^{−q} (1 + 2q)`,
+    /// `q = ln2 Σ r_i²/w_i²`, the Hessian bound of the Gaussian — and never
+    /// below the drag rate; never shorter than the fixed first step
+    /// `2 rtol^{1/5}/ω_max`. Far out in the Gaussian's tail, where the force
+    /// is a tiny fraction of its peak, the first step is the whole tick
+    /// instead of a ladder of growing steps from the centre's rate.
+    #[inline]
+    fn first_step(&self, y0: &Phase<D>) -> f64 {
+        let Some((c, kmax_m, floor)) = self.first else {
+            return self.h0;
+        };
+        // ω² ≤ (κ_max/m) e^{−q} (1 + 2q), at least the drag rate squared
+        let rate2 = |r: &nalgebra::SVector<f64, D>| {
+            let q = self.model.well.exponent(r);
+            (kmax_m * crate::fastexp::exp(-q) * (1.0 + 2.0 * q)).max(floor)
+        };
+        let w0 = rate2(&y0.r);
+        let mut h = if w0 > 0.0 { c / w0.sqrt() } else { self.dt };
+        h = h.min(self.dt);
+        // the rate where the candidate step would take the particle
+        if y0.v.iter().any(|v| *v != 0.0) {
+            let w1 = rate2(&(y0.r + y0.v * h));
+            if w1 > w0 {
+                h = h.min(c / w1.sqrt());
+            }
+        }
+        h.max(self.h0)
     }
 
     /// Overdamped models carry no velocity; report the drift velocity at the end.
