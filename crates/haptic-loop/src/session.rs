@@ -218,7 +218,7 @@ pub struct SessionReport {
 }
 
 /// Reads the script text for a local device: the given one or the scene's default script.
-fn script_text(opts: &SessionOptions, file: &SceneFile) -> Result<String, SessionError> {
+pub fn script_text(opts: &SessionOptions, file: &SceneFile) -> Result<String, SessionError> {
     match &opts.script {
         Some(t) => Ok(t.clone()),
         None => {
