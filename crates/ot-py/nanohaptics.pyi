@@ -490,13 +490,15 @@ def sweep(
     device: Optional[Literal["falcon", "touch"]] = None,
     metrics: Optional[Callable[[dict], Mapping[str, Any]]] = None,
     record_dir: Optional[PathLike] = None,
+    chunksize: Optional[int] = None,
 ) -> Any:
     """Run a scene (or fn(run, seed) -> dict) once per override dict of `runs`
     on a thread pool (GIL released), any concurrent.futures executor or a Dask
     Client; run i gets seed run_seed(seed, i). Returns a pandas DataFrame, one
     row per run: run, seed, the overrides, summary metrics (units in the
-    names), and with arrays=True the per-tick arrays. Ctrl-C returns the runs
-    that finished (df.attrs["interrupted"]). See docs/sweeps.md."""
+    names), and with arrays=True the per-tick arrays; chunksize: runs per
+    task on an executor. Ctrl-C returns the runs that finished
+    (df.attrs["interrupted"]). See docs/sweeps.md."""
 
 def grid(axes: Mapping[str, Sequence[Any]]) -> List[Dict[str, Any]]:
     """Every combination of the axes (dotted name → values), last axis fastest,

@@ -180,6 +180,27 @@ def test_two_threads_give_the_serial_bits(serial):
     ot, th = both(workers=2)
     assert_identical(serial[0], ot)
     assert_identical(serial[1], th)
+    # any concurrent.futures executor, runs handed out in chunks: the same bits
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(2) as pool:
+        chunked = nh.sweep(thermal_run, THERMAL_RUNS, seed=11, arrays=True, executor=pool,
+                           chunksize=4, progress=False)
+    assert_identical(serial[1], chunked)
+
+
+def failing_run(run, seed):
+    if run["i"] == 2:
+        raise ZeroDivisionError("division by zero")
+    return {"i": run["i"]}
+
+
+def test_a_failed_run_is_named():
+    for workers in (1, 2):
+        with pytest.raises(RuntimeError, match=r"^sweep: run 2: ZeroDivisionError: division by zero$"):
+            nh.sweep(failing_run, [{"i": i} for i in range(4)], workers=workers, progress=False)
+    with pytest.raises(ValueError, match=r"^chunksize = 0: allowed a whole number ≥ 1$"):
+        nh.sweep(failing_run, [], chunksize=0)
 
 
 def test_a_dask_process_cluster_gives_the_serial_bits(serial):
