@@ -348,7 +348,7 @@ def sweep(
             jobs.append((i, seeds[i], "scene", (resolved, kwargs, metrics), arrays, out))
 
     results: Dict[int, tuple] = {}
-    futures: Dict[Any, int] = {}
+    futures: Dict[Any, list] = {}  # future → its chunk of jobs
     bar = _Progress(len(jobs), progress)
     interrupted = False
     t0 = time.perf_counter()
