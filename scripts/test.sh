@@ -23,7 +23,10 @@ if [ -d crates/ot-py ]; then
   .venv/bin/pip install --quiet --upgrade pip
   # maturin >= 1.9.4 sets PYO3_BUILD_EXTENSION_MODULE (pyo3 0.30 has no
   # extension-module feature): the wheel then does not link libpython.
-  .venv/bin/pip install --quiet "maturin>=1.9.4,<2" "pytest>=8" "numpy>=1.26"
+  # pandas and dask[distributed]: the sweep tests (a 2-worker Dask process cluster) and the
+  # docs' sweep examples (the extras `nanohaptics[sweep]` / `[dask]`).
+  .venv/bin/pip install --quiet "maturin>=1.9.4,<2" "pytest>=8" "numpy>=1.26" "pandas>=1.5" \
+    "dask[distributed]>=2023.1"
   rm -rf target/wheels-test
   # pyproject.toml (at the workspace root) names crates/ot-py; the wheel is abi3 (CPython >= 3.9).
   .venv/bin/maturin build --release --out target/wheels-test --interpreter .venv/bin/python

@@ -6,7 +6,7 @@ naming the argument and its allowed range.
 
 import os
 from types import ModuleType
-from typing import Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -392,6 +392,7 @@ def run_scene(
     device: Union[Literal["falcon", "touch"], str, None] = None,
     out: Optional[PathLike] = None,
     wait_s: float = 120.0,
+    overrides: Optional[Mapping[str, Any]] = None,
 ) -> dict:
     """Run a scene in batch mode with a script, or in real time against a
     device in another process (device="udp:HOST:PORT", see nanohaptics.bridge;
@@ -401,7 +402,23 @@ def run_scene(
     world_force_n (T, 3), device_force_n (T, 3), device_stiffness_n_per_m
     (T, 3, 3), engagement, watchdog, status, compute_ns, start_late_ns,
     events [(tick, name, detail)], rate_hz, stats (tick timing, "link"
-    counters, "end", per-sink "sinks" timing). Optionally records to `out`."""
+    counters, "end", per-sink "sinks" timing). Optionally records to `out`.
+    `scene` may also be a dict of resolve_scene; `overrides` changes fields by
+    dotted name, validated like a scene file (see resolve_scene)."""
+
+def resolve_scene(
+    scene: Union[PathLike, dict],
+    *,
+    script: Optional[PathLike] = None,
+    overrides: Optional[Mapping[str, Any]] = None,
+    device: Optional[Literal["falcon", "touch"]] = None,
+) -> dict:
+    """A scene with its files read and `overrides` (dotted field name → value,
+    e.g. {"optical_tweezers.stiffness_n_per_m": 0.4, "loop.rate_hz": 2000};
+    "operator.*" names change the simulated hand) applied and validated:
+    {"name", "kind", "device", "scene_toml", "script_toml"}, plain data that
+    pickles. ValueError names an unknown field (listing the valid names), a
+    wrong type, or a value out of range (the scene file's own errors)."""
 
 def read_recording(path: PathLike, *, salvage: bool = False) -> dict:
     """An MCAP recording as the arrays of run_scene (without stats)."""
@@ -455,3 +472,41 @@ bridge: ModuleType
 """The device bridge: protocol client (BridgeClient, run) and adapters for a
 Touch (pyOpenHaptics) and Force Dimension devices / the Falcon
 (forcedimension_core). See docs/device-bridge.md."""
+
+# ---------------------------------------------------------------- parameter studies
+
+def sweep(
+    scene: Union[PathLike, dict, Callable[[dict, int], Mapping[str, Any]]],
+    runs: Sequence[Mapping[str, Any]],
+    *,
+    seed: int = 0,
+    executor: Any = None,
+    arrays: bool = False,
+    progress: bool = True,
+    workers: Optional[int] = None,
+    script: Optional[PathLike] = None,
+    seconds: Optional[float] = None,
+    operator: Union[Literal["script", "rigid", "hand"], dict, None] = None,
+    device: Optional[Literal["falcon", "touch"]] = None,
+    metrics: Optional[Callable[[dict], Mapping[str, Any]]] = None,
+    record_dir: Optional[PathLike] = None,
+    chunksize: Optional[int] = None,
+) -> Any:
+    """Run a scene (or fn(run, seed) -> dict) once per override dict of `runs`
+    on a thread pool (GIL released), any concurrent.futures executor or a Dask
+    Client; run i gets seed run_seed(seed, i). Returns a pandas DataFrame, one
+    row per run: run, seed, the overrides, summary metrics (units in the
+    names), and with arrays=True the per-tick arrays; chunksize: runs per
+    task on an executor. Ctrl-C returns the runs that finished
+    (df.attrs["interrupted"]). See docs/sweeps.md."""
+
+def grid(axes: Mapping[str, Sequence[Any]]) -> List[Dict[str, Any]]:
+    """Every combination of the axes (dotted name → values), last axis fastest,
+    as a list of override dicts for sweep."""
+
+def run_seed(seed: int, index: int) -> int:
+    """Seed of run `index` of a sweep with master seed `seed` (numpy
+    SeedSequence(seed, spawn_key=(index,)), 0 ..= 2**64 - 1)."""
+
+sweeps: ModuleType
+"""Parameter studies: sweep, grid, run_seed, scene_metrics. See docs/sweeps.md."""

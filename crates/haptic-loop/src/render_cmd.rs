@@ -728,8 +728,10 @@ mod tests {
             view: None,
         };
         let (a, b) = (args("recorded"), args("recomputed"));
-        let recorded = recording_frames(&a, None, Some(a.out.clone()), None, false).expect("recorded state");
-        let recomputed = recording_frames(&b, None, Some(b.out.clone()), None, true).expect("recomputed");
+        let recorded =
+            recording_frames(&a, None, Some(a.out.clone()), None, false).expect("recorded state");
+        let recomputed =
+            recording_frames(&b, None, Some(b.out.clone()), None, true).expect("recomputed");
         assert!(recorded.from_recorded_state && !recomputed.from_recorded_state);
         assert_eq!(recorded.ticks, recomputed.ticks);
         assert_eq!(recorded.frames, recomputed.frames);

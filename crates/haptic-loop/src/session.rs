@@ -315,14 +315,13 @@ pub struct SessionReport {
     pub sinks: Vec<crate::runner::SinkTime>,
 }
 
-/// Reads the script text for a local device (the given one or the scene's default script)
-/// and parses it; errors name the file, line and column.
-fn load_script(
+/// The script text for a local device (the given one or the scene's default script) and
+/// where it came from, as errors name it (a path, `built-in NAME`, or `script`).
+pub fn script_source(
     opts: &SessionOptions,
     file: &SceneFile,
-    specs: &crate::device::DeviceSpecs,
-) -> Result<(Script, String), SessionError> {
-    let (text, origin) = match &opts.script {
+) -> Result<(String, String), SessionError> {
+    Ok(match &opts.script {
         Some(t) => (
             t.clone(),
             opts.script_origin
@@ -361,7 +360,17 @@ fn load_script(
                 }
             }
         }
-    };
+    })
+}
+
+/// Reads the script text for a local device (see [`script_source`]) and parses it; errors
+/// name the file, line and column.
+fn load_script(
+    opts: &SessionOptions,
+    file: &SceneFile,
+    specs: &crate::device::DeviceSpecs,
+) -> Result<(Script, String), SessionError> {
+    let (text, origin) = script_source(opts, file)?;
     let script = Script::from_toml(&text, specs).map_err(|error| SessionError::ScriptFile {
         at: Location {
             at: error.position(&text),

@@ -52,7 +52,7 @@ pub(crate) fn to_py<'py, T: Serialize>(py: Python<'py>, t: &T) -> PyResult<Bound
 /// included, so that they reach the wrapped crate's validation, which names
 /// the field and its range. A `None` inside a dict means the key is absent.
 /// `path` names the value in errors (`params.substrate.nx`).
-fn py_to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
+pub(crate) fn py_to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
     if obj.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(obj.extract()?));
     }

@@ -34,8 +34,9 @@ use pyo3::prelude::*;
 /// Haptic manipulation at the nanoscale, from Python: optical-trap dynamics
 /// (GaussianTrap), the inverse trap solver and working envelope (solve_trap,
 /// working_envelope, clip_command), the nano world (NanoWorld) and the brick
-/// world (BrickWorld), and haptic-loop sessions and recordings (run_scene,
-/// read_recording). SI units throughout (J, m, kg, s, Pa·s, K, N).
+/// world (BrickWorld), haptic-loop sessions and recordings (run_scene,
+/// read_recording, resolve_scene), and parameter studies (sweep, grid,
+/// run_seed). SI units throughout (J, m, kg, s, Pa·s, K, N).
 #[pymodule]
 fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
@@ -51,6 +52,7 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(envelope::working_envelope_3d, m)?)?;
     m.add_function(wrap_pyfunction!(session::run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(session::read_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(session::resolve_scene, m)?)?;
     m.add_class::<live::Session>()?;
     // The device bridge's client and the device adapters are Python (they import the devices'
     // Python SDKs); the source ships inside the extension and becomes `nanohaptics.bridge`.
@@ -65,6 +67,22 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     py.import("sys")?
         .getattr("modules")?
         .set_item("nanohaptics.bridge", &bridge)?;
+    // Parameter studies (`nanohaptics.sweeps`): Python over run_scene, re-exported as
+    // nanohaptics.sweep / grid / run_seed. Its functions pickle by reference
+    // (`nanohaptics.sweeps._execute`): importing nanohaptics registers the module.
+    let sweeps = PyModule::from_code(
+        py,
+        pyo3::ffi::c_str!(include_str!("../python/nanohaptics/sweeps.py")),
+        c"nanohaptics/sweeps.py",
+        c"nanohaptics.sweeps",
+    )?;
+    m.add_submodule(&sweeps)?;
+    py.import("sys")?
+        .getattr("modules")?
+        .set_item("nanohaptics.sweeps", &sweeps)?;
+    for name in ["sweep", "grid", "run_seed"] {
+        m.add(name, sweeps.getattr(name)?)?;
+    }
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

@@ -4,10 +4,13 @@
 use haptic_loop::DeviceModel;
 use haptic_loop::bridge::BridgeConfig;
 use haptic_loop::device::OperatorParams;
+use haptic_loop::device::Script;
 use haptic_loop::record::RecordingError;
+use haptic_loop::scene::overrides::{override_scene, override_script};
+use haptic_loop::scene::{SceneFile, load_scene};
 use haptic_loop::session::{
-    OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions, read_arrays,
-    run_session_until,
+    Location, OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions,
+    read_arrays, read_toml_text, run_session_until, script_source,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -16,7 +19,7 @@ use pyo3::types::{PyDict, PyList, PyString};
 use std::path::PathBuf;
 
 use crate::convert::array2_flat;
-use crate::json::{from_py, to_py};
+use crate::json::{from_py, py_to_toml, to_py};
 
 /// File errors as `OSError`, everything else (bad scene, script, options,
 /// corrupt recording) as `ValueError`, with the crate's text.
@@ -132,11 +135,182 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceArg> {
     }
 }
 
+type Overrides = Vec<(String, toml::Value)>;
+
+/// The `overrides` argument: a dict of dotted field name → value, split into the scene's
+/// fields and the simulated hand's (`operator.*`, the script's `[operator]` table), in the
+/// dict's order.
+fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<(Overrides, Overrides)> {
+    let (mut scene, mut script) = (Vec::new(), Vec::new());
+    let Some(obj) = obj else {
+        return Ok((scene, script));
+    };
+    if obj.is_none() {
+        return Ok((scene, script));
+    }
+    let d = obj.cast::<PyDict>().map_err(|_| {
+        PyValueError::new_err(
+            "overrides: expected a dict of dotted field names to values, e.g. \
+             {\"optical_tweezers.stiffness_n_per_m\": 0.4, \"loop.rate_hz\": 2000}",
+        )
+    })?;
+    for (k, v) in d.iter() {
+        let key: String = k.extract().map_err(|_| {
+            PyValueError::new_err(format!(
+                "overrides: keys must be dotted field names (str), got {k}"
+            ))
+        })?;
+        let value = py_to_toml(&v, &format!("overrides[{key:?}]"))?;
+        if key == "operator" || key.starts_with("operator.") || key.starts_with("operator[") {
+            script.push((key, value));
+        } else {
+            scene.push((key, value));
+        }
+    }
+    Ok((scene, script))
+}
+
+/// A scene resolved on this side (files read, overrides applied and validated): its TOML
+/// text, its script's TOML text and the device model it runs with.
+struct Resolved {
+    source: SceneSource,
+    script: String,
+    file: SceneFile,
+    model: DeviceModel,
+}
+
+fn value_err(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// The scene argument: a path or built-in name, or a dict of `resolve_scene` (its scene and
+/// script texts).
+fn scene_source(scene: &Bound<'_, PyAny>) -> PyResult<(SceneSource, Option<String>)> {
+    let Ok(d) = scene.cast::<PyDict>() else {
+        let source = SceneSource::resolve(&path_arg(scene, "scene")?).map_err(session_error)?;
+        return Ok((source, None));
+    };
+    let text = |key: &str| -> PyResult<Option<String>> {
+        match d.get_item(key)? {
+            Some(v) if !v.is_none() => Ok(Some(v.extract().map_err(|_| {
+                PyValueError::new_err(format!("scene[{key:?}]: expected a str of TOML"))
+            })?)),
+            _ => Ok(None),
+        }
+    };
+    let scene_toml = text("scene_toml")?.ok_or_else(|| {
+        PyValueError::new_err(
+            "scene: a dict scene needs \"scene_toml\" (and \"script_toml\"), as resolve_scene returns",
+        )
+    })?;
+    let source = SceneSource::from_text(scene_toml, "scene_toml");
+    Ok((source, text("script_toml")?))
+}
+
+/// `scene` (a path, a built-in name, or a dict of `resolve_scene`) and `script`, with
+/// `overrides` applied; every field checked as a scene file's is (names, types, ranges).
+fn resolve(
+    scene: &Bound<'_, PyAny>,
+    script: Option<&Bound<'_, PyAny>>,
+    overrides: Option<&Bound<'_, PyAny>>,
+    device: Option<DeviceModel>,
+) -> PyResult<Resolved> {
+    let (mut source, script_toml) = scene_source(scene)?;
+    let mut script_toml = script_toml.map(|t| (t, "script_toml".to_string()));
+    if let Some(s) = script {
+        let p = path_arg(s, "script")?;
+        let text = read_toml_text(&p).map_err(session_error)?;
+        script_toml = Some((text, p.display().to_string()));
+    }
+    let (scene_ov, script_ov) = overrides_from_py(overrides)?;
+    source.text = override_scene(&source.text, &scene_ov).map_err(value_err)?;
+    // Errors name the file, line and column (of the overridden text).
+    let file = source.parse().map_err(session_error)?;
+    let model = device.unwrap_or(file.device.model);
+    // Ranges: the scene's own validation, as for a scene file.
+    load_scene(&source.text, Some(model)).map_err(|e| session_error(source.locate(e)))?;
+    let (base, origin) = match script_toml {
+        Some(t) => t,
+        None => {
+            script_source(&SessionOptions::new(source.clone()), &file).map_err(session_error)?
+        }
+    };
+    let specs = model.specs();
+    let script = override_script(&base, &script_ov, specs).map_err(value_err)?;
+    Script::from_toml(&script, specs).map_err(|error| {
+        session_error(SessionError::ScriptFile {
+            at: Location {
+                at: error.position(&script),
+                file: origin,
+            },
+            error: Box::new(error),
+        })
+    })?;
+    Ok(Resolved {
+        source,
+        script,
+        file,
+        model,
+    })
+}
+
+/// A scene ready to run anywhere: its files read and `overrides` applied and validated
+/// here, so that a sweep fails before its first run and a worker on another machine needs no
+/// files.
+///
+/// Args:
+///     scene: path to a scene TOML file, a built-in scene name, or a dict
+///         returned by this function (overrides are then applied on top).
+///     script: path to a script TOML file; default: the scene's
+///         ``default_script``.
+///     overrides: dict of dotted field name → value, e.g.
+///         ``{"optical_tweezers.stiffness_n_per_m": 0.4, "loop.rate_hz": 2000}``;
+///         ``operator.*`` names change the simulated hand (the script's
+///         ``[operator]`` table: mass_kg, stiffness_n_per_m,
+///         damping_n_s_per_m, yield_force_n).
+///     device: None (the scene's), "falcon" or "touch" (ranges such as the
+///         stiffness cap depend on it).
+///
+/// Returns:
+///     dict: "name", "kind", "device", "scene_toml", "script_toml" (str),
+///     plain data that pickles; pass it to :func:`run_scene` or :func:`sweep`.
+///
+/// Raises ValueError naming the field: an unknown name (with the valid names
+/// at that level), a wrong type, or a value out of the field's range (the
+/// same errors as a scene file's).
+#[pyfunction]
+#[pyo3(signature = (scene, *, script=None, overrides=None, device=None))]
+pub fn resolve_scene<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyAny>,
+    script: Option<&Bound<'py, PyAny>>,
+    overrides: Option<&Bound<'py, PyAny>>,
+    device: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let model = match device_from_py(device)? {
+        DeviceArg::Model(m) => m,
+        DeviceArg::Bridge(_) => {
+            return Err(PyValueError::new_err(
+                "device: resolve_scene takes \"falcon\" or \"touch\" (a bridged device announces its own)",
+            ));
+        }
+    };
+    let r = resolve(scene, script, overrides, model)?;
+    let d = PyDict::new(py);
+    d.set_item("name", &r.file.scene.name)?;
+    d.set_item("kind", &r.file.scene.kind)?;
+    d.set_item("device", r.model.name())?;
+    d.set_item("scene_toml", &r.source.text)?;
+    d.set_item("script_toml", &r.script)?;
+    Ok(d)
+}
+
 /// Run a scene of the haptic loop in batch mode (no wall clock) with a
 /// script driving the device, and return every tick as arrays.
 ///
 /// Args:
-///     scene: path to a scene TOML file (``scenes/*.toml``).
+///     scene: path to a scene TOML file (``scenes/*.toml``), a built-in scene
+///         name, or a dict of :func:`resolve_scene`.
 ///     script: path to a script TOML file; default: the scene's
 ///         ``default_script``.
 ///     seconds: session length (s), 0 < seconds <= 3600; default: the
@@ -152,6 +326,9 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceArg> {
 ///         says goodbye or ``seconds`` pass.
 ///     out: path of an MCAP recording to write, or None.
 ///     wait_s: how long to wait for a bridged device's hello, s.
+///     overrides: dict of dotted field name → value changing the scene (and,
+///         with ``operator.*`` names, the simulated hand), validated as in
+///         :func:`resolve_scene`.
 ///
 /// Returns:
 ///     dict: "rate_hz", "state_fields" (names of the state columns), per-tick
@@ -164,7 +341,7 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceArg> {
 ///     timing). The GIL is released while the session runs.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments
-#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None, wait_s=120.0))]
+#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None, wait_s=120.0, overrides=None))]
 pub fn run_scene<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -174,29 +351,39 @@ pub fn run_scene<'py>(
     device: Option<&Bound<'py, PyAny>>,
     out: Option<&Bound<'py, PyAny>>,
     wait_s: f64,
+    overrides: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
         return Err(PyValueError::new_err(format!(
             "wait_s = {wait_s}: allowed 0–86400 s"
         )));
     }
-    let scene_path = path_arg(scene, "scene")?;
-    let source = SceneSource::resolve(&scene_path).map_err(session_error)?;
-    let mut opts = SessionOptions::new(source);
-    if let Some(s) = script {
-        let p = path_arg(s, "script")?;
-        opts.script = Some(haptic_loop::session::read_toml_text(&p).map_err(session_error)?);
-        opts.script_origin = Some(p.display().to_string());
-    }
+    let mut opts = match device_from_py(device)? {
+        DeviceArg::Model(m) => {
+            let r = resolve(scene, script, overrides, m)?;
+            let mut opts = SessionOptions::new(r.source);
+            opts.script = Some(r.script);
+            opts.device = m;
+            opts
+        }
+        DeviceArg::Bridge(mut b) => {
+            // A device in another process: no script, so only the scene's fields change.
+            let (scene_ov, script_ov) = overrides_from_py(overrides)?;
+            if let Some((k, _)) = script_ov.first() {
+                return Err(PyValueError::new_err(format!(
+                    "override `{k}`: the simulated hand is not used with a bridged device"
+                )));
+            }
+            let (mut source, _) = scene_source(scene)?;
+            source.text = override_scene(&source.text, &scene_ov).map_err(value_err)?;
+            b.wait_s = wait_s;
+            let mut opts = SessionOptions::new(source);
+            opts.bridge = Some(b);
+            opts
+        }
+    };
     opts.seconds = seconds;
     opts.operator = operator_from_py(operator)?;
-    match device_from_py(device)? {
-        DeviceArg::Model(m) => opts.device = m,
-        DeviceArg::Bridge(mut b) => {
-            b.wait_s = wait_s;
-            opts.bridge = Some(b);
-        }
-    }
     opts.out = match out {
         Some(o) => Some(path_arg(o, "out")?),
         None => None,

@@ -9,6 +9,7 @@ pub mod brick;
 pub mod file;
 pub mod nano;
 pub mod optical;
+pub mod overrides;
 pub mod wall;
 
 use crate::device::Buttons;
