@@ -5,7 +5,8 @@
 //!                  [--timeout-ms M] [--findings DIR] [--json]
 //! nanohaptics-fuzz --target T --seed N --replay-index I     (one input, in this process)
 //! nanohaptics-fuzz --target T --run-file FILE               (one input from a file)
-//! nanohaptics-fuzz --ci [--seconds-per-target S]            (every target, bounded time)
+//! nanohaptics-fuzz --ci [--seconds S]  (every target: a fixed input count each, or S seconds each)
+//! nanohaptics-fuzz --all --inputs N [--seed N]  (every target, N inputs each: a campaign)
 //! ```
 //!
 //! Targets: `scene`, `script` (the TOML parsers and what the parsed files drive), `recording`
@@ -108,7 +109,7 @@ fn parse_args() -> Result<Args, String> {
             "--run-file" => a.run_file = Some(PathBuf::from(val("--run-file")?)),
             "--json" => a.json = true,
             "--worker" => a.worker = true,
-            "--ci" => a.ci = true,
+            "--ci" | "--all" => a.ci = true,
             "-h" | "--help" => return Err(usage()),
             other => return Err(format!("unknown option `{other}`\n{}", usage())),
         }
@@ -324,17 +325,22 @@ fn save_finding(a: &Args, t: &Target, kind: &str, index: u64) -> Option<PathBuf>
 }
 
 /// Runs one target's campaign: batches in child processes, crashes narrowed input by input.
-fn campaign(a: &Args, target: &str, seconds: Option<f64>) -> Result<(Tally, f64), String> {
+fn campaign(
+    a: &Args,
+    target: &str,
+    inputs: u64,
+    seconds: Option<f64>,
+) -> Result<(Tally, f64), String> {
     let t0 = Instant::now();
     let deadline = seconds.map(|s| t0 + Duration::from_secs_f64(s));
     let mut tally = Tally::default();
     let mut next = 0u64;
-    while next < a.inputs {
+    while next < inputs {
         let left = deadline.map(|d| d.saturating_duration_since(Instant::now()).as_secs_f64());
         if left.is_some_and(|l| l <= 0.0) {
             break;
         }
-        let count = a.batch.min(a.inputs - next);
+        let count = a.batch.min(inputs - next);
         match run_batch(a, target, next, count, left, &mut tally)? {
             BatchEnd::Done => next += count,
             BatchEnd::Hang(i) => next = i + 1,
@@ -424,6 +430,16 @@ fn print_report(j: &serde_json::Value, json: bool) {
     }
 }
 
+/// Inputs per target in `--ci` mode.
+fn ci_inputs(target: &str) -> u64 {
+    match target {
+        "scene" | "script" => 12_000,
+        "recording" | "verify" => 6000,
+        "bridge" => 60_000,
+        _ => 300,
+    }
+}
+
 fn real_main() -> Result<ExitCode, String> {
     let a = parse_args()?;
     if a.worker {
@@ -448,19 +464,18 @@ fn real_main() -> Result<ExitCode, String> {
         (Some(t), false) => vec![t.clone()],
         _ => TARGETS.iter().map(|t| t.to_string()).collect(),
     };
-    let per = if a.ci {
-        Some(a.seconds.unwrap_or(8.0))
-    } else {
-        a.seconds
-    };
     let mut any = false;
-    let mut all = Vec::new();
     for target in &list {
-        let (tally, wall) = campaign(&a, target, per)?;
+        // CI: a fixed number of inputs per target (the same inputs on every machine, about
+        // 2–6 s each on an idle core), unless --inputs or --seconds is given.
+        let inputs = match (a.ci, a.inputs, a.seconds) {
+            (true, u64::MAX, None) => ci_inputs(target),
+            (_, n, _) => n,
+        };
+        let (tally, wall) = campaign(&a, target, inputs, a.seconds)?;
         any |= !tally.findings.is_empty();
         let j = report(&a, target, &tally, wall);
         print_report(&j, a.json);
-        all.push(j);
     }
     let _ = std::fs::remove_dir_all(targets::work_dir());
     Ok(if any {

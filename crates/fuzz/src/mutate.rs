@@ -29,11 +29,6 @@ impl Rng {
         (self.next() % n.max(1) as u64) as usize
     }
 
-    /// True with probability `1/n`.
-    pub fn one_in(&mut self, n: usize) -> bool {
-        self.below(n) == 0
-    }
-
     /// One element of `v` (non-empty).
     pub fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
         &v[self.below(v.len())]

@@ -174,7 +174,7 @@ impl Target {
     pub fn input(&self, seed: u64, index: u64) -> Vec<u8> {
         let mut r = Rng::for_input(seed, index);
         let mut b = r.pick(&self.seeds).clone();
-        let n = 1 + r.below(4);
+        let n = 1 + r.below(if self.name == "cli" { 2 } else { 4 });
         for _ in 0..n {
             match self.name {
                 "scene" | "script" => mutate::mutate_text(&mut r, &mut b, &self.seeds),

@@ -492,21 +492,23 @@ fn cmd_replay(rec: &Path, strict: bool, salvage: bool, json: bool) -> Result<Exi
                     }
                 );
                 let i = &r.integrity;
-                println!(
-                    "  checked: {} chunk CRCs{}, ticks 0–{} in sequence{}",
-                    i.chunk_crcs,
-                    if i.summary {
-                        ", the data-section and summary CRCs, the summary against the records"
-                    } else {
-                        " (the file ends early: no data-section or summary CRC)"
-                    },
+                let mut checked = vec![format!("{} chunk CRCs", i.chunk_crcs)];
+                if i.data_crc {
+                    checked.push("the data-section CRC".into());
+                }
+                if i.summary {
+                    checked.push("the summary CRC and the summary against the records".into());
+                }
+                checked.push(format!(
+                    "ticks 0–{} in sequence{}",
                     i.ticks.saturating_sub(1),
                     if i.ticks_match_metadata {
                         " and as many as the session record says"
                     } else {
                         ""
                     }
-                );
+                ));
+                println!("  checked: {}", checked.join(", "));
             }
             Some(d) => println!(
                 "{}: DIVERGED at tick {} on {}: {}",
