@@ -161,6 +161,7 @@ fn one_line(s: &str) -> String {
 fn worker(a: &Args) -> Result<ExitCode, String> {
     let target = a.target.clone().unwrap_or_default();
     let t = Target::new(&target, Duration::from_millis(a.timeout_ms))?;
+    println!("S");
     quiet_panics();
     let t0 = Instant::now();
     let current = std::sync::Arc::new(AtomicU64::new(u64::MAX));
@@ -264,11 +265,13 @@ fn run_batch(
         .map_err(|e| format!("cannot start a worker: {e}"))?;
     let out = child.stdout.take().ok_or("no worker output")?;
     let mut end = None;
+    let mut started = false;
     for line in BufReader::new(out).lines() {
         let line = line.map_err(|e| e.to_string())?;
         let f: Vec<&str> = line.splitn(5, '\t').collect();
         let n = |k: usize| f.get(k).and_then(|x| x.parse::<u64>().ok()).unwrap_or(0);
         match f.first().copied() {
+            Some("S") => started = true,
             Some("F") => {
                 tally.findings.push((
                     f.get(2).unwrap_or(&"").to_string(),
@@ -301,6 +304,12 @@ fn run_batch(
     let mut err = String::new();
     if let Some(mut e) = child.stderr.take() {
         let _ = std::io::Read::read_to_string(&mut e, &mut err);
+    }
+    if !started {
+        return Err(format!(
+            "{target}: the worker did not start: {}",
+            err.lines().last().unwrap_or("(no message)")
+        ));
     }
     Ok(match end {
         Some(e) => e,
@@ -341,12 +350,15 @@ fn campaign(
             break;
         }
         let count = a.batch.min(inputs - next);
+        let mark = tally.findings.len();
         match run_batch(a, target, next, count, left, &mut tally)? {
             BatchEnd::Done => next += count,
             BatchEnd::Hang(i) => next = i + 1,
             BatchEnd::Crashed(why) => {
-                // Re-run the batch one input per process to name the culprit(s).
-                let before = tally.inputs;
+                // Re-run the batch one input per process to name the culprit(s) (what the
+                // crashed batch reported is reported again by those runs).
+                tally.findings.truncate(mark);
+                let before = tally.findings.len();
                 for i in next..next + count {
                     match run_batch(a, target, i, 1, None, &mut tally)? {
                         BatchEnd::Crashed(w) => {
@@ -356,8 +368,13 @@ fn campaign(
                         BatchEnd::Done | BatchEnd::Hang(_) => {}
                     }
                 }
-                if tally.inputs == before {
-                    return Err(format!("{target}: the worker fails at start: {why}"));
+                if tally.findings.len() == before {
+                    // Not reproducible input by input: say so rather than lose it.
+                    tally.findings.push((
+                        "abort".into(),
+                        next,
+                        format!("batch {next}+{count}: {why}"),
+                    ));
                 }
                 next += count;
             }
@@ -374,9 +391,16 @@ fn load() -> String {
 
 fn report(a: &Args, target: &str, tally: &Tally, wall_s: f64) -> serde_json::Value {
     let t = Target::new(target, Duration::from_millis(a.timeout_ms)).ok();
+    // The first five findings of each kind are listed (and their inputs saved); all are counted.
+    let mut shown: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
     let findings: Vec<serde_json::Value> = tally
         .findings
         .iter()
+        .filter(|(kind, _, _)| {
+            let n = shown.entry(kind.as_str()).or_default();
+            *n += 1;
+            *n <= 5
+        })
         .map(|(kind, i, detail)| {
             let file = t.as_ref().and_then(|t| save_finding(a, t, kind, *i));
             let shown = t.as_ref().map(|t| t.show(&t.input(a.seed, *i)));

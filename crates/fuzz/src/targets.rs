@@ -89,6 +89,7 @@ impl Target {
     pub fn new(name: &str, timeout: Duration) -> Result<Target, String> {
         let name = *TARGETS
             .iter()
+            .chain(&["selftest"])
             .find(|t| **t == name)
             .ok_or_else(|| format!("unknown target `{name}` (targets: {})", TARGETS.join(", ")))?;
         let dir = work_dir();
@@ -102,6 +103,7 @@ impl Target {
             timeout,
         };
         match name {
+            "selftest" => t.seeds = vec![b"selftest".to_vec()],
             "scene" => {
                 t.seeds = builtins
                     .iter()
@@ -194,6 +196,7 @@ impl Target {
             "recording" => self.run_recording(input),
             "verify" => self.run_verify(input, index),
             "bridge" => run_bridge(input),
+            "selftest" => selftest(index, self.timeout),
             _ => self.run_cli(input),
         }
     }
@@ -672,6 +675,21 @@ fn run_bridge(input: &[u8]) -> Outcome {
                 }
             }
         }
+        _ => Outcome::Accepted,
+    }
+}
+
+/// The harness's own check (`--target selftest`, not part of `--all`): input 3 of every 100
+/// panics, input 5 aborts, input 7 hangs, input 9 gives a non-finite force; the rest pass.
+fn selftest(index: u64, timeout: Duration) -> Outcome {
+    match index % 100 {
+        3 => panic!("selftest panic at input {index}"),
+        5 => std::process::abort(),
+        7 => {
+            std::thread::sleep(timeout * 3);
+            Outcome::Accepted
+        }
+        9 => Outcome::Finding("non-finite", "selftest force NaN".into()),
         _ => Outcome::Accepted,
     }
 }
