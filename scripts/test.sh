@@ -16,6 +16,10 @@ cargo clippy --workspace --all-targets --release -- -D warnings
 step "cargo test (release profile)"
 cargo test --workspace --release
 
+step "fuzz targets: a fixed number of inputs each, about 15 s (docs/fuzzing.md)"
+cargo build --release -q -p haptic-loop --bin nanohaptics
+cargo run --release -q -p nanohaptics-fuzz -- --ci
+
 if [ -d crates/ot-py ]; then
   step "Python wheel in a fresh virtual environment"
   rm -rf .venv

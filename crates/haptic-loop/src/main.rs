@@ -514,21 +514,42 @@ fn cmd_replay(rec: &Path, strict: bool, salvage: bool, json: bool) -> Result<Exi
     if json {
         println!(
             "{}",
-            serde_json::json!({"recording": rec.display().to_string(), "truncated": r.truncated, "report": report})
+            serde_json::json!({"recording": rec.display().to_string(), "truncated": r.truncated,
+                "integrity": r.integrity, "report": report})
         );
     } else {
         match &report.divergence {
-            None => println!(
-                "{}: {} ticks replayed, {} output messages identical bit for bit{}",
-                rec.display(),
-                report.ticks,
-                report.messages_compared,
-                if r.truncated.is_some() {
-                    " (salvaged part of a truncated file)"
-                } else {
-                    ""
+            None => {
+                println!(
+                    "{}: {} ticks replayed, {} output messages identical bit for bit{}",
+                    rec.display(),
+                    report.ticks,
+                    report.messages_compared,
+                    if r.truncated.is_some() {
+                        " (salvaged part of a truncated file)"
+                    } else {
+                        ""
+                    }
+                );
+                let i = &r.integrity;
+                let mut checked = vec![format!("{} chunk CRCs", i.chunk_crcs)];
+                if i.data_crc {
+                    checked.push("the data-section CRC".into());
                 }
-            ),
+                if i.summary {
+                    checked.push("the summary CRC and the summary against the records".into());
+                }
+                checked.push(format!(
+                    "ticks 0–{} in sequence{}",
+                    i.ticks.saturating_sub(1),
+                    if i.ticks_match_metadata {
+                        " and as many as the session record says"
+                    } else {
+                        ""
+                    }
+                ));
+                println!("  checked: {}", checked.join(", "));
+            }
             Some(d) => println!(
                 "{}: DIVERGED at tick {} on {}: {}",
                 rec.display(),

@@ -28,6 +28,12 @@ pub(crate) fn session_error(e: SessionError) -> PyErr {
         SessionError::Io { .. }
         | SessionError::DefaultScript { .. }
         | SessionError::Recording(RecordingError::Io { .. }) => PyOSError::new_err(e.to_string()),
+        // Creating or writing the recording (a full disk): OSError with the OS's errno, the
+        // path and the ticks that reached the disk in its text.
+        SessionError::Record(r) => match r.os_code() {
+            Some(code) => PyOSError::new_err((code, r.to_string())),
+            None => PyOSError::new_err(r.to_string()),
+        },
         other => PyValueError::new_err(other.to_string()),
     }
 }

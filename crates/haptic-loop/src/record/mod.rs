@@ -6,6 +6,7 @@
 pub mod cdr;
 pub mod foxglove_out;
 pub mod messages;
+pub mod parse;
 pub mod reader;
 pub mod sink;
 pub mod writer;
@@ -15,7 +16,7 @@ use crate::haptic::{HapticLoop, TickResult};
 use crate::scene::Primitive;
 pub use messages::Channel;
 use messages::{DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TimingMsg};
-pub use reader::{Recording, RecordingError, read_recording, read_recording_file};
+pub use reader::{Integrity, Recording, RecordingError, read_recording, read_recording_file};
 pub use writer::{Recorder, RecorderSetup, WriteSummary};
 
 /// One encoded message of a tick.
@@ -195,8 +196,30 @@ pub fn rewrite(
     if let Some(c) = cur {
         w.write(c)?;
     }
+    // The copy holds the ticks read (a salvage holds fewer than the session ran): its `session`
+    // record says so, as the reader checks.
+    let ticks = rec
+        .messages
+        .iter()
+        .filter(|m| m.channel == Channel::DeviceInput)
+        .count();
     for (name, md) in &rec.metadata {
-        w.metadata(name, md.clone())?;
+        let mut md = md.clone();
+        if name == "session" {
+            if let Some(t) = md.insert("ticks".into(), ticks.to_string()) {
+                if t != ticks.to_string() {
+                    md.insert("ticks_in_the_original".into(), t);
+                }
+            }
+        }
+        w.metadata(name, md)?;
+    }
+    if !rec.metadata.contains_key("session") {
+        // A salvaged file ends before the session's closing record: say how much it holds.
+        let mut md = std::collections::BTreeMap::new();
+        md.insert("ticks".to_string(), ticks.to_string());
+        md.insert("salvaged".to_string(), "true".to_string());
+        w.metadata("session", md)?;
     }
     w.finish()
 }

@@ -41,9 +41,55 @@ pub enum RecordError {
         /// What failed.
         message: String,
     },
+    /// Writing failed after the file was created (a full disk, a lost mount): the OS error,
+    /// and how many ticks were flushed to the file before it.
+    #[error("recording {path}: {message}; {ticks_on_disk} ticks reached the disk")]
+    Write {
+        /// Path of the recording.
+        path: String,
+        /// The OS error (e.g. `No space left on device (os error 28)`).
+        message: String,
+        /// The OS error number, when the error came from the OS.
+        os_code: Option<i32>,
+        /// Ticks flushed to the file before the error.
+        ticks_on_disk: u64,
+    },
     /// The writer thread stopped (after an earlier error) or panicked.
     #[error("the recording writer stopped: {0}")]
     WriterStopped(String),
+}
+
+impl RecordError {
+    /// The OS error number behind this error, if any (`ENOSPC` = 28 for a full disk).
+    pub fn os_code(&self) -> Option<i32> {
+        match self {
+            RecordError::Write { os_code, .. } => *os_code,
+            _ => None,
+        }
+    }
+}
+
+/// The I/O error inside an MCAP error (whose own text hides it): the OS's words and number.
+fn os_error(e: &mcap::McapError) -> (String, Option<i32>) {
+    let mut src: Option<&(dyn std::error::Error + 'static)> = Some(e);
+    while let Some(s) = src {
+        if let Some(io) = s.downcast_ref::<std::io::Error>() {
+            return (io.to_string(), io.raw_os_error());
+        }
+        src = s.source();
+    }
+    (e.to_string(), None)
+}
+
+/// A write error after `ticks_on_disk` ticks were flushed.
+fn write_err(path: &str, e: &mcap::McapError, ticks_on_disk: u64) -> RecordError {
+    let (message, os_code) = os_error(e);
+    RecordError::Write {
+        path: path.to_string(),
+        message,
+        os_code,
+        ticks_on_disk,
+    }
 }
 
 /// What the writer needs before the first tick.
@@ -107,7 +153,7 @@ fn open(
         ));
     let mut w = opts
         .create(BufWriter::with_capacity(1 << 20, file))
-        .map_err(|e| io_err(path, e))?;
+        .map_err(|e| write_err(path, &e, 0))?;
     let d = &setup.description;
     let (state_name, state_text) = messages::state_schema(&d.scene_kind, &d.state_fields);
     let mut ids = BTreeMap::new();
@@ -131,10 +177,10 @@ fn open(
         let msg_enc = if enc == "protobuf" { "protobuf" } else { "cdr" };
         let sid = w
             .add_schema(&name, &enc, &data)
-            .map_err(|e| io_err(path, e))?;
+            .map_err(|e| write_err(path, &e, 0))?;
         let cid = w
             .add_channel(sid, ch.topic(), msg_enc, &meta)
-            .map_err(|e| io_err(path, e))?;
+            .map_err(|e| write_err(path, &e, 0))?;
         ids.insert(ch, cid);
     }
     Ok((w, ids))
@@ -155,6 +201,7 @@ fn write_msgs(
     log_time: u64,
     msgs: &[OutMsg],
     path: &str,
+    on_disk: u64,
 ) -> Result<u64, RecordError> {
     for m in msgs {
         let channel_id = ids[&m.channel];
@@ -166,7 +213,7 @@ fn write_msgs(
             publish_time: log_time,
         };
         w.write_to_known_channel(&header, &m.data)
-            .map_err(|e| io_err(path, e))?;
+            .map_err(|e| write_err(path, &e, on_disk))?;
     }
     Ok(msgs.len() as u64)
 }
@@ -202,12 +249,15 @@ fn write_all(
     };
     let mut sum = WriteSummary::default();
     let mut seq = 0u32;
+    // Ticks handed to the MCAP writer, and ticks in chunks flushed to the file.
+    let mut ticks = 0u64;
+    let mut on_disk = 0u64;
     let desc = OutMsg {
         channel: Channel::Description,
         data: setup.description.encode(),
     };
-    sum.messages += write_msgs(&mut w, &ids, &mut seq, 0, &[desc], path)?;
-    w.flush().map_err(|e| io_err(path, e))?;
+    sum.messages += write_msgs(&mut w, &ids, &mut seq, 0, &[desc], path, on_disk)?;
+    w.flush().map_err(|e| write_err(path, &e, on_disk))?;
     let mut next_flush = setup
         .description
         .start_time_ns
@@ -228,18 +278,27 @@ fn write_all(
                 Cmd::Tick(t) => {
                     if t.log_time_ns >= next_flush {
                         // Close the chunk of the previous second and push it to the OS.
-                        w.flush().map_err(|e| io_err(path, e))?;
+                        w.flush().map_err(|e| write_err(path, &e, on_disk))?;
+                        on_disk = ticks;
                         sum.flushes += 1;
                         while next_flush <= t.log_time_ns {
                             next_flush += setup.flush_every_ns;
                         }
                     }
-                    sum.messages +=
-                        write_msgs(&mut w, &ids, &mut seq, t.log_time_ns, &t.msgs, path)?;
+                    sum.messages += write_msgs(
+                        &mut w,
+                        &ids,
+                        &mut seq,
+                        t.log_time_ns,
+                        &t.msgs,
+                        path,
+                        on_disk,
+                    )?;
+                    ticks += 1;
                 }
                 Cmd::Metadata(name, metadata) => {
                     w.write_metadata(&mcap::records::Metadata { name, metadata })
-                        .map_err(|e| io_err(path, e))?;
+                        .map_err(|e| write_err(path, &e, on_disk))?;
                 }
             }
         }
@@ -248,8 +307,16 @@ fn write_all(
         }
         std::thread::sleep(POLL);
     }
-    w.finish().map_err(|e| io_err(path, e))?;
-    drop(w);
+    w.finish().map_err(|e| write_err(path, &e, on_disk))?;
+    // The summary is written into the buffer; push it to the file.
+    let mut file = w.into_inner();
+    std::io::Write::flush(&mut file).map_err(|e| RecordError::Write {
+        path: path.to_string(),
+        message: e.to_string(),
+        os_code: e.raw_os_error(),
+        ticks_on_disk: on_disk,
+    })?;
+    drop(file);
     sum.bytes = std::fs::metadata(path).map_err(|e| io_err(path, e))?.len();
     Ok(sum)
 }
@@ -294,10 +361,12 @@ impl Recorder {
     /// Queues a tick's messages for the writer thread (never blocks, never wakes a thread).
     pub fn write(&mut self, t: TickMessages) -> Result<(), RecordError> {
         if self.shared.failed.load(Ordering::Acquire) {
-            return Err(RecordError::WriterStopped(format!(
-                "{}: the writer failed (its error is returned by finish)",
-                self.path
-            )));
+            // The thread has ended with its error (the OS's words, the path, the ticks on
+            // disk): hand that error to the session, not a generic one.
+            return Err(match self.handle.take().map(JoinHandle::join) {
+                Some(Ok(Err(e))) => e,
+                _ => RecordError::WriterStopped(format!("{}: the writer failed", self.path)),
+            });
         }
         self.local.push(Cmd::Tick(t));
         self.hand_over();
