@@ -6,7 +6,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ParamError {
     /// A number is outside its closed/open range. `range` is human readable, e.g. `"(0, 1e4]"`.
-    #[error("parameter `{field}` = {value} is out of range: allowed {range}")]
+    #[error("parameter `{field}` = {} is out of range: allowed {range}", num(*value))]
     OutOfRange {
         /// Dotted path of the field, e.g. `blueprint.slots[2].center_m[0]`.
         field: String,
@@ -56,11 +56,21 @@ impl WorldError {
     }
 }
 
+/// A number as people read it: plain between 1e-3 and 1e6, in exponent form beyond (never
+/// 300 digits of `1e308`).
+fn num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-3..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// A cursor sample from a device or script cannot be used.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum InputError {
     /// A position component is NaN or infinite.
-    #[error("cursor input `position_m[{axis}]` = {value} is not finite")]
+    #[error("cursor input `position_m[{axis}]` = {} is not finite", num(*value))]
     NotFinite {
         /// Component index 0..3 (x, y, z).
         axis: usize,
@@ -69,7 +79,8 @@ pub enum InputError {
     },
     /// A position component is outside the world's workspace box.
     #[error(
-        "cursor input `position_m[{axis}]` = {value} m is outside the workspace: allowed [-{limit}, {limit}] m"
+        "cursor input `position_m[{axis}]` = {} m is outside the workspace: allowed [-{limit}, {limit}] m",
+        num(*value)
     )]
     OutsideWorkspace {
         /// Component index 0..3 (x, y, z).

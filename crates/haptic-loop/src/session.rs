@@ -94,12 +94,16 @@ pub enum SessionError {
         message: String,
     },
     /// Session length out of range.
-    #[error("session length {0} s is out of range (allowed: 0 < seconds ≤ 3600)")]
+    #[error(
+        "session length {} s is out of range (allowed: 0 < seconds ≤ 3600)",
+        crate::scene::file::fmt_num(*.0)
+    )]
     Seconds(f64),
     /// A session shorter than one tick.
     #[error(
-        "session length {seconds} s is shorter than one tick ({} ms at {rate_hz} Hz): allowed \
+        "session length {} s is shorter than one tick ({} ms at {rate_hz} Hz): allowed \
          {} ≤ seconds ≤ 3600",
+        crate::scene::file::fmt_num(*seconds),
         1e3 / f64::from(*rate_hz),
         0.5 / f64::from(*rate_hz)
     )]

@@ -424,6 +424,10 @@ fn a_session_shorter_than_one_tick_is_refused() {
         "error: session length 0.0004 s is shorter than one tick (1 ms at 1000 Hz): allowed \
          0.0005 ≤ seconds ≤ 3600"
     );
+    assert_eq!(
+        error_in(&root(), &["run", "wall", "--seconds", "1e308"]),
+        "error: session length 1e308 s is out of range (allowed: 0 < seconds ≤ 3600)"
+    );
     // Half a tick rounds to one tick.
     let run = json(&nh(&["run", "wall", "--seconds", "0.0005", "--json"]));
     assert_eq!(run["ticks"], 1);
