@@ -213,7 +213,7 @@ fn brick_with_initial_velocity_and_own_friction_slides_v2_over_2_mu_g() {
 /// Fuzz finding: extreme numbers are written in exponent form, not as 309 digits.
 #[test]
 fn extreme_values_in_errors_are_written_in_exponent_form() {
-    let mut w = world(Params::default());
+    let mut w = world(brickworld::Params::default());
     assert_eq!(
         w.set_friction(1e308).unwrap_err().to_string(),
         "parameter `friction` = 1e308 is out of range: allowed [0, 10]"
