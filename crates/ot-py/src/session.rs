@@ -229,12 +229,23 @@ fn resolve(
         script_toml = Some((text, p.display().to_string()));
     }
     let (scene_ov, script_ov) = overrides_from_py(overrides)?;
+    // The file as read: its errors name the file, line and column.
+    source.parse().map_err(session_error)?;
+    // With overrides, errors name the overridden field by its dotted name instead (a line of
+    // the rewritten text would point nowhere the user wrote).
     source.text = override_scene(&source.text, &scene_ov).map_err(value_err)?;
-    // Errors name the file, line and column (of the overridden text).
-    let file = source.parse().map_err(session_error)?;
+    let located = scene_ov.is_empty();
+    let scene_err = |e: haptic_loop::scene::SceneError| {
+        if located {
+            session_error(source.locate(e))
+        } else {
+            value_err(e)
+        }
+    };
+    let file = SceneFile::parse(&source.text).map_err(scene_err)?;
     let model = device.unwrap_or(file.device.model);
     // Ranges: the scene's own validation, as for a scene file.
-    load_scene(&source.text, Some(model)).map_err(|e| session_error(source.locate(e)))?;
+    load_scene(&source.text, Some(model)).map_err(scene_err)?;
     let (base, origin) = match script_toml {
         Some(t) => t,
         None => {
@@ -242,16 +253,17 @@ fn resolve(
         }
     };
     let specs = model.specs();
-    let script = override_script(&base, &script_ov, specs).map_err(value_err)?;
-    Script::from_toml(&script, specs).map_err(|error| {
+    Script::from_toml(&base, specs).map_err(|error| {
         session_error(SessionError::ScriptFile {
             at: Location {
-                at: error.position(&script),
+                at: error.position(&base),
                 file: origin,
             },
             error: Box::new(error),
         })
     })?;
+    let script = override_script(&base, &script_ov, specs).map_err(value_err)?;
+    Script::from_toml(&script, specs).map_err(value_err)?;
     Ok(Resolved {
         source,
         script,
