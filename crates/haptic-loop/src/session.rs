@@ -105,7 +105,7 @@ pub enum SessionError {
          {} ≤ seconds ≤ 3600",
         crate::scene::file::fmt_num(*seconds),
         1e3 / f64::from(*rate_hz),
-        0.5 / f64::from(*rate_hz)
+        crate::scene::file::fmt_num(0.5 / f64::from(*rate_hz))
     )]
     TooShort {
         /// The length asked for, s.

@@ -421,8 +421,8 @@ fn file_errors_say_file_line_column_and_what_was_expected() {
 fn a_session_shorter_than_one_tick_is_refused() {
     assert_eq!(
         error_in(&root(), &["run", "wall", "--seconds", "0.0004"]),
-        "error: session length 0.0004 s is shorter than one tick (1 ms at 1000 Hz): allowed \
-         0.0005 ≤ seconds ≤ 3600"
+        "error: session length 4e-4 s is shorter than one tick (1 ms at 1000 Hz): allowed \
+         5e-4 ≤ seconds ≤ 3600"
     );
     assert_eq!(
         error_in(&root(), &["run", "wall", "--seconds", "1e308"]),
