@@ -237,3 +237,16 @@ def test_tick_map_substeps_are_bounded_where_every_call_runs_hundreds_of_flows()
     d = trap.displacement([(0.0, 0.0)], (0.0, 0.0), nh.PAPER_DT, method="rk4", substeps=20_000)
     assert np.all(np.isfinite(d))
 
+
+
+def test_a_long_envelope_stops_on_ctrl_c():
+    # Δt = 10 µs at the paper's constants: about two minutes of crossing search when left
+    # alone; Ctrl-C stops it at the next segment.
+    trap = nh.paper_trap()
+    threading.Timer(0.5, _thread.interrupt_main).start()
+    t0 = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        nh.working_envelope(trap, (0.0, 0.0), 1e-5)
+    assert time.perf_counter() - t0 < 60.0
+    # The next call is not affected.
+    assert len(nh.working_envelope(trap, (0.0, 0.0), nh.PAPER_DT)) > 10

@@ -16,7 +16,7 @@
 
 use crate::error::{Result, finite_vec, positive};
 use crate::folds::{hermite_polylines, trace};
-use crate::geometry::{self, outer_boundary};
+use crate::geometry::{self, try_outer_boundary};
 use crate::region::{DEFAULT_MARGIN_WAISTS, OffsetRegion, free_drift};
 use crate::sample::{SampledMap, coarse_companion};
 use nalgebra::Vector2;
@@ -160,14 +160,14 @@ pub(crate) fn envelope_and_folds(
     // its thousands of segment pairs are never tested.
     let polygon = match lines.split_last() {
         Some((edge, folds)) if !folds.is_empty() => {
-            let inner = outer_boundary(folds, snap);
+            let inner = try_outer_boundary(folds, snap)?;
             if inner.len() >= 3 && geometry::box_inside(&inner, &geometry::bbox(&edge.0)) {
                 inner
             } else {
-                outer_boundary(&lines, snap)
+                try_outer_boundary(&lines, snap)?
             }
         }
-        _ => outer_boundary(&lines, snap),
+        _ => try_outer_boundary(&lines, snap)?,
     };
     let touches_region_edge = polygon
         .iter()

@@ -39,8 +39,20 @@ impl Dsu {
 /// repeated. Points that are bit-identical are the same vertex; crossings
 /// closer than `snap` (same unit as the points) to an endpoint snap onto it.
 ///
-/// Returns an empty vector when there are no segments.
+/// Returns an empty vector when there are no segments. Under a raised
+/// [`ot_physics::cancel`] flag it returns an empty vector early: use
+/// [`try_outer_boundary`] to tell the two apart.
 pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
+    try_outer_boundary(polylines, snap).unwrap_or_default()
+}
+
+/// [`outer_boundary`] that stops with [`ot_physics::PhysicsError::Interrupted`] when the
+/// thread's [`ot_physics::cancel`] flag is raised (it checks once per segment of the
+/// crossing search, its costly part: a tangled arrangement at a long Δt takes minutes).
+pub fn try_outer_boundary(
+    polylines: &[(Vec<V2>, bool)],
+    snap: f64,
+) -> Result<Vec<V2>, ot_physics::PhysicsError> {
     // 1. vertices (bit-identical points merged) and segments.
     let mut pts: Vec<V2> = Vec::new();
     let mut ids: BTreeMap<(u64, u64), usize> = BTreeMap::new();
@@ -67,7 +79,7 @@ pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
         }
     }
     if segs.is_empty() {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     // 2. all crossings, found through a bucket grid.
     let (mut lo, mut hi) = (pts[0], pts[0]);
@@ -106,6 +118,7 @@ pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
     for (cell_idx, list) in grid.iter().enumerate() {
         let (ci, cj) = (cell_idx / nby, cell_idx % nby);
         for x in 0..list.len() {
+            ot_physics::cancel::check()?;
             for y in x + 1..list.len() {
                 let (s1, s2) = (list[x], list[y]);
                 let (a, b) = segs[s1];
@@ -198,7 +211,7 @@ pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
                 .then(pts[i].y.total_cmp(&pts[j].y))
         })
     else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
     let pick = |cur: usize, prev: Option<usize>, d_in: V2| -> usize {
         let mut best = adj[cur][0];
@@ -251,7 +264,7 @@ pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
     if signed_area(&out) < 0.0 {
         out.reverse();
     }
-    out
+    Ok(out)
 }
 
 /// Bounding box `(lo, hi)` of a point set (m); `(+∞, −∞)` when empty.
