@@ -203,6 +203,24 @@ impl OpticalScene {
             .build()
             .map_err(ot_error)?;
         let dt_s = p.dt_us * 1e-6;
+        // A haptic tick must be cheap: its envelope's cost grows with how many small
+        // oscillations of the trapped particle one tick holds (their folds multiply the
+        // envelope's boundary). At paper constants the period is 0.94 µs: 1 µs ticks cost
+        // ~2 ms at p99, 5 µs ticks up to 0.5 s; a 1000× lighter particle at 0.2 µs never
+        // finished building the scene. Refuse beyond two periods instead of hanging.
+        let max_dt_us = 2.0 * small_oscillation_period_s(&p) * 1e6;
+        if !(p.dt_us <= max_dt_us) {
+            return Err(super::file::out_of_range(
+                "optical_tweezers.dt_us",
+                p.dt_us,
+                format!(
+                    "0 < dt_us ≤ {} µs, two periods of the particle's small oscillation in \
+                     this trap (period 2π·√(mass·waist²/(4·depth)), narrower waist); a longer \
+                     tick makes the envelope too costly for a haptic loop",
+                    three_digits_down(max_dt_us)
+                ),
+            ));
+        }
         let physics = ot_error::<ot_physics::PhysicsError>;
         let (prop, report) = match p.rk4_substeps {
             Some(n) => {
@@ -503,6 +521,24 @@ impl Look {
     }
 }
 
+/// `x` (> 0) rounded down to three significant digits, as text (a bound stated inside itself).
+fn three_digits_down(x: f64) -> String {
+    let e = x.log10().floor() as i32;
+    let unit = 10f64.powi(e - 2);
+    let decimals = usize::try_from(2 - e).unwrap_or(0);
+    format!("{:.*}", decimals, (x / unit).floor() * unit)
+}
+
+/// The period (s) of the particle's small oscillation about the centre of the well, along the
+/// narrower waist: ω² = 4·depth / (mass · waist²) for the well −depth·e^{−2x²/w²}.
+fn small_oscillation_period_s(p: &OtParams) -> f64 {
+    let depth_j = p.depth_nj * 1e-9;
+    let mass_kg = p.mass_g * 1e-3;
+    let w_m = p.waist_x_nm.min(p.waist_y_nm) * 1e-9;
+    let omega = (4.0 * depth_j / (mass_kg * w_m * w_m)).sqrt();
+    2.0 * std::f64::consts::PI / omega
+}
+
 /// An optical-tweezers model or steering error as a scene error (located at the
 /// `[optical_tweezers]` table: the model's field names are not the scene's).
 fn ot_error<E: std::fmt::Display>(e: E) -> SceneError {
@@ -680,5 +716,36 @@ mod tests {
             "scene: `optical_tweezers.rk4_substeps` = 0 is out of range (allowed: 1 ≤ \
              optical_tweezers.rk4_substeps ≤ 1000)"
         );
+    }
+
+    #[test]
+    fn a_tick_longer_than_two_small_oscillations_is_refused() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/optical_tweezers.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let with = |from: &str, to: &str| {
+            let t = text.replace(from, to);
+            let p = SceneFile::parse(&t).unwrap().optical_tweezers.unwrap();
+            OpticalScene::new(p, 3.0).err().map(|e| e.to_string())
+        };
+        // Paper constants: period 2π·√(1e-15 kg · (300 nm)² / (4e-15 J)) = 0.942 µs.
+        assert_eq!(
+            with("dt_us = 0.2", "dt_us = 5.0").as_deref(),
+            Some(
+                "scene: `optical_tweezers.dt_us` = 5 is out of range (allowed: 0 < dt_us ≤ 1.88 \
+                 µs, two periods of the particle's small oscillation in this trap (period \
+                 2π·√(mass·waist²/(4·depth)), narrower waist); a longer tick makes the envelope \
+                 too costly for a haptic loop)"
+            )
+        );
+        // The fuzz finding: a particle 1000× lighter at the default 0.2 µs tick.
+        let light = with("mass_g = 1.0e-12", "mass_g = 1e-15").unwrap_or_default();
+        assert!(light.contains("≤ 0.0596 µs"), "{light}");
+        assert_eq!(with("dt_us = 0.2", "dt_us = 1.0"), None);
+        assert_eq!(three_digits_down(1.8849), "1.88");
+        assert_eq!(three_digits_down(0.059605), "0.0596");
+        assert_eq!(three_digits_down(123456.0), "123000");
     }
 }
