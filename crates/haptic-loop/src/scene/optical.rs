@@ -209,7 +209,7 @@ impl OpticalScene {
         // ~2 ms at p99, 5 µs ticks up to 0.5 s; a 1000× lighter particle at 0.2 µs never
         // finished building the scene. Refuse beyond two periods instead of hanging.
         let max_dt_us = 2.0 * small_oscillation_period_s(&p) * 1e6;
-        if !(p.dt_us <= max_dt_us) {
+        if !max_dt_us.is_finite() || p.dt_us > max_dt_us {
             return Err(super::file::out_of_range(
                 "optical_tweezers.dt_us",
                 p.dt_us,
