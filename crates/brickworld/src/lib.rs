@@ -30,6 +30,7 @@ pub mod blueprint;
 pub mod error;
 pub mod estimator;
 pub mod impact;
+pub mod impacts;
 pub mod input;
 pub mod params;
 pub mod proxy;
@@ -45,6 +46,6 @@ pub use params::{
     Params, ParamsFromTomlError,
 };
 pub use world::{
-    Axis, BoxView, BrickId, BrickView, Event, SLEEP_MAX_ACCEL_M_S2, SLEEP_SPEED_M_S, SlotView,
+    Axis, Body, BoxView, BrickId, BrickView, Event, NEAREST_MAX_M, SLEEP_MAX_ACCEL_M_S2, SLEEP_SPEED_M_S, SlotView,
     StepReport, Touch, World,
 };

@@ -13,6 +13,7 @@ use crate::blueprint::{self, Score};
 use crate::error::{InputError, ParamError, WorldError};
 use crate::estimator::MotionEstimator;
 use crate::impact::{IMPACT_MIN_SPEED_M_S, ImpactHook, is_support};
+use crate::impacts::ImpactTracker;
 use crate::input::{Buttons, CursorInput};
 use crate::params::{AccelEstimator, BrickPlacement, BrickProps, DeviceLimits, Lo, Params, range};
 use crate::proxy::{self, HeldShape};
@@ -21,8 +22,9 @@ use crate::proxy::{self, HeldShape};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 pub struct BrickId(pub u32);
 
-/// What the cursor can touch.
+/// What the cursor can touch (serialized `"ground"`, `{"brick": 3}`, `{"obstacle": 0}`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Touch {
     /// The ground plane `z = 0`.
     Ground,
@@ -32,8 +34,34 @@ pub enum Touch {
     Obstacle(usize),
 }
 
+/// A body taking part in an impact (serialized `"cursor"`, `"ground"`, `{"brick": 3}`,
+/// `{"obstacle": 0}`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Body {
+    /// The cursor sphere (the hand).
+    Cursor,
+    /// The ground plane.
+    Ground,
+    /// A brick.
+    Brick(BrickId),
+    /// A fixed obstacle, by its index in [`Params::obstacles`].
+    Obstacle(usize),
+}
+
+impl From<Touch> for Body {
+    fn from(t: Touch) -> Body {
+        match t {
+            Touch::Ground => Body::Ground,
+            Touch::Brick(b) => Body::Brick(b),
+            Touch::Obstacle(i) => Body::Obstacle(i),
+        }
+    }
+}
+
 /// A world axis (for the rotate buttons).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Axis {
     /// x.
     X,
@@ -44,7 +72,11 @@ pub enum Axis {
 }
 
 /// Something that happened during a step, in the order it happened.
+///
+/// Its serialized form (the recording's event detail) is JSON with a `type` tag and named
+/// fields, e.g. `{"type":"impact","a":{"brick":0},"b":"ground","impulse_n_s":1.2,...}`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
 pub enum Event {
     /// A brick appeared in the loading zone.
     Spawned {
@@ -109,6 +141,22 @@ pub enum Event {
         slot: usize,
         /// The brick that left.
         brick: BrickId,
+    },
+    /// A collision: a contact that began this step with bodies approaching faster than
+    /// [`IMPACT_MIN_SPEED_M_S`] (see [`crate::impacts`]). Between the cursor and what it touches,
+    /// the impulse is the brick mass × the cursor's approach speed (the cursor has no mass in
+    /// the world; this is the impulse that would stop a brick arriving at that speed).
+    Impact {
+        /// One body.
+        a: Body,
+        /// The other.
+        b: Body,
+        /// Normal impulse of the contact over the step, N·s.
+        impulse_n_s: f64,
+        /// Approach speed along the contact normal just before the step, m/s.
+        speed_m_s: f64,
+        /// Centroid of the contact, m.
+        point_m: [f64; 3],
     },
 }
 
@@ -189,6 +237,9 @@ pub const CENTRAL_LOAD_M: f64 = 1e-3;
 /// Half-extent of the ground slab in x and y, m (the ground is a 100 m × 100 m slab whose top
 /// face is the plane z = 0).
 pub const GROUND_HALF_EXTENT_M: f64 = 50.0;
+/// Range of [`World::nearest_m`], m: farther solids count as none.
+pub const NEAREST_MAX_M: f64 = 1.0;
+
 /// A brick slower than this (m/s) counts as resting for the blueprint.
 pub const RESTING_SPEED_M_S: f64 = 0.05;
 
@@ -246,6 +297,9 @@ pub struct World {
     slots: Vec<Option<BrickId>>,
     tick: u64,
     started: bool,
+    impacts: ImpactTracker,
+    /// The proxy's speed over the last tick, m/s (for cursor impacts).
+    proxy_speed: f64,
 }
 
 fn arr(v: Vector) -> [f64; 3] {
@@ -330,6 +384,8 @@ impl World {
             buttons: Buttons::default(),
             motion,
             touching: Vec::new(),
+            impacts: ImpactTracker::default(),
+            proxy_speed: 0.0,
             in_zone: false,
             slots,
             tick: 0,
@@ -644,6 +700,23 @@ impl World {
         }
     }
 
+    /// Distance from the cursor sphere's surface to the nearest solid (ground, obstacle or
+    /// brick other than the carried one), m: 0 when touching, `f64::INFINITY` when nothing is
+    /// within [`NEAREST_MAX_M`] (the proximity sound's input).
+    pub fn nearest_m(&self) -> f64 {
+        let mut filter = QueryFilter::default();
+        if let Some(h) = self.held {
+            filter = filter.exclude_collider(self.bricks[h.brick.0 as usize].collider);
+        }
+        let r = self.params.proxy_radius_m;
+        let qp = self.phys.query_pipeline_with_filter(filter);
+        match qp.project_point(self.proxy, NEAREST_MAX_M + r, true) {
+            Some((_, proj)) if proj.is_inside => 0.0,
+            Some((_, proj)) => ((proj.point - self.proxy).length() - r).max(0.0),
+            None => f64::INFINITY,
+        }
+    }
+
     /// Number of bricks the physics engine currently simulates (awake), for cost accounting.
     pub fn awake_brick_count(&self) -> usize {
         self.bricks
@@ -698,6 +771,9 @@ impl World {
             let qp = self.phys.query_pipeline_with_filter(filter);
             proxy::update_proxy(&qp, &ball, &held_shape, self.proxy, c)
         };
+        let moved = (upd.position - self.proxy).length() / self.params.dt_s;
+        let approach_speed = moved.max(self.proxy_speed);
+        self.proxy_speed = if self.tick == 0 { 0.0 } else { moved };
         self.proxy = upd.position;
         if self.tick == 0 {
             self.motion.reset(self.proxy.to_array());
@@ -759,6 +835,15 @@ impl World {
         for t in &touching {
             if self.touching.binary_search(t).is_err() {
                 events.push(Event::TouchBegan { target: *t });
+                if self.tick > 0 && approach_speed >= IMPACT_MIN_SPEED_M_S {
+                    events.push(Event::Impact {
+                        a: Body::Cursor,
+                        b: Body::from(*t),
+                        impulse_n_s: self.params.brick_mass_kg * approach_speed,
+                        speed_m_s: approach_speed,
+                        point_m: arr(self.proxy),
+                    });
+                }
             }
         }
         self.touching = touching;
@@ -794,7 +879,18 @@ impl World {
         let hook = ImpactHook {
             impacted: self.impacted_bodies(),
         };
+        self.impacts
+            .before_step(&self.phys, self.bricks.iter().map(|b| b.body));
         self.phys.step_with_events(&hook, &());
+        {
+            let colliders = &self.phys.colliders;
+            let body_of = |c: ColliderHandle| {
+                colliders
+                    .get(c)
+                    .map_or(Body::Ground, |co| Body::from(tag_of(co.user_data)))
+            };
+            self.impacts.after_step(&self.phys, body_of, &mut events);
+        }
 
         // 7. Blueprint.
         self.update_slots(&mut events);

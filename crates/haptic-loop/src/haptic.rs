@@ -27,10 +27,15 @@
 //! - **local stiffness**: the device also gets the 3×3 stiffness of the rendered field (scaled
 //!   by mapping, engagement, watchdog and clamp), so a driver may render between packets.
 //!
+//! - **switches**: [`HapticLoop::switch`] changes what the teaching game's menu changes
+//!   (gravity, friction, …) between two ticks; the change is an input of the next tick
+//!   ([`TickResult::switches`], a `switch.set` event), recorded on `/scene/switch`.
+//!
 //! The world force, the sent force and the status of every tick are returned in
 //! [`TickResult`]; the sent force is always finite and of norm ≤ the device maximum.
 
 use crate::device::{Buttons, DeviceSample, DeviceSpecs, ForceCommand};
+use crate::scene::switch::{self, Switch, SwitchError};
 use crate::scene::{Event, Scene, SceneInput, SceneOutput};
 use crate::vec3::{self, Vec3};
 
@@ -129,6 +134,8 @@ pub struct TickResult {
     pub status: u8,
     /// Events of this tick: loop events, button events, scene events.
     pub events: Vec<Event>,
+    /// Switches applied before this tick's step (an input of the tick; usually empty).
+    pub switches: Vec<Switch>,
 }
 
 /// The haptic loop around one scene.
@@ -144,6 +151,7 @@ pub struct HapticLoop {
     link_lost: bool,
     out: SceneOutput,
     result: TickResult,
+    pending: Vec<Switch>,
 }
 
 /// `k a aᵀ` for a unit axis `a`, `k I` without one (row-major).
@@ -192,6 +200,7 @@ impl HapticLoop {
             link_lost: false,
             out: SceneOutput::default(),
             result: TickResult::default(),
+            pending: Vec::new(),
         }
     }
 
@@ -235,6 +244,26 @@ impl HapticLoop {
         }
     }
 
+    /// Sets a run-time switch of the scene (see [`crate::scene::switch`]): checked against the
+    /// scene's switches, applied at once, and recorded as an input of the next tick (its
+    /// [`TickResult::switches`] and a `switch.set` event).
+    pub fn switch(&mut self, name: &str, value: f64) -> Result<(), SwitchError> {
+        let kind = self.scene.kind();
+        switch::check(kind, self.scene.switches(), name, value)?;
+        self.scene
+            .set_switch(name, value)
+            .map_err(|message| SwitchError::Refused {
+                name: name.to_string(),
+                value,
+                message,
+            })?;
+        self.pending.push(Switch {
+            name: name.to_string(),
+            value,
+        });
+        Ok(())
+    }
+
     /// Why a device sample is invalid, or `None` when it is valid.
     pub fn check_sample(specs: &DeviceSpecs, s: &DeviceSample) -> Option<String> {
         let [x, y, z] = s.position_m;
@@ -267,6 +296,11 @@ impl HapticLoop {
         r.tick = tick;
         r.status = 0;
         r.events.clear();
+        r.switches.clear();
+        for sw in self.pending.drain(..) {
+            r.events.push(Event::new("switch.set", switch::event_detail(&sw)));
+            r.switches.push(sw);
+        }
 
         // 1. Input validation and mapping.
         let problem = Self::check_sample(&self.config.specs, &sample);
@@ -349,7 +383,10 @@ impl HapticLoop {
             r.status |= status::FORCE_INVALID;
             r.events.push(Event::new(
                 "force.invalid",
-                format!("scene force {:?} N is not finite", self.out.force_n),
+                format!(
+                    "scene force ({}, {}, {}) N is not finite",
+                    self.out.force_n[0], self.out.force_n[1], self.out.force_n[2]
+                ),
             ));
             force_ok = false;
         } else if self.out.stiffness_n_per_m > cap * (1.0 + 1e-12) {

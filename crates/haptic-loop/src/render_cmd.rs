@@ -423,8 +423,10 @@ fn replay_into(
     let mut dev = ReplayDevice::from_recording(rec, config.specs.clone(), config.period_ns())?;
     let ticks = dev.ticks();
     let flags = dev.deadline_flags();
+    let switches = haptic_loop::record::switch_schedule(rec, config.period_ns())?;
     let mut lp = HapticLoop::new(config, loaded.scene);
     Runner::new(sinks)
+        .with_switches(switches)
         .run(
             &mut lp,
             &mut dev,

@@ -228,7 +228,8 @@ pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
         compared: 0,
         divergence: None,
     };
-    Runner::new(vec![&mut sink]).run(
+    let switches = crate::record::switch_schedule(rec, period)?;
+    Runner::new(vec![&mut sink]).with_switches(switches).run(
         &mut lp,
         &mut dev,
         d,

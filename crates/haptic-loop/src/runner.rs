@@ -19,6 +19,7 @@ use crate::device::{DeviceError, DeviceSample, HapticDevice, TickTime};
 use crate::haptic::{HapticLoop, LoopConfig, TickResult};
 use crate::pacing::{Pacer, Percentiles, TickStats};
 use crate::record::messages::DescriptionMsg;
+use crate::scene::Switch;
 use crate::session::SessionError;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -101,6 +102,7 @@ pub struct Runner<'s> {
     sinks: Vec<&'s mut dyn Sink>,
     stop: Option<&'s AtomicBool>,
     sink_ns: Vec<Vec<u64>>,
+    switches: Vec<(u64, Switch)>,
 }
 
 /// Time each sink took per tick (its `tick` call), ns.
@@ -128,7 +130,17 @@ impl<'s> Runner<'s> {
             sinks,
             stop: None,
             sink_ns: vec![Vec::new(); n],
+            switches: Vec::new(),
         }
+    }
+
+    /// Sets switches at given ticks (tick, switch): each is applied just before its tick's
+    /// step (a script's `[[switch]]` entries, or a recording's `/scene/switch` on replay).
+    /// Several at one tick apply in the given order.
+    pub fn with_switches(mut self, mut switches: Vec<(u64, Switch)>) -> Self {
+        switches.sort_by_key(|(t, _)| *t);
+        self.switches = switches;
+        self
     }
 
     /// Stops the run cleanly (after the current tick) when `flag` becomes true.
@@ -204,6 +216,11 @@ impl<'s> Runner<'s> {
                 Pacing::Recorded(flags) => flags.get(n as usize).copied().unwrap_or(false),
                 _ => false,
             };
+            let due = self.switches.partition_point(|(t, _)| *t < n);
+            for (_, sw) in self.switches[due..].iter().take_while(|(t, _)| *t == n) {
+                lp.switch(&sw.name, sw.value)
+                    .map_err(|error| SessionError::Switch { tick: n, error })?;
+            }
             lp.tick(sample, recorded_missed);
             let missed = match &pacing {
                 Pacing::Realtime => pacer.as_ref().is_some_and(|p| p.deadline_passed(n)),

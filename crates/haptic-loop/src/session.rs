@@ -23,7 +23,8 @@ use crate::record::sink::RecorderSink;
 use crate::record::writer::RecordError;
 use crate::record::{RecordingError, WriteSummary};
 use crate::runner::{EndReason, Pacing, Runner, Sink};
-use crate::scene::{SceneError, SceneFile, load_scene_for};
+use crate::device::TickTime;
+use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
 pub use crate::textpos::Location;
 use crate::textpos::field_position;
 use std::path::{Path, PathBuf};
@@ -122,6 +123,14 @@ pub enum SessionError {
     /// An option out of range or inconsistent with another.
     #[error("{0}")]
     Option(String),
+    /// A switch that the scene refused at a tick (scheduled by a script or a recording).
+    #[error("tick {tick}: {error}")]
+    Switch {
+        /// The tick it was to apply to.
+        tick: u64,
+        /// Why it was refused.
+        error: crate::scene::SwitchError,
+    },
 }
 
 /// A scene file's text and the folder it came from (to find its default script).
@@ -373,16 +382,67 @@ fn load_script(
     opts: &SessionOptions,
     file: &SceneFile,
     specs: &crate::device::DeviceSpecs,
-) -> Result<(Script, String), SessionError> {
+) -> Result<(Script, String, String), SessionError> {
     let (text, origin) = script_source(opts, file)?;
     let script = Script::from_toml(&text, specs).map_err(|error| SessionError::ScriptFile {
         at: Location {
             at: error.position(&text),
-            file: origin,
+            file: origin.clone(),
         },
         error: Box::new(error),
     })?;
-    Ok((script, text))
+    Ok((script, text, origin))
+}
+
+/// The first tick whose time (`n / rate_hz`, as the device sees it) is at or after `t_s`: the
+/// tick a script event at `t_s` applies to.
+pub fn tick_at(t_s: f64, rate_hz: u32) -> u64 {
+    let mut n = (t_s * f64::from(rate_hz)).ceil().max(0.0) as u64;
+    while n > 0 && TickTime::new(n - 1, rate_hz).time_s >= t_s {
+        n -= 1;
+    }
+    while TickTime::new(n, rate_hz).time_s < t_s {
+        n += 1;
+    }
+    n
+}
+
+/// A script's switches checked against the scene (errors name `switch[i].name` or
+/// `switch[i].value` with the line and column) and turned into ticks.
+fn script_switches(
+    script: &Script,
+    text: &str,
+    origin: &str,
+    scene: &dyn crate::scene::Scene,
+    rate_hz: u32,
+) -> Result<Vec<(u64, Switch)>, SessionError> {
+    let mut out = Vec::with_capacity(script.switches.len());
+    for sw in script.switches.iter() {
+        if let Err(e) =
+            crate::scene::switch::check(scene.kind(), scene.switches(), &sw.name, sw.value)
+        {
+            let i = sw.index;
+            let field = match e {
+                crate::scene::SwitchError::Unknown { .. } => format!("switch[{i}].name"),
+                _ => format!("switch[{i}].value"),
+            };
+            return Err(SessionError::ScriptFile {
+                at: Location {
+                    at: field_position(text, &field),
+                    file: origin.to_string(),
+                },
+                error: Box::new(ScriptError::Switch { field, source: e }),
+            });
+        }
+        out.push((
+            tick_at(sw.t_s, rate_hz),
+            Switch {
+                name: sw.name.clone(),
+                value: sw.value,
+            },
+        ));
+    }
+    Ok(out)
 }
 
 /// Wall-clock time now, ns since the Unix epoch (information only: it never reaches the
@@ -418,7 +478,7 @@ pub fn run_session_until(
         Some(b) => (DeviceSource::Udp(b.clone()), None),
         None => {
             let model = opts.device.unwrap_or(file.device.model);
-            let (script, text) = load_script(opts, &file, model.specs())?;
+            let (script, text, origin) = load_script(opts, &file, model.specs())?;
             let source = match &opts.operator {
                 OperatorChoice::Rigid => DeviceSource::Script(model),
                 OperatorChoice::Hand(p) => {
@@ -432,7 +492,7 @@ pub fn run_session_until(
                     DeviceSource::Hand(model, script.operator.unwrap_or_default())
                 }
             };
-            (source, Some((script, text)))
+            (source, Some((script, text, origin)))
         }
     };
     let mut dev = open_device(&source, script.as_ref().map(|s| &s.0))?;
@@ -454,7 +514,7 @@ pub fn run_session(
 fn run_with_device(
     opts: &SessionOptions,
     source: &DeviceSource,
-    script: Option<(Script, String)>,
+    script: Option<(Script, String, String)>,
     dev: &mut dyn crate::device::HapticDevice,
     progress: &mut dyn FnMut(u64, u64),
     stop: Option<&AtomicBool>,
@@ -466,7 +526,7 @@ fn run_with_device(
     let rate = loaded.config.rate_hz;
     let ticks = match (opts.seconds, &script) {
         (Some(s), _) => Some(ticks_for(s, rate)?),
-        (None, Some((s, _))) => Some(ticks_for(s.duration_s, rate)?),
+        (None, Some((s, _, _))) => Some(ticks_for(s.duration_s, rate)?),
         (None, None) => None,
     };
     let fields = loaded.scene.state_fields();
@@ -480,7 +540,7 @@ fn run_with_device(
         "batch"
     };
     let (script_name, script_toml) = match &script {
-        Some((s, t)) => (s.name.clone(), t.clone()),
+        Some((s, t, _)) => (s.name.clone(), t.clone()),
         None => (String::new(), String::new()),
     };
     let mut description = DescriptionMsg::new(
@@ -493,6 +553,12 @@ fn run_with_device(
     description.script_name = script_name;
     description.script_toml = script_toml;
     description.operator = source.describe();
+    let switches = match &script {
+        Some((s, text, origin)) => {
+            script_switches(s, text, origin, loaded.scene.as_ref(), rate)?
+        }
+        None => Vec::new(),
+    };
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let mut arrays = SessionArrays::new(rate, fields);
     let mut recorder = opts.out.clone().map(RecorderSink::new);
@@ -517,7 +583,7 @@ fn run_with_device(
     } else {
         Pacing::Batch
     };
-    let mut runner = Runner::new(sinks);
+    let mut runner = Runner::new(sinks).with_switches(switches);
     if let Some(f) = stop {
         runner = runner.stop_on(f);
     }

@@ -152,6 +152,15 @@ impl Stepper {
         Ok(self.lp.last_result())
     }
 
+    /// Sets a run-time switch of the scene before the next tick (recorded as that tick's
+    /// input, like a script's `[[switch]]`); errors name the switch and its allowed range.
+    pub fn switch(&mut self, name: &str, value: f64) -> Result<(), SessionError> {
+        let tick = self.lp.next_tick();
+        self.lp
+            .switch(name, value)
+            .map_err(|error| SessionError::Switch { tick, error })
+    }
+
     /// The command for the device after the last tick (force, local stiffness, status).
     pub fn command(&self) -> ForceCommand {
         self.lp.command(0)

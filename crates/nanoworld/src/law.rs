@@ -10,7 +10,8 @@
 use crate::params::{Interaction, Params};
 
 /// The four pair types of the nano world.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum PairKind {
     /// Tip ↔ substrate.
     TipSubstrate,

@@ -48,7 +48,8 @@ fn check_position(p: &Vector3<f64>) -> Result<(), StepError> {
 }
 
 /// A body of the tip assembly: the tip itself or an atom it carries.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Member {
     /// The AFM tip apex.
     Tip,
@@ -57,7 +58,8 @@ pub enum Member {
 }
 
 /// What a member of the tip assembly touches.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Target {
     /// Substrate atom with this index (game mode).
     SubstrateAtom(usize),
@@ -74,7 +76,8 @@ impl Target {
 }
 
 /// Which link of the chain tip → (carried atom) → target → target's support broke at pull-off.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum BrokenLink {
     /// The tip's own contact with the target (tip–substrate or tip–atom).
     TipContact,
@@ -87,7 +90,11 @@ pub enum BrokenLink {
 }
 
 /// A typed event, listed in the order it happened within the tick.
-#[derive(Debug, Clone, Copy, PartialEq)]
+///
+/// Its serialized form (the recording's event detail) is JSON with a `type` tag and named
+/// fields: `{"type":"snap","member":"tip","target":{"substrate_atom":12},...}`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
 pub enum Event {
     /// A movable atom appeared in the loading zone.
     AtomSpawned {
@@ -139,6 +146,19 @@ pub enum Event {
     AtomPickedUp {
         /// Index of the atom.
         atom: usize,
+    },
+    /// The load on the carried atoms (their weight and the inertial force −m·a of the hand's
+    /// acceleration) exceeded the tip's hold on them (the tip–atom pull-off force): they left
+    /// the tip. At this scale a freed atom does not fly: it meets the surface below within
+    /// nanoseconds and sticks there (it is placed at its rest position under the point where
+    /// it left, or bonded where it is when that spot is taken).
+    AtomsThrownOff {
+        /// How many atoms left the tip.
+        atoms: usize,
+        /// Magnitude of the load on them, N.
+        load_n: f64,
+        /// The tip–atom pull-off force it exceeded, N.
+        pull_off_n: f64,
     },
     /// A blueprint slot became filled.
     SlotFilled {
@@ -364,7 +384,14 @@ impl World {
         let prev = self.history;
         self.history = [Some(self.cursor), prev[0]];
         self.cursor = input.position_m;
-        let load = self.load(dt_s);
+        let mut load = self.load(dt_s);
+        if self.contact == TipContact::Free && !self.carried.is_empty() {
+            let hold = self.laws.get(PairKind::TipAtom).pull_off_n;
+            if load.norm() >= hold {
+                self.throw_off(load.norm(), hold, &mut events);
+                load = Vector3::zeros();
+            }
+        }
 
         self.maybe_spawn(&mut events);
         if let TipContact::Anchored(a) = self.contact {
@@ -509,6 +536,97 @@ impl World {
                 self.atoms[i].position = p + o;
             }
         }
+    }
+
+    /// The carried atoms leave the tip (see [`Event::AtomsThrownOff`]).
+    fn throw_off(&mut self, load_n: f64, pull_off_n: f64, events: &mut Vec<Event>) {
+        let cluster = std::mem::take(&mut self.carried);
+        let r = self.params.atoms.radius_m;
+        for &c in &cluster {
+            self.atoms[c].carried_offset = None;
+            self.disarm(Member::Tip, Some(c));
+            let p = self.atoms[c].position;
+            let rest = self.rest_position([p.x, p.y]);
+            let (sx, sy) = self.substrate_extent_m();
+            let over = p.x >= 0.0 && p.x <= sx && p.y >= 0.0 && p.y <= sy;
+            let taken = self
+                .atoms
+                .iter()
+                .enumerate()
+                .find(|(j, a)| *j != c && (a.position - rest).norm() < 2.0 * r * (1.0 - 1e-9))
+                .map(|(j, _)| j);
+            match taken {
+                None if over => {
+                    self.atoms[c].position = rest;
+                    self.atoms[c].on_substrate = true;
+                }
+                _ => {
+                    // Bonded where it is, to the nearest other atom (or, off the substrate,
+                    // resting on nothing: it stays put, unbound).
+                    let nearest = self
+                        .atoms
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != c && !cluster.contains(j))
+                        .min_by(|(_, a), (_, b)| {
+                            (a.position - p).norm().total_cmp(&(b.position - p).norm())
+                        })
+                        .map(|(j, _)| j);
+                    if let (Some(j), Some(_)) = (nearest, taken) {
+                        for (x, y) in [(c, j), (j, c)] {
+                            if !self.atoms[x].bonds.contains(&y) {
+                                self.atoms[x].bonds.push(y);
+                                self.atoms[x].bonds.sort_unstable();
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        events.push(Event::AtomsThrownOff {
+            atoms: cluster.len(),
+            load_n,
+            pull_off_n,
+        });
+    }
+
+    /// Extent of the substrate's atom centres, m: x and y from 0 to these.
+    fn substrate_extent_m(&self) -> (f64, f64) {
+        let s = &self.params.substrate;
+        (
+            (s.nx - 1) as f64 * s.spacing_m,
+            (s.ny - 1) as f64 * s.spacing_m,
+        )
+    }
+
+    /// Gap between the tip assembly and the nearest body it does not carry, m: the smallest
+    /// surface-to-surface distance from the tip or a carried atom to a substrate atom (game) or
+    /// the substrate plane (physical) or an uncarried movable atom. 0 in contact (never
+    /// negative); the proximity sound's input.
+    pub fn nearest_gap_m(&self) -> f64 {
+        let mut members: Vec<(Vector3<f64>, f64)> = vec![(self.tip, self.params.tip.radius_m)];
+        for &c in &self.carried {
+            members.push((self.atoms[c].position, self.params.atoms.radius_m));
+        }
+        let rs = self.substrate.radius_m();
+        let ra = self.params.atoms.radius_m;
+        let mut best = f64::INFINITY;
+        for (p, r) in members {
+            if self.laws.physical {
+                best = best.min(p.z - r - self.plane_z());
+            } else {
+                // The nearest lattice site under the member (the lattice is regular).
+                let s = &self.params.substrate;
+                let i = (p.x / s.spacing_m).round().clamp(0.0, (s.nx - 1) as f64);
+                let j = (p.y / s.spacing_m).round().clamp(0.0, (s.ny - 1) as f64);
+                let q = Vector3::new(i * s.spacing_m, j * s.spacing_m, 0.0);
+                best = best.min((p - q).norm() - r - rs);
+            }
+            for a in self.atoms.iter().filter(|a| !a.is_carried()) {
+                best = best.min((a.position - p).norm() - r - ra);
+            }
+        }
+        best.max(0.0)
     }
 
     /// Pull-off force holding an uncarried atom where it is (N): the strongest of its bonds.

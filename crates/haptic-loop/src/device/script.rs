@@ -23,6 +23,11 @@
 //! t_s = 1.0
 //! name = "centre"
 //! down = true
+//!
+//! [[switch]]                  # optional: the teaching game's menu, at a time
+//! t_s = 2.0
+//! name = "gravity_m_s2"       # one of the scene's switches (docs/haptic-loop.md)
+//! value = 0.0                 # a number, or true / false for on/off switches
 //! ```
 
 use super::{
@@ -59,6 +64,14 @@ pub enum ScriptError {
         /// The allowed range in words.
         allowed: String,
     },
+    /// A switch the scene does not have, or a value outside its range.
+    #[error("script: `{field}`: {source}")]
+    Switch {
+        /// Field path, e.g. `switch[0].name`.
+        field: String,
+        /// What the scene allows.
+        source: crate::scene::SwitchError,
+    },
     /// A button the device does not have.
     #[error("script: `{field}`: {source}")]
     Button {
@@ -76,7 +89,9 @@ impl ScriptError {
         use crate::textpos::{field_position, position};
         match self {
             ScriptError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
-            ScriptError::OutOfRange { field, .. } | ScriptError::Button { field, .. } => {
+            ScriptError::OutOfRange { field, .. }
+            | ScriptError::Button { field, .. }
+            | ScriptError::Switch { field, .. } => {
                 field_position(text, field)
             }
             ScriptError::NoWaypoints => field_position(text, "script"),
@@ -95,6 +110,8 @@ struct ScriptFile {
     waypoint: Vec<WaypointFile>,
     #[serde(default)]
     button: Vec<ButtonFile>,
+    #[serde(default)]
+    switch: Vec<SwitchFile>,
 }
 
 #[derive(Deserialize)]
@@ -133,6 +150,35 @@ struct ButtonFile {
     down: bool,
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SwitchFile {
+    t_s: f64,
+    name: String,
+    value: SwitchValue,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum SwitchValue {
+    Bool(bool),
+    Number(f64),
+}
+
+/// A scheduled switch: at `t_s` the scene's switch `name` takes `value` (applied before the
+/// first tick whose time is ≥ `t_s`, like button events).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SwitchEvent {
+    /// Time, s.
+    pub t_s: f64,
+    /// The switch (checked against the scene when the session starts).
+    pub name: String,
+    /// Its value (booleans as 0 / 1).
+    pub value: f64,
+    /// Its index in the file's `[[switch]]` list (errors name `switch[index]`).
+    pub index: usize,
+}
+
 /// A waypoint: the stylus is at `position_m` at time `t_s`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Waypoint {
@@ -164,6 +210,8 @@ pub struct Script {
     pub waypoints: Vec<Waypoint>,
     /// Button events in non-decreasing time (file order kept on equal times).
     pub buttons: Vec<ButtonEvent>,
+    /// Switch events in non-decreasing time (file order kept on equal times).
+    pub switches: Vec<SwitchEvent>,
     /// Operator hand parameters given by the script, if any.
     pub operator: Option<OperatorParams>,
     /// How the script wants to be played by default.
@@ -257,7 +305,37 @@ impl Script {
             });
         }
         buttons.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
-        let natural = buttons.iter().map(|b| b.t_s).fold(last_t, f64::max);
+        let mut switches = Vec::with_capacity(file.switch.len());
+        for (i, w) in file.switch.iter().enumerate() {
+            check(
+                format!("switch[{i}].t_s"),
+                w.t_s,
+                w.t_s.is_finite() && (0.0..=MAX_SCRIPT_S).contains(&w.t_s),
+                &range,
+            )?;
+            let value = match w.value {
+                SwitchValue::Bool(b) => f64::from(u8::from(b)),
+                SwitchValue::Number(v) => v,
+            };
+            check(
+                format!("switch[{i}].value"),
+                value,
+                value.is_finite(),
+                "a finite number",
+            )?;
+            switches.push(SwitchEvent {
+                t_s: w.t_s,
+                name: w.name.clone(),
+                value,
+                index: i,
+            });
+        }
+        switches.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        let natural = buttons
+            .iter()
+            .map(|b| b.t_s)
+            .chain(switches.iter().map(|s| s.t_s))
+            .fold(last_t, f64::max);
         let duration_s = match file.script.duration_s {
             Some(d) => {
                 check(
@@ -289,6 +367,7 @@ impl Script {
             duration_s,
             waypoints,
             buttons,
+            switches,
             operator: file.operator,
             operator_kind: file.script.operator,
         })

@@ -24,6 +24,9 @@ pub enum CdrError {
     /// Bytes left after the last field.
     #[error("{0} bytes left after the last field")]
     Trailing(usize),
+    /// Fields that contradict each other (e.g. sequences of different lengths).
+    #[error("{0}")]
+    Invalid(String),
     /// A recording of another format version.
     #[error(
         "recorded with format {0}; this build reads {fmt} (re-record the session, or replay it with the build that wrote it)",
@@ -105,6 +108,12 @@ impl CdrWriter {
             self.f64(*x);
         }
         self
+    }
+
+    /// Writes a `float64[]` (unbounded sequence: a u32 count, then the elements).
+    pub fn f64_seq(&mut self, v: &[f64]) -> &mut Self {
+        self.u32(v.len() as u32);
+        self.f64s(v)
     }
 
     /// Writes a `string`.
@@ -218,6 +227,19 @@ impl<'a> CdrReader<'a> {
             return Err(CdrError::BadString(at));
         }
         String::from_utf8(b[..n - 1].to_vec()).map_err(|_| CdrError::BadString(at))
+    }
+
+    /// Reads a `float64[]` (unbounded sequence).
+    pub fn f64_seq(&mut self) -> Result<Vec<f64>, CdrError> {
+        let n = self.u32()? as usize;
+        // Each element takes 8 bytes: refuse counts the message cannot hold.
+        if n > (self.buf.len() - self.pos) / 8 {
+            return Err(CdrError::Eof {
+                at: self.pos,
+                what: "float64[]",
+            });
+        }
+        (0..n).map(|_| self.f64()).collect()
     }
 
     /// Reads a `string[]`.

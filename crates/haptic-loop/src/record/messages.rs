@@ -5,7 +5,7 @@ use super::cdr::{CdrError, CdrReader, CdrWriter};
 use crate::vec3::Vec3;
 
 /// Format version written in the scene description; bumped on any layout change.
-pub const FORMAT_VERSION: &str = "nanohaptics-recording/2";
+pub const FORMAT_VERSION: &str = "nanohaptics-recording/3";
 
 /// The channels of a recording.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -14,6 +14,8 @@ pub enum Channel {
     Description,
     /// `/device/input`, every tick (an input of replay).
     DeviceInput,
+    /// `/scene/switch`, on ticks where switches were set (an input of replay).
+    Switch,
     /// `/world/state`, every tick.
     State,
     /// `/haptic/force`, every tick.
@@ -32,9 +34,10 @@ pub enum Channel {
 
 impl Channel {
     /// Every channel, in registration order.
-    pub const ALL: [Channel; 9] = [
+    pub const ALL: [Channel; 10] = [
         Channel::Description,
         Channel::DeviceInput,
+        Channel::Switch,
         Channel::State,
         Channel::Force,
         Channel::Events,
@@ -49,6 +52,7 @@ impl Channel {
         match self {
             Channel::Description => "/scene/description",
             Channel::DeviceInput => "/device/input",
+            Channel::Switch => "/scene/switch",
             Channel::State => "/world/state",
             Channel::Force => "/haptic/force",
             Channel::Events => "/events",
@@ -68,7 +72,7 @@ impl Channel {
     pub fn verified(self) -> bool {
         !matches!(
             self,
-            Channel::Description | Channel::DeviceInput | Channel::Timing
+            Channel::Description | Channel::DeviceInput | Channel::Switch | Channel::Timing
         )
     }
 }
@@ -111,6 +115,16 @@ pub const EVENTS_SCHEMA: (&str, &str) = (
      uint64 tick\n\
      string[] names\n\
      string[] details\n",
+);
+
+/// Schema of `/scene/switch`.
+pub const SWITCH_SCHEMA: (&str, &str) = (
+    "nanohaptics_msgs/msg/Switch",
+    "# Run-time switches set just before this tick's step (the teaching game's menu), in order.\n\
+     uint64 tick\n\
+     string[] names\n\
+     # new values (on/off switches: 1 / 0)\n\
+     float64[] values\n",
 );
 
 /// Schema of `/loop/timing`.
@@ -358,6 +372,51 @@ impl EventsMsg {
         };
         r.end()?;
         Ok(m)
+    }
+}
+
+/// `/scene/switch`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SwitchMsg {
+    /// Tick index.
+    pub tick: u64,
+    /// The switches set before the tick's step, in order.
+    pub switches: Vec<crate::scene::Switch>,
+}
+
+impl SwitchMsg {
+    /// Encodes the `switches` of `tick` to CDR.
+    pub fn encode(tick: u64, switches: &[crate::scene::Switch]) -> Vec<u8> {
+        let values: Vec<f64> = switches.iter().map(|s| s.value).collect();
+        let mut w = CdrWriter::new();
+        w.u64(tick)
+            .strings(switches.iter().map(|s| s.name.as_str()))
+            .f64_seq(&values);
+        w.finish()
+    }
+
+    /// Decodes from CDR; names and values must be of the same length.
+    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let tick = r.u64()?;
+        let names = r.strings()?;
+        let values = r.f64_seq()?;
+        r.end()?;
+        if names.len() != values.len() {
+            return Err(CdrError::Invalid(format!(
+                "{} switch names but {} values",
+                names.len(),
+                values.len()
+            )));
+        }
+        Ok(SwitchMsg {
+            tick,
+            switches: names
+                .into_iter()
+                .zip(values)
+                .map(|(name, value)| crate::scene::Switch { name, value })
+                .collect(),
+        })
     }
 }
 

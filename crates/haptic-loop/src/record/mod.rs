@@ -88,6 +88,14 @@ impl TickEncoder {
         }
     }
 
+    /// The `/scene/switch` message of a tick, when switches were set before it.
+    pub fn switches(r: &TickResult) -> Option<OutMsg> {
+        (!r.switches.is_empty()).then(|| OutMsg {
+            channel: Channel::Switch,
+            data: messages::SwitchMsg::encode(r.tick, &r.switches),
+        })
+    }
+
     /// The `/loop/timing` message of a tick.
     pub fn timing(tick: u64, start_late_ns: i64, compute_ns: u64) -> OutMsg {
         OutMsg {
@@ -157,6 +165,33 @@ impl TickEncoder {
             });
         }
     }
+}
+
+/// The switches of a recording as a schedule (tick, switch) for the runner, from its
+/// `/scene/switch` messages (log time `start + tick · period_ns`).
+pub fn switch_schedule(
+    rec: &Recording,
+    period_ns: u64,
+) -> Result<Vec<(u64, crate::scene::Switch)>, RecordingError> {
+    let start = rec.description.start_time_ns;
+    let mut out = Vec::new();
+    for m in rec.messages.iter().filter(|m| m.channel == Channel::Switch) {
+        let bad = |detail: String| RecordingError::BadMessage {
+            topic: Channel::Switch.topic().to_string(),
+            log_time_ns: m.log_time_ns,
+            detail,
+        };
+        let d = messages::SwitchMsg::decode(&m.data).map_err(|e| bad(e.to_string()))?;
+        let at = start.saturating_add(d.tick.saturating_mul(period_ns));
+        if m.log_time_ns != at {
+            return Err(bad(format!(
+                "tick {} belongs at {at} ns, found at {} ns",
+                d.tick, m.log_time_ns
+            )));
+        }
+        out.extend(d.switches.into_iter().map(|s| (d.tick, s)));
+    }
+    Ok(out)
 }
 
 /// Writes `rec` (e.g. the salvaged part of a truncated recording) as a new, complete MCAP

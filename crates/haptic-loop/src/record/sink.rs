@@ -76,6 +76,7 @@ impl Sink for RecorderSink {
         let n = t.result.tick;
         let mut msgs = Vec::with_capacity(8);
         msgs.push(TickEncoder::input(n, &t.sample, t.deadline_missed));
+        msgs.extend(TickEncoder::switches(t.result));
         enc.outputs(t.result, t.lp, &mut msgs);
         msgs.push(TickEncoder::timing(n, t.start_late_ns, t.compute_ns));
         rec.write(TickMessages {

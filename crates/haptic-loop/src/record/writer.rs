@@ -162,6 +162,7 @@ fn open(
         let (name, enc, data): (String, String, Vec<u8>) = match ch {
             Channel::Description => s(messages::DESCRIPTION_SCHEMA),
             Channel::DeviceInput => s(messages::DEVICE_INPUT_SCHEMA),
+            Channel::Switch => s(messages::SWITCH_SCHEMA),
             Channel::State => (
                 state_name.clone(),
                 "ros2msg".into(),

@@ -9,7 +9,8 @@
 //! The world's `dt_s` must equal the loop's tick.
 
 use super::file::{SceneError, out_of_range};
-use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
+use super::score::{self, DROP_HEIGHT_M, HouseScore};
+use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec};
 use crate::vec3::Vec3;
 use brickworld::{Buttons as BrickButtons, CursorInput, DeviceLimits, Params, World};
 use serde::Deserialize;
@@ -40,7 +41,19 @@ pub struct BrickScene {
     force_n: Vec3,
     penetration_m: f64,
     ground_half_m: f64,
+    score: HouseScore,
+    /// Bricks let go by the hand that have not hit anything since.
+    released: Vec<(brickworld::BrickId, f64)>,
 }
+
+/// The macro world's switches (the paper's menu), named as in `[brickworld.params]`.
+pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
+    SwitchSpec::number("gravity_m_s2", 0.0, 100.0, "gravity, m/s² (0: off)"),
+    SwitchSpec::number("restitution", 0.0, 1.0, "restitution of every contact"),
+    SwitchSpec::number("friction", 0.0, 10.0, "friction coefficient of every contact"),
+    SwitchSpec::on_off("inertia", "the carried brick's inertial force −M a"),
+    SwitchSpec::number("brick_mass_kg", 1e-3, 100.0, "mass of every brick, kg"),
+];
 
 impl BrickScene {
     /// Builds the scene: `cap_n_per_m` and `max_force_world_n` are the device limits mapped to
@@ -64,6 +77,7 @@ impl BrickScene {
             max_stiffness_n_m: cap_n_per_m,
             max_force_n: max_force_world_n,
         };
+        let slots = s.params.blueprint.slots.len();
         let world = World::new(s.params, limits).map_err(|e| SceneError::World {
             section: "brickworld.params".into(),
             field: Some(e.field().to_string()),
@@ -87,6 +101,8 @@ impl BrickScene {
             force_n: [0.0; 3],
             penetration_m: 0.0,
             ground_half_m: s.draw_ground_half_m,
+            score: HouseScore::new(slots, max_force_world_n, dt_s),
+            released: Vec::new(),
         })
     }
 
@@ -110,6 +126,50 @@ fn event_name(e: &brickworld::Event) -> &'static str {
         E::TouchEnded { .. } => "brick.touch_ended",
         E::SlotFilled { .. } => "brick.slot_filled",
         E::SlotVacated { .. } => "brick.slot_vacated",
+        E::Impact { .. } => "brick.impact",
+    }
+}
+
+/// An event's detail: its JSON form (`{"type":"impact","a":"cursor",...}`).
+fn event_detail(e: &brickworld::Event) -> String {
+    serde_json::to_string(e).unwrap_or_default()
+}
+
+/// Counts drops for the score: a brick let go by the hand that fell [`DROP_HEIGHT_M`] or more
+/// before its first impact, the height from the speeds under gravity g:
+/// `h = (v_impact² − v_release²) / (2 g)` (a brick pressed down and let go just above its
+/// place falls less than a millimetre; a thrown brick's speed is mostly horizontal).
+fn track_drops(
+    e: &brickworld::Event,
+    released: &mut Vec<(brickworld::BrickId, f64)>,
+    g_m_s2: f64,
+    score: &mut HouseScore,
+) {
+    use brickworld::{Body, Event as E};
+    match e {
+        E::Released {
+            brick,
+            velocity_m_s: v,
+        } => released.push((*brick, (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())),
+        E::Grabbed { brick } => released.retain(|(b, _)| b != brick),
+        E::Impact { a, b, speed_m_s, .. } => {
+            for body in [a, b] {
+                if let Body::Brick(id) = body
+                    && let Some(i) = released.iter().position(|(r, _)| r == id)
+                {
+                    let (_, v0) = released.swap_remove(i);
+                    let fall = if g_m_s2 > 0.0 {
+                        (speed_m_s * speed_m_s - v0 * v0) / (2.0 * g_m_s2)
+                    } else {
+                        0.0
+                    };
+                    if fall >= DROP_HEIGHT_M {
+                        score.drop_one();
+                    }
+                }
+            }
+        }
+        _ => {}
     }
 }
 
@@ -128,10 +188,32 @@ impl Scene for BrickScene {
             "awake_bricks",
             "slots_filled",
             "proxy_penetration_m",
+            "nearest_m",
         ]
         .iter()
+        .chain(score::FIELDS.iter())
         .map(|s| s.to_string())
         .collect()
+    }
+
+    fn switches(&self) -> &'static [SwitchSpec] {
+        &BRICK_SWITCHES
+    }
+
+    fn set_switch(&mut self, name: &str, value: f64) -> Result<(), String> {
+        let w = &mut self.world;
+        match name {
+            "gravity_m_s2" => w.set_gravity(value),
+            "restitution" => w.set_restitution(value),
+            "friction" => w.set_friction(value),
+            "inertia" => {
+                w.set_inertia(value != 0.0);
+                Ok(())
+            }
+            "brick_mass_kg" => w.set_brick_mass(value),
+            other => return Err(format!("the brickworld scene has no switch `{other}`")),
+        }
+        .map_err(|e| e.to_string())
     }
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
@@ -163,9 +245,13 @@ impl Scene for BrickScene {
         self.last_input = Some(ci);
         let r = self.world.step(&ci);
         for e in &r.events {
-            out.events.push(Event::new(event_name(e), format!("{e:?}")));
+            out.events.push(Event::new(event_name(e), event_detail(e)));
+            let g = self.world.params().gravity_m_s2;
+            track_drops(e, &mut self.released, g, &mut self.score);
         }
         self.force_n = if self.rejected { [0.0; 3] } else { r.force_n };
+        self.score
+            .update(input.tick, self.force_n, self.world.score().filled);
         self.penetration_m = r.proxy_penetration_m;
         out.force_n = self.force_n;
         out.stiffness_n_per_m = r.stiffness_n_m;
@@ -179,6 +265,8 @@ impl Scene for BrickScene {
         out.push(self.world.awake_brick_count() as f64);
         out.push(self.world.score().filled as f64);
         out.push(self.penetration_m);
+        out.push(self.world.nearest_m());
+        self.score.state(out);
     }
 
     fn draw(&self, out: &mut Vec<Primitive>) {

@@ -399,7 +399,8 @@ fn build(file: SceneFile, specs: DeviceSpecs) -> Result<LoadedScene, SceneError>
         }
         "nanoworld" => {
             let p = file.nanoworld.clone().ok_or_else(|| missing("nanoworld"))?;
-            Box::new(NanoScene::new(p, cap, dt)?)
+            let fmax = config.specs.max_force_n / config.mapping.force_scale;
+            Box::new(NanoScene::new(p, cap, fmax, dt)?)
         }
         "optical_tweezers" => {
             let p = file

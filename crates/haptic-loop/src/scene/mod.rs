@@ -10,12 +10,15 @@ pub mod file;
 pub mod nano;
 pub mod optical;
 pub mod overrides;
+pub mod score;
+pub mod switch;
 pub mod wall;
 
 use crate::device::Buttons;
 use crate::vec3::Vec3;
 
 pub use file::{SceneError, SceneFile, load_scene, load_scene_for};
+pub use switch::{Switch, SwitchError, SwitchSpec};
 
 /// What the loop tells the scene each tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,4 +101,14 @@ pub trait Scene {
     fn state(&self, out: &mut Vec<f64>);
     /// Appends the primitives to draw the current state to `out`.
     fn draw(&self, out: &mut Vec<Primitive>);
+    /// The run-time switches this scene offers (the teaching game's menu); none by default.
+    fn switches(&self) -> &'static [SwitchSpec] {
+        &[]
+    }
+    /// Sets a switch, already checked against [`Scene::switches`] (name known, value in range);
+    /// it takes effect from the next step. `Err` carries the world's reason when it cannot
+    /// hold the value.
+    fn set_switch(&mut self, name: &str, _value: f64) -> Result<(), String> {
+        Err(format!("the {} scene has no switch `{name}`", self.kind()))
+    }
 }

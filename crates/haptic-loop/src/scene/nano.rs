@@ -12,7 +12,8 @@
 //! scene reports the adhesion `k` of the anchored contact (game mode) or `k_c` (physical).
 
 use super::file::{SceneError, out_of_range};
-use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
+use super::score::{self, HouseScore};
+use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec};
 use crate::vec3::Vec3;
 use nalgebra::Vector3;
 use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};
@@ -39,12 +40,62 @@ fn default_draw_radius() -> f64 {
 
 /// The nano-world scene.
 pub struct NanoScene {
+    /// The parameters in force (the scene file's, with the switches applied).
     params: Params,
+    /// The scene file's parameters (switch scales apply to these).
+    base: Params,
+    /// Strength scales: all pairs, then tip–substrate, tip–atom, atom–atom, atom–substrate.
+    scales: [f64; 5],
     world: Option<World>,
     dt_s: f64,
     draw_radius_m: f64,
     saturated: bool,
     force_n: Vec3,
+    score: HouseScore,
+}
+
+/// The nano world's switches (the paper's menu: pair strengths and masses; gravity and
+/// inertia too). A strength scale multiplies the scene file's pair strength A (game) or
+/// Hamaker constant (physical); below 1 it also scales the game's adhesion stiffness k, so that
+/// the contact still holds after it snaps (k must stay below pull_off_ratio × snap force / snap
+/// gap, which scales with A).
+pub const NANO_SWITCHES: [SwitchSpec; 8] = [
+    SwitchSpec::number("adhesion_scale", 0.0, 10.0, "every pair strength × this"),
+    SwitchSpec::number("tip_substrate_scale", 0.0, 10.0, "tip–substrate strength × this"),
+    SwitchSpec::number("tip_atom_scale", 0.0, 10.0, "tip–atom strength × this"),
+    SwitchSpec::number("atom_atom_scale", 0.0, 10.0, "atom–atom strength × this"),
+    SwitchSpec::number("atom_substrate_scale", 0.0, 10.0, "atom–substrate strength × this"),
+    SwitchSpec::number("atom_mass_kg", 0.0, 1.0, "mass of every movable atom, kg"),
+    SwitchSpec::number("gravity_m_s2", 0.0, 1000.0, "gravity, m/s² (0: off)"),
+    SwitchSpec::on_off("inertia", "the carried atoms' inertial force −m a"),
+];
+
+/// `base` with the strength `scales` applied (see [`NANO_SWITCHES`]).
+fn scaled(base: &Params, scales: [f64; 5]) -> Params {
+    let mut p = base.clone();
+    let s = |k: usize| scales[0] * scales[k];
+    match &mut p.interaction {
+        Interaction::Game(g) => {
+            for (pair, f) in [
+                (&mut g.pairs.tip_substrate, s(1)),
+                (&mut g.pairs.tip_atom, s(2)),
+                (&mut g.pairs.atom_atom, s(3)),
+                (&mut g.pairs.atom_substrate, s(4)),
+            ] {
+                pair.strength_n_m2 *= f;
+                if f < 1.0 && f > 0.0 {
+                    pair.stiffness_n_per_m *= f;
+                }
+            }
+        }
+        Interaction::Physical(ph) => {
+            ph.hamaker_j.tip_substrate *= s(1);
+            ph.hamaker_j.tip_atom *= s(2);
+            ph.hamaker_j.atom_atom *= s(3);
+            ph.hamaker_j.atom_substrate *= s(4);
+        }
+    }
+    p
 }
 
 fn max_render_stiffness(p: &Params) -> (String, f64) {
@@ -74,8 +125,14 @@ fn max_render_stiffness(p: &Params) -> (String, f64) {
 }
 
 impl NanoScene {
-    /// Builds the scene from its section, the world stiffness cap (N/m) and the tick (s).
-    pub fn new(s: NanoSection, cap_n_per_m: f64, dt_s: f64) -> Result<Self, SceneError> {
+    /// Builds the scene from its section, the world stiffness cap (N/m), the device's largest
+    /// force mapped to the world (N, for the score's comfort limit) and the tick (s).
+    pub fn new(
+        s: NanoSection,
+        cap_n_per_m: f64,
+        max_force_world_n: f64,
+        dt_s: f64,
+    ) -> Result<Self, SceneError> {
         let params = match (&s.preset, s.params) {
             (Some(name), None) => match name.as_str() {
                 "game" => Params::game_default(),
@@ -114,13 +171,17 @@ impl NanoScene {
             ));
         }
         super::file::check_positive("nanoworld.draw_radius_m", s.draw_radius_m, 1e-6)?;
+        let slots = params.house.as_ref().map_or(0, |h| h.slots_m.len());
         Ok(NanoScene {
+            base: params.clone(),
             params,
+            scales: [1.0; 5],
             world: None,
             dt_s,
             draw_radius_m: s.draw_radius_m,
             saturated: false,
             force_n: [0.0; 3],
+            score: HouseScore::new(slots, max_force_world_n, dt_s),
         })
     }
 
@@ -146,6 +207,7 @@ fn event_name(e: &nanoworld::Event) -> &'static str {
         E::SlotFilled { .. } => "nano.slot_filled",
         E::SlotEmptied { .. } => "nano.slot_emptied",
         E::HouseComplete => "nano.house_complete",
+        E::AtomsThrownOff { .. } => "nano.atoms_thrown_off",
     }
 }
 
@@ -163,10 +225,41 @@ impl Scene for NanoScene {
             "carried_atoms",
             "movable_atoms",
             "house_score",
+            "nearest_m",
         ]
         .iter()
+        .chain(score::FIELDS.iter())
         .map(|s| s.to_string())
         .collect()
+    }
+
+    fn switches(&self) -> &'static [SwitchSpec] {
+        &NANO_SWITCHES
+    }
+
+    fn set_switch(&mut self, name: &str, value: f64) -> Result<(), String> {
+        let mut scales = self.scales;
+        let mut base = self.base.clone();
+        match name {
+            "adhesion_scale" => scales[0] = value,
+            "tip_substrate_scale" => scales[1] = value,
+            "tip_atom_scale" => scales[2] = value,
+            "atom_atom_scale" => scales[3] = value,
+            "atom_substrate_scale" => scales[4] = value,
+            "atom_mass_kg" => base.atoms.mass_kg = value,
+            "gravity_m_s2" => base.gravity_m_s2 = value,
+            "inertia" => base.inertia = value != 0.0,
+            other => return Err(format!("the nanoworld scene has no switch `{other}`")),
+        }
+        let params = scaled(&base, scales);
+        match self.world.as_mut() {
+            Some(w) => w.set_params(params.clone()).map_err(|e| e.to_string())?,
+            None => params.validate().map_err(|e| e.to_string())?,
+        }
+        self.params = params;
+        self.base = base;
+        self.scales = scales;
+        Ok(())
     }
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
@@ -186,7 +279,15 @@ impl Scene for NanoScene {
         match world.step(&TipInput { position_m: cursor }, self.dt_s) {
             Ok(r) => {
                 for e in &r.events {
-                    out.events.push(Event::new(event_name(e), format!("{e:?}")));
+                    out.events.push(Event::new(
+                        event_name(e),
+                        serde_json::to_string(e).unwrap_or_default(),
+                    ));
+                    if let nanoworld::Event::AtomsThrownOff { atoms, .. } = e {
+                        for _ in 0..*atoms {
+                            self.score.drop_one();
+                        }
+                    }
                 }
                 if r.saturated && !self.saturated {
                     out.events.push(Event::new(
@@ -207,6 +308,7 @@ impl Scene for NanoScene {
             }
         }
         out.force_n = self.force_n;
+        self.score.update(input.tick, self.force_n, world.house().score());
         out.stiffness_n_per_m = match (&self.params.interaction, world.tip_contact()) {
             (Interaction::Physical(p), _) => p.cantilever_stiffness_n_per_m,
             (Interaction::Game(_), TipContact::Anchored(a)) => {
@@ -228,9 +330,14 @@ impl Scene for NanoScene {
                 out.push(w.carried().len() as f64);
                 out.push(w.atoms().len() as f64);
                 out.push(w.house().score() as f64);
+                out.push(w.nearest_gap_m());
             }
-            None => out.extend_from_slice(&[0.0; 7]),
+            None => {
+                out.extend_from_slice(&[0.0; 7]);
+                out.push(f64::INFINITY);
+            }
         }
+        self.score.state(out);
     }
 
     fn draw(&self, out: &mut Vec<Primitive>) {

@@ -1,0 +1,187 @@
+//! The teaching game as a whole: switches during a session (recorded as inputs, replayed bit
+//! for bit), collision and contact events with their JSON details, the proximity state, and
+//! the house score.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use haptic_loop::record::messages::Channel;
+use haptic_loop::record::read_recording_file;
+use haptic_loop::replay::verify;
+use haptic_loop::session::{
+    OperatorChoice, SceneSource, SessionArrays, SessionOptions, run_session,
+};
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("haptic-loop-game-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn scene(name: &str) -> SceneSource {
+    SceneSource::from_path(&root().join("scenes").join(name)).unwrap()
+}
+
+/// The scene's default script with `extra` TOML appended.
+fn script_plus(name: &str, extra: &str) -> String {
+    let t = std::fs::read_to_string(root().join("scenes").join(name)).unwrap();
+    format!("{t}\n{extra}")
+}
+
+fn run(scene_file: &str, script: Option<String>, secs: f64, out: Option<PathBuf>) -> SessionArrays {
+    let mut o = SessionOptions::new(scene(scene_file));
+    o.script = script;
+    o.operator = OperatorChoice::Rigid;
+    o.seconds = Some(secs);
+    o.out = out;
+    run_session(&o, &mut |_, _| {}).unwrap().arrays
+}
+
+fn json(detail: &str) -> serde_json::Value {
+    serde_json::from_str(detail).unwrap_or_else(|e| panic!("detail {detail:?}: {e}"))
+}
+
+#[test]
+fn switching_gravity_off_mid_carry_removes_the_weight_and_replays_bit_exactly() {
+    // The default script carries the first brick from 1.529 s to 3.575 s; from 2.104 s to
+    // 3.004 s it moves horizontally. Gravity goes off at 2.5 s and back on at 2.8 s.
+    let extra = "[[switch]]\nt_s = 2.5\nname = \"gravity_m_s2\"\nvalue = 0.0\n\n\
+                 [[switch]]\nt_s = 2.8\nname = \"gravity_m_s2\"\nvalue = 9.81\n";
+    let p = tmp("gravity.mcap");
+    let a = run(
+        "brickworld.toml",
+        Some(script_plus("brickworld.script.toml", extra)),
+        3.0,
+        Some(p.clone()),
+    );
+    let sets: Vec<_> = a.events.iter().filter(|e| e.1 == "switch.set").collect();
+    assert_eq!(sets.len(), 2);
+    assert_eq!(sets[0].0, 2500);
+    assert_eq!(sets[1].0, 2800);
+    assert_eq!(
+        json(&sets[0].2),
+        serde_json::json!({"name": "gravity_m_s2", "value": 0.0})
+    );
+    // The weight of the 0.5 kg brick, −M g = −4.905 N, is felt before and after, not between.
+    let fz = |t: usize| a.world_force_n[t][2];
+    let w = -0.5 * 9.81;
+    assert!((fz(2499) - w).abs() < 0.05, "before: {}", fz(2499));
+    assert!(fz(2600).abs() < 0.05, "gravity off: {}", fz(2600));
+    assert!((fz(2900) - w).abs() < 0.05, "back on: {}", fz(2900));
+    // The switch is an input of the recording, and replay applies it on the same tick.
+    let rec = read_recording_file(&p, false).unwrap();
+    let sw: Vec<_> = rec
+        .messages
+        .iter()
+        .filter(|m| m.channel == Channel::Switch)
+        .collect();
+    assert_eq!(sw.len(), 2);
+    let v = verify(&rec).unwrap();
+    assert!(v.ok(), "{:?}", v.divergence);
+    // Without its switches the same inputs give another session: replay notices.
+    let mut stripped = rec.clone();
+    stripped.messages.retain(|m| m.channel != Channel::Switch);
+    let d = verify(&stripped).unwrap().divergence.unwrap();
+    assert_eq!(d.tick, 2500);
+}
+
+#[test]
+fn halving_adhesion_halves_the_snap_force_felt() {
+    let snaps = |a: &SessionArrays| -> Vec<f64> {
+        a.events
+            .iter()
+            .filter(|e| e.1 == "nano.snap")
+            .map(|e| json(&e.2)["snap_force_n"].as_f64().unwrap())
+            .collect()
+    };
+    let base = run("nanoworld.toml", None, 3.0, None);
+    let extra = "[[switch]]\nt_s = 0.0\nname = \"adhesion_scale\"\nvalue = 0.5\n";
+    let half = run(
+        "nanoworld.toml",
+        Some(script_plus("nanoworld.script.toml", extra)),
+        3.0,
+        None,
+    );
+    let (a, b) = (snaps(&base), snaps(&half));
+    assert!(!a.is_empty() && !b.is_empty());
+    assert!((b[0] / a[0] - 0.5).abs() < 1e-12, "{} vs {}", b[0], a[0]);
+}
+
+#[test]
+fn a_script_switch_the_scene_lacks_is_refused_with_its_line() {
+    let extra = "[[switch]]\nt_s = 1.0\nname = \"gravity\"\nvalue = 0.0\n";
+    let mut o = SessionOptions::new(scene("brickworld.toml"));
+    o.script = Some(script_plus("brickworld.script.toml", extra));
+    o.script_origin = Some("s.toml".into());
+    let e = run_session(&o, &mut |_, _| {}).unwrap_err().to_string();
+    let line = script_plus("brickworld.script.toml", extra)
+        .lines()
+        .position(|l| l == "name = \"gravity\"")
+        .unwrap()
+        + 1;
+    assert_eq!(
+        e,
+        format!(
+            "s.toml:{line}:8: script: `switch[0].name`: the brickworld scene has no switch \
+             `gravity` (its switches: gravity_m_s2, restitution, friction, inertia, brick_mass_kg)"
+        )
+    );
+    let extra = "[[switch]]\nt_s = 1.0\nname = \"restitution\"\nvalue = 1.5\n";
+    o.script = Some(script_plus("brickworld.script.toml", extra));
+    let e = run_session(&o, &mut |_, _| {}).unwrap_err().to_string();
+    assert!(
+        e.ends_with(
+            "script: `switch[0].value`: switch `restitution` = 1.5 is out of range \
+             (allowed: 0 ≤ value ≤ 1)"
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn collisions_carry_their_impulse_and_the_house_is_scored() {
+    let a = run("brickworld.toml", None, 21.937, None);
+    let impacts: Vec<serde_json::Value> = a
+        .events
+        .iter()
+        .filter(|e| e.1 == "brick.impact")
+        .map(|e| json(&e.2))
+        .collect();
+    // The script presses each brick down and lets go 1 mm above its place: it lands at
+    // 0.757 m/s and the ground's impulse is M v (1 + e) for the 0.5 kg brick.
+    let ground: Vec<_> = impacts
+        .iter()
+        .filter(|i| i["b"] == "ground" || i["a"] == "ground")
+        .collect();
+    assert!(!ground.is_empty());
+    // M v (1 + e) plus the weight's impulse over the tick, M g dt (e = 0.2, M = 0.5 kg).
+    for i in ground.iter().filter(|i| i["speed_m_s"].as_f64().unwrap() > 0.5) {
+        let v = i["speed_m_s"].as_f64().unwrap();
+        let want = 0.5 * v * 1.2 + 0.5 * 9.81 * 1e-3;
+        let got = i["impulse_n_s"].as_f64().unwrap();
+        assert!((got / want - 1.0).abs() < 2e-3, "impulse {got} N s, M v (1+e) + M g dt = {want}");
+    }
+    for i in &impacts {
+        assert_eq!(i["type"], "impact");
+        assert!(i["impulse_n_s"].as_f64().unwrap() > 0.0);
+        assert!(i["speed_m_s"].as_f64().unwrap() >= 0.05);
+    }
+    let n = a.state_fields.len();
+    let col = |name: &str| a.state_fields.iter().position(|f| f == name).unwrap();
+    let last = &a.state[a.state.len() - n..];
+    assert_eq!(last[col("slots_filled")], 4.0);
+    assert_eq!(last[col("dropped")], 0.0);
+    // The score's rule: 100 × 4/4 − 5 × seconds above the comfort limit (half of 8 N).
+    let over = last[col("comfort_exceeded_s")];
+    assert!((last[col("score")] - (100.0 - 5.0 * over).max(0.0)).abs() < 1e-9);
+    assert!(last[col("complete_s")] > 0.0);
+    // Proximity: 0 while touching, positive in free space.
+    let near = a.state_column("nearest_m").unwrap();
+    assert!(near.iter().all(|d| *d >= 0.0));
+    assert!(near.iter().any(|d| *d == 0.0));
+    assert!(near.iter().any(|d| *d > 0.05));
+}
+
