@@ -46,7 +46,7 @@ fn run_info_and_verify() {
     let info = json(&nh(&["info", r, "--json"]));
     assert_eq!(info["ticks"], 1500);
     assert_eq!(info["duration_s"], 1.5);
-    assert_eq!(info["channels"].as_array().unwrap().len(), 9);
+    assert_eq!(info["channels"].as_array().unwrap().len(), 10);
     let v = json(&nh(&["replay", r, "--verify", "--json"]));
     assert_eq!(v["report"]["ticks"], 1500);
     assert!(v["report"]["divergence"].is_null());
