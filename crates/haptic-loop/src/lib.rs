@@ -34,6 +34,7 @@ pub mod bridge;
 pub mod builtin;
 pub mod device;
 pub mod haptic;
+pub mod lesson;
 pub mod live;
 pub mod pacing;
 pub mod record;

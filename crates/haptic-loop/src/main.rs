@@ -15,6 +15,7 @@
 //! ```
 //! Exit status: 0 success, 1 error (bad input, unreadable file), 2 replay diverged.
 
+mod lesson_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
@@ -87,6 +88,9 @@ enum Cmd {
     /// A stand-in haptic device process: plays a script over the UDP bridge to `nanohaptics run
     /// --device udp:HOST:PORT`, with injectable loss, jitter, latency and an outage.
     FakeDevice(FakeArgs),
+    /// The macro-vs-nano lesson: run both house tasks and the lesson's experiments, write a
+    /// Markdown report with figures (`--out DIR`).
+    Lesson(lesson_cmd::LessonArgs),
     /// Run every scene with its default script, record, verify, and summarise.
     Demo {
         /// Folder of scene files (default: `./scenes` if it exists, else the built-in scenes,
@@ -781,6 +785,7 @@ fn main() -> ExitCode {
             json,
         } => cmd_replay(&rec, verify, salvage, json),
         Cmd::Info { rec, salvage, json } => cmd_info(&rec, salvage, json),
+        Cmd::Lesson(a) => lesson_cmd::cmd(&a),
         Cmd::Demo { scenes, out, json } => cmd_demo(scenes.as_deref(), &out, json),
         Cmd::Scenes { action, dir } => cmd_scenes(action.as_deref(), dir.as_deref()),
         Cmd::FakeDevice(a) => cmd_fake(a),

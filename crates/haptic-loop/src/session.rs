@@ -209,6 +209,16 @@ impl SceneSource {
         SceneFile::parse(&self.text).map_err(|e| self.locate(e))
     }
 
+    /// The built-in scene `name` (`wall` or `wall.toml`) with its default script.
+    pub fn builtin(name: &str) -> Option<Self> {
+        crate::builtin::find(name).map(|b| SceneSource {
+            text: b.scene.to_string(),
+            origin: format!("built-in {}", b.name),
+            dir: None,
+            scripts: vec![(b.script_file.to_string(), b.script.to_string())],
+        })
+    }
+
     /// A scene file on disk, or else a built-in scene by name (`wall`, `wall.toml`): files on
     /// disk override the built-ins, so this works from any directory.
     pub fn resolve(arg: &Path) -> Result<Self, SessionError> {
@@ -223,13 +233,8 @@ impl SceneSource {
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_default();
-        match crate::builtin::find(&name) {
-            Some(b) if parent_ok => Ok(SceneSource {
-                text: b.scene.to_string(),
-                origin: format!("built-in {}", b.name),
-                dir: None,
-                scripts: vec![(b.script_file.to_string(), b.script.to_string())],
-            }),
+        match Self::builtin(&name) {
+            Some(s) if parent_ok => Ok(s),
             _ => Err(SessionError::Io {
                 path: arg.display().to_string(),
                 message: format!(

@@ -32,6 +32,7 @@
 //! ```
 
 pub mod camera;
+pub mod chart;
 mod draw;
 pub mod error;
 pub mod frame;

@@ -1,0 +1,85 @@
+//! `nanohaptics lesson`: the macro-vs-nano lesson report (see `haptic_loop::lesson`).
+
+use haptic_loop::lesson::{LessonOptions, report::si, run_lesson};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `nanohaptics lesson`.
+#[derive(clap::Args)]
+pub struct LessonArgs {
+    /// Folder for the report (`lesson.md`, PNG figures, recordings, `lesson.json`).
+    #[arg(long, default_value = "nanohaptics-lesson")]
+    pub out: PathBuf,
+    /// Width of the figures, px (200–4000; height is half of it).
+    #[arg(long, default_value_t = 1200)]
+    pub width: u32,
+    /// Print the measured numbers as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the lesson and prints where the report is.
+pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
+    if !(200..=4000).contains(&args.width) {
+        return Err(format!(
+            "--width = {} is out of range: allowed 200–4000 px",
+            args.width
+        ));
+    }
+    let pb = (!args.json).then(|| {
+        let pb = ProgressBar::new(1);
+        let style = ProgressStyle::with_template("{prefix:>10} [{bar:30}] {pos}/{len} runs: {msg}")
+            .map(|s| s.progress_chars("=> "))
+            .unwrap_or_else(|_| ProgressStyle::default_bar());
+        pb.set_style(style);
+        pb.set_prefix("lesson");
+        pb
+    });
+    let opts = LessonOptions {
+        out: args.out.clone(),
+        width_px: args.width,
+    };
+    let s = run_lesson(&opts, &mut |done, total, run| {
+        if let Some(pb) = &pb {
+            pb.set_length(total as u64);
+            pb.set_position(done as u64);
+            pb.set_message(run.to_string());
+        }
+    })
+    .map_err(|e| e.to_string())?;
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string(&s).map_err(|e| e.to_string())?
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    println!(
+        "bricks: {} of 4 slots, score {:.1}; atoms: {} of 7 slots, score {:.1}",
+        s.macro_house.filled, s.macro_house.score, s.nano_house.filled, s.nano_house.score
+    );
+    println!(
+        "brick weight felt {}, carry inertia {}; snap {}, pull-off {} ({:.2}×)",
+        si(-s.lift_weight_n[0], "N"),
+        si(s.lift_inertia_n[0], "N"),
+        si(s.hysteresis.snap_force_n, "N"),
+        si(s.hysteresis.pull_off_n, "N"),
+        s.hysteresis.ratio
+    );
+    println!(
+        "a thrown brick lands {} away; an atom {} (it would need {} of hand acceleration)",
+        si(s.brick_throw.distance_m, "m"),
+        if s.atom_stayed { "stays on the tip" } else { "left the tip" },
+        si(s.atom_threshold_hand_m_s2, "m/s²")
+    );
+    println!(
+        "report: {} ({} files)",
+        args.out.join("lesson.md").display(),
+        s.files.len()
+    );
+    Ok(ExitCode::SUCCESS)
+}
