@@ -1,0 +1,66 @@
+//! The lesson's report: every figure it states is checked against the physics it claims.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use haptic_loop::lesson::{LessonOptions, run_lesson};
+
+#[test]
+fn the_lesson_measures_what_it_says() {
+    let out = std::env::temp_dir().join(format!("nh-lesson-{}", std::process::id()));
+    let mut calls = Vec::new();
+    let s = run_lesson(
+        &LessonOptions {
+            out: out.clone(),
+            width_px: 600,
+        },
+        &mut |done, total, run| calls.push((done, total, run.to_string())),
+    )
+    .unwrap();
+    // Progress: one call per run and one for the report, counting up to the total.
+    assert_eq!(calls.len(), calls[0].1);
+    assert!(calls.iter().enumerate().all(|(i, c)| c.0 == i));
+    // Both houses built by the same rigid operator, nothing dropped.
+    assert_eq!(s.macro_house.filled, 4.0);
+    assert_eq!(s.nano_house.filled, 7.0);
+    assert_eq!(s.macro_house.dropped, 0.0);
+    assert_eq!(s.nano_house.dropped, 0.0);
+    // Weight M g held still; gravity off removes it, inertia off leaves it.
+    let mg = s.brick_mass_kg * s.gravity_m_s2;
+    assert!((s.lift_weight_n[0] + mg).abs() < 1e-6 * mg, "{}", s.lift_weight_n[0]);
+    assert!(s.lift_weight_n[1].abs() < 1e-9);
+    assert!((s.lift_weight_n[2] + mg).abs() < 1e-6 * mg);
+    // Inertia: the minimum-jerk peak M·5.77·D/T², within the 3-point estimate's 0.5 %.
+    let rel = s.lift_inertia_n[0] / s.lift_inertia_predicted_n - 1.0;
+    assert!(rel.abs() < 5e-3, "inertia {} vs {}", s.lift_inertia_n[0], s.lift_inertia_predicted_n);
+    assert!((s.lift_inertia_n[1] / s.lift_inertia_n[0] - 1.0).abs() < 1e-9);
+    assert!(s.lift_inertia_n[2] < 1e-9);
+    // The tenfold pull-off, and halving the adhesion halves both forces.
+    assert!((s.hysteresis.ratio - 10.0).abs() < 1e-9);
+    assert!((s.hysteresis_half.snap_force_n / s.hysteresis.snap_force_n - 0.5).abs() < 1e-12);
+    assert!((s.hysteresis_half.pull_off_n / s.hysteresis.pull_off_n - 0.5).abs() < 1e-12);
+    assert!(s.hysteresis.pull_off_height_m > s.hysteresis.snap_height_m);
+    // The brick flies ballistically: distance = release speed × flight time (horizontal
+    // throw) within the tick's resolution.
+    let t = &s.brick_throw;
+    assert!(t.thrown);
+    assert!((t.distance_m / (t.release_speed_m_s * t.flight_s) - 1.0).abs() < 0.02);
+    // The atom stays; the heavy atom's measured threshold brackets hold / (m · scale).
+    assert!(s.atom_stayed);
+    assert!(s.atom_hold_n / s.atom_load_n > 1e14);
+    let sw = &s.sweep;
+    assert!(sw.kept_below_m_s2 < sw.predicted_hand_m_s2);
+    assert!(sw.thrown_from_m_s2 >= sw.predicted_hand_m_s2);
+    assert!(sw.runs.iter().all(|r| r.2 == (r.1 >= sw.predicted_hand_m_s2)));
+    // The report and its figures are there.
+    for f in &s.files {
+        let p = out.join(f);
+        assert!(p.metadata().unwrap().len() > 1000, "{}", p.display());
+    }
+    let md = std::fs::read_to_string(out.join("lesson.md")).unwrap();
+    for img in ["macro_forces.png", "nano_forces.png", "hysteresis.png", "throw_threshold.png", "scale_forces.png"] {
+        assert!(md.contains(&format!("({img})")), "{img}");
+    }
+    assert!(md.contains(&format!("{:.2} times the snap force", s.hysteresis.ratio)));
+    // The house sessions replay bit for bit.
+    let rec = haptic_loop::record::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
+}
