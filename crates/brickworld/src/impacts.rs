@@ -50,7 +50,12 @@ impl ImpactTracker {
 
     /// Velocity of body `h` at `point` before the step (zero for fixed bodies; kinematic bodies,
     /// the carried brick, use their current velocity).
-    fn velocity_at(&self, phys: &PhysicsWorld, h: Option<RigidBodyHandle>, point: Vector) -> Vector {
+    fn velocity_at(
+        &self,
+        phys: &PhysicsWorld,
+        h: Option<RigidBodyHandle>,
+        point: Vector,
+    ) -> Vector {
         let Some(h) = h else {
             return Vector::ZERO;
         };
@@ -113,7 +118,14 @@ impl ImpactTracker {
                 - self.velocity_at(phys, c2.parent(), centroid))
             .dot(normal);
             if approach >= IMPACT_MIN_SPEED_M_S {
-                found.push((k, pair.collider1, pair.collider2, impulse, approach, centroid));
+                found.push((
+                    k,
+                    pair.collider1,
+                    pair.collider2,
+                    impulse,
+                    approach,
+                    centroid,
+                ));
             }
         }
         self.cur.sort_unstable();

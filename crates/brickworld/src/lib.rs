@@ -46,6 +46,6 @@ pub use params::{
     Params, ParamsFromTomlError,
 };
 pub use world::{
-    Axis, Body, BoxView, BrickId, BrickView, Event, NEAREST_MAX_M, SLEEP_MAX_ACCEL_M_S2, SLEEP_SPEED_M_S, SlotView,
-    StepReport, Touch, World,
+    Axis, Body, BoxView, BrickId, BrickView, Event, NEAREST_MAX_M, SLEEP_MAX_ACCEL_M_S2,
+    SLEEP_SPEED_M_S, SlotView, StepReport, Touch, World,
 };

@@ -298,7 +298,8 @@ impl HapticLoop {
         r.events.clear();
         r.switches.clear();
         for sw in self.pending.drain(..) {
-            r.events.push(Event::new("switch.set", switch::event_detail(&sw)));
+            r.events
+                .push(Event::new("switch.set", switch::event_detail(&sw)));
             r.switches.push(sw);
         }
 

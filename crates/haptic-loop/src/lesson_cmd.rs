@@ -52,10 +52,7 @@ pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
         pb.finish_and_clear();
     }
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string(&s).map_err(|e| e.to_string())?
-        );
+        println!("{}", serde_json::to_string(&s).map_err(|e| e.to_string())?);
         return Ok(ExitCode::SUCCESS);
     }
     println!(
@@ -73,7 +70,11 @@ pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
     println!(
         "a thrown brick lands {} away; an atom {} (it would need {} of hand acceleration)",
         si(s.brick_throw.distance_m, "m"),
-        if s.atom_stayed { "stays on the tip" } else { "left the tip" },
+        if s.atom_stayed {
+            "stays on the tip"
+        } else {
+            "left the tip"
+        },
         si(s.atom_threshold_hand_m_s2, "m/s²")
     );
     println!(

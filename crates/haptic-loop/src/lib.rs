@@ -42,6 +42,7 @@ pub mod replay;
 pub mod runner;
 pub mod scene;
 pub mod session;
+pub mod sound;
 pub mod stepper;
 pub mod textpos;
 pub mod vec3;

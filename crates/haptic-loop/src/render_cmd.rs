@@ -21,8 +21,9 @@ pub struct RenderArgs {
     /// What to write, chosen by the name's extension: `NAME.png` one picture (a scene's
     /// initial state, a recording's last tick); `NAME.gif` a recording as an animation; a
     /// name without extension (or an existing folder) a recording's frames as PNG files.
+    /// Optional with `--audio`.
     #[arg(long)]
-    pub out: PathBuf,
+    pub out: Option<PathBuf>,
     /// Draw every N-th tick of a recording (default: tick rate / 30, i.e. 30 frames per second
     /// of session).
     #[arg(long)]
@@ -36,6 +37,18 @@ pub struct RenderArgs {
     /// Camera: top, side or oblique (default: top for a flat world, oblique otherwise).
     #[arg(long)]
     pub view: Option<String>,
+    /// Write the recording's sound to this WAV file (16-bit mono): an impact sound per
+    /// collision (loudness from its impulse), a click at snap-to-contact and another at
+    /// pull-off (docs/render.md, "Sound").
+    #[arg(long)]
+    pub audio: Option<PathBuf>,
+    /// With `--audio`: add the proximity tone, whose pitch rises as the cursor nears the
+    /// nearest object (brick and nano worlds).
+    #[arg(long)]
+    pub proximity: bool,
+    /// With `--audio`: sample rate, Hz (8000–192000).
+    #[arg(long, default_value_t = render::audio::SAMPLE_RATE_HZ)]
+    pub sample_rate: u32,
 }
 
 /// Why `render` failed.
@@ -90,6 +103,12 @@ pub enum RenderCmdError {
     /// The scene file, with where in it.
     #[error(transparent)]
     Input(#[from] haptic_loop::session::SessionError),
+    /// Turning the recording into sound.
+    #[error("--audio: {0}")]
+    Sound(#[from] haptic_loop::sound::SoundError),
+    /// Neither `--out` nor `--audio`.
+    #[error("nothing to write: pass --out FILE (pictures) and/or --audio FILE.wav (sound)")]
+    NoOutput,
 }
 
 /// Text and scale bar colour, light on the dark background the scenes' colours are chosen for
@@ -249,16 +268,80 @@ pub fn output_for(recording: bool, out: &Path) -> Result<Output, RenderCmdError>
 /// Runs `nanohaptics render`.
 pub fn run(args: &RenderArgs) -> Result<RenderSummary, RenderCmdError> {
     check_width(args.width)?;
+    if args.proximity && args.audio.is_none() {
+        return Err(RenderCmdError::Arg {
+            flag: "proximity",
+            value: "set".into(),
+            allowed: "only with --audio FILE.wav".into(),
+        });
+    }
+    let mut summary = match &args.out {
+        Some(out) => pictures(args, out)?,
+        None if args.audio.is_some() => RenderSummary {
+            frames: 0,
+            ticks: 0,
+            from_recorded_state: false,
+            gif_bytes: 0,
+            written: Vec::new(),
+        },
+        None => return Err(RenderCmdError::NoOutput),
+    };
+    if let Some(wav) = &args.audio {
+        summary.written.push(write_audio(args, wav)?);
+    }
+    Ok(summary)
+}
+
+/// The sound of a recording into a WAV file; the summary line.
+fn write_audio(args: &RenderArgs, wav: &Path) -> Result<String, RenderCmdError> {
+    if args.input.extension().and_then(|e| e.to_str()) != Some("mcap") {
+        return Err(RenderCmdError::OutKind {
+            out: wav.to_path_buf(),
+            problem: "a scene file has no sound; --audio needs a recording (.mcap)".into(),
+            allowed: SCENE_OUTPUTS,
+        });
+    }
+    if !(8_000..=192_000).contains(&args.sample_rate) {
+        return Err(RenderCmdError::Arg {
+            flag: "sample-rate",
+            value: args.sample_rate.to_string(),
+            allowed: "8000–192000 Hz".into(),
+        });
+    }
+    let rec = read_recording_file(&args.input, false)?;
+    let arrays = haptic_loop::session::SessionArrays::from_recording(&rec)?;
+    let s = haptic_loop::sound::session_sound(
+        &arrays,
+        &rec.description.scene_kind,
+        args.proximity,
+        args.sample_rate,
+    )?;
+    render::audio::write_wav(wav, &s.samples, s.sample_rate_hz)?;
+    let secs = s.samples.len() as f64 / f64::from(s.sample_rate_hz);
+    Ok(format!(
+        "{} ({secs:.3} s, {} sounds{})",
+        written_file("WAV sound", wav),
+        s.sounds.len(),
+        if args.proximity {
+            ", with the proximity tone"
+        } else {
+            ""
+        }
+    ))
+}
+
+/// The pictures of `run` (`--out`).
+fn pictures(args: &RenderArgs, out: &Path) -> Result<RenderSummary, RenderCmdError> {
     let view = parse_view(&args.view)?;
     let recording = match args.input.extension().and_then(|e| e.to_str()) {
         Some("toml") => false,
         Some("mcap") => true,
         _ => return Err(RenderCmdError::InputKind(args.input.clone())),
     };
-    let output = output_for(recording, &args.out)?;
+    let output = output_for(recording, out)?;
     if args.gif.is_some() && !matches!(output, Output::Frames(_)) {
         return Err(RenderCmdError::OutKind {
-            out: args.out.clone(),
+            out: out.to_path_buf(),
             problem: "--gif adds an animation to a folder of frames only".into(),
             allowed: if recording {
                 RECORDING_OUTPUTS
@@ -687,11 +770,14 @@ mod tests {
         let gif_path = dir.join("ot.gif");
         let args = RenderArgs {
             input: root().join("recordings/optical_tweezers.mcap"),
-            out: dir.join("frames"),
+            out: Some(dir.join("frames")),
             every: Some(100),
             width: 320,
             gif: Some(gif_path.clone()),
             view: None,
+            audio: None,
+            proximity: false,
+            sample_rate: 44_100,
         };
         let s = run(&args).expect("render");
         // ticks 0, 100, …: one frame per started 100 ticks
@@ -723,25 +809,27 @@ mod tests {
             std::env::temp_dir().join(format!("nanohaptics-render-ot-{}", std::process::id()));
         let args = |out: &str| RenderArgs {
             input: root().join("recordings/optical_tweezers.mcap"),
-            out: dir.join(out),
+            out: Some(dir.join(out)),
             every: Some(100),
             width: 320,
             gif: None,
             view: None,
+            audio: None,
+            proximity: false,
+            sample_rate: 44_100,
         };
         let (a, b) = (args("recorded"), args("recomputed"));
         let recorded =
-            recording_frames(&a, None, Some(a.out.clone()), None, false).expect("recorded state");
-        let recomputed =
-            recording_frames(&b, None, Some(b.out.clone()), None, true).expect("recomputed");
+            recording_frames(&a, None, a.out.clone(), None, false).expect("recorded state");
+        let recomputed = recording_frames(&b, None, b.out.clone(), None, true).expect("recomputed");
         assert!(recorded.from_recorded_state && !recomputed.from_recorded_state);
         assert_eq!(recorded.ticks, recomputed.ticks);
         assert_eq!(recorded.frames, recomputed.frames);
         assert!(recorded.frames > 5);
         for k in 0..recorded.frames {
             let name = format!("frame_{k:05}.png");
-            let x = std::fs::read(a.out.join(&name)).expect("png");
-            let y = std::fs::read(b.out.join(&name)).expect("png");
+            let x = std::fs::read(dir.join("recorded").join(&name)).expect("png");
+            let y = std::fs::read(dir.join("recomputed").join(&name)).expect("png");
             assert!(x == y, "{name} differs");
         }
         // a cadence off the display ticks (every 20 at 1 kHz) is recomputed
@@ -760,15 +848,201 @@ mod tests {
         std::fs::remove_dir_all(&dir).ok();
     }
 
+    fn audio_args(input: &str, wav: &Path, proximity: bool) -> RenderArgs {
+        RenderArgs {
+            input: root().join(input),
+            out: None,
+            every: None,
+            width: 640,
+            gif: None,
+            view: None,
+            audio: Some(wav.to_path_buf()),
+            proximity,
+            sample_rate: 44_100,
+        }
+    }
+
+    /// Reads a WAV file as samples in [−1, 1] and its rate.
+    fn read_wav(p: &Path) -> (Vec<f64>, f64) {
+        let mut r = hound::WavReader::open(p).expect("wav");
+        let sr = f64::from(r.spec().sample_rate);
+        let x = r
+            .samples::<i16>()
+            .map(|v| f64::from(v.expect("sample")) / 32767.0)
+            .collect();
+        (x, sr)
+    }
+
+    /// The recording's `brick.impact` events: (time s, impulse N·s).
+    fn impacts(rec: &Path) -> Vec<(f64, f64)> {
+        let rec = read_recording_file(rec, false).expect("recording");
+        let a = haptic_loop::session::SessionArrays::from_recording(&rec).expect("arrays");
+        a.events
+            .iter()
+            .filter(|e| e.1 == "brick.impact")
+            .map(|e| {
+                let v: serde_json::Value = serde_json::from_str(&e.2).expect("json");
+                (
+                    e.0 as f64 / 1000.0,
+                    v["impulse_n_s"].as_f64().expect("impulse"),
+                )
+            })
+            .collect()
+    }
+
+    /// First sample at or after `t` whose |x| reaches 10 % of the peak of the 25 ms after `t`,
+    /// as a time, and that peak. Asserts silence in the 20 ms before (up to 1 ms early).
+    fn onset_and_peak(x: &[f64], sr: f64, t: f64) -> (f64, f64) {
+        let k = (t * sr).round() as usize;
+        let before = &x[k - (0.02 * sr) as usize..k - (0.001 * sr) as usize];
+        assert!(before.iter().all(|v| v.abs() < 2e-3), "sound before {t} s");
+        let win = &x[k - (0.001 * sr) as usize..k + (0.025 * sr) as usize];
+        let peak = win.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let first = win
+            .iter()
+            .position(|v| v.abs() >= 0.1 * peak)
+            .expect("onset");
+        (t - 0.001 + first as f64 / sr, peak)
+    }
+
+    /// Each recorded impact with silence before it starts a sound within ±1 ms of its tick
+    /// (read back from the WAV that `render --audio` wrote for the golden brick recording).
+    #[test]
+    fn the_wav_has_a_sound_on_each_recorded_impact() {
+        let wav = std::env::temp_dir().join(format!("nh-brick-{}.wav", std::process::id()));
+        let s = run(&audio_args("recordings/brickworld.mcap", &wav, false)).expect("audio");
+        assert!(s.written[0].starts_with("WAV sound"), "{}", s.written[0]);
+        let (x, sr) = read_wav(&wav);
+        let hits = impacts(&root().join("recordings/brickworld.mcap"));
+        let rec = read_recording_file(&root().join("recordings/brickworld.mcap"), false)
+            .expect("recording");
+        let ticks = haptic_loop::session::SessionArrays::from_recording(&rec)
+            .expect("arrays")
+            .tick
+            .len();
+        assert_eq!(x.len(), (ticks as f64 / 1000.0 * sr).round() as usize);
+        let mut checked = 0;
+        for (t, _) in &hits {
+            // Impacts with nothing sounding in the 150 ms before (a thud rings ~100 ms).
+            if hits.iter().any(|(u, _)| u < t && t - u < 0.15) {
+                continue;
+            }
+            let (onset, peak) = onset_and_peak(&x, sr, *t);
+            assert!(
+                (onset - t).abs() <= 1e-3,
+                "onset {onset} s for an impact at {t} s"
+            );
+            assert!(peak > 0.1);
+            checked += 1;
+        }
+        assert!(checked >= 4, "{checked} isolated impacts");
+        assert!(x.iter().all(|v| v.abs() <= 0.98 + 1e-4));
+        std::fs::remove_file(&wav).ok();
+    }
+
+    /// A brick let go from higher lands with a larger impulse, and its sound is louder.
+    #[test]
+    fn a_brick_dropped_from_higher_sounds_louder() {
+        use haptic_loop::lesson::scripts::{BRICK_PICK_MM, ScriptText};
+        use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
+        let dir = std::env::temp_dir().join(format!("nh-drops-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let [x0, y0, z0] = BRICK_PICK_MM;
+        let mut level = Vec::new();
+        for (i, z) in [0.0, 6.0, 15.0].into_iter().enumerate() {
+            // Pick the brick up, lift it to z mm of stylus (20× in the world), hold, let go.
+            let script = ScriptText::new("drop")
+                .at(0.0, [x0, y0, 7.5])
+                .at(0.6, [x0, y0, z0])
+                .at(0.7, [x0, y0, z0])
+                .button(0.65, "centre", true)
+                .at(1.5, [x0, y0, z])
+                .at(2.0, [x0, y0, z])
+                .button(2.0, "centre", false)
+                .at(3.0, [x0, y0, z])
+                .text();
+            let rec = dir.join(format!("drop{i}.mcap"));
+            let mut o = SessionOptions::new(SceneSource::builtin("brickworld").expect("built in"));
+            o.script = Some(script);
+            o.operator = OperatorChoice::Rigid;
+            o.out = Some(rec.clone());
+            run_session(&o, &mut |_, _| {}).expect("session");
+            let wav = dir.join(format!("drop{i}.wav"));
+            let args = RenderArgs {
+                input: rec.clone(),
+                ..audio_args("recordings/wall.mcap", &wav, false)
+            };
+            run(&args).expect("audio");
+            let (x, sr) = read_wav(&wav);
+            let (t, j) = *impacts(&rec)
+                .iter()
+                .find(|(t, _)| *t > 2.0)
+                .expect("the landing");
+            let (onset, peak) = onset_and_peak(&x, sr, t);
+            assert!((onset - t).abs() <= 1e-3);
+            level.push((j, peak));
+        }
+        for w in level.windows(2) {
+            assert!(w[1].0 > w[0].0 * 1.2, "impulses {level:?}");
+            assert!(w[1].1 > w[0].1, "louder for a larger impulse: {level:?}");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn audio_flags_are_checked() {
+        let wav = std::env::temp_dir().join(format!("nh-wall-{}.wav", std::process::id()));
+        let e = run(&audio_args("recordings/wall.mcap", &wav, true))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "--audio: --proximity: the wall scene records no distance to the nearest object \
+             (allowed: brickworld, nanoworld)"
+        );
+        // A wall session has no impacts: exact silence, of the session's length.
+        let s = run(&audio_args("recordings/wall.mcap", &wav, false)).expect("audio");
+        assert!(s.written[0].contains("0 sounds"), "{}", s.written[0]);
+        let mut r = hound::WavReader::open(&wav).expect("wav");
+        assert!(r.samples::<i16>().all(|v| v.expect("sample") == 0));
+        let e = run(&RenderArgs {
+            sample_rate: 10,
+            ..audio_args("recordings/wall.mcap", &wav, false)
+        })
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            e,
+            "--sample-rate = 10 is out of range: allowed 8000–192000 Hz"
+        );
+        let e = run(&RenderArgs {
+            audio: None,
+            ..audio_args("recordings/wall.mcap", &wav, false)
+        })
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            e,
+            "nothing to write: pass --out FILE (pictures) and/or --audio FILE.wav (sound)"
+        );
+        // The proximity tone of a nano session: present while the tip is within 1 nm.
+        let s = run(&audio_args("recordings/nanoworld.mcap", &wav, true)).expect("audio");
+        assert!(s.written[0].contains("with the proximity tone"));
+        std::fs::remove_file(&wav).ok();
+    }
+
     #[test]
     fn a_gif_faster_than_50_fps_is_refused() {
         let args = RenderArgs {
             input: root().join("recordings/optical_tweezers.mcap"),
-            out: std::env::temp_dir().join("nanohaptics-render-refused"),
+            out: Some(std::env::temp_dir().join("nanohaptics-render-refused")),
             every: Some(10),
             width: 320,
             gif: Some(std::env::temp_dir().join("nanohaptics-render-refused.gif")),
             view: None,
+            audio: None,
+            proximity: false,
+            sample_rate: 44_100,
         };
         let e = run(&args).unwrap_err().to_string();
         assert!(
@@ -812,11 +1086,14 @@ mod tests {
         std::fs::create_dir_all(&dir).expect("dir");
         let base = RenderArgs {
             input: root().join("recordings/wall.mcap"),
-            out: dir.join("wall.gif"),
+            out: Some(dir.join("wall.gif")),
             every: Some(200),
             width: 160,
             gif: None,
             view: None,
+            audio: None,
+            proximity: false,
+            sample_rate: 44_100,
         };
         let s = run(&base).expect("gif");
         let gif = std::fs::read(dir.join("wall.gif")).expect("gif written");
@@ -830,7 +1107,7 @@ mod tests {
         );
         let png = dir.join("end.png");
         let s = run(&RenderArgs {
-            out: png.clone(),
+            out: Some(png.clone()),
             ..base
         })
         .expect("png");

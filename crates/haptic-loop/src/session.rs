@@ -12,6 +12,7 @@
 //! ```
 
 use crate::bridge::BridgeConfig;
+use crate::device::TickTime;
 use crate::device::script::{OperatorKind, Script};
 use crate::device::source::{DeviceSource, open_device};
 use crate::device::{DeviceError, DeviceModel, OperatorParams, ScriptError};
@@ -23,7 +24,6 @@ use crate::record::sink::RecorderSink;
 use crate::record::writer::RecordError;
 use crate::record::{RecordingError, WriteSummary};
 use crate::runner::{EndReason, Pacing, Runner, Sink};
-use crate::device::TickTime;
 use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
 pub use crate::textpos::Location;
 use crate::textpos::field_position;
@@ -559,9 +559,7 @@ fn run_with_device(
     description.script_toml = script_toml;
     description.operator = source.describe();
     let switches = match &script {
-        Some((s, text, origin)) => {
-            script_switches(s, text, origin, loaded.scene.as_ref(), rate)?
-        }
+        Some((s, text, origin)) => script_switches(s, text, origin, loaded.scene.as_ref(), rate)?,
         None => Vec::new(),
     };
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);

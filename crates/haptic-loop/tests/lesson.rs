@@ -25,12 +25,21 @@ fn the_lesson_measures_what_it_says() {
     assert_eq!(s.nano_house.dropped, 0.0);
     // Weight M g held still; gravity off removes it, inertia off leaves it.
     let mg = s.brick_mass_kg * s.gravity_m_s2;
-    assert!((s.lift_weight_n[0] + mg).abs() < 1e-6 * mg, "{}", s.lift_weight_n[0]);
+    assert!(
+        (s.lift_weight_n[0] + mg).abs() < 1e-6 * mg,
+        "{}",
+        s.lift_weight_n[0]
+    );
     assert!(s.lift_weight_n[1].abs() < 1e-9);
     assert!((s.lift_weight_n[2] + mg).abs() < 1e-6 * mg);
     // Inertia: the minimum-jerk peak M·5.77·D/T², within the 3-point estimate's 0.5 %.
     let rel = s.lift_inertia_n[0] / s.lift_inertia_predicted_n - 1.0;
-    assert!(rel.abs() < 5e-3, "inertia {} vs {}", s.lift_inertia_n[0], s.lift_inertia_predicted_n);
+    assert!(
+        rel.abs() < 5e-3,
+        "inertia {} vs {}",
+        s.lift_inertia_n[0],
+        s.lift_inertia_predicted_n
+    );
     assert!((s.lift_inertia_n[1] / s.lift_inertia_n[0] - 1.0).abs() < 1e-9);
     assert!(s.lift_inertia_n[2] < 1e-9);
     // The tenfold pull-off, and halving the adhesion halves both forces.
@@ -49,18 +58,29 @@ fn the_lesson_measures_what_it_says() {
     let sw = &s.sweep;
     assert!(sw.kept_below_m_s2 < sw.predicted_hand_m_s2);
     assert!(sw.thrown_from_m_s2 >= sw.predicted_hand_m_s2);
-    assert!(sw.runs.iter().all(|r| r.2 == (r.1 >= sw.predicted_hand_m_s2)));
+    assert!(
+        sw.runs
+            .iter()
+            .all(|r| r.2 == (r.1 >= sw.predicted_hand_m_s2))
+    );
     // The report and its figures are there.
     for f in &s.files {
         let p = out.join(f);
         assert!(p.metadata().unwrap().len() > 1000, "{}", p.display());
     }
     let md = std::fs::read_to_string(out.join("lesson.md")).unwrap();
-    for img in ["macro_forces.png", "nano_forces.png", "hysteresis.png", "throw_threshold.png", "scale_forces.png"] {
+    for img in [
+        "macro_forces.png",
+        "nano_forces.png",
+        "hysteresis.png",
+        "throw_threshold.png",
+        "scale_forces.png",
+    ] {
         assert!(md.contains(&format!("({img})")), "{img}");
     }
     assert!(md.contains(&format!("{:.2} times the snap force", s.hysteresis.ratio)));
     // The house sessions replay bit for bit.
-    let rec = haptic_loop::record::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();
+    let rec =
+        haptic_loop::record::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }

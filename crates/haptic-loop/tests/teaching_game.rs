@@ -158,11 +158,17 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
         .collect();
     assert!(!ground.is_empty());
     // M v (1 + e) plus the weight's impulse over the tick, M g dt (e = 0.2, M = 0.5 kg).
-    for i in ground.iter().filter(|i| i["speed_m_s"].as_f64().unwrap() > 0.5) {
+    for i in ground
+        .iter()
+        .filter(|i| i["speed_m_s"].as_f64().unwrap() > 0.5)
+    {
         let v = i["speed_m_s"].as_f64().unwrap();
         let want = 0.5 * v * 1.2 + 0.5 * 9.81 * 1e-3;
         let got = i["impulse_n_s"].as_f64().unwrap();
-        assert!((got / want - 1.0).abs() < 2e-3, "impulse {got} N s, M v (1+e) + M g dt = {want}");
+        assert!(
+            (got / want - 1.0).abs() < 2e-3,
+            "impulse {got} N s, M v (1+e) + M g dt = {want}"
+        );
     }
     for i in &impacts {
         assert_eq!(i["type"], "impact");
@@ -184,4 +190,3 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
     assert!(near.iter().any(|d| *d == 0.0));
     assert!(near.iter().any(|d| *d > 0.05));
 }
-

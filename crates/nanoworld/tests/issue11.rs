@@ -243,17 +243,14 @@ fn tiny_time_steps_are_refused_and_the_shortest_accepted_is_finite() {
         assert!(r.force_n.norm() <= w.params().max_force_n * (1.0 + 1e-12));
         // 0.1 m in 1 ns from rest: a = 1e17 m/s², m·a = 1e-8 N on the atom, more than the
         // tip's 3 nN hold: the atom is thrown off the tip, and the force stays finite.
-        let thrown = r
-            .events
-            .iter()
-            .find_map(|e| match e {
-                nanoworld::Event::AtomsThrownOff {
-                    atoms,
-                    load_n,
-                    pull_off_n,
-                } => Some((*atoms, *load_n, *pull_off_n)),
-                _ => None,
-            });
+        let thrown = r.events.iter().find_map(|e| match e {
+            nanoworld::Event::AtomsThrownOff {
+                atoms,
+                load_n,
+                pull_off_n,
+            } => Some((*atoms, *load_n, *pull_off_n)),
+            _ => None,
+        });
         if k == 1 {
             let (n, load, hold) = thrown.expect("thrown off");
             assert_eq!(n, 1);

@@ -19,9 +19,7 @@
 
 use std::path::Path;
 
-use tiny_skia::{
-    Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform,
-};
+use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
 
 use crate::error::RenderError;
 use crate::image::Image;
@@ -155,7 +153,9 @@ pub enum ChartError {
         axis: &'static str,
     },
     /// A range that is not two finite increasing numbers (positive on a log axis).
-    #[error("{field} = [{lo}, {hi}] is not a usable range: allowed two finite numbers lo < hi (both > 0 on a log axis)")]
+    #[error(
+        "{field} = [{lo}, {hi}] is not a usable range: allowed two finite numbers lo < hi (both > 0 on a log axis)"
+    )]
     Range {
         /// `x_range` or `y_range`.
         field: &'static str,
@@ -450,8 +450,13 @@ impl Canvas {
 
     fn dot(&mut self, x: f32, y: f32, r: f32, c: [u8; 3]) {
         if let Some(p) = PathBuilder::from_circle(x, y, r) {
-            self.pm
-                .fill_path(&p, &paint(c, 255), FillRule::Winding, Transform::identity(), None);
+            self.pm.fill_path(
+                &p,
+                &paint(c, 255),
+                FillRule::Winding,
+                Transform::identity(),
+                None,
+            );
         }
     }
 
@@ -494,7 +499,15 @@ fn axes(
         if let Some(py) = y.px(v) {
             let py = py as f32;
             cv.line(&[(l, py), (r, py)], GRID, 1.0, false, 255);
-            cv.text(&tick_label(v), l - 0.4 * f, py + 0.35 * f, 0.9 * f, 1.0, 0.0, INK)?;
+            cv.text(
+                &tick_label(v),
+                l - 0.4 * f,
+                py + 0.35 * f,
+                0.9 * f,
+                1.0,
+                0.0,
+                INK,
+            )?;
         }
     }
     for v in x.ticks() {
@@ -504,7 +517,13 @@ fn axes(
             cv.text(&tick_label(v), px, b + 1.3 * f, 0.9 * f, 0.5, 0.0, INK)?;
         }
     }
-    cv.line(&[(l, t), (r, t), (r, b), (l, b), (l, t)], INK, 1.2, false, 255);
+    cv.line(
+        &[(l, t), (r, t), (r, b), (l, b), (l, t)],
+        INK,
+        1.2,
+        false,
+        255,
+    );
     let w = cv.pm.width() as f32;
     cv.text(title, w / 2.0, 1.9 * f, 1.2 * f, 0.5, 0.0, INK)?;
     cv.text(x_label, (l + r) / 2.0, b + 2.9 * f, f, 0.5, 0.0, INK)?;
@@ -525,7 +544,13 @@ fn legend(cv: &mut Canvas, items: &[(String, [u8; 3])], r: f32, t: f32) -> Resul
     let h = items.len() as f32 * 1.35 * f + 0.6 * f;
     cv.rect(x0, y0, r - 0.5 * f, y0 + h, [255, 255, 255], 220);
     cv.line(
-        &[(x0, y0), (r - 0.5 * f, y0), (r - 0.5 * f, y0 + h), (x0, y0 + h), (x0, y0)],
+        &[
+            (x0, y0),
+            (r - 0.5 * f, y0),
+            (r - 0.5 * f, y0 + h),
+            (x0, y0 + h),
+            (x0, y0),
+        ],
         [180, 180, 180],
         1.0,
         false,
@@ -533,7 +558,14 @@ fn legend(cv: &mut Canvas, items: &[(String, [u8; 3])], r: f32, t: f32) -> Resul
     );
     for (i, (s, c)) in items.iter().enumerate() {
         let yy = y0 + 0.3 * f + (i as f32 + 1.0) * 1.35 * f;
-        cv.rect(x0 + 0.5 * f, yy - 0.75 * f, x0 + 1.7 * f, yy + 0.05 * f, *c, 255);
+        cv.rect(
+            x0 + 0.5 * f,
+            yy - 0.75 * f,
+            x0 + 1.7 * f,
+            yy + 0.05 * f,
+            *c,
+            255,
+        );
         cv.text(s, x0 + 2.2 * f, yy, f, 0.0, 0.0, INK)?;
     }
     Ok(())
@@ -612,7 +644,12 @@ impl Chart {
         let mut cv = Canvas::new(width_px, height_px)?;
         let (x, y) = self.axes(width_px, height_px)?;
         let f = cv.font;
-        let (l, t, r, b) = (x.px_lo as f32, y.px_hi as f32, x.px_hi as f32, y.px_lo as f32);
+        let (l, t, r, b) = (
+            x.px_lo as f32,
+            y.px_hi as f32,
+            x.px_hi as f32,
+            y.px_lo as f32,
+        );
         let clampy = |v: f64| (v as f32).clamp(t, b);
         for band in &self.bands {
             let (Some(a), Some(c)) = (y.px(band.y_min), y.px(band.y_max)) else {
@@ -688,16 +725,15 @@ impl BarChart {
         if !self.bars.iter().any(|b| b.value.is_finite()) {
             return Err(ChartError::NoData { field: "bars" });
         }
-        let r = auto_range(
-            self.bars.iter().map(|b| b.value),
-            self.y_scale,
-            true,
-            "y",
-        )?;
+        let r = auto_range(self.bars.iter().map(|b| b.value), self.y_scale, true, "y")?;
         let (_, t, _, b) = plot_area(width_px, height_px);
         // Room under the plot for two rows of bar labels.
         let font = (width_px.min(2 * height_px) as f64 / 70.0).clamp(9.0, 40.0);
-        let r = if self.y_scale == Scale::Linear { [r[0].min(0.0), r[1] * 1.08] } else { r };
+        let r = if self.y_scale == Scale::Linear {
+            [r[0].min(0.0), r[1] * 1.08]
+        } else {
+            r
+        };
         Ok(Axis {
             lo: r[0],
             hi: r[1],
@@ -734,7 +770,15 @@ impl BarChart {
             if let Some(py) = y.px(v) {
                 let py = py as f32;
                 cv.line(&[(l as f32, py), (r as f32, py)], GRID, 1.0, false, 255);
-                cv.text(&tick_label(v), l as f32 - 0.4 * f, py + 0.35 * f, 0.9 * f, 1.0, 0.0, INK)?;
+                cv.text(
+                    &tick_label(v),
+                    l as f32 - 0.4 * f,
+                    py + 0.35 * f,
+                    0.9 * f,
+                    1.0,
+                    0.0,
+                    INK,
+                )?;
             }
         }
         let base = match self.y_scale {
@@ -752,7 +796,15 @@ impl BarChart {
                     let py = (py as f32).clamp(t, b);
                     cv.rect(x0 + pad, py, x1 - pad, base, bar.color, 255);
                     let label = value_label(bar.value);
-                    cv.text(&label, (x0 + x1) / 2.0, py - 0.3 * f, 0.8 * f, 0.5, 0.0, INK)?;
+                    cv.text(
+                        &label,
+                        (x0 + x1) / 2.0,
+                        py - 0.3 * f,
+                        0.8 * f,
+                        0.5,
+                        0.0,
+                        INK,
+                    )?;
                 }
                 let ly = b + (1.0 + (k % 2) as f32) * 0.95 * f;
                 cv.text(&bar.label, (x0 + x1) / 2.0, ly, 0.72 * f, 0.5, 0.0, INK)?;
@@ -765,7 +817,13 @@ impl BarChart {
             }
         }
         cv.line(
-            &[(l as f32, t), (r as f32, t), (r as f32, b), (l as f32, b), (l as f32, t)],
+            &[
+                (l as f32, t),
+                (r as f32, t),
+                (r as f32, b),
+                (l as f32, b),
+                (l as f32, t),
+            ],
             INK,
             1.2,
             false,
@@ -879,8 +937,18 @@ mod tests {
             y_label: "v".into(),
             y_scale: Scale::Log10,
             bars: vec![
-                Bar { group: "a".into(), label: "1e-9".into(), value: 1e-9, color: [255, 0, 0] },
-                Bar { group: "b".into(), label: "1".into(), value: 1.0, color: [255, 0, 0] },
+                Bar {
+                    group: "a".into(),
+                    label: "1e-9".into(),
+                    value: 1e-9,
+                    color: [255, 0, 0],
+                },
+                Bar {
+                    group: "b".into(),
+                    label: "1".into(),
+                    value: 1.0,
+                    color: [255, 0, 0],
+                },
             ],
         };
         let y = bars.axis(800, 400).unwrap();

@@ -69,6 +69,14 @@ pub enum RenderError {
     /// GIF encoding or writing failed.
     #[error("GIF: {0}")]
     Gif(String),
+    /// Writing a sound file failed.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 /// Checks that `value` is finite.

@@ -31,6 +31,7 @@
 //! # Ok::<(), render::RenderError>(())
 //! ```
 
+pub mod audio;
 pub mod camera;
 pub mod chart;
 mod draw;

@@ -91,9 +91,7 @@ impl ScriptError {
             ScriptError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
             ScriptError::OutOfRange { field, .. }
             | ScriptError::Button { field, .. }
-            | ScriptError::Switch { field, .. } => {
-                field_position(text, field)
-            }
+            | ScriptError::Switch { field, .. } => field_position(text, field),
             ScriptError::NoWaypoints => field_position(text, "script"),
             ScriptError::Parse(_) => None,
         }

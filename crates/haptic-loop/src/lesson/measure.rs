@@ -9,15 +9,12 @@ pub fn events<'a>(
     name: &'a str,
 ) -> impl Iterator<Item = (f64, serde_json::Value)> + 'a {
     let dt = 1.0 / f64::from(a.rate_hz);
-    a.events
-        .iter()
-        .filter(move |e| e.1 == name)
-        .map(move |e| {
-            (
-                e.0 as f64 * dt,
-                serde_json::from_str(&e.2).unwrap_or(serde_json::Value::Null),
-            )
-        })
+    a.events.iter().filter(move |e| e.1 == name).map(move |e| {
+        (
+            e.0 as f64 * dt,
+            serde_json::from_str(&e.2).unwrap_or(serde_json::Value::Null),
+        )
+    })
 }
 
 /// A number field of a JSON event detail.
@@ -180,7 +177,8 @@ pub fn brick_throw(a: &SessionArrays) -> Option<BrickThrow> {
     let py = a.state_column("proxy_y_m")?;
     let (x0, y0) = (*px.get(i)?, *py.get(i)?);
     let (ti, hit) = events(a, "brick.impact").find(|(t, e)| {
-        *t > tr && (e.get("a") == Some(&json_brick(&brick)) || e.get("b") == Some(&json_brick(&brick)))
+        *t > tr
+            && (e.get("a") == Some(&json_brick(&brick)) || e.get("b") == Some(&json_brick(&brick)))
     })?;
     let p = hit.get("point_m")?.as_array()?;
     let (x1, y1) = (p.first()?.as_f64()?, p.get(1)?.as_f64()?);

@@ -157,12 +157,11 @@ fn run(
     o.operator = OperatorChoice::Rigid;
     o.out = out;
     o.start_time_ns = Some(0);
-    let report = crate::session::run_session(&o, &mut |_, _| {}).map_err(|error| {
-        LessonError::Run {
+    let report =
+        crate::session::run_session(&o, &mut |_, _| {}).map_err(|error| LessonError::Run {
             run: name.to_string(),
             error,
-        }
-    })?;
+        })?;
     Ok(Run {
         name,
         arrays: report.arrays,
@@ -221,7 +220,12 @@ pub fn run_lesson(
         ("approach_retract_half", vec![("adhesion_scale", 0.5)]),
     ] {
         step(name);
-        cycles.push(run(name, "nanoworld", Some(scripts::approach_retract(&sw)), None)?);
+        cycles.push(run(
+            name,
+            "nanoworld",
+            Some(scripts::approach_retract(&sw)),
+            None,
+        )?);
     }
     step("brick_throw");
     let (text, _) = scripts::brick_throw(0.3);
@@ -240,7 +244,10 @@ pub fn run_lesson(
             swing,
             &[("gravity_m_s2", 0.0), ("atom_mass_kg", SWEEP_MASS_KG)],
         );
-        sweep_runs.push((swing, run("heavy_atom_throw", "nanoworld", Some(text), None)?));
+        sweep_runs.push((
+            swing,
+            run("heavy_atom_throw", "nanoworld", Some(text), None)?,
+        ));
     }
     step("report");
 
@@ -257,7 +264,9 @@ pub fn run_lesson(
         lift_weight_n[i] = measure::mean_force(a, measure::window(a, hold_w.0, hold_w.1), 2);
         lift_inertia_n[i] = measure::peak_force(a, measure::window(a, carry_w.0, carry_w.1), 0);
     }
-    let hyst = |r: &Run| measure::hysteresis(&r.arrays).ok_or_else(|| missing(r.name, "no snap and pull-off"));
+    let hyst = |r: &Run| {
+        measure::hysteresis(&r.arrays).ok_or_else(|| missing(r.name, "no snap and pull-off"))
+    };
     let hysteresis = hyst(&cycles[0])?;
     let hysteresis_half = hyst(&cycles[1])?;
     let brick_throw = measure::brick_throw(&brick_throw_run.arrays)
@@ -272,10 +281,16 @@ pub fn run_lesson(
     let carried_end = measure::last(&atom_throw_run.arrays, "carried_atoms").unwrap_or(0.0);
     let mut runs = Vec::new();
     for (swing, r) in &sweep_runs {
-        let thrown = measure::events(&r.arrays, "nano.atoms_thrown_off").next().is_some();
+        let thrown = measure::events(&r.arrays, "nano.atoms_thrown_off")
+            .next()
+            .is_some();
         runs.push((*swing, measure::peak_hand_acceleration(&r.arrays), thrown));
     }
-    let kept_below = runs.iter().filter(|r| !r.2).map(|r| r.1).fold(0.0, f64::max);
+    let kept_below = runs
+        .iter()
+        .filter(|r| !r.2)
+        .map(|r| r.1)
+        .fold(0.0, f64::max);
     let thrown_from = runs
         .iter()
         .filter(|r| r.2)
@@ -311,13 +326,13 @@ pub fn run_lesson(
         sweep,
         sizes_m: [
             ("brick, longest edge".into(), 2.0 * e[0].max(e[1]).max(e[2])),
-            ("cursor sphere, diameter".into(), 2.0 * brick_params.proxy_radius_m),
+            (
+                "cursor sphere, diameter".into(),
+                2.0 * brick_params.proxy_radius_m,
+            ),
             ("AFM tip, diameter".into(), 2.0 * nano_params.tip.radius_m),
             ("atom, diameter".into(), 2.0 * nano_params.atoms.radius_m),
-            (
-                "substrate spacing".into(),
-                nano_params.substrate.spacing_m,
-            ),
+            ("substrate spacing".into(), nano_params.substrate.spacing_m),
         ],
         files: Vec::new(),
     };

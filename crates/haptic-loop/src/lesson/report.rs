@@ -106,7 +106,10 @@ fn branches(r: &Run) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
         .zip(&a.world_force_n)
         .map(|(c, f)| [c[2] * 1e9, f[2] * 1e9])
         .collect();
-    (pts[..=low.min(pts.len().saturating_sub(1))].to_vec(), pts[low..].to_vec())
+    (
+        pts[..=low.min(pts.len().saturating_sub(1))].to_vec(),
+        pts[low..].to_vec(),
+    )
 }
 
 /// Short form of a number with its unit: `4.91 N`, `3 nN`, `1.2e-24 N`.
@@ -115,13 +118,7 @@ pub fn si(v: f64, unit: &str) -> String {
         return format!("{v} {unit}");
     }
     let a = v.abs();
-    let prefixes = [
-        (1e-9, "n"),
-        (1e-6, "µ"),
-        (1e-3, "m"),
-        (1.0, ""),
-        (1e3, "k"),
-    ];
+    let prefixes = [(1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, ""), (1e3, "k")];
     if a == 0.0 {
         return format!("0 {unit}");
     }
@@ -161,8 +158,18 @@ pub fn write(
         "force (N)",
     );
     c.series = vec![
-        series("vertical force Fz", force_curve(&runs.macro_house, 2, 1.0), BLUE, Style::Line),
-        series("|F|", force_norm(&runs.macro_house, 1.0), ORANGE, Style::Line),
+        series(
+            "vertical force Fz",
+            force_curve(&runs.macro_house, 2, 1.0),
+            BLUE,
+            Style::Line,
+        ),
+        series(
+            "|F|",
+            force_norm(&runs.macro_house, 1.0),
+            ORANGE,
+            Style::Line,
+        ),
     ];
     c.markers = markers(
         &runs.macro_house,
@@ -179,8 +186,18 @@ pub fn write(
         "force (nN)",
     );
     c.series = vec![
-        series("vertical force Fz", force_curve(&runs.nano_house, 2, 1e9), BLUE, Style::Line),
-        series("|F|", force_norm(&runs.nano_house, 1e9), ORANGE, Style::Line),
+        series(
+            "vertical force Fz",
+            force_curve(&runs.nano_house, 2, 1e9),
+            BLUE,
+            Style::Line,
+        ),
+        series(
+            "|F|",
+            force_norm(&runs.nano_house, 1e9),
+            ORANGE,
+            Style::Line,
+        ),
     ];
     c.markers = markers(
         &runs.nano_house,
@@ -253,8 +270,18 @@ pub fn write(
     // 4. Throwing: the heavy-atom sweep against the predicted threshold.
     let sw = &s.sweep;
     let ratio = |a_hand: f64| sw.mass_kg * a_hand * 1.5e-7 / sw.hold_n;
-    let kept: Vec<[f64; 2]> = sw.runs.iter().filter(|r| !r.2).map(|r| [r.1, ratio(r.1)]).collect();
-    let off: Vec<[f64; 2]> = sw.runs.iter().filter(|r| r.2).map(|r| [r.1, ratio(r.1)]).collect();
+    let kept: Vec<[f64; 2]> = sw
+        .runs
+        .iter()
+        .filter(|r| !r.2)
+        .map(|r| [r.1, ratio(r.1)])
+        .collect();
+    let off: Vec<[f64; 2]> = sw
+        .runs
+        .iter()
+        .filter(|r| r.2)
+        .map(|r| [r.1, ratio(r.1)])
+        .collect();
     let mut c = Chart::new(
         "Throwing a (3 g, gravity off) atom: it leaves the tip when m·a exceeds the tip's hold",
         "peak hand acceleration (m/s²)",
@@ -292,7 +319,12 @@ pub fn write(
         bars: vec![
             bar("macro", "brick weight", s.lift_weight_n[0].abs(), BLUE),
             bar("macro", "carry inertia", s.lift_inertia_n[0], BLUE),
-            bar("macro", "peak (house task)", s.macro_house.peak_world_force_n, BLUE),
+            bar(
+                "macro",
+                "peak (house task)",
+                s.macro_house.peak_world_force_n,
+                BLUE,
+            ),
             bar("nano", "snap", s.hysteresis.snap_force_n, ORANGE),
             bar("nano", "pull-off", s.hysteresis.pull_off_n, ORANGE),
             bar("nano", "atom weight", atom_weight, ORANGE),
@@ -308,7 +340,14 @@ pub fn write(
             .sizes_m
             .iter()
             .enumerate()
-            .map(|(i, (l, v))| bar(if i < 2 { "macro" } else { "nano" }, l, *v, if i < 2 { BLUE } else { ORANGE }))
+            .map(|(i, (l, v))| {
+                bar(
+                    if i < 2 { "macro" } else { "nano" },
+                    l,
+                    *v,
+                    if i < 2 { BLUE } else { ORANGE },
+                )
+            })
             .collect(),
     };
     save_bars(dir, "scale_sizes.png", w, &sizes, &mut files)?;
@@ -448,8 +487,16 @@ pub fn markdown(s: &LessonSummary) -> String {
         si(t.release_speed_m_s, "m/s"),
         si(t.distance_m, "m"),
         t.flight_s,
-        if t.thrown { " (a throw, in the world's terms)" } else { "" },
-        if s.atom_stayed { "stayed on the tip" } else { "left the tip" },
+        if t.thrown {
+            " (a throw, in the world's terms)"
+        } else {
+            ""
+        },
+        if s.atom_stayed {
+            "stayed on the tip"
+        } else {
+            "left the tip"
+        },
         si(s.atom_inertia_n, "N"),
         si(s.atom_mass_kg * 9.81, "N"),
         si(s.atom_hold_n, "N"),

@@ -50,7 +50,12 @@ pub struct BrickScene {
 pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
     SwitchSpec::number("gravity_m_s2", 0.0, 100.0, "gravity, m/s² (0: off)"),
     SwitchSpec::number("restitution", 0.0, 1.0, "restitution of every contact"),
-    SwitchSpec::number("friction", 0.0, 10.0, "friction coefficient of every contact"),
+    SwitchSpec::number(
+        "friction",
+        0.0,
+        10.0,
+        "friction coefficient of every contact",
+    ),
     SwitchSpec::on_off("inertia", "the carried brick's inertial force −M a"),
     SwitchSpec::number("brick_mass_kg", 1e-3, 100.0, "mass of every brick, kg"),
 ];
@@ -152,7 +157,9 @@ fn track_drops(
             velocity_m_s: v,
         } => released.push((*brick, (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())),
         E::Grabbed { brick } => released.retain(|(b, _)| b != brick),
-        E::Impact { a, b, speed_m_s, .. } => {
+        E::Impact {
+            a, b, speed_m_s, ..
+        } => {
             for body in [a, b] {
                 if let Body::Brick(id) = body
                     && let Some(i) = released.iter().position(|(r, _)| r == id)

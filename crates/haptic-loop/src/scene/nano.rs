@@ -61,10 +61,20 @@ pub struct NanoScene {
 /// gap, which scales with A).
 pub const NANO_SWITCHES: [SwitchSpec; 8] = [
     SwitchSpec::number("adhesion_scale", 0.0, 10.0, "every pair strength × this"),
-    SwitchSpec::number("tip_substrate_scale", 0.0, 10.0, "tip–substrate strength × this"),
+    SwitchSpec::number(
+        "tip_substrate_scale",
+        0.0,
+        10.0,
+        "tip–substrate strength × this",
+    ),
     SwitchSpec::number("tip_atom_scale", 0.0, 10.0, "tip–atom strength × this"),
     SwitchSpec::number("atom_atom_scale", 0.0, 10.0, "atom–atom strength × this"),
-    SwitchSpec::number("atom_substrate_scale", 0.0, 10.0, "atom–substrate strength × this"),
+    SwitchSpec::number(
+        "atom_substrate_scale",
+        0.0,
+        10.0,
+        "atom–substrate strength × this",
+    ),
     SwitchSpec::number("atom_mass_kg", 0.0, 1.0, "mass of every movable atom, kg"),
     SwitchSpec::number("gravity_m_s2", 0.0, 1000.0, "gravity, m/s² (0: off)"),
     SwitchSpec::on_off("inertia", "the carried atoms' inertial force −m a"),
@@ -308,7 +318,8 @@ impl Scene for NanoScene {
             }
         }
         out.force_n = self.force_n;
-        self.score.update(input.tick, self.force_n, world.house().score());
+        self.score
+            .update(input.tick, self.force_n, world.house().score());
         out.stiffness_n_per_m = match (&self.params.interaction, world.tip_contact()) {
             (Interaction::Physical(p), _) => p.cantilever_stiffness_n_per_m,
             (Interaction::Game(_), TipContact::Anchored(a)) => {

@@ -63,7 +63,8 @@ impl HouseScore {
 
     /// Updates after tick `tick` with the world force felt (N) and the slots filled.
     pub fn update(&mut self, tick: u64, force_n: [f64; 3], filled: usize) {
-        let f = (force_n[0] * force_n[0] + force_n[1] * force_n[1] + force_n[2] * force_n[2]).sqrt();
+        let f =
+            (force_n[0] * force_n[0] + force_n[1] * force_n[1] + force_n[2] * force_n[2]).sqrt();
         if f > self.comfort_n {
             self.over_ticks += 1;
         }

@@ -1,0 +1,397 @@
+//! Sound from a session: impacts, contact clicks and a proximity tone, synthesised sample by
+//! sample (a pure function of its inputs: the same events give the same samples), and WAV
+//! writing (16-bit PCM mono, via the `hound` crate).
+//!
+//! - **Onsets**: a sound at time `t` starts at sample `round(t · sample_rate)` and reaches its
+//!   peak within [`ATTACK_S`] (0.5 ms): onsets land on their event's tick within ±1 ms.
+//! - **Loudness**: a sound of strength `x` (an impulse in N·s, a force in N) over its reference
+//!   `x_ref` has peak amplitude `A = A_MAX · (1 − exp(−x / x_ref))`: it grows strictly with `x`
+//!   and never exceeds [`A_MAX`].
+//! - **No clipping**: sounds add up; if the sum would exceed [`CEILING`] anywhere, the whole
+//!   track is scaled by `CEILING / peak` (so relative loudness is kept and |sample| ≤ 0.98).
+//! - **Proximity tone** (an aid for blind students): while the distance to the nearest object
+//!   is below the world's `on_distance`, a sine whose pitch rises from 220 Hz (at that distance)
+//!   to 880 Hz (in contact), `f = 220 · 4^(1 − d/d_on)` Hz, at amplitude [`TONE_AMPLITUDE`];
+//!   silent beyond it. Amplitude and pitch change smoothly between ticks (no clicks).
+
+use std::path::Path;
+
+use crate::error::RenderError;
+
+/// Largest peak amplitude of one sound.
+pub const A_MAX: f64 = 0.8;
+/// Largest |sample| of a track after the anti-clipping rule.
+pub const CEILING: f64 = 0.98;
+/// Rise time of every sound, s.
+pub const ATTACK_S: f64 = 5e-4;
+/// Amplitude of the proximity tone.
+pub const TONE_AMPLITUDE: f64 = 0.12;
+/// Default sample rate, Hz.
+pub const SAMPLE_RATE_HZ: u32 = 44_100;
+
+/// What made a collision sound (its timbre).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Impact {
+    /// A brick on the ground: a low thud.
+    BrickGround,
+    /// A brick on a brick: a wooden clack.
+    BrickBrick,
+    /// The hand (cursor) on a brick or the ground: a short tap.
+    Cursor,
+}
+
+/// A sound at a time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Sound {
+    /// A collision with its loudness (0–[`A_MAX`]).
+    Impact {
+        /// Which pair.
+        kind: Impact,
+        /// Peak amplitude.
+        amplitude: f64,
+    },
+    /// Snap-to-contact: a bright click.
+    Snap {
+        /// Peak amplitude.
+        amplitude: f64,
+    },
+    /// Pull-off: a lower pop with a falling pitch.
+    PullOff {
+        /// Peak amplitude.
+        amplitude: f64,
+    },
+}
+
+/// A sound and when it starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoundEvent {
+    /// Onset, s from the start of the session.
+    pub t_s: f64,
+    /// The sound.
+    pub sound: Sound,
+}
+
+/// The loudness law: peak amplitude of a sound of strength `x` with reference `x_ref`.
+pub fn amplitude(x: f64, x_ref: f64) -> f64 {
+    if !(x.is_finite() && x > 0.0 && x_ref > 0.0) {
+        return 0.0;
+    }
+    A_MAX * (1.0 - (-x / x_ref).exp())
+}
+
+/// The proximity tone's input: the distance to the nearest object per tick.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Proximity {
+    /// Tick length, s.
+    pub dt_s: f64,
+    /// Distance per tick, m (non-finite: nothing near).
+    pub distance_m: Vec<f64>,
+    /// Distance from which the tone sounds, m.
+    pub on_distance_m: f64,
+}
+
+/// Pitch of the proximity tone at distance `d` (Hz), `None` when silent.
+pub fn tone_hz(d: f64, on_distance_m: f64) -> Option<f64> {
+    if !(d.is_finite() && d < on_distance_m && on_distance_m > 0.0) {
+        return None;
+    }
+    let x = (1.0 - d.max(0.0) / on_distance_m).clamp(0.0, 1.0);
+    Some(220.0 * 4f64.powf(x))
+}
+
+/// A tiny deterministic noise source (xorshift64*), for the noisy part of impacts.
+struct Noise(u64);
+
+impl Noise {
+    fn next(&mut self) -> f64 {
+        let mut x = self.0;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        self.0 = x;
+        let v = x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
+        v as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
+/// One sound's waveform: (length s, sample at time τ after the onset, normalised to peak 1).
+fn voice(sound: &Sound, seed: u64) -> (f64, Box<dyn FnMut(f64) -> f64>) {
+    let attack = |tau: f64| (tau / ATTACK_S).min(1.0);
+    let mut noise = Noise(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let tau2 = std::f64::consts::TAU;
+    match *sound {
+        Sound::Impact { kind, .. } => {
+            let (f1, f2, decay, noise_mix) = match kind {
+                Impact::BrickGround => (140.0, 310.0, 0.060, 0.35),
+                Impact::BrickBrick => (520.0, 1250.0, 0.040, 0.25),
+                Impact::Cursor => (900.0, 2100.0, 0.015, 0.15),
+            };
+            (
+                6.0 * decay,
+                Box::new(move |tau| {
+                    let env = attack(tau) * (-tau / decay).exp();
+                    let tone = 0.65 * (tau2 * f1 * tau).sin() + 0.35 * (tau2 * f2 * tau).sin();
+                    env * ((1.0 - noise_mix) * tone + noise_mix * noise.next())
+                }),
+            )
+        }
+        Sound::Snap { .. } => (
+            0.012,
+            Box::new(move |tau| {
+                let env = attack(tau) * (-tau / 0.002).exp();
+                env * (tau2 * 2400.0 * tau).sin()
+            }),
+        ),
+        Sound::PullOff { .. } => (
+            0.05,
+            Box::new(move |tau| {
+                let env = attack(tau) * (-tau / 0.008).exp();
+                // A falling chirp: 900 Hz → 300 Hz; phase = ∫ f dt.
+                let phase = tau2 * (300.0 * tau + 600.0 * 0.01 * (1.0 - (-tau / 0.01).exp()));
+                env * phase.sin()
+            }),
+        ),
+    }
+}
+
+fn peak_of(sound: &Sound) -> f64 {
+    match *sound {
+        Sound::Impact { amplitude, .. }
+        | Sound::Snap { amplitude }
+        | Sound::PullOff { amplitude } => amplitude.clamp(0.0, A_MAX),
+    }
+}
+
+/// Synthesises `duration_s` of sound at `sample_rate_hz`: the events, and the proximity tone
+/// when given. Deterministic; |sample| ≤ [`CEILING`].
+pub fn synthesize(
+    events: &[SoundEvent],
+    proximity: Option<&Proximity>,
+    duration_s: f64,
+    sample_rate_hz: u32,
+) -> Result<Vec<f32>, RenderError> {
+    if !(8_000..=192_000).contains(&sample_rate_hz) {
+        return Err(RenderError::OutOfRange {
+            field: "sample_rate_hz".into(),
+            value: f64::from(sample_rate_hz),
+            allowed: "8000–192000 Hz",
+        });
+    }
+    if !(duration_s.is_finite() && (0.0..=3600.0).contains(&duration_s)) {
+        return Err(RenderError::OutOfRange {
+            field: "duration_s".into(),
+            value: duration_s,
+            allowed: "0–3600 s",
+        });
+    }
+    let sr = f64::from(sample_rate_hz);
+    let n = (duration_s * sr).round() as usize;
+    let mut out = vec![0.0f64; n];
+    for (i, e) in events.iter().enumerate() {
+        if !(e.t_s.is_finite() && e.t_s >= 0.0) {
+            continue;
+        }
+        let a = peak_of(&e.sound);
+        if a == 0.0 {
+            continue;
+        }
+        let start = (e.t_s * sr).round() as usize;
+        let (len_s, mut wave) = voice(&e.sound, i as u64 + 1);
+        let len = (len_s * sr).ceil() as usize;
+        // Normalise the waveform's peak to 1 (it depends on the timbre only).
+        let mut norm = 0.0f64;
+        let samples: Vec<f64> = (0..len)
+            .map(|k| {
+                let v = wave(k as f64 / sr);
+                norm = norm.max(v.abs());
+                v
+            })
+            .collect();
+        let g = if norm > 0.0 { a / norm } else { 0.0 };
+        for (k, v) in samples.iter().enumerate() {
+            if let Some(o) = out.get_mut(start + k) {
+                *o += g * v;
+            }
+        }
+    }
+    if let Some(p) = proximity {
+        tone(&mut out, p, sr);
+    }
+    let peak = out.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale = if peak > CEILING { CEILING / peak } else { 1.0 };
+    Ok(out.iter().map(|v| (v * scale) as f32).collect())
+}
+
+/// Adds the proximity tone: pitch and amplitude interpolated linearly between tick centres,
+/// phase continuous.
+fn tone(out: &mut [f64], p: &Proximity, sr: f64) {
+    if p.distance_m.is_empty() || !(p.dt_s > 0.0) {
+        return;
+    }
+    let at = |i: usize| -> (f64, f64) {
+        match p
+            .distance_m
+            .get(i)
+            .and_then(|d| tone_hz(*d, p.on_distance_m))
+        {
+            Some(f) => (f, TONE_AMPLITUDE),
+            None => (0.0, 0.0),
+        }
+    };
+    let mut phase = 0.0f64;
+    let mut last_f = 220.0;
+    for (k, o) in out.iter_mut().enumerate() {
+        let t = k as f64 / sr / p.dt_s;
+        let i = t.floor() as usize;
+        let w = t - t.floor();
+        let ((f0, a0), (f1, a1)) = (at(i), at(i + 1));
+        let amp = a0 * (1.0 - w) + a1 * w;
+        // While fading in or out, keep the pitch of the sounding side.
+        let f = match (a0 > 0.0, a1 > 0.0) {
+            (true, true) => f0 * (1.0 - w) + f1 * w,
+            (true, false) => f0,
+            (false, true) => f1,
+            (false, false) => last_f,
+        };
+        last_f = f;
+        phase = (phase + std::f64::consts::TAU * f / sr) % std::f64::consts::TAU;
+        *o += amp * phase.sin();
+    }
+}
+
+/// Writes samples as a 16-bit PCM mono WAV file.
+pub fn write_wav(path: &Path, samples: &[f32], sample_rate_hz: u32) -> Result<(), RenderError> {
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: sample_rate_hz,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let err = |e: hound::Error| RenderError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let mut w = hound::WavWriter::create(path, spec).map_err(err)?;
+    for s in samples {
+        let v = (f64::from(*s).clamp(-1.0, 1.0) * 32767.0).round() as i16;
+        w.write_sample(v).map_err(err)?;
+    }
+    w.finalize().map_err(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn impact(t_s: f64, impulse: f64) -> SoundEvent {
+        SoundEvent {
+            t_s,
+            sound: Sound::Impact {
+                kind: Impact::BrickGround,
+                amplitude: amplitude(impulse, 0.2),
+            },
+        }
+    }
+
+    /// First sample whose |value| reaches 10 % of the track's peak after `from`.
+    fn onset(s: &[f32], from: usize) -> usize {
+        let peak = s[from..].iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        from + s[from..]
+            .iter()
+            .position(|v| v.abs() >= 0.1 * peak)
+            .unwrap_or(0)
+    }
+
+    #[test]
+    fn onsets_land_within_a_millisecond() {
+        for t in [0.1, 0.2503, 1.0] {
+            let s = synthesize(&[impact(t, 0.5)], None, 1.5, SAMPLE_RATE_HZ).unwrap();
+            let got = onset(&s, 0) as f64 / f64::from(SAMPLE_RATE_HZ);
+            assert!((got - t).abs() <= 1e-3, "onset {got} for {t}");
+            assert!(got >= t - 1.0 / f64::from(SAMPLE_RATE_HZ));
+        }
+    }
+
+    #[test]
+    fn louder_with_a_larger_impulse_and_never_clipping() {
+        let peaks: Vec<f32> = [0.01, 0.05, 0.2, 1.0, 5.0]
+            .iter()
+            .map(|j| {
+                let s = synthesize(&[impact(0.01, *j)], None, 0.5, SAMPLE_RATE_HZ).unwrap();
+                s.iter().fold(0.0f32, |m, v| m.max(v.abs()))
+            })
+            .collect();
+        assert!(peaks.windows(2).all(|w| w[1] > w[0]), "{peaks:?}");
+        assert!(peaks.iter().all(|p| f64::from(*p) <= A_MAX + 1e-6));
+        // 200 loud overlapping impacts: scaled down to the ceiling, not clipped.
+        let many: Vec<SoundEvent> = (0..200)
+            .map(|i| impact(0.1 + i as f64 * 1e-4, 10.0))
+            .collect();
+        let s = synthesize(&many, None, 0.5, SAMPLE_RATE_HZ).unwrap();
+        let peak = s.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        assert!((f64::from(peak) - CEILING).abs() < 1e-6, "{peak}");
+    }
+
+    #[test]
+    fn the_proximity_tone_rises_as_the_cursor_nears_and_is_silent_when_far() {
+        assert_eq!(tone_hz(0.2, 0.1), None);
+        assert_eq!(tone_hz(f64::INFINITY, 0.1), None);
+        assert_eq!(tone_hz(0.0, 0.1), Some(880.0));
+        let f: Vec<f64> = [0.09, 0.05, 0.01]
+            .iter()
+            .map(|d| tone_hz(*d, 0.1).unwrap())
+            .collect();
+        assert!(f.windows(2).all(|w| w[1] > w[0]));
+        // Far for 0.5 s, near for 0.5 s at 1 kHz ticks: silence, then a tone.
+        let mut d = vec![1.0; 500];
+        d.extend(vec![0.0; 500]);
+        let p = Proximity {
+            dt_s: 1e-3,
+            distance_m: d,
+            on_distance_m: 0.1,
+        };
+        let s = synthesize(&[], Some(&p), 1.0, SAMPLE_RATE_HZ).unwrap();
+        assert!(s[..22_000].iter().all(|v| *v == 0.0));
+        let near = &s[23_000..44_000];
+        let peak = near.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        assert!((f64::from(peak) - TONE_AMPLITUDE).abs() < 1e-3);
+        // 880 Hz: count zero crossings over 21 000 samples (0.476 s): about 2 · 880 · 0.476.
+        let crossings = near
+            .windows(2)
+            .filter(|w| (w[0] < 0.0) != (w[1] < 0.0))
+            .count();
+        assert!(
+            (crossings as f64 - 2.0 * 880.0 * 21_000.0 / 44_100.0).abs() < 4.0,
+            "{crossings}"
+        );
+    }
+
+    #[test]
+    fn deterministic_and_bad_settings_named() {
+        let e = [impact(0.1, 0.3)];
+        assert_eq!(
+            synthesize(&e, None, 0.5, SAMPLE_RATE_HZ).unwrap(),
+            synthesize(&e, None, 0.5, SAMPLE_RATE_HZ).unwrap()
+        );
+        assert_eq!(
+            synthesize(&e, None, 0.5, 100).unwrap_err().to_string(),
+            "sample_rate_hz = 100 is out of range: allowed 8000–192000 Hz"
+        );
+        assert_eq!(
+            synthesize(&e, None, f64::NAN, SAMPLE_RATE_HZ)
+                .unwrap_err()
+                .to_string(),
+            "duration_s = NaN is out of range: allowed 0–3600 s"
+        );
+    }
+
+    #[test]
+    fn a_wav_file_reads_back() {
+        let p = std::env::temp_dir().join(format!("nh-audio-{}.wav", std::process::id()));
+        let s = synthesize(&[impact(0.01, 0.3)], None, 0.1, SAMPLE_RATE_HZ).unwrap();
+        write_wav(&p, &s, SAMPLE_RATE_HZ).unwrap();
+        let r = hound::WavReader::open(&p).unwrap();
+        assert_eq!(r.spec().sample_rate, SAMPLE_RATE_HZ);
+        assert_eq!(r.len() as usize, s.len());
+    }
+}
