@@ -138,6 +138,12 @@ pub(crate) fn tagged_to_py<'py, T: Serialize>(
         .map_err(|e| PyValueError::new_err(format!("cannot convert to Python: {e}")))?;
     let d = PyDict::new(py);
     match &v {
+        // Internally tagged (`{"type": "grabbed", "brick": 0}`): the fields as they are.
+        Value::Object(m) if m.get("type").is_some_and(Value::is_string) => {
+            for (f, x) in m {
+                d.set_item(f, value_to_py(py, x)?)?;
+            }
+        }
         Value::String(s) => d.set_item("type", snake(s))?,
         Value::Object(m) if m.len() == 1 => {
             for (k, inner) in m {

@@ -110,6 +110,16 @@ fn event<'py>(py: Python<'py>, e: &Event) -> PyResult<Bound<'py, PyDict>> {
         Event::HouseComplete => {
             d.set_item("type", "house_complete")?;
         }
+        Event::AtomsThrownOff {
+            atoms,
+            load_n,
+            pull_off_n,
+        } => {
+            d.set_item("type", "atoms_thrown_off")?;
+            d.set_item("atoms", atoms)?;
+            d.set_item("load_n", load_n)?;
+            d.set_item("pull_off_n", pull_off_n)?;
+        }
     }
     Ok(d)
 }

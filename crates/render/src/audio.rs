@@ -225,7 +225,7 @@ pub fn synthesize(
 /// Adds the proximity tone: pitch and amplitude interpolated linearly between tick centres,
 /// phase continuous.
 fn tone(out: &mut [f64], p: &Proximity, sr: f64) {
-    if p.distance_m.is_empty() || !(p.dt_s > 0.0) {
+    if p.distance_m.is_empty() || p.dt_s.is_nan() || p.dt_s <= 0.0 {
         return;
     }
     let at = |i: usize| -> (f64, f64) {

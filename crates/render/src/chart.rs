@@ -395,13 +395,12 @@ impl Canvas {
         Ok(layout(s, 0.0, 0.0, size)?.width_px)
     }
 
-    /// Text with its baseline at `y`, anchored at `x` (`align`: 0 left, 0.5 centre, 1 right),
+    /// Text with its baseline at `y`, anchored at `x` (`(x, y)`) (`align`: 0 left, 0.5 centre, 1 right),
     /// rotated by `rot_deg` about the anchor.
     fn text(
         &mut self,
         s: &str,
-        x: f32,
-        y: f32,
+        (x, y): (f32, f32),
         size: f32,
         align: f32,
         rot_deg: f32,
@@ -501,8 +500,7 @@ fn axes(
             cv.line(&[(l, py), (r, py)], GRID, 1.0, false, 255);
             cv.text(
                 &tick_label(v),
-                l - 0.4 * f,
-                py + 0.35 * f,
+                (l - 0.4 * f, py + 0.35 * f),
                 0.9 * f,
                 1.0,
                 0.0,
@@ -514,7 +512,7 @@ fn axes(
         if let Some(px) = x.px(v) {
             let px = px as f32;
             cv.line(&[(px, t), (px, b)], GRID, 1.0, false, 255);
-            cv.text(&tick_label(v), px, b + 1.3 * f, 0.9 * f, 0.5, 0.0, INK)?;
+            cv.text(&tick_label(v), (px, b + 1.3 * f), 0.9 * f, 0.5, 0.0, INK)?;
         }
     }
     cv.line(
@@ -525,9 +523,9 @@ fn axes(
         255,
     );
     let w = cv.pm.width() as f32;
-    cv.text(title, w / 2.0, 1.9 * f, 1.2 * f, 0.5, 0.0, INK)?;
-    cv.text(x_label, (l + r) / 2.0, b + 2.9 * f, f, 0.5, 0.0, INK)?;
-    cv.text(y_label, 1.4 * f, (t + b) / 2.0, f, 0.5, -90.0, INK)?;
+    cv.text(title, (w / 2.0, 1.9 * f), 1.2 * f, 0.5, 0.0, INK)?;
+    cv.text(x_label, ((l + r) / 2.0, b + 2.9 * f), f, 0.5, 0.0, INK)?;
+    cv.text(y_label, (1.4 * f, (t + b) / 2.0), f, 0.5, -90.0, INK)?;
     Ok(())
 }
 
@@ -566,7 +564,7 @@ fn legend(cv: &mut Canvas, items: &[(String, [u8; 3])], r: f32, t: f32) -> Resul
             *c,
             255,
         );
-        cv.text(s, x0 + 2.2 * f, yy, f, 0.0, 0.0, INK)?;
+        cv.text(s, (x0 + 2.2 * f, yy), f, 0.0, 0.0, INK)?;
     }
     Ok(())
 }
@@ -671,7 +669,7 @@ impl Chart {
             let row = (0..4).find(|k| px - last_px[*k] > w + 0.4 * f).unwrap_or(0);
             last_px[row] = px;
             let ty = t + (1.0 + row as f32) * 0.95 * f;
-            cv.text(&m.label, px + 0.2 * f, ty, 0.75 * f, 0.0, 0.0, m.color)?;
+            cv.text(&m.label, (px + 0.2 * f, ty), 0.75 * f, 0.0, 0.0, m.color)?;
         }
         // Series, clipped to the plot area.
         let inside = |p: (f32, f32)| p.0 >= l - 1.0 && p.0 <= r + 1.0;
@@ -772,8 +770,7 @@ impl BarChart {
                 cv.line(&[(l as f32, py), (r as f32, py)], GRID, 1.0, false, 255);
                 cv.text(
                     &tick_label(v),
-                    l as f32 - 0.4 * f,
-                    py + 0.35 * f,
+                    (l as f32 - 0.4 * f, py + 0.35 * f),
                     0.9 * f,
                     1.0,
                     0.0,
@@ -798,8 +795,7 @@ impl BarChart {
                     let label = value_label(bar.value);
                     cv.text(
                         &label,
-                        (x0 + x1) / 2.0,
-                        py - 0.3 * f,
+                        ((x0 + x1) / 2.0, py - 0.3 * f),
                         0.8 * f,
                         0.5,
                         0.0,
@@ -807,11 +803,11 @@ impl BarChart {
                     )?;
                 }
                 let ly = b + (1.0 + (k % 2) as f32) * 0.95 * f;
-                cv.text(&bar.label, (x0 + x1) / 2.0, ly, 0.72 * f, 0.5, 0.0, INK)?;
+                cv.text(&bar.label, ((x0 + x1) / 2.0, ly), 0.72 * f, 0.5, 0.0, INK)?;
                 slot += 1;
             }
             let gx = (x.px_lo + (first as f64 + (slot - first) as f64 / 2.0) * slot_w) as f32;
-            cv.text(g, gx, b + 3.3 * f, f, 0.5, 0.0, INK)?;
+            cv.text(g, (gx, b + 3.3 * f), f, 0.5, 0.0, INK)?;
             if gi + 1 < groups.len() {
                 slot += 1;
             }
@@ -830,8 +826,8 @@ impl BarChart {
             255,
         );
         let w = cv.pm.width() as f32;
-        cv.text(&self.title, w / 2.0, 1.9 * f, 1.2 * f, 0.5, 0.0, INK)?;
-        cv.text(&self.y_label, 1.4 * f, (t + b) / 2.0, f, 0.5, -90.0, INK)?;
+        cv.text(&self.title, (w / 2.0, 1.9 * f), 1.2 * f, 0.5, 0.0, INK)?;
+        cv.text(&self.y_label, (1.4 * f, (t + b) / 2.0), f, 0.5, -90.0, INK)?;
         Ok(cv.image())
     }
 

@@ -27,7 +27,7 @@ pub enum LessonError {
         /// The run's name.
         run: String,
         /// Why.
-        error: SessionError,
+        error: Box<SessionError>,
     },
     /// A run did not show what the lesson measures (an event that did not happen).
     #[error("lesson run `{run}`: {what}")]
@@ -160,7 +160,7 @@ fn run(
     let report =
         crate::session::run_session(&o, &mut |_, _| {}).map_err(|error| LessonError::Run {
             run: name.to_string(),
-            error,
+            error: Box::new(error),
         })?;
     Ok(Run {
         name,
