@@ -423,6 +423,17 @@ def resolve_scene(
 def read_recording(path: PathLike, *, salvage: bool = False) -> dict:
     """An MCAP recording as the arrays of run_scene (without stats)."""
 
+def render_audio(
+    path: PathLike,
+    *,
+    proximity: bool = False,
+    sample_rate: int = 44100,
+    out: Optional[PathLike] = None,
+) -> Tuple[npt.NDArray[np.float32], int]:
+    """The sound of a recorded session: (float32 mono samples, sample rate);
+    impacts by impulse, snap and pull-off clicks, and with proximity=True a
+    tone rising as the cursor nears the nearest object. out: also a WAV file."""
+
 class Session:
     """The haptic loop stepped one tick at a time from Python, with the same
     recorder and per-tick arrays as every session (replays bit for bit).
@@ -440,6 +451,8 @@ class Session:
     ) -> None: ...
     def tick(self, position: ArrayLike, buttons: Union[int, Sequence[str], None] = None) -> F64Array:
         """One tick with the device at `position` (3,) m; returns the force (3,) N."""
+    def switch(self, name: str, value: Union[float, bool]) -> None:
+        """Set a run-time switch of the scene before the next tick (recorded)."""
     @property
     def stiffness(self) -> F64Array:
         """Local stiffness sent with the last force, (3, 3) N/m."""

@@ -60,6 +60,13 @@ pub struct SessionSound {
     pub sounds: Vec<SoundEvent>,
 }
 
+impl SessionSound {
+    /// Writes the samples as a 16-bit PCM mono WAV file.
+    pub fn write_wav(&self, path: &std::path::Path) -> Result<(), SoundError> {
+        Ok(audio::write_wav(path, &self.samples, self.sample_rate_hz)?)
+    }
+}
+
 fn field(v: &serde_json::Value, key: &str, tick: u64, event: &str) -> Result<f64, SoundError> {
     v.get(key)
         .and_then(serde_json::Value::as_f64)

@@ -52,6 +52,7 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(envelope::working_envelope_3d, m)?)?;
     m.add_function(wrap_pyfunction!(session::run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(session::read_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(session::render_audio, m)?)?;
     m.add_function(wrap_pyfunction!(session::resolve_scene, m)?)?;
     m.add_class::<live::Session>()?;
     // The device bridge's client and the device adapters are Python (they import the devices'

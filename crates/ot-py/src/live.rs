@@ -154,6 +154,27 @@ impl Session {
         Ok(PyArray1::from_slice(py, &r.device_force_n))
     }
 
+    /// Sets a run-time switch of the scene before the next tick (the
+    /// teaching game's menu: ``gravity_m_s2``, ``friction``, ``inertia``,
+    /// ``adhesion_scale``, ``atom_mass_kg``, ...), recorded as that tick's
+    /// input. ``value``: a number, or True / False for on/off switches.
+    ///
+    /// Raises ValueError naming the switch and its allowed range.
+    fn switch(&mut self, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let v: f64 = if let Ok(b) = value.cast::<pyo3::types::PyBool>() {
+            f64::from(u8::from(b.is_true()))
+        } else {
+            value.extract::<f64>().map_err(|_| {
+                PyValueError::new_err(format!("switch `{name}`: value must be a number or a bool"))
+            })?
+        };
+        let s = self
+            .inner
+            .as_mut()
+            .ok_or_else(|| PyRuntimeError::new_err("the session is closed"))?;
+        s.switch(name, v).map_err(session_error)
+    }
+
     /// Local stiffness sent with the last force, (3, 3) N/m, device frame.
     #[getter]
     fn stiffness<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {

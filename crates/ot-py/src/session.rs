@@ -444,3 +444,55 @@ pub fn read_recording<'py>(
         .map_err(session_error)?;
     arrays_to_py(py, a)
 }
+
+/// The sound of a recorded session, as `nanohaptics render REC --audio` writes
+/// it: an impact sound per collision (loudness from its impulse), a click at
+/// snap-to-contact and another at pull-off, and with ``proximity`` a tone whose
+/// pitch rises as the cursor nears the nearest object.
+///
+/// Args:
+///     path: the recording (MCAP).
+///     proximity: add the proximity tone (brick and nano worlds).
+///     sample_rate: Hz, 8000–192000.
+///     out: also write a 16-bit WAV file there.
+///
+/// Returns (samples, sample_rate): float32 mono samples in [-0.98, 0.98].
+/// Raises OSError when the file cannot be read and ValueError for a bad
+/// recording or argument (naming it).
+#[pyfunction]
+#[pyo3(signature = (path, *, proximity=false, sample_rate=44100, out=None))]
+pub fn render_audio<'py>(
+    py: Python<'py>,
+    path: &Bound<'py, PyAny>,
+    proximity: bool,
+    sample_rate: i64,
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(Bound<'py, PyArray1<f32>>, u32)> {
+    let p = path_arg(path, "path")?;
+    let out = out.map(|o| path_arg(o, "out")).transpose()?;
+    if !(8_000..=192_000).contains(&sample_rate) {
+        return Err(PyValueError::new_err(format!(
+            "sample_rate = {sample_rate} is out of range: allowed 8000–192000 Hz"
+        )));
+    }
+    let rate = sample_rate as u32;
+    let s = py.detach(|| -> PyResult<_> {
+        let rec = haptic_loop::record::read_recording_file(&p, false)
+            .map_err(|e| session_error(SessionError::from(e)))?;
+        let arrays = haptic_loop::session::SessionArrays::from_recording(&rec)
+            .map_err(|e| session_error(SessionError::from(e)))?;
+        let s = haptic_loop::sound::session_sound(
+            &arrays,
+            &rec.description.scene_kind,
+            proximity,
+            rate,
+        )
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        if let Some(o) = &out {
+            s.write_wav(o)
+                .map_err(|e| PyOSError::new_err(e.to_string()))?;
+        }
+        Ok(s)
+    })?;
+    Ok((PyArray1::from_vec(py, s.samples), rate))
+}
