@@ -14,6 +14,9 @@ pub struct LessonArgs {
     /// Width of the figures, px (200–4000; height is half of it).
     #[arg(long, default_value_t = 1200)]
     pub width: u32,
+    /// Sample rate of the house tasks' sounds (WAV), Hz (8000–192000).
+    #[arg(long, default_value_t = 44_100)]
+    pub sample_rate: u32,
     /// Print the measured numbers as JSON.
     #[arg(long)]
     pub json: bool,
@@ -25,6 +28,12 @@ pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
         return Err(format!(
             "--width = {} is out of range: allowed 200–4000 px",
             args.width
+        ));
+    }
+    if !(8_000..=192_000).contains(&args.sample_rate) {
+        return Err(format!(
+            "--sample-rate = {} is out of range: allowed 8000–192000 Hz",
+            args.sample_rate
         ));
     }
     let pb = (!args.json).then(|| {
@@ -39,6 +48,7 @@ pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
     let opts = LessonOptions {
         out: args.out.clone(),
         width_px: args.width,
+        sample_rate_hz: args.sample_rate,
     };
     let s = run_lesson(&opts, &mut |done, total, run| {
         if let Some(pb) = &pb {

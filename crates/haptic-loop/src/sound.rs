@@ -4,9 +4,9 @@
 //!
 //! | event | sound | loudness from |
 //! |---|---|---|
-//! | `brick.impact` (brick–ground, brick–obstacle) | low thud | `impulse_n_s`, reference 0.2 N·s |
-//! | `brick.impact` (brick–brick) | wooden clack | `impulse_n_s`, reference 0.2 N·s |
-//! | `brick.impact` (cursor–anything) | short tap | `impulse_n_s`, reference 0.2 N·s |
+//! | `brick.impact` (brick–ground, brick–obstacle) | low thud | `impulse_n_s`, reference 1 N·s |
+//! | `brick.impact` (brick–brick) | wooden clack | `impulse_n_s`, reference 1 N·s |
+//! | `brick.impact` (cursor–anything) | short tap | `impulse_n_s`, reference 1 N·s |
 //! | `nano.snap` | bright click | `snap_force_n`, reference 0.5 nN |
 //! | `nano.pull_off` | falling pop | `pull_off_n`, reference 0.5 nN |
 //!
@@ -18,7 +18,7 @@ use crate::session::SessionArrays;
 use render::audio::{self, Impact, Proximity, Sound, SoundEvent};
 
 /// Loudness reference of impacts, N·s.
-pub const IMPULSE_REF_N_S: f64 = 0.2;
+pub const IMPULSE_REF_N_S: f64 = 1.0;
 /// Loudness reference of nano contact clicks, N.
 pub const CONTACT_FORCE_REF_N: f64 = 0.5e-9;
 
@@ -228,7 +228,7 @@ mod tests {
             s[0].sound,
             Sound::Impact {
                 kind: Impact::BrickGround,
-                amplitude: audio::amplitude(0.4, 0.2)
+                amplitude: audio::amplitude(0.4, 1.0)
             }
         );
         assert!(matches!(

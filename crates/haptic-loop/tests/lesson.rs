@@ -11,6 +11,7 @@ fn the_lesson_measures_what_it_says() {
         &LessonOptions {
             out: out.clone(),
             width_px: 600,
+            sample_rate_hz: 8000,
         },
         &mut |done, total, run| calls.push((done, total, run.to_string())),
     )
@@ -79,6 +80,21 @@ fn the_lesson_measures_what_it_says() {
         assert!(md.contains(&format!("({img})")), "{img}");
     }
     assert!(md.contains(&format!("{:.2} times the snap force", s.hysteresis.ratio)));
+    assert!(md.contains("(macro_house.wav)") && md.contains("(nano_house.wav)"));
+    // The copy in docs/ holds exactly these numbers (regenerate it with
+    // `nanohaptics lesson --out docs/lesson --width 1000 --sample-rate 22050`, keeping the
+    // report, figures, sounds and lesson.json).
+    let docs =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/lesson/lesson.json");
+    let committed: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(docs).unwrap()).unwrap();
+    let fresh = serde_json::to_value(&s).unwrap();
+    for key in fresh.as_object().unwrap().keys().filter(|k| *k != "files") {
+        assert_eq!(
+            committed[key], fresh[key],
+            "docs/lesson/lesson.json `{key}` is stale"
+        );
+    }
     // The house sessions replay bit for bit.
     let rec =
         haptic_loop::record::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();

@@ -62,6 +62,8 @@ pub struct LessonOptions {
     pub out: PathBuf,
     /// Width of the figures, px (200–4000).
     pub width_px: u32,
+    /// Sample rate of the house tasks' sounds, Hz (8000–192000).
+    pub sample_rate_hz: u32,
 }
 
 /// One run of the lesson: its name and what it produced.
@@ -352,8 +354,23 @@ pub fn run_lesson(
     })?;
     write_file(&opts.out.join("lesson.json"), json.as_bytes())?;
     summary.files.push("lesson.json".into());
-    summary.files.push("macro_house.mcap".into());
-    summary.files.push("nano_house.mcap".into());
+    // The sounds of the two house tasks, from their recordings (with the proximity tone).
+    for name in ["macro_house", "nano_house"] {
+        let rec = opts.out.join(format!("{name}.mcap"));
+        let wav = format!("{name}.wav");
+        let sound = sound_of(&rec, opts.sample_rate_hz).map_err(|what| LessonError::Missing {
+            run: name.to_string(),
+            what,
+        })?;
+        sound
+            .write_wav(&opts.out.join(&wav))
+            .map_err(|e| LessonError::Io {
+                path: opts.out.join(&wav).display().to_string(),
+                message: e.to_string(),
+            })?;
+        summary.files.push(format!("{name}.mcap"));
+        summary.files.push(wav);
+    }
     Ok(summary)
 }
 
@@ -373,6 +390,14 @@ pub struct Runs {
     pub atom_throw: Run,
     /// Heavy-atom throws: (swing time s, run).
     pub sweep: Vec<(f64, Run)>,
+}
+
+/// The sound of a recording, with the proximity tone.
+fn sound_of(rec: &Path, sample_rate_hz: u32) -> Result<crate::sound::SessionSound, String> {
+    let r = crate::record::read_recording_file(rec, false).map_err(|e| e.to_string())?;
+    let a = SessionArrays::from_recording(&r).map_err(|e| e.to_string())?;
+    crate::sound::session_sound(&a, &r.description.scene_kind, true, sample_rate_hz)
+        .map_err(|e| e.to_string())
 }
 
 /// The tip's hold on a carried atom: the tip–atom pull-off force, N.

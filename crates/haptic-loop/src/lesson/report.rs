@@ -422,6 +422,10 @@ pub fn markdown(s: &LessonSummary) -> String {
         m,
         "\nScore = 100 × filled / slots − 10 per dropped brick or atom − 5 per second the hand \
          felt more than half the device's largest force (4 N on a Falcon); never below 0.\n\n\
+         Listen: [bricks](macro_house.wav), [atoms](nano_house.wav) — a thud or a clack per \
+         collision (louder for a larger impulse), a click at each snap and a pop at each \
+         pull-off, and a tone that rises as the cursor nears the nearest object (the aid the \
+         paper gave blind students).\n\n\
          ![force over time, macro world](macro_forces.png)\n\n\
          ![force over time, nano world](nano_forces.png)\n\n\
          In the macro world the hand feels the brick's **weight** while carrying it and a push \
