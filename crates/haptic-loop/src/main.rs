@@ -306,6 +306,25 @@ fn parse_operator(s: &str) -> Result<OperatorChoice, String> {
     }
 }
 
+/// The house task's score at the end of a session (brick and nano worlds), from the last
+/// tick's state: `score`, slots filled, `dropped`, `comfort_exceeded_s`, `complete_s`.
+fn house_score(a: &SessionArrays) -> serde_json::Value {
+    let last = |f: &str| a.state_column(f).and_then(|c| c.last().copied());
+    let Some(score) = last("score") else {
+        return serde_json::Value::Null;
+    };
+    let filled = last("slots_filled").or_else(|| last("house_score"));
+    serde_json::json!({
+        "score": score,
+        "slots_filled": filled,
+        "dropped": last("dropped"),
+        "comfort_exceeded_s": last("comfort_exceeded_s"),
+        "complete_s": last("complete_s"),
+        "rule": "100 × filled / slots − 10 per dropped brick or atom − 5 per second above half \
+                 the device's largest force; never below 0",
+    })
+}
+
 fn summary_json(r: &SessionReport) -> serde_json::Value {
     let a = &r.arrays;
     let peak = a
@@ -333,6 +352,7 @@ fn summary_json(r: &SessionReport) -> serde_json::Value {
         "watchdog_ticks": a.status.iter().filter(|s| **s & 32 != 0).count(),
         "live": r.live,
         "sinks": r.sinks,
+        "house_score": house_score(a),
     })
 }
 
@@ -362,6 +382,22 @@ fn print_summary(r: &SessionReport) {
         s.jitter.p99_ns as f64 / 1e3,
         s.missed
     );
+    let h = &j["house_score"];
+    if let Some(score) = h["score"].as_f64() {
+        let complete = h["complete_s"].as_f64().unwrap_or(-1.0);
+        println!(
+            "  house score {score:.1}: {:.0} slots filled, {:.0} dropped, {:.2} s above the \
+             comfort force, {}",
+            h["slots_filled"].as_f64().unwrap_or(0.0),
+            h["dropped"].as_f64().unwrap_or(0.0),
+            h["comfort_exceeded_s"].as_f64().unwrap_or(0.0),
+            if complete >= 0.0 {
+                format!("complete at {complete:.2} s")
+            } else {
+                "not complete".to_string()
+            }
+        );
+    }
     if !r.sinks.is_empty() {
         let parts: Vec<String> = r
             .sinks

@@ -488,3 +488,66 @@ fn a_closed_pipe_ends_the_program_quietly() {
         assert_eq!(o.status.code(), Some(141), "{args:?}");
     }
 }
+
+/// `lesson` and `render --audio` from a directory with no `scenes/` (the built-in scenes), and
+/// the house score in the run summary.
+#[test]
+fn lesson_audio_and_score_work_from_any_directory() {
+    let dir = tmp("elsewhere");
+    std::fs::create_dir_all(&dir).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args([
+            "lesson",
+            "--out",
+            "my-lesson",
+            "--width",
+            "400",
+            "--sample-rate",
+            "8000",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("bricks: 4 of 4 slots"), "{out}");
+    assert!(out.contains("pull-off 3.00 nN (10.00×)"), "{out}");
+    for f in [
+        "lesson.md",
+        "hysteresis.png",
+        "macro_house.wav",
+        "nano_house.mcap",
+        "lesson.json",
+    ] {
+        assert!(dir.join("my-lesson").join(f).is_file(), "{f}");
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args(["lesson", "--width", "10"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: --width = 10 is out of range: allowed 200–4000 px"
+    );
+    let rec = dir.join("my-lesson/macro_house.mcap");
+    let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args([
+            "render",
+            rec.to_str().unwrap(),
+            "--audio",
+            "b.wav",
+            "--proximity",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("wrote WAV sound b.wav"));
+    let run = json(&nh(&["run", "nanoworld", "--json"]));
+    assert_eq!(run["house_score"]["score"], 100.0);
+    assert_eq!(run["house_score"]["slots_filled"], 7.0);
+    let wall = json(&nh(&["run", "wall", "--json", "--seconds", "0.1"]));
+    assert!(wall["house_score"].is_null());
+}
