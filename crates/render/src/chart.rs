@@ -475,6 +475,16 @@ pub fn plot_area(width_px: u32, height_px: u32) -> (f64, f64, f64, f64) {
     )
 }
 
+/// The plot area's edges in pixels: (left, top, right, bottom).
+fn frame(x: &Axis, y: &Axis) -> (f32, f32, f32, f32) {
+    (
+        x.px_lo as f32,
+        y.px_hi as f32,
+        x.px_hi as f32,
+        y.px_lo as f32,
+    )
+}
+
 const GRID: [u8; 3] = [225, 225, 225];
 const INK: [u8; 3] = [40, 40, 40];
 
@@ -488,12 +498,7 @@ fn axes(
     y_label: &str,
 ) -> Result<(), ChartError> {
     let f = cv.font;
-    let (l, t, r, b) = (
-        x.px_lo as f32,
-        y.px_hi as f32,
-        x.px_hi as f32,
-        y.px_lo as f32,
-    );
+    let (l, t, r, b) = frame(x, y);
     for v in y.ticks() {
         if let Some(py) = y.px(v) {
             let py = py as f32;
@@ -642,12 +647,7 @@ impl Chart {
         let mut cv = Canvas::new(width_px, height_px)?;
         let (x, y) = self.axes(width_px, height_px)?;
         let f = cv.font;
-        let (l, t, r, b) = (
-            x.px_lo as f32,
-            y.px_hi as f32,
-            x.px_hi as f32,
-            y.px_lo as f32,
-        );
+        let (l, t, r, b) = frame(&x, &y);
         let clampy = |v: f64| (v as f32).clamp(t, b);
         for band in &self.bands {
             let (Some(a), Some(c)) = (y.px(band.y_min), y.px(band.y_max)) else {

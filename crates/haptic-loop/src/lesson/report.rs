@@ -152,62 +152,30 @@ pub fn write(
     let mut files = Vec::new();
 
     // 1. The house tasks: force over time with events.
-    let mut c = Chart::new(
+    let macro_chart = house_chart(
         "Macro world: building the wall (force on the hand, world frame)",
-        "time (s)",
         "force (N)",
-    );
-    c.series = vec![
-        series(
-            "vertical force Fz",
-            force_curve(&runs.macro_house, 2, 1.0),
-            BLUE,
-            Style::Line,
-        ),
-        series(
-            "|F|",
-            force_norm(&runs.macro_house, 1.0),
-            ORANGE,
-            Style::Line,
-        ),
-    ];
-    c.markers = markers(
         &runs.macro_house,
+        1.0,
         &[
             ("brick.grabbed", "grab", GREEN),
             ("brick.released", "release", RED),
             ("brick.slot_filled", "slot", PURPLE),
         ],
     );
-    save(dir, "macro_forces.png", w, &c, &mut files)?;
-    let mut c = Chart::new(
+    save(dir, "macro_forces.png", w, &macro_chart, &mut files)?;
+    let nano_chart = house_chart(
         "Nano world: building the house (force on the tip, world frame)",
-        "time (s)",
         "force (nN)",
-    );
-    c.series = vec![
-        series(
-            "vertical force Fz",
-            force_curve(&runs.nano_house, 2, 1e9),
-            BLUE,
-            Style::Line,
-        ),
-        series(
-            "|F|",
-            force_norm(&runs.nano_house, 1e9),
-            ORANGE,
-            Style::Line,
-        ),
-    ];
-    c.markers = markers(
         &runs.nano_house,
+        1e9,
         &[
             ("nano.snap", "snap", GREEN),
             ("nano.pull_off", "pull-off", RED),
             ("nano.slot_filled", "slot", PURPLE),
         ],
     );
-    save(dir, "nano_forces.png", w, &c, &mut files)?;
+    save(dir, "nano_forces.png", w, &nano_chart, &mut files)?;
 
     // 2. Lifting a brick: weight, inertia, and the same motion with switches.
     let labels = ["normal", "gravity off", "inertia off"];
@@ -356,6 +324,28 @@ pub fn write(
     write_file(&dir.join("lesson.md"), md.as_bytes())?;
     files.insert(0, "lesson.md".to_string());
     Ok(files)
+}
+
+/// Force over time of a house task (vertical and magnitude, × `unit`) with its events marked.
+fn house_chart(
+    title: &str,
+    y_label: &str,
+    r: &Run,
+    unit: f64,
+    events: &[(&str, &str, [u8; 3])],
+) -> Chart {
+    let mut c = Chart::new(title, "time (s)", y_label);
+    c.series = vec![
+        series(
+            "vertical force Fz",
+            force_curve(r, 2, unit),
+            BLUE,
+            Style::Line,
+        ),
+        series("|F|", force_norm(r, unit), ORANGE, Style::Line),
+    ];
+    c.markers = markers(r, events);
+    c
 }
 
 fn lift_markers() -> Vec<Marker> {
