@@ -12,7 +12,8 @@
 //!   acceleration).
 //! - **comfort**: the force the hand feels above half the device's largest force (4 N on a
 //!   Falcon), counted in seconds.
-//! - The time the house was completed is recorded too (`complete_s`, −1 until it is).
+//! - **time**: the time the house was completed is recorded too (`complete_s`, −1 until it
+//!   is); between equal scores the earlier completion ranks first.
 //!
 //! The score's parts are state fields of the scene (`score`, `dropped`, `comfort_exceeded_s`,
 //! `complete_s`), so they are in the recording, the per-tick arrays and the run summary.

@@ -69,7 +69,10 @@ impl WallScene {
         if !(len.is_finite() && len > 0.0) {
             return Err(out_of_range(
                 "wall.normal",
-                format!("{:?}", params.normal),
+                format!(
+                    "[{}, {}, {}]",
+                    params.normal[0], params.normal[1], params.normal[2]
+                ),
                 "a non-zero finite vector",
             ));
         }
