@@ -461,6 +461,14 @@ const CLI_SEEDS: &[&[&str]] = &[
     &["replay", "seed.mcap", "--verify", "--json"],
     &["replay", "seed.mcap", "--salvage"],
     &["info", "seed.mcap", "--json"],
+    &[
+        "render",
+        "seed.mcap",
+        "--audio",
+        "a.wav",
+        "--sample-rate",
+        "8000",
+    ],
     &["scenes"],
 ];
 
@@ -477,6 +485,9 @@ const FLAGS: &[&str] = &[
     "--width",
     "--live-hz",
     "--wait-s",
+    "--audio",
+    "--proximity",
+    "--sample-rate",
     "rigid",
     "hand",
     "hand:mass_kg=1",
