@@ -524,7 +524,7 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&WALL.replace("[0.0, 0.0, 1.0]", "[0.0, 0.0, 0.0]")),
-            "scene: `wall.normal` = [0.0, 0.0, 0.0] is out of range (allowed: a non-zero finite vector)"
+            "scene: `wall.normal` = [0, 0, 0] is out of range (allowed: a non-zero finite vector)"
         );
     }
 }
