@@ -574,6 +574,24 @@ fn legend(cv: &mut Canvas, items: &[(String, [u8; 3])], r: f32, t: f32) -> Resul
     Ok(())
 }
 
+/// Anything that draws itself into a PNG file (a [`Chart`] or a [`BarChart`]).
+pub trait Figure {
+    /// Draws into a PNG file of `width_px` × `height_px`.
+    fn write_png(&self, path: &Path, width_px: u32, height_px: u32) -> Result<(), ChartError>;
+}
+
+impl Figure for Chart {
+    fn write_png(&self, path: &Path, width_px: u32, height_px: u32) -> Result<(), ChartError> {
+        Chart::write_png(self, path, width_px, height_px)
+    }
+}
+
+impl Figure for BarChart {
+    fn write_png(&self, path: &Path, width_px: u32, height_px: u32) -> Result<(), ChartError> {
+        BarChart::write_png(self, path, width_px, height_px)
+    }
+}
+
 impl Chart {
     /// An empty chart with linear axes.
     pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {

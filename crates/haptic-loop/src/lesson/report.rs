@@ -2,7 +2,7 @@
 
 use super::measure::{self, events, times};
 use super::{LessonError, LessonSummary, Run, Runs, write_file};
-use render::chart::{Band, Bar, BarChart, Chart, Marker, Scale, Series, Style};
+use render::chart::{Band, Bar, BarChart, Chart, Figure, Marker, Scale, Series, Style};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -56,31 +56,15 @@ fn markers(r: &Run, names: &[(&str, &str, [u8; 3])]) -> Vec<Marker> {
     out
 }
 
+/// Draws `figure` into `dir/name` (`w` × `w/2` px) and lists the file.
 fn save(
     dir: &Path,
     name: &str,
     w: u32,
-    chart: &Chart,
+    figure: &dyn Figure,
     files: &mut Vec<String>,
 ) -> Result<(), LessonError> {
-    chart
-        .write_png(&dir.join(name), w, w / 2)
-        .map_err(|e| LessonError::Figure {
-            figure: name.to_string(),
-            message: e.to_string(),
-        })?;
-    files.push(name.to_string());
-    Ok(())
-}
-
-fn save_bars(
-    dir: &Path,
-    name: &str,
-    w: u32,
-    chart: &BarChart,
-    files: &mut Vec<String>,
-) -> Result<(), LessonError> {
-    chart
+    figure
         .write_png(&dir.join(name), w, w / 2)
         .map_err(|e| LessonError::Figure {
             figure: name.to_string(),
@@ -299,7 +283,7 @@ pub fn write(
             bar("nano", "atom inertia (throw)", s.atom_inertia_n, ORANGE),
         ],
     };
-    save_bars(dir, "scale_forces.png", w, &forces, &mut files)?;
+    save(dir, "scale_forces.png", w, &forces, &mut files)?;
     let sizes = BarChart {
         title: "Sizes in the two worlds (log scale): metres against nanometres".into(),
         y_label: "size (m)".into(),
@@ -318,7 +302,7 @@ pub fn write(
             })
             .collect(),
     };
-    save_bars(dir, "scale_sizes.png", w, &sizes, &mut files)?;
+    save(dir, "scale_sizes.png", w, &sizes, &mut files)?;
 
     let md = markdown(s);
     write_file(&dir.join("lesson.md"), md.as_bytes())?;
