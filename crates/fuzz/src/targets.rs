@@ -3,8 +3,8 @@
 
 use crate::mutate::{self, Rng};
 use haptic_loop::bridge::protocol::{Packet, Sample};
+use haptic_loop::channels::messages::Channel;
 use haptic_loop::device::Script;
-use haptic_loop::record::messages::Channel;
 use haptic_loop::record::{Recording, read_recording};
 use haptic_loop::scene::load_scene_for;
 use haptic_loop::session::{SceneSource, SessionOptions, run_session};

@@ -3,10 +3,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use haptic_loop::channels::messages::ForceMsg;
 use haptic_loop::device::{Buttons, DeviceSample};
 use haptic_loop::haptic::HapticLoop;
 use haptic_loop::record::TickEncoder;
-use haptic_loop::record::messages::ForceMsg;
 use haptic_loop::scene::load_scene;
 use std::hint::black_box;
 

@@ -31,7 +31,11 @@ fn brick() {
     let loaded = load_scene(&text, None).unwrap();
     let cfg = &loaded.config;
     let m = &cfg.mapping;
-    let params = file.brickworld.unwrap().params;
+    let params = file
+        .world::<haptic_loop::scene::brick::BrickSection>()
+        .unwrap()
+        .unwrap()
+        .params;
     let limits = brickworld::DeviceLimits {
         max_stiffness_n_m: cfg.world_stiffness_cap_n_per_m(),
         max_force_n: cfg.specs.max_force_n / m.force_scale,

@@ -15,6 +15,7 @@
 //! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
 
 use haptic_loop::scene::SceneFile;
+use haptic_loop::scene::optical::OtParams;
 use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
 use nalgebra::Vector2;
 use ot_envelope::geometry::hausdorff;
@@ -72,14 +73,8 @@ fn load() -> String {
 /// Hausdorff distance from converged dynamics every `every` grabbed ticks.
 fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String, BoxError> {
     let file = SceneFile::parse(text)?;
-    let old = file
-        .optical_tweezers
-        .as_ref()
-        .is_some_and(|p| !p.warm_start);
-    let p = file
-        .optical_tweezers
-        .clone()
-        .ok_or("not an optical scene")?;
+    let p: OtParams = file.world()?.ok_or("not an optical scene")?;
+    let old = !p.warm_start;
     let model = TrapModel::builder(
         p.depth_nj * 1e-9,
         [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],

@@ -1,11 +1,12 @@
 //! Per-tick arrays of a session (struct of arrays), filled straight from the loop as a sink of
 //! the runner, or decoded from a recording.
 
+use crate::channels::messages::{
+    Channel, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TimingMsg,
+};
 use crate::haptic::HapticLoop;
-use crate::record::messages::{Channel, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TimingMsg};
 use crate::record::{Recording, RecordingError};
-use crate::runner::{SessionInfo, Sink, TickView};
-use crate::session::SessionError;
+use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use crate::vec3::Vec3;
 
 /// Per-tick arrays of a session (struct of arrays; `state` is row-major ticks × fields).
@@ -127,7 +128,7 @@ impl SessionArrays {
         &mut self,
         channel: Channel,
         data: &[u8],
-    ) -> Result<(), crate::record::cdr::CdrError> {
+    ) -> Result<(), crate::channels::cdr::CdrError> {
         match channel {
             Channel::DeviceInput => {
                 let m = DeviceInputMsg::decode(data)?;
@@ -190,7 +191,7 @@ impl Sink for SessionArrays {
         "arrays"
     }
 
-    fn start(&mut self, info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SessionError> {
+    fn start(&mut self, info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SinkError> {
         self.rate_hz = info.config.rate_hz;
         self.state_fields = info.description.state_fields.clone();
         if let Some(n) = info.ticks {
@@ -199,7 +200,7 @@ impl Sink for SessionArrays {
         Ok(())
     }
 
-    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
         self.push_tick(t);
         Ok(())
     }

@@ -35,65 +35,10 @@
 //! [`TickResult`]; the sent force is always finite and of norm ≤ the device maximum.
 
 use crate::device::{Buttons, DeviceSample, DeviceSpecs, ForceCommand};
-use crate::scene::switch::{self, Switch, SwitchError};
+pub use crate::scene::loop_config::{LoopConfig, Mapping};
 use crate::scene::{Event, Scene, SceneInput, SceneOutput};
+use crate::switch::{self, Switch, SwitchError};
 use crate::vec3::{self, Vec3};
-
-/// Device ↔ world mapping.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Mapping {
-    /// World metres per device metre.
-    pub workspace_scale: f64,
-    /// Device newtons per world newton.
-    pub force_scale: f64,
-    /// World point under the device origin, m.
-    pub origin_m: Vec3,
-}
-
-impl Mapping {
-    /// World position (m) of device position `p_m` (m).
-    pub fn to_world(&self, p_m: Vec3) -> Vec3 {
-        vec3::add(self.origin_m, vec3::scale(p_m, self.workspace_scale))
-    }
-}
-
-/// Everything the loop needs besides the scene.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoopConfig {
-    /// Tick rate, Hz.
-    pub rate_hz: u32,
-    /// Length of the soft-engagement ramp, ticks (0: none).
-    pub engage_ticks: u64,
-    /// Foxglove display channels are written every this many ticks.
-    pub display_every: u32,
-    /// Display metres per world metre (Foxglove channels only).
-    pub display_scale: f64,
-    /// Device ↔ world mapping.
-    pub mapping: Mapping,
-    /// The device's specifications.
-    pub specs: DeviceSpecs,
-    /// Ticks a stale device sample is tolerated at full force.
-    pub watchdog_grace_ticks: u32,
-    /// Ticks after the last fresh sample at which the force has ramped to zero (> grace).
-    pub watchdog_timeout_ticks: u32,
-}
-
-impl LoopConfig {
-    /// Tick length, s.
-    pub fn dt_s(&self) -> f64 {
-        1.0 / f64::from(self.rate_hz)
-    }
-
-    /// Tick length, ns (exact: validated to be whole).
-    pub fn period_ns(&self) -> u64 {
-        1_000_000_000 / u64::from(self.rate_hz)
-    }
-
-    /// The largest world-frame stiffness that renders within the device's stiffness limit, N/m.
-    pub fn world_stiffness_cap_n_per_m(&self) -> f64 {
-        self.specs.max_stiffness_n_per_m / (self.mapping.force_scale * self.mapping.workspace_scale)
-    }
-}
 
 /// Status bits of a tick (`TickResult::status`).
 pub mod status {
@@ -244,7 +189,7 @@ impl HapticLoop {
         }
     }
 
-    /// Sets a run-time switch of the scene (see [`crate::scene::switch`]): checked against the
+    /// Sets a run-time switch of the scene (see [`crate::switch`]): checked against the
     /// scene's switches, applied at once, and recorded as an input of the next tick (its
     /// [`TickResult::switches`] and a `switch.set` event).
     pub fn switch(&mut self, name: &str, value: f64) -> Result<(), SwitchError> {

@@ -32,6 +32,7 @@
 pub mod arrays;
 pub mod bridge;
 pub mod builtin;
+pub mod channels;
 pub mod device;
 pub mod haptic;
 pub mod lesson;
@@ -42,10 +43,13 @@ pub mod replay;
 pub mod runner;
 pub mod scene;
 pub mod session;
+pub mod sink;
 pub mod sound;
+pub mod source;
 pub mod stepper;
+pub mod switch;
 pub mod textpos;
-pub mod vec3;
+pub use render::vec3;
 
 pub use device::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};
 pub use haptic::{HapticLoop, LoopConfig, TickResult};

@@ -21,9 +21,25 @@
 use crate::haptic::HapticLoop;
 use crate::pacing::TickStats;
 use crate::record::foxglove_out;
-use crate::runner::{SessionInfo, Sink, TickView};
+use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+
+/// Why the live view could not start or publish.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum LiveError {
+    /// The `--live` option is malformed.
+    #[error("{0}")]
+    Option(String),
+    /// The server could not start or a publish failed.
+    #[error("live view: {0}")]
+    Serve(String),
+}
+
+impl From<LiveError> for SinkError {
+    fn from(e: LiveError) -> Self {
+        SinkError::new(e)
+    }
+}
 use crate::scene::{Event, Primitive};
-use crate::session::SessionError;
 use crate::vec3::Vec3;
 use foxglove::schemas::{FrameTransform, Log, SceneUpdate};
 use foxglove::{Context, PartialMetadata, RawChannel, Schema, WebSocketServerHandle};
@@ -47,9 +63,9 @@ pub struct LiveConfig {
 impl LiveConfig {
     /// Parses `ws:HOST:PORT`, or `ws:PORT` for loopback (the `--live` option), with the default
     /// rates (50 Hz scene, 200 Hz plots).
-    pub fn parse(spec: &str) -> Result<Self, SessionError> {
+    pub fn parse(spec: &str) -> Result<Self, LiveError> {
         let bind = crate::bridge::parse_endpoint(spec, "ws", "--live", "ws:127.0.0.1:8765")
-            .map_err(SessionError::Option)?;
+            .map_err(LiveError::Option)?;
         Ok(LiveConfig {
             bind,
             display_hz: 50,
@@ -112,14 +128,14 @@ pub struct LiveSink {
 
 impl LiveSink {
     /// Starts the WebSocket server (clients may connect before the first tick).
-    pub fn new(config: LiveConfig) -> Result<Self, SessionError> {
+    pub fn new(config: LiveConfig) -> Result<Self, LiveError> {
         let ctx = Context::new();
         let server = ctx
             .websocket_server()
             .name("nanohaptics")
             .bind(config.bind.ip().to_string(), config.bind.port())
             .start_blocking()
-            .map_err(|e| SessionError::Live(format!("cannot serve on ws:{}: {e}", config.bind)))?;
+            .map_err(|e| LiveError::Serve(format!("cannot serve on ws:{}: {e}", config.bind)))?;
         Ok(LiveSink {
             config,
             server: Some(server),
@@ -258,7 +274,7 @@ impl Sink for LiveSink {
         "live"
     }
 
-    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
+    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SinkError> {
         let c = info.config;
         self.display_every = every(c.rate_hz, self.config.display_hz);
         self.plot_every = every(c.rate_hz, self.config.plot_hz);
@@ -272,7 +288,7 @@ impl Sink for LiveSink {
                 STATE_SCHEMA.as_bytes().to_vec(),
             ))
             .build_raw()
-            .map_err(|e| SessionError::Live(e.to_string()))?;
+            .map_err(|e| SinkError::from(LiveError::Serve(e.to_string())))?;
         let ch = Channels {
             scene: ctx.channel_builder("/foxglove/scene").build(),
             tf: ctx.channel_builder("/foxglove/tf").build(),
@@ -287,12 +303,12 @@ impl Sink for LiveSink {
             std::thread::Builder::new()
                 .name("live-view".into())
                 .spawn(move || publish(shared, ch, start_ns, period, rate, scale))
-                .map_err(|e| SessionError::Live(e.to_string()))?,
+                .map_err(|e| SinkError::from(LiveError::Serve(e.to_string())))?,
         );
         Ok(())
     }
 
-    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
         let r = t.result;
         let display = r.tick % self.display_every == 0;
         if r.tick % self.plot_every != 0 && !display && r.events.is_empty() {
@@ -323,14 +339,15 @@ impl Sink for LiveSink {
         &mut self,
         _stats: &TickStats,
         _link: &[(&'static str, u64)],
-    ) -> Result<(), SessionError> {
+    ) -> Result<(), SinkError> {
         if let Ok(mut q) = self.shared.queue.lock() {
             q.append(&mut self.local);
         }
         self.shared.done.store(true, Ordering::Release);
         if let Some(t) = self.thread.take() {
-            t.join()
-                .map_err(|_| SessionError::Live("the publisher thread panicked".into()))?;
+            t.join().map_err(|_| {
+                SinkError::from(LiveError::Serve("the publisher thread panicked".into()))
+            })?;
         }
         Ok(())
     }

@@ -20,9 +20,9 @@ mod render_cmd;
 
 use clap::{Parser, Subcommand};
 use haptic_loop::bridge::BridgeConfig;
+use haptic_loop::channels::messages::Channel;
 use haptic_loop::device::{DeviceModel, OperatorParams};
 use haptic_loop::live::LiveConfig;
-use haptic_loop::record::messages::Channel;
 use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{

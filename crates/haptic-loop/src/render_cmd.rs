@@ -4,12 +4,14 @@
 
 use std::path::{Path, PathBuf};
 
-use haptic_loop::device::{DeviceError, HapticDevice, ReplayDevice, TickTime};
+use haptic_loop::device::{DeviceError, HapticDevice, TickTime};
+use haptic_loop::record::ReplayDevice;
 use haptic_loop::record::{RecordingError, read_recording_file};
-use haptic_loop::runner::{Pacing, Runner, Sink, TickView};
+use haptic_loop::runner::{Pacing, Runner};
 use haptic_loop::scene::optical::RecordedPicture;
 use haptic_loop::scene::{SceneError, load_scene, load_scene_for};
 use haptic_loop::session::SessionError;
+use haptic_loop::sink::{Sink, SinkError, TickView};
 use haptic_loop::{HapticLoop, LoopConfig, Scene};
 use render::{Camera, Frame, GifWriter, Image, Palette, Primitive, RenderError, Rgba, Style, View};
 
@@ -485,13 +487,13 @@ impl Sink for FramesSink<'_> {
         "frames"
     }
 
-    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
         let n = t.result.tick;
         if n % self.every != 0 {
             return Ok(());
         }
         self.draw_tick(n, t.lp.scene())
-            .map_err(|e| SessionError::Option(e.to_string()))
+            .map_err(|e| SinkError::new(SessionError::Option(e.to_string())))
     }
 }
 
@@ -620,12 +622,12 @@ fn recording_frames(
 /// reads; `None` for other scenes (they are recomputed).
 fn recorded_picture(
     loaded: &haptic_loop::scene::file::LoadedScene,
-    d: &haptic_loop::record::messages::DescriptionMsg,
+    d: &haptic_loop::channels::messages::DescriptionMsg,
 ) -> Option<RecordedPicture> {
     if d.scene_kind != "optical_tweezers" {
         return None;
     }
-    let pic = RecordedPicture::new(loaded.file.optical_tweezers.as_ref()?);
+    let pic = RecordedPicture::new(&loaded.file.world().ok()??);
     pic.reads(&d.state_fields).then_some(pic)
 }
 
@@ -641,8 +643,8 @@ fn draw_recorded(
     sink: &mut FramesSink<'_>,
 ) -> Result<u64, RenderCmdError> {
     use foxglove::Decode;
+    use haptic_loop::channels::messages::{ForceMsg, StateMsg};
     use haptic_loop::record::Channel;
-    use haptic_loop::record::messages::{ForceMsg, StateMsg};
     let bad = |m: &haptic_loop::record::reader::RecordedMessage, detail: String| {
         RenderCmdError::Recording(RecordingError::BadMessage {
             topic: m.channel.topic().to_string(),

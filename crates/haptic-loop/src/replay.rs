@@ -6,13 +6,14 @@
 //! (state, force, events, Foxglove channels) and compares it byte for byte with the recorded
 //! one. The first difference names its tick and channel.
 
-use crate::device::ReplayDevice;
+use crate::channels::messages::{Channel, ForceMsg, StateMsg};
 use crate::haptic::HapticLoop;
-use crate::record::messages::{Channel, ForceMsg, StateMsg};
+use crate::record::ReplayDevice;
 use crate::record::{OutMsg, Recording, RecordingError, TickEncoder};
-use crate::runner::{Pacing, Runner, SessionInfo, Sink, TickView};
+use crate::runner::{Pacing, Runner};
 use crate::scene::load_scene_for;
 use crate::session::SessionError;
+use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 
 /// The first difference between a recording and its replay.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -113,12 +114,12 @@ impl Sink for VerifySink<'_> {
         "verifier"
     }
 
-    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
+    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SinkError> {
         self.enc = Some(TickEncoder::new(lp, info.description.start_time_ns));
         Ok(())
     }
 
-    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
         let Some(enc) = self.enc.as_mut() else {
             return Ok(());
         };

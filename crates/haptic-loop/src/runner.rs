@@ -12,63 +12,35 @@
 //! device, and must not block: the recorder and the live view hand their data to threads of
 //! their own.
 //!
-//! Adding a sink is one new file implementing [`Sink`] and one line where the session builds
-//! its list of sinks (`session::run_session`).
+//! Adding a sink is one new file implementing [`Sink`](crate::sink::Sink) and one line where the
+//! session builds its list of sinks (`session::run_session`).
 
-use crate::device::{DeviceError, DeviceSample, HapticDevice, TickTime};
-use crate::haptic::{HapticLoop, LoopConfig, TickResult};
+use crate::channels::messages::DescriptionMsg;
+use crate::device::{DeviceError, HapticDevice, TickTime};
+use crate::haptic::HapticLoop;
 use crate::pacing::{Pacer, Percentiles, TickStats};
-use crate::record::messages::DescriptionMsg;
-use crate::scene::Switch;
-use crate::session::SessionError;
+use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use crate::switch::{Switch, SwitchError};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-/// One tick as the sinks see it.
-pub struct TickView<'a> {
-    /// The device reading the tick ran on (the tick's recorded input).
-    pub sample: DeviceSample,
-    /// Whether the tick's real-time deadline was missed (zero force was sent); an input too.
-    pub deadline_missed: bool,
-    /// What the tick produced.
-    pub result: &'a TickResult,
-    /// The loop after the tick (scene state and drawing).
-    pub lp: &'a HapticLoop,
-    /// Start lateness against the schedule, ns (0 in batch mode; wall clock, not reproducible).
-    pub start_late_ns: i64,
-    /// Work of the tick from reading the device to sending the force, ns (wall clock).
-    pub compute_ns: u64,
-}
-
-/// What a sink learns before the first tick.
-pub struct SessionInfo<'a> {
-    /// The session's description (as recorded).
-    pub description: &'a DescriptionMsg,
-    /// The loop's configuration.
-    pub config: &'a LoopConfig,
-    /// Number of ticks planned (`None`: until the device ends the session).
-    pub ticks: Option<u64>,
-}
-
-/// A consumer of ticks.
-pub trait Sink {
-    /// Short name for reports (`recorder`, `arrays`, `live`, ...).
-    fn name(&self) -> &'static str;
-    /// Called once before the first tick.
-    fn start(&mut self, _info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SessionError> {
-        Ok(())
-    }
-    /// Called once per tick, after the force was sent; must not block.
-    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError>;
-    /// Called once after the last tick with the session's statistics and the device's link
-    /// counters (empty for headless devices).
-    fn finish(
-        &mut self,
-        _stats: &TickStats,
-        _link: &[(&'static str, u64)],
-    ) -> Result<(), SessionError> {
-        Ok(())
-    }
+/// Why a run stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The device failed.
+    #[error("device: {0}")]
+    Device(#[from] DeviceError),
+    /// A sink failed.
+    #[error(transparent)]
+    Sink(#[from] SinkError),
+    /// A scheduled switch could not be applied.
+    #[error("tick {tick}: {error}")]
+    Switch {
+        /// The tick it was due at.
+        tick: u64,
+        /// Why the world refused it.
+        error: SwitchError,
+    },
 }
 
 /// How ticks are paced and where the deadline flag comes from.
@@ -114,14 +86,6 @@ pub struct SinkTime {
     pub tick: Percentiles,
 }
 
-/// Hands one tick to every sink, in order.
-pub fn deliver(sinks: &mut [&mut dyn Sink], view: &TickView<'_>) -> Result<(), SessionError> {
-    for s in sinks.iter_mut() {
-        s.tick(view)?;
-    }
-    Ok(())
-}
-
 impl<'s> Runner<'s> {
     /// A runner handing ticks to `sinks`, in order.
     pub fn new(sinks: Vec<&'s mut dyn Sink>) -> Self {
@@ -160,7 +124,7 @@ impl<'s> Runner<'s> {
         ticks: Option<u64>,
         pacing: Pacing,
         progress: &mut dyn FnMut(u64, u64),
-    ) -> Result<(TickStats, EndReason), SessionError> {
+    ) -> Result<(TickStats, EndReason), RunError> {
         let info = SessionInfo {
             description,
             config: lp.config(),
@@ -219,7 +183,7 @@ impl<'s> Runner<'s> {
             let due = self.switches.partition_point(|(t, _)| *t < n);
             for (_, sw) in self.switches[due..].iter().take_while(|(t, _)| *t == n) {
                 lp.switch(&sw.name, sw.value)
-                    .map_err(|error| SessionError::Switch { tick: n, error })?;
+                    .map_err(|error| RunError::Switch { tick: n, error })?;
             }
             lp.tick(sample, recorded_missed);
             let missed = match &pacing {

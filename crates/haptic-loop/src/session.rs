@@ -12,19 +12,20 @@
 //! ```
 
 use crate::bridge::BridgeConfig;
+use crate::channels::messages::{self, DescriptionMsg};
 use crate::device::TickTime;
 use crate::device::script::{OperatorKind, Script};
-use crate::device::source::{DeviceSource, open_device};
 use crate::device::{DeviceError, DeviceModel, OperatorParams, ScriptError};
 use crate::haptic::HapticLoop;
-use crate::live::{LiveConfig, LiveSink};
+use crate::live::{LiveConfig, LiveError, LiveSink};
 use crate::pacing::TickStats;
-use crate::record::messages::{self, DescriptionMsg};
 use crate::record::sink::RecorderSink;
 use crate::record::writer::RecordError;
 use crate::record::{RecordingError, WriteSummary};
-use crate::runner::{EndReason, Pacing, Runner, Sink};
+use crate::runner::{EndReason, Pacing, RunError, Runner};
 use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
+use crate::sink::{Sink, SinkError};
+use crate::source::{DeviceSource, open_device};
 pub use crate::textpos::Location;
 use crate::textpos::field_position;
 use std::path::{Path, PathBuf};
@@ -97,16 +98,16 @@ pub enum SessionError {
     /// Session length out of range.
     #[error(
         "session length {} s is out of range (allowed: 0 < seconds ≤ 3600)",
-        crate::scene::file::fmt_num(*.0)
+        crate::scene::check::fmt_num(*.0)
     )]
     Seconds(f64),
     /// A session shorter than one tick.
     #[error(
         "session length {} s is shorter than one tick ({} ms at {rate_hz} Hz): allowed \
          {} ≤ seconds ≤ 3600",
-        crate::scene::file::fmt_num(*seconds),
+        crate::scene::check::fmt_num(*seconds),
         1e3 / f64::from(*rate_hz),
-        crate::scene::file::fmt_num(0.5 / f64::from(*rate_hz))
+        crate::scene::check::fmt_num(0.5 / f64::from(*rate_hz))
     )]
     TooShort {
         /// The length asked for, s.
@@ -123,6 +124,9 @@ pub enum SessionError {
     /// An option out of range or inconsistent with another.
     #[error("{0}")]
     Option(String),
+    /// A sink (live view, frames) failed.
+    #[error("{0}")]
+    Sink(String),
     /// A switch that the scene refused at a tick (scheduled by a script or a recording).
     #[error("tick {tick}: {error}")]
     Switch {
@@ -131,6 +135,48 @@ pub enum SessionError {
         /// Why it was refused.
         error: crate::scene::SwitchError,
     },
+}
+
+impl From<SinkError> for SessionError {
+    /// Gives a sink's error back its type: a recording's write error stays
+    /// [`SessionError::Record`] (with its OS error), a read error [`SessionError::Recording`].
+    fn from(e: SinkError) -> Self {
+        let e = match e.0.downcast::<SessionError>() {
+            Ok(s) => return *s,
+            Err(e) => e,
+        };
+        let e = match e.downcast::<RecordError>() {
+            Ok(r) => return SessionError::Record(*r),
+            Err(e) => e,
+        };
+        let e = match e.downcast::<RecordingError>() {
+            Ok(r) => return SessionError::Recording(*r),
+            Err(e) => e,
+        };
+        match e.downcast::<LiveError>() {
+            Ok(l) => (*l).into(),
+            Err(e) => SessionError::Sink(e.to_string()),
+        }
+    }
+}
+
+impl From<LiveError> for SessionError {
+    fn from(e: LiveError) -> Self {
+        match e {
+            LiveError::Option(m) => SessionError::Option(m),
+            LiveError::Serve(m) => SessionError::Live(m),
+        }
+    }
+}
+
+impl From<RunError> for SessionError {
+    fn from(e: RunError) -> Self {
+        match e {
+            RunError::Device(d) => SessionError::Device(d),
+            RunError::Sink(s) => s.into(),
+            RunError::Switch { tick, error } => SessionError::Switch { tick, error },
+        }
+    }
 }
 
 /// A scene file's text and the folder it came from (to find its default script).
@@ -423,9 +469,7 @@ fn script_switches(
 ) -> Result<Vec<(u64, Switch)>, SessionError> {
     let mut out = Vec::with_capacity(script.switches.len());
     for sw in script.switches.iter() {
-        if let Err(e) =
-            crate::scene::switch::check(scene.kind(), scene.switches(), &sw.name, sw.value)
-        {
+        if let Err(e) = crate::switch::check(scene.kind(), scene.switches(), &sw.name, sw.value) {
             let i = sw.index;
             let field = match e {
                 crate::scene::SwitchError::Unknown { .. } => format!("switch[{i}].name"),

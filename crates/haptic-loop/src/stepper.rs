@@ -19,15 +19,15 @@
 //! ```
 
 use crate::arrays::SessionArrays;
+use crate::channels::messages::{self, DescriptionMsg};
 use crate::device::{DeviceModel, DeviceSample, ForceCommand};
 use crate::haptic::{HapticLoop, TickResult};
 use crate::pacing::{Percentiles, TickStats};
 use crate::record::WriteSummary;
-use crate::record::messages::{self, DescriptionMsg};
 use crate::record::sink::RecorderSink;
-use crate::runner::{SessionInfo, Sink, TickView, deliver};
 use crate::scene::load_scene;
 use crate::session::{SceneSource, SessionError, now_unix_ns};
+use crate::sink::{SessionInfo, Sink, TickView, deliver};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -48,7 +48,7 @@ fn steady_state_optical_tick_allocates_nothing() {
     let text = std::fs::read_to_string(path).unwrap();
     let file = SceneFile::parse(&text).unwrap();
     let config = file.loop_config(file.device.model).unwrap();
-    let params = file.optical_tweezers.clone().expect("an optical scene");
+    let params = file.world().unwrap().expect("an optical scene");
     let mut scene = OpticalScene::new(params, config.world_stiffness_cap_n_per_m()).unwrap();
     let mut out = SceneOutput::default();
     out.events.reserve(8);

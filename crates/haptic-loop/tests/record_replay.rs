@@ -2,7 +2,7 @@
 //! and the golden recordings under `recordings/`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::record::messages::{Channel, DeviceInputMsg, ForceMsg};
+use haptic_loop::channels::messages::{Channel, DeviceInputMsg, ForceMsg};
 use haptic_loop::record::{RecordingError, read_recording, read_recording_file};
 use haptic_loop::replay::verify;
 use haptic_loop::session::{

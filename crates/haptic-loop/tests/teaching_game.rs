@@ -3,7 +3,7 @@
 //! the house score.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::record::messages::Channel;
+use haptic_loop::channels::messages::Channel;
 use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{

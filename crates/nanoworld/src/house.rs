@@ -3,7 +3,6 @@
 use nalgebra::Vector3;
 
 use crate::params::HouseParams;
-use crate::world::{Event, World};
 
 /// Blueprint slots and which are filled.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,38 +64,56 @@ impl HouseStatus {
     }
 }
 
-impl World {
-    /// Recompute slot fills: each slot takes the lowest-index uncarried atom within the
-    /// tolerance not already used by an earlier slot.
-    pub(crate) fn update_house(&mut self, events: &mut Vec<Event>) {
-        let n = self.house.slots.len();
+/// A change of the house found by [`HouseStatus::update`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum HouseChange {
+    /// Slot `k` became filled.
+    Filled(usize),
+    /// Slot `k` became empty.
+    Emptied(usize),
+    /// Every slot is filled (reported once, when it becomes so).
+    Complete,
+}
+
+impl HouseStatus {
+    /// Recompute slot fills: each slot takes the lowest-index free atom within the tolerance not
+    /// already used by an earlier slot. `free(i)` is atom `i`'s position, `None` while carried.
+    pub(crate) fn update(
+        &mut self,
+        n_atoms: usize,
+        free: impl Fn(usize) -> Option<Vector3<f64>>,
+        mut emit: impl FnMut(HouseChange),
+    ) {
+        let n = self.slots.len();
         if n == 0 {
             return;
         }
-        let mut used = vec![false; self.atoms.len()];
+        let mut used = vec![false; n_atoms];
         let mut filled = vec![None; n];
-        for (k, s) in self.house.slots.iter().enumerate() {
-            for (i, a) in self.atoms.iter().enumerate() {
-                if !used[i] && !a.is_carried() && (a.position - s).norm() <= self.house.tolerance_m
+        for (k, s) in self.slots.iter().enumerate() {
+            for (i, u) in used.iter_mut().enumerate() {
+                if let Some(p) = free(i)
+                    && !*u
+                    && (p - s).norm() <= self.tolerance_m
                 {
-                    used[i] = true;
+                    *u = true;
                     filled[k] = Some(i);
                     break;
                 }
             }
         }
-        for (k, (old, new)) in self.house.filled.iter().zip(&filled).enumerate() {
+        for (k, (old, new)) in self.filled.iter().zip(&filled).enumerate() {
             match (old.is_some(), new.is_some()) {
-                (false, true) => events.push(Event::SlotFilled { slot: k }),
-                (true, false) => events.push(Event::SlotEmptied { slot: k }),
+                (false, true) => emit(HouseChange::Filled(k)),
+                (true, false) => emit(HouseChange::Emptied(k)),
                 _ => {}
             }
         }
         let complete = filled.iter().all(|f| f.is_some());
-        if complete && !self.house.complete {
-            events.push(Event::HouseComplete);
+        if complete && !self.complete {
+            emit(HouseChange::Complete);
         }
-        self.house.filled = filled;
-        self.house.complete = complete;
+        self.filled = filled;
+        self.complete = complete;
     }
 }

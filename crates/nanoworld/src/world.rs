@@ -8,7 +8,7 @@
 use nalgebra::Vector3;
 
 use crate::error::{ParamError, StepError};
-use crate::house::HouseStatus;
+use crate::house::{HouseChange, HouseStatus};
 use crate::law::{PairKind, PairLaws};
 use crate::params::{Interaction, LoadingZone, Params};
 use crate::substrate::Substrate;
@@ -643,6 +643,22 @@ impl World {
     }
 
     // ---- read access -------------------------------------------------------------------
+
+    /// Recompute slot fills and report the changes as events.
+    pub(crate) fn update_house(&mut self, events: &mut Vec<Event>) {
+        let atoms = &self.atoms;
+        self.house.update(
+            atoms.len(),
+            |i| (!atoms[i].is_carried()).then_some(atoms[i].position),
+            |c| {
+                events.push(match c {
+                    HouseChange::Filled(slot) => Event::SlotFilled { slot },
+                    HouseChange::Emptied(slot) => Event::SlotEmptied { slot },
+                    HouseChange::Complete => Event::HouseComplete,
+                })
+            },
+        );
+    }
 
     /// The parameters in force.
     pub fn params(&self) -> &Params {

@@ -7,8 +7,8 @@
 //! scale bar is exact.
 
 use crate::error::{RenderError, finite, finite3};
-use crate::math::{Vec3, add, axes, cross, dot, normalize, scale, sub};
 use crate::primitive::Primitive;
+use crate::vec3::{Vec3, add, axes, cross, dot, normalize, scale, sub};
 
 /// Largest image side the renderer makes, px.
 pub const MAX_SIDE_PX: u32 = 8192;

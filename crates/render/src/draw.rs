@@ -8,9 +8,9 @@ use tiny_skia::{
 
 use crate::error::RenderError;
 use crate::frame::{Frame, ScaleBar, format_length};
-use crate::math::{Vec3, add, axes, dot, normalize, scale};
 use crate::primitive::{Primitive, Rgba};
 use crate::text;
+use crate::vec3::{Vec3, add, axes, box_corners, dot, normalize, normq, scale};
 
 impl Frame {
     /// Light direction (unit, world frame): from the viewer's upper left.
@@ -381,23 +381,4 @@ pub(crate) fn solid(c: Rgba) -> Paint<'static> {
     };
     p.set_color(c.skia());
     p
-}
-
-pub(crate) fn normq(q: [f64; 4]) -> [f64; 4] {
-    let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-    q.map(|v| v / n)
-}
-
-pub(crate) fn box_corners(c: Vec3, ax: [Vec3; 3], h: Vec3) -> [Vec3; 8] {
-    let mut out = [[0.0; 3]; 8];
-    for (k, o) in out.iter_mut().enumerate() {
-        let sx = if k & 1 == 0 { -h[0] } else { h[0] };
-        let sy = if k & 2 == 0 { -h[1] } else { h[1] };
-        let sz = if k & 4 == 0 { -h[2] } else { h[2] };
-        *o = add(
-            add(add(c, scale(ax[0], sx)), scale(ax[1], sy)),
-            scale(ax[2], sz),
-        );
-    }
-    out
 }

@@ -2,12 +2,12 @@
 //! [`Image`].
 
 use crate::camera::Camera;
-use crate::draw::{box_corners, normq};
 use crate::error::{RenderError, finite, finite3};
 use crate::image::Image;
-use crate::math::{Vec3, add, axes, scale, sub};
 use crate::order::{Item, Shape, back_to_front};
 use crate::primitive::{Primitive, Rgba};
+use crate::vec3::{Vec3, add, axes, scale, sub};
+use crate::vec3::{box_corners, normq};
 
 /// How a frame looks apart from its primitives.
 #[derive(Clone, Copy, Debug, PartialEq)]

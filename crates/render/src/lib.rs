@@ -39,18 +39,18 @@ pub mod error;
 pub mod frame;
 pub mod gif;
 pub mod image;
-mod math;
 mod order;
 pub mod primitive;
 mod text;
+pub mod vec3;
 
 pub use camera::{Camera, MAX_SIDE_PX, Projected, View, bounds};
 pub use error::RenderError;
 pub use frame::{Frame, Style, format_length, nice_length_m};
 pub use gif::{BAD_PIXEL_ERROR, BAD_PIXEL_SHARE, GifWriter, Palette, frame_delays_cs};
 pub use image::Image;
-pub use math::Vec3;
 pub use primitive::{Primitive, Rgba};
+pub use vec3::Vec3;
 
 /// The user guide's examples (`docs/render.md`), compiled and run as doc-tests.
 #[cfg(doctest)]

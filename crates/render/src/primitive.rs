@@ -6,7 +6,7 @@
 //! haptic cursor and blueprint slots.
 
 use crate::error::{RenderError, finite, finite3};
-use crate::math::Vec3;
+use crate::vec3::Vec3;
 
 /// An RGBA colour, each channel in 0–1 (straight, not premultiplied alpha).
 #[derive(Clone, Copy, Debug, PartialEq)]

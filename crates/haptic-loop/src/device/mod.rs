@@ -6,15 +6,13 @@
 //! is described by its [`DeviceSpecs`].
 
 pub mod operator;
-pub mod replay;
 pub mod script;
-pub mod source;
 
 use crate::vec3::Vec3;
 use serde::{Deserialize, Serialize};
 
-pub use operator::{OperatorParams, SimulatedOperator};
-pub use replay::ReplayDevice;
+pub use operator::SimulatedOperator;
+pub use script::OperatorParams;
 pub use script::{Script, ScriptError, ScriptedDevice};
 use std::borrow::Cow;
 

@@ -33,9 +33,8 @@
 use super::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
-use crate::device::operator::OperatorParams;
 use crate::vec3::{self, Vec3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Errors in a script file; each names the field and the allowed range.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -70,7 +69,7 @@ pub enum ScriptError {
         /// Field path, e.g. `switch[0].name`.
         field: String,
         /// What the scene allows.
-        source: crate::scene::SwitchError,
+        source: crate::switch::SwitchError,
     },
     /// A button the device does not have.
     #[error("script: `{field}`: {source}")]
@@ -468,6 +467,80 @@ impl HapticDevice for ScriptedDevice {
     fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
         self.last_force_n = cmd.force_n;
         Ok(())
+    }
+}
+
+/// Parameters of the simulated hand.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OperatorParams {
+    /// Effective mass of hand and stylus, kg. Allowed: 0.01–10.
+    pub mass_kg: f64,
+    /// Stiffness pulling the hand toward the intent, N/m. Allowed: 1–10 000.
+    pub stiffness_n_per_m: f64,
+    /// Damping relative to the intended velocity, N·s/m. Allowed: 0–1000.
+    pub damping_n_s_per_m: f64,
+    /// Felt force that halves the operator's intended speed, N (0: off, a passive hand).
+    /// Allowed: 0–100.
+    pub yield_force_n: f64,
+}
+
+impl Default for OperatorParams {
+    fn default() -> Self {
+        OperatorParams {
+            mass_kg: 0.3,
+            stiffness_n_per_m: 300.0,
+            damping_n_s_per_m: 12.0,
+            yield_force_n: 0.0,
+        }
+    }
+}
+
+impl OperatorParams {
+    /// Checks every field against its allowed range.
+    pub fn validate(&self) -> Result<(), ScriptError> {
+        let fields = [
+            ("mass_kg", self.mass_kg, 0.01, 10.0),
+            ("stiffness_n_per_m", self.stiffness_n_per_m, 1.0, 1.0e4),
+            ("damping_n_s_per_m", self.damping_n_s_per_m, 0.0, 1.0e3),
+            ("yield_force_n", self.yield_force_n, 0.0, 100.0),
+        ];
+        for (field, value, lo, hi) in fields {
+            if !(value.is_finite() && value >= lo && value <= hi) {
+                return Err(ScriptError::OutOfRange {
+                    field: field.to_string(),
+                    value,
+                    allowed: format!("{lo} ≤ {field} ≤ {hi}"),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Parses `key=value,key=value` overrides (keys are the field names) on top of `self`.
+    pub fn with_overrides(mut self, spec: &str) -> Result<Self, ScriptError> {
+        for part in spec.split(',').filter(|p| !p.trim().is_empty()) {
+            let (key, value) = part.split_once('=').ok_or_else(|| {
+                ScriptError::Parse(format!("operator: expected key=value, got `{part}`"))
+            })?;
+            let v: f64 = value.trim().parse().map_err(|_| {
+                ScriptError::Parse(format!("operator: `{}` is not a number", value.trim()))
+            })?;
+            match key.trim() {
+                "mass_kg" => self.mass_kg = v,
+                "stiffness_n_per_m" => self.stiffness_n_per_m = v,
+                "damping_n_s_per_m" => self.damping_n_s_per_m = v,
+                "yield_force_n" => self.yield_force_n = v,
+                other => {
+                    return Err(ScriptError::Parse(format!(
+                        "operator: unknown key `{other}` (allowed: mass_kg, stiffness_n_per_m, \
+                         damping_n_s_per_m, yield_force_n)"
+                    )));
+                }
+            }
+        }
+        self.validate()?;
+        Ok(self)
     }
 }
 

@@ -3,20 +3,20 @@
 //!
 //! Layout and schemas: `docs/recording-format.md`.
 
-pub mod cdr;
 pub mod foxglove_out;
-pub mod messages;
 pub mod parse;
 pub mod reader;
+pub mod replay_device;
 pub mod sink;
 pub mod writer;
 
+pub use crate::channels::messages::Channel;
+use crate::channels::messages::{self, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TimingMsg};
 use crate::device::DeviceSample;
 use crate::haptic::{HapticLoop, TickResult};
 use crate::scene::Primitive;
-pub use messages::Channel;
-use messages::{DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TimingMsg};
 pub use reader::{Integrity, Recording, RecordingError, read_recording, read_recording_file};
+pub use replay_device::ReplayDevice;
 pub use writer::{Recorder, RecorderSetup, WriteSummary};
 
 /// One encoded message of a tick.

@@ -4,8 +4,7 @@
 use super::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
 use crate::haptic::HapticLoop;
 use crate::pacing::TickStats;
-use crate::runner::{SessionInfo, Sink, TickView};
-use crate::session::SessionError;
+use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -56,20 +55,23 @@ impl Sink for RecorderSink {
         "recorder"
     }
 
-    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SessionError> {
-        self.recorder = Some(Recorder::create(
-            &self.path,
-            RecorderSetup {
-                description: info.description.clone(),
-                flush_every_ns: 1_000_000_000,
-            },
-        )?);
+    fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SinkError> {
+        self.recorder = Some(
+            Recorder::create(
+                &self.path,
+                RecorderSetup {
+                    description: info.description.clone(),
+                    flush_every_ns: 1_000_000_000,
+                },
+            )
+            .map_err(SinkError::new)?,
+        );
         self.enc = Some(TickEncoder::new(lp, info.description.start_time_ns));
         self.mode = info.description.mode.clone();
         Ok(())
     }
 
-    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SessionError> {
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
         let (Some(rec), Some(enc)) = (self.recorder.as_mut(), self.enc.as_mut()) else {
             return Ok(());
         };
@@ -83,26 +85,25 @@ impl Sink for RecorderSink {
             tick: n,
             log_time_ns: enc.log_time_ns(n),
             msgs,
-        })?;
+        })
+        .map_err(SinkError::new)?;
         Ok(())
     }
 
-    fn finish(
-        &mut self,
-        stats: &TickStats,
-        link: &[(&'static str, u64)],
-    ) -> Result<(), SessionError> {
+    fn finish(&mut self, stats: &TickStats, link: &[(&'static str, u64)]) -> Result<(), SinkError> {
         if let Some(mut rec) = self.recorder.take() {
-            rec.metadata("session", stats_metadata(stats, &self.mode))?;
+            rec.metadata("session", stats_metadata(stats, &self.mode))
+                .map_err(SinkError::new)?;
             if !link.is_empty() {
                 rec.metadata(
                     "device_link",
                     link.iter()
                         .map(|(k, v)| (k.to_string(), v.to_string()))
                         .collect(),
-                )?;
+                )
+                .map_err(SinkError::new)?;
             }
-            self.summary = Some(rec.finish()?);
+            self.summary = Some(rec.finish().map_err(SinkError::new)?);
         }
         Ok(())
     }

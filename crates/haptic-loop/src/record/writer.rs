@@ -9,8 +9,8 @@
 //! most the last second. The thread compresses single-threaded (`compression_threads(0)`) to
 //! leave the other core to the loop.
 
-use super::messages::{self, Channel, DescriptionMsg};
 use super::{OutMsg, TickMessages, foxglove_out};
+use crate::channels::messages::{self, Channel, DescriptionMsg};
 use foxglove::schemas::{FrameTransform, Log, SceneUpdate};
 use std::collections::BTreeMap;
 use std::fs::File;

@@ -8,12 +8,31 @@
 //! plus / minus / forward → turn about x / y / z; Touch button1 → grab, button2 → turn about z.
 //! The world's `dt_s` must equal the loop's tick.
 
-use super::file::{SceneError, out_of_range};
+use super::check::{SceneError, check_positive, out_of_range};
 use super::score::{self, DROP_HEIGHT_M, HouseScore};
-use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec};
+use super::{
+    Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
+};
 use crate::vec3::Vec3;
 use brickworld::{Buttons as BrickButtons, CursorInput, DeviceLimits, Params, World};
 use serde::Deserialize;
+
+/// The brick world in the scene registry: `kind = "brickworld"`, table `[brickworld]`.
+pub const WORLD: WorldKind = WorldKind {
+    kind: "brickworld",
+    check: |text| super::table::pick::<BrickSection>(text, "brickworld").map(drop),
+    build: |text, config| {
+        let p: BrickSection = world_table(text, "brickworld")?;
+        let scene = BrickScene::new(
+            p,
+            config.world_stiffness_cap_n_per_m(),
+            config.world_max_force_n(),
+            config.dt_s(),
+            &config.specs.button_strs(),
+        )?;
+        Ok(Box::new(scene))
+    },
+};
 
 /// `[brickworld]`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -77,7 +96,7 @@ impl BrickScene {
                 format!("{dt_s} s, the loop's tick (1 / loop.rate_hz)"),
             ));
         }
-        super::file::check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;
+        check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;
         let limits = DeviceLimits {
             max_stiffness_n_m: cap_n_per_m,
             max_force_n: max_force_world_n,

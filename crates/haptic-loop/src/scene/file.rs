@@ -1,6 +1,10 @@
 //! Scene files: TOML under `scenes/`, parsed with unknown fields refused and validated with
 //! errors that name the field and the allowed range.
 //!
+//! The common tables (`[scene]`, `[device]`, `[mapping]`, `[loop]`, `[display]`) are read here;
+//! a world's own table (`[wall]`, `[brickworld]`, …) is read by that world's adapter, found in
+//! [`super::registry`] by `scene.kind`. Adding a world does not touch this file.
+//!
 //! ```toml
 //! [scene]
 //! name = "stiff wall"
@@ -30,124 +34,12 @@
 //! ```
 
 use super::Scene;
-use super::brick::{BrickScene, BrickSection};
-use super::nano::{NanoScene, NanoSection};
-use super::optical::{OpticalScene, OtParams};
-use super::wall::{WallParams, WallScene};
+use super::check::SceneError;
+use super::loop_config::{DisplaySection, LoopConfig, LoopSection, MappingSection};
+use super::registry;
+use super::table;
 use crate::device::{DeviceModel, DeviceSpecs};
-use crate::haptic::{LoopConfig, Mapping};
-use crate::textpos::{Position, field_position, position};
 use serde::Deserialize;
-
-/// Errors in a scene file.
-#[derive(Debug, thiserror::Error, PartialEq)]
-pub enum SceneError {
-    /// Not valid TOML for a scene (unknown field, wrong type, missing field, ...).
-    #[error("scene: {message}")]
-    Syntax {
-        /// What the TOML reader found wrong and what it expected.
-        message: String,
-        /// Byte offset in the text where it went wrong, when known.
-        offset: Option<usize>,
-    },
-    /// A world refused its parameters.
-    #[error("scene: {section}: {message}")]
-    World {
-        /// The scene table the world reads, e.g. `nanoworld.params`.
-        section: String,
-        /// The offending field's dotted path inside `section`, when the world names one.
-        field: Option<String>,
-        /// The world's own message (names the field and the allowed range).
-        message: String,
-    },
-    /// A number out of its allowed range.
-    #[error("scene: `{field}` = {value} is out of range (allowed: {allowed})")]
-    OutOfRange {
-        /// Field path, e.g. `mapping.force_scale`.
-        field: String,
-        /// The value found, as written.
-        value: String,
-        /// The allowed range in words.
-        allowed: String,
-    },
-    /// `scene.kind` names no known world, or its table is missing.
-    #[error("scene: `scene.kind` = \"{kind}\" {problem}")]
-    Kind {
-        /// The kind found.
-        kind: String,
-        /// What is wrong.
-        problem: String,
-    },
-    /// The file could not be read.
-    #[error("scene: cannot read {path}: {message}")]
-    Io {
-        /// Path.
-        path: String,
-        /// OS error.
-        message: String,
-    },
-}
-
-impl SceneError {
-    /// Where in the scene's `text` the error is: the TOML reader's position, or the named
-    /// field's value (`None` when neither is known).
-    pub fn position(&self, text: &str) -> Option<Position> {
-        match self {
-            SceneError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
-            SceneError::OutOfRange { field, .. } => field_position(text, field),
-            SceneError::Kind { .. } => field_position(text, "scene.kind"),
-            SceneError::World { section, field, .. } => field
-                .as_ref()
-                .and_then(|f| field_position(text, &format!("{section}.{f}")))
-                .or_else(|| field_position(text, section)),
-            SceneError::Io { .. } => None,
-        }
-    }
-}
-
-/// Builds an out-of-range error.
-pub fn out_of_range(field: &str, value: impl ToString, allowed: impl Into<String>) -> SceneError {
-    SceneError::OutOfRange {
-        field: field.to_string(),
-        value: value.to_string(),
-        allowed: allowed.into(),
-    }
-}
-
-/// Formats a bound for an error message: plain in 1e-3..1e6, scientific outside (`1e-6`).
-pub fn fmt_num(x: f64) -> String {
-    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
-
-/// Checks `lo ≤ value ≤ hi` (and finite).
-pub fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<(), SceneError> {
-    if value.is_finite() && value >= lo && value <= hi {
-        Ok(())
-    } else {
-        Err(out_of_range(
-            field,
-            value,
-            format!("{} ≤ {field} ≤ {}", fmt_num(lo), fmt_num(hi)),
-        ))
-    }
-}
-
-/// Checks `0 < value ≤ hi` (and finite).
-pub fn check_positive(field: &str, value: f64, hi: f64) -> Result<(), SceneError> {
-    if value.is_finite() && value > 0.0 && value <= hi {
-        Ok(())
-    } else {
-        Err(out_of_range(
-            field,
-            value,
-            format!("0 < {field} ≤ {}", fmt_num(hi)),
-        ))
-    }
-}
 
 /// `[scene]`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -155,7 +47,8 @@ pub fn check_positive(field: &str, value: f64, hi: f64) -> Result<(), SceneError
 pub struct SceneHeader {
     /// Display name.
     pub name: String,
-    /// World kind: `wall`.
+    /// World kind, one of [`registry::kinds`]: `wall`, `nanoworld`, `brickworld`,
+    /// `optical_tweezers`.
     pub kind: String,
     /// Default script, relative to the scene file.
     #[serde(default)]
@@ -181,116 +74,78 @@ impl Default for DeviceSection {
     }
 }
 
-/// `[mapping]`.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct MappingSection {
-    /// World metres per device metre (e.g. 1e-4: 1 mm of stylus = 100 nm). Allowed: 1e-12–1e3.
-    pub workspace_scale: f64,
-    /// Device newtons per world newton. Allowed: 1e-6–1e18.
-    pub force_scale: f64,
-    /// World point under the device origin, m.
-    pub origin_m: [f64; 3],
+/// The tables every scene file shares (the world's own table is read by its adapter).
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+struct Common {
+    scene: Option<SceneHeader>,
+    #[serde(default)]
+    device: DeviceSection,
+    #[serde(default)]
+    mapping: MappingSection,
+    #[serde(default, rename = "loop")]
+    loop_: LoopSection,
+    #[serde(default)]
+    display: DisplaySection,
 }
 
-impl Default for MappingSection {
-    fn default() -> Self {
-        MappingSection {
-            workspace_scale: 1.0,
-            force_scale: 1.0,
-            origin_m: [0.0; 3],
-        }
-    }
-}
-
-/// `[loop]`.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct LoopSection {
-    /// Tick rate, Hz. Allowed: 100–10 000 and a whole number of nanoseconds per tick.
-    pub rate_hz: u32,
-    /// Soft-engagement ramp at start (and after invalid input), s. Allowed: 0–10.
-    pub engage_s: f64,
-    /// How long a bridged device's last sample is used at full force, s. Allowed: 0–0.1.
-    pub watchdog_grace_s: f64,
-    /// Time after the last sample at which the force has ramped to zero, s. Allowed: more than
-    /// `watchdog_grace_s` plus one tick, at most 1.
-    pub watchdog_timeout_s: f64,
-}
-
-impl Default for LoopSection {
-    fn default() -> Self {
-        LoopSection {
-            rate_hz: 1000,
-            engage_s: 0.25,
-            watchdog_grace_s: 0.003,
-            watchdog_timeout_s: 0.010,
-        }
-    }
-}
-
-/// `[display]`.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct DisplaySection {
-    /// Rate of the Foxglove channels, Hz; must divide the tick rate. Allowed: 1–tick rate.
-    pub rate_hz: u32,
-    /// Display metres per world metre in the Foxglove channels (1e6: 1 µm shows as 1 m).
-    pub scale: f64,
-}
-
-impl Default for DisplaySection {
-    fn default() -> Self {
-        DisplaySection {
-            rate_hz: 50,
-            scale: 1.0,
-        }
-    }
-}
+/// The names of the common tables.
+const COMMON: [&str; 5] = ["scene", "device", "mapping", "loop", "display"];
 
 /// A whole scene file.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SceneFile {
     /// `[scene]`.
     pub scene: SceneHeader,
     /// `[device]`.
-    #[serde(default)]
     pub device: DeviceSection,
     /// `[mapping]`.
-    #[serde(default)]
     pub mapping: MappingSection,
     /// `[loop]`.
-    #[serde(default, rename = "loop")]
     pub loop_: LoopSection,
     /// `[display]`.
-    #[serde(default)]
     pub display: DisplaySection,
-    /// `[wall]`: parameters of the wall scene.
-    #[serde(default)]
-    pub wall: Option<WallParams>,
-    /// `[nanoworld]`: the nano world (crate `nanoworld`).
-    #[serde(default)]
-    pub nanoworld: Option<NanoSection>,
-    /// `[brickworld]`: the macro world (crate `brickworld`).
-    #[serde(default)]
-    pub brickworld: Option<BrickSection>,
-    /// `[optical_tweezers]`: the optical-tweezers steering scene (crates `ot-physics`,
-    /// `ot-envelope`).
-    #[serde(default)]
-    pub optical_tweezers: Option<OtParams>,
+    /// The file's text, from which the world's table is read (with its positions).
+    text: String,
 }
 
-/// The world kinds this build knows.
-pub const KINDS: &[&str] = &["wall", "nanoworld", "brickworld", "optical_tweezers"];
-
 impl SceneFile {
-    /// Parses a scene file's text (no validation of ranges yet).
+    /// Parses a scene file's text: the common tables, and every world table present is checked
+    /// by its world for unknown fields and types (no validation of ranges yet).
     pub fn parse(text: &str) -> Result<SceneFile, SceneError> {
-        toml::from_str(text).map_err(|e: toml::de::Error| SceneError::Syntax {
-            message: e.message().trim().to_string(),
-            offset: e.span().map(|s| s.start),
+        let kinds = registry::kinds();
+        let allowed: Vec<&str> = COMMON
+            .iter()
+            .copied()
+            .chain(kinds.iter().copied())
+            .collect();
+        table::check_keys(text, &allowed)?;
+        let common: Common = table::parse(text)?;
+        let scene = common.scene.ok_or_else(|| SceneError::Syntax {
+            message: "missing field `scene`".into(),
+            offset: None,
+        })?;
+        for world in registry::WORLDS {
+            (world.check)(text)?;
+        }
+        Ok(SceneFile {
+            scene,
+            device: common.device,
+            mapping: common.mapping,
+            loop_: common.loop_,
+            display: common.display,
+            text: text.to_string(),
         })
+    }
+
+    /// The text the file was parsed from.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The world's own table (`[<scene.kind>]`) as the world's parameter type `T`; `None` when
+    /// the file has no such table.
+    pub fn world<T: serde::de::DeserializeOwned>(&self) -> Result<Option<T>, SceneError> {
+        table::pick(&self.text, &self.scene.kind)
     }
 
     /// Builds the loop configuration for device `model`, checking every common field.
@@ -301,62 +156,7 @@ impl SceneFile {
     /// Builds the loop configuration for a device with `specs` (e.g. announced by a bridged
     /// device), checking every common field.
     pub fn loop_config_for(&self, specs: DeviceSpecs) -> Result<LoopConfig, SceneError> {
-        let m = &self.mapping;
-        check_range("mapping.workspace_scale", m.workspace_scale, 1e-12, 1e3)?;
-        check_range("mapping.force_scale", m.force_scale, 1e-6, 1e18)?;
-        for (k, c) in m.origin_m.iter().enumerate() {
-            check_range(&format!("mapping.origin_m[{k}]"), *c, -1e3, 1e3)?;
-        }
-        let l = &self.loop_;
-        // Up to 20 kHz (the optical-tweezers tick runs at 10 kHz with room to spare); the
-        // period stays exact in whole nanoseconds.
-        if !(100..=20_000).contains(&l.rate_hz) || 1_000_000_000 % l.rate_hz != 0 {
-            return Err(out_of_range(
-                "loop.rate_hz",
-                l.rate_hz,
-                "100 ≤ rate_hz ≤ 20000 with 10^9 / rate_hz a whole number",
-            ));
-        }
-        check_range("loop.engage_s", l.engage_s, 0.0, 10.0)?;
-        check_range("loop.watchdog_grace_s", l.watchdog_grace_s, 0.0, 0.1)?;
-        // A stale tick of age a runs (a + 0.5) periods after the last sample: the grace covers
-        // the ages whose tick is within watchdog_grace_s, and the force is zero from the first
-        // age whose tick is within watchdog_timeout_s of the last sample.
-        let rate = f64::from(l.rate_hz);
-        let grace_ticks = (l.watchdog_grace_s * rate - 0.5).floor().max(0.0);
-        let min_timeout = (grace_ticks + 1.5) / rate;
-        check_range(
-            "loop.watchdog_timeout_s",
-            l.watchdog_timeout_s,
-            min_timeout,
-            1.0,
-        )?;
-        let timeout_ticks = (l.watchdog_timeout_s * rate - 0.5)
-            .floor()
-            .max(grace_ticks + 1.0);
-        let d = &self.display;
-        if d.rate_hz == 0 || d.rate_hz > l.rate_hz || l.rate_hz % d.rate_hz != 0 {
-            return Err(out_of_range(
-                "display.rate_hz",
-                d.rate_hz,
-                format!("a divisor of loop.rate_hz = {}", l.rate_hz),
-            ));
-        }
-        check_range("display.scale", d.scale, 1e-3, 1e12)?;
-        Ok(LoopConfig {
-            rate_hz: l.rate_hz,
-            engage_ticks: (l.engage_s * f64::from(l.rate_hz)).round() as u64,
-            display_every: l.rate_hz / d.rate_hz,
-            display_scale: d.scale,
-            mapping: Mapping {
-                workspace_scale: m.workspace_scale,
-                force_scale: m.force_scale,
-                origin_m: m.origin_m,
-            },
-            specs,
-            watchdog_grace_ticks: grace_ticks as u32,
-            watchdog_timeout_ticks: timeout_ticks as u32,
-        })
+        LoopConfig::new(&self.mapping, &self.loop_, &self.display, specs)
     }
 }
 
@@ -386,50 +186,15 @@ pub fn load_scene_for(text: &str, specs: DeviceSpecs) -> Result<LoadedScene, Sce
 
 fn build(file: SceneFile, specs: DeviceSpecs) -> Result<LoadedScene, SceneError> {
     let config = file.loop_config_for(specs)?;
-    let cap = config.world_stiffness_cap_n_per_m();
-    let dt = 1.0 / f64::from(config.rate_hz);
-    let missing = |kind: &str| SceneError::Kind {
+    let kind = file.scene.kind.as_str();
+    let world = registry::find(kind).ok_or_else(|| SceneError::Kind {
         kind: kind.to_string(),
-        problem: format!("needs a `[{kind}]` table"),
-    };
-    let scene: Box<dyn Scene> = match file.scene.kind.as_str() {
-        "wall" => {
-            let p = file.wall.clone().ok_or_else(|| missing("wall"))?;
-            Box::new(WallScene::new(p, cap, dt)?)
-        }
-        "nanoworld" => {
-            let p = file.nanoworld.clone().ok_or_else(|| missing("nanoworld"))?;
-            let fmax = config.specs.max_force_n / config.mapping.force_scale;
-            Box::new(NanoScene::new(p, cap, fmax, dt)?)
-        }
-        "optical_tweezers" => {
-            let p = file
-                .optical_tweezers
-                .clone()
-                .ok_or_else(|| missing("optical_tweezers"))?;
-            Box::new(OpticalScene::new(p, cap)?)
-        }
-        "brickworld" => {
-            let p = file
-                .brickworld
-                .clone()
-                .ok_or_else(|| missing("brickworld"))?;
-            let fmax = config.specs.max_force_n / config.mapping.force_scale;
-            Box::new(BrickScene::new(
-                p,
-                cap,
-                fmax,
-                dt,
-                &config.specs.button_strs(),
-            )?)
-        }
-        other => {
-            return Err(SceneError::Kind {
-                kind: other.to_string(),
-                problem: format!("is not a known world (allowed: {})", KINDS.join(", ")),
-            });
-        }
-    };
+        problem: format!(
+            "is not a known world (allowed: {})",
+            registry::kinds().join(", ")
+        ),
+    })?;
+    let scene = (world.build)(&file.text, &config)?;
     Ok(LoadedScene {
         file,
         config,

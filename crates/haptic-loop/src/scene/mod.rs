@@ -6,19 +6,24 @@
 //! fields) and the primitives a renderer draws.
 
 pub mod brick;
+pub mod check;
 pub mod file;
+pub mod loop_config;
 pub mod nano;
 pub mod optical;
 pub mod overrides;
+pub mod registry;
 pub mod score;
-pub mod switch;
+pub mod table;
 pub mod wall;
 
 use crate::device::Buttons;
 use crate::vec3::Vec3;
 
-pub use file::{SceneError, SceneFile, load_scene, load_scene_for};
-pub use switch::{Switch, SwitchError, SwitchSpec};
+pub use crate::switch::{Switch, SwitchError, SwitchSpec};
+pub use check::SceneError;
+pub use file::{SceneFile, load_scene, load_scene_for};
+pub use loop_config::{LoopConfig, Mapping};
 
 /// What the loop tells the scene each tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -111,4 +116,31 @@ pub trait Scene {
     fn set_switch(&mut self, name: &str, _value: f64) -> Result<(), String> {
         Err(format!("the {} scene has no switch `{name}`", self.kind()))
     }
+}
+
+/// A world constructor: a scene file's text and the checked loop configuration → the world.
+pub type BuildWorld = fn(&str, &LoopConfig) -> Result<Box<dyn Scene>, SceneError>;
+
+/// A world as the scene registry knows it: its `scene.kind` name (also the name of its table in
+/// a scene file), a check of its table and its constructor. Each adapter defines one
+/// (`pub const WORLD: WorldKind`) and [`registry::WORLDS`] lists them.
+pub struct WorldKind {
+    /// The kind name, e.g. `wall`; the world's table in a scene file is `[<kind>]`.
+    pub kind: &'static str,
+    /// Checks the world's table in a scene file's text (unknown fields, types) when present.
+    pub check: fn(&str) -> Result<(), SceneError>,
+    /// Builds the world from a scene file's text and the checked loop configuration.
+    pub build: BuildWorld,
+}
+
+/// Reads world table `kind` from a scene's text for [`WorldKind::build`]; an error when the
+/// file has none.
+pub fn world_table<T: serde::de::DeserializeOwned>(
+    text: &str,
+    kind: &str,
+) -> Result<T, SceneError> {
+    table::pick(text, kind)?.ok_or_else(|| SceneError::Kind {
+        kind: kind.to_string(),
+        problem: format!("needs a `[{kind}]` table"),
+    })
 }

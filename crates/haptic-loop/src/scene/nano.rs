@@ -11,13 +11,31 @@
 //! refused otherwise (lower `mapping.force_scale` or `mapping.workspace_scale`). Each tick the
 //! scene reports the adhesion `k` of the anchored contact (game mode) or `k_c` (physical).
 
-use super::file::{SceneError, out_of_range};
+use super::check::{SceneError, check_positive, out_of_range};
 use super::score::{self, HouseScore};
-use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec};
+use super::{
+    Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
+};
 use crate::vec3::Vec3;
 use nalgebra::Vector3;
 use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};
 use serde::Deserialize;
+
+/// The nano world in the scene registry: `kind = "nanoworld"`, table `[nanoworld]`.
+pub const WORLD: WorldKind = WorldKind {
+    kind: "nanoworld",
+    check: |text| super::table::pick::<NanoSection>(text, "nanoworld").map(drop),
+    build: |text, config| {
+        let p: NanoSection = world_table(text, "nanoworld")?;
+        let scene = NanoScene::new(
+            p,
+            config.world_stiffness_cap_n_per_m(),
+            config.world_max_force_n(),
+            config.dt_s(),
+        )?;
+        Ok(Box::new(scene))
+    },
+};
 
 /// `[nanoworld]`: a preset or a full parameter table.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -180,7 +198,7 @@ impl NanoScene {
                 ),
             ));
         }
-        super::file::check_positive("nanoworld.draw_radius_m", s.draw_radius_m, 1e-6)?;
+        check_positive("nanoworld.draw_radius_m", s.draw_radius_m, 1e-6)?;
         let slots = params.house.as_ref().map_or(0, |h| h.slots_m.len());
         Ok(NanoScene {
             base: params.clone(),

@@ -20,8 +20,8 @@
 //! `ot_envelope::TickController`: warm-started from the last full envelope build (translated by
 //! the change of free drift, checked at fold points), allocation-free in a steady-state tick.
 
-use super::file::{SceneError, check_positive, check_range};
-use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
+use super::check::{SceneError, check_positive, check_range, out_of_range};
+use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use crate::vec3::Vec3;
 use nalgebra::Vector2;
 use ot_envelope::ClipMode;
@@ -33,6 +33,20 @@ use ot_physics::{Method, Propagator, TrapModel};
 use serde::Deserialize;
 
 type V2 = Vector2<f64>;
+
+/// The optical tweezers in the scene registry: `kind = "optical_tweezers"`, table
+/// `[optical_tweezers]`.
+pub const WORLD: WorldKind = WorldKind {
+    kind: "optical_tweezers",
+    check: |text| super::table::pick::<OtParams>(text, "optical_tweezers").map(drop),
+    build: |text, config| {
+        let p: OtParams = world_table(text, "optical_tweezers")?;
+        Ok(Box::new(OpticalScene::new(
+            p,
+            config.world_stiffness_cap_n_per_m(),
+        )?))
+    },
+};
 
 /// `[optical_tweezers]`: what a human types, with units in the names.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -168,7 +182,7 @@ impl OpticalScene {
             cap_n_per_m,
         )
         .map_err(|_| {
-            super::file::out_of_range(
+            out_of_range(
                 "optical_tweezers.stiffness_n_per_m",
                 p.stiffness_n_per_m,
                 format!(
@@ -210,7 +224,7 @@ impl OpticalScene {
         // finished building the scene. Refuse beyond two periods instead of hanging.
         let max_dt_us = 2.0 * small_oscillation_period_s(&p) * 1e6;
         if !max_dt_us.is_finite() || p.dt_us > max_dt_us {
-            return Err(super::file::out_of_range(
+            return Err(out_of_range(
                 "optical_tweezers.dt_us",
                 p.dt_us,
                 format!(
@@ -634,7 +648,8 @@ mod tests {
         let text = text.replace("tick_map_tol_nm = 0.01", extra);
         SceneFile::parse(&text)
             .unwrap()
-            .optical_tweezers
+            .world::<OtParams>()
+            .unwrap()
             .expect("optical scene")
     }
 
@@ -727,7 +742,11 @@ mod tests {
         let text = std::fs::read_to_string(path).unwrap();
         let with = |from: &str, to: &str| {
             let t = text.replace(from, to);
-            let p = SceneFile::parse(&t).unwrap().optical_tweezers.unwrap();
+            let p = SceneFile::parse(&t)
+                .unwrap()
+                .world::<OtParams>()
+                .unwrap()
+                .unwrap();
             OpticalScene::new(p, 3.0).err().map(|e| e.to_string())
         };
         // Paper constants: period 2π·√(1e-15 kg · (300 nm)² / (4e-15 J)) = 0.942 µs.

@@ -21,7 +21,8 @@
 //!     "override `wall.stifness_n_per_m`: unknown field `stifness_n_per_m`, expected"));
 //! ```
 
-use super::file::{SceneError, SceneFile};
+use super::check::SceneError;
+use super::file::SceneFile;
 use crate::device::DeviceSpecs;
 use crate::device::script::{Script, ScriptError};
 use toml::{Table, Value};
@@ -244,7 +245,10 @@ mod tests {
              optical_tweezers.cursor_radius_nm = 200\n"
         ));
         let f = SceneFile::parse(&text).unwrap();
-        let ot = f.optical_tweezers.clone().unwrap();
+        let ot = f
+            .world::<crate::scene::optical::OtParams>()
+            .unwrap()
+            .unwrap();
         assert_eq!(ot.stiffness_n_per_m, 0.4);
         assert_eq!(ot.cursor_radius_nm, 200.0);
         assert_eq!(f.loop_.rate_hz, 2000);
@@ -253,7 +257,13 @@ mod tests {
         // everything else as in the file, bit for bit
         let base = SceneFile::parse(OT).unwrap();
         assert_eq!(f.display, base.display);
-        assert_eq!(ot.waist_x_nm, base.optical_tweezers.unwrap().waist_x_nm);
+        assert_eq!(
+            ot.waist_x_nm,
+            base.world::<crate::scene::optical::OtParams>()
+                .unwrap()
+                .unwrap()
+                .waist_x_nm
+        );
         let loaded = load_scene(&text, None).unwrap();
         assert_eq!(loaded.config.rate_hz, 2000);
     }

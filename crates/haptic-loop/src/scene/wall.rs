@@ -9,10 +9,21 @@
 //! It checks the loop's stiffness cap and force clamp: pressed `d` deep, a wall of stiffness
 //! `k` gives `k·d` until the device maximum, then exactly the maximum, in the same direction.
 
-use super::file::{SceneError, check_positive, check_range, out_of_range};
-use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput};
+use super::check::{SceneError, check_positive, check_range, out_of_range};
+use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use crate::vec3::{self, Vec3};
 use serde::Deserialize;
+
+/// The wall in the scene registry: `kind = "wall"`, table `[wall]`.
+pub const WORLD: WorldKind = WorldKind {
+    kind: "wall",
+    check: |text| super::table::pick::<WallParams>(text, "wall").map(drop),
+    build: |text, config| {
+        let p: WallParams = world_table(text, "wall")?;
+        let scene = WallScene::new(p, config.world_stiffness_cap_n_per_m(), config.dt_s())?;
+        Ok(Box::new(scene))
+    },
+};
 
 /// Parameters of the wall (`[wall]` table).
 #[derive(Clone, Debug, Deserialize, PartialEq)]

@@ -1,10 +1,10 @@
 //! The replay device: plays back the device inputs of a recording, tick by tick.
 
-use super::{
+use super::{Recording, RecordingError};
+use crate::channels::messages::{Channel, DeviceInputMsg};
+use crate::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
-use crate::record::messages::{Channel, DeviceInputMsg};
-use crate::record::{Recording, RecordingError};
 use crate::vec3::Vec3;
 
 /// Inputs of a recording played back as a device.

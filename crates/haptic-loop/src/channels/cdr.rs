@@ -30,7 +30,7 @@ pub enum CdrError {
     /// A recording of another format version.
     #[error(
         "recorded with format {0}; this build reads {fmt} (re-record the session, or replay it with the build that wrote it)",
-        fmt = super::messages::FORMAT_VERSION
+        fmt = super::FORMAT_VERSION
     )]
     Format(String),
 }

@@ -1,10 +1,10 @@
 //! The device sources a session can be driven by, registered in one place: adding a device is
-//! one new file implementing [`HapticDevice`](super::HapticDevice) and one arm here.
+//! one new file implementing [`HapticDevice`](crate::device::HapticDevice) and one arm here.
 
-use super::SimulatedOperator;
-use super::script::Script;
-use super::{DeviceError, DeviceModel, HapticDevice, OperatorParams, ScriptedDevice};
 use crate::bridge::{BridgeConfig, UdpDevice};
+use crate::device::SimulatedOperator;
+use crate::device::script::Script;
+use crate::device::{DeviceError, DeviceModel, HapticDevice, OperatorParams, ScriptedDevice};
 
 /// Which device drives a session.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,11 +1,9 @@
 //! The recording's channels, their schemas (ROS 2 `.msg` text, CDR encoding) and the typed
 //! messages with their encoders and decoders.
 
-use super::cdr::{CdrError, CdrReader, CdrWriter};
+use super::FORMAT_VERSION;
+use crate::channels::cdr::{CdrError, CdrReader, CdrWriter};
 use crate::vec3::Vec3;
-
-/// Format version written in the scene description; bumped on any layout change.
-pub const FORMAT_VERSION: &str = "nanohaptics-recording/3";
 
 /// The channels of a recording.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]

@@ -1,0 +1,198 @@
+//! The loop's configuration: the `[mapping]`, `[loop]` and `[display]` tables of a scene file,
+//! checked, and what the haptic loop makes of them ([`LoopConfig`]).
+
+use super::check::{SceneError, check_range, out_of_range};
+use crate::device::DeviceSpecs;
+use crate::vec3::{self, Vec3};
+use serde::Deserialize;
+
+/// `[mapping]`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct MappingSection {
+    /// World metres per device metre (e.g. 1e-4: 1 mm of stylus = 100 nm). Allowed: 1e-12–1e3.
+    pub workspace_scale: f64,
+    /// Device newtons per world newton. Allowed: 1e-6–1e18.
+    pub force_scale: f64,
+    /// World point under the device origin, m.
+    pub origin_m: [f64; 3],
+}
+
+impl Default for MappingSection {
+    fn default() -> Self {
+        MappingSection {
+            workspace_scale: 1.0,
+            force_scale: 1.0,
+            origin_m: [0.0; 3],
+        }
+    }
+}
+
+/// `[loop]`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct LoopSection {
+    /// Tick rate, Hz. Allowed: 100–10 000 and a whole number of nanoseconds per tick.
+    pub rate_hz: u32,
+    /// Soft-engagement ramp at start (and after invalid input), s. Allowed: 0–10.
+    pub engage_s: f64,
+    /// How long a bridged device's last sample is used at full force, s. Allowed: 0–0.1.
+    pub watchdog_grace_s: f64,
+    /// Time after the last sample at which the force has ramped to zero, s. Allowed: more than
+    /// `watchdog_grace_s` plus one tick, at most 1.
+    pub watchdog_timeout_s: f64,
+}
+
+impl Default for LoopSection {
+    fn default() -> Self {
+        LoopSection {
+            rate_hz: 1000,
+            engage_s: 0.25,
+            watchdog_grace_s: 0.003,
+            watchdog_timeout_s: 0.010,
+        }
+    }
+}
+
+/// `[display]`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct DisplaySection {
+    /// Rate of the Foxglove channels, Hz; must divide the tick rate. Allowed: 1–tick rate.
+    pub rate_hz: u32,
+    /// Display metres per world metre in the Foxglove channels (1e6: 1 µm shows as 1 m).
+    pub scale: f64,
+}
+
+impl Default for DisplaySection {
+    fn default() -> Self {
+        DisplaySection {
+            rate_hz: 50,
+            scale: 1.0,
+        }
+    }
+}
+
+/// Device ↔ world mapping.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mapping {
+    /// World metres per device metre.
+    pub workspace_scale: f64,
+    /// Device newtons per world newton.
+    pub force_scale: f64,
+    /// World point under the device origin, m.
+    pub origin_m: Vec3,
+}
+
+impl Mapping {
+    /// World position (m) of device position `p_m` (m).
+    pub fn to_world(&self, p_m: Vec3) -> Vec3 {
+        vec3::add(self.origin_m, vec3::scale(p_m, self.workspace_scale))
+    }
+}
+
+/// Everything the loop needs besides the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopConfig {
+    /// Tick rate, Hz.
+    pub rate_hz: u32,
+    /// Length of the soft-engagement ramp, ticks (0: none).
+    pub engage_ticks: u64,
+    /// Foxglove display channels are written every this many ticks.
+    pub display_every: u32,
+    /// Display metres per world metre (Foxglove channels only).
+    pub display_scale: f64,
+    /// Device ↔ world mapping.
+    pub mapping: Mapping,
+    /// The device's specifications.
+    pub specs: DeviceSpecs,
+    /// Ticks a stale device sample is tolerated at full force.
+    pub watchdog_grace_ticks: u32,
+    /// Ticks after the last fresh sample at which the force has ramped to zero (> grace).
+    pub watchdog_timeout_ticks: u32,
+}
+
+impl LoopConfig {
+    /// Builds the loop configuration from the `[mapping]`, `[loop]` and `[display]` tables for a
+    /// device with `specs`, checking every field.
+    pub fn new(
+        m: &MappingSection,
+        l: &LoopSection,
+        d: &DisplaySection,
+        specs: DeviceSpecs,
+    ) -> Result<LoopConfig, SceneError> {
+        check_range("mapping.workspace_scale", m.workspace_scale, 1e-12, 1e3)?;
+        check_range("mapping.force_scale", m.force_scale, 1e-6, 1e18)?;
+        for (k, c) in m.origin_m.iter().enumerate() {
+            check_range(&format!("mapping.origin_m[{k}]"), *c, -1e3, 1e3)?;
+        }
+        // Up to 20 kHz (the optical-tweezers tick runs at 10 kHz with room to spare); the
+        // period stays exact in whole nanoseconds.
+        if !(100..=20_000).contains(&l.rate_hz) || 1_000_000_000 % l.rate_hz != 0 {
+            return Err(out_of_range(
+                "loop.rate_hz",
+                l.rate_hz,
+                "100 ≤ rate_hz ≤ 20000 with 10^9 / rate_hz a whole number",
+            ));
+        }
+        check_range("loop.engage_s", l.engage_s, 0.0, 10.0)?;
+        check_range("loop.watchdog_grace_s", l.watchdog_grace_s, 0.0, 0.1)?;
+        // A stale tick of age a runs (a + 0.5) periods after the last sample: the grace covers
+        // the ages whose tick is within watchdog_grace_s, and the force is zero from the first
+        // age whose tick is within watchdog_timeout_s of the last sample.
+        let rate = f64::from(l.rate_hz);
+        let grace_ticks = (l.watchdog_grace_s * rate - 0.5).floor().max(0.0);
+        let min_timeout = (grace_ticks + 1.5) / rate;
+        check_range(
+            "loop.watchdog_timeout_s",
+            l.watchdog_timeout_s,
+            min_timeout,
+            1.0,
+        )?;
+        let timeout_ticks = (l.watchdog_timeout_s * rate - 0.5)
+            .floor()
+            .max(grace_ticks + 1.0);
+        if d.rate_hz == 0 || d.rate_hz > l.rate_hz || l.rate_hz % d.rate_hz != 0 {
+            return Err(out_of_range(
+                "display.rate_hz",
+                d.rate_hz,
+                format!("a divisor of loop.rate_hz = {}", l.rate_hz),
+            ));
+        }
+        check_range("display.scale", d.scale, 1e-3, 1e12)?;
+        Ok(LoopConfig {
+            rate_hz: l.rate_hz,
+            engage_ticks: (l.engage_s * f64::from(l.rate_hz)).round() as u64,
+            display_every: l.rate_hz / d.rate_hz,
+            display_scale: d.scale,
+            mapping: Mapping {
+                workspace_scale: m.workspace_scale,
+                force_scale: m.force_scale,
+                origin_m: m.origin_m,
+            },
+            specs,
+            watchdog_grace_ticks: grace_ticks as u32,
+            watchdog_timeout_ticks: timeout_ticks as u32,
+        })
+    }
+
+    /// Tick length, s.
+    pub fn dt_s(&self) -> f64 {
+        1.0 / f64::from(self.rate_hz)
+    }
+
+    /// Tick length, ns (exact: validated to be whole).
+    pub fn period_ns(&self) -> u64 {
+        1_000_000_000 / u64::from(self.rate_hz)
+    }
+
+    /// The device's largest force expressed in the world, N (`max_force_n / force_scale`).
+    pub fn world_max_force_n(&self) -> f64 {
+        self.specs.max_force_n / self.mapping.force_scale
+    }
+
+    /// The largest world-frame stiffness that renders within the device's stiffness limit, N/m.
+    pub fn world_stiffness_cap_n_per_m(&self) -> f64 {
+        self.specs.max_stiffness_n_per_m / (self.mapping.force_scale * self.mapping.workspace_scale)
+    }
+}
