@@ -1,0 +1,160 @@
+//! # world-form — what every nanohaptics world shares
+//!
+//! Every world (optical tweezers, bricks, atoms, the calibration wall) is built from its SI
+//! `Params` and the [`Limits`] of the device it renders to, and steps with
+//! `step(&Input) -> StepReport` (force N, stiffness felt N/m, typed events). This crate holds the
+//! one piece of that form they all need: the device limits, defined once.
+//!
+//! What it is for: one [`Limits`] type (largest force, N; largest stable stiffness, N/m) with the
+//! shipped device models' figures and one range check, used by `brickworld`, `nanoworld`,
+//! `ot-envelope`'s optical-tweezers world and `haptic-loop`'s device specifications.
+//!
+//! What it is not: no device I/O, no buttons or workspace (those are `haptic-loop`'s device
+//! specifications), no physics.
+//!
+//! ```
+//! use world_form::Limits;
+//! assert_eq!(Limits::FALCON.max_force_n, 8.0);
+//! let bad = Limits { max_force_n: f64::NAN, ..Limits::FALCON };
+//! assert_eq!(
+//!     bad.validate().unwrap_err().to_string(),
+//!     "`max_force_n` = NaN is out of range (allowed: 0 < max_force_n ≤ 100000 N)"
+//! );
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+/// What a haptic device can render, expressed where a world uses it (CHAI3D's
+/// `cHapticDeviceInfo`: `m_maxLinearForce`, `m_maxLinearStiffness`).
+///
+/// A world scales its force down to `max_force_n` and never renders a spring stiffer than
+/// `max_stiffness_n_per_m`. The haptic loop hands each world the device's limits mapped into
+/// the world's frame and units (divided by the force scale of the mapping).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Limits {
+    /// Largest force magnitude the device renders, N.
+    pub max_force_n: f64,
+    /// Largest stiffness the device renders stably at a 1 kHz servo rate, N/m.
+    #[serde(alias = "max_stiffness_n_m")]
+    pub max_stiffness_n_per_m: f64,
+}
+
+/// Largest force a [`Limits`] may state, N.
+pub const MAX_FORCE_LIMIT_N: f64 = 1e5;
+/// Largest stiffness a [`Limits`] may state, N/m.
+pub const MAX_STIFFNESS_LIMIT_N_PER_M: f64 = 1e7;
+
+/// A limit that is not finite, not positive or beyond the largest allowed value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("`{field}` = {value} is out of range (allowed: 0 < {field} ≤ {max} {unit})")]
+pub struct LimitsError {
+    /// The field's name (`max_force_n` or `max_stiffness_n_per_m`).
+    pub field: &'static str,
+    /// The offending value.
+    pub value: f64,
+    /// The largest allowed value.
+    pub max: f64,
+    /// The field's unit.
+    pub unit: &'static str,
+}
+
+impl Limits {
+    /// Novint Falcon: 8 N, 3000 N/m — the figures of CHAI3D's Falcon driver
+    /// (`CFalconDevice.cpp`: `m_maxLinearForce = 8.0`, `m_maxLinearStiffness = 3000.0`).
+    /// Novint's brochure says "over 2 lbf" (8.9 N) peak; 8 N is what CHAI3D renders, and the one
+    /// figure used everywhere here.
+    pub const FALCON: Limits = Limits {
+        max_force_n: 8.0,
+        max_stiffness_n_per_m: 3000.0,
+    };
+
+    /// 3D Systems Touch (SensAble Phantom Omni class): 3.3 N peak force, 400 N/m (the low end
+    /// of the published 400–700 N/m).
+    pub const TOUCH: Limits = Limits {
+        max_force_n: 3.3,
+        max_stiffness_n_per_m: 400.0,
+    };
+
+    /// Checks both limits are finite, positive and at most [`MAX_FORCE_LIMIT_N`] /
+    /// [`MAX_STIFFNESS_LIMIT_N_PER_M`].
+    pub fn validate(&self) -> Result<(), LimitsError> {
+        check("max_force_n", self.max_force_n, MAX_FORCE_LIMIT_N, "N")?;
+        check(
+            "max_stiffness_n_per_m",
+            self.max_stiffness_n_per_m,
+            MAX_STIFFNESS_LIMIT_N_PER_M,
+            "N/m",
+        )
+    }
+
+    /// These limits divided by a force scale (device N per world N, > 0): what the device can
+    /// render expressed in the world.
+    pub fn scaled_down(&self, force_scale: f64) -> Limits {
+        Limits {
+            max_force_n: self.max_force_n / force_scale,
+            max_stiffness_n_per_m: self.max_stiffness_n_per_m / force_scale,
+        }
+    }
+}
+
+fn check(field: &'static str, value: f64, max: f64, unit: &'static str) -> Result<(), LimitsError> {
+    if value.is_finite() && value > 0.0 && value <= max {
+        Ok(())
+    } else {
+        Err(LimitsError {
+            field,
+            value,
+            max,
+            unit,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn each_bad_limit_is_named_with_its_range() {
+        let e = Limits {
+            max_stiffness_n_per_m: 0.0,
+            ..Limits::FALCON
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "`max_stiffness_n_per_m` = 0 is out of range (allowed: 0 < max_stiffness_n_per_m ≤ \
+             10000000 N/m)"
+        );
+        let e = Limits {
+            max_force_n: 2e5,
+            ..Limits::TOUCH
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.field, "max_force_n");
+        assert!(Limits::FALCON.validate().is_ok());
+        assert!(Limits::TOUCH.validate().is_ok());
+    }
+
+    #[test]
+    fn scaling_divides_both_limits() {
+        let l = Limits::FALCON.scaled_down(1e9);
+        assert_eq!(l.max_force_n, 8e-9);
+        assert_eq!(l.max_stiffness_n_per_m, 3e-6);
+    }
+
+    #[test]
+    fn the_old_unit_spelling_still_loads() {
+        let l: Limits = toml::from_str("max_force_n = 9.0\nmax_stiffness_n_m = 3000.0").unwrap();
+        assert_eq!(l.max_stiffness_n_per_m, 3000.0);
+        let err = toml::from_str::<Limits>("max_force_n = 9.0\nstiffness = 1.0").unwrap_err();
+        assert!(
+            err.to_string().contains("unknown field `stiffness`"),
+            "{err}"
+        );
+    }
+}
