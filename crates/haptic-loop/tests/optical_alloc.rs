@@ -49,7 +49,7 @@ fn steady_state_optical_tick_allocates_nothing() {
     let file = SceneFile::parse(&text).unwrap();
     let config = file.loop_config(file.device.model).unwrap();
     let params = file.world().unwrap().expect("an optical scene");
-    let mut scene = OpticalScene::new(params, config.world_stiffness_cap_n_per_m()).unwrap();
+    let mut scene = OpticalScene::new(params, &config.world_limits()).unwrap();
     let mut out = SceneOutput::default();
     out.events.reserve(8);
     let mut state = Vec::with_capacity(64);

@@ -15,6 +15,9 @@
 //! * [`tick::TickController`]: the same law warm-started from the previous
 //!   tick's envelope (translate, check fold points, rebuild on failure),
 //!   allocation-free in steady state — the haptic loop's tick;
+//! * [`world::World`]: the optical-tweezers world itself — SI [`world::Params`], built with
+//!   the device's `world_form::Limits`, stepped with an [`world::Input`] (cursor, button) to a
+//!   [`world::StepReport`] (force, stiffness felt, typed events);
 //! * [`paper`]: the paper's own method (grid of targets, marching-squares
 //!   seeds, Newton, subdivision, contour), kept as the benchmark baseline.
 //!
@@ -57,6 +60,7 @@ pub mod region;
 pub mod sample;
 pub mod steer;
 pub mod tick;
+pub mod world;
 
 pub use bounded::{Bounded, SteeringRange};
 pub use clip::{ClipMode, Clipped, clip_command, clip_to_polygon};
@@ -69,3 +73,8 @@ pub use inverse::{Solutions, solve_trap};
 pub use region::OffsetRegion;
 pub use sample::SampledMap;
 pub use tick::{TickController, TickOutput, TickParams, TickStats};
+
+/// The user guide's examples (`docs/ot-envelope.md`), compiled and run as doc-tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/ot-envelope.md")]
+pub struct UserGuide;

@@ -88,12 +88,15 @@ impl Limits {
         )
     }
 
-    /// These limits divided by a force scale (device N per world N, > 0): what the device can
-    /// render expressed in the world.
-    pub fn scaled_down(&self, force_scale: f64) -> Limits {
+    /// What the device can render expressed in a world the device maps onto: one world newton
+    /// is `force_scale` device newtons and one device metre is `workspace_scale` world metres
+    /// (both > 0). Forces divide by `force_scale`; stiffnesses by
+    /// `force_scale · workspace_scale` (a world spring `k` is felt as `k · force_scale ·
+    /// workspace_scale` on the device).
+    pub fn in_world(&self, force_scale: f64, workspace_scale: f64) -> Limits {
         Limits {
             max_force_n: self.max_force_n / force_scale,
-            max_stiffness_n_per_m: self.max_stiffness_n_per_m / force_scale,
+            max_stiffness_n_per_m: self.max_stiffness_n_per_m / (force_scale * workspace_scale),
         }
     }
 }
@@ -141,10 +144,11 @@ mod tests {
     }
 
     #[test]
-    fn scaling_divides_both_limits() {
-        let l = Limits::FALCON.scaled_down(1e9);
-        assert_eq!(l.max_force_n, 8e-9);
-        assert_eq!(l.max_stiffness_n_per_m, 3e-6);
+    fn limits_in_a_world_follow_the_mapping() {
+        // The optical-tweezers scene: 1 mm of stylus = 1 µm, 1 µN of world force = 1 N felt.
+        let l = Limits::FALCON.in_world(1e6, 1e-3);
+        assert_eq!(l.max_force_n, 8e-6);
+        assert_eq!(l.max_stiffness_n_per_m, 3.0);
     }
 
     #[test]

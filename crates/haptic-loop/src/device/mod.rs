@@ -10,6 +10,7 @@ pub mod script;
 
 use crate::vec3::Vec3;
 use serde::{Deserialize, Serialize};
+use world_form::Limits;
 
 pub use operator::SimulatedOperator;
 pub use script::OperatorParams;
@@ -49,8 +50,8 @@ pub enum DeviceModel {
 /// Novint Falcon specifications.
 pub const FALCON: DeviceSpecs = DeviceSpecs {
     name: Cow::Borrowed("falcon"),
-    max_force_n: 8.0,
-    max_stiffness_n_per_m: 3000.0,
+    max_force_n: Limits::FALCON.max_force_n,
+    max_stiffness_n_per_m: Limits::FALCON.max_stiffness_n_per_m,
     workspace_radius_m: 0.04,
     button_names: Cow::Borrowed(&[
         Cow::Borrowed("centre"),
@@ -63,8 +64,8 @@ pub const FALCON: DeviceSpecs = DeviceSpecs {
 /// Touch / Omni class specifications (conservative end of the published ranges).
 pub const TOUCH: DeviceSpecs = DeviceSpecs {
     name: Cow::Borrowed("touch"),
-    max_force_n: 3.3,
-    max_stiffness_n_per_m: 400.0,
+    max_force_n: Limits::TOUCH.max_force_n,
+    max_stiffness_n_per_m: Limits::TOUCH.max_stiffness_n_per_m,
     workspace_radius_m: 0.075,
     button_names: Cow::Borrowed(&[Cow::Borrowed("button1"), Cow::Borrowed("button2")]),
 };
@@ -97,6 +98,15 @@ impl DeviceModel {
 }
 
 impl DeviceSpecs {
+    /// What the device can render (largest force, N; largest stable stiffness, N/m), in the
+    /// device's own frame.
+    pub fn limits(&self) -> Limits {
+        Limits {
+            max_force_n: self.max_force_n,
+            max_stiffness_n_per_m: self.max_stiffness_n_per_m,
+        }
+    }
+
     /// Bit index of a named button, or an error naming the allowed buttons.
     pub fn button_index(&self, name: &str) -> Result<u32, DeviceError> {
         self.button_names

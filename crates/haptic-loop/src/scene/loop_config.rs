@@ -191,6 +191,14 @@ impl LoopConfig {
         self.specs.max_force_n / self.mapping.force_scale
     }
 
+    /// The device's limits expressed in the world (force and stiffness through the mapping):
+    /// what every world is built with.
+    pub fn world_limits(&self) -> world_form::Limits {
+        self.specs
+            .limits()
+            .in_world(self.mapping.force_scale, self.mapping.workspace_scale)
+    }
+
     /// The largest world-frame stiffness that renders within the device's stiffness limit, N/m.
     pub fn world_stiffness_cap_n_per_m(&self) -> f64 {
         self.specs.max_stiffness_n_per_m / (self.mapping.force_scale * self.mapping.workspace_scale)

@@ -1,36 +1,27 @@
-//! The optical-tweezers steering scene (Lee, Lyons & LeBrun, §2.4 and §3.3): a 1 µm particle
-//! in an elliptic Gaussian trap, a cursor sphere on the stylus, grab by touching the particle
-//! and pressing the button, steering through `ot-envelope`'s controller, release on button up.
+//! The optical-tweezers scene: the adapter of `ot_envelope::world` (Lee, Lyons & LeBrun, §2.4 and
+//! §3.3) to the haptic loop. The world — particle, trap, grab / steer / release, the tick map
+//! and the working envelope — is `ot_envelope::world::World`; this file maps the scene file's
+//! `[optical_tweezers]` table (human units: nm, µs, nJ, g) to the world's SI
+//! `ot_envelope::world::Params`, the loop's cursor and first button to its `Input`, its report
+//! to the loop's force and events, and draws it.
 //!
-//! Each haptic tick advances the particle by `dt_us` of particle time (the paper's control
-//! cycle). While grabbed, the controller computes this tick's working envelope from the
-//! particle's current velocity, clips the command (cursor − particle) to it, places the trap so
-//! that the particle makes the allowed displacement, and returns the spring force `−k·excess`
-//! felt on the stylus (when `feedback` is on). The particle is then moved by the trap's flow
-//! map (not by the command), so what the recording shows is the physics, not the wish. Not
-//! grabbed, the particle evolves in the last trap. The paper's viscous simplification (the
-//! velocity kept to a fraction each cycle) is `velocity_retain` (1: none).
-//!
-//! The tick map is chosen from an error budget (`tick_map_tol_nm`, default 0.01 nm from
-//! converged dynamics, see `ot_physics::budget`) unless `rk4_substeps` fixes it; the choice and
-//! its measured error are reported by an `ot.tick_map` event on the first tick. The envelope's
-//! offset region and grid spacing are sized from `envelope_tol_nm` and the tick
-//! (`ot_envelope::grid::choose_grid`) unless `envelope_margin_waists` / `envelope_cell_waists` fix
-//! them, reported by an `ot.envelope_grid` event on the first tick. The controller is
-//! `ot_envelope::TickController`: warm-started from the last full envelope build (translated by
-//! the change of free drift, checked at fold points), allocation-free in a steady-state tick.
+//! The tick map is model data chosen in the scene file: `tick_map = "budget"` (the default: the
+//! cheapest RK4/RK8 map within `tick_map_tol_nm`, default 0.01 nm, of converged dynamics) or a
+//! method by name (`tick_map = "rk4"`, `"rk8"`, `"dopri5"`, `"adaptive"`, …) with
+//! `tick_map_substeps` or `tick_map_rtol`. The older `rk4_substeps = n` still loads and means
+//! `tick_map = "rk4"`, `tick_map_substeps = n`. The choice and its measured error are reported
+//! by an `ot.tick_map` event on the first tick, the envelope grid by `ot.envelope_grid`; every
+//! event's detail is its JSON form (`{"type":"grab","gap_m":1e-7}`).
 
 use super::check::{SceneError, check_positive, check_range, out_of_range};
 use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use crate::vec3::Vec3;
 use nalgebra::Vector2;
 use ot_envelope::ClipMode;
-use ot_envelope::grid::choose_grid;
-use ot_envelope::steer::{ParticleState, SteerParams};
-use ot_envelope::tick::{TickController, TickParams};
-use ot_physics::budget::{choose_tick_map, measure};
-use ot_physics::{Method, Propagator, TrapModel};
+use ot_envelope::world::{Input, Params, TickMap, World, WorldError};
+use ot_physics::Propagator;
 use serde::Deserialize;
+use world_form::Limits;
 
 type V2 = Vector2<f64>;
 
@@ -41,10 +32,7 @@ pub const WORLD: WorldKind = WorldKind {
     check: |text| super::table::pick::<OtParams>(text, "optical_tweezers").map(drop),
     build: |text, config| {
         let p: OtParams = world_table(text, "optical_tweezers")?;
-        Ok(Box::new(OpticalScene::new(
-            p,
-            config.world_stiffness_cap_n_per_m(),
-        )?))
+        Ok(Box::new(OpticalScene::new(p, &config.world_limits())?))
     },
 };
 
@@ -62,12 +50,21 @@ pub struct OtParams {
     pub mass_g: f64,
     /// Particle time per haptic tick, µs (paper: 1).
     pub dt_us: f64,
-    /// RK4 substeps of the tick map, fixed by hand (1–1000); absent: the tick map is chosen
-    /// from `tick_map_tol_nm`.
+    /// Integrator of the tick map: `"budget"` (default: the cheapest RK4/RK8 within
+    /// `tick_map_tol_nm`) or an `ot_physics` method name (`"rk4"`, `"rk8"`, `"dopri5"`,
+    /// `"adaptive"`, `"paper-rk4"`, `"symplectic"`, `"yoshida4"`, `"yoshida6"`).
+    #[serde(default)]
+    pub tick_map: Option<String>,
+    /// Substeps of a named fixed-step tick map (1–1000; default: the method's own).
+    #[serde(default)]
+    pub tick_map_substeps: Option<u32>,
+    /// Relative tolerance of a named adaptive tick map (1e-14–1e-2; default: the method's own).
+    #[serde(default)]
+    pub tick_map_rtol: Option<f64>,
+    /// The older form of `tick_map = "rk4"` with `tick_map_substeps` (1–1000); still accepted.
     #[serde(default)]
     pub rk4_substeps: Option<u32>,
-    /// Error budget of the tick map, nm from converged dynamics (default 0.01); the cheapest
-    /// RK4/RK8 map within it is chosen (`ot_physics::budget::choose_tick_map`).
+    /// Error budget of the `"budget"` tick map, nm from converged dynamics (default 0.01).
     #[serde(default)]
     pub tick_map_tol_nm: Option<f64>,
     /// Largest particle speed the tick map's budget is checked for, m/s (default 0.1, the
@@ -122,47 +119,17 @@ fn hundred() -> f64 {
     100.0
 }
 
-/// The optical-tweezers scene.
-pub struct OpticalScene {
-    p: OtParams,
-    prop: Propagator<2>,
-    controller: TickController,
-    /// The tick map's report, sent as an `ot.tick_map` event on the first tick.
-    tick_map_report: Option<String>,
-    /// The envelope grid's report, sent as an `ot.envelope_grid` event on the first tick.
-    grid_report: Option<String>,
-    particle_r_m: f64,
-    cursor_r_m: f64,
-    position: V2,
-    velocity: V2,
-    trap: V2,
-    cursor: V2,
-    grabbed: bool,
-    button_was: bool,
-    excess: V2,
-    force: V2,
-    envelope: Vec<V2>,
-    clipping: bool,
-}
-
-impl OpticalScene {
-    /// Builds the scene; `cap_n_per_m` is the world stiffness cap.
-    pub fn new(p: OtParams, cap_n_per_m: f64) -> Result<Self, SceneError> {
+impl OtParams {
+    /// Checks the table in its own units (errors name the scene file's fields and ranges) and
+    /// converts it to the world's SI parameters; `limits` are the device's, in the world.
+    pub fn world_params(&self, limits: &Limits) -> Result<Params, SceneError> {
+        let p = self;
         check_positive("optical_tweezers.depth_nj", p.depth_nj, 1e3)?;
         check_positive("optical_tweezers.waist_x_nm", p.waist_x_nm, 1e6)?;
         check_positive("optical_tweezers.waist_y_nm", p.waist_y_nm, 1e6)?;
         check_positive("optical_tweezers.mass_g", p.mass_g, 1.0)?;
         check_positive("optical_tweezers.dt_us", p.dt_us, 1e6)?;
-        if let Some(n) = p.rk4_substeps {
-            check_range("optical_tweezers.rk4_substeps", f64::from(n), 1.0, 1000.0)?;
-        }
-        let map_tol_m = match p.tick_map_tol_nm {
-            Some(t) => {
-                check_range("optical_tweezers.tick_map_tol_nm", t, 1e-4, 100.0)?;
-                t * 1e-9
-            }
-            None => ot_physics::DEFAULT_TOL_M,
-        };
+        let tick_map = self.tick_map_choice()?;
         let map_speed = match p.tick_map_speed_m_per_s {
             Some(v) => {
                 check_range("optical_tweezers.tick_map_speed_m_per_s", v, 0.0, 1e3)?;
@@ -176,18 +143,17 @@ impl OpticalScene {
             1e3,
         )?;
         check_positive("optical_tweezers.cursor_radius_nm", p.cursor_radius_nm, 1e6)?;
+        let cap = limits.max_stiffness_n_per_m;
         check_positive(
             "optical_tweezers.stiffness_n_per_m",
             p.stiffness_n_per_m,
-            cap_n_per_m,
+            cap,
         )
         .map_err(|_| {
             out_of_range(
                 "optical_tweezers.stiffness_n_per_m",
                 p.stiffness_n_per_m,
-                format!(
-                    "0 < stiffness ≤ {cap_n_per_m} N/m, the device's limit mapped to the world"
-                ),
+                format!("0 < stiffness ≤ {cap} N/m, the device's limit mapped to the world"),
             )
         })?;
         check_range(
@@ -211,18 +177,34 @@ impl OpticalScene {
         for (k, c) in p.start_um.iter().enumerate() {
             check_range(&format!("optical_tweezers.start_um[{k}]"), *c, -1e6, 1e6)?;
         }
-        let waists_m = [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9];
-        let model = TrapModel::builder(p.depth_nj * 1e-9, waists_m)
-            .mass(p.mass_g * 1e-3)
-            .build()
-            .map_err(ot_error)?;
-        let dt_s = p.dt_us * 1e-6;
-        // A haptic tick must be cheap: its envelope's cost grows with how many small
-        // oscillations of the trapped particle one tick holds (their folds multiply the
-        // envelope's boundary). At paper constants the period is 0.94 µs: 1 µs ticks cost
-        // ~2 ms at p99, 5 µs ticks up to 0.5 s; a 1000× lighter particle at 0.2 µs never
-        // finished building the scene. Refuse beyond two periods instead of hanging.
-        let max_dt_us = 2.0 * small_oscillation_period_s(&p) * 1e6;
+        if let Some(c) = p.envelope_cell_waists {
+            check_range("optical_tweezers.envelope_cell_waists", c, 0.01, 2.0)?;
+        }
+        if let Some(m) = p.envelope_margin_waists {
+            check_range("optical_tweezers.envelope_margin_waists", m, 1.0, 10.0)?;
+        }
+        let params = Params {
+            depth_j: p.depth_nj * 1e-9,
+            waists_m: [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
+            mass_kg: p.mass_g * 1e-3,
+            dt_s: p.dt_us * 1e-6,
+            tick_map,
+            map_speed_m_per_s: map_speed,
+            warm_start: p.warm_start,
+            particle_radius_m: 0.5 * p.particle_diameter_um * 1e-6,
+            cursor_radius_m: p.cursor_radius_nm * 1e-9,
+            stiffness_n_per_m: p.stiffness_n_per_m,
+            feedback: p.feedback,
+            clip: p.clip,
+            velocity_retain: p.velocity_retain,
+            start_m: [p.start_um[0] * 1e-6, p.start_um[1] * 1e-6],
+            envelope_tol_m: tol,
+            envelope_cell_waists: p.envelope_cell_waists,
+            envelope_margin_waists: p.envelope_margin_waists,
+        };
+        // A haptic tick must be cheap: refuse a tick longer than two small oscillations, in
+        // the scene's unit (the world's own check would speak in seconds).
+        let max_dt_us = params.max_dt_s() * 1e6;
         if !max_dt_us.is_finite() || p.dt_us > max_dt_us {
             return Err(out_of_range(
                 "optical_tweezers.dt_us",
@@ -235,97 +217,115 @@ impl OpticalScene {
                 ),
             ));
         }
-        let physics = ot_error::<ot_physics::PhysicsError>;
-        let (prop, report) = match p.rk4_substeps {
-            Some(n) => {
-                let method = Method::Rk4 { substeps: n };
-                let m = measure(model, method, dt_s, map_speed).map_err(physics)?;
-                let prop = Propagator::new(model, method, dt_s).map_err(physics)?;
-                (prop, format!("fixed by rk4_substeps: {m}"))
-            }
-            None => {
-                let (prop, c) =
-                    choose_tick_map(model, dt_s, map_tol_m, map_speed).map_err(physics)?;
-                (prop, format!("chosen from tick_map_tol_nm: {c}"))
-            }
-        };
-        if let Some(c) = p.envelope_cell_waists {
-            check_range("optical_tweezers.envelope_cell_waists", c, 0.01, 2.0)?;
-        }
-        if let Some(m) = p.envelope_margin_waists {
-            check_range("optical_tweezers.envelope_margin_waists", m, 1.0, 10.0)?;
-        }
-        let envelope = ot_error::<ot_envelope::EnvelopeError>;
-        let (margin, cell, grid_report) = match (p.envelope_margin_waists, p.envelope_cell_waists) {
-            (Some(m), Some(c)) => (
-                m,
-                c,
-                format!(
-                    "fixed by envelope_margin_waists and envelope_cell_waists: region {m} waists beyond the drift path, cell {c} waists"
-                ),
-            ),
-            (m, c) => {
-                let g = choose_grid(&prop, tol, map_speed).map_err(envelope)?;
-                (
-                    m.unwrap_or(g.margin_waists),
-                    c.unwrap_or(g.cell_waists),
-                    format!("chosen from envelope_tol_nm: {g}"),
-                )
-            }
-        };
-        let mut tick = TickParams::new(SteerParams {
-            stiffness: p.stiffness_n_per_m,
-            mode: p.clip,
-            tol,
-            margin_waists: margin,
-        });
-        tick.warm_start = p.warm_start;
-        tick.cell_waists = Some(cell);
-        let controller = TickController::new(tick).map_err(ot_error)?;
-        let start = V2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
-        Ok(OpticalScene {
-            particle_r_m: 0.5 * p.particle_diameter_um * 1e-6,
-            cursor_r_m: p.cursor_radius_nm * 1e-9,
-            p,
-            prop,
-            controller,
-            tick_map_report: Some(report),
-            grid_report: Some(grid_report),
-            position: start,
-            velocity: V2::zeros(),
-            trap: start,
-            cursor: start,
-            grabbed: false,
-            button_was: false,
-            excess: V2::zeros(),
-            force: V2::zeros(),
-            envelope: Vec::new(),
-            clipping: false,
-        })
+        Ok(params)
     }
 
-    /// Advances the particle in the trap at `self.trap` for one tick.
-    fn advance(&mut self) -> Result<(), String> {
-        let offset = self.trap - self.position;
-        let (d, v, _) = self
-            .prop
-            .flow(&offset, &self.velocity)
-            .map_err(|e| e.to_string())?;
-        self.position += d;
-        self.velocity = v * self.p.velocity_retain;
-        Ok(())
+    /// The tick map the table asks for: by name (`tick_map`, or the older `rk4_substeps`), or
+    /// from the error budget.
+    fn tick_map_choice(&self) -> Result<TickMap, SceneError> {
+        let p = self;
+        if let Some(n) = p.tick_map_substeps {
+            check_range(
+                "optical_tweezers.tick_map_substeps",
+                f64::from(n),
+                1.0,
+                1000.0,
+            )?;
+        }
+        if let Some(r) = p.tick_map_rtol {
+            check_range("optical_tweezers.tick_map_rtol", r, 1e-14, 1e-2)?;
+        }
+        let tol_m = match p.tick_map_tol_nm {
+            Some(t) => {
+                check_range("optical_tweezers.tick_map_tol_nm", t, 1e-4, 100.0)?;
+                t * 1e-9
+            }
+            None => ot_physics::DEFAULT_TOL_M,
+        };
+        let name = match (p.rk4_substeps, p.tick_map.as_deref()) {
+            (Some(n), None) => {
+                check_range("optical_tweezers.rk4_substeps", f64::from(n), 1.0, 1000.0)?;
+                return Ok(TickMap::Named {
+                    name: "rk4".into(),
+                    substeps: Some(n),
+                    rtol: None,
+                });
+            }
+            (Some(_), Some(_)) => {
+                return Err(SceneError::World {
+                    section: "optical_tweezers".into(),
+                    field: Some("rk4_substeps".into()),
+                    message: "`rk4_substeps` is the older form of `tick_map = \"rk4\"` with \
+                              `tick_map_substeps`: give one of them, not both"
+                        .into(),
+                });
+            }
+            (None, None) | (None, Some("budget")) => return Ok(TickMap::Budget { tol_m }),
+            (None, Some(name)) => name,
+        };
+        if p.tick_map_tol_nm.is_some() {
+            return Err(SceneError::World {
+                section: "optical_tweezers".into(),
+                field: Some("tick_map_tol_nm".into()),
+                message: format!(
+                    "`tick_map_tol_nm` is the budget of `tick_map = \"budget\"`; the named map \
+                     `{name}` is set by `tick_map_substeps` or `tick_map_rtol`"
+                ),
+            });
+        }
+        let mut allowed = String::from("\"budget\", ");
+        allowed.push_str(ot_physics::integrate::METHOD_NAMES);
+        ot_physics::Method::from_name(name, p.tick_map_rtol, p.tick_map_substeps).map_err(|e| {
+            SceneError::World {
+                section: "optical_tweezers".into(),
+                field: Some("tick_map".into()),
+                message: match e {
+                    ot_physics::PhysicsError::UnknownMethod { .. } => {
+                        format!("`tick_map` = \"{name}\" is not a tick map (allowed: {allowed})")
+                    }
+                    other => other.to_string(),
+                },
+            }
+        })?;
+        Ok(TickMap::Named {
+            name: name.to_string(),
+            substeps: p.tick_map_substeps,
+            rtol: p.tick_map_rtol,
+        })
     }
 }
 
+/// The optical-tweezers scene: the world and how it is drawn.
+pub struct OpticalScene {
+    world: World,
+    look: Look,
+}
+
 impl OpticalScene {
+    /// Builds the scene from its table; `limits` are the device's limits in the world
+    /// (`LoopConfig::world_limits`).
+    pub fn new(p: OtParams, limits: &Limits) -> Result<Self, SceneError> {
+        let params = p.world_params(limits)?;
+        let world = World::new(&params, limits).map_err(ot_error)?;
+        Ok(OpticalScene {
+            world,
+            look: Look::of(&p),
+        })
+    }
+
     /// The steering counters so far (rebuilds, warm ticks, solves).
     pub fn tick_stats(&self) -> ot_envelope::TickStats {
-        self.controller.stats()
+        self.world.tick_stats()
     }
 
     /// The tick map in use.
     pub fn tick_map(&self) -> &Propagator<2> {
-        &self.prop
+        self.world.tick_map()
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.world
     }
 }
 
@@ -339,110 +339,58 @@ impl Scene for OpticalScene {
     }
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
-        if let Some(r) = self.tick_map_report.take() {
-            out.events.push(Event::new("ot.tick_map", r));
-        }
-        if let Some(r) = self.grid_report.take() {
-            out.events.push(Event::new("ot.envelope_grid", r));
-        }
-        self.cursor = V2::new(input.cursor_m[0], input.cursor_m[1]);
-        let button = input.buttons.pressed(0);
-        if button && !self.button_was && !self.grabbed {
-            let gap = (self.cursor - self.position).norm();
-            if gap <= self.particle_r_m + self.cursor_r_m {
-                self.grabbed = true;
-                self.controller.reset();
-                out.events.push(Event::new(
-                    "ot.grab",
-                    format!("cursor {gap:e} m from the particle centre"),
-                ));
-            } else {
-                out.events.push(Event::new(
-                    "ot.grab_missed",
-                    format!("cursor {gap:e} m from the particle centre"),
-                ));
-            }
-        }
-        if !button && self.grabbed {
-            self.grabbed = false;
-            out.events.push(Event::new("ot.release", ""));
-        }
-        self.button_was = button;
-        self.excess = V2::zeros();
-        self.force = V2::zeros();
-        if self.grabbed {
-            let state = ParticleState {
-                position: self.position,
-                velocity: self.velocity,
-            };
-            match self.controller.step(&self.prop, &state, &self.cursor) {
-                Ok(s) => {
-                    self.trap = s.trap;
-                    self.excess = s.excess;
-                    if self.p.feedback {
-                        self.force = s.force;
-                    }
-                    // reuse the buffer: no allocation once it has grown
-                    self.envelope.clear();
-                    self.envelope.extend_from_slice(self.controller.envelope());
-                }
-                Err(e) => {
-                    out.events
-                        .push(Event::new("ot.controller_error", e.to_string()));
-                }
-            }
-        } else {
-            self.envelope.clear();
-        }
-        let clipping = self.excess.norm() > 0.0;
-        if clipping && !self.clipping {
+        let r = self.world.step(&Input {
+            cursor_m: [input.cursor_m[0], input.cursor_m[1]],
+            grab: input.buttons.pressed(0),
+        });
+        for e in &r.events {
             out.events.push(Event::new(
-                "ot.clipped",
-                "command outside the working envelope",
+                format!("ot.{}", e.name()),
+                serde_json::to_string(e).unwrap_or_default(),
             ));
         }
-        self.clipping = clipping;
-        if let Err(e) = self.advance() {
-            out.events.push(Event::new("ot.physics_error", e));
-        }
-        out.force_n = [self.force.x, self.force.y, 0.0];
-        out.stiffness_n_per_m = if self.grabbed && self.p.feedback {
-            self.p.stiffness_n_per_m
-        } else {
-            0.0
-        };
+        out.force_n = [r.force_n[0], r.force_n[1], 0.0];
+        out.stiffness_n_per_m = r.stiffness_n_per_m;
     }
 
     fn state(&self, out: &mut Vec<f64>) {
+        let w = &self.world;
+        let (p, v, t, c) = (
+            w.position_m(),
+            w.velocity_m_per_s(),
+            w.trap_m(),
+            w.cursor_m(),
+        );
         out.extend_from_slice(&[
-            self.position.x,
-            self.position.y,
-            self.velocity.x,
-            self.velocity.y,
-            self.trap.x,
-            self.trap.y,
-            f64::from(u8::from(self.grabbed)),
-            self.excess.norm(),
-            (self.cursor - self.position).norm(),
-            self.envelope.len() as f64,
+            p[0],
+            p[1],
+            v[0],
+            v[1],
+            t[0],
+            t[1],
+            f64::from(u8::from(w.grabbed())),
+            w.excess_m(),
+            (V2::new(c[0], c[1]) - V2::new(p[0], p[1])).norm(),
+            w.envelope().len() as f64,
         ]);
     }
 
     fn draw(&self, out: &mut Vec<Primitive>) {
-        let p = self.position;
-        let s = self.p.envelope_draw_scale;
-        let envelope: Vec<Vec3> = self
-            .envelope
+        let w = &self.world;
+        let (p, f, t, c) = (w.position_m(), w.force_n(), w.trap_m(), w.cursor_m());
+        let s = self.look.draw_scale;
+        let envelope: Vec<Vec3> = w
+            .envelope()
             .iter()
-            .map(|q| [p.x + s * q.x, p.y + s * q.y, 0.0])
+            .map(|q| [p[0] + s * q.x, p[1] + s * q.y, 0.0])
             .collect();
-        Look::of(&self.p).draw(
+        self.look.draw(
             &Shown {
-                position: self.position,
-                trap: self.trap,
-                cursor: self.cursor,
-                grabbed: self.grabbed,
-                force: self.force,
+                position: V2::new(p[0], p[1]),
+                trap: V2::new(t[0], t[1]),
+                cursor: V2::new(c[0], c[1]),
+                grabbed: w.grabbed(),
+                force: V2::new(f[0], f[1]),
             },
             envelope,
             out,
@@ -543,19 +491,9 @@ fn three_digits_down(x: f64) -> String {
     format!("{:.*}", decimals, (x / unit).floor() * unit)
 }
 
-/// The period (s) of the particle's small oscillation about the centre of the well, along the
-/// narrower waist: ω² = 4·depth / (mass · waist²) for the well −depth·e^{−2x²/w²}.
-fn small_oscillation_period_s(p: &OtParams) -> f64 {
-    let depth_j = p.depth_nj * 1e-9;
-    let mass_kg = p.mass_g * 1e-3;
-    let w_m = p.waist_x_nm.min(p.waist_y_nm) * 1e-9;
-    let omega = (4.0 * depth_j / (mass_kg * w_m * w_m)).sqrt();
-    2.0 * std::f64::consts::PI / omega
-}
-
 /// An optical-tweezers model or steering error as a scene error (located at the
 /// `[optical_tweezers]` table: the model's field names are not the scene's).
-fn ot_error<E: std::fmt::Display>(e: E) -> SceneError {
+fn ot_error(e: WorldError) -> SceneError {
     SceneError::World {
         section: "optical_tweezers".into(),
         field: None,
@@ -653,8 +591,12 @@ mod tests {
             .expect("optical scene")
     }
 
+    fn limits() -> Limits {
+        Limits::FALCON.in_world(1e6, 1e-3)
+    }
+
     fn first_events(p: OtParams) -> Vec<Event> {
-        let mut s = OpticalScene::new(p, 3.0).unwrap();
+        let mut s = OpticalScene::new(p, &limits()).unwrap();
         let mut out = SceneOutput::default();
         let input = SceneInput {
             tick: 0,
@@ -667,6 +609,13 @@ mod tests {
         out.events
     }
 
+    fn build_error(extra: &str) -> String {
+        match OpticalScene::new(params(extra), &limits()) {
+            Ok(_) => panic!("accepted {extra}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
     #[test]
     fn the_tick_map_choice_is_reported_once() {
         let ev = first_events(params("tick_map_tol_nm = 0.01"));
@@ -676,24 +625,64 @@ mod tests {
         assert!(
             ev[1]
                 .detail
-                .starts_with("chosen from envelope_tol_nm: envelope grid: region "),
+                .starts_with(r#"{"type":"envelope_grid","chosen_by":"budget","margin_waists":"#),
             "{}",
             ev[1].detail
         );
         assert!(
-            ev[0]
-                .detail
-                .starts_with("chosen from tick_map_tol_nm: tick map rk4×2: "),
+            ev[0].detail.starts_with(
+                r#"{"type":"tick_map","chosen_by":"budget","method":"rk4×2","error_m":"#
+            ),
             "{}",
             ev[0].detail
         );
-        let fixed = first_events(params("rk4_substeps = 8"));
+        // the older form, and the same map by name: one choice, one report
+        for form in [
+            "rk4_substeps = 8",
+            "tick_map = \"rk4\"\ntick_map_substeps = 8",
+        ] {
+            let fixed = first_events(params(form));
+            assert!(
+                fixed[0].detail.starts_with(
+                    r#"{"type":"tick_map","chosen_by":"named","method":"rk4×8","error_m":"#
+                ),
+                "{form}: {}",
+                fixed[0].detail
+            );
+        }
+        let adaptive = first_events(params("tick_map = \"dopri5\"\ntick_map_rtol = 1e-9"));
         assert!(
-            fixed[0]
+            adaptive[0]
                 .detail
-                .starts_with("fixed by rk4_substeps: tick map rk4×8: "),
+                .contains(r#""chosen_by":"named","method":"dopri5×1""#),
             "{}",
-            fixed[0].detail
+            adaptive[0].detail
+        );
+    }
+
+    #[test]
+    fn the_tick_map_is_chosen_by_name_with_clear_errors() {
+        assert_eq!(
+            build_error("tick_map = \"euler\""),
+            "scene: optical_tweezers: `tick_map` = \"euler\" is not a tick map (allowed: \"budget\", \
+             \"paper-rk4\", \"rk4\", \"rk8\", \"dopri5\", \"adaptive\", \"symplectic\", \
+             \"yoshida4\", \"yoshida6\")"
+        );
+        assert_eq!(
+            build_error("rk4_substeps = 4\ntick_map = \"rk8\""),
+            "scene: optical_tweezers: `rk4_substeps` is the older form of \
+             `tick_map = \"rk4\"` with `tick_map_substeps`: give one of them, not both"
+        );
+        assert_eq!(
+            build_error("tick_map = \"rk8\"\ntick_map_tol_nm = 0.1"),
+            "scene: optical_tweezers: `tick_map_tol_nm` is the budget of \
+             `tick_map = \"budget\"`; the named map `rk8` is set by `tick_map_substeps` or \
+             `tick_map_rtol`"
+        );
+        assert_eq!(
+            build_error("tick_map = \"rk4\"\ntick_map_substeps = 0"),
+            "scene: `optical_tweezers.tick_map_substeps` = 0 is out of range (allowed: 1 ≤ \
+             optical_tweezers.tick_map_substeps ≤ 1000)"
         );
     }
 
@@ -712,10 +701,7 @@ mod tests {
 
     #[test]
     fn budget_fields_are_validated_with_their_range() {
-        let err = |extra: &str| match OpticalScene::new(params(extra), 3.0) {
-            Ok(_) => panic!("accepted {extra}"),
-            Err(e) => e.to_string(),
-        };
+        let err = build_error;
         assert_eq!(
             err("tick_map_tol_nm = 0.0"),
             "scene: `optical_tweezers.tick_map_tol_nm` = 0 is out of range (allowed: 1e-4 ≤ \
@@ -747,7 +733,7 @@ mod tests {
                 .world::<OtParams>()
                 .unwrap()
                 .unwrap();
-            OpticalScene::new(p, 3.0).err().map(|e| e.to_string())
+            OpticalScene::new(p, &limits()).err().map(|e| e.to_string())
         };
         // Paper constants: period 2π·√(1e-15 kg · (300 nm)² / (4e-15 J)) = 0.942 µs.
         assert_eq!(
