@@ -12,7 +12,8 @@
 use super::check::{SceneError, check_positive, check_range, out_of_range};
 use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use crate::vec3::{self, Vec3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
+use world_form::Limits;
 
 /// The wall in the scene registry: `kind = "wall"`, table `[wall]`.
 pub const WORLD: WorldKind = WorldKind {
@@ -20,13 +21,13 @@ pub const WORLD: WorldKind = WorldKind {
     check: |text| super::table::pick::<WallParams>(text, "wall").map(drop),
     build: |text, config| {
         let p: WallParams = world_table(text, "wall")?;
-        let scene = WallScene::new(p, config.world_stiffness_cap_n_per_m(), config.dt_s())?;
+        let scene = WallScene::new(&p, &config.world_limits(), config.dt_s())?;
         Ok(Box::new(scene))
     },
 };
 
-/// Parameters of the wall (`[wall]` table).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+/// Parameters of the wall (`[wall]` table), SI.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct WallParams {
     /// Outward normal of the wall (normalised on load; must be non-zero).
@@ -74,8 +75,10 @@ pub struct WallScene {
 }
 
 impl WallScene {
-    /// A wall from `params`, with the world stiffness cap `cap_n_per_m` and tick `dt_s`.
-    pub fn new(params: WallParams, cap_n_per_m: f64, dt_s: f64) -> Result<Self, SceneError> {
+    /// A wall from `params`, rendered within the device's `limits` in the world (its stiffness
+    /// is capped at `limits.max_stiffness_n_per_m`), stepped every `dt_s` (s).
+    pub fn new(params: &WallParams, limits: &Limits, dt_s: f64) -> Result<Self, SceneError> {
+        let cap_n_per_m = limits.max_stiffness_n_per_m;
         let len = vec3::norm(params.normal);
         if !(len.is_finite() && len > 0.0) {
             return Err(out_of_range(
@@ -118,6 +121,46 @@ impl WallScene {
     }
 }
 
+/// What happens at the wall. Serialized with a `type` tag and named fields, the detail of the
+/// loop's `wall.<type>` event.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum WallEvent {
+    /// The wall asked for more stiffness than the device renders (first tick only).
+    StiffnessCapped {
+        /// The stiffness asked for, N/m.
+        requested_n_per_m: f64,
+        /// The stiffness rendered: the device's limit in the world, N/m.
+        rendered_n_per_m: f64,
+    },
+    /// The cursor entered the wall.
+    ContactBegin {
+        /// Depth of the cursor in the wall at the first tick of contact, m.
+        penetration_m: f64,
+    },
+    /// The cursor left the wall.
+    ContactEnd,
+}
+
+impl WallEvent {
+    /// The event's short name (its `type` tag).
+    pub fn name(&self) -> &'static str {
+        match self {
+            WallEvent::StiffnessCapped { .. } => "stiffness_capped",
+            WallEvent::ContactBegin { .. } => "contact_begin",
+            WallEvent::ContactEnd => "contact_end",
+        }
+    }
+}
+
+/// Adds a wall event to the tick's output: name `wall.<type>`, detail its JSON form.
+fn push(out: &mut SceneOutput, e: &WallEvent) {
+    out.events.push(Event::new(
+        format!("wall.{}", e.name()),
+        serde_json::to_string(e).unwrap_or_default(),
+    ));
+}
+
 /// Unit quaternion `[x, y, z, w]` rotating +z onto the unit vector `n`.
 pub fn quat_z_to(n: Vec3) -> [f64; 4] {
     let w = 1.0 + n[2];
@@ -146,13 +189,13 @@ impl Scene for WallScene {
         if !self.started {
             self.started = true;
             if self.stiffness < self.requested_stiffness {
-                out.events.push(Event::new(
-                    "wall.stiffness_capped",
-                    format!(
-                        "requested {} N/m, rendering {} N/m (device limit mapped to the world)",
-                        self.requested_stiffness, self.stiffness
-                    ),
-                ));
+                push(
+                    out,
+                    &WallEvent::StiffnessCapped {
+                        requested_n_per_m: self.requested_stiffness,
+                        rendered_n_per_m: self.stiffness,
+                    },
+                );
             }
         }
         self.cursor_m = input.cursor_m;
@@ -165,12 +208,14 @@ impl Scene for WallScene {
         let contact = d > 0.0;
         self.penetration_m = d.max(0.0);
         if contact != self.in_contact {
-            let name = if contact {
-                "wall.contact_begin"
+            let e = if contact {
+                WallEvent::ContactBegin {
+                    penetration_m: self.penetration_m,
+                }
             } else {
-                "wall.contact_end"
+                WallEvent::ContactEnd
             };
-            out.events.push(Event::new(name, ""));
+            push(out, &e);
         }
         self.in_contact = contact;
         if contact {
@@ -231,7 +276,7 @@ mod tests {
 
     fn wall(k: f64, cap: f64, b: f64) -> WallScene {
         WallScene::new(
-            WallParams {
+            &WallParams {
                 normal: [0.0, 0.0, 2.0],
                 point_m: [0.0, 0.0, 0.01],
                 stiffness_n_per_m: k,
@@ -239,7 +284,10 @@ mod tests {
                 draw_half_size_m: 0.04,
                 cursor_radius_m: 0.002,
             },
-            cap,
+            &Limits {
+                max_force_n: 8.0,
+                max_stiffness_n_per_m: cap,
+            },
             1e-3,
         )
         .unwrap()
@@ -265,13 +313,22 @@ mod tests {
         let mut w = wall(5000.0, 3000.0, 0.0);
         let out = step(&mut w, 0, 0.008);
         assert_eq!(out.events[0].name, "wall.stiffness_capped");
+        assert_eq!(
+            out.events[0].detail,
+            r#"{"type":"stiffness_capped","requested_n_per_m":5000.0,"rendered_n_per_m":3000.0}"#
+        );
         assert_eq!(out.events[1].name, "wall.contact_begin");
+        assert_eq!(
+            out.events[1].detail,
+            r#"{"type":"contact_begin","penetration_m":0.002}"#
+        );
         // 2 mm deep at the capped 3000 N/m: 6 N along +z (normal normalised).
         assert!((out.force_n[2] - 6.0).abs() < 1e-12 && out.force_n[0] == 0.0);
         assert_eq!(out.stiffness_n_per_m, 3000.0);
         let out = step(&mut w, 1, 0.02);
         assert_eq!(out.force_n, [0.0; 3]);
         assert_eq!(out.events[0].name, "wall.contact_end");
+        assert_eq!(out.events[0].detail, r#"{"type":"contact_end"}"#);
     }
 
     #[test]
