@@ -269,7 +269,8 @@ fn estimators() -> Vec<EstimatorRow> {
 
 fn main() {
     let base = Params::default();
-    let mut md = Report::start("brickworld", "brickworld — macro world (rapier f64, 1 kHz)").unwrap();
+    let mut md =
+        Report::start("brickworld", "brickworld — macro world (rapier f64, 1 kHz)").unwrap();
     md.para(&format!(
         "One tick = one 1 ms step of the whole world: god-object proxy update, buttons, loading zone, \
          rapier step (f64, enhanced determinism, {} solver iterations, contacts {} Hz), blueprint, device force. \
@@ -365,7 +366,10 @@ fn main() {
         .unwrap();
     }
     md.table(&t);
-    let worst_p99 = rows[1..].iter().map(|(_, t)| t.cpu.p99()).fold(0.0, f64::max);
+    let worst_p99 = rows[1..]
+        .iter()
+        .map(|(_, t)| t.cpu.p99())
+        .fold(0.0, f64::max);
     let resting_cost = rows[1].1.cpu.median() - rows[0].1.cpu.median();
     let awake_cost = rows[2].1.cpu.median() - rows[0].1.cpu.median();
     writeln!(

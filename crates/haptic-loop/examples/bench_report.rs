@@ -290,7 +290,10 @@ fn main() {
         tick_row(&mut t, &name, &r.arrays.compute_ns);
     }
     md.table(&t);
-    let (on_t, off_t) = (tick_us(&on.arrays.compute_ns), tick_us(&off.arrays.compute_ns));
+    let (on_t, off_t) = (
+        tick_us(&on.arrays.compute_ns),
+        tick_us(&off.arrays.compute_ns),
+    );
     writeln!(
         md,
         "Real-time pacing (20 s): start jitter p99 {:.1} µs, max {:.1} µs; {} missed deadlines \
@@ -535,7 +538,11 @@ fn plot_wall(path: &Path, pen: &[f64], a: &haptic_loop::SessionArrays) {
         )
         .width(1),
     )
-    .with(Series::line("scene force (capped at 3000 N/m)", world, BLUE))
+    .with(Series::line(
+        "scene force (capped at 3000 N/m)",
+        world,
+        BLUE,
+    ))
     .with(Series::line("force sent (clamped at 8 N)", sent, RED).width(3))
     .legend(Some(SeriesLabelPosition::LowerRight))
     .save(path, (900, 500))

@@ -95,10 +95,22 @@ fn time_world(n: usize, ticks: usize) -> Res<Timing> {
 
 fn curve_plot(r: &Report, file: &str, title: &str, c: &ForceCurve, gap_label: &str) -> Res<()> {
     let nm = |(g, f): (&f64, &f64)| (g / 1e-9, f / 1e-9);
-    let approach: Vec<(f64, f64)> = c.approach_gap_m.iter().zip(&c.approach_force_n).map(nm).collect();
-    let retract: Vec<(f64, f64)> = c.retract_gap_m.iter().zip(&c.retract_force_n).map(nm).collect();
+    let approach: Vec<(f64, f64)> = c
+        .approach_gap_m
+        .iter()
+        .zip(&c.approach_force_n)
+        .map(nm)
+        .collect();
+    let retract: Vec<(f64, f64)> = c
+        .retract_gap_m
+        .iter()
+        .zip(&c.retract_force_n)
+        .map(nm)
+        .collect();
     let all = approach.iter().chain(&retract);
-    let (x0, x1) = all.clone().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (x0, x1) = all
+        .clone()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
     let (y0, y1) = all.fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
     let pad = 0.05 * (y1 - y0);
     Chart::new(
@@ -113,7 +125,11 @@ fn curve_plot(r: &Report, file: &str, title: &str, c: &ForceCurve, gap_label: &s
 }
 
 fn cost_plot(r: &Report, rows: &[Timing]) -> Res<()> {
-    let ymax = rows.iter().map(|r| r.tick.p99().max(r.brute_us)).fold(0.0, f64::max) * 2.0;
+    let ymax = rows
+        .iter()
+        .map(|r| r.tick.p99().max(r.brute_us))
+        .fold(0.0, f64::max)
+        * 2.0;
     let pts = |f: &dyn Fn(&Timing) -> f64| -> Vec<(f64, f64)> {
         rows.iter().map(|r| (r.atoms as f64, f(r))).collect()
     };
@@ -186,7 +202,11 @@ fn main() -> Res<()> {
     writeln!(
         md,
         "- Target tick p99 ≤ 250 µs at 10⁵ substrate atoms: **{}** ({:.2} µs at {} atoms).",
-        if r5.tick.p99() <= 250.0 { "met" } else { "not met" },
+        if r5.tick.p99() <= 250.0 {
+            "met"
+        } else {
+            "not met"
+        },
         r5.tick.p99(),
         r5.atoms
     )?;

@@ -5,6 +5,9 @@
 //! Run: `cargo run --release -p ot-envelope --example ot-envelope-report`
 //! (about two minutes; single thread).
 
+use bench_harness::plot::{Axis, Chart, Series};
+use bench_harness::plotters::prelude::{BLUE, RED};
+use bench_harness::{Report, Summary, Table, Timings, span};
 use nalgebra::{Vector2, Vector3};
 use ot_envelope::envelope3::working_envelope_3d;
 use ot_envelope::geometry::nearest_on_boundary;
@@ -13,9 +16,6 @@ use ot_envelope::paper::paper_envelope;
 use ot_envelope::reference::Reference;
 use ot_envelope::{OffsetRegion, SampledMap, envelope_from_map, working_envelope};
 use ot_physics::{Method, Propagator, TrapModel};
-use bench_harness::plot::{Axis, Chart, Series};
-use bench_harness::plotters::prelude::{BLUE, RED};
-use bench_harness::{Report, Summary, Table, Timings, span};
 use std::fmt::Write as _;
 
 type V2 = Vector2<f64>;

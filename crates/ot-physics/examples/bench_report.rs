@@ -521,8 +521,12 @@ fn plot(ours: &[Row], peer: &[Row], scipy: Option<&Scipy>, path: &Path) -> Resul
         path,
         (1400, 600),
         &[
-            panel("CPU time", "CPU time per trajectory (ns)", |r| r.ns_per_traj),
-            panel("work", "force evaluations per trajectory", |r| r.evals_per_traj),
+            panel("CPU time", "CPU time per trajectory (ns)", |r| {
+                r.ns_per_traj
+            }),
+            panel("work", "force evaluations per trajectory", |r| {
+                r.evals_per_traj
+            }),
         ],
     )?;
     Ok(())

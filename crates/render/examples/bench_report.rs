@@ -356,9 +356,9 @@ fn plot_speed(runs: &[Run], path: &Path) -> Result<(), BoxError> {
             BLACK.stroke_width(3),
         ))?;
         if i == 0 {
-            cpu_line.label("CPU time, whole session").legend(|(x, y)| {
-                PathElement::new([(x, y), (x + 12, y)], BLACK.stroke_width(3))
-            });
+            cpu_line
+                .label("CPU time, whole session")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 12, y)], BLACK.stroke_width(3)));
         }
         chart.draw_series(std::iter::once(Text::new(
             r.name.to_string(),
