@@ -292,7 +292,13 @@ fn main() {
         tick_row(&mut t, &name, &r.arrays.compute_ns);
     }
     md.table(&t);
-    let mut t = Table::new(["session", "sink", "per tick p50 (µs)", "p99 (µs)", "max (µs)"]);
+    let mut t = Table::new([
+        "session",
+        "sink",
+        "per tick p50 (µs)",
+        "p99 (µs)",
+        "max (µs)",
+    ]);
     for (name, r) in [
         ("batch 60 s, logging on", &on),
         ("batch 60 s, logging off", &off),
