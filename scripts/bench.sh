@@ -2,7 +2,10 @@
 # Regenerates BENCHMARKS.md and the plots under docs/figures/ in one command:
 # every crate's report example (`<crate>-report`, examples/bench_report.rs)
 # writes docs/bench/<crate>.md, then the
-# sections are assembled in a fixed order. A Python venv with scipy (the
+# sections are assembled in a fixed order. Every report is built on the one
+# harness in crates/bench-harness (timers, the nearest-rank percentile,
+# Markdown tables, plots), which opens each section with the machine's CPU,
+# core count and load average at the start and end of its run. A Python venv with scipy (the
 # ot-physics peer) is created in .venv-bench on first use.
 # `scripts/bench.sh --assemble` only re-assembles BENCHMARKS.md from the
 # existing docs/bench/*.md sections.

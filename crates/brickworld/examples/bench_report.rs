@@ -1,14 +1,16 @@
 //! Measures brickworld's speed and error and writes `docs/bench/brickworld.md` plus
-//! `docs/figures/brickworld-*.png`. Run: `cargo run --release -p brickworld --example brickworld-report`.
+//! `docs/figures/brickworld-*.png` through the shared `bench-harness`.
+//! Run: `cargo run --release -p brickworld --example brickworld-report`.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::fmt::Write as _;
-use std::time::Instant;
 
+use bench_harness::plot::{Axis, Chart, Series};
+use bench_harness::plotters::prelude::*;
+use bench_harness::{Align, Report, Summary, Table, Timings};
 use brickworld::{
     AccelEstimator, BrickId, BrickPlacement, Buttons, DeviceLimits, MotionEstimator, Params, World,
 };
-use plotters::prelude::*;
 
 const PARK: [f64; 3] = [0.0, 0.0, 0.5];
 
@@ -47,38 +49,25 @@ fn scene(n_bricks: usize, p: &Params) -> World {
     World::new(p, DeviceLimits::NOVINT_FALCON).expect("valid scene")
 }
 
-/// Percentiles of one tick's cost, in µs: thread CPU time (what the tick costs) and wall time
-/// (what it took on the shared machine, preemption included).
+/// One tick's cost, in µs: thread CPU time (what the tick costs) and wall time (what it took
+/// on the shared machine, preemption included), nearest-rank percentiles.
 struct Timing {
-    p50_us: f64,
-    p99_us: f64,
-    max_us: f64,
-    wall_p50_us: f64,
-    wall_p99_us: f64,
+    cpu: Summary,
+    wall: Summary,
     awake: usize,
 }
 
-/// Times `n` ticks; `input(k)` gives the k-th sample.
+/// Times `n` ticks; `input(k)` gives the k-th sample (built outside the timed step).
 fn measure(w: &mut World, n: usize, input: impl Fn(usize) -> ([f64; 3], Buttons)) -> Timing {
-    let mut cpu = Vec::with_capacity(n);
-    let mut wall = Vec::with_capacity(n);
+    let mut t = Timings::with_capacity(n);
     for k in 0..n {
         let (pos, b) = input(k);
         let i = w.input(pos, b).unwrap();
-        let s = Instant::now();
-        let c = cpu_time::ThreadTime::now();
-        std::hint::black_box(w.step(&i));
-        cpu.push(c.elapsed().as_secs_f64() * 1e6);
-        wall.push(s.elapsed().as_secs_f64() * 1e6);
+        t.time(|| std::hint::black_box(w.step(&i)));
     }
-    cpu.sort_by(|a, b| a.total_cmp(b));
-    wall.sort_by(|a, b| a.total_cmp(b));
     Timing {
-        p50_us: cpu[n / 2],
-        p99_us: cpu[n * 99 / 100],
-        max_us: cpu[n - 1],
-        wall_p50_us: wall[n / 2],
-        wall_p99_us: wall[n * 99 / 100],
+        cpu: t.cpu_us().expect("n > 0 ticks"),
+        wall: t.wall_us().expect("n > 0 ticks"),
         awake: w.awake_brick_count(),
     }
 }
@@ -279,19 +268,16 @@ fn estimators() -> Vec<EstimatorRow> {
 }
 
 fn main() {
-    let t0 = Instant::now();
-    let mut md = String::new();
     let base = Params::default();
-    writeln!(md, "## brickworld — macro world (rapier f64, 1 kHz)\n").unwrap();
-    writeln!(
-        md,
+    let mut md =
+        Report::start("brickworld", "brickworld — macro world (rapier f64, 1 kHz)").unwrap();
+    md.para(&format!(
         "One tick = one 1 ms step of the whole world: god-object proxy update, buttons, loading zone, \
          rapier step (f64, enhanced determinism, {} solver iterations, contacts {} Hz), blueprint, device force. \
          Measured in one run of `cargo run --release -p brickworld --example brickworld-report` on the shared 2-core machine; \
-         compare ratios, not absolute times.\n",
+         compare ratios, not absolute times.",
         base.solver_iterations, base.contact_frequency_hz
-    )
-    .unwrap();
+    ));
 
     // 1. Tick time.
     let mut rows = Vec::new();
@@ -351,30 +337,44 @@ fn main() {
         })
     };
     rows.push(("100 bricks, carrying one over the scene", carry));
-    writeln!(md, "### Tick time (5000 ticks each)\n").unwrap();
-    writeln!(
-        md,
+    md.heading("Tick time (5000 ticks each)");
+    md.para(
         "CPU = the ticking thread's CPU time (`CLOCK_THREAD_CPUTIME_ID`), the tick's own cost. Wall = elapsed time; \
-         on this shared 2-core machine (load average above 5 during the run) the scheduler preempts the thread \
-         for 4–8 ms slices every ~20 ticks, which is what the wall p99 shows.\n"
-    )
-    .unwrap();
-    writeln!(md, "| scene | awake bricks | CPU p50 (µs) | CPU p99 (µs) | CPU max (µs) | wall p50 (µs) | wall p99 (µs) |").unwrap();
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|").unwrap();
-    for (name, t) in &rows {
-        writeln!(
-            md,
-            "| {name} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
-            t.awake, t.p50_us, t.p99_us, t.max_us, t.wall_p50_us, t.wall_p99_us
-        )
+         on a shared 2-core machine the scheduler preempts the thread for 4–8 ms slices when other jobs run \
+         (see the load average above), which is what the wall p99 shows. Percentiles are nearest rank.",
+    );
+    let mut t = Table::new([
+        "scene",
+        "awake bricks",
+        "CPU p50 (µs)",
+        "CPU p99 (µs)",
+        "CPU max (µs)",
+        "wall p50 (µs)",
+        "wall p99 (µs)",
+    ])
+    .align_from(1, Align::Right);
+    for (name, tm) in &rows {
+        t.row([
+            name.to_string(),
+            tm.awake.to_string(),
+            format!("{:.1}", tm.cpu.median()),
+            format!("{:.1}", tm.cpu.p99()),
+            format!("{:.1}", tm.cpu.max()),
+            format!("{:.1}", tm.wall.median()),
+            format!("{:.1}", tm.wall.p99()),
+        ])
         .unwrap();
     }
-    let worst_p99 = rows[1..].iter().map(|(_, t)| t.p99_us).fold(0.0, f64::max);
-    let resting_cost = rows[1].1.p50_us - rows[0].1.p50_us;
-    let awake_cost = rows[2].1.p50_us - rows[0].1.p50_us;
+    md.table(&t);
+    let worst_p99 = rows[1..]
+        .iter()
+        .map(|(_, t)| t.cpu.p99())
+        .fold(0.0, f64::max);
+    let resting_cost = rows[1].1.cpu.median() - rows[0].1.cpu.median();
+    let awake_cost = rows[2].1.cpu.median() - rows[0].1.cpu.median();
     writeln!(
         md,
-        "\n- Target tick p99 ≤ 500 µs with 100 bricks (50 stacked), CPU time: **{}** (worst CPU p99 {worst_p99:.1} µs over the three 100-brick scenes, \
+        "- Target tick p99 ≤ 500 µs with 100 bricks (50 stacked), CPU time: **{}** (worst CPU p99 {worst_p99:.1} µs over the three 100-brick scenes, \
          including the case where sleeping is disabled and all 100 bricks are simulated). Wall-clock p99 on this loaded machine is not a property of the code.",
         if worst_p99 <= 500.0 { "met" } else { "not met" }
     )
@@ -389,21 +389,23 @@ fn main() {
     .unwrap();
 
     // 2. Speed vs error over solver settings.
-    writeln!(md, "### Speed vs error over solver settings\n").unwrap();
-    writeln!(
-        md,
+    md.heading("Speed vs error over solver settings");
+    md.para(
         "Stack sink: how far the top of a 10-brick stack settles below the exact stack (contact compliance). \
          Drift: largest motion of any stack brick between 2 s and 10 s. Cursor sink: deepest the cursor sphere \
          gets into a resting brick pressed at 0.5 m/s. Tick: p50/p99 of the 100-brick scene with sleeping \
-         disabled (worst case: everything simulated). Defaults: 4 iterations, 500 Hz.\n"
-    )
-    .unwrap();
-    writeln!(
-        md,
-        "| iterations | contact Hz | stack sink (mm) | drift 2–10 s (mm) | cursor sink (mm) | tick CPU p50 (µs) | tick CPU p99 (µs) |"
-    )
-    .unwrap();
-    writeln!(md, "|---:|---:|---:|---:|---:|---:|---:|").unwrap();
+         disabled (worst case: everything simulated). Defaults: 4 iterations, 500 Hz.",
+    );
+    let mut t = Table::new([
+        "iterations",
+        "contact Hz",
+        "stack sink (mm)",
+        "drift 2–10 s (mm)",
+        "cursor sink (mm)",
+        "tick CPU p50 (µs)",
+        "tick CPU p99 (µs)",
+    ])
+    .align_from(0, Align::Right);
     let mut pts = Vec::new();
     for it in [1usize, 2, 4, 8] {
         for hz in [30.0, 120.0, 500.0] {
@@ -425,52 +427,57 @@ fn main() {
                 step_idle(&mut w, PARK);
             }
             let tm = time_ticks(&mut w, 1500);
-            writeln!(
-                md,
-                "| {it}{} | {hz} | {:.3} | {:.4} | {:.4} | {:.1} | {:.1} |",
-                if drift > 1e-3 { " (stack falls)" } else { "" },
-                sink * 1e3,
-                drift * 1e3,
-                cs * 1e3,
-                tm.p50_us,
-                tm.p99_us
-            )
+            t.row([
+                format!("{it}{}", if drift > 1e-3 { " (stack falls)" } else { "" }),
+                format!("{hz}"),
+                format!("{:.3}", sink * 1e3),
+                format!("{:.4}", drift * 1e3),
+                format!("{:.4}", cs * 1e3),
+                format!("{:.1}", tm.cpu.median()),
+                format!("{:.1}", tm.cpu.p99()),
+            ])
             .unwrap();
-            pts.push((it, hz, tm.p50_us, sink.abs() * 1e3));
+            pts.push((it, hz, tm.cpu.median(), sink.abs() * 1e3));
         }
     }
+    md.table(&t);
 
     // 3. Accuracy of the physics checks.
-    writeln!(md, "\n### Restitution (flat brick dropped from 0.5 m)\n").unwrap();
-    writeln!(md, "| e | h1/h0 | e² | relative error |").unwrap();
-    writeln!(md, "|---:|---:|---:|---:|").unwrap();
+    md.heading("Restitution (flat brick dropped from 0.5 m)");
+    let mut t = Table::new(["e", "h1/h0", "e²", "relative error"]).align_from(0, Align::Right);
     let mut worst_b = 0.0_f64;
     for e in [0.3, 0.5, 0.7, 0.9] {
         let r = bounce(e);
         let rel = (r - e * e).abs() / (e * e);
         worst_b = worst_b.max(rel);
-        writeln!(md, "| {e} | {r:.4} | {:.4} | {:.2} % |", e * e, rel * 100.0).unwrap();
+        t.row([
+            format!("{e}"),
+            format!("{r:.4}"),
+            format!("{:.4}", e * e),
+            format!("{:.2} %", rel * 100.0),
+        ])
+        .unwrap();
     }
-    writeln!(
-        md,
-        "\nTarget within 3 %: **{}** (worst {:.2} %). Without the crate's impact hook rapier 0.36 gives 0.10 for e = 0.5 (see docs/brickworld.md).\n",
+    md.table(&t);
+    md.para(&format!(
+        "Target within 3 %: **{}** (worst {:.2} %). Without the crate's impact hook rapier 0.36 gives 0.10 for e = 0.5 (see docs/brickworld.md).",
         if worst_b < 0.03 { "met" } else { "not met" },
         worst_b * 100.0
-    )
-    .unwrap();
+    ));
 
-    writeln!(md, "### Static friction on a ramp\n").unwrap();
-    writeln!(
-        md,
-        "Smallest ramp angle at which a brick slides more than 5 mm in 1 s (bisection to 0.01°), against tan θ = μ.\n"
-    )
-    .unwrap();
-    writeln!(
-        md,
-        "| μ | atan μ (°) | slides from (°) | error (°) | slid in 1 s at atan μ + 3° (m) | analytic ½ g (sin θ − μ cos θ) t² (m) |"
-    )
-    .unwrap();
-    writeln!(md, "|---:|---:|---:|---:|---:|---:|").unwrap();
+    md.heading("Static friction on a ramp");
+    md.para(
+        "Smallest ramp angle at which a brick slides more than 5 mm in 1 s (bisection to 0.01°), against tan θ = μ.",
+    );
+    let mut t = Table::new([
+        "μ",
+        "atan μ (°)",
+        "slides from (°)",
+        "error (°)",
+        "slid in 1 s at atan μ + 3° (m)",
+        "analytic ½ g (sin θ − μ cos θ) t² (m)",
+    ])
+    .align_from(0, Align::Right);
     let mut worst_s = 0.0_f64;
     let mut worst_a = 0.0_f64;
     for mu in [0.3, 0.6, 1.0] {
@@ -481,74 +488,67 @@ fn main() {
         let d = slide(mu, crit + 3.0);
         let an = 0.5 * 9.81 * (t3.sin() - mu * t3.cos());
         worst_a = worst_a.max((d - an).abs() / an);
-        writeln!(
-            md,
-            "| {mu} | {crit:.2} | {th:.2} | {:+.2} | {d:.4} | {an:.4} |",
-            th - crit
-        )
+        t.row([
+            format!("{mu}"),
+            format!("{crit:.2}"),
+            format!("{th:.2}"),
+            format!("{:+.2}", th - crit),
+            format!("{d:.4}"),
+            format!("{an:.4}"),
+        ])
         .unwrap();
     }
-    writeln!(
-        md,
-        "\nTarget within 1°: **{}** (worst {worst_s:.2}°; the 5 mm-in-1 s criterion itself accounts for about 0.06°). \
+    md.table(&t);
+    md.para(&format!(
+        "Target within 1°: **{}** (worst {worst_s:.2}°; the 5 mm-in-1 s criterion itself accounts for about 0.06°). \
          Sliding distance off by at most {:.2} %. rapier's per-point `Coulomb` friction model, by contrast, starts sliding \
-         up to 1° early and, 2° above atan μ, slides 30–53 % too far; the crate uses the default `Simplified` model.\n",
+         up to 1° early and, 2° above atan μ, slides 30–53 % too far; the crate uses the default `Simplified` model.",
         if worst_s <= 1.0 { "met" } else { "not met" },
         worst_a * 100.0
-    )
-    .unwrap();
+    ));
 
     // 4. Acceleration estimators.
     let est = estimators();
-    writeln!(md, "### Inertial-force acceleration estimators\n").unwrap();
-    writeln!(
-        md,
+    md.heading("Inertial-force acceleration estimators");
+    md.para(
         "2 Hz, 3 cm sinusoid (peak 4.7 m/s²) sampled at 1 kHz and quantized to 50 µm. RMS error against the true \
-         acceleration at the estimator's own delay; noise gain = RMS acceleration per metre of white position noise.\n"
-    )
-    .unwrap();
-    writeln!(md, "| estimator | delay (ms) | noise gain (1/s²) | RMS error (m/s²) | inertial force error for 0.5 kg (N RMS) |").unwrap();
-    writeln!(md, "|---|---:|---:|---:|---:|").unwrap();
+         acceleration at the estimator's own delay; noise gain = RMS acceleration per metre of white position noise.",
+    );
+    let mut t = Table::new([
+        "estimator",
+        "delay (ms)",
+        "noise gain (1/s²)",
+        "RMS error (m/s²)",
+        "inertial force error for 0.5 kg (N RMS)",
+    ])
+    .align_from(1, Align::Right);
     for (name, rms, lag, gain, _) in &est {
-        writeln!(
-            md,
-            "| {name} | {:.1} | {gain:.3e} | {rms:.3} | {:.3} |",
-            lag * 1e3,
-            rms * 0.5
-        )
+        t.row([
+            name.clone(),
+            format!("{:.1}", lag * 1e3),
+            format!("{gain:.3e}"),
+            format!("{rms:.3}"),
+            format!("{:.3}", rms * 0.5),
+        ])
         .unwrap();
     }
-    plot_estimators(&est);
-    plot_speed_error(&pts);
+    md.table(&t);
+    plot_estimators(&md, &est);
+    plot_speed_error(&md, &pts);
 
     // 5. The scripted house-task session.
     let (secs, score, traj, w) = build_wall();
-    writeln!(
-        md,
-        "\n### Scripted house task\n\n`script::WallScript` builds a 4-slot wall (two courses, one brick turned 90°) from the loading zone \
-         in {secs:.1} s of simulated time; score **{}/{}**. Side and top views below (grey outlines: blueprint slots; blue: cursor path).\n",
+    md.heading("Scripted house task");
+    md.para(&format!(
+        "`script::WallScript` builds a 4-slot wall (two courses, one brick turned 90°) from the loading zone \
+         in {secs:.1} s of simulated time; score **{}/{}**. Side and top views below (grey outlines: blueprint slots; blue: cursor path).",
         score.filled, score.total
-    )
-    .unwrap();
-    plot_wall(&w, &traj);
-    writeln!(md, "![scripted wall](../figures/brickworld-wall.png)\n").unwrap();
-    writeln!(
-        md,
-        "\n![acceleration estimators](../figures/brickworld-accel-estimators.png)\n\n![speed vs error](../figures/brickworld-speed-error.png)\n"
-    )
-    .unwrap();
-    writeln!(
-        md,
-        "Report generated in {:.0} s.",
-        t0.elapsed().as_secs_f64()
-    )
-    .unwrap();
-    std::fs::create_dir_all("docs/bench").unwrap();
-    std::fs::write("docs/bench/brickworld.md", md).unwrap();
-    println!(
-        "wrote docs/bench/brickworld.md in {:.0} s",
-        t0.elapsed().as_secs_f64()
-    );
+    ));
+    plot_wall(&md, &w, &traj);
+    md.image("scripted wall", "brickworld-wall.png");
+    md.image("acceleration estimators", "brickworld-accel-estimators.png");
+    md.image("speed vs error", "brickworld-speed-error.png");
+    md.finish().unwrap();
 }
 
 /// Blueprint of the scripted session (same as the test `scripted_session_builds_the_wall`).
@@ -606,9 +606,9 @@ fn aabb(c: [f64; 3], q: [f64; 4], h: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     )
 }
 
-fn plot_wall(w: &World, traj: &[[f64; 3]]) {
-    let root =
-        BitMapBackend::new("docs/figures/brickworld-wall.png", (1000, 450)).into_drawing_area();
+fn plot_wall(r: &Report, w: &World, traj: &[[f64; 3]]) {
+    let path = r.figure("brickworld-wall.png");
+    let root = BitMapBackend::new(&path, (1000, 450)).into_drawing_area();
     root.fill(&WHITE).unwrap();
     let (left, right) = root.split_horizontally(500);
     let h = w.params().brick_half_extents_m;
@@ -660,84 +660,37 @@ fn plot_wall(w: &World, traj: &[[f64; 3]]) {
     root.present().unwrap();
 }
 
-fn plot_estimators(est: &[EstimatorRow]) {
-    std::fs::create_dir_all("docs/figures").unwrap();
-    let root = BitMapBackend::new("docs/figures/brickworld-accel-estimators.png", (900, 500))
-        .into_drawing_area();
-    root.fill(&WHITE).unwrap();
-    let mut ch = ChartBuilder::on(&root)
-        .caption(
-            "Cursor acceleration estimate (50 µm quantization)",
-            ("sans-serif", 20),
-        )
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(55)
-        .build_cartesian_2d(1.0f64..1.5, -30.0f64..30.0)
-        .unwrap();
-    ch.configure_mesh()
-        .x_desc("time (s)")
-        .y_desc("acceleration (m/s²)")
-        .draw()
-        .unwrap();
+fn plot_estimators(r: &Report, est: &[EstimatorRow]) {
     let colors = [RED, BLUE, GREEN, BLACK];
+    let mut c = Chart::new(
+        "Cursor acceleration estimate (50 µm quantization)",
+        Axis::linear("time (s)", 1.0, 1.5),
+        Axis::linear("acceleration (m/s²)", -30.0, 30.0),
+    );
     for (i, (name, _, _, _, tr)) in est.iter().enumerate() {
-        let c = colors[i % 4];
-        ch.draw_series(LineSeries::new(
-            tr.iter().map(|&(t, a)| (t, a.clamp(-30.0, 30.0))),
-            c,
-        ))
-        .unwrap()
-        .label(name.clone())
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+        let pts = tr.iter().map(|&(t, a)| (t, a.clamp(-30.0, 30.0))).collect();
+        c = c.with(Series::line(name, pts, colors[i % 4]).width(1));
     }
-    ch.configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
+    c.save(&r.figure("brickworld-accel-estimators.png"), (900, 500))
         .unwrap();
-    root.present().unwrap();
 }
 
-fn plot_speed_error(pts: &[(usize, f64, f64, f64)]) {
-    let root = BitMapBackend::new("docs/figures/brickworld-speed-error.png", (800, 500))
-        .into_drawing_area();
-    root.fill(&WHITE).unwrap();
+fn plot_speed_error(r: &Report, pts: &[(usize, f64, f64, f64)]) {
     let xmax = pts.iter().map(|p| p.2).fold(0.0, f64::max) * 1.2;
-    let mut ch = ChartBuilder::on(&root)
-        .caption(
-            "Tick time vs 10-stack sink (100 bricks awake)",
-            ("sans-serif", 20),
-        )
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..xmax, (0.01f64..100.0).log_scale())
-        .unwrap();
-    ch.configure_mesh()
-        .x_desc("tick CPU p50 (µs)")
-        .y_desc("stack sink (mm)")
-        .draw()
-        .unwrap();
-    let colors = [RED, BLUE, GREEN];
-    for (k, hz) in [30.0, 120.0, 500.0].iter().enumerate() {
-        let c = colors[k];
+    let mut c = Chart::new(
+        "Tick time vs 10-stack sink (100 bricks awake)",
+        Axis::linear("tick CPU p50 (µs)", 0.0, xmax),
+        Axis::log("stack sink (mm)", 0.01, 100.0),
+    );
+    for (hz, color) in [(30.0, RED), (120.0, BLUE), (500.0, GREEN)] {
         let s: Vec<(f64, f64)> = pts
             .iter()
-            .filter(|p| p.1 == *hz)
+            .filter(|p| p.1 == hz)
             .map(|p| (p.2, p.3.max(0.011)))
             .collect();
-        ch.draw_series(LineSeries::new(s.clone(), c))
-            .unwrap()
-            .label(format!("contacts {hz} Hz (1, 2, 4, 8 iterations)"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
-        ch.draw_series(s.iter().map(|&p| Circle::new(p, 4, c.filled())))
-            .unwrap();
+        let name = format!("contacts {hz} Hz (1, 2, 4, 8 iterations)");
+        c = c.with(Series::line(&name, s, color).width(1).markers(4));
     }
-    ch.configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
+    c.save(&r.figure("brickworld-speed-error.png"), (800, 500))
         .unwrap();
-    root.present().unwrap();
 }

@@ -1,25 +1,21 @@
 //! Benchmark report of the haptic loop: tick times with MCAP logging on and off (batch and real
 //! time), replay speed, MCAP bytes per minute, and the accuracy of what the loop renders
 //! (stiffness cap, force clamp, bit-exact replay). Writes `docs/bench/haptic-loop.md` and
-//! `docs/figures/haptic-loop-*.png`.
+//! `docs/figures/haptic-loop-*.png` through the shared `bench-harness`.
 //!
 //! `cargo run --release -p haptic-loop --example haptic-loop-report` (about 1 minute: it includes a
 //! 20 s real-time session).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use bench_harness::plot::{Axis, Chart, Series};
+use bench_harness::plotters::prelude::{BLUE, GREEN, RED, RGBColor, SeriesLabelPosition};
+use bench_harness::{Report, Summary, Table, span};
 use haptic_loop::device::OperatorParams;
-use haptic_loop::pacing::{Percentiles, TickStats};
 use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
-use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 /// A 60 s workload: press into the wall and slide, every 1.5 s, the centre button held while
 /// pressing (so contact, clamp and button events keep happening).
@@ -56,16 +52,48 @@ fn us(ns: u64) -> f64 {
     ns as f64 / 1e3
 }
 
+/// Nearest-rank percentiles of a session's per-tick work, µs.
+fn tick_us(compute_ns: &[u64]) -> Summary {
+    Summary::of(compute_ns.iter().map(|&n| us(n))).expect("a session has ticks")
+}
+
+/// The tick-time table, one row per session: p50, p99, p99.9, max, ticks over 250 µs and 1 ms.
+fn tick_table() -> Table {
+    Table::new([
+        "session",
+        "p50 (µs)",
+        "p99 (µs)",
+        "p99.9 (µs)",
+        "max (µs)",
+        "ticks > 250 µs",
+        "ticks > 1 ms",
+    ])
+}
+
+fn tick_row(t: &mut Table, name: &str, compute_ns: &[u64]) {
+    let s = tick_us(compute_ns);
+    t.row([
+        name.to_string(),
+        format!("{:.2}", s.median()),
+        format!("{:.2}", s.p99()),
+        format!("{:.2}", s.p999()),
+        format!("{:.1}", s.max()),
+        s.count_above(250.0).to_string(),
+        s.count_above(1000.0).to_string(),
+    ])
+    .unwrap();
+}
+
 fn main() {
-    let root = root();
+    let mut md = Report::start(
+        "haptic-loop",
+        "haptic-loop: tick times, recording size, replay",
+    )
+    .unwrap();
+    let root = md.root().to_path_buf();
     let scene = SceneSource::from_path(&root.join("scenes/wall.toml")).unwrap();
     let tmp = std::env::temp_dir().join(format!("haptic-loop-bench-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
-    let mut md = String::new();
-    let figs = root.join("docs/figures");
-    std::fs::create_dir_all(&figs).unwrap();
-    let load = || std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-    let load_start = load();
 
     // 1. Batch, 60 s, logging on and off.
     let run = |seconds: f64, out: Option<PathBuf>, realtime: bool| {
@@ -93,9 +121,8 @@ fn main() {
 
     // 3. Replay speed and exactness.
     let rec = read_recording_file(&rec60, false).unwrap();
-    let t0 = Instant::now();
-    let v = verify(&rec).unwrap();
-    let replay_s = t0.elapsed().as_secs_f64();
+    let (v, replay) = span(|| verify(&rec).unwrap());
+    let replay_s = replay.wall_s;
     let rt_v = verify(&read_recording_file(&rt_rec, false).unwrap()).unwrap();
 
     // 4. Accuracy of the rendering: a rigid stylus pushed slowly 20 mm into the wall.
@@ -141,14 +168,14 @@ fn main() {
 
     // Figures.
     plot_ticks(
-        &figs.join("haptic-loop-tick-times.png"),
+        &md.figure("haptic-loop-tick-times.png"),
         &[
             ("batch, logging on", &on.arrays.compute_ns, RED),
             ("batch, logging off", &off.arrays.compute_ns, BLUE),
             ("real time, logging on", &rt.arrays.compute_ns, GREEN),
         ],
     );
-    plot_wall(&figs.join("haptic-loop-wall.png"), &pen, a);
+    plot_wall(&md.figure("haptic-loop-wall.png"), &pen, a);
 
     // 5. Every world scene with its default script, logging on.
     let mut worlds = Vec::new();
@@ -232,7 +259,7 @@ fn main() {
     let (lag_on, max_on) = experiment(true, passive);
     let (lag_on_y, max_on_y) = experiment(true, yielding);
     plot_lag(
-        &figs.join("haptic-loop-ot-drag.png"),
+        &md.figure("haptic-loop-ot-drag.png"),
         &[
             ("feedback off", &lag_off, RED),
             ("feedback on, passive hand", &lag_on, BLUE),
@@ -243,258 +270,230 @@ fn main() {
             ),
         ],
     );
-    let load_end = load();
     // Report.
-    let row = |name: &str, s: &Percentiles| {
-        format!(
-            "| {name} | {:.2} | {:.2} | {:.2} | {:.1} |",
-            us(s.p50_ns),
-            us(s.p99_ns),
-            us(s.p999_ns),
-            us(s.max_ns)
-        )
-    };
-    let over = |v: &[u64], ns: u64| v.iter().filter(|&&x| x > ns).count();
-    let row2 = |name: &str, st: &TickStats, v: &[u64]| {
-        format!(
-            "{} {} | {} |\n",
-            row(name, &st.compute),
-            over(v, 250_000),
-            over(v, 1_000_000)
-        )
-    };
-    let _ = writeln!(md, "## haptic-loop: tick times, recording size, replay\n");
-    let _ = writeln!(
-        md,
+    md.para(
         "Scene `scenes/wall.toml` (stiff wall, Falcon, 1 kHz), 60 s script of repeated presses \
-         through the simulated hand (`bench_report` example). Tick work = device read, world \
-         step, force mapping, encoding of every channel and the hand-off to the MCAP writer \
-         thread. One run, 2 shared cores.\n"
+         through the simulated hand (`bench_report` example). Tick work = the runner's \
+         `compute_ns`: device read, world step, force mapping and sending the force. The sinks \
+         (the recorder's encoding of every channel and its hand-off to the MCAP writer thread, \
+         the per-tick arrays) run after it, each timed on its own (second table). One run, 2 \
+         shared cores: the largest ticks are scheduler preemptions (they appear with logging \
+         off too). Percentiles are nearest rank over every tick's work.",
     );
-    let _ = writeln!(
-        md,
-        "Machine load (/proc/loadavg) at start: `{}`, at end: `{}` — the 2 cores are shared \
-         with other jobs, so the largest ticks are scheduler preemptions (they appear with \
-         logging off too).\n",
-        load_start.trim(),
-        load_end.trim()
-    );
-    let _ = writeln!(
-        md,
-        "| session | p50 (µs) | p99 (µs) | p99.9 (µs) | max (µs) | ticks > 250 µs | ticks > 1 ms |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
-    md += &row2("batch 60 s, logging on", &on.stats, &on.arrays.compute_ns);
-    md += &row2(
-        "batch 60 s, logging off",
-        &off.stats,
-        &off.arrays.compute_ns,
-    );
-    md += &row2(
-        "real time 20 s, logging on",
-        &rt.stats,
-        &rt.arrays.compute_ns,
-    );
+    let mut t = tick_table();
+    tick_row(&mut t, "batch 60 s, logging on", &on.arrays.compute_ns);
+    tick_row(&mut t, "batch 60 s, logging off", &off.arrays.compute_ns);
+    tick_row(&mut t, "real time 20 s, logging on", &rt.arrays.compute_ns);
     for (name, r, _) in &worlds {
-        md += &row2(
-            &format!(
-                "{name}, default script ({:.1} s), batch, logging on",
-                r.stats.ticks as f64 / 1e3
-            ),
-            &r.stats,
-            &r.arrays.compute_ns,
+        let name = format!(
+            "{name}, default script ({:.1} s), batch, logging on",
+            r.stats.ticks as f64 / 1e3
         );
+        tick_row(&mut t, &name, &r.arrays.compute_ns);
     }
-    let _ = writeln!(
+    md.table(&t);
+    let mut t = Table::new([
+        "session",
+        "sink",
+        "per tick p50 (µs)",
+        "p99 (µs)",
+        "max (µs)",
+    ]);
+    for (name, r) in [
+        ("batch 60 s, logging on", &on),
+        ("batch 60 s, logging off", &off),
+        ("real time 20 s, logging on", &rt),
+    ] {
+        for s in &r.sinks {
+            t.row([
+                name.to_string(),
+                s.sink.to_string(),
+                format!("{:.2}", us(s.tick.p50_ns)),
+                format!("{:.2}", us(s.tick.p99_ns)),
+                format!("{:.1}", us(s.tick.max_ns)),
+            ])
+            .unwrap();
+        }
+    }
+    md.table(&t);
+    let (on_t, off_t) = (
+        tick_us(&on.arrays.compute_ns),
+        tick_us(&off.arrays.compute_ns),
+    );
+    writeln!(
         md,
-        "\nReal-time pacing (20 s): start jitter p99 {:.1} µs, max {:.1} µs; {} missed deadlines \
+        "Real-time pacing (20 s): start jitter p99 {:.1} µs, max {:.1} µs; {} missed deadlines \
          of {} ticks (zero force sent on each, logged).",
         us(rt.stats.jitter.p99_ns),
         us(rt.stats.jitter.max_ns),
         rt.stats.missed,
         rt.stats.ticks
-    );
-    let _ = writeln!(
+    )
+    .unwrap();
+    writeln!(
         md,
         "Logging on/off p99 ratio, same run: {:.2}.\n",
-        on.stats.compute.p99_ns as f64 / off.stats.compute.p99_ns.max(1) as f64
-    );
-    let target_p99 = on.stats.compute.p99_ns <= 250_000;
-    let target_max = on.stats.compute.max_ns <= 1_000_000;
-    let _ = writeln!(md, "| target | measured | status |\n|---|---|---|");
-    let _ = writeln!(
-        md,
-        "| tick p99 ≤ 250 µs, logging on (wall scene) | {:.2} µs | {} |",
-        us(on.stats.compute.p99_ns),
-        if target_p99 { "met" } else { "not met" }
-    );
-    let _ = writeln!(
-        md,
-        "| tick max ≤ 1 ms, logging on (wall scene) | {:.1} µs | {} |",
-        us(on.stats.compute.max_ns),
-        if target_max { "met" } else { "not met" }
-    );
-    let _ = writeln!(
-        md,
-        "| replay bit-exact | {} of {} output messages differ (60 s batch), {} (20 s real time) | {} |",
-        if v.ok() { 0 } else { 1 },
-        v.messages_compared,
-        if rt_v.ok() { "0 differ" } else { "DIVERGED" },
-        if v.ok() && rt_v.ok() {
-            "met"
-        } else {
-            "not met"
-        }
-    );
-    let _ = writeln!(
-        md,
-        "\nMCAP size: {:.0} kB per minute of session ({} messages; zstd chunks flushed every \
+        on_t.p99() / off_t.p99().max(1e-3)
+    )
+    .unwrap();
+    let met = |ok: bool| if ok { "met" } else { "not met" };
+    let mut t = Table::new(["target", "measured", "status"]);
+    t.row([
+        "tick p99 ≤ 250 µs, logging on (wall scene)".to_string(),
+        format!("{:.2} µs", on_t.p99()),
+        met(on_t.p99() <= 250.0).to_string(),
+    ])
+    .unwrap();
+    t.row([
+        "tick max ≤ 1 ms, logging on (wall scene)".to_string(),
+        format!("{:.1} µs", on_t.max()),
+        met(on_t.max() <= 1000.0).to_string(),
+    ])
+    .unwrap();
+    t.row([
+        "replay bit-exact".to_string(),
+        format!(
+            "{} of {} output messages differ (60 s batch), {} (20 s real time)",
+            if v.ok() { 0 } else { 1 },
+            v.messages_compared,
+            if rt_v.ok() { "0 differ" } else { "DIVERGED" }
+        ),
+        met(v.ok() && rt_v.ok()).to_string(),
+    ])
+    .unwrap();
+    md.table(&t);
+    md.para(&format!(
+        "MCAP size: {:.0} kB per minute of session ({} messages; zstd chunks flushed every \
          session second; the writer queue peaked at {} ticks). Replay with verification: \
-         {:.0} ticks/s ({:.2} s for 60 s).\n",
+         {:.0} ticks/s ({:.2} s for 60 s).",
         bytes_per_min / 1e3,
         w.messages,
         w.max_queue_ticks,
         v.ticks as f64 / replay_s,
         replay_s
-    );
-    let _ = writeln!(
-        md,
-        "| scene | MCAP kB per minute | replay bit-exact |\n|---|---|---|"
-    );
-    let _ = writeln!(
-        md,
-        "| wall (60 s) | {:.0} | {} |",
-        bytes_per_min / 1e3,
-        v.ok()
-    );
+    ));
+    let mut t = Table::new(["scene", "MCAP kB per minute", "replay bit-exact"]);
+    t.row([
+        "wall (60 s)".to_string(),
+        format!("{:.0}", bytes_per_min / 1e3),
+        v.ok().to_string(),
+    ])
+    .unwrap();
     for (name, r, ok) in &worlds {
         let w = r.written.as_ref().unwrap();
-        let _ = writeln!(
-            md,
-            "| {name} ({:.1} s) | {:.0} | {ok} |",
-            r.stats.ticks as f64 / 1e3,
-            w.bytes as f64 / 1e3 * 60.0 / (r.stats.ticks as f64 / 1e3)
-        );
+        t.row([
+            format!("{name} ({:.1} s)", r.stats.ticks as f64 / 1e3),
+            format!(
+                "{:.0}",
+                w.bytes as f64 / 1e3 * 60.0 / (r.stats.ticks as f64 / 1e3)
+            ),
+            ok.to_string(),
+        ])
+        .unwrap();
     }
-    let _ = writeln!(md);
-    let _ = writeln!(
-        md,
-        "Accuracy of the rendered force (rigid stylus pushed 21 mm into a 5000 N/m wall):\n"
+    md.table(&t);
+    md.para("Accuracy of the rendered force (rigid stylus pushed 21 mm into a 5000 N/m wall):");
+    let mut t = Table::new(["quantity", "expected", "worst error"]);
+    t.row([
+        "force in the unclamped range vs k·d − b·v_n, k capped at 3000 N/m".to_string(),
+        "exact".to_string(),
+        format!("{stiff_err:.1e} relative"),
+    ])
+    .unwrap();
+    t.row([
+        "clamped force norm".to_string(),
+        "8 N".to_string(),
+        format!("{clamp_err:.1e} N"),
+    ])
+    .unwrap();
+    t.row([
+        "direction of the sent force vs the world force".to_string(),
+        "same".to_string(),
+        format!("{clamp_dir:.1e} rad"),
+    ])
+    .unwrap();
+    md.table(&t);
+    md.heading("Optical tweezers: steering with the working envelope every tick");
+    md.para(
+        "Scene `scenes/optical_tweezers.toml` (paper constants; the scene's tick map, \
+         `tick_map_tol_nm = 0.01`: the cheapest RK4/RK8 within 0.01 nm of converged dynamics; \
+         `ot-envelope` controller with the warm-started envelope: envelope, clip, inverse solve \
+         while grabbed), 60 s of steering around a 4 µm square, logging on.",
     );
-    let _ = writeln!(md, "| quantity | expected | worst error |\n|---|---|---|");
-    let _ = writeln!(
-        md,
-        "| force in the unclamped range vs k·d − b·v_n, k capped at 3000 N/m | exact | {stiff_err:.1e} relative |"
-    );
-    let _ = writeln!(md, "| clamped force norm | 8 N | {clamp_err:.1e} N |");
-    let _ = writeln!(
-        md,
-        "| direction of the sent force vs the world force | same | {clamp_dir:.1e} rad |"
-    );
-    let _ = writeln!(
-        md,
-        "\n### Optical tweezers: steering with the working envelope every tick\n"
-    );
-    let _ = writeln!(
-        md,
-        "Scene `scenes/optical_tweezers.toml` (paper constants, 0.2 µs control cycle per 1 ms \
-         tick, RK4 ×8 tick map, `ot-envelope` controller: envelope, clip, inverse solve every \
-         tick while grabbed), 60 s of steering around a 4 µm square, logging on.\n"
-    );
-    let _ = writeln!(
-        md,
-        "| session | p50 (µs) | p99 (µs) | p99.9 (µs) | max (µs) | ticks > 250 µs | ticks > 1 ms |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
-    md += &row2(
+    let mut t = tick_table();
+    tick_row(
+        &mut t,
         "optical tweezers 60 s, batch, logging on",
-        &ot60.stats,
         &ot60.arrays.compute_ns,
     );
+    md.table(&t);
+    let ot_t = tick_us(&ot60.arrays.compute_ns);
     let ow = ot60.written.as_ref().unwrap();
-    let _ = writeln!(md, "\n| target | measured | status |\n|---|---|---|");
-    let _ = writeln!(
-        md,
-        "| OT tick p99 ≤ 250 µs (envelope + logging on) | {:.1} µs | {} |",
-        us(ot60.stats.compute.p99_ns),
-        if ot60.stats.compute.p99_ns <= 250_000 {
-            "met"
-        } else {
-            "not met"
-        }
-    );
-    let _ = writeln!(
-        md,
-        "| OT tick max ≤ 1 ms | {:.1} µs | {} |",
-        us(ot60.stats.compute.max_ns),
-        if ot60.stats.compute.max_ns <= 1_000_000 {
-            "met"
-        } else {
-            "not met"
-        }
-    );
-    let _ = writeln!(
-        md,
-        "| replay bit-exact (60 s) | {} | {} |",
+    let mut t = Table::new(["target", "measured", "status"]);
+    t.row([
+        "OT tick p99 ≤ 250 µs (envelope + logging on)".to_string(),
+        format!("{:.1} µs", ot_t.p99()),
+        met(ot_t.p99() <= 250.0).to_string(),
+    ])
+    .unwrap();
+    t.row([
+        "OT tick max ≤ 1 ms".to_string(),
+        format!("{:.1} µs", ot_t.max()),
+        met(ot_t.max() <= 1000.0).to_string(),
+    ])
+    .unwrap();
+    t.row([
+        "replay bit-exact (60 s)",
         if ot60_ok { "identical" } else { "DIVERGED" },
-        if ot60_ok { "met" } else { "not met" }
-    );
-    let _ = writeln!(
-        md,
-        "\nMCAP size: {:.0} kB per minute (the envelope is drawn in `/foxglove/scene` at 50 Hz).\n",
+        met(ot60_ok),
+    ])
+    .unwrap();
+    md.table(&t);
+    md.para(&format!(
+        "MCAP size: {:.0} kB per minute (the envelope is drawn in `/foxglove/scene` at 50 Hz).",
         ow.bytes as f64 / 1e3
-    );
-    let _ = writeln!(
-        md,
+    ));
+    md.para(
         "The paper's experiment, headless: grab the particle, then the simulated operator drags \
          the cursor 10 µm in 0.25 s (peak 75 nm per tick, beyond what the trap can move the \
-         particle in one cycle), holds, releases. Largest cursor–particle distance while grabbed:\n"
+         particle in one cycle), holds, releases. Largest cursor–particle distance while grabbed:",
     );
-    let _ = writeln!(
-        md,
-        "| run | largest cursor–particle distance | paper |\n|---|---|---|"
-    );
-    let _ = writeln!(
-        md,
-        "| feedback off | {:.2} µm | up to 3 µm |",
-        max_off * 1e6
-    );
-    let _ = writeln!(
-        md,
-        "| feedback on, passive hand (0.3 kg, 300 N/m, 12 N·s/m) | {:.2} µm | under 0.3 µm |",
-        max_on * 1e6
-    );
-    let _ = writeln!(
-        md,
-        "| feedback on, hand that slows down under force (0.5 N halves its speed) | {:.2} µm | under 0.3 µm |",
-        max_on_y * 1e6
-    );
-    let _ = writeln!(
-        md,
-        "\nA passive hand is held back only by the spring (800 N/m on the device against its own \
+    let mut t = Table::new(["run", "largest cursor–particle distance", "paper"]);
+    t.row([
+        "feedback off".to_string(),
+        format!("{:.2} µm", max_off * 1e6),
+        "up to 3 µm".to_string(),
+    ])
+    .unwrap();
+    t.row([
+        "feedback on, passive hand (0.3 kg, 300 N/m, 12 N·s/m)".to_string(),
+        format!("{:.2} µm", max_on * 1e6),
+        "under 0.3 µm".to_string(),
+    ])
+    .unwrap();
+    t.row([
+        "feedback on, hand that slows down under force (0.5 N halves its speed)".to_string(),
+        format!("{:.2} µm", max_on_y * 1e6),
+        "under 0.3 µm".to_string(),
+    ])
+    .unwrap();
+    md.table(&t);
+    md.para(&format!(
+        "A passive hand is held back only by the spring (800 N/m on the device against its own \
          300 N/m pull); the paper's operators also slowed down because they felt the wall, which \
-         the yielding hand models. Feedback on/off ratio (passive): {:.2}; (yielding): {:.2}.\n",
+         the yielding hand models. Feedback on/off ratio (passive): {:.2}; (yielding): {:.2}.",
         max_on / max_off,
         max_on_y / max_off
-    );
-    let _ = writeln!(
-        md,
-        "![OT drag experiment](../figures/haptic-loop-ot-drag.png)"
-    );
-    let _ = writeln!(
-        md,
-        "\n![tick times](../figures/haptic-loop-tick-times.png)\n\n![wall](../figures/haptic-loop-wall.png)"
-    );
-    let bench = root.join("docs/bench");
-    std::fs::create_dir_all(&bench).unwrap();
-    std::fs::write(bench.join("haptic-loop.md"), &md).unwrap();
-    print!("{md}");
+    ));
+    md.image("OT drag experiment", "haptic-loop-ot-drag.png");
+    md.image("tick times", "haptic-loop-tick-times.png");
+    md.image("wall", "haptic-loop-wall.png");
+    let (_, text) = md.finish().unwrap();
+    print!("{text}");
     let _ = std::fs::remove_dir_all(&tmp);
 }
 
 fn plot_ticks(path: &Path, series: &[(&str, &Vec<u64>, RGBColor)]) {
-    let area = BitMapBackend::new(path, (900, 500)).into_drawing_area();
-    area.fill(&WHITE).unwrap();
     let max = series
         .iter()
         .flat_map(|s| s.1.iter())
@@ -502,50 +501,26 @@ fn plot_ticks(path: &Path, series: &[(&str, &Vec<u64>, RGBColor)]) {
         .max()
         .unwrap_or(1) as f64
         / 1e3;
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            "tick work (up to the writer hand-off): fraction of ticks above a time",
-            ("sans-serif", 20),
-        )
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d((0.1f64..max * 1.5).log_scale(), (1e-5f64..1.0).log_scale())
-        .unwrap();
-    chart
-        .configure_mesh()
-        .x_desc("tick work (µs)")
-        .y_desc("fraction of ticks ≥ x")
-        .draw()
-        .unwrap();
+    let mut c = Chart::new(
+        "tick work (up to the writer hand-off): fraction of ticks above a time",
+        Axis::log("tick work (µs)", 0.1, max * 1.5),
+        Axis::log("fraction of ticks ≥ x", 1e-5, 1.0),
+    );
     for (name, data, color) in series {
-        let mut v: Vec<f64> = data.iter().map(|&x| (x as f64 / 1e3).max(0.1)).collect();
-        v.sort_by(f64::total_cmp);
+        let v = tick_us(data);
         let n = v.len() as f64;
-        let pts: Vec<(f64, f64)> = v
+        let pts = v
+            .sorted()
             .iter()
             .enumerate()
-            .map(|(i, &x)| (x, ((n - i as f64) / n).max(1e-5)))
+            .map(|(i, &x)| (x.max(0.1), ((n - i as f64) / n).max(1e-5)))
             .collect();
-        let c = *color;
-        chart
-            .draw_series(LineSeries::new(pts, c.stroke_width(2)))
-            .unwrap()
-            .label(*name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+        c = c.with(Series::line(name, pts, *color));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .unwrap();
-    area.present().unwrap();
+    c.save(path, (900, 500)).unwrap();
 }
 
 fn plot_lag(path: &Path, series: &[(&str, &Vec<f64>, RGBColor)]) {
-    let area = BitMapBackend::new(path, (900, 500)).into_drawing_area();
-    area.fill(&WHITE).unwrap();
     let ymax = series
         .iter()
         .flat_map(|s| s.1.iter())
@@ -553,95 +528,50 @@ fn plot_lag(path: &Path, series: &[(&str, &Vec<f64>, RGBColor)]) {
         .fold(0.0, f64::max)
         * 1e6
         * 1.1;
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            "optical tweezers: cursor–particle distance while dragging too fast",
-            ("sans-serif", 20),
-        )
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(0.0f64..2.5, 0.0f64..ymax.max(1.0))
-        .unwrap();
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .y_desc("cursor–particle distance (µm)")
-        .draw()
-        .unwrap();
+    let mut c = Chart::new(
+        "optical tweezers: cursor–particle distance while dragging too fast",
+        Axis::linear("time (s)", 0.0, 2.5),
+        Axis::linear("cursor–particle distance (µm)", 0.0, ymax.max(1.0)),
+    );
     for (name, lag, color) in series {
-        let c = *color;
-        let pts: Vec<(f64, f64)> = lag
+        let pts = lag
             .iter()
             .enumerate()
             .map(|(i, l)| (i as f64 / 1000.0, l * 1e6))
             .collect();
-        chart
-            .draw_series(LineSeries::new(pts, c.stroke_width(2)))
-            .unwrap()
-            .label(*name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+        c = c.with(Series::line(name, pts, *color));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .unwrap();
-    area.present().unwrap();
+    c.save(path, (900, 500)).unwrap();
 }
 
 fn plot_wall(path: &Path, pen: &[f64], a: &haptic_loop::SessionArrays) {
-    let area = BitMapBackend::new(path, (900, 500)).into_drawing_area();
-    area.fill(&WHITE).unwrap();
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            "stiff wall: force sent vs penetration (Falcon, rigid stylus)",
-            ("sans-serif", 20),
-        )
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(0.0f64..21.0, 0.0f64..12.0)
-        .unwrap();
-    chart
-        .configure_mesh()
-        .x_desc("penetration (mm)")
-        .y_desc("force (N)")
-        .draw()
-        .unwrap();
-    chart
-        .draw_series(LineSeries::new(
-            [(0.0, 0.0), (2.4, 12.0)],
-            RGBColor(180, 180, 180).stroke_width(1),
-        ))
-        .unwrap()
-        .label("requested 5000 N/m")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(180, 180, 180)));
-    let world: Vec<(f64, f64)> = (0..pen.len())
-        .filter(|&i| a.engagement[i] == 1.0)
+    let engaged = || (0..pen.len()).filter(|&i| a.engagement[i] == 1.0);
+    let world = engaged()
         .map(|i| (pen[i] * 1e3, a.world_force_n[i][2].min(12.0)))
         .collect();
-    chart
-        .draw_series(LineSeries::new(world, BLUE.stroke_width(2)))
-        .unwrap()
-        .label("scene force (capped at 3000 N/m)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
-    let sent: Vec<(f64, f64)> = (0..pen.len())
-        .filter(|&i| a.engagement[i] == 1.0)
+    let sent = engaged()
         .map(|i| (pen[i] * 1e3, a.device_force_n[i][2]))
         .collect();
-    chart
-        .draw_series(LineSeries::new(sent, RED.stroke_width(3)))
-        .unwrap()
-        .label("force sent (clamped at 8 N)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .unwrap();
-    area.present().unwrap();
+    Chart::new(
+        "stiff wall: force sent vs penetration (Falcon, rigid stylus)",
+        Axis::linear("penetration (mm)", 0.0, 21.0),
+        Axis::linear("force (N)", 0.0, 12.0),
+    )
+    .with(
+        Series::line(
+            "requested 5000 N/m",
+            vec![(0.0, 0.0), (2.4, 12.0)],
+            RGBColor(180, 180, 180),
+        )
+        .width(1),
+    )
+    .with(Series::line(
+        "scene force (capped at 3000 N/m)",
+        world,
+        BLUE,
+    ))
+    .with(Series::line("force sent (clamped at 8 N)", sent, RED).width(3))
+    .legend(Some(SeriesLabelPosition::LowerRight))
+    .save(path, (900, 500))
+    .unwrap();
 }

@@ -14,6 +14,8 @@
 //!
 //! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
 
+use bench_harness::Summary;
+use bench_harness::machine::LoadAvg;
 use haptic_loop::scene::SceneFile;
 use haptic_loop::scene::optical::OtParams;
 use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
@@ -62,11 +64,9 @@ fn us(ns: u64) -> f64 {
     ns as f64 / 1e3
 }
 
+/// The load average now (1, 5, 15 min), from the shared harness.
 fn load() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .unwrap_or_default()
-        .trim()
-        .to_string()
+    LoadAvg::now().map_or("?".to_string(), |l| l.to_string())
 }
 
 /// Replays the new session's steering from its recorded states and measures the envelope's
@@ -219,26 +219,23 @@ fn main() -> Result<(), BoxError> {
                 .arrays
                 .state_column("grabbed")
                 .ok_or("no grabbed column")?;
-            let mut gt: Vec<u64> = r
-                .arrays
-                .compute_ns
-                .iter()
-                .zip(&g)
-                .filter(|(_, g)| **g == 1.0)
-                .map(|(t, _)| *t)
-                .collect();
-            gt.sort_unstable();
-            let pct = |q: f64| {
-                gt.get(((gt.len() as f64 * q).ceil() as usize).saturating_sub(1))
-                    .map_or(0.0, |t| us(*t))
-            };
+            // grabbed ticks' work, µs, nearest-rank percentiles (0 when none was grabbed)
+            let gt = Summary::of(
+                r.arrays
+                    .compute_ns
+                    .iter()
+                    .zip(&g)
+                    .filter(|(_, g)| **g == 1.0)
+                    .map(|(t, _)| us(*t)),
+            );
+            let pct = |q: f64| gt.as_ref().and_then(|s| s.percentile(q)).unwrap_or(0.0);
             println!(
                 "| {name} | {} | {:.1} | {:.1} | {:.1} | {} | {:.1} | {:.1} | {:.1} | {} |",
                 s.ticks,
                 us(s.compute.p50_ns),
                 us(s.compute.p99_ns),
                 us(s.compute.max_ns),
-                gt.len(),
+                gt.as_ref().map_or(0, Summary::len),
                 pct(0.5),
                 pct(0.99),
                 pct(1.0),

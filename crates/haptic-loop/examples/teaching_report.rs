@@ -1,24 +1,26 @@
 //! The teaching game's figures with their accuracy: the lesson (17 runs, report, figures,
 //! sounds) and the sound of the golden recordings, timed in CPU time, three runs each.
-//! Writes `docs/bench/teaching-game.md` (run from the repository root, or pass `--out FILE`).
+//! Writes `docs/bench/teaching-game.md` (or `--out FILE`) through the shared `bench-harness`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use bench_harness::report::out_arg;
+use bench_harness::{Report, Summary, Table, span};
 
 use haptic_loop::lesson::{LessonOptions, LessonSummary, run_lesson};
 use haptic_loop::record::read_recording_file;
 use haptic_loop::session::SessionArrays;
 use haptic_loop::sound::session_sound;
 use std::fmt::Write;
-use std::path::{Path, PathBuf};
 
+/// Runs `f` and returns its value with the thread-CPU time it took, s.
 fn cpu<T>(f: impl FnOnce() -> T) -> (T, f64) {
-    let t = cpu_time::ThreadTime::now();
-    let v = f();
-    (v, t.elapsed().as_secs_f64())
+    let (v, s) = span(f);
+    (v, s.cpu_s)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+/// Nearest-rank median of a few run times, s.
+fn median(v: Vec<f64>) -> f64 {
+    Summary::of(v).expect("three runs").median()
 }
 
 /// Largest |onset − event time| over the impacts with 150 ms of silence before them, s, and
@@ -48,16 +50,10 @@ fn onset_error(a: &SessionArrays, samples: &[f32], rate: f64) -> (f64, usize) {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1))
-        .map_or_else(
-            || PathBuf::from("docs/bench/teaching-game.md"),
-            PathBuf::from,
-        );
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut md = Report::start("teaching-game", "teaching game — lesson and sound")
+        .unwrap()
+        .output(out_arg());
+    let root = md.root().to_path_buf();
     let dir = std::env::temp_dir().join(format!("nh-teaching-report-{}", std::process::id()));
 
     // 1. The lesson.
@@ -82,7 +78,13 @@ fn main() {
     let mg = s.brick_mass_kg * s.gravity_m_s2;
 
     // 2. Sound of the golden recordings.
-    let mut rows = String::new();
+    let mut rows = Table::new([
+        "recording",
+        "sounds",
+        "CPU (ms)",
+        "faster than real time",
+        "peak amplitude",
+    ]);
     let mut onset = (0.0, 0);
     for name in ["brickworld", "nanoworld"] {
         let rec = read_recording_file(&root.join(format!("recordings/{name}.mcap")), false)
@@ -105,63 +107,103 @@ fn main() {
             onset = onset_error(&a, &plain.samples, 44_100.0);
         }
         let m = median(t);
-        let _ = writeln!(
-            rows,
-            "| {name} (golden, {secs:.1} s, proximity tone on) | {} | {:.1} | {:.0}× | {peak:.3} |",
-            snd.sounds.len(),
-            m * 1e3,
-            secs / m
-        );
+        rows.row([
+            format!("{name} (golden, {secs:.1} s, proximity tone on)"),
+            snd.sounds.len().to_string(),
+            format!("{:.1}", m * 1e3),
+            format!("{:.0}×", secs / m),
+            format!("{peak:.3}"),
+        ])
+        .unwrap();
     }
     std::fs::remove_dir_all(&dir).ok();
 
-    let mut md = String::new();
     let _ = writeln!(
         md,
-        "## teaching game — lesson and sound\n\n\
-         `cargo run --release -p haptic-loop --example haptic-loop-teaching-report`: thread CPU \
+        "`cargo run --release -p haptic-loop --example haptic-loop-teaching-report`: thread CPU \
          time, median of three runs on the shared 2-core machine.\n\n\
          ### The lesson (`nanohaptics lesson`)\n\n\
          17 sessions (two house tasks, three lifts, two approach–retract cycles, two throws, seven \
          heavy-atom throws), 8 figures at 1200 px, 2 recordings, 2 WAV files: **{:.2} s** CPU \
          (runs: {}). Target: under 10 s, so a teacher can rerun it in class — **met**.\n\n\
-         Accuracy of what the report states (each checked by `tests/lesson.rs`):\n\n\
-         | figure | measured | reference | error |\n|---|---|---|---|\n\
-         | weight of the held brick | {:.6} N | M g = {:.6} N | {:.1e} |\n\
-         | peak inertial force of the carry | {:.5} N | M·5.7735·D/T² = {:.5} N | {:+.3} % |\n\
-         | weight with gravity off / inertia with inertia off | {:.1e} N / {:.1e} N | 0 | exact |\n\
-         | pull-off / snap force | {:.12} | 10 (the paper) | {:.1e} |\n\
-         | snap and pull-off with adhesion halved | ×{:.12}, ×{:.12} | ×0.5 | {:.1e} |\n\
-         | throw threshold of the 3 g atom (hand) | stays ≤ {:.2}, thrown ≥ {:.2} m/s² | hold/(m·scale) = {:.2} m/s² | bracketed |\n\
-         | brick throw: distance / (speed × flight time) | {:.4} | 1 (ballistic, horizontal) | {:+.2} % |\n\
-         \nTarget: {}.\n",
+         Accuracy of what the report states (each checked by `tests/lesson.rs`):\n",
         median(times.clone()),
         times
             .iter()
             .map(|t| format!("{t:.2} s"))
             .collect::<Vec<_>>()
             .join(", "),
-        -s.lift_weight_n[0],
-        mg,
-        (-s.lift_weight_n[0] - mg).abs() / mg,
-        s.lift_inertia_n[0],
-        s.lift_inertia_predicted_n,
-        100.0 * (s.lift_inertia_n[0] / s.lift_inertia_predicted_n - 1.0),
-        s.lift_weight_n[1].abs(),
-        s.lift_inertia_n[2],
-        s.hysteresis.ratio,
-        (s.hysteresis.ratio - 10.0).abs(),
-        s.hysteresis_half.snap_force_n / s.hysteresis.snap_force_n,
-        s.hysteresis_half.pull_off_n / s.hysteresis.pull_off_n,
-        (s.hysteresis_half.pull_off_n / s.hysteresis.pull_off_n - 0.5).abs(),
-        s.sweep.kept_below_m_s2,
-        s.sweep.thrown_from_m_s2,
-        s.sweep.predicted_hand_m_s2,
-        s.brick_throw.distance_m / (s.brick_throw.release_speed_m_s * s.brick_throw.flight_s),
-        100.0
-            * (s.brick_throw.distance_m
-                / (s.brick_throw.release_speed_m_s * s.brick_throw.flight_s)
-                - 1.0),
+    );
+    let throw =
+        s.brick_throw.distance_m / (s.brick_throw.release_speed_m_s * s.brick_throw.flight_s);
+    let mut acc = Table::new(["figure", "measured", "reference", "error"]);
+    for r in [
+        [
+            "weight of the held brick".to_string(),
+            format!("{:.6} N", -s.lift_weight_n[0]),
+            format!("M g = {mg:.6} N"),
+            format!("{:.1e}", (-s.lift_weight_n[0] - mg).abs() / mg),
+        ],
+        [
+            "peak inertial force of the carry".to_string(),
+            format!("{:.5} N", s.lift_inertia_n[0]),
+            format!("M·5.7735·D/T² = {:.5} N", s.lift_inertia_predicted_n),
+            format!(
+                "{:+.3} %",
+                100.0 * (s.lift_inertia_n[0] / s.lift_inertia_predicted_n - 1.0)
+            ),
+        ],
+        [
+            "weight with gravity off / inertia with inertia off".to_string(),
+            format!(
+                "{:.1e} N / {:.1e} N",
+                s.lift_weight_n[1].abs(),
+                s.lift_inertia_n[2]
+            ),
+            "0".to_string(),
+            "exact".to_string(),
+        ],
+        [
+            "pull-off / snap force".to_string(),
+            format!("{:.12}", s.hysteresis.ratio),
+            "10 (the paper)".to_string(),
+            format!("{:.1e}", (s.hysteresis.ratio - 10.0).abs()),
+        ],
+        [
+            "snap and pull-off with adhesion halved".to_string(),
+            format!(
+                "×{:.12}, ×{:.12}",
+                s.hysteresis_half.snap_force_n / s.hysteresis.snap_force_n,
+                s.hysteresis_half.pull_off_n / s.hysteresis.pull_off_n
+            ),
+            "×0.5".to_string(),
+            format!(
+                "{:.1e}",
+                (s.hysteresis_half.pull_off_n / s.hysteresis.pull_off_n - 0.5).abs()
+            ),
+        ],
+        [
+            "throw threshold of the 3 g atom (hand)".to_string(),
+            format!(
+                "stays ≤ {:.2}, thrown ≥ {:.2} m/s²",
+                s.sweep.kept_below_m_s2, s.sweep.thrown_from_m_s2
+            ),
+            format!("hold/(m·scale) = {:.2} m/s²", s.sweep.predicted_hand_m_s2),
+            "bracketed".to_string(),
+        ],
+        [
+            "brick throw: distance / (speed × flight time)".to_string(),
+            format!("{throw:.4}"),
+            "1 (ballistic, horizontal)".to_string(),
+            format!("{:+.2} %", 100.0 * (throw - 1.0)),
+        ],
+    ] {
+        acc.row(r).unwrap();
+    }
+    md.table(&acc);
+    let _ = writeln!(
+        md,
+        "Target: {}.\n",
         if s.sweep.kept_below_m_s2 < s.sweep.predicted_hand_m_s2
             && s.sweep.thrown_from_m_s2 >= s.sweep.predicted_hand_m_s2
             && (s.hysteresis.ratio - 10.0).abs() < 1e-9
@@ -176,8 +218,7 @@ fn main() {
         "The inertia figure's error is the three-point acceleration estimate's (a backward \
          difference lags the minimum-jerk peak by one tick); the throw's is the flight time's \
          tick resolution.\n\n\
-         ### Sound (`render --audio`)\n\n\
-         | recording | sounds | CPU (ms) | faster than real time | peak amplitude |\n|---|---|---|---|---|\n{rows}\n\
+         ### Sound (`render --audio`)\n\n{rows}\n\
          Onsets: on the golden brick recording, the {} impacts with silence before them start \
          within **{:.3} ms** of their tick (target ±1 ms: **{}**; one sample is 0.023 ms). Peaks \
          stay below the 0.98 ceiling by construction (the anti-clipping rule).\n\n\
@@ -189,6 +230,6 @@ fn main() {
         onset.0 * 1e3,
         if onset.0 <= 1e-3 { "met" } else { "missed" }
     );
-    std::fs::write(&out, md).expect("write report");
+    let (out, _) = md.finish().expect("write report");
     println!("wrote {}", out.display());
 }

@@ -1,10 +1,13 @@
 //! Measures speed AND error of the envelope, the inverse solver and the
 //! paper-method baseline, and writes `docs/bench/ot-envelope.md` plus
-//! `docs/figures/ot-envelope-bench.png`.
+//! `docs/figures/ot-envelope-bench.png` through the shared `bench-harness`.
 //!
 //! Run: `cargo run --release -p ot-envelope --example ot-envelope-report`
 //! (about two minutes; single thread).
 
+use bench_harness::plot::{Axis, Chart, Series};
+use bench_harness::plotters::prelude::{BLUE, RED};
+use bench_harness::{Report, Summary, Table, Timings, span};
 use nalgebra::{Vector2, Vector3};
 use ot_envelope::envelope3::working_envelope_3d;
 use ot_envelope::geometry::nearest_on_boundary;
@@ -13,23 +16,15 @@ use ot_envelope::paper::paper_envelope;
 use ot_envelope::reference::Reference;
 use ot_envelope::{OffsetRegion, SampledMap, envelope_from_map, working_envelope};
 use ot_physics::{Method, Propagator, TrapModel};
-use plotters::prelude::*;
 use std::fmt::Write as _;
-use std::time::Instant;
 
 type V2 = Vector2<f64>;
 const NM: f64 = 1e-9;
 
-/// (min, median) seconds of `f` over `n` runs.
-fn time<T>(n: usize, mut f: impl FnMut() -> T) -> (f64, f64) {
-    let mut t = Vec::with_capacity(n);
-    for _ in 0..n {
-        let s = Instant::now();
-        std::hint::black_box(f());
-        t.push(s.elapsed().as_secs_f64());
-    }
-    t.sort_by(f64::total_cmp);
-    (t[0], t[n / 2])
+/// (min, median) wall-clock seconds of `f` over `n` runs (nearest-rank median).
+fn time<T>(n: usize, f: impl FnMut() -> T) -> (f64, f64) {
+    let t = Timings::repeat(n, f).wall_us().expect("n > 0 runs");
+    (t.min() * 1e-6, t.median() * 1e-6)
 }
 
 fn model(w: [f64; 2]) -> TrapModel<2> {
@@ -44,15 +39,14 @@ fn met(ok: bool) -> &'static str {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut md = String::new();
+    let mut md = Report::start(
+        "ot-envelope",
+        "ot-envelope — inverse trap solver and working envelope",
+    )?;
     let paper_w = [600e-9, 300e-9];
     let m = model(paper_w);
     let fast = Propagator::new(m, Method::Rk4 { substeps: 8 }, 1e-6)?;
     let conv = Propagator::new(m, Method::Adaptive { rtol: 1e-10 }, 1e-6)?;
-    writeln!(
-        md,
-        "## ot-envelope — inverse trap solver and working envelope\n"
-    )?;
     writeln!(
         md,
         "Paper constants: P0 = 1e-15 J, a = 600 nm, b = 300 nm, m = 1e-15 kg, Δt = 1 µs. Our tick map: RK4 × 8 substeps (`Method::Rk4 {{ substeps: 8 }}`). \"Converged\" = DOP853 at rtol 1e-10. Times: one core, min and median of repeated runs on a shared 2-core machine (other jobs running); ratios are from this one run.\n"
@@ -63,10 +57,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         md,
         "### Tick-map accuracy (max displacement error over 41×41 offsets within ±3 waists)\n"
     )?;
-    writeln!(
-        md,
-        "| method | max error vs converged (nm) | flow_jacobian time (µs) |\n|---|---|---|"
-    )?;
+    let mut t = Table::new([
+        "method",
+        "max error vs converged (nm)",
+        "flow_jacobian time (µs)",
+    ]);
     for (name, meth) in [
         ("paper-rk4 (one step)", Method::PaperRk4),
         ("rk4 × 4", Method::Rk4 { substeps: 4 }),
@@ -85,19 +80,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (tmin, _) = time(2000, || {
             p.flow_jacobian(&V2::new(-100e-9, -50e-9), &V2::zeros())
         });
-        writeln!(md, "| {name} | {:.3} | {:.2} |", err / NM, tmin * 1e6)?;
+        t.row([
+            name.to_string(),
+            format!("{:.3}", err / NM),
+            format!("{:.2}", tmin * 1e6),
+        ])?;
     }
+    md.table(&t);
 
     // 2. envelope speed and error
-    writeln!(md, "\n### Working envelope, paper constants\n")?;
+    md.heading("Working envelope, paper constants");
     writeln!(
         md,
         "Error = Hausdorff distance between the polygon's region and the reachable set, from a 900×900 forward sampling of the converged map over the search region (±3 waists): `outside` = sampled displacements outside the polygon, `overreach` = polygon boundary points (every 2 nm) farther than this from any reachable displacement (nearest sample polished by Levenberg–Marquardt).\n"
     )?;
-    writeln!(
-        md,
-        "| v0 (nm/µs) | vertices | force evals | time min / median (ms) | outside (nm) | overreach (nm) | Hausdorff (nm) | target ≤ 1 nm in ≤ 1 ms |\n|---|---|---|---|---|---|---|---|"
-    )?;
+    let mut t = Table::new([
+        "v0 (nm/µs)",
+        "vertices",
+        "force evals",
+        "time min / median (ms)",
+        "outside (nm)",
+        "overreach (nm)",
+        "Hausdorff (nm)",
+        "target ≤ 1 nm in ≤ 1 ms",
+    ]);
     let mut ours_err: f64 = 0.0;
     let mut ours_t: f64 = 0.0;
     for v0 in [V2::zeros(), V2::new(0.1, 0.1)] {
@@ -107,21 +113,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let e = r.errors(&conv, &we.polygon, 2.0 * NM)?;
         ours_err = ours_err.max(e.hausdorff());
         ours_t = ours_t.max(tmed);
-        writeln!(
-            md,
-            "| ({:.0}, {:.0}) | {} | {} | {:.3} / {:.3} | {:.3} | {:.3} | {:.3} | {} |",
-            v0.x * 1e3,
-            v0.y * 1e3,
-            we.polygon.len(),
-            we.evals,
-            tmin * 1e3,
-            tmed * 1e3,
-            e.outside / NM,
-            e.overreach / NM,
-            e.hausdorff() / NM,
-            met(e.hausdorff() <= NM && tmed <= 1e-3)
-        )?;
+        t.row([
+            format!("({:.0}, {:.0})", v0.x * 1e3, v0.y * 1e3),
+            we.polygon.len().to_string(),
+            we.evals.to_string(),
+            format!("{:.3} / {:.3}", tmin * 1e3, tmed * 1e3),
+            format!("{:.3}", e.outside / NM),
+            format!("{:.3}", e.overreach / NM),
+            format!("{:.3}", e.hausdorff() / NM),
+            met(e.hausdorff() <= NM && tmed <= 1e-3).to_string(),
+        ])?;
     }
+    md.table(&t);
 
     // 3. the paper's method as baseline, same run
     writeln!(
@@ -132,10 +135,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         md,
         "Same tick map (RK4 × 8), same Newton residual (1e-12 m); seeds from an offset grid of the stated cell size (the paper's \"square elements\"), subdivided twice on failure. Error measured as above. Its error has two parts: about half the target spacing (overreach) and a seeding floor near the fold, where plain Newton from marching-squares seeds fails and boundary targets are lost (outside); finer seed cells lower the floor at a cost per target.\n"
     )?;
-    writeln!(
-        md,
-        "| seed cell (waists) | target spacing (nm) | targets | Newton runs | time (s) | outside (nm) | overreach (nm) | Hausdorff (nm) | time / ours |\n|---|---|---|---|---|---|---|---|---|"
-    )?;
+    let mut t = Table::new([
+        "seed cell (waists)",
+        "target spacing (nm)",
+        "targets",
+        "Newton runs",
+        "time (s)",
+        "outside (nm)",
+        "overreach (nm)",
+        "Hausdorff (nm)",
+        "time / ours",
+    ]);
     let we0 = working_envelope(&fast, &V2::zeros(), None)?;
     let (tours, _) = time(200, || working_envelope(&fast, &V2::zeros(), None));
     let r0 = Reference::sample(&conv, &V2::zeros(), &we0.region, 900)?;
@@ -152,38 +162,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (0.3, 2.0),
         (0.05, 8.0),
     ] {
-        let s = Instant::now();
-        let b = paper_envelope(
-            &fast,
-            &V2::zeros(),
-            &we0.region,
-            cell,
-            t_lo,
-            t_hi,
-            spacing * NM,
-        )?;
-        let tb = s.elapsed().as_secs_f64();
+        let (b, sb) = span(|| {
+            paper_envelope(
+                &fast,
+                &V2::zeros(),
+                &we0.region,
+                cell,
+                t_lo,
+                t_hi,
+                spacing * NM,
+            )
+        });
+        let (b, tb) = (b?, sb.wall_s);
         let e = r0.errors(&conv, &b.polygon, 2.0 * NM)?;
-        writeln!(
-            md,
-            "| {cell} | {spacing} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0}× |",
-            b.targets,
-            b.newton_runs,
-            tb,
-            e.outside / NM,
-            e.overreach / NM,
-            e.hausdorff() / NM,
-            tb / tours
-        )?;
+        t.row([
+            format!("{cell}"),
+            format!("{spacing}"),
+            b.targets.to_string(),
+            b.newton_runs.to_string(),
+            format!("{tb:.2}"),
+            format!("{:.2}", e.outside / NM),
+            format!("{:.2}", e.overreach / NM),
+            format!("{:.2}", e.hausdorff() / NM),
+            format!("{:.0}×", tb / tours),
+        ])?;
         base_pts.push((tb, e.hausdorff()));
         if e.hausdorff() >= e_ours {
             best_ratio = best_ratio.max(tb / tours);
         }
         best_err = best_err.min(e.hausdorff());
     }
+    md.table(&t);
     writeln!(
         md,
-        "\nOurs: {:.3} ms (min), Hausdorff {:.3} nm. No baseline run reached our accuracy (best {:.2} nm); every one of them is less accurate and up to {:.0}× slower, so the ratio at equal accuracy is larger than that.",
+        "Ours: {:.3} ms (min), Hausdorff {:.3} nm. No baseline run reached our accuracy (best {:.2} nm); every one of them is less accurate and up to {:.0}× slower, so the ratio at equal accuracy is larger than that.",
         tours * 1e3,
         e_ours / NM,
         best_err / NM,
@@ -203,7 +215,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let p02 = Propagator::new(m, Method::Rk4 { substeps: 4 }, 0.2e-6)?;
     let conv02 = Propagator::new(m, Method::Adaptive { rtol: 1e-10 }, 0.2e-6)?;
-    let s = Instant::now();
+    let s961 = std::time::Instant::now();
     let mut verts = 0usize;
     let mut sample_we = None;
     for i in 0..31 {
@@ -219,7 +231,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
-    let t961 = s.elapsed().as_secs_f64();
+    let t961 = s961.elapsed().as_secs_f64();
     let mut e961 = 0.0;
     if let Some(we) = &sample_we {
         let r = Reference::sample(&conv02, &we.v0, &we.region, 700)?;
@@ -249,7 +261,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         lo = lo.inf(q);
         hi = hi.sup(q);
     }
-    let mut t_all = Vec::new();
+    let mut t_all = Timings::with_capacity(900);
     let mut t_in = Vec::new();
     let mut n_sol = [0usize; 5];
     let mut mismatch = 0;
@@ -262,12 +274,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     (a as f64 + 0.5) / k as f64,
                     (b as f64 + 0.5) / k as f64,
                 ));
-            let s = Instant::now();
-            let (sol, _) = solver.solve(&t)?;
-            let dt = s.elapsed().as_secs_f64();
-            t_all.push(dt);
+            let (sol, _) = t_all.time(|| solver.solve(&t))?;
             if we.contains(&t) {
-                t_in.push(dt);
+                t_in.push(t_all.wall_s()[t_all.len() - 1] * 1e6);
             }
             n_sol[sol.offsets().len().min(4)] += 1;
             if nearest_on_boundary(&we.polygon, &t).1 > 2.0 * NM {
@@ -278,9 +287,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
-    t_all.sort_by(f64::total_cmp);
-    t_in.sort_by(f64::total_cmp);
-    let med = t_all[t_all.len() / 2];
+    let t_all = t_all.wall_us().ok_or("no targets")?;
+    let t_in = Summary::of(t_in).ok_or("no target inside the envelope")?;
+    let med = t_all.median() * 1e-6;
     // steering: continuation from the previous tick's offset
     let target = V2::new(250e-9, 120e-9);
     let prev = solver.solve(&target)?.0.offsets()[0] + V2::new(8e-9, -5e-9);
@@ -292,34 +301,37 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     });
     writeln!(
         md,
-        "{} targets on a 30×30 grid over the envelope's bounding box (+ outside corners). Solution counts 0/1/2/3/4+: {:?}. Solvable ⇔ inside the envelope for all {} targets farther than 2 nm from its boundary: {} mismatches. Every branch against a brute-force piecewise-linear preimage count: `tests/inverse.rs` (paper tick, 5 µs tick, line trap, fast particle: no missed branch).\n",
+        "{} targets on a 30×30 grid over the envelope's bounding box (+ outside corners). Solution counts 0/1/2/3/4+: {}. Solvable ⇔ inside the envelope for all {} targets farther than 2 nm from its boundary: {} mismatches. Every branch against a brute-force piecewise-linear preimage count: `tests/inverse.rs` (paper tick, 5 µs tick, line trap, fast particle: no missed branch).\n",
         k * k,
-        n_sol,
+        n_sol.map(|c| c.to_string()).join("/"),
         checked,
         mismatch
     )?;
-    writeln!(md, "| solve | median (µs) | notes |\n|---|---|---|")?;
+    let mut t = Table::new(["solve", "median (µs)", "notes"]);
+    t.row([
+        "all solutions, sampled map ready".to_string(),
+        format!("{:.1}", med * 1e6),
+        format!(
+            "median over all {} targets (inside only: {:.1}); max {:.0} µs near the far-field drift point",
+            t_all.len(),
+            t_in.median(),
+            t_all.max()
+        ),
+    ])?;
+    t.row([
+        "steering continuation (Newton from the previous offset)".to_string(),
+        format!("{:.1}", tc * 1e6),
+        "min of 2000".to_string(),
+    ])?;
+    t.row([
+        "cold: sample the map + all solutions".to_string(),
+        format!("{:.1}", tcold * 1e6),
+        "min of 50".to_string(),
+    ])?;
+    md.table(&t);
     writeln!(
         md,
-        "| all solutions, sampled map ready | {:.1} | median over all {} targets (inside only: {:.1}); max {:.0} µs near the far-field drift point |",
-        med * 1e6,
-        t_all.len(),
-        t_in[t_in.len() / 2] * 1e6,
-        t_all[t_all.len() - 1] * 1e6
-    )?;
-    writeln!(
-        md,
-        "| steering continuation (Newton from the previous offset) | {:.1} | min of 2000 |",
-        tc * 1e6
-    )?;
-    writeln!(
-        md,
-        "| cold: sample the map + all solutions | {:.1} | min of 50 |",
-        tcold * 1e6
-    )?;
-    writeln!(
-        md,
-        "\nTarget median ≤ 50 µs with no missed branch: {} ({:.1} µs, map shared with the tick's envelope).\n",
+        "Target median ≤ 50 µs with no missed branch: {} ({:.1} µs, map shared with the tick's envelope).\n",
         met(med <= 50e-6 && mismatch == 0),
         med * 1e6
     )?;
@@ -329,10 +341,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         md,
         "### Hard cases (error vs a 700×700 sampling of the same map)\n"
     )?;
-    writeln!(
-        md,
-        "| case | method | fold curves | vertices | time (ms) | zero displ. inside | Hausdorff (nm) |\n|---|---|---|---|---|---|---|"
-    )?;
+    let mut t = Table::new([
+        "case",
+        "method",
+        "fold curves",
+        "vertices",
+        "time (ms)",
+        "zero displ. inside",
+        "Hausdorff (nm)",
+    ]);
     let cases: Vec<(&str, [f64; 2], V2, f64, Method)> = vec![
         (
             "paper, one-step model (paper-rk4)",
@@ -378,16 +395,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (tmin, _) = time(5, || working_envelope(&p, &v0, None));
         let r = Reference::sample(&p, &v0, &we.region, 700)?;
         let e = r.errors(&p, &we.polygon, 2.0 * NM)?;
-        writeln!(
-            md,
-            "| {name} | {} | {} | {} | {:.2} | {} | {:.3} |",
-            meth.name(),
-            we.fold_curves,
-            we.polygon.len(),
-            tmin * 1e3,
-            we.contains(&V2::zeros()),
-            e.hausdorff() / NM
-        )?;
+        t.row([
+            name.to_string(),
+            meth.name().to_string(),
+            we.fold_curves.to_string(),
+            we.polygon.len().to_string(),
+            format!("{:.2}", tmin * 1e3),
+            we.contains(&V2::zeros()).to_string(),
+            format!("{:.3}", e.hausdorff() / NM),
+        ])?;
     }
     // 3D
     let m3 = TrapModel::builder(1e-15, [600e-9, 300e-9, 900e-9])
@@ -395,9 +411,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .build()?;
     let p3 = Propagator::new(m3, Method::Rk4 { substeps: 8 }, 1e-6)?;
     let v3 = Vector3::new(0.05, 0.0, 0.02);
-    let s = Instant::now();
-    let we3 = working_envelope_3d(&p3, &v3, 4, 3.0, 0.1)?;
-    let t3 = s.elapsed().as_secs_f64();
+    let (we3, s3) = span(|| working_envelope_3d(&p3, &v3, 4, 3.0, 0.1));
+    let (we3, t3) = (we3?, s3.wall_s);
     let mut worst: f64 = 0.0;
     let n = 30;
     let w3 = Vector3::new(600e-9, 300e-9, 900e-9);
@@ -413,65 +428,52 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
+    t.row([
+        "3D, waists 600/300/900 nm, v0 = (50, 0, 20) nm/µs".to_string(),
+        "rk4".to_string(),
+        "1 surface".to_string(),
+        format!(
+            "{} vertices, {} triangles",
+            we3.mesh.vertices.len(),
+            we3.mesh.triangles.len()
+        ),
+        format!("{:.0}", t3 * 1e3),
+        "true".to_string(),
+        format!(
+            "{:.2} (sampled displacements outside the mesh, 30³ offsets)",
+            worst / NM
+        ),
+    ])?;
+    md.table(&t);
     writeln!(
         md,
-        "| 3D, waists 600/300/900 nm, v0 = (50, 0, 20) nm/µs | rk4 | 1 surface | {} vertices, {} triangles | {:.0} | true | {:.2} (sampled displacements outside the mesh, 30³ offsets) |",
-        we3.mesh.vertices.len(),
-        we3.mesh.triangles.len(),
-        t3 * 1e3,
-        worst / NM
-    )?;
-    writeln!(
-        md,
-        "\nAll hard cases are also tests (`tests/envelope.rs`, `tests/inverse.rs`, `tests/envelope3d.rs`)."
+        "All hard cases are also tests (`tests/envelope.rs`, `tests/inverse.rs`, `tests/envelope3d.rs`)."
     )?;
 
     // plot: time vs error
-    std::fs::create_dir_all("docs/figures")?;
-    std::fs::create_dir_all("docs/bench")?;
-    {
-        let root = BitMapBackend::new("docs/figures/ot-envelope-bench.png", (800, 560))
-            .into_drawing_area();
-        root.fill(&WHITE)?;
-        let mut c = ChartBuilder::on(&root)
-            .caption(
-                "Working envelope: time vs Hausdorff error (paper constants, v0 = 0)",
-                ("sans-serif", 18),
-            )
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
-            .build_cartesian_2d((0.05f64..50.0).log_scale(), (1e-4f64..100.0).log_scale())?;
-        c.configure_mesh()
-            .x_desc("Hausdorff error (nm)")
-            .y_desc("time (s)")
-            .draw()?;
-        c.draw_series(LineSeries::new(
-            base_pts.iter().map(|(t, e)| (e / NM, *t)),
-            &RED,
-        ))?
-        .label("paper method (grid of targets)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-        c.draw_series(
-            base_pts
-                .iter()
-                .map(|(t, e)| Circle::new((e / NM, *t), 4, RED.filled())),
-        )?;
-        c.draw_series(std::iter::once(Circle::new(
-            (e_ours / NM, tours),
-            6,
-            BLUE.filled(),
-        )))?
-        .label("ours (fold curves)")
-        .legend(|(x, y)| Circle::new((x + 10, y), 5, BLUE.filled()));
-        c.configure_series_labels()
-            .border_style(BLACK)
-            .background_style(WHITE)
-            .draw()?;
-        root.present()?;
-    }
-    writeln!(md, "\n![time vs error](../figures/ot-envelope-bench.png)")?;
-    std::fs::write("docs/bench/ot-envelope.md", &md)?;
-    println!("{md}");
+    Chart::new(
+        "Working envelope: time vs Hausdorff error (paper constants, v0 = 0)",
+        Axis::log("Hausdorff error (nm)", 0.05, 50.0),
+        Axis::log("time (s)", 1e-4, 100.0),
+    )
+    .with(
+        Series::line(
+            "paper method (grid of targets)",
+            base_pts.iter().map(|(t, e)| (e / NM, *t)).collect(),
+            RED,
+        )
+        .width(1)
+        .markers(4),
+    )
+    .with(Series::dots(
+        "ours (fold curves)",
+        vec![(e_ours / NM, tours)],
+        BLUE,
+        6,
+    ))
+    .save(&md.figure("ot-envelope-bench.png"), (800, 560))?;
+    writeln!(md)?;
+    md.image("time vs error", "ot-envelope-bench.png");
+    md.finish()?;
     Ok(())
 }

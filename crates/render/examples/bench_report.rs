@@ -3,17 +3,18 @@
 //! the paper's Fig. 9 layout and one still per world.
 //!
 //! `cargo run --release -p render --example render-report` writes `docs/bench/render.md` and
-//! `docs/figures/render-*.png` (GIFs go to `target/render-bench/`, not committed).
+//! `docs/figures/render-*.png` (GIFs go to `target/render-bench/`, not committed), framed and
+//! timed by the shared `bench-harness`.
 //! `--quick` renders 180 frames per session instead of 1800 (for a smoke run).
 
 mod scenes;
 
-use plotters::prelude::*;
+use bench_harness::plotters::prelude::*;
+use bench_harness::{Align, Report, Span, Table, span};
 use render::{Camera, Frame, GifWriter, Image, Palette, Rgba, Style, View};
 use scenes::*;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::path::Path;
 
 type BoxError = Box<dyn std::error::Error>;
 
@@ -23,28 +24,18 @@ const W: u32 = 640;
 const H: u32 = 480;
 const TARGET_S: f64 = 30.0;
 
-/// CPU time this thread has run, ns (from /proc/thread-self/schedstat; `None` where the
-/// kernel does not provide it). On a shared machine this is the "one core" time: it excludes
-/// the time the thread waited for a core.
-fn thread_cpu_ns() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    s.split_whitespace().next()?.parse().ok()
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
 struct Run {
     name: &'static str,
     frames: u64,
     primitives: usize,
-    render: Duration,
-    encode: Duration,
-    palette: Duration,
+    /// Wall-clock time of rendering, GIF encoding and the palette, s.
+    render: f64,
+    encode: f64,
+    palette: f64,
     gif_bytes: u64,
-    /// CPU time of the whole session (palette, render, encode), s, if measured.
-    cpu_s: Option<f64>,
+    /// Thread-CPU time of the whole session (palette, render, encode, finish), s: on a shared
+    /// machine the "one core" time, without the time the thread waited for a core.
+    cpu_s: f64,
     stored_frac: f64,
     switches: u64,
     /// Mean time to encode one frame as PNG, s, and its mean size, bytes (sampled frames).
@@ -58,19 +49,20 @@ struct Run {
 }
 
 impl Run {
-    fn total(&self) -> Duration {
+    /// Wall time of the session, s.
+    fn total(&self) -> f64 {
         self.render + self.encode + self.palette
     }
     fn fps(&self) -> f64 {
-        self.frames as f64 / self.total().as_secs_f64()
+        self.frames as f64 / self.total()
     }
     /// Wall time for the full 1800-frame session, s (scaled when fewer frames were run).
     fn session_s(&self) -> f64 {
-        self.total().as_secs_f64() * (SECONDS * FPS) / self.frames as f64
+        self.total() * (SECONDS * FPS) / self.frames as f64
     }
     /// CPU time for the full 1800-frame session, s (scaled when fewer frames were run).
-    fn session_cpu_s(&self) -> Option<f64> {
-        self.cpu_s.map(|c| c * (SECONDS * FPS) / self.frames as f64)
+    fn session_cpu_s(&self) -> f64 {
+        self.cpu_s * (SECONDS * FPS) / self.frames as f64
     }
 }
 
@@ -86,47 +78,50 @@ fn run_session(
     let mut img = Image::new(W, H)?;
     let t_of = |i: u64| i as f64 / FPS;
     // palette from the first, middle and last frames
-    let cpu0 = thread_cpu_ns();
-    let t0 = Instant::now();
-    let mut samples = Vec::new();
-    for i in [0, frames / 2, frames - 1] {
-        frame.clear();
-        draw(&mut frame, t_of(i))?;
-        samples.push(frame.finish()?);
-    }
-    let refs: Vec<&Image> = samples.iter().collect();
-    let pal = Palette::from_images(&refs, 255)?;
-    let palette = t0.elapsed();
+    let (pal, pal_span) = span(|| -> Result<Palette, BoxError> {
+        let mut samples = Vec::new();
+        for i in [0, frames / 2, frames - 1] {
+            frame.clear();
+            draw(&mut frame, t_of(i))?;
+            samples.push(frame.finish()?);
+        }
+        let refs: Vec<&Image> = samples.iter().collect();
+        Ok(Palette::from_images(&refs, 255)?)
+    });
+    let pal = pal?;
+    let palette = pal_span.wall_s;
+    // the session's thread-CPU time: the timed stages only (the measurements aside, PNG and
+    // palette error, are left out)
+    let mut cpu_s = pal_span.cpu_s;
     let file = std::io::BufWriter::new(std::fs::File::create(out)?);
     let mut gif = GifWriter::new(file, W, H, FPS, pal.clone())?;
-    let (mut render, mut encode) = (Duration::ZERO, Duration::ZERO);
+    let (mut render, mut encode) = (0.0, 0.0);
     let mut primitives = 0;
     let (mut err_sum, mut err_n, mut max_err) = (0.0f64, 0u64, 0u8);
-    let (mut png_t, mut png_b, mut png_n) = (Duration::ZERO, 0usize, 0u32);
-    let (mut pngd_t, mut pngd_b) = (Duration::ZERO, 0usize);
-    // CPU time spent on the measurements aside (PNG, palette error), left out of the session
-    let mut aside_ns = 0u64;
+    let (mut png_t, mut png_b, mut png_n) = (0.0, 0usize, 0u32);
+    let (mut pngd_t, mut pngd_b) = (0.0, 0usize);
     for i in 0..frames {
-        let a = Instant::now();
-        frame.clear();
-        draw(&mut frame, t_of(i))?;
-        frame.draw_into(&mut img)?;
-        let b = Instant::now();
-        gif.add_frame(&img)?;
-        let c = Instant::now();
-        render += b - a;
-        encode += c - b;
+        let (r, a) = span(|| -> Result<(), BoxError> {
+            frame.clear();
+            draw(&mut frame, t_of(i))?;
+            Ok(frame.draw_into(&mut img)?)
+        });
+        r?;
+        let (r, b): (_, Span) = span(|| gif.add_frame(&img));
+        r?;
+        render += a.wall_s;
+        encode += b.wall_s;
+        cpu_s += a.cpu_s + b.cpu_s;
         primitives = primitives.max(frame.primitives().len());
         if i % 100 == 7 {
-            let aside0 = thread_cpu_ns();
-            // PNG cost (what `render --out DIR` adds per frame), timed apart
-            let p0 = Instant::now();
-            png_b += img.encode_png()?.len();
-            png_t += p0.elapsed();
+            // PNG cost (what `render --out DIR` adds per frame), timed apart (wall clock)
+            let (bytes, p0) = span(|| img.encode_png());
+            png_b += bytes?.len();
+            png_t += p0.wall_s;
             png_n += 1;
-            let p1 = Instant::now();
-            pngd_b += png_default(&img)?.len();
-            pngd_t += p1.elapsed();
+            let (bytes, p1) = span(|| png_default(&img));
+            pngd_b += bytes?.len();
+            pngd_t += p1.wall_s;
             // palette error on every 100th frame (not timed)
             for px in img.data().chunks_exact(4) {
                 let q = pal.colors()[usize::from(pal.index_of([px[0], px[1], px[2]]))];
@@ -137,20 +132,17 @@ fn run_session(
                 }
                 err_n += 3;
             }
-            if let (Some(a), Some(b)) = (aside0, thread_cpu_ns()) {
-                aside_ns += b - a;
-            }
         }
     }
     let stored = gif.pixels_stored();
     let switches = gif.palette_switches();
-    let mut w = gif.finish()?;
-    std::io::Write::flush(&mut w)?;
-    drop(w);
-    let cpu_s = match (cpu0, thread_cpu_ns()) {
-        (Some(a), Some(b)) => Some((b - a).saturating_sub(aside_ns) as f64 * 1e-9),
-        _ => None,
-    };
+    let (r, fin) = span(|| -> Result<(), BoxError> {
+        let mut w = gif.finish()?;
+        std::io::Write::flush(&mut w)?;
+        Ok(())
+    });
+    r?;
+    cpu_s += fin.cpu_s;
     let gif_bytes = std::fs::metadata(out)?.len();
     Ok(Run {
         name,
@@ -162,9 +154,9 @@ fn run_session(
         gif_bytes,
         cpu_s,
         switches,
-        png_s: png_t.as_secs_f64() / f64::from(png_n.max(1)),
+        png_s: png_t / f64::from(png_n.max(1)),
         png_bytes: png_b as f64 / f64::from(png_n.max(1)),
-        png_default_s: pngd_t.as_secs_f64() / f64::from(png_n.max(1)),
+        png_default_s: pngd_t / f64::from(png_n.max(1)),
         png_default_bytes: pngd_b as f64 / f64::from(png_n.max(1)),
         stored_frac: stored as f64 / (frames as f64 * f64::from(W * H)),
         mean_err: err_sum / err_n.max(1) as f64,
@@ -227,11 +219,10 @@ fn loop_radius_check() -> Result<(f64, f64), BoxError> {
 fn main() -> Result<(), BoxError> {
     let quick = std::env::args().any(|a| a == "--quick");
     let frames = if quick { 180 } else { (SECONDS * FPS) as u64 };
-    let root = root();
+    let mut md = Report::start("render", "Renderer (crates/render)")?;
+    let root = md.root().to_path_buf();
     let figs = root.join("docs/figures");
     let gifs = root.join("target/render-bench");
-    std::fs::create_dir_all(&figs)?;
-    std::fs::create_dir_all(root.join("docs/bench"))?;
     std::fs::create_dir_all(&gifs)?;
 
     eprintln!("[1/4] figures…");
@@ -304,8 +295,8 @@ fn main() -> Result<(), BoxError> {
 
     eprintln!("[4/4] report…");
     plot_speed(&runs, &figs.join("render-speed.png"))?;
-    let md = report(&runs, frames, r_mean, r_worst, &fig9)?;
-    std::fs::write(root.join("docs/bench/render.md"), md)?;
+    report(&mut md, &runs, frames, r_mean, r_worst, &fig9)?;
+    md.finish()?;
     Ok(())
 }
 
@@ -314,7 +305,7 @@ fn plot_speed(runs: &[Run], path: &Path) -> Result<(), BoxError> {
     area.fill(&WHITE)?;
     let max_ms = runs
         .iter()
-        .map(|r| r.total().as_secs_f64() * 1e3 / r.frames as f64)
+        .map(|r| r.total() * 1e3 / r.frames as f64)
         .fold(TARGET_S * 1e3 / (SECONDS * FPS), f64::max)
         * 1.45;
     let mut chart = ChartBuilder::on(&area)
@@ -331,8 +322,8 @@ fn plot_speed(runs: &[Run], path: &Path) -> Result<(), BoxError> {
         .draw()?;
     for (i, r) in runs.iter().enumerate() {
         let x = i as f64;
-        let rm = r.render.as_secs_f64() * 1e3 / r.frames as f64;
-        let em = (r.encode + r.palette).as_secs_f64() * 1e3 / r.frames as f64;
+        let rm = r.render * 1e3 / r.frames as f64;
+        let em = (r.encode + r.palette) * 1e3 / r.frames as f64;
         let render_bar = chart.draw_series(std::iter::once(Rectangle::new(
             [(x + 0.2, 0.0), (x + 0.8, rm)],
             RGBColor(70, 110, 190).filled(),
@@ -359,17 +350,15 @@ fn plot_speed(runs: &[Run], path: &Path) -> Result<(), BoxError> {
                     )
                 });
         }
-        if let Some(cpu) = r.cpu_s {
-            let c = cpu * 1e3 / r.frames as f64;
-            let cpu_line = chart.draw_series(LineSeries::new(
-                [(x + 0.15, c), (x + 0.85, c)],
-                BLACK.stroke_width(3),
-            ))?;
-            if i == 0 {
-                cpu_line.label("CPU time, whole session").legend(|(x, y)| {
-                    PathElement::new([(x, y), (x + 12, y)], BLACK.stroke_width(3))
-                });
-            }
+        let c = r.cpu_s * 1e3 / r.frames as f64;
+        let cpu_line = chart.draw_series(LineSeries::new(
+            [(x + 0.15, c), (x + 0.85, c)],
+            BLACK.stroke_width(3),
+        ))?;
+        if i == 0 {
+            cpu_line
+                .label("CPU time, whole session")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 12, y)], BLACK.stroke_width(3)));
         }
         chart.draw_series(std::iter::once(Text::new(
             r.name.to_string(),
@@ -399,116 +388,113 @@ fn plot_speed(runs: &[Run], path: &Path) -> Result<(), BoxError> {
 }
 
 fn report(
+    md: &mut Report,
     runs: &[Run],
     frames: u64,
     r_mean: f64,
     r_worst: f64,
     fig9: &Tweezers,
-) -> Result<String, BoxError> {
-    let mut md = String::new();
-    writeln!(md, "## Renderer (crates/render)\n")?;
-    writeln!(
-        md,
+) -> Result<(), BoxError> {
+    md.para(&format!(
         "Generated by `cargo run --release -p render --example render-report`. One process, one \
          thread, {W}×{H} px, {FPS} fps, {frames} frames per session ({} s of session). Each \
          session draws its scene afresh every frame from the state at that time (a recording's \
-         replay does the same), renders it and appends it to a GIF file.\n",
+         replay does the same), renders it and appends it to a GIF file.",
         frames as f64 / FPS
-    )?;
-    writeln!(
-        md,
-        "### Target: a 60 s recording becomes a 30 fps GIF in under 30 s on one core\n"
-    )?;
-    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-    let load1 = load.split_whitespace().next().unwrap_or("?");
-    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
-    writeln!(
-        md,
-        "The target is judged on the session's CPU time (one thread, so one core; the time the \
-         thread waited for a core on this shared machine is left out). Wall-clock time is shown \
-         too: this run had a 1-minute load average of {load1} on {cores} cores.\n"
-    )?;
-    writeln!(
-        md,
-        "| session | primitives / frame | render ms/frame | GIF ms/frame | frames/s (wall) | 1800 frames, wall | 1800 frames, CPU | target ≤ {TARGET_S} s CPU | GIF size | pixels stored | palette switches | palette error, mean / max (8-bit) |"
-    )?;
-    writeln!(
-        md,
-        "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|"
-    )?;
+    ));
+    md.heading("Target: a 60 s recording becomes a 30 fps GIF in under 30 s on one core");
+    md.para(
+        "The target is judged on the session's thread-CPU time (one thread, so one core; the time \
+         the thread waited for a core on this shared machine is left out). Wall-clock time is \
+         shown too: see the load average at the top of this section.",
+    );
+    let mut t = Table::new([
+        "session".to_string(),
+        "primitives / frame".into(),
+        "render ms/frame".into(),
+        "GIF ms/frame".into(),
+        "frames/s (wall)".into(),
+        "1800 frames, wall".into(),
+        "1800 frames, CPU".into(),
+        format!("target ≤ {TARGET_S} s CPU"),
+        "GIF size".into(),
+        "pixels stored".into(),
+        "palette switches".into(),
+        "palette error, mean / max (8-bit)".into(),
+    ])
+    .align_from(1, Align::Right)
+    .align(7, Align::Default);
     for r in runs {
         let n = r.frames as f64;
-        let judged = r.session_cpu_s().unwrap_or(r.session_s());
-        writeln!(
-            md,
-            "| {} | {} | {:.2} | {:.2} | {:.0} | {:.1} s | {} | {} ({:.1} s) | {:.2} MB | {:.1} % | {} | {:.2} / {} |",
-            r.name,
-            r.primitives,
-            r.render.as_secs_f64() * 1e3 / n,
-            (r.encode + r.palette).as_secs_f64() * 1e3 / n,
-            r.fps(),
-            r.session_s(),
-            r.session_cpu_s()
-                .map_or("n/a".to_string(), |c| format!("{c:.1} s")),
-            if judged <= TARGET_S {
-                "met"
-            } else {
-                "**not met**"
-            },
-            judged,
-            r.gif_bytes as f64 / 1e6,
-            100.0 * r.stored_frac,
-            r.switches,
-            r.mean_err,
-            r.max_err,
-        )?;
+        let judged = r.session_cpu_s();
+        t.row([
+            r.name.to_string(),
+            r.primitives.to_string(),
+            format!("{:.2}", r.render * 1e3 / n),
+            format!("{:.2}", (r.encode + r.palette) * 1e3 / n),
+            format!("{:.0}", r.fps()),
+            format!("{:.1} s", r.session_s()),
+            format!("{judged:.1} s"),
+            format!(
+                "{} ({judged:.1} s)",
+                if judged <= TARGET_S {
+                    "met"
+                } else {
+                    "**not met**"
+                }
+            ),
+            format!("{:.2} MB", r.gif_bytes as f64 / 1e6),
+            format!("{:.1} %", 100.0 * r.stored_frac),
+            r.switches.to_string(),
+            format!("{:.2} / {}", r.mean_err, r.max_err),
+        ])?;
     }
-    writeln!(
-        md,
-        "\n*render* and *GIF* columns are wall-clock. *GIF ms/frame* includes the palette (median \
+    md.table(&t);
+    md.para(&format!(
+        "*render* and *GIF* columns are wall-clock. *GIF ms/frame* includes the palette (median \
          cut over three sample frames, built once). *Pixels stored*: share of all frame pixels \
          written to the GIF after cropping each frame to the rectangle that changed. *Palette \
          error*: |GIF colour − rendered colour| per channel over every 100th frame (255 colours, \
          15-bit lookup); this measurement and the PNG timing below are left out of the CPU time. *Palette \
          switches*: frames where more than {:.2} % of the pixels were off by more than {} and \
-         the writer moved to a palette made from that frame.\n",
+         the writer moved to a palette made from that frame.",
         100.0 * render::BAD_PIXEL_SHARE,
         render::BAD_PIXEL_ERROR
-    )?;
-    writeln!(
-        md,
+    ));
+    md.para(
         "Writing every frame as a PNG as well (`nanohaptics render REC --out DIR`) adds the \
          PNG encoding, measured (wall-clock) on every 100th frame. `Image::encode_png` uses the \
          png crate's fast deflate; its default (balanced deflate, adaptive filter) is shown for \
-         comparison, same frames, same run:\n"
-    )?;
-    writeln!(
-        md,
-        "| session | PNG ms/frame (fast) | size (fast) | PNG ms/frame (default) | size (default) | speed-up | 1800 frames with PNGs: CPU above + fast PNG time |"
-    )?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|")?;
+         comparison, same frames, same run:",
+    );
+    let mut t = Table::new([
+        "session",
+        "PNG ms/frame (fast)",
+        "size (fast)",
+        "PNG ms/frame (default)",
+        "size (default)",
+        "speed-up",
+        "1800 frames with PNGs: CPU above + fast PNG time",
+    ])
+    .align_from(1, Align::Right);
     for r in runs {
-        let cpu = r.session_cpu_s().unwrap_or(r.session_s());
-        writeln!(
-            md,
-            "| {} | {:.2} | {:.0} kB | {:.2} | {:.0} kB | {:.1}× | {:.1} s |",
-            r.name,
-            r.png_s * 1e3,
-            r.png_bytes / 1e3,
-            r.png_default_s * 1e3,
-            r.png_default_bytes / 1e3,
-            r.png_default_s / r.png_s,
-            cpu + r.png_s * SECONDS * FPS
-        )?;
+        t.row([
+            r.name.to_string(),
+            format!("{:.2}", r.png_s * 1e3),
+            format!("{:.0} kB", r.png_bytes / 1e3),
+            format!("{:.2}", r.png_default_s * 1e3),
+            format!("{:.0} kB", r.png_default_bytes / 1e3),
+            format!("{:.1}×", r.png_default_s / r.png_s),
+            format!("{:.1} s", r.session_cpu_s() + r.png_s * SECONDS * FPS),
+        ])?;
     }
-    writeln!(md)?;
-    writeln!(md, "![time per frame](../figures/render-speed.png)\n")?;
-    writeln!(md, "### Geometry\n")?;
-    writeln!(
-        md,
+    md.table(&t);
+    md.image("time per frame", "render-speed.png");
+    md.heading("Geometry");
+    md.para(&format!(
         "A 3 nm circle drawn ×100 about its centre at 1e8 px/m must be a 30 px circle: measured \
-         radius (darkness centroid over 36 rays) {r_mean:.3} px, worst ray off by {r_worst:.3} px.\n"
-    )?;
+         radius (darkness centroid over 36 rays) {r_mean:.3} px, worst ray off by {r_worst:.3} px."
+    ));
     let fmag = (fig9.force_n[0].powi(2) + fig9.force_n[1].powi(2)).sqrt();
     let reach_x = fig9
         .envelope_m
@@ -520,7 +506,7 @@ fn report(
         .iter()
         .map(|p| p[1])
         .fold(f64::NEG_INFINITY, f64::max);
-    writeln!(md, "### Paper Fig. 9, reproduced\n")?;
+    md.heading("Paper Fig. 9, reproduced");
     writeln!(
         md,
         "![Fig. 9 layout](../figures/render-fig9.png)\n\n(a) The initial screen: a particle of \
@@ -533,10 +519,11 @@ fn report(
         reach_y * 1e9,
         fmag * 1e12
     )?;
-    writeln!(md, "| brick world | nano world |\n|---|---|")?;
-    writeln!(
-        md,
-        "| ![bricks](../figures/render-bricks.png) | ![nano](../figures/render-nano.png) |"
-    )?;
-    Ok(md)
+    let mut t = Table::new(["brick world", "nano world"]);
+    t.row([
+        "![bricks](../figures/render-bricks.png)",
+        "![nano](../figures/render-nano.png)",
+    ])?;
+    md.table(&t);
+    Ok(())
 }

@@ -2,7 +2,6 @@
 //! `paper_table` and `bench_report` examples.
 #![allow(dead_code)]
 
-use cpu_time::ThreadTime;
 use nalgebra::Vector2;
 use ot_physics::{Method, PhysicsError, Propagator, TrapModel, paper};
 use std::hint::black_box;
@@ -66,25 +65,11 @@ pub struct Row {
     pub evals_per_traj: f64,
 }
 
-/// CPU time of this thread per call of `f` over `n_calls` items (ns):
-/// blocks of ≥ `min_ms` ms, minimum over 7 blocks. Thread CPU time (not wall
-/// time) and the minimum keep other processes on a shared machine out of it.
-pub fn time_per_call(n_calls: usize, min_ms: f64, mut f: impl FnMut()) -> f64 {
-    let mut best = f64::INFINITY;
-    for _ in 0..7 {
-        let mut reps = 0usize;
-        let t0 = ThreadTime::now();
-        loop {
-            f();
-            reps += 1;
-            if t0.elapsed().as_secs_f64() * 1e3 >= min_ms {
-                break;
-            }
-        }
-        let ns = t0.elapsed().as_secs_f64() * 1e9 / (reps * n_calls) as f64;
-        best = best.min(ns);
-    }
-    best
+/// CPU time of this thread per call of `f` over `n_calls` items (ns): blocks of ≥ `min_ms` ms,
+/// minimum over 7 blocks (`bench_harness::best_block_cpu_s`). Thread CPU time (not wall time)
+/// and the minimum keep other processes on a shared machine out of it.
+pub fn time_per_call(n_calls: usize, min_ms: f64, f: impl FnMut()) -> f64 {
+    bench_harness::best_block_cpu_s(7, min_ms * 1e-3, n_calls, f) * 1e9
 }
 
 /// Errors of `displacements` against the reference: (max, mean) in nm.
