@@ -358,7 +358,8 @@ mod tests {
             Axis::linear("a", 0.0, 1.0),
             Axis::linear("force (N)", 2.0, 2.0),
         );
-        let area = BitMapBackend::new("unused.png", (10, 10)).into_drawing_area();
+        let mut pixels = vec![0u8; 10 * 10 * 3];
+        let area = BitMapBackend::with_buffer(&mut pixels, (10, 10)).into_drawing_area();
         assert_eq!(
             c.draw_on(&area).unwrap_err(),
             PlotError::Axis {
