@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use haptic_loop::channels::messages::{Channel, DeviceInputMsg, ForceMsg};
+use haptic_loop::record::writer::channel_schema;
 use haptic_loop::record::{RecordingError, read_recording, read_recording_file};
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
@@ -240,6 +241,54 @@ fn golden_recordings_replay_bit_exactly() {
         }
     }
     assert!(n >= 1, "no golden recordings in {}", dir.display());
+}
+
+/// The schemas written today (from the channel declarations) are, byte for byte, the schemas
+/// stored in every golden recording, channel by channel, with the same ids and encodings.
+#[test]
+fn golden_recordings_hold_the_schemas_the_declarations_write() {
+    let dir = root().join("recordings");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "mcap") {
+            continue;
+        }
+        let buf = std::fs::read(&p).unwrap();
+        let rec = read_recording(&buf, false).unwrap();
+        let summary = mcap::Summary::read(&buf).unwrap().unwrap();
+        assert_eq!(summary.channels.len(), Channel::COUNT, "{}", p.display());
+        for (k, ch) in Channel::ALL.into_iter().enumerate() {
+            let c = summary
+                .channels
+                .values()
+                .find(|c| c.topic == ch.topic())
+                .unwrap_or_else(|| panic!("{}: no {}", p.display(), ch.topic()));
+            // Channels and schemas are registered in declaration order (ids from 1).
+            assert_eq!(usize::from(c.id), k + 1, "{}", ch.topic());
+            assert_eq!(c.message_encoding, ch.message_encoding(), "{}", ch.topic());
+            let stored = c.schema.as_ref().unwrap();
+            assert_eq!(usize::from(stored.id), k + 1, "{}", ch.topic());
+            let (name, enc, data) = channel_schema(ch, &rec.description);
+            assert_eq!(
+                (stored.name.as_str(), stored.encoding.as_str()),
+                (name.as_str(), enc.as_str()),
+                "{}: {}",
+                p.display(),
+                ch.topic()
+            );
+            assert!(
+                stored.data.as_ref() == data.as_slice(),
+                "{}: the {} schema differs from the declaration's:\n{}\n--- declared:\n{}",
+                p.display(),
+                ch.topic(),
+                String::from_utf8_lossy(&stored.data),
+                String::from_utf8_lossy(&data)
+            );
+        }
+        n += 1;
+    }
+    assert_eq!(n, 4, "golden recordings in {}", dir.display());
 }
 
 #[test]
