@@ -88,8 +88,9 @@ impl SessionArrays {
     /// Adds one recorded message.
     pub fn push(&mut self, channel: Channel, data: &[u8]) -> Result<(), CdrError> {
         match channel {
-            Channel::State => StateMsg::decode(data, self.state_fields.len())?
-                .push_columns(&mut self.columns),
+            Channel::State => {
+                StateMsg::decode(data, self.state_fields.len())?.push_columns(&mut self.columns)
+            }
             Channel::Events => {
                 let m = EventsMsg::decode(data)?;
                 for (n, d) in m.names.into_iter().zip(m.details) {

@@ -362,3 +362,33 @@ fn an_unwritable_recording_path_is_a_typed_error() {
         "recording /nonexistent-dir/x.mcap: No such file or directory (os error 2)"
     );
 }
+
+/// Without a recording nothing is encoded: the arrays are the only sink (filled straight from
+/// each tick), and they equal, column by column, what a recorded run of the same session reads
+/// back from its file (bar the wall-clock columns).
+#[test]
+fn an_unrecorded_session_runs_only_the_arrays_and_matches_its_recording() {
+    let mut o = wall_opts(None);
+    o.seconds = Some(0.5);
+    o.start_time_ns = Some(1_700_000_000_000_000_000);
+    let plain = run_session(&o, &mut |_, _| {}).unwrap();
+    let sinks: Vec<&str> = plain.sinks.iter().map(|s| s.sink).collect();
+    assert_eq!(sinks, ["arrays"]);
+    let p = tmp("wall-half-second.mcap");
+    o.out = Some(p.clone());
+    let recorded = run_session(&o, &mut |_, _| {}).unwrap();
+    let sinks: Vec<&str> = recorded.sinks.iter().map(|s| s.sink).collect();
+    assert_eq!(sinks, ["arrays", "recorder"]);
+    let back = read_arrays(&p, false).unwrap();
+    assert_eq!(back, recorded.arrays);
+    assert_eq!(plain.arrays.tick.len(), 500);
+    let (a, b) = (plain.arrays.columns(), back.columns());
+    assert_eq!(a.len(), b.len());
+    for ((info, x), (_, y)) in a.into_iter().zip(b) {
+        if !["compute_ns", "start_late_ns"].contains(&info.name) {
+            assert_eq!(x, y, "{}", info.name);
+        }
+    }
+    assert_eq!(plain.arrays.events, back.events);
+    assert_eq!(plain.arrays.state_fields, back.state_fields);
+}

@@ -3,6 +3,7 @@
 
 use haptic_loop::DeviceModel;
 use haptic_loop::bridge::BridgeConfig;
+use haptic_loop::channels::declare::ColumnData;
 use haptic_loop::device::OperatorParams;
 use haptic_loop::device::Script;
 use haptic_loop::record::RecordingError;
@@ -12,7 +13,6 @@ use haptic_loop::session::{
     Location, OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions,
     read_arrays, read_toml_text, run_session_until, script_source,
 };
-use haptic_loop::channels::declare::ColumnData;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -64,11 +64,14 @@ pub(crate) fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<B
             ColumnData::U64(v) => int(v.iter().map(|&x| x as i64).collect()),
             ColumnData::I64(v) => PyArray1::from_slice(py, v).into_any(),
             ColumnData::F64(v) => PyArray1::from_slice(py, v).into_any(),
-            ColumnData::Vec3(v) => array2_flat(py, v.iter().flatten().copied().collect(), 3)?
-                .into_any(),
+            ColumnData::Vec3(v) => {
+                array2_flat(py, v.iter().flatten().copied().collect(), 3)?.into_any()
+            }
             ColumnData::Mat3(v) => {
                 let k: Vec<f64> = v.iter().flatten().copied().collect();
-                PyArray1::from_vec(py, k).reshape([v.len(), 3, 3])?.into_any()
+                PyArray1::from_vec(py, k)
+                    .reshape([v.len(), 3, 3])?
+                    .into_any()
             }
             ColumnData::Table(v) => {
                 let rows = v.len().checked_div(fields).unwrap_or(n);

@@ -45,9 +45,7 @@ fn message_section(ch: Channel, m: &MessageInfo) -> String {
 /// The generated part of `docs/recording-format.md` (between [`BEGIN`] and [`END`], exclusive):
 /// the channel table, then one field table per CDR message.
 pub fn markdown() -> String {
-    let mut s = String::from(
-        "| topic | schema (encoding) | rate | replay |\n|---|---|---|---|\n",
-    );
+    let mut s = String::from("| topic | schema (encoding) | rate | replay |\n|---|---|---|---|\n");
     for ch in Channel::ALL {
         let enc = match ch.message_encoding() {
             "cdr" => "ros2msg / cdr",
@@ -130,7 +128,9 @@ pub fn disagreements(doc: &str) -> Vec<String> {
     }
     for (h, _) in &in_doc {
         if !MESSAGES.iter().any(|m| m.schema_name == h) {
-            out.push(format!("table `{h}` is in the doc but no message is declared so"));
+            out.push(format!(
+                "table `{h}` is in the doc but no message is declared so"
+            ));
         }
     }
     if out.is_empty() {
@@ -158,7 +158,10 @@ mod tests {
     use super::*;
     use crate::channels::messages::TickColumns;
 
-    const DOC: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/recording-format.md");
+    const DOC: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../docs/recording-format.md"
+    );
 
     #[test]
     fn recording_format_doc_matches_the_declarations() {
@@ -188,7 +191,10 @@ mod tests {
         let stub = concat!(env!("CARGO_MANIFEST_DIR"), "/../ot-py/nanohaptics.pyi");
         let text = std::fs::read_to_string(stub).expect("nanohaptics.pyi");
         let start = text.find("def run_scene(").expect("run_scene in the stub");
-        let end = start + text[start..].find("\"\"\"\n").expect("end of its docstring");
+        let end = start
+            + text[start..]
+                .find("\"\"\"\n")
+                .expect("end of its docstring");
         let doc = &text[start..end];
         let words: Vec<&str> = doc
             .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
@@ -216,7 +222,9 @@ mod tests {
         );
         assert_eq!(
             disagreements(&missing),
-            vec!["`nanohaptics_msgs/msg/Force`: field `watchdog` is declared but missing from the doc"]
+            vec![
+                "`nanohaptics_msgs/msg/Force`: field `watchdog` is declared but missing from the doc"
+            ]
         );
         let extra = good.replace(
             "| `seq` |",
@@ -224,7 +232,9 @@ mod tests {
         );
         assert_eq!(
             disagreements(&extra),
-            vec!["`nanohaptics_msgs/msg/DeviceInput`: field `bogus_n` is in the doc but not declared"]
+            vec![
+                "`nanohaptics_msgs/msg/DeviceInput`: field `bogus_n` is in the doc but not declared"
+            ]
         );
         let reworded = good.replace("Tick rate, Hz.", "Tick rate.");
         assert_eq!(

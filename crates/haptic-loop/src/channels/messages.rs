@@ -489,7 +489,10 @@ mod tests {
             .collect();
         assert_eq!(ros2.len(), OLD_SCHEMAS.len());
         for (name, text) in OLD_SCHEMAS {
-            let got = ros2.iter().find(|(n, _)| *n == name).map(|(_, t)| t.as_str());
+            let got = ros2
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, t)| t.as_str());
             assert_eq!(got, Some(text), "{name}");
         }
         // The state's fixed part, then one line per scene field.
@@ -527,7 +530,9 @@ mod tests {
         let verified: Vec<bool> = Channel::ALL.into_iter().map(Channel::verified).collect();
         assert_eq!(
             verified,
-            [false, false, false, true, true, true, false, true, true, true]
+            [
+                false, false, false, true, true, true, false, true, true, true
+            ]
         );
         assert_eq!(Channel::from_topic("/haptic/force"), Some(Channel::Force));
         assert_eq!(Channel::from_topic("/haptic/forces"), None);
@@ -557,7 +562,12 @@ mod tests {
                 "compute_ns"
             ]
         );
-        assert_eq!(TickColumns::INFO[13].doc.lines().next(), Some(" Local stiffness sent with the force, N/m, device frame, row-major 3×3 (k a aᵀ for a"));
+        assert_eq!(
+            TickColumns::INFO[13].doc.lines().next(),
+            Some(
+                " Local stiffness sent with the force, N/m, device frame, row-major 3×3 (k a aᵀ for a"
+            )
+        );
     }
 
     #[test]
@@ -572,7 +582,13 @@ mod tests {
             Err(CdrError::Invalid("1 switch names but 2 values".into()))
         );
         let mut d = DescriptionMsg::decode_message(&[0, 1, 0, 0]).unwrap_err();
-        assert_eq!(d, CdrError::Eof { at: 4, what: "uint32" });
+        assert_eq!(
+            d,
+            CdrError::Eof {
+                at: 4,
+                what: "uint32"
+            }
+        );
         let mut w = CdrWriter::new();
         w.string("nanohaptics-recording/2");
         d = DescriptionMsg::decode(&w.finish()).unwrap_err();
