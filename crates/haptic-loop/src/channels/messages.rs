@@ -400,6 +400,20 @@ mod tests {
         };
         assert_eq!(StateMsg::decode(&s.encode(), 2), Ok(s.clone()));
         assert!(StateMsg::decode(&s.encode(), 3).is_err());
+        let sw = SwitchMsg::from_tick(
+            7,
+            &[Switch {
+                name: "gravity_m_per_s2".into(),
+                value: 0.0,
+            }],
+        );
+        let b = sw.encode();
+        // header, tick, one name (u32 count, u32 length, 17 bytes with NUL), pad to 4, the
+        // values (u32 count, then one f64 already 8-aligned)
+        assert_eq!(b.len(), 4 + 8 + 4 + 4 + 17 + 3 + 4 + 8);
+        let back = SwitchMsg::decode(&b).unwrap();
+        assert_eq!(back, sw);
+        assert_eq!(back.switches()[0].name, "gravity_m_per_s2");
         assert!(StateMsg::decode(&s.encode(), 1).is_err());
     }
 
