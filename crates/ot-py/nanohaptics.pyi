@@ -396,13 +396,14 @@ def run_scene(
 ) -> dict:
     """Run a scene in batch mode with a script, or in real time against a
     device in another process (device="udp:HOST:PORT", see nanohaptics.bridge;
-    wait_s: how long to wait for its hello). Per-tick arrays: tick, time_s,
-    device_position_m (T, 3), device_buttons, device_seq, device_age_ticks,
-    deadline_missed, cursor_m (T, 3), state (T, F) with state_fields,
-    world_force_n (T, 3), device_force_n (T, 3), device_stiffness_n_per_m
-    (T, 3, 3), engagement, watchdog, status, compute_ns, start_late_ns,
-    events [(tick, name, detail)], rate_hz, stats (tick timing, "link"
-    counters, "end", per-sink "sinks" timing). Optionally records to `out`.
+    wait_s: how long to wait for its hello). Per-tick arrays (the columns of
+    docs/recording-format.md; integers int64, flags bool, status uint8): tick,
+    time_s, device_position_m (T, 3), device_buttons, device_seq,
+    device_age_ticks, deadline_missed, cursor_m (T, 3), state (T, F) with
+    state_fields, world_force_n (T, 3), device_force_n (T, 3),
+    device_stiffness_n_per_m (T, 3, 3), engagement, watchdog, status,
+    compute_ns, start_late_ns, events [(tick, name, detail)], rate_hz, stats
+    (tick timing, "link" counters, "end", per-sink "sinks" timing). Optionally records to `out`.
     `scene` may also be a dict of resolve_scene; `overrides` changes fields by
     dotted name, validated like a scene file (see resolve_scene)."""
 

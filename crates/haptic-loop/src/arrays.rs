@@ -1,55 +1,41 @@
 //! Per-tick arrays of a session (struct of arrays), filled straight from the loop as a sink of
 //! the runner, or decoded from a recording.
 
+use crate::channels::cdr::CdrError;
 use crate::channels::messages::{
-    Channel, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TimingMsg,
+    Channel, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TickColumns, TimingMsg,
 };
 use crate::haptic::HapticLoop;
 use crate::record::{Recording, RecordingError};
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
-use crate::vec3::Vec3;
 
-/// Per-tick arrays of a session (struct of arrays; `state` is row-major ticks × fields).
+/// Per-tick arrays of a session: the columns declared with the recording's messages
+/// ([`TickColumns`], reached through `Deref`: `a.tick`, `a.device_force_n`, `a.state`, …) and
+/// the events.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct SessionArrays {
     /// Tick rate, Hz.
     pub rate_hz: u32,
-    /// Names of the state columns.
+    /// Names of the state columns (each with its unit).
     pub state_fields: Vec<String>,
-    /// Tick index.
-    pub tick: Vec<u64>,
-    /// Raw device position, m, device frame.
-    pub device_position_m: Vec<Vec3>,
-    /// Raw button bits.
-    pub device_buttons: Vec<u32>,
-    /// Deadline-missed flag.
-    pub deadline_missed: Vec<bool>,
-    /// The device's sequence number of each reading.
-    pub device_seq: Vec<u64>,
-    /// Age of each reading, ticks (0: fresh).
-    pub device_age_ticks: Vec<u32>,
-    /// Cursor, world frame, m.
-    pub cursor_m: Vec<Vec3>,
-    /// Scene state, ticks × fields.
-    pub state: Vec<f64>,
-    /// Scene force, world frame, N.
-    pub world_force_n: Vec<Vec3>,
-    /// Force sent, device frame, N.
-    pub device_force_n: Vec<Vec3>,
-    /// Soft-engagement factor.
-    pub engagement: Vec<f64>,
-    /// Watchdog factor (1: device samples fresh).
-    pub watchdog: Vec<f64>,
-    /// Local stiffness sent with the force, N/m, device frame, row-major 3×3.
-    pub device_stiffness_n_per_m: Vec<[f64; 9]>,
-    /// Status bits (see `haptic::status`).
-    pub status: Vec<u8>,
+    /// The per-tick columns.
+    #[serde(flatten)]
+    pub columns: TickColumns,
     /// Events: (tick, name, detail).
     pub events: Vec<(u64, String, String)>,
-    /// Work per tick, ns (wall clock; not reproducible).
-    pub compute_ns: Vec<u64>,
-    /// Start lateness per tick, ns (real-time mode).
-    pub start_late_ns: Vec<i64>,
+}
+
+impl std::ops::Deref for SessionArrays {
+    type Target = TickColumns;
+    fn deref(&self) -> &TickColumns {
+        &self.columns
+    }
+}
+
+impl std::ops::DerefMut for SessionArrays {
+    fn deref_mut(&mut self) -> &mut TickColumns {
+        &mut self.columns
+    }
 }
 
 impl SessionArrays {
@@ -65,22 +51,7 @@ impl SessionArrays {
     /// Reserves room for `ticks` more ticks, so that no array grows (and copies) mid-session.
     pub fn reserve(&mut self, ticks: usize) {
         let n = self.state_fields.len();
-        self.tick.reserve(ticks);
-        self.device_position_m.reserve(ticks);
-        self.device_buttons.reserve(ticks);
-        self.deadline_missed.reserve(ticks);
-        self.device_seq.reserve(ticks);
-        self.device_age_ticks.reserve(ticks);
-        self.watchdog.reserve(ticks);
-        self.device_stiffness_n_per_m.reserve(ticks);
-        self.cursor_m.reserve(ticks);
-        self.state.reserve(ticks * n);
-        self.world_force_n.reserve(ticks);
-        self.device_force_n.reserve(ticks);
-        self.engagement.reserve(ticks);
-        self.status.reserve(ticks);
-        self.compute_ns.reserve(ticks);
-        self.start_late_ns.reserve(ticks);
+        self.columns.reserve(ticks, n);
     }
 
     /// Time of each tick, s.
@@ -98,61 +69,27 @@ impl SessionArrays {
         Some(self.state.chunks(n).map(|row| row[k]).collect())
     }
 
-    /// Adds one tick straight from the loop (no encoding).
+    /// Adds one tick straight from the loop: each message is built from the tick as a plain
+    /// struct (never encoded) and its column fields are appended.
     pub fn push_tick(&mut self, t: &TickView<'_>) {
         let r = t.result;
-        self.tick.push(r.tick);
-        self.device_position_m.push(t.sample.position_m);
-        self.device_buttons.push(t.sample.buttons.0);
-        self.deadline_missed.push(t.deadline_missed);
-        self.device_seq.push(t.sample.seq);
-        self.device_age_ticks.push(t.sample.age_ticks);
-        self.cursor_m.push(r.cursor_m);
-        t.lp.scene_state(&mut self.state);
-        self.world_force_n.push(r.world_force_n);
-        self.device_force_n.push(r.device_force_n);
-        self.engagement.push(r.engagement);
-        self.status.push(r.status);
-        self.watchdog.push(r.watchdog);
-        self.device_stiffness_n_per_m
-            .push(r.device_stiffness_n_per_m);
+        let c = &mut self.columns;
+        DeviceInputMsg::from_tick(r.tick, &t.sample, t.deadline_missed).push_columns(c);
+        // The state message's columns, with the scene's fields written in place.
+        c.cursor_m.push(r.cursor_m);
+        t.lp.scene_state(&mut c.state);
+        ForceMsg::from_tick(r).push_columns(c);
+        TimingMsg::from_tick(r.tick, t.start_late_ns, t.compute_ns).push_columns(c);
         for e in &r.events {
             self.events.push((r.tick, e.name.clone(), e.detail.clone()));
         }
-        self.compute_ns.push(t.compute_ns);
-        self.start_late_ns.push(t.start_late_ns);
     }
 
-    /// Adds one message.
-    pub fn push(
-        &mut self,
-        channel: Channel,
-        data: &[u8],
-    ) -> Result<(), crate::channels::cdr::CdrError> {
+    /// Adds one recorded message.
+    pub fn push(&mut self, channel: Channel, data: &[u8]) -> Result<(), CdrError> {
         match channel {
-            Channel::DeviceInput => {
-                let m = DeviceInputMsg::decode(data)?;
-                self.tick.push(m.tick);
-                self.device_position_m.push(m.position_m);
-                self.device_buttons.push(m.buttons);
-                self.deadline_missed.push(m.deadline_missed);
-                self.device_seq.push(m.seq);
-                self.device_age_ticks.push(m.age_ticks);
-            }
             Channel::State => {
-                let m = StateMsg::decode(data, self.state_fields.len())?;
-                self.cursor_m.push(m.cursor_m);
-                self.state.extend_from_slice(&m.values);
-            }
-            Channel::Force => {
-                let m = ForceMsg::decode(data)?;
-                self.world_force_n.push(m.world_force_n);
-                self.device_force_n.push(m.device_force_n);
-                self.engagement.push(m.engagement);
-                self.status.push(m.status);
-                self.watchdog.push(m.watchdog);
-                self.device_stiffness_n_per_m
-                    .push(m.device_stiffness_n_per_m);
+                StateMsg::decode(data, self.state_fields.len())?.push_columns(&mut self.columns)
             }
             Channel::Events => {
                 let m = EventsMsg::decode(data)?;
@@ -160,12 +97,7 @@ impl SessionArrays {
                     self.events.push((m.tick, n, d));
                 }
             }
-            Channel::Timing => {
-                let m = TimingMsg::decode(data)?;
-                self.compute_ns.push(m.compute_ns);
-                self.start_late_ns.push(m.start_late_ns);
-            }
-            _ => {}
+            other => other.push_columns(data, &mut self.columns)?,
         }
         Ok(())
     }

@@ -2,7 +2,10 @@
 //! and the golden recordings under `recordings/`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::channels::messages::{Channel, DeviceInputMsg, ForceMsg};
+use haptic_loop::channels::messages::{
+    Channel, DescriptionMsg, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, SwitchMsg, TimingMsg,
+};
+use haptic_loop::record::writer::channel_schema;
 use haptic_loop::record::{RecordingError, read_recording, read_recording_file};
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
@@ -242,6 +245,105 @@ fn golden_recordings_replay_bit_exactly() {
     assert!(n >= 1, "no golden recordings in {}", dir.display());
 }
 
+/// The schemas written today (from the channel declarations) are, byte for byte, the schemas
+/// stored in every golden recording, channel by channel, with the same ids and encodings.
+#[test]
+fn golden_recordings_hold_the_schemas_the_declarations_write() {
+    let dir = root().join("recordings");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "mcap") {
+            continue;
+        }
+        let buf = std::fs::read(&p).unwrap();
+        let rec = read_recording(&buf, false).unwrap();
+        let summary = mcap::Summary::read(&buf).unwrap().unwrap();
+        assert_eq!(summary.channels.len(), Channel::COUNT, "{}", p.display());
+        for (k, ch) in Channel::ALL.into_iter().enumerate() {
+            let c = summary
+                .channels
+                .values()
+                .find(|c| c.topic == ch.topic())
+                .unwrap_or_else(|| panic!("{}: no {}", p.display(), ch.topic()));
+            // Channels and schemas are registered in declaration order (ids from 1).
+            assert_eq!(usize::from(c.id), k + 1, "{}", ch.topic());
+            assert_eq!(c.message_encoding, ch.message_encoding(), "{}", ch.topic());
+            let stored = c.schema.as_ref().unwrap();
+            assert_eq!(usize::from(stored.id), k + 1, "{}", ch.topic());
+            let (name, enc, data) = channel_schema(ch, &rec.description);
+            assert_eq!(
+                (stored.name.as_str(), stored.encoding.as_str()),
+                (name.as_str(), enc.as_str()),
+                "{}: {}",
+                p.display(),
+                ch.topic()
+            );
+            assert!(
+                stored.data.as_ref() == data.as_slice(),
+                "{}: the {} schema differs from the declaration's:\n{}\n--- declared:\n{}",
+                p.display(),
+                ch.topic(),
+                String::from_utf8_lossy(&stored.data),
+                String::from_utf8_lossy(&data)
+            );
+        }
+        n += 1;
+    }
+    assert_eq!(n, 4, "golden recordings in {}", dir.display());
+}
+
+/// Every CDR message of every golden recording, decoded with the declared decoder and encoded
+/// again with the declared encoder, gives back its recorded bytes (inputs, description and
+/// timing included, which replay does not recompute).
+#[test]
+fn golden_messages_reencode_to_their_recorded_bytes() {
+    let dir = root().join("recordings");
+    let mut per_channel = std::collections::BTreeMap::new();
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "mcap") {
+            continue;
+        }
+        let rec = read_recording_file(&p, false).unwrap();
+        let n = rec.description.state_fields.len();
+        for m in &rec.messages {
+            let d = &m.data;
+            let again = match m.channel {
+                Channel::Description => DescriptionMsg::decode(d).unwrap().encode(),
+                Channel::DeviceInput => DeviceInputMsg::decode(d).unwrap().encode(),
+                Channel::Switch => SwitchMsg::decode(d).unwrap().encode(),
+                Channel::State => StateMsg::decode(d, n).unwrap().encode(),
+                Channel::Force => ForceMsg::decode(d).unwrap().encode(),
+                Channel::Events => EventsMsg::decode(d).unwrap().encode(),
+                Channel::Timing => TimingMsg::decode(d).unwrap().encode(),
+                Channel::FoxgloveScene | Channel::FoxgloveTf | Channel::FoxgloveLog => continue,
+            };
+            assert!(
+                again == *d,
+                "{}: a {} message at {} ns re-encodes differently",
+                p.display(),
+                m.channel.topic(),
+                m.log_time_ns
+            );
+            *per_channel.entry(m.channel.topic()).or_insert(0u64) += 1;
+        }
+    }
+    // Every CDR channel but `/scene/switch` (no golden session sets a switch) was exercised.
+    let topics: Vec<&str> = per_channel.keys().copied().collect();
+    assert_eq!(
+        topics,
+        [
+            "/device/input",
+            "/events",
+            "/haptic/force",
+            "/loop/timing",
+            "/scene/description",
+            "/world/state"
+        ]
+    );
+}
+
 #[test]
 fn realtime_session_replays_exactly_including_its_missed_deadlines() {
     let p = tmp("rt.mcap");
@@ -312,4 +414,34 @@ fn an_unwritable_recording_path_is_a_typed_error() {
         e.to_string(),
         "recording /nonexistent-dir/x.mcap: No such file or directory (os error 2)"
     );
+}
+
+/// Without a recording nothing is encoded: the arrays are the only sink (filled straight from
+/// each tick), and they equal, column by column, what a recorded run of the same session reads
+/// back from its file (bar the wall-clock columns).
+#[test]
+fn an_unrecorded_session_runs_only_the_arrays_and_matches_its_recording() {
+    let mut o = wall_opts(None);
+    o.seconds = Some(0.5);
+    o.start_time_ns = Some(1_700_000_000_000_000_000);
+    let plain = run_session(&o, &mut |_, _| {}).unwrap();
+    let sinks: Vec<&str> = plain.sinks.iter().map(|s| s.sink).collect();
+    assert_eq!(sinks, ["arrays"]);
+    let p = tmp("wall-half-second.mcap");
+    o.out = Some(p.clone());
+    let recorded = run_session(&o, &mut |_, _| {}).unwrap();
+    let sinks: Vec<&str> = recorded.sinks.iter().map(|s| s.sink).collect();
+    assert_eq!(sinks, ["arrays", "recorder"]);
+    let back = read_arrays(&p, false).unwrap();
+    assert_eq!(back, recorded.arrays);
+    assert_eq!(plain.arrays.tick.len(), 500);
+    let (a, b) = (plain.arrays.columns(), back.columns());
+    assert_eq!(a.len(), b.len());
+    for ((info, x), (_, y)) in a.into_iter().zip(b) {
+        if !["compute_ns", "start_late_ns"].contains(&info.name) {
+            assert_eq!(x, y, "{}", info.name);
+        }
+    }
+    assert_eq!(plain.arrays.events, back.events);
+    assert_eq!(plain.arrays.state_fields, back.state_fields);
 }

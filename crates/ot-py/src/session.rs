@@ -3,6 +3,7 @@
 
 use haptic_loop::DeviceModel;
 use haptic_loop::bridge::BridgeConfig;
+use haptic_loop::channels::declare::ColumnData;
 use haptic_loop::device::OperatorParams;
 use haptic_loop::device::Script;
 use haptic_loop::record::RecordingError;
@@ -43,56 +44,50 @@ pub(crate) fn path_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<PathBuf> 
         .map_err(|_| PyValueError::new_err(format!("{name}: expected a path (str or os.PathLike)")))
 }
 
-/// Per-tick arrays as a dict of numpy arrays.
+/// Per-tick arrays as a dict of numpy arrays: every declared column
+/// (`haptic_loop::channels::messages::TickColumns`) by its element type (integers as int64,
+/// `float64[3]` as (T, 3), `float64[9]` as (T, 3, 3), the scene state as (T, F)), plus
+/// `rate_hz`, `state_fields`, `time_s` and `events`.
 pub(crate) fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let time = a.time_s();
     let n = a.tick.len();
     let fields = a.state_fields.len();
     d.set_item("rate_hz", a.rate_hz)?;
+    d.set_item("time_s", PyArray1::from_vec(py, a.time_s()))?;
+    for (info, data) in a.columns.columns() {
+        let int = |v: Vec<i64>| PyArray1::from_vec(py, v).into_any();
+        let arr = match data {
+            ColumnData::U8(v) => PyArray1::from_slice(py, v).into_any(),
+            ColumnData::Bool(v) => PyArray1::from_slice(py, v).into_any(),
+            ColumnData::U32(v) => int(v.iter().map(|&x| i64::from(x)).collect()),
+            // Tick indices, counters and durations in ns stay far below 2^63.
+            ColumnData::U64(v) => int(v.iter().map(|&x| x as i64).collect()),
+            ColumnData::I64(v) => PyArray1::from_slice(py, v).into_any(),
+            ColumnData::F64(v) => PyArray1::from_slice(py, v).into_any(),
+            ColumnData::Vec3(v) => {
+                array2_flat(py, v.iter().flatten().copied().collect(), 3)?.into_any()
+            }
+            ColumnData::Mat3(v) => {
+                let k: Vec<f64> = v.iter().flatten().copied().collect();
+                PyArray1::from_vec(py, k)
+                    .reshape([v.len(), 3, 3])?
+                    .into_any()
+            }
+            ColumnData::Table(v) => {
+                let rows = v.len().checked_div(fields).unwrap_or(n);
+                PyArray1::from_slice(py, v)
+                    .reshape([rows, fields])?
+                    .into_any()
+            }
+        };
+        d.set_item(info.name, arr)?;
+    }
     d.set_item("state_fields", a.state_fields)?;
-    let tick: Vec<i64> = a.tick.iter().map(|&t| t as i64).collect();
-    d.set_item("tick", PyArray1::from_vec(py, tick))?;
-    d.set_item("time_s", PyArray1::from_vec(py, time))?;
-    let v3 = |v: Vec<[f64; 3]>| v.into_iter().flatten().collect::<Vec<f64>>();
-    d.set_item(
-        "device_position_m",
-        array2_flat(py, v3(a.device_position_m), 3)?,
-    )?;
-    let buttons: Vec<i64> = a.device_buttons.iter().map(|&b| i64::from(b)).collect();
-    d.set_item("device_buttons", PyArray1::from_vec(py, buttons))?;
-    d.set_item("deadline_missed", PyArray1::from_vec(py, a.deadline_missed))?;
-    d.set_item("cursor_m", array2_flat(py, v3(a.cursor_m), 3)?)?;
-    let rows = a.state.len().checked_div(fields).unwrap_or(n);
-    d.set_item(
-        "state",
-        PyArray1::from_vec(py, a.state).reshape([rows, fields])?,
-    )?;
-    d.set_item("world_force_n", array2_flat(py, v3(a.world_force_n), 3)?)?;
-    d.set_item("device_force_n", array2_flat(py, v3(a.device_force_n), 3)?)?;
-    d.set_item("engagement", PyArray1::from_vec(py, a.engagement))?;
-    d.set_item("watchdog", PyArray1::from_vec(py, a.watchdog))?;
-    let k: Vec<f64> = a.device_stiffness_n_per_m.into_iter().flatten().collect();
-    let rows = k.len() / 9;
-    d.set_item(
-        "device_stiffness_n_per_m",
-        PyArray1::from_vec(py, k).reshape([rows, 3, 3])?,
-    )?;
-    let seq: Vec<i64> = a.device_seq.iter().map(|&s| s as i64).collect();
-    d.set_item("device_seq", PyArray1::from_vec(py, seq))?;
-    d.set_item(
-        "device_age_ticks",
-        PyArray1::from_vec(py, a.device_age_ticks),
-    )?;
-    d.set_item("status", PyArray1::from_vec(py, a.status))?;
     let ev = PyList::empty(py);
     for (t, name, detail) in a.events {
         ev.append((t, name, detail))?;
     }
     d.set_item("events", ev)?;
-    let compute: Vec<i64> = a.compute_ns.iter().map(|&c| c as i64).collect();
-    d.set_item("compute_ns", PyArray1::from_vec(py, compute))?;
-    d.set_item("start_late_ns", PyArray1::from_vec(py, a.start_late_ns))?;
     Ok(d)
 }
 

@@ -255,12 +255,105 @@ impl<'a> CdrReader<'a> {
         (0..n).map(|_| self.string()).collect()
     }
 
+    /// Bytes not read yet.
+    pub fn remaining(&self) -> usize {
+        self.buf.len() - self.pos
+    }
+
     /// Checks that the whole message was read.
     pub fn end(&self) -> Result<(), CdrError> {
         match self.buf.len() - self.pos {
             0 => Ok(()),
             n => Err(CdrError::Trailing(n)),
         }
+    }
+}
+
+/// A value that is one field of a recording message: its ROS 2 `.msg` type and its CDR
+/// encoding (the declarations in [`super::messages`] build every encoder and decoder from it).
+pub trait CdrField: Sized {
+    /// The field's type in the `.msg` schema text (`uint64`, `float64[3]`, `string[]`, …).
+    const MSG_TYPE: &'static str;
+    /// Appends the value to `w`.
+    fn put(&self, w: &mut CdrWriter);
+    /// Reads the value from `r`.
+    fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError>;
+}
+
+macro_rules! cdr_scalar {
+    ($($t:ty, $msg:literal, $put:ident;)*) => {$(
+        impl CdrField for $t {
+            const MSG_TYPE: &'static str = $msg;
+            fn put(&self, w: &mut CdrWriter) {
+                w.$put(*self);
+            }
+            fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+                r.$put()
+            }
+        }
+    )*};
+}
+
+cdr_scalar! {
+    u8, "uint8", u8;
+    bool, "bool", bool;
+    u32, "uint32", u32;
+    u64, "uint64", u64;
+    i64, "int64", i64;
+    f64, "float64", f64;
+}
+
+impl CdrField for [f64; 3] {
+    const MSG_TYPE: &'static str = "float64[3]";
+    fn put(&self, w: &mut CdrWriter) {
+        w.f64s(self);
+    }
+    fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        r.vec3()
+    }
+}
+
+impl CdrField for [f64; 9] {
+    const MSG_TYPE: &'static str = "float64[9]";
+    fn put(&self, w: &mut CdrWriter) {
+        w.f64s(self);
+    }
+    fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        let mut k = [0.0; 9];
+        for v in &mut k {
+            *v = r.f64()?;
+        }
+        Ok(k)
+    }
+}
+
+impl CdrField for String {
+    const MSG_TYPE: &'static str = "string";
+    fn put(&self, w: &mut CdrWriter) {
+        w.string(self);
+    }
+    fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        r.string()
+    }
+}
+
+impl CdrField for Vec<String> {
+    const MSG_TYPE: &'static str = "string[]";
+    fn put(&self, w: &mut CdrWriter) {
+        w.strings(self.iter().map(String::as_str));
+    }
+    fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        r.strings()
+    }
+}
+
+impl CdrField for Vec<f64> {
+    const MSG_TYPE: &'static str = "float64[]";
+    fn put(&self, w: &mut CdrWriter) {
+        w.f64_seq(self);
+    }
+    fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        r.f64_seq()
     }
 }
 

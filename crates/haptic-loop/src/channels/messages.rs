@@ -1,66 +1,185 @@
-//! The recording's channels, their schemas (ROS 2 `.msg` text, CDR encoding) and the typed
-//! messages with their encoders and decoders.
+//! The recording's channels and their messages, each declared once (see [`super::declare`]):
+//! the struct, its CDR encoder and decoder, its ROS 2 `.msg` schema text, its per-tick columns
+//! and its constructor from a tick all come from the declaration below.
 
 use super::FORMAT_VERSION;
-use crate::channels::cdr::{CdrError, CdrReader, CdrWriter};
+use super::cdr::{CdrError, CdrField, CdrReader, CdrWriter};
+use super::declare::{ColumnData, ColumnField, recording_channels};
+use crate::device::DeviceSample;
+use crate::haptic::TickResult;
+use crate::scene::{Event, Switch};
 use crate::vec3::Vec3;
 
-/// The channels of a recording.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Channel {
-    /// `/scene/description`, once at tick 0.
-    Description,
-    /// `/device/input`, every tick (an input of replay).
-    DeviceInput,
-    /// `/scene/switch`, on ticks where switches were set (an input of replay).
-    Switch,
-    /// `/world/state`, every tick.
-    State,
-    /// `/haptic/force`, every tick.
-    Force,
-    /// `/events`, on ticks with events.
-    Events,
-    /// `/loop/timing`, every tick (wall-clock measurements, not verified).
-    Timing,
-    /// `/foxglove/scene` (`foxglove.SceneUpdate`), at display rate.
-    FoxgloveScene,
-    /// `/foxglove/tf` (`foxglove.FrameTransform`), at display rate.
-    FoxgloveTf,
-    /// `/foxglove/log` (`foxglove.Log`), on ticks with events.
-    FoxgloveLog,
+recording_channels! {
+    channel Description = "/scene/description", Input, "once, tick 0",
+    message DescriptionMsg(Clone, Debug, PartialEq, serde::Serialize)
+        = "nanohaptics_msgs/msg/SceneDescription",
+        "The session: everything replay needs besides the per-tick inputs."
+    {
+        /// The format version (`FORMAT_VERSION`, `nanohaptics-recording/3`; a reader refuses any
+        /// other).
+        #[check = check_format]
+        format: String,
+        /// Scene name.
+        scene_name: String,
+        /// Scene kind (`wall`, `nanoworld`, `brickworld`, `optical_tweezers`, …).
+        scene_kind: String,
+        /// The whole scene file: replay rebuilds the world from it.
+        scene_toml: String,
+        /// Device model used (`falcon`, `touch`, or the name a bridged device announced).
+        device_model: String,
+        /// Tick rate, Hz.
+        rate_hz: u32,
+        /// `batch`, `realtime` or `stepped`.
+        mode: String,
+        /// Script name (information only).
+        script_name: String,
+        /// Script text (information only: replay uses the logged inputs).
+        script_toml: String,
+        /// Operator: `rigid`, the simulated hand's parameters, `person` or `python` (information
+        /// only).
+        operator: String,
+        /// Names of the scene's state fields, each with its unit.
+        state_fields: Vec<String>,
+        /// Wall-clock start of the session, ns since the Unix epoch (information; log times and
+        /// Foxglove timestamps are `start_time_ns + tick · period`).
+        #[msg = "wall-clock start of the session, ns since the Unix epoch (log times are start + tick time)"]
+        start_time_ns: u64,
+        /// How the device was connected: `script`, `hand`, `replay`, `udp:HOST:PORT`, `python`.
+        #[msg = "how the device was connected: script, hand, replay, udp:HOST:PORT, python"]
+        device_link: String,
+        /// The device's maximum force, N (replay rebuilds the loop with the device's
+        /// specifications).
+        device_max_force_n: f64,
+        /// The device's maximum stiffness, N/m.
+        device_max_stiffness_n_per_m: f64,
+        /// The device's workspace radius, m.
+        device_workspace_radius_m: f64,
+        /// The device's button names.
+        device_buttons: Vec<String>,
+    }
+
+    channel DeviceInput = "/device/input", Input, "every tick",
+    message DeviceInputMsg(Clone, Copy, Debug, PartialEq) = "nanohaptics_msgs/msg/DeviceInput",
+        "Device reading of one tick (device frame) and the real-time deadline flag.",
+        from(tick: u64, sample: &DeviceSample, deadline_missed: bool)
+    {
+        /// Tick index.
+        tick: u64 => tick = tick,
+        /// Stylus position, device frame, m (raw, possibly invalid).
+        position_m: Vec3 => device_position_m = sample.position_m,
+        /// Button bits (raw): bit i = button i of the device (Falcon: centre, plus, minus,
+        /// forward).
+        buttons: u32 => device_buttons = sample.buttons.0,
+        /// The real-time deadline of this tick was missed (zero force was sent).
+        deadline_missed: bool => deadline_missed = deadline_missed,
+        /// The device's sequence number of the reading (information only).
+        #[msg = "the device's sequence number of this reading (information only)"]
+        seq: u64 => device_seq = sample.seq,
+        /// Age of the reading, ticks since it arrived (0: fresh; the watchdog ramps the force
+        /// down from it).
+        #[msg = "ticks since the reading arrived (0: fresh; the watchdog ramps the force down from it)"]
+        age_ticks: u32 => device_age_ticks = sample.age_ticks,
+    }
+
+    channel Switch = "/scene/switch", Input, "ticks with switches",
+    message SwitchMsg(Clone, Debug, PartialEq) = "nanohaptics_msgs/msg/Switch",
+        "Run-time switches set just before this tick's step (the teaching game's menu), in order.",
+        from(tick: u64, switches: &[Switch]),
+        validate = same_lengths
+    {
+        /// Tick index.
+        tick: u64 = tick,
+        /// Names of the switches set before the tick's step, in order.
+        names: Vec<String> = switches.iter().map(|s| s.name.clone()).collect(),
+        /// Their new values, in the switch's unit (on/off switches: 1 / 0); same length as
+        /// `names`.
+        #[msg = "new values (on/off switches: 1 / 0)"]
+        values: Vec<f64> = switches.iter().map(|s| s.value).collect(),
+    }
+
+    channel State = "/world/state", Verified, "every tick",
+    message StateMsg(Clone, Debug, PartialEq) = "nanohaptics_msgs/msg/<Kind>State",
+        "World state after one tick; cursor in the world frame.",
+        from(r: &TickResult, values: &[f64]),
+        decode = custom
+    {
+        /// Tick index.
+        tick: u64 = r.tick,
+        /// Cursor, world frame, m (held at the last valid input when the input is invalid).
+        cursor_m: Vec3 => cursor_m = r.cursor_m,
+        /// Buttons given to the scene (bits).
+        buttons: u32 = r.buttons.0,
+        /// The scene's state fields, one `float64` each, named with its unit, in the order of
+        /// the description's `state_fields`.
+        values: StateValues => state = StateValues(values.to_vec()),
+    }
+
+    channel Force = "/haptic/force", Verified, "every tick",
+    message ForceMsg(Clone, Copy, Debug, PartialEq) = "nanohaptics_msgs/msg/Force",
+        "Force of one tick: the scene's (world frame) and the one sent (device frame).",
+        from(r: &TickResult)
+    {
+        /// Tick index.
+        tick: u64 = r.tick,
+        /// Force of the scene on the cursor, world frame, N.
+        world_force_n: Vec3 => world_force_n = r.world_force_n,
+        /// Force sent, device frame, N (finite, norm ≤ the device's maximum).
+        device_force_n: Vec3 => device_force_n = r.device_force_n,
+        /// Soft-engagement factor, 0–1.
+        engagement: f64 => engagement = r.engagement,
+        /// Status bits (`haptic::status`): 1 clamped, 2 input invalid, 4 deadline missed, 8
+        /// scene stiffness over the cap, 16 scene force not finite, 32 watchdog (stale device
+        /// samples reduced the force).
+        #[msg = "bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid,"]
+        #[msg = "32 watchdog"]
+        status: u8 => status = r.status,
+        /// Watchdog factor applied to the force, 0–1 (1: device samples fresh).
+        #[msg = "watchdog factor applied to the force (1: device samples fresh)"]
+        watchdog: f64 => watchdog = r.watchdog,
+        /// Local stiffness sent with the force, N/m, device frame, row-major 3×3 (k a aᵀ for a
+        /// wall, k I for a proxy spring), scaled by mapping, engagement, watchdog and clamp.
+        #[msg = "local stiffness sent with the force, N/m, device frame, row-major 3x3"]
+        device_stiffness_n_per_m: [f64; 9] => device_stiffness_n_per_m
+            = r.device_stiffness_n_per_m,
+    }
+
+    channel Events = "/events", Verified, "ticks with events",
+    message EventsMsg(Clone, Debug, PartialEq) = "nanohaptics_msgs/msg/Events",
+        "Events raised during one tick, in order.",
+        from(tick: u64, events: &[Event])
+    {
+        /// Tick index.
+        tick: u64 = tick,
+        /// Event names (`button.down`, `wall.contact_begin`, `force.clamped`, …).
+        names: Vec<String> = events.iter().map(|e| e.name.clone()).collect(),
+        /// Event details, same length as `names` (JSON with a `type` tag and named fields, or
+        /// words; may be empty).
+        details: Vec<String> = events.iter().map(|e| e.detail.clone()).collect(),
+    }
+
+    channel Timing = "/loop/timing", Unverified, "every tick",
+    message TimingMsg(Clone, Copy, Debug, PartialEq) = "nanohaptics_msgs/msg/Timing",
+        "Wall-clock measurements of one tick (not reproducible, not verified by replay).",
+        from(tick: u64, start_late_ns: i64, compute_ns: u64)
+    {
+        /// Tick index.
+        tick: u64 = tick,
+        /// Start lateness against the real-time schedule, ns (0 in batch mode).
+        start_late_ns: i64 => start_late_ns = start_late_ns,
+        /// Work of the tick up to the hand-off of its messages, ns (wall clock).
+        compute_ns: u64 => compute_ns = compute_ns,
+    }
+
+    protobuf FoxgloveScene = "/foxglove/scene", Verified,
+        "display rate (`[display] rate_hz`, default 50 Hz)", "foxglove.SceneUpdate";
+    protobuf FoxgloveTf = "/foxglove/tf", Verified,
+        "display rate (`world` → `cursor`)", "foxglove.FrameTransform";
+    protobuf FoxgloveLog = "/foxglove/log", Verified,
+        "ticks with events (one per event)", "foxglove.Log";
 }
 
 impl Channel {
-    /// Every channel, in registration order.
-    pub const ALL: [Channel; 10] = [
-        Channel::Description,
-        Channel::DeviceInput,
-        Channel::Switch,
-        Channel::State,
-        Channel::Force,
-        Channel::Events,
-        Channel::Timing,
-        Channel::FoxgloveScene,
-        Channel::FoxgloveTf,
-        Channel::FoxgloveLog,
-    ];
-
-    /// MCAP topic.
-    pub fn topic(self) -> &'static str {
-        match self {
-            Channel::Description => "/scene/description",
-            Channel::DeviceInput => "/device/input",
-            Channel::Switch => "/scene/switch",
-            Channel::State => "/world/state",
-            Channel::Force => "/haptic/force",
-            Channel::Events => "/events",
-            Channel::Timing => "/loop/timing",
-            Channel::FoxgloveScene => "/foxglove/scene",
-            Channel::FoxgloveTf => "/foxglove/tf",
-            Channel::FoxgloveLog => "/foxglove/log",
-        }
-    }
-
     /// The channel with this topic.
     pub fn from_topic(topic: &str) -> Option<Channel> {
         Channel::ALL.into_iter().find(|c| c.topic() == topic)
@@ -68,96 +187,101 @@ impl Channel {
 
     /// True for outputs that replay recomputes and compares bit for bit.
     pub fn verified(self) -> bool {
-        !matches!(
-            self,
-            Channel::Description | Channel::DeviceInput | Channel::Switch | Channel::Timing
-        )
+        self.role() == super::declare::Role::Verified
     }
 }
 
-/// Schema of `/device/input`.
-pub const DEVICE_INPUT_SCHEMA: (&str, &str) = (
-    "nanohaptics_msgs/msg/DeviceInput",
-    "# Device reading of one tick (device frame) and the real-time deadline flag.\n\
-     uint64 tick\n\
-     float64[3] position_m\n\
-     uint32 buttons\n\
-     bool deadline_missed\n\
-     # the device's sequence number of this reading (information only)\n\
-     uint64 seq\n\
-     # ticks since the reading arrived (0: fresh; the watchdog ramps the force down from it)\n\
-     uint32 age_ticks\n",
-);
+/// A description of another format version is refused before the rest is read (its layout
+/// may differ).
+fn check_format(format: &str) -> Result<(), CdrError> {
+    if format == FORMAT_VERSION {
+        Ok(())
+    } else {
+        Err(CdrError::Format(format.to_string()))
+    }
+}
 
-/// Schema of `/haptic/force`.
-pub const FORCE_SCHEMA: (&str, &str) = (
-    "nanohaptics_msgs/msg/Force",
-    "# Force of one tick: the scene's (world frame) and the one sent (device frame).\n\
-     uint64 tick\n\
-     float64[3] world_force_n\n\
-     float64[3] device_force_n\n\
-     float64 engagement\n\
-     # bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid,\n\
-     # 32 watchdog\n\
-     uint8 status\n\
-     # watchdog factor applied to the force (1: device samples fresh)\n\
-     float64 watchdog\n\
-     # local stiffness sent with the force, N/m, device frame, row-major 3x3\n\
-     float64[9] device_stiffness_n_per_m\n",
-);
+/// Switch names and values come in pairs.
+fn same_lengths(m: &SwitchMsg) -> Result<(), CdrError> {
+    if m.names.len() == m.values.len() {
+        Ok(())
+    } else {
+        Err(CdrError::Invalid(format!(
+            "{} switch names but {} values",
+            m.names.len(),
+            m.values.len()
+        )))
+    }
+}
 
-/// Schema of `/events`.
-pub const EVENTS_SCHEMA: (&str, &str) = (
-    "nanohaptics_msgs/msg/Events",
-    "# Events raised during one tick, in order.\n\
-     uint64 tick\n\
-     string[] names\n\
-     string[] details\n",
-);
+impl SwitchMsg {
+    /// The switches, in order.
+    pub fn switches(&self) -> Vec<Switch> {
+        self.names
+            .iter()
+            .zip(&self.values)
+            .map(|(name, &value)| Switch {
+                name: name.clone(),
+                value,
+            })
+            .collect()
+    }
+}
 
-/// Schema of `/scene/switch`.
-pub const SWITCH_SCHEMA: (&str, &str) = (
-    "nanohaptics_msgs/msg/Switch",
-    "# Run-time switches set just before this tick's step (the teaching game's menu), in order.\n\
-     uint64 tick\n\
-     string[] names\n\
-     # new values (on/off switches: 1 / 0)\n\
-     float64[] values\n",
-);
+/// The scene's state fields of one tick (one `float64` each in `/world/state`, after the fixed
+/// fields; their names and count are the description's `state_fields`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StateValues(pub Vec<f64>);
 
-/// Schema of `/loop/timing`.
-pub const TIMING_SCHEMA: (&str, &str) = (
-    "nanohaptics_msgs/msg/Timing",
-    "# Wall-clock measurements of one tick (not reproducible, not verified by replay).\n\
-     uint64 tick\n\
-     int64 start_late_ns\n\
-     uint64 compute_ns\n",
-);
+impl std::ops::Deref for StateValues {
+    type Target = Vec<f64>;
+    fn deref(&self) -> &Vec<f64> {
+        &self.0
+    }
+}
 
-/// Schema of `/scene/description`.
-pub const DESCRIPTION_SCHEMA: (&str, &str) = (
-    "nanohaptics_msgs/msg/SceneDescription",
-    "# The session: everything replay needs besides the per-tick inputs.\n\
-     string format\n\
-     string scene_name\n\
-     string scene_kind\n\
-     string scene_toml\n\
-     string device_model\n\
-     uint32 rate_hz\n\
-     string mode\n\
-     string script_name\n\
-     string script_toml\n\
-     string operator\n\
-     string[] state_fields\n\
-     # wall-clock start of the session, ns since the Unix epoch (log times are start + tick time)\n\
-     uint64 start_time_ns\n\
-     # how the device was connected: script, hand, replay, udp:HOST:PORT, python\n\
-     string device_link\n\
-     float64 device_max_force_n\n\
-     float64 device_max_stiffness_n_per_m\n\
-     float64 device_workspace_radius_m\n\
-     string[] device_buttons\n",
-);
+impl CdrField for StateValues {
+    /// Empty: the fields are named by the scene and appended by [`state_schema`].
+    const MSG_TYPE: &'static str = "";
+    fn put(&self, w: &mut CdrWriter) {
+        w.f64s(&self.0);
+    }
+    /// Reads `float64` values up to the end of the message.
+    fn get(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        let mut v = Vec::new();
+        while r.remaining() > 0 {
+            v.push(r.f64()?);
+        }
+        Ok(StateValues(v))
+    }
+}
+
+impl ColumnField for StateValues {
+    type Column = Vec<f64>;
+    fn push_to(&self, col: &mut Vec<f64>) {
+        col.extend_from_slice(&self.0);
+    }
+    fn reserve(col: &mut Vec<f64>, rows: usize, width: usize) {
+        col.reserve(rows.saturating_mul(width));
+    }
+    fn data(col: &Vec<f64>) -> ColumnData<'_> {
+        ColumnData::Table(col)
+    }
+}
+
+impl StateMsg {
+    /// Decodes from CDR with `n` scene fields (the description's `state_fields`).
+    pub fn decode(b: &[u8], n: usize) -> Result<Self, CdrError> {
+        let m = Self::decode_message(b)?;
+        if m.values.len() != n {
+            return Err(CdrError::Invalid(format!(
+                "{} state values, the description names {n} state fields",
+                m.values.len()
+            )));
+        }
+        Ok(m)
+    }
+}
 
 /// Schema name and text of `/world/state` for a scene kind and its state fields.
 pub fn state_schema(kind: &str, fields: &[String]) -> (String, String) {
@@ -169,12 +293,7 @@ pub fn state_schema(kind: &str, fields: &[String]) -> (String, String) {
             camel.push_str(c.as_str());
         }
     }
-    let mut text = String::from(
-        "# World state after one tick; cursor in the world frame.\n\
-         uint64 tick\n\
-         float64[3] cursor_m\n\
-         uint32 buttons\n",
-    );
+    let mut text = StateMsg::schema_text();
     for f in fields {
         text.push_str("float64 ");
         text.push_str(f);
@@ -194,302 +313,6 @@ pub fn valid_field_name(name: &str) -> bool {
         && !name.contains("__")
         && !name.ends_with('_')
         && !["tick", "cursor_m", "buttons"].contains(&name)
-}
-
-/// `/device/input`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DeviceInputMsg {
-    /// Tick index.
-    pub tick: u64,
-    /// Stylus position, m, device frame (raw, possibly invalid).
-    pub position_m: Vec3,
-    /// Button bits (raw).
-    pub buttons: u32,
-    /// The real-time deadline of this tick was missed (zero force was sent).
-    pub deadline_missed: bool,
-    /// The device's sequence number of the reading.
-    pub seq: u64,
-    /// Ticks since the reading arrived (0: fresh).
-    pub age_ticks: u32,
-}
-
-impl DeviceInputMsg {
-    /// Encodes to CDR.
-    pub fn encode(&self) -> Vec<u8> {
-        let mut w = CdrWriter::new();
-        w.u64(self.tick)
-            .f64s(&self.position_m)
-            .u32(self.buttons)
-            .bool(self.deadline_missed)
-            .u64(self.seq)
-            .u32(self.age_ticks);
-        w.finish()
-    }
-
-    /// Decodes from CDR.
-    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
-        let mut r = CdrReader::new(b)?;
-        let m = DeviceInputMsg {
-            tick: r.u64()?,
-            position_m: r.vec3()?,
-            buttons: r.u32()?,
-            deadline_missed: r.bool()?,
-            seq: r.u64()?,
-            age_ticks: r.u32()?,
-        };
-        r.end()?;
-        Ok(m)
-    }
-}
-
-/// `/haptic/force`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ForceMsg {
-    /// Tick index.
-    pub tick: u64,
-    /// Scene force, world frame, N.
-    pub world_force_n: Vec3,
-    /// Force sent, device frame, N.
-    pub device_force_n: Vec3,
-    /// Soft-engagement factor.
-    pub engagement: f64,
-    /// Status bits (see `haptic::status`).
-    pub status: u8,
-    /// Watchdog factor.
-    pub watchdog: f64,
-    /// Local stiffness sent, N/m, device frame, row-major 3×3.
-    pub device_stiffness_n_per_m: [f64; 9],
-}
-
-impl ForceMsg {
-    /// Encodes to CDR.
-    pub fn encode(&self) -> Vec<u8> {
-        let mut w = CdrWriter::new();
-        w.u64(self.tick)
-            .f64s(&self.world_force_n)
-            .f64s(&self.device_force_n)
-            .f64(self.engagement)
-            .u8(self.status)
-            .f64(self.watchdog)
-            .f64s(&self.device_stiffness_n_per_m);
-        w.finish()
-    }
-
-    /// Decodes from CDR.
-    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
-        let mut r = CdrReader::new(b)?;
-        let m = ForceMsg {
-            tick: r.u64()?,
-            world_force_n: r.vec3()?,
-            device_force_n: r.vec3()?,
-            engagement: r.f64()?,
-            status: r.u8()?,
-            watchdog: r.f64()?,
-            device_stiffness_n_per_m: {
-                let mut k = [0.0; 9];
-                for v in &mut k {
-                    *v = r.f64()?;
-                }
-                k
-            },
-        };
-        r.end()?;
-        Ok(m)
-    }
-}
-
-/// `/world/state`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StateMsg {
-    /// Tick index.
-    pub tick: u64,
-    /// Cursor, world frame, m.
-    pub cursor_m: Vec3,
-    /// Buttons given to the scene.
-    pub buttons: u32,
-    /// The scene's state fields, in the order of the description's `state_fields`.
-    pub values: Vec<f64>,
-}
-
-impl StateMsg {
-    /// Encodes to CDR.
-    pub fn encode(&self) -> Vec<u8> {
-        let mut w = CdrWriter::new();
-        w.u64(self.tick)
-            .f64s(&self.cursor_m)
-            .u32(self.buttons)
-            .f64s(&self.values);
-        w.finish()
-    }
-
-    /// Decodes from CDR with `n` scene fields.
-    pub fn decode(b: &[u8], n: usize) -> Result<Self, CdrError> {
-        let mut r = CdrReader::new(b)?;
-        let tick = r.u64()?;
-        let cursor_m = r.vec3()?;
-        let buttons = r.u32()?;
-        let values = (0..n).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
-        r.end()?;
-        Ok(StateMsg {
-            tick,
-            cursor_m,
-            buttons,
-            values,
-        })
-    }
-}
-
-/// `/events`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct EventsMsg {
-    /// Tick index.
-    pub tick: u64,
-    /// Event names.
-    pub names: Vec<String>,
-    /// Event details (same length as `names`).
-    pub details: Vec<String>,
-}
-
-impl EventsMsg {
-    /// Encodes `events` of `tick` to CDR.
-    pub fn encode(tick: u64, events: &[crate::scene::Event]) -> Vec<u8> {
-        let mut w = CdrWriter::new();
-        w.u64(tick)
-            .strings(events.iter().map(|e| e.name.as_str()))
-            .strings(events.iter().map(|e| e.detail.as_str()));
-        w.finish()
-    }
-
-    /// Decodes from CDR.
-    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
-        let mut r = CdrReader::new(b)?;
-        let m = EventsMsg {
-            tick: r.u64()?,
-            names: r.strings()?,
-            details: r.strings()?,
-        };
-        r.end()?;
-        Ok(m)
-    }
-}
-
-/// `/scene/switch`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SwitchMsg {
-    /// Tick index.
-    pub tick: u64,
-    /// The switches set before the tick's step, in order.
-    pub switches: Vec<crate::scene::Switch>,
-}
-
-impl SwitchMsg {
-    /// Encodes the `switches` of `tick` to CDR.
-    pub fn encode(tick: u64, switches: &[crate::scene::Switch]) -> Vec<u8> {
-        let values: Vec<f64> = switches.iter().map(|s| s.value).collect();
-        let mut w = CdrWriter::new();
-        w.u64(tick)
-            .strings(switches.iter().map(|s| s.name.as_str()))
-            .f64_seq(&values);
-        w.finish()
-    }
-
-    /// Decodes from CDR; names and values must be of the same length.
-    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
-        let mut r = CdrReader::new(b)?;
-        let tick = r.u64()?;
-        let names = r.strings()?;
-        let values = r.f64_seq()?;
-        r.end()?;
-        if names.len() != values.len() {
-            return Err(CdrError::Invalid(format!(
-                "{} switch names but {} values",
-                names.len(),
-                values.len()
-            )));
-        }
-        Ok(SwitchMsg {
-            tick,
-            switches: names
-                .into_iter()
-                .zip(values)
-                .map(|(name, value)| crate::scene::Switch { name, value })
-                .collect(),
-        })
-    }
-}
-
-/// `/loop/timing`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TimingMsg {
-    /// Tick index.
-    pub tick: u64,
-    /// Start lateness against the real-time schedule, ns (0 in batch mode).
-    pub start_late_ns: i64,
-    /// Work of the tick, ns.
-    pub compute_ns: u64,
-}
-
-impl TimingMsg {
-    /// Encodes to CDR.
-    pub fn encode(&self) -> Vec<u8> {
-        let mut w = CdrWriter::new();
-        w.u64(self.tick)
-            .i64(self.start_late_ns)
-            .u64(self.compute_ns);
-        w.finish()
-    }
-
-    /// Decodes from CDR.
-    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
-        let mut r = CdrReader::new(b)?;
-        let m = TimingMsg {
-            tick: r.u64()?,
-            start_late_ns: r.i64()?,
-            compute_ns: r.u64()?,
-        };
-        r.end()?;
-        Ok(m)
-    }
-}
-
-/// `/scene/description`.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct DescriptionMsg {
-    /// [`FORMAT_VERSION`].
-    pub format: String,
-    /// Scene name.
-    pub scene_name: String,
-    /// Scene kind.
-    pub scene_kind: String,
-    /// The scene file's text.
-    pub scene_toml: String,
-    /// Device model used (may override the scene file's).
-    pub device_model: String,
-    /// Tick rate, Hz.
-    pub rate_hz: u32,
-    /// `batch` or `realtime`.
-    pub mode: String,
-    /// Script name (information only).
-    pub script_name: String,
-    /// Script text (information only: replay uses the logged inputs).
-    pub script_toml: String,
-    /// Operator (`rigid` or the hand parameters; information only).
-    pub operator: String,
-    /// Names of the scene's state fields.
-    pub state_fields: Vec<String>,
-    /// Wall-clock start of the session, ns since the Unix epoch (information; log times and
-    /// Foxglove timestamps are `start_time_ns + tick · period`).
-    pub start_time_ns: u64,
-    /// How the device was connected (`script`, `hand`, `udp:HOST:PORT`, `python`).
-    pub device_link: String,
-    /// The device's maximum force, N.
-    pub device_max_force_n: f64,
-    /// The device's maximum stiffness, N/m.
-    pub device_max_stiffness_n_per_m: f64,
-    /// The device's workspace radius, m.
-    pub device_workspace_radius_m: f64,
-    /// The device's button names.
-    pub device_buttons: Vec<String>,
 }
 
 impl DescriptionMsg {
@@ -542,62 +365,6 @@ impl DescriptionMsg {
     }
 }
 
-impl DescriptionMsg {
-    /// Encodes to CDR.
-    pub fn encode(&self) -> Vec<u8> {
-        let mut w = CdrWriter::new();
-        w.string(&self.format)
-            .string(&self.scene_name)
-            .string(&self.scene_kind)
-            .string(&self.scene_toml)
-            .string(&self.device_model)
-            .u32(self.rate_hz)
-            .string(&self.mode)
-            .string(&self.script_name)
-            .string(&self.script_toml)
-            .string(&self.operator)
-            .strings(self.state_fields.iter().map(|s| s.as_str()))
-            .u64(self.start_time_ns)
-            .string(&self.device_link)
-            .f64(self.device_max_force_n)
-            .f64(self.device_max_stiffness_n_per_m)
-            .f64(self.device_workspace_radius_m)
-            .strings(self.device_buttons.iter().map(|s| s.as_str()));
-        w.finish()
-    }
-
-    /// Decodes from CDR. A recording of another format version is refused with
-    /// [`CdrError::Format`] naming the version it was recorded with.
-    pub fn decode(b: &[u8]) -> Result<Self, CdrError> {
-        let mut r = CdrReader::new(b)?;
-        let format = r.string()?;
-        if format != FORMAT_VERSION {
-            return Err(CdrError::Format(format));
-        }
-        let m = DescriptionMsg {
-            format,
-            scene_name: r.string()?,
-            scene_kind: r.string()?,
-            scene_toml: r.string()?,
-            device_model: r.string()?,
-            rate_hz: r.u32()?,
-            mode: r.string()?,
-            script_name: r.string()?,
-            script_toml: r.string()?,
-            operator: r.string()?,
-            state_fields: r.strings()?,
-            start_time_ns: r.u64()?,
-            device_link: r.string()?,
-            device_max_force_n: r.f64()?,
-            device_max_stiffness_n_per_m: r.f64()?,
-            device_workspace_radius_m: r.f64()?,
-            device_buttons: r.strings()?,
-        };
-        r.end()?;
-        Ok(m)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -629,11 +396,229 @@ mod tests {
             tick: 2,
             cursor_m: [1.0, 2.0, 3.0],
             buttons: 1,
-            values: vec![4.0, 5.0],
+            values: StateValues(vec![4.0, 5.0]),
         };
         assert_eq!(StateMsg::decode(&s.encode(), 2), Ok(s.clone()));
         assert!(StateMsg::decode(&s.encode(), 3).is_err());
+        let sw = SwitchMsg::from_tick(
+            7,
+            &[Switch {
+                name: "gravity_m_per_s2".into(),
+                value: 0.0,
+            }],
+        );
+        let b = sw.encode();
+        // header, tick, one name (u32 count, u32 length, 17 bytes with NUL), pad to 4, the
+        // values (u32 count, then one f64 already 8-aligned)
+        assert_eq!(b.len(), 4 + 8 + 4 + 4 + 17 + 3 + 4 + 8);
+        let back = SwitchMsg::decode(&b).unwrap();
+        assert_eq!(back, sw);
+        assert_eq!(back.switches()[0].name, "gravity_m_per_s2");
         assert!(StateMsg::decode(&s.encode(), 1).is_err());
+    }
+
+    /// The schema texts as they were written out by hand before the declarations (format 3),
+    /// copied here once: the declarations must give exactly these bytes.
+    const OLD_SCHEMAS: [(&str, &str); 6] = [
+        (
+            "nanohaptics_msgs/msg/DeviceInput",
+            "# Device reading of one tick (device frame) and the real-time deadline flag.\n\
+             uint64 tick\n\
+             float64[3] position_m\n\
+             uint32 buttons\n\
+             bool deadline_missed\n\
+             # the device's sequence number of this reading (information only)\n\
+             uint64 seq\n\
+             # ticks since the reading arrived (0: fresh; the watchdog ramps the force down from it)\n\
+             uint32 age_ticks\n",
+        ),
+        (
+            "nanohaptics_msgs/msg/Force",
+            "# Force of one tick: the scene's (world frame) and the one sent (device frame).\n\
+             uint64 tick\n\
+             float64[3] world_force_n\n\
+             float64[3] device_force_n\n\
+             float64 engagement\n\
+             # bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid,\n\
+             # 32 watchdog\n\
+             uint8 status\n\
+             # watchdog factor applied to the force (1: device samples fresh)\n\
+             float64 watchdog\n\
+             # local stiffness sent with the force, N/m, device frame, row-major 3x3\n\
+             float64[9] device_stiffness_n_per_m\n",
+        ),
+        (
+            "nanohaptics_msgs/msg/Events",
+            "# Events raised during one tick, in order.\n\
+             uint64 tick\n\
+             string[] names\n\
+             string[] details\n",
+        ),
+        (
+            "nanohaptics_msgs/msg/Switch",
+            "# Run-time switches set just before this tick's step (the teaching game's menu), in order.\n\
+             uint64 tick\n\
+             string[] names\n\
+             # new values (on/off switches: 1 / 0)\n\
+             float64[] values\n",
+        ),
+        (
+            "nanohaptics_msgs/msg/Timing",
+            "# Wall-clock measurements of one tick (not reproducible, not verified by replay).\n\
+             uint64 tick\n\
+             int64 start_late_ns\n\
+             uint64 compute_ns\n",
+        ),
+        (
+            "nanohaptics_msgs/msg/SceneDescription",
+            "# The session: everything replay needs besides the per-tick inputs.\n\
+             string format\n\
+             string scene_name\n\
+             string scene_kind\n\
+             string scene_toml\n\
+             string device_model\n\
+             uint32 rate_hz\n\
+             string mode\n\
+             string script_name\n\
+             string script_toml\n\
+             string operator\n\
+             string[] state_fields\n\
+             # wall-clock start of the session, ns since the Unix epoch (log times are start + tick time)\n\
+             uint64 start_time_ns\n\
+             # how the device was connected: script, hand, replay, udp:HOST:PORT, python\n\
+             string device_link\n\
+             float64 device_max_force_n\n\
+             float64 device_max_stiffness_n_per_m\n\
+             float64 device_workspace_radius_m\n\
+             string[] device_buttons\n",
+        ),
+    ];
+
+    #[test]
+    fn declared_schemas_are_the_old_texts_byte_for_byte() {
+        let ros2: Vec<(&str, String)> = Channel::ALL
+            .into_iter()
+            .filter(|c| *c != Channel::State)
+            .filter_map(Channel::ros2_schema)
+            .collect();
+        assert_eq!(ros2.len(), OLD_SCHEMAS.len());
+        for (name, text) in OLD_SCHEMAS {
+            let got = ros2
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, t)| t.as_str());
+            assert_eq!(got, Some(text), "{name}");
+        }
+        // The state's fixed part, then one line per scene field.
+        let (name, text) = state_schema("wall", &["penetration_m".into(), "in_contact".into()]);
+        assert_eq!(name, "nanohaptics_msgs/msg/WallState");
+        assert_eq!(
+            text,
+            "# World state after one tick; cursor in the world frame.\n\
+             uint64 tick\n\
+             float64[3] cursor_m\n\
+             uint32 buttons\n\
+             float64 penetration_m\n\
+             float64 in_contact\n"
+        );
+    }
+
+    #[test]
+    fn channels_keep_their_topics_order_and_roles() {
+        let topics: Vec<&str> = Channel::ALL.into_iter().map(Channel::topic).collect();
+        assert_eq!(
+            topics,
+            [
+                "/scene/description",
+                "/device/input",
+                "/scene/switch",
+                "/world/state",
+                "/haptic/force",
+                "/events",
+                "/loop/timing",
+                "/foxglove/scene",
+                "/foxglove/tf",
+                "/foxglove/log"
+            ]
+        );
+        let verified: Vec<bool> = Channel::ALL.into_iter().map(Channel::verified).collect();
+        assert_eq!(
+            verified,
+            [
+                false, false, false, true, true, true, false, true, true, true
+            ]
+        );
+        assert_eq!(Channel::from_topic("/haptic/force"), Some(Channel::Force));
+        assert_eq!(Channel::from_topic("/haptic/forces"), None);
+    }
+
+    #[test]
+    fn columns_are_the_session_arrays_names() {
+        let names: Vec<&str> = TickColumns::INFO.iter().map(|c| c.name).collect();
+        assert_eq!(
+            names,
+            [
+                "tick",
+                "device_position_m",
+                "device_buttons",
+                "deadline_missed",
+                "device_seq",
+                "device_age_ticks",
+                "cursor_m",
+                "state",
+                "world_force_n",
+                "device_force_n",
+                "engagement",
+                "status",
+                "watchdog",
+                "device_stiffness_n_per_m",
+                "start_late_ns",
+                "compute_ns"
+            ]
+        );
+        assert_eq!(
+            TickColumns::INFO[13].doc.lines().next(),
+            Some(
+                " Local stiffness sent with the force, N/m, device frame, row-major 3×3 (k a aᵀ for a"
+            )
+        );
+    }
+
+    #[test]
+    fn decoders_refuse_what_does_not_fit() {
+        let s = SwitchMsg {
+            tick: 3,
+            names: vec!["gravity_m_per_s2".into()],
+            values: vec![0.0, 1.0],
+        };
+        assert_eq!(
+            SwitchMsg::decode(&s.encode()),
+            Err(CdrError::Invalid("1 switch names but 2 values".into()))
+        );
+        let mut d = DescriptionMsg::decode_message(&[0, 1, 0, 0]).unwrap_err();
+        assert_eq!(
+            d,
+            CdrError::Eof {
+                at: 4,
+                what: "uint32"
+            }
+        );
+        let mut w = CdrWriter::new();
+        w.string("nanohaptics-recording/2");
+        d = DescriptionMsg::decode(&w.finish()).unwrap_err();
+        assert_eq!(d, CdrError::Format("nanohaptics-recording/2".into()));
+        let st = StateMsg {
+            tick: 2,
+            cursor_m: [1.0, 2.0, 3.0],
+            buttons: 1,
+            values: StateValues(vec![4.0]),
+        };
+        assert_eq!(
+            StateMsg::decode(&st.encode(), 2),
+            Err(CdrError::Invalid(
+                "1 state values, the description names 2 state fields".into()
+            ))
+        );
     }
 
     #[test]

@@ -11,7 +11,9 @@ pub mod sink;
 pub mod writer;
 
 pub use crate::channels::messages::Channel;
-use crate::channels::messages::{self, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TimingMsg};
+use crate::channels::messages::{
+    DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, SwitchMsg, TimingMsg,
+};
 use crate::device::DeviceSample;
 use crate::haptic::{HapticLoop, TickResult};
 use crate::scene::Primitive;
@@ -76,15 +78,7 @@ impl TickEncoder {
     pub fn input(tick: u64, sample: &DeviceSample, deadline_missed: bool) -> OutMsg {
         OutMsg {
             channel: Channel::DeviceInput,
-            data: DeviceInputMsg {
-                tick,
-                position_m: sample.position_m,
-                buttons: sample.buttons.0,
-                deadline_missed,
-                seq: sample.seq,
-                age_ticks: sample.age_ticks,
-            }
-            .encode(),
+            data: DeviceInputMsg::from_tick(tick, sample, deadline_missed).encode(),
         }
     }
 
@@ -92,7 +86,7 @@ impl TickEncoder {
     pub fn switches(r: &TickResult) -> Option<OutMsg> {
         (!r.switches.is_empty()).then(|| OutMsg {
             channel: Channel::Switch,
-            data: messages::SwitchMsg::encode(r.tick, &r.switches),
+            data: SwitchMsg::from_tick(r.tick, &r.switches).encode(),
         })
     }
 
@@ -100,12 +94,7 @@ impl TickEncoder {
     pub fn timing(tick: u64, start_late_ns: i64, compute_ns: u64) -> OutMsg {
         OutMsg {
             channel: Channel::Timing,
-            data: TimingMsg {
-                tick,
-                start_late_ns,
-                compute_ns,
-            }
-            .encode(),
+            data: TimingMsg::from_tick(tick, start_late_ns, compute_ns).encode(),
         }
     }
 
@@ -117,31 +106,16 @@ impl TickEncoder {
         l.scene_state(&mut self.state);
         out.push(OutMsg {
             channel: Channel::State,
-            data: StateMsg {
-                tick: r.tick,
-                cursor_m: r.cursor_m,
-                buttons: r.buttons.0,
-                values: std::mem::take(&mut self.state),
-            }
-            .encode(),
+            data: StateMsg::from_tick(r, &self.state).encode(),
         });
         out.push(OutMsg {
             channel: Channel::Force,
-            data: ForceMsg {
-                tick: r.tick,
-                world_force_n: r.world_force_n,
-                device_force_n: r.device_force_n,
-                engagement: r.engagement,
-                status: r.status,
-                watchdog: r.watchdog,
-                device_stiffness_n_per_m: r.device_stiffness_n_per_m,
-            }
-            .encode(),
+            data: ForceMsg::from_tick(r).encode(),
         });
         if !r.events.is_empty() {
             out.push(OutMsg {
                 channel: Channel::Events,
-                data: EventsMsg::encode(r.tick, &r.events),
+                data: EventsMsg::from_tick(r.tick, &r.events).encode(),
             });
         }
         if r.tick % self.display_every == 0 {
@@ -181,7 +155,7 @@ pub fn switch_schedule(
             log_time_ns: m.log_time_ns,
             detail,
         };
-        let d = messages::SwitchMsg::decode(&m.data).map_err(|e| bad(e.to_string()))?;
+        let d = SwitchMsg::decode(&m.data).map_err(|e| bad(e.to_string()))?;
         let at = start.saturating_add(d.tick.saturating_mul(period_ns));
         if m.log_time_ns != at {
             return Err(bad(format!(
@@ -189,7 +163,7 @@ pub fn switch_schedule(
                 d.tick, m.log_time_ns
             )));
         }
-        out.extend(d.switches.into_iter().map(|s| (d.tick, s)));
+        out.extend(d.switches().into_iter().map(|s| (d.tick, s)));
     }
     Ok(out)
 }

@@ -154,45 +154,38 @@ fn open(
     let mut w = opts
         .create(BufWriter::with_capacity(1 << 20, file))
         .map_err(|e| write_err(path, &e, 0))?;
-    let d = &setup.description;
-    let (state_name, state_text) = messages::state_schema(&d.scene_kind, &d.state_fields);
     let mut ids = BTreeMap::new();
     let meta = BTreeMap::new();
     for ch in Channel::ALL {
-        let (name, enc, data): (String, String, Vec<u8>) = match ch {
-            Channel::Description => s(messages::DESCRIPTION_SCHEMA),
-            Channel::DeviceInput => s(messages::DEVICE_INPUT_SCHEMA),
-            Channel::Switch => s(messages::SWITCH_SCHEMA),
-            Channel::State => (
-                state_name.clone(),
-                "ros2msg".into(),
-                state_text.clone().into_bytes(),
-            ),
-            Channel::Force => s(messages::FORCE_SCHEMA),
-            Channel::Events => s(messages::EVENTS_SCHEMA),
-            Channel::Timing => s(messages::TIMING_SCHEMA),
-            Channel::FoxgloveScene => foxglove_out::schema::<SceneUpdate>(),
-            Channel::FoxgloveTf => foxglove_out::schema::<FrameTransform>(),
-            Channel::FoxgloveLog => foxglove_out::schema::<Log>(),
-        };
-        let msg_enc = if enc == "protobuf" { "protobuf" } else { "cdr" };
+        let (name, enc, data) = channel_schema(ch, &setup.description);
         let sid = w
             .add_schema(&name, &enc, &data)
             .map_err(|e| write_err(path, &e, 0))?;
         let cid = w
-            .add_channel(sid, ch.topic(), msg_enc, &meta)
+            .add_channel(sid, ch.topic(), ch.message_encoding(), &meta)
             .map_err(|e| write_err(path, &e, 0))?;
         ids.insert(ch, cid);
     }
     Ok((w, ids))
 }
 
-fn s((name, text): (&str, &str)) -> (String, String, Vec<u8>) {
-    (
-        name.to_string(),
-        "ros2msg".to_string(),
-        text.as_bytes().to_vec(),
-    )
+/// The schema (name, encoding, bytes) written for `ch` in a recording of the session `d`: the
+/// declared `.msg` text of a CDR channel (the state's with the scene's fields), Foxglove's
+/// protobuf descriptor set for its channels.
+pub fn channel_schema(ch: Channel, d: &DescriptionMsg) -> (String, String, Vec<u8>) {
+    match ch {
+        Channel::State => {
+            let (name, text) = messages::state_schema(&d.scene_kind, &d.state_fields);
+            (name, "ros2msg".into(), text.into_bytes())
+        }
+        Channel::FoxgloveScene => foxglove_out::schema::<SceneUpdate>(),
+        Channel::FoxgloveTf => foxglove_out::schema::<FrameTransform>(),
+        Channel::FoxgloveLog => foxglove_out::schema::<Log>(),
+        _ => match ch.ros2_schema() {
+            Some((name, text)) => (name.to_string(), "ros2msg".into(), text.into_bytes()),
+            None => (ch.schema_name().to_string(), String::new(), Vec::new()),
+        },
+    }
 }
 
 fn write_msgs(
