@@ -94,9 +94,9 @@ def test_weight_of_a_carried_brick_is_m_g():
     # Run-time switches change what is felt.
     w.set_brick_mass(0.8)
     assert w.step((0, 0, 0.3), {"center": True})["force_n"][2] == pytest.approx(-0.8 * g, rel=1e-9)
-    w.set_brick_mass(1.0)  # 9.81 N: more than the Falcon's 9 N, scaled down and flagged
-    over = w.step((0, 0, 0.3), {"center": True})
-    assert over["saturated"] and over["force_n"][2] == pytest.approx(-9.0, rel=1e-12)
+    w.set_brick_mass(1.0)  # 9.81 N: more than the Falcon's 8 N, scaled down and flagged
+    over = w.step((0, 0, 0.3), {"hold": True})  # the grip's own name; "center" still works
+    assert over["saturated"] and over["force_n"][2] == pytest.approx(-8.0, rel=1e-12)
     assert over["weight_force_n"][2] == pytest.approx(-9.81, rel=1e-12)
     w.set_gravity(0.0)
     assert w.step((0, 0, 0.3), {"center": True})["force_n"] == pytest.approx([0, 0, 0], abs=1e-9)
@@ -172,10 +172,10 @@ def test_run_equals_repeated_step():
 def test_bad_arguments_raise_value_error_naming_them():
     cases = [
         (lambda: nh.BrickWorld({"restitution": 1.5}), "parameter `restitution` = 1.5 is out of range: allowed [0, 1]"),
-        (lambda: nh.BrickWorld(device="phantom"), 'device = "phantom": allowed "falcon" or a dict with max_stiffness_n_m and max_force_n'),
+        (lambda: nh.BrickWorld(device="phantom"), 'device = "phantom": allowed "falcon" or a dict with max_force_n and max_stiffness_n_per_m'),
         (lambda: nh.BrickWorld().step((0, 0, 3.0)), "cursor input `position_m[2]` = 3 m is outside the workspace: allowed [-2, 2] m"),
         (lambda: nh.BrickWorld().step((0, 0)), "position_m: expected shape (3,), got (2,)"),
-        (lambda: nh.BrickWorld().step((0, 0, 0.1), {"centre": True}), "buttons: unknown button \"centre\": allowed [\"center\", \"rotate_x\", \"rotate_y\", \"rotate_z\"]"),
+        (lambda: nh.BrickWorld().step((0, 0, 0.1), {"centre": True}), "buttons: unknown button \"centre\": allowed [\"hold\", \"turn_x\", \"turn_y\", \"turn_z\"] or [\"center\", \"rotate_x\", \"rotate_y\", \"rotate_z\"]"),
         (lambda: nh.BrickWorld().brick(3), "unknown brick id 3"),
         (lambda: nh.BrickWorld().set_restitution(-0.1), "parameter `restitution` = -0.1 is out of range: allowed [0, 1]"),
         (lambda: nh.BrickWorld().run([[0, 0, 0.1], [0, 0, float("nan")]]), "positions_m[1, 2] = NaN is out of range: allowed finite (m)"),

@@ -121,7 +121,7 @@ def test_tiny_dt_while_carrying_is_refused_and_the_smallest_is_finite():
     for dz in (0.0, 0.1, 0.4):
         r = w.step(c + (0.0, 0.0, dz), dt_s=1e-9)
         assert np.all(np.isfinite(r["force"])) and np.all(np.isfinite(r["unlimited_force"]))
-        assert np.linalg.norm(r["force"]) <= w.params["max_force_n"] * (1 + 1e-12)
+        assert np.linalg.norm(r["force"]) <= w.device["max_force_n"] * (1 + 1e-12)
         # 0.1 m in 1 ns: m·a = 1e-8 N on the atom, more than the tip's 3 nN hold: it is thrown
         # off the tip (and the force stays finite, unsaturated).
         thrown = [e for e in r["events"] if e["type"] == "atoms_thrown_off"]

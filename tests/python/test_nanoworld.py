@@ -147,7 +147,7 @@ def test_house_session_builds_the_house_and_replays_bit_for_bit():
     for slot, atom in enumerate(h["filled"]):
         assert np.linalg.norm(w1.atoms[atom] - h["slots"][slot]) <= h["tolerance_m"]
     # The device force never exceeds the limit.
-    fmax = w1.params["max_force_n"]
+    fmax = w1.device["max_force_n"]
     assert np.all(np.linalg.norm(r1["force"], axis=1) <= fmax * (1 + 1e-12))
     assert np.all(np.isfinite(r1["force"]))
     # Same inputs, same bits.

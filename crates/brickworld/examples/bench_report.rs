@@ -5,10 +5,9 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use brickworld::{
-    AccelEstimator, BrickId, BrickPlacement, Buttons, DeviceLimits, MotionEstimator, Params, World,
-};
+use brickworld::{AccelEstimator, BrickId, BrickPlacement, Grip, MotionEstimator, Params, World};
 use plotters::prelude::*;
+use world_form::Limits;
 
 const PARK: [f64; 3] = [0.0, 0.0, 0.5];
 
@@ -20,7 +19,7 @@ fn at(c: [f64; 3]) -> BrickPlacement {
 }
 
 fn step_idle(w: &mut World, pos: [f64; 3]) -> brickworld::StepReport {
-    let i = w.input(pos, Buttons::default()).unwrap();
+    let i = w.input(pos, Grip::default()).unwrap();
     w.step(&i)
 }
 
@@ -44,7 +43,7 @@ fn scene(n_bricks: usize, p: &Params) -> World {
             ]));
         }
     }
-    World::new(p, DeviceLimits::NOVINT_FALCON).expect("valid scene")
+    World::new(&p, &Limits::FALCON).expect("valid scene")
 }
 
 /// Percentiles of one tick's cost, in µs: thread CPU time (what the tick costs) and wall time
@@ -59,7 +58,7 @@ struct Timing {
 }
 
 /// Times `n` ticks; `input(k)` gives the k-th sample.
-fn measure(w: &mut World, n: usize, input: impl Fn(usize) -> ([f64; 3], Buttons)) -> Timing {
+fn measure(w: &mut World, n: usize, input: impl Fn(usize) -> ([f64; 3], Grip)) -> Timing {
     let mut cpu = Vec::with_capacity(n);
     let mut wall = Vec::with_capacity(n);
     for k in 0..n {
@@ -86,10 +85,7 @@ fn measure(w: &mut World, n: usize, input: impl Fn(usize) -> ([f64; 3], Buttons)
 /// Times `n` ticks with the cursor sweeping in free space above the scene.
 fn time_ticks(w: &mut World, n: usize) -> Timing {
     measure(w, n, |k| {
-        (
-            [0.3 * (k as f64 * 2e-3).sin(), 0.0, 0.7],
-            Buttons::default(),
-        )
+        ([0.3 * (k as f64 * 2e-3).sin(), 0.0, 0.7], Grip::default())
     })
 }
 
@@ -102,7 +98,7 @@ fn stack_error(p: &Params) -> (f64, f64) {
         .map(|i| at([0.0, 0.0, h[2] * (2 * i + 1) as f64]))
         .collect();
     let top0 = p.bricks[9].center_m[2];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     for _ in 0..2000 {
         step_idle(&mut w, [1.0, 1.0, 1.0]);
     }
@@ -131,7 +127,7 @@ fn press_error(p: &Params, speed: f64) -> f64 {
     let h = p.brick_half_extents_m;
     let r = p.proxy_radius_m;
     p.bricks = vec![at([0.0, 0.0, h[2]])];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     for _ in 0..1500 {
         step_idle(&mut w, [1.0, 1.0, 1.0]);
     }
@@ -158,7 +154,7 @@ fn bounce(e: f64) -> f64 {
     };
     let hz = p.brick_half_extents_m[2];
     p.bricks = vec![at([0.0, 0.0, hz + 0.5])];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     let (mut hit, mut apex) = (false, 0.0_f64);
     for _ in 0..4000 {
         step_idle(&mut w, [1.0, 1.0, 1.0]);
@@ -197,7 +193,7 @@ fn slide(mu: f64, theta_deg: f64) -> f64 {
         center_m: c,
         rotation_deg: [0.0, theta_deg, 0.0],
     }];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     for _ in 0..1000 {
         step_idle(&mut w, [1.5, 1.5, 1.5]);
     }
@@ -331,9 +327,9 @@ fn main() {
                 [above[0], above[1], above[2] + 0.03 - 1e-4 * i as f64],
             );
         }
-        let b = Buttons {
-            center: true,
-            ..Buttons::default()
+        let b = Grip {
+            hold: true,
+            ..Grip::default()
         };
         w.step(&w.input([above[0], above[1], above[2] - 0.002], b).unwrap());
         assert_eq!(
@@ -574,7 +570,7 @@ fn wall_params() -> Params {
 
 /// Runs the scripted wall session; returns (simulated s, score, cursor path, world).
 fn build_wall() -> (f64, brickworld::Score, Vec<[f64; 3]>, World) {
-    let mut w = World::new(wall_params(), DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&wall_params(), &Limits::FALCON).unwrap();
     let mut script = brickworld::script::WallScript::new(&w, [0.3, -0.4, 0.35]).unwrap();
     let mut traj = Vec::new();
     let mut ticks = 0usize;

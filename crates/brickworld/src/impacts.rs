@@ -12,8 +12,8 @@
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{ColliderHandle, PairContacts, PhysicsWorld, RigidBodyHandle};
 
+use crate::event::{Body, Event};
 use crate::impact::IMPACT_MIN_SPEED_M_S;
-use crate::world::{Body, Event};
 
 /// Tracks the contact pairs that carried impulse, step to step.
 #[derive(Debug, Default, Clone)]

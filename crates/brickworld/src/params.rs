@@ -5,7 +5,9 @@
 //! Run-time switches (gravity, restitution, friction, inertia, brick mass) are changed through
 //! the validated setters on [`crate::World`], which reuse the same range checks.
 
+use rapier3d_f64::math::{Rotation, Vector};
 use serde::{Deserialize, Serialize};
+use world_form::Limits;
 
 use crate::error::ParamError;
 
@@ -145,6 +147,14 @@ pub struct BrickPlacement {
     pub rotation_deg: [f64; 3],
 }
 
+impl BrickPlacement {
+    /// The orientation (rotation vector in degrees) as a unit quaternion.
+    pub fn rotation(&self) -> Rotation {
+        let v = Vector::from_array(self.rotation_deg) * (std::f64::consts::PI / 180.0);
+        Rotation::from_scaled_axis(v)
+    }
+}
+
 /// Properties of one brick that may differ from the world's ([`crate::World::add_brick_with`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -194,35 +204,6 @@ impl Default for Blueprint {
             position_tolerance_m: 0.01,
             angle_tolerance_deg: 5.0,
         }
-    }
-}
-
-/// Limits of the haptic device the world renders to (CHAI3D-style device specification).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DeviceLimits {
-    /// Largest stiffness the device renders stably, N/m.
-    pub max_stiffness_n_m: f64,
-    /// Largest force magnitude the device can produce, N.
-    pub max_force_n: f64,
-}
-
-impl DeviceLimits {
-    /// Nominal Novint Falcon figures: about 9 N peak force; a few kN/m of stable stiffness.
-    pub const NOVINT_FALCON: DeviceLimits = DeviceLimits {
-        max_stiffness_n_m: 3000.0,
-        max_force_n: 9.0,
-    };
-
-    /// Checks both limits are finite and positive.
-    pub fn validate(&self) -> Result<(), ParamError> {
-        range(
-            "device.max_stiffness_n_m",
-            self.max_stiffness_n_m,
-            Lo::Open(0.0),
-            1e7,
-        )?;
-        range("device.max_force_n", self.max_force_n, Lo::Open(0.0), 1e5)
     }
 }
 
@@ -403,14 +384,20 @@ impl Params {
         Ok(())
     }
 
-    /// Checks the parameters that depend on the device (the proxy stiffness).
-    pub fn validate_for_device(&self, device: &DeviceLimits) -> Result<(), ParamError> {
-        device.validate()?;
+    /// Checks the parameters that depend on the device: the limits themselves (named
+    /// `device.max_force_n` / `device.max_stiffness_n_per_m`) and the proxy stiffness, which
+    /// must not exceed [`Limits::max_stiffness_n_per_m`].
+    pub fn validate_for_device(&self, limits: &Limits) -> Result<(), ParamError> {
+        limits.validate().map_err(|e| ParamError::OutOfRange {
+            field: format!("device.{}", e.field),
+            value: e.value,
+            range: format!("(0, {}]", e.max),
+        })?;
         range(
             "proxy_stiffness_n_m",
             self.proxy_stiffness_n_m,
             Lo::Open(0.0),
-            device.max_stiffness_n_m,
+            limits.max_stiffness_n_per_m,
         )
     }
 }

@@ -4,11 +4,11 @@
 mod common;
 use brickworld::script::WallScript;
 use brickworld::{
-    AccelEstimator, BrickId, BrickPlacement, Buttons, DeviceLimits, Event, InputError, ParamError,
-    Params, World,
+    AccelEstimator, BrickId, BrickPlacement, Event, Grip, InputError, ParamError, Params, World,
 };
 use common::*;
 use proptest::prelude::*;
+use world_form::Limits;
 
 #[test]
 fn bad_parameters_name_the_field_and_range() {
@@ -26,7 +26,7 @@ fn bad_parameters_name_the_field_and_range() {
     );
     let mut p = Params::default();
     p.proxy_stiffness_n_m = 5000.0;
-    let e = World::new(p, DeviceLimits::NOVINT_FALCON).err().unwrap();
+    let e = World::new(&p, &Limits::FALCON).err().unwrap();
     assert_eq!(
         e.to_string(),
         "parameter `proxy_stiffness_n_m` = 5000 is out of range: allowed (0, 3000]"
@@ -100,14 +100,14 @@ fn parameters_round_trip_through_toml() {
 fn bad_cursor_input_and_switches_are_typed_errors() {
     let mut w = world(bare());
     assert_eq!(
-        w.input([0.0, f64::INFINITY, 0.0], Buttons::default()),
+        w.input([0.0, f64::INFINITY, 0.0], Grip::default()),
         Err(InputError::NotFinite {
             axis: 1,
             value: f64::INFINITY
         })
     );
     assert_eq!(
-        w.input([0.0, 0.0, 3.0], Buttons::default())
+        w.input([0.0, 0.0, 3.0], Grip::default())
             .unwrap_err()
             .to_string(),
         "cursor input `position_m[2]` = 3 m is outside the workspace: allowed [-2, 2] m"
@@ -248,10 +248,10 @@ fn rotate_buttons_turn_the_carried_brick_by_quarter_turns() {
     }
     let c = w.cursor_position_m();
     let q0 = w.brick(BrickId(0)).unwrap().orientation_xyzw;
-    let b = Buttons {
-        center: true,
-        rotate_z: true,
-        ..Buttons::default()
+    let b = Grip {
+        hold: true,
+        turn_z: true,
+        ..Grip::default()
     };
     let rep = w.step(&w.input(c, b).unwrap());
     assert!(rep.events.contains(&Event::Rotated {
@@ -292,7 +292,7 @@ proptest! {
         p.bricks = vec![at([0.0, 0.0, h[2]]), at([0.0, 0.0, 3.0 * h[2]])];
         let mut w = world(p);
         let r = w.params().proxy_radius_m;
-        let max_f = w.device().max_force_n;
+        let max_f = w.limits().max_force_n;
         for (x, y, z, c) in path {
             for _ in 0..10 {
                 let rep = hold(&mut w, [x, y, z], c);

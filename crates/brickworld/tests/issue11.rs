@@ -115,7 +115,7 @@ fn pressing_down_on_the_centre_does_not_walk_the_brick() {
     let start = w.brick(BrickId(0)).unwrap().position_m;
     let top = start[2] + h[2];
     let r = w.params().proxy_radius_m;
-    let max_f = w.device().max_force_n;
+    let max_f = w.limits().max_force_n;
     let mut worst_lateral = 0.0_f64;
     let mut last = None;
     for i in 0..4000 {

@@ -495,10 +495,10 @@ fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
     // Standing on the ground, a quarter turn about y would stand the brick on its end through
     // the ground: refused, and nothing moves.
     let before = w.brick(BrickId(0)).unwrap();
-    let turn_y = brickworld::Buttons {
-        center: true,
-        rotate_y: true,
-        ..brickworld::Buttons::default()
+    let turn_y = brickworld::Grip {
+        hold: true,
+        turn_y: true,
+        ..brickworld::Grip::default()
     };
     let rep = w.step(&w.input(c, turn_y).unwrap());
     assert!(
@@ -533,10 +533,10 @@ fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
     for _ in 0..100 {
         hold(&mut w, c, true);
     }
-    let turn_z = brickworld::Buttons {
-        center: true,
-        rotate_z: true,
-        ..brickworld::Buttons::default()
+    let turn_z = brickworld::Grip {
+        hold: true,
+        turn_z: true,
+        ..brickworld::Grip::default()
     };
     let rep = w.step(&w.input(c, turn_z).unwrap());
     assert!(rep.events.contains(&Event::Rotated {

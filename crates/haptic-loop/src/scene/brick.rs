@@ -2,10 +2,11 @@
 //! god-object cursor, grab / carry / rotate / throw, blueprint score.
 //!
 //! A thin adapter. `[brickworld.params]` is the world's own [`brickworld::Params`] table
-//! (every field has a default). The device limits handed to the world are the device's,
-//! mapped to the world (`k_max / (force_scale · workspace_scale)`, `F_max / force_scale`), so the
-//! world's proxy stiffness is checked against the real device. Buttons: Falcon centre → grab,
-//! plus / minus / forward → turn about x / y / z; Touch button1 → grab, button2 → turn about z.
+//! (every field has a default). The world is built with the device's limits mapped to the world
+//! ([`super::LoopConfig::world_limits`]), so its proxy stiffness is checked against the real
+//! device. The device's buttons become the hand's [`Grip`] commands: Falcon centre → `hold`,
+//! plus / minus / forward → `turn_x` / `turn_y` / `turn_z`; Touch button1 → `hold`, button2 →
+//! `turn_z`.
 //! The world's `dt_s` must equal the loop's tick.
 
 use super::check::{SceneError, check_positive, out_of_range};
@@ -14,8 +15,9 @@ use super::{
     Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
 };
 use crate::vec3::Vec3;
-use brickworld::{Buttons as BrickButtons, CursorInput, DeviceLimits, Params, World};
+use brickworld::{CursorInput, Grip, Params, World};
 use serde::Deserialize;
+use world_form::Limits;
 
 /// The brick world in the scene registry: `kind = "brickworld"`, table `[brickworld]`.
 pub const WORLD: WorldKind = WorldKind {
@@ -25,8 +27,7 @@ pub const WORLD: WorldKind = WorldKind {
         let p: BrickSection = world_table(text, "brickworld")?;
         let scene = BrickScene::new(
             p,
-            config.world_stiffness_cap_n_per_m(),
-            config.world_max_force_n(),
+            &config.world_limits(),
             config.dt_s(),
             &config.specs.button_strs(),
         )?;
@@ -53,7 +54,8 @@ fn default_ground() -> f64 {
 /// The brick-world scene.
 pub struct BrickScene {
     world: World,
-    /// Bit of the device button for centre, x, y, z turns (`None`: the device has none).
+    /// Bit of the device button for `hold`, `turn_x`, `turn_y`, `turn_z` (`None`: the device
+    /// has none).
     bits: [Option<u32>; 4],
     last_input: Option<CursorInput>,
     rejected: bool,
@@ -80,12 +82,11 @@ pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
 ];
 
 impl BrickScene {
-    /// Builds the scene: `cap_n_per_m` and `max_force_world_n` are the device limits mapped to
-    /// the world, `dt_s` the tick, `buttons` the device's button names.
+    /// Builds the scene: `limits` are the device's limits mapped to the world, `dt_s` the
+    /// tick, `buttons` the device's button names.
     pub fn new(
         s: BrickSection,
-        cap_n_per_m: f64,
-        max_force_world_n: f64,
+        limits: &Limits,
         dt_s: f64,
         buttons: &[&str],
     ) -> Result<Self, SceneError> {
@@ -97,12 +98,8 @@ impl BrickScene {
             ));
         }
         check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;
-        let limits = DeviceLimits {
-            max_stiffness_n_m: cap_n_per_m,
-            max_force_n: max_force_world_n,
-        };
         let slots = s.params.blueprint.slots.len();
-        let world = World::new(s.params, limits).map_err(|e| SceneError::World {
+        let world = World::new(&s.params, limits).map_err(|e| SceneError::World {
             section: "brickworld.params".into(),
             field: Some(e.field().to_string()),
             message: e.to_string(),
@@ -125,7 +122,7 @@ impl BrickScene {
             force_n: [0.0; 3],
             penetration_m: 0.0,
             ground_half_m: s.draw_ground_half_m,
-            score: HouseScore::new(slots, max_force_world_n, dt_s),
+            score: HouseScore::new(slots, limits.max_force_n, dt_s),
             released: Vec::new(),
         })
     }
@@ -244,13 +241,13 @@ impl Scene for BrickScene {
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         let pressed = |bit: Option<u32>| bit.is_some_and(|b| input.buttons.pressed(b));
-        let buttons = BrickButtons {
-            center: pressed(self.bits[0]),
-            rotate_x: pressed(self.bits[1]),
-            rotate_y: pressed(self.bits[2]),
-            rotate_z: pressed(self.bits[3]),
+        let grip = Grip {
+            hold: pressed(self.bits[0]),
+            turn_x: pressed(self.bits[1]),
+            turn_y: pressed(self.bits[2]),
+            turn_z: pressed(self.bits[3]),
         };
-        let cursor_input = match self.world.input(input.cursor_m, buttons) {
+        let cursor_input = match self.world.input(input.cursor_m, grip) {
             Ok(i) => {
                 self.rejected = false;
                 Some(i)
