@@ -319,7 +319,7 @@ class BrickWorld:
         center_m: ArrayLike,
         rotation_deg: Optional[ArrayLike] = None,
         *,
-        velocity_m_s: Optional[ArrayLike] = None,
+        velocity_m_per_s: Optional[ArrayLike] = None,
         mass_kg: Optional[float] = None,
         friction: Optional[float] = None,
         restitution: Optional[float] = None,
@@ -328,8 +328,8 @@ class BrickWorld:
         m/s, its own mass kg / friction / restitution); returns its id."""
     def step(self, position_m: ArrayLike, buttons: Buttons = None) -> dict:
         """One tick: {"tick", "force_n", "saturated", "spring_force_n",
-        "stiffness_n_m", "weight_force_n", "inertia_force_n",
-        "acceleration_m_s2", "proxy_penetration_m", "events"}."""
+        "stiffness_n_per_m", "weight_force_n", "inertia_force_n",
+        "acceleration_m_per_s2", "proxy_penetration_m", "events"}."""
     def run(self, positions_m: ArrayLike, buttons: Union[Buttons, ArrayLike] = None) -> dict:
         """One tick per row of (T, 3) positions; buttons None, one set, or (T, 4).
         Per-tick arrays: force, spring_force, weight_force, inertia_force (T, 3) N,
@@ -341,11 +341,11 @@ class BrickWorld:
     def run_wall_script(self, start_m: ArrayLike, max_ticks: int = 40000, settle_ticks: int = 1000) -> dict:
         """Run the scripted wall builder; same arrays as run()."""
     def brick(self, id: int) -> dict:
-        """One brick: position_m, orientation_xyzw, half_extents_m, velocity_m_s, held, sleeping."""
+        """One brick: position_m, orientation_xyzw, half_extents_m, velocity_m_per_s, held, sleeping."""
     @property
     def bricks(self) -> dict:
         """Same keys as brick(): id (B,), position_m (B, 3) m, orientation_xyzw
-        (B, 4), half_extents_m (B, 3) m, velocity_m_s (B, 3) m/s, held (B,),
+        (B, 4), half_extents_m (B, 3) m, velocity_m_per_s (B, 3) m/s, held (B,),
         sleeping (B,)."""
     @property
     def proxy_position(self) -> F64Array: ...
@@ -373,7 +373,7 @@ class BrickWorld:
     def tick(self) -> int: ...
     @property
     def time(self) -> float: ...
-    def set_gravity(self, g_m_s2: float) -> None: ...
+    def set_gravity(self, g_m_per_s2: float) -> None: ...
     def set_restitution(self, e: float) -> None: ...
     def set_friction(self, mu: float) -> None: ...
     def set_inertia(self, on: bool) -> None: ...

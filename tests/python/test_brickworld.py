@@ -38,7 +38,7 @@ def test_bounce_height_ratio_is_e_squared():
     for _ in range(4000):
         w.step(PARK)
         b = w.brick(0)
-        bottom, vz = b["position_m"][2] - HZ, b["velocity_m_s"][2]
+        bottom, vz = b["position_m"][2] - HZ, b["velocity_m_per_s"][2]
         hit = hit or vz > 0.0
         if hit:
             apex = max(apex, bottom)
@@ -50,7 +50,7 @@ def test_bounce_height_ratio_is_e_squared():
 def test_proxy_spring_against_the_ground():
     w = nh.BrickWorld()
     r = w.params["proxy_radius_m"]
-    k = w.params["proxy_stiffness_n_m"]
+    k = w.params["proxy_stiffness_n_per_m"]
     w.step((0.0, 0.0, 0.1))
     rep = w.step((0.0, 0.0, -0.001))
     # The proxy stays on the surface (within a few µm of skin); the device feels
@@ -59,7 +59,7 @@ def test_proxy_spring_against_the_ground():
     assert pz == pytest.approx(r, abs=5e-6)
     assert rep["force_n"][2] == pytest.approx(k * (pz + 0.001), rel=1e-9)
     assert rep["force_n"][0] == 0.0 and rep["force_n"][1] == 0.0
-    assert rep["stiffness_n_m"] == k
+    assert rep["stiffness_n_per_m"] == k
     # Deeper: the force is scaled down to the Falcon's 9 N, direction kept, flagged.
     deep = w.step((0.0, 0.0, -0.05))
     assert deep["saturated"] and deep["force_n"][2] == pytest.approx(9.0, rel=1e-12)
@@ -87,7 +87,7 @@ def test_weight_of_a_carried_brick_is_m_g():
     r = _grab_and_lift(w)
     assert any(e["type"] == "grabbed" and e["brick"] == 0 for _, e in r["events"])
     assert r["held"][-1] == 0 and w.held_brick == 0
-    m, g = w.params["brick_mass_kg"], w.params["gravity_m_s2"]
+    m, g = w.params["brick_mass_kg"], w.params["gravity_m_per_s2"]
     # Held still in free space: only the weight, −M g along z (inertia is zero at rest).
     np.testing.assert_allclose(r["weight_force"][-1], [0, 0, -m * g], rtol=1e-12)
     np.testing.assert_allclose(r["force"][-1], [0, 0, -m * g], rtol=1e-9, atol=1e-9)
@@ -107,7 +107,7 @@ def test_weight_of_a_carried_brick_is_m_g():
 
 
 def test_inertia_of_a_carried_brick_is_minus_m_a():
-    w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}], "gravity_m_s2": 0.0})
+    w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}], "gravity_m_per_s2": 0.0})
     _grab_and_lift(w, hold_ticks=50)
     # Accelerate the carried brick along x with a = 2 m/s²: x = a t²/2.
     a, dt = 2.0, w.params["dt_s"]

@@ -159,12 +159,12 @@ fn bounce(e: f64) -> f64 {
     for _ in 0..4000 {
         step_idle(&mut w, [1.0, 1.0, 1.0]);
         let b = w.brick(BrickId(0)).unwrap();
-        if b.velocity_m_s[2] > 0.0 {
+        if b.velocity_m_per_s[2] > 0.0 {
             hit = true;
         }
         if hit {
             apex = apex.max(b.position_m[2] - hz);
-            if b.velocity_m_s[2] < 0.0 && apex > 0.0 {
+            if b.velocity_m_per_s[2] < 0.0 && apex > 0.0 {
                 break;
             }
         }

@@ -8,7 +8,7 @@ use crate::event::{BrickId, Event};
 use crate::params::{Blueprint, BrickPlacement, Params};
 
 /// A brick slower than this (m/s) counts as resting for the blueprint.
-pub const RESTING_SPEED_M_S: f64 = 0.05;
+pub const RESTING_SPEED_M_PER_S: f64 = 0.05;
 
 /// A blueprint slot and whether it is filled.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -109,7 +109,7 @@ impl Slots {
                     continue;
                 }
                 let rb = &bricks.phys.bodies[bricks.body(id)];
-                if rb.linvel().length() > RESTING_SPEED_M_S {
+                if rb.linvel().length() > RESTING_SPEED_M_PER_S {
                     continue;
                 }
                 if let Some(d) = fills(&params.blueprint, slot, rb.translation(), *rb.rotation())

@@ -24,7 +24,7 @@ pub const GROUND_HALF_EXTENT_M: f64 = 50.0;
 /// Speed (m/s, farthest point of the brick) below which a brick may start to count as resting;
 /// rapier's own threshold for the sleep timer (its default is 0.05 m/s, which freezes a brick
 /// gliding at 4 cm/s on frictionless ground).
-pub const SLEEP_SPEED_M_S: f64 = 2e-3;
+pub const SLEEP_SPEED_M_PER_S: f64 = 2e-3;
 /// Net acceleration (m/s², farthest point) at or above which a slow brick is never put to sleep:
 /// over rapier's 0.5 s sleep window its velocity must change by less than this × the window.
 /// A brick starting from rest on a ramp 0.01° steeper than the friction angle (μ = 0.6)
@@ -32,7 +32,7 @@ pub const SLEEP_SPEED_M_S: f64 = 2e-3;
 /// acceleration may sleep after moving under 0.5 mm in its first second. Resting bricks and
 /// stacks sleep (tests `resting_brick_and_brick_below_friction_angle_fall_asleep`,
 /// `stack_of_ten_bricks_stays_put_for_60_s`).
-pub const SLEEP_MAX_ACCEL_M_S2: f64 = 1e-3;
+pub const SLEEP_MAX_ACCEL_M_PER_S2: f64 = 1e-3;
 
 const TAG_GROUND: u128 = 0;
 const TAG_OBSTACLE: u128 = 1 << 64;
@@ -50,7 +50,7 @@ pub struct BrickView {
     /// Half-extents along its local axes, m.
     pub half_extents_m: [f64; 3],
     /// Linear velocity, m/s.
-    pub velocity_m_s: [f64; 3],
+    pub velocity_m_per_s: [f64; 3],
     /// Whether the cursor is carrying it.
     pub held: bool,
     /// Whether the physics engine has put it to sleep (resting, not simulated).
@@ -106,7 +106,7 @@ impl BrickSet {
     /// scene queries up to date.
     pub(crate) fn new(params: &Params) -> BrickSet {
         let mut phys = PhysicsWorld::new();
-        phys.gravity = Vector::new(0.0, 0.0, -params.gravity_m_s2);
+        phys.gravity = Vector::new(0.0, 0.0, -params.gravity_m_per_s2);
         phys.integration_parameters.dt = params.dt_s;
         phys.integration_parameters.num_solver_iterations = params.solver_iterations;
         // rapier's default friction model (one friction constraint per manifold plus a twist
@@ -201,9 +201,9 @@ impl BrickSet {
             Some(body),
         );
         if let Some(rb) = self.phys.bodies.get_mut(body) {
-            rb.activation_mut().normalized_linear_threshold = SLEEP_SPEED_M_S;
-            if props.velocity_m_s != [0.0; 3] {
-                rb.set_linvel(Vector::from_array(props.velocity_m_s), true);
+            rb.activation_mut().normalized_linear_threshold = SLEEP_SPEED_M_PER_S;
+            if props.velocity_m_per_s != [0.0; 3] {
+                rb.set_linvel(Vector::from_array(props.velocity_m_per_s), true);
             }
         }
         self.bricks.push(Brick {
@@ -247,8 +247,8 @@ impl BrickSet {
     pub(crate) fn check_props(props: &BrickProps) -> Result<(), WorldError> {
         for i in 0..3 {
             range(
-                &format!("brick.velocity_m_s[{i}]"),
-                props.velocity_m_s[i],
+                &format!("brick.velocity_m_per_s[{i}]"),
+                props.velocity_m_per_s[i],
                 Lo::Closed(-100.0),
                 100.0,
             )?;
@@ -315,7 +315,7 @@ impl BrickSet {
             position_m: rb.translation().to_array(),
             orientation_xyzw: quat(*rb.rotation()),
             half_extents_m: params.brick_half_extents_m,
-            velocity_m_s: rb.linvel().to_array(),
+            velocity_m_per_s: rb.linvel().to_array(),
             held: held == Some(id),
             sleeping: rb.is_sleeping(),
         })
@@ -359,10 +359,10 @@ impl BrickSet {
     }
 
     /// The sleep policy: rapier puts a body to sleep once it has been slower than
-    /// [`SLEEP_SPEED_M_S`] for 0.5 s. That alone freezes a brick that starts sliding from rest
+    /// [`SLEEP_SPEED_M_PER_S`] for 0.5 s. That alone freezes a brick that starts sliding from rest
     /// with a small net force (it stays slow for its first half second). So a slow brick is
     /// allowed to fall asleep only if its velocity also stayed constant over that window (net
-    /// acceleration below [`SLEEP_MAX_ACCEL_M_S2`]): a brick under an unbalanced force is kept
+    /// acceleration below [`SLEEP_MAX_ACCEL_M_PER_S2`]): a brick under an unbalanced force is kept
     /// awake, and sleep only skips bricks that are truly at rest. `tick` is the tick about to
     /// be simulated.
     pub(crate) fn veto_sleep(&mut self, params: &Params, tick: u64) {
@@ -393,7 +393,7 @@ impl BrickSet {
             let reach = params.brick_half_extents_m;
             let r = (reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]).sqrt();
             let change = (v - v0).length() + (w - w0).length() * r;
-            if change >= SLEEP_MAX_ACCEL_M_S2 * elapsed.max(dt) {
+            if change >= SLEEP_MAX_ACCEL_M_PER_S2 * elapsed.max(dt) {
                 rb.wake_up(true);
                 b.slow_since = Some((tick, v, w));
             }
@@ -428,8 +428,8 @@ impl BrickSet {
     // ----- run-time switches (values already checked) ---------------------------------
 
     /// Gravity `g` (m/s²) along −z; wakes every body.
-    pub(crate) fn set_gravity(&mut self, g_m_s2: f64) {
-        self.phys.gravity = Vector::new(0.0, 0.0, -g_m_s2);
+    pub(crate) fn set_gravity(&mut self, g_m_per_s2: f64) {
+        self.phys.gravity = Vector::new(0.0, 0.0, -g_m_per_s2);
         self.phys.wake_up_all(true);
     }
 

@@ -80,14 +80,14 @@ pub enum Event {
         /// The brick let go.
         brick: BrickId,
         /// Its initial velocity, m/s (the grip point's velocity).
-        velocity_m_s: [f64; 3],
+        velocity_m_per_s: [f64; 3],
     },
-    /// Same release, faster than [`crate::Params::throw_min_speed_m_s`]: a throw.
+    /// Same release, faster than [`crate::Params::throw_min_speed_m_per_s`]: a throw.
     Thrown {
         /// The thrown brick.
         brick: BrickId,
         /// Its initial velocity, m/s.
-        velocity_m_s: [f64; 3],
+        velocity_m_per_s: [f64; 3],
     },
     /// The carried brick turned by +90° about a world axis (through the grip point).
     Rotated {
@@ -128,7 +128,7 @@ pub enum Event {
         brick: BrickId,
     },
     /// A collision: a contact that began this step with bodies approaching faster than
-    /// [`crate::impact::IMPACT_MIN_SPEED_M_S`] (see [`crate::impacts`]). Between the cursor and what it touches,
+    /// [`crate::impact::IMPACT_MIN_SPEED_M_PER_S`] (see [`crate::impacts`]). Between the cursor and what it touches,
     /// the impulse is the brick mass × the cursor's approach speed (the cursor has no mass in
     /// the world; this is the impulse that would stop a brick arriving at that speed).
     Impact {
@@ -139,7 +139,7 @@ pub enum Event {
         /// Normal impulse of the contact over the step, N·s.
         impulse_n_s: f64,
         /// Approach speed along the contact normal just before the step, m/s.
-        speed_m_s: f64,
+        speed_m_per_s: f64,
         /// Centroid of the contact, m.
         point_m: [f64; 3],
     },

@@ -10,7 +10,7 @@ use world_form::Limits;
 use crate::bricks::BrickSet;
 use crate::estimator::MotionEstimator;
 use crate::event::{Axis, Body, BrickId, Event, Touch};
-use crate::impact::IMPACT_MIN_SPEED_M_S;
+use crate::impact::IMPACT_MIN_SPEED_M_PER_S;
 use crate::input::{CursorInput, Grip};
 use crate::params::{AccelEstimator, Params};
 use crate::proxy::{self, HeldShape};
@@ -181,11 +181,11 @@ impl Hand {
         //    to the device limit. The hand pushes the world with exactly the reaction of the
         //    spring part of it (action = reaction at the coupling): a proxy pressed deep into a
         //    brick pushes with at most the device's force, not with the stretched spring's.
-        let spring = (self.proxy - c) * params.proxy_stiffness_n_m;
+        let spring = (self.proxy - c) * params.proxy_stiffness_n_per_m;
         let m = params.brick_mass_kg;
         let accel = Vector::from_array(self.motion.acceleration());
         let (weight, inertia) = if self.held.is_some() {
-            let w = Vector::new(0.0, 0.0, -m * params.gravity_m_s2);
+            let w = Vector::new(0.0, 0.0, -m * params.gravity_m_per_s2);
             let i = if params.inertia {
                 -accel * m
             } else {
@@ -221,12 +221,12 @@ impl Hand {
         for t in &touching {
             if self.touching.binary_search(t).is_err() {
                 events.push(Event::TouchBegan { target: *t });
-                if tick > 0 && approach_speed >= IMPACT_MIN_SPEED_M_S {
+                if tick > 0 && approach_speed >= IMPACT_MIN_SPEED_M_PER_S {
                     events.push(Event::Impact {
                         a: Body::Cursor,
                         b: Body::from(*t),
                         impulse_n_s: params.brick_mass_kg * approach_speed,
-                        speed_m_s: approach_speed,
+                        speed_m_per_s: approach_speed,
                         point_m: self.proxy.to_array(),
                     });
                 }
@@ -333,7 +333,7 @@ impl Hand {
     }
 
     /// `hold` released: the brick leaves the hand with the grip point's velocity (a throw when
-    /// faster than [`Params::throw_min_speed_m_s`]).
+    /// faster than [`Params::throw_min_speed_m_per_s`]).
     fn release(&mut self, params: &Params, bricks: &mut BrickSet, events: &mut Vec<Event>) {
         let Some(h) = self.held.take() else {
             return;
@@ -347,12 +347,12 @@ impl Hand {
         bricks.wake_neighbours(bricks.collider(h.brick));
         events.push(Event::Released {
             brick: h.brick,
-            velocity_m_s: v.to_array(),
+            velocity_m_per_s: v.to_array(),
         });
-        if v.length() >= params.throw_min_speed_m_s {
+        if v.length() >= params.throw_min_speed_m_per_s {
             events.push(Event::Thrown {
                 brick: h.brick,
-                velocity_m_s: v.to_array(),
+                velocity_m_per_s: v.to_array(),
             });
         }
     }

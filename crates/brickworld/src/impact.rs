@@ -10,7 +10,7 @@
 //! Physically the four corners hit at once and, by symmetry, the brick rebounds without spin at
 //! `e v`. This hook reproduces that: on the step of an impact — a manifold of several points, none
 //! of which carried an impulse on the previous step, approaching faster than
-//! [`IMPACT_MIN_SPEED_M_S`] — it replaces the points by one point at their centroid, so the
+//! [`IMPACT_MIN_SPEED_M_PER_S`] — it replaces the points by one point at their centroid, so the
 //! single-point restitution pass (exact) applies the whole impulse through the centroid. Resting
 //! and sliding contacts (which carried impulse) and slow approaches are left untouched, so stacks
 //! keep their full four-point support.
@@ -22,7 +22,7 @@ use rapier3d_f64::prelude::{
 };
 
 /// Approach speed (m/s) below which a new contact is treated as a gentle placement, not an impact.
-pub const IMPACT_MIN_SPEED_M_S: f64 = 0.05;
+pub const IMPACT_MIN_SPEED_M_PER_S: f64 = 0.05;
 
 /// Horizontal distance (m) from a body's centre of mass within which a support load counts as
 /// central (no moment), so that an impact may pass through the body's supports merged at their
@@ -51,7 +51,7 @@ pub struct ImpactHook {
 impl ImpactHook {
     /// The bodies of an impact about to be solved (see [`ImpactHook`]): a body touched by a
     /// support contact (within 45° of vertical) approaching faster than
-    /// [`IMPACT_MIN_SPEED_M_S`] at its centroid — a new contact, or a resting one that the body
+    /// [`IMPACT_MIN_SPEED_M_PER_S`] at its centroid — a new contact, or a resting one that the body
     /// above has just driven down — whose load passes through the body's centre of mass
     /// (within [`CENTRAL_LOAD_M`]), and, through such central supports, the bodies below and
     /// above it. An off-centre load keeps every support point: its lever arms are physical.
@@ -103,7 +103,8 @@ impl ImpactHook {
                 centroid /= m.points.len() as f64;
                 // Approach of the contact as a whole (at its centroid): a rocking body's corners
                 // approach while its centroid does not, and that is no impact.
-                let fast = (vel(b1, centroid) - vel(b2, centroid)).dot(n) >= IMPACT_MIN_SPEED_M_S;
+                let fast =
+                    (vel(b1, centroid) - vel(b2, centroid)).dot(n) >= IMPACT_MIN_SPEED_M_PER_S;
                 if fast {
                     for h in [b1, b2].into_iter().flatten() {
                         if central(h, centroid) && !seeds.contains(&h) {
@@ -170,7 +171,7 @@ impl PhysicsHooks for ImpactHook {
         };
         // The normal points from body 1 toward body 2: approaching when (v1 - v2)·n > 0.
         let approach = (vel(rb1, a1) - vel(rb2, a2)).dot(*m.normal);
-        if approach < IMPACT_MIN_SPEED_M_S {
+        if approach < IMPACT_MIN_SPEED_M_PER_S {
             return;
         }
         merge(m.solver_contacts);

@@ -12,7 +12,7 @@ use crate::error::InputError;
 pub struct Grip {
     /// Held down: grab the nearest brick within reach on the press edge and carry it; let go:
     /// drop it, or throw it when the hand moves faster than
-    /// [`crate::Params::throw_min_speed_m_s`].
+    /// [`crate::Params::throw_min_speed_m_per_s`].
     pub hold: bool,
     /// Turns the carried brick by +90° about the world x axis (on the press edge).
     pub turn_x: bool,

@@ -51,8 +51,10 @@ pub mod script;
 pub mod spawner;
 pub mod world;
 
-pub use blueprint::{RESTING_SPEED_M_S, Score, SlotView};
-pub use bricks::{BoxView, BrickView, GROUND_HALF_EXTENT_M, SLEEP_MAX_ACCEL_M_S2, SLEEP_SPEED_M_S};
+pub use blueprint::{RESTING_SPEED_M_PER_S, Score, SlotView};
+pub use bricks::{
+    BoxView, BrickView, GROUND_HALF_EXTENT_M, SLEEP_MAX_ACCEL_M_PER_S2, SLEEP_SPEED_M_PER_S,
+};
 pub use error::{InputError, ParamError, WorldError};
 pub use estimator::MotionEstimator;
 pub use event::{Axis, Body, BrickId, Event, Touch};

@@ -4,7 +4,7 @@
 //! in order it enters the loading zone, waits for a brick, touches its top, grabs it, lifts it,
 //! carries it over the slot, turns it about z if the slot asks for it, lowers it to 1 mm above
 //! the slot, lets go, waits for it to rest and leaves the zone's reach. The cursor moves in
-//! straight lines at [`WallScript::SPEED_M_S`]. Deterministic: same world, same inputs.
+//! straight lines at [`WallScript::SPEED_M_PER_S`]. Deterministic: same world, same inputs.
 
 use crate::blueprint::cuboid_orientation_error_rad;
 use crate::error::InputError;
@@ -58,7 +58,7 @@ pub struct WallScript {
 
 impl WallScript {
     /// Cursor speed along straight segments, m/s.
-    pub const SPEED_M_S: f64 = 0.5;
+    pub const SPEED_M_PER_S: f64 = 0.5;
     /// Height the cursor carries bricks at, m.
     pub const CARRY_Z_M: f64 = 0.35;
 
@@ -86,7 +86,7 @@ impl WallScript {
 
     fn go(&mut self, target: Vector, dt: f64) -> bool {
         let d = target - self.cursor;
-        let step = Self::SPEED_M_S * dt;
+        let step = Self::SPEED_M_PER_S * dt;
         if d.length() <= step {
             self.cursor = target;
             true

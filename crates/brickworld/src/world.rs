@@ -29,15 +29,15 @@ pub struct StepReport {
     pub saturated: bool,
     /// Proxy spring `k (p - c)`, N (`-k d n` against one surface).
     pub spring_force_n: [f64; 3],
-    /// Local stiffness of the rendered force field this tick, N/m: `proxy_stiffness_n_m` while
+    /// Local stiffness of the rendered force field this tick, N/m: `proxy_stiffness_n_per_m` while
     /// the cursor (or carried brick) touches something, 0 in free space (where `p = c`).
-    pub stiffness_n_m: f64,
+    pub stiffness_n_per_m: f64,
     /// Weight of the carried brick `-M g z`, N (zero when nothing is carried or gravity is off).
     pub weight_force_n: [f64; 3],
     /// Inertial force of the carried brick `-M a`, N (zero when nothing is carried or inertia is off).
     pub inertia_force_n: [f64; 3],
     /// Grip-point acceleration estimate used for the inertial force, m/s².
-    pub acceleration_m_s2: [f64; 3],
+    pub acceleration_m_per_s2: [f64; 3],
     /// Deepest penetration of the cursor sphere or carried brick into anything at the start of the
     /// tick (bodies that moved into it), m, before it was pushed out.
     pub proxy_penetration_m: f64,
@@ -115,10 +115,10 @@ impl World {
     // ----- run-time switches -------------------------------------------------------------
 
     /// Sets the magnitude of gravity, m/s² in `[0, 100]` (0 = off). Wakes every brick.
-    pub fn set_gravity(&mut self, g_m_s2: f64) -> Result<(), ParamError> {
-        range("gravity_m_s2", g_m_s2, Lo::Closed(0.0), 100.0)?;
-        self.params.gravity_m_s2 = g_m_s2;
-        self.bricks.set_gravity(g_m_s2);
+    pub fn set_gravity(&mut self, g_m_per_s2: f64) -> Result<(), ParamError> {
+        range("gravity_m_per_s2", g_m_per_s2, Lo::Closed(0.0), 100.0)?;
+        self.params.gravity_m_per_s2 = g_m_per_s2;
+        self.bricks.set_gravity(g_m_per_s2);
         Ok(())
     }
 
@@ -290,14 +290,14 @@ impl World {
             force_n: arr(felt.force),
             saturated: felt.saturated,
             spring_force_n: arr(felt.spring),
-            stiffness_n_m: if self.hand.touching().is_empty() {
+            stiffness_n_per_m: if self.hand.touching().is_empty() {
                 0.0
             } else {
-                params.proxy_stiffness_n_m
+                params.proxy_stiffness_n_per_m
             },
             weight_force_n: arr(felt.weight),
             inertia_force_n: arr(felt.inertia),
-            acceleration_m_s2: arr(felt.acceleration),
+            acceleration_m_per_s2: arr(felt.acceleration),
             proxy_penetration_m: felt.penetration_m,
             events,
         };

@@ -25,11 +25,11 @@ fn bad_parameters_name_the_field_and_range() {
         "parameter `brick_half_extents_m[1]` = NaN is out of range: allowed [0.001, 1]"
     );
     let mut p = Params::default();
-    p.proxy_stiffness_n_m = 5000.0;
+    p.proxy_stiffness_n_per_m = 5000.0;
     let e = World::new(&p, &Limits::FALCON).err().unwrap();
     assert_eq!(
         e.to_string(),
-        "parameter `proxy_stiffness_n_m` = 5000 is out of range: allowed (0, 3000]"
+        "parameter `proxy_stiffness_n_per_m` = 5000 is out of range: allowed (0, 3000]"
     );
     let mut p = Params::default();
     p.accel_estimator = AccelEstimator::SavitzkyGolay { window: 3 };
@@ -53,7 +53,7 @@ fn bad_parameters_name_the_field_and_range() {
 fn toml_parameters_parse_and_reject_unknown_fields() {
     let p = Params::from_toml(
         r#"
-        gravity_m_s2 = 1.62
+        gravity_m_per_s2 = 1.62
         restitution = 0.4
         accel_estimator = { savitzky_golay = { window = 21 } }
         [[bricks]]
@@ -63,7 +63,7 @@ fn toml_parameters_parse_and_reject_unknown_fields() {
         "#,
     )
     .unwrap();
-    assert_eq!(p.gravity_m_s2, 1.62);
+    assert_eq!(p.gravity_m_per_s2, 1.62);
     assert_eq!(
         p.accel_estimator,
         AccelEstimator::SavitzkyGolay { window: 21 }
@@ -115,7 +115,7 @@ fn bad_cursor_input_and_switches_are_typed_errors() {
     assert_eq!(
         w.set_gravity(-1.0).unwrap_err(),
         ParamError::OutOfRange {
-            field: "gravity_m_s2".into(),
+            field: "gravity_m_per_s2".into(),
             value: -1.0,
             range: "[0, 100]".into()
         }

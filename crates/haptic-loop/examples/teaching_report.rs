@@ -79,7 +79,7 @@ fn main() {
         last = Some(s);
     }
     let s = last.expect("three runs");
-    let mg = s.brick_mass_kg * s.gravity_m_s2;
+    let mg = s.brick_mass_kg * s.gravity_m_per_s2;
 
     // 2. Sound of the golden recordings.
     let mut rows = String::new();
@@ -154,16 +154,16 @@ fn main() {
         s.hysteresis_half.snap_force_n / s.hysteresis.snap_force_n,
         s.hysteresis_half.pull_off_n / s.hysteresis.pull_off_n,
         (s.hysteresis_half.pull_off_n / s.hysteresis.pull_off_n - 0.5).abs(),
-        s.sweep.kept_below_m_s2,
-        s.sweep.thrown_from_m_s2,
-        s.sweep.predicted_hand_m_s2,
-        s.brick_throw.distance_m / (s.brick_throw.release_speed_m_s * s.brick_throw.flight_s),
+        s.sweep.kept_below_m_per_s2,
+        s.sweep.thrown_from_m_per_s2,
+        s.sweep.predicted_hand_m_per_s2,
+        s.brick_throw.distance_m / (s.brick_throw.release_speed_m_per_s * s.brick_throw.flight_s),
         100.0
             * (s.brick_throw.distance_m
-                / (s.brick_throw.release_speed_m_s * s.brick_throw.flight_s)
+                / (s.brick_throw.release_speed_m_per_s * s.brick_throw.flight_s)
                 - 1.0),
-        if s.sweep.kept_below_m_s2 < s.sweep.predicted_hand_m_s2
-            && s.sweep.thrown_from_m_s2 >= s.sweep.predicted_hand_m_s2
+        if s.sweep.kept_below_m_per_s2 < s.sweep.predicted_hand_m_per_s2
+            && s.sweep.thrown_from_m_per_s2 >= s.sweep.predicted_hand_m_per_s2
             && (s.hysteresis.ratio - 10.0).abs() < 1e-9
         {
             "every stated figure within its reference's error as listed (pull-off 10× exact, threshold bracketed) — **met**"

@@ -48,7 +48,7 @@ pub struct Params {
     pub interaction: Interaction,
     /// Gravitational acceleration along −z (m/s²); 0 switches weight off. Range [0, 1000].
     #[serde(default)]
-    pub gravity_m_s2: f64,
+    pub gravity_m_per_s2: f64,
     /// Include the inertial force −m·a of carried atoms (a from the last three cursor positions).
     #[serde(default)]
     pub inertia: bool,
@@ -79,7 +79,8 @@ struct ParamsTable {
     interaction: Interaction,
     /// Gravitational acceleration along −z (m/s²); 0 switches weight off. Range [0, 1000].
     #[serde(default)]
-    gravity_m_s2: f64,
+    #[serde(alias = "gravity_m_s2")]
+    gravity_m_per_s2: f64,
     /// Include the inertial force −m·a of carried atoms (a from the last three cursor positions).
     #[serde(default)]
     inertia: bool,
@@ -111,7 +112,7 @@ impl TryFrom<ParamsTable> for Params {
             tip: t.tip,
             atoms: t.atoms,
             interaction: t.interaction,
-            gravity_m_s2: t.gravity_m_s2,
+            gravity_m_per_s2: t.gravity_m_per_s2,
             inertia: t.inertia,
             loading_zone: t.loading_zone,
             initial_atoms_xy_m: t.initial_atoms_xy_m,
@@ -381,7 +382,7 @@ impl Params {
             self.atoms.max_count <= MAX_MOVABLE_ATOMS,
             || format!("0 <= value <= {MAX_MOVABLE_ATOMS}"),
         )?;
-        nonneg_up_to("gravity_m_s2", self.gravity_m_s2, 1000.0)?;
+        nonneg_up_to("gravity_m_per_s2", self.gravity_m_per_s2, 1000.0)?;
         match &self.interaction {
             Interaction::Game(g) => {
                 check(
@@ -584,7 +585,7 @@ impl Params {
                     atom_substrate: pair(0.5),
                 },
             }),
-            gravity_m_s2: 9.81,
+            gravity_m_per_s2: 9.81,
             inertia: true,
             loading_zone: Some(LoadingZone {
                 min_xy_m: [1.0e-9, 1.0e-9],

@@ -463,7 +463,7 @@ impl World {
         if m == 0.0 {
             return Vector3::zeros();
         }
-        let mut f = Vector3::new(0.0, 0.0, -m * self.params.gravity_m_s2);
+        let mut f = Vector3::new(0.0, 0.0, -m * self.params.gravity_m_per_s2);
         if self.params.inertia
             && let [Some(c1), Some(c2)] = self.history
         {

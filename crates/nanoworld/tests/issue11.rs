@@ -284,7 +284,7 @@ fn an_atom_is_thrown_off_exactly_above_the_pull_off_load() {
     for (factor, leaves) in [(0.999, false), (1.001, true)] {
         // A heavy "atom" (1 mg): the hold is reached at a = 3 mm/s², a jump of 3 nm in 1 ms.
         let mut p = Params::game_default();
-        p.gravity_m_s2 = 0.0;
+        p.gravity_m_per_s2 = 0.0;
         p.atoms.mass_kg = 1e-6;
         let mut w =
             World::new(&p, &p.default_limits(), Vector3::new(4e-9, 4e-9, 4e-9)).expect("valid");

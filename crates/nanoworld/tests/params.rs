@@ -73,7 +73,7 @@ fn nan_and_negative_values_are_rejected_not_clamped() {
 #[test]
 fn scene_table_parses_and_unknown_fields_are_rejected() {
     let toml_text = r#"
-        gravity_m_s2 = 9.81
+        gravity_m_per_s2 = 9.81
         [substrate]
         nx = 10
         ny = 10
@@ -102,8 +102,8 @@ fn scene_table_parses_and_unknown_fields_are_rejected() {
     assert!(e.to_string().contains("unknown field `radius_nm`"), "{e}");
     // The force limit moved to the device: an old table that still sets it is refused, by name.
     let old = toml_text.replace(
-        "gravity_m_s2 = 9.81",
-        "gravity_m_s2 = 9.81\nmax_force_n = 1e-8",
+        "gravity_m_per_s2 = 9.81",
+        "gravity_m_per_s2 = 9.81\nmax_force_n = 1e-8",
     );
     let e = toml::from_str::<Params>(&old).expect_err("removed field");
     assert!(

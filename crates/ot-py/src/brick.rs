@@ -137,7 +137,7 @@ fn ticks_to_py<'py>(
     )?;
     d.set_item(
         "acceleration",
-        array2_flat(py, flat(|r| r.acceleration_m_s2), 3)?,
+        array2_flat(py, flat(|r| r.acceleration_m_per_s2), 3)?,
     )?;
     let proxy: Vec<f64> = ticks.iter().flat_map(|t| t.proxy).collect();
     d.set_item("proxy", array2_flat(py, proxy, 3)?)?;
@@ -156,7 +156,7 @@ fn ticks_to_py<'py>(
     )?;
     let sat: Vec<bool> = ticks.iter().map(|t| t.report.saturated).collect();
     d.set_item("saturated", PyArray1::from_vec(py, sat))?;
-    let k: Vec<f64> = ticks.iter().map(|t| t.report.stiffness_n_m).collect();
+    let k: Vec<f64> = ticks.iter().map(|t| t.report.stiffness_n_per_m).collect();
     d.set_item("stiffness", PyArray1::from_vec(py, k))?;
     let pen: Vec<f64> = ticks.iter().map(|t| t.report.proxy_penetration_m).collect();
     d.set_item("penetration", PyArray1::from_vec(py, pen))?;
@@ -220,7 +220,7 @@ fn record(world: &World, report: StepReport) -> Tick {
 /// Args:
 ///     params: None (defaults) or a dict with the scene-table layout; missing
 ///         fields take their defaults (see :attr:`params` for the full set:
-///         dt_s, gravity_m_s2, restitution, friction, inertia, brick_mass_kg,
+///         dt_s, gravity_m_per_s2, restitution, friction, inertia, brick_mass_kg,
 ///         brick_half_extents_m, loading_zone, blueprint, bricks, ...).
 ///     device: "falcon" (Novint Falcon: 8 N, 3000 N/m, CHAI3D's figures) or
 ///         a dict {"max_force_n": ..., "max_stiffness_n_per_m": ...} (the old
@@ -252,16 +252,16 @@ impl BrickWorld {
 
     /// Add a brick with its centre at ``center_m`` (3,) (m), turned by the
     /// rotation vector ``rotation_deg`` (axis · angle, degrees), moving at
-    /// ``velocity_m_s`` (3,) (m/s, each in [-100, 100]), with its own
+    /// ``velocity_m_per_s`` (3,) (m/s, each in [-100, 100]), with its own
     /// ``mass_kg`` ([1e-3, 100]), ``friction`` ([0, 10]) and ``restitution``
     /// ([0, 1]); None takes the world's value (a contact uses the mean of
     /// its two bodies' friction and restitution). Returns its id.
-    #[pyo3(signature = (center_m, rotation_deg=None, *, velocity_m_s=None, mass_kg=None, friction=None, restitution=None))]
+    #[pyo3(signature = (center_m, rotation_deg=None, *, velocity_m_per_s=None, mass_kg=None, friction=None, restitution=None))]
     fn add_brick(
         &mut self,
         center_m: &Bound<'_, PyAny>,
         rotation_deg: Option<&Bound<'_, PyAny>>,
-        velocity_m_s: Option<&Bound<'_, PyAny>>,
+        velocity_m_per_s: Option<&Bound<'_, PyAny>>,
         mass_kg: Option<f64>,
         friction: Option<f64>,
         restitution: Option<f64>,
@@ -271,8 +271,8 @@ impl BrickWorld {
             Some(r) if !r.is_none() => vector::<3>(r, "rotation_deg", "deg")?,
             _ => nalgebra::Vector3::zeros(),
         };
-        let v = match velocity_m_s {
-            Some(v) if !v.is_none() => vector::<3>(v, "velocity_m_s", "m/s")?,
+        let v = match velocity_m_per_s {
+            Some(v) if !v.is_none() => vector::<3>(v, "velocity_m_per_s", "m/s")?,
             _ => nalgebra::Vector3::zeros(),
         };
         let id = self
@@ -283,7 +283,7 @@ impl BrickWorld {
                     rotation_deg: [r.x, r.y, r.z],
                 },
                 BrickProps {
-                    velocity_m_s: [v.x, v.y, v.z],
+                    velocity_m_per_s: [v.x, v.y, v.z],
                     mass_kg,
                     friction,
                     restitution,
@@ -299,8 +299,8 @@ impl BrickWorld {
     /// Returns:
     ///     the step report as a dict: "tick", "force_n" (device force, N,
     ///     within the device limit), "saturated", "spring_force_n",
-    ///     "stiffness_n_m", "weight_force_n", "inertia_force_n",
-    ///     "acceleration_m_s2", "proxy_penetration_m" and "events" (dicts
+    ///     "stiffness_n_per_m", "weight_force_n", "inertia_force_n",
+    ///     "acceleration_m_per_s2", "proxy_penetration_m" and "events" (dicts
     ///     with a "type" key: "grabbed", "released", "thrown", "rotated",
     ///     "spawned", "touch_began", "slot_filled", ...).
     #[pyo3(signature = (position_m, buttons=None))]
@@ -449,7 +449,7 @@ impl BrickWorld {
 
     /// Every brick, with the same keys as :meth:`brick`: {"id" (B,) int,
     /// "position_m" (B, 3) m, "orientation_xyzw" (B, 4) [x, y, z, w],
-    /// "half_extents_m" (B, 3) m, "velocity_m_s" (B, 3) m/s, "held" (B,)
+    /// "half_extents_m" (B, 3) m, "velocity_m_per_s" (B, 3) m/s, "held" (B,)
     /// bool, "sleeping" (B,) bool}, in id order.
     #[getter]
     fn bricks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -470,7 +470,10 @@ impl BrickWorld {
             "half_extents_m",
             array2_flat(py, f3(|v| v.half_extents_m), 3)?,
         )?;
-        d.set_item("velocity_m_s", array2_flat(py, f3(|v| v.velocity_m_s), 3)?)?;
+        d.set_item(
+            "velocity_m_per_s",
+            array2_flat(py, f3(|v| v.velocity_m_per_s), 3)?,
+        )?;
         let held: Vec<bool> = b.iter().map(|v| v.held).collect();
         d.set_item("held", PyArray1::from_vec(py, held))?;
         let sl: Vec<bool> = b.iter().map(|v| v.sleeping).collect();
@@ -479,7 +482,7 @@ impl BrickWorld {
     }
 
     /// One brick by id: {"id", "position_m", "orientation_xyzw",
-    /// "half_extents_m", "velocity_m_s", "held", "sleeping"}.
+    /// "half_extents_m", "velocity_m_per_s", "held", "sleeping"}.
     fn brick<'py>(&self, py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let b = brick_id(&self.world, id)?;
         to_py(py, &self.world.brick(b).map_err(err)?)
@@ -565,8 +568,8 @@ impl BrickWorld {
     }
 
     /// Gravity magnitude (m/s², 0 switches it off), validated.
-    fn set_gravity(&mut self, g_m_s2: f64) -> PyResult<()> {
-        self.world.set_gravity(g_m_s2).map_err(err)
+    fn set_gravity(&mut self, g_m_per_s2: f64) -> PyResult<()> {
+        self.world.set_gravity(g_m_per_s2).map_err(err)
     }
 
     /// Restitution of every contact (0..1), validated.

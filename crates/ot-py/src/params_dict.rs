@@ -153,7 +153,7 @@ pub(crate) fn params_to_py<'py>(py: Python<'py>, p: &Params) -> PyResult<Bound<'
     a.set_item("max_count", p.atoms.max_count)?;
     d.set_item("atoms", a)?;
     d.set_item("interaction", interaction(py, &p.interaction)?)?;
-    d.set_item("gravity_m_s2", p.gravity_m_s2)?;
+    d.set_item("gravity_m_per_s2", p.gravity_m_per_s2)?;
     d.set_item("inertia", p.inertia)?;
     match &p.loading_zone {
         Some(z) => d.set_item("loading_zone", zone(py, z)?)?,

@@ -69,7 +69,8 @@ pub struct BrickScene {
 
 /// The macro world's switches (the paper's menu), named as in `[brickworld.params]`.
 pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
-    SwitchSpec::number("gravity_m_s2", 0.0, 100.0, "gravity, m/s² (0: off)"),
+    SwitchSpec::number("gravity_m_per_s2", 0.0, 100.0, "gravity, m/s² (0: off)")
+        .or_old_name("gravity_m_s2"),
     SwitchSpec::number("restitution", 0.0, 1.0, "restitution of every contact"),
     SwitchSpec::number(
         "friction",
@@ -163,26 +164,29 @@ fn event_detail(e: &brickworld::Event) -> String {
 fn track_drops(
     e: &brickworld::Event,
     released: &mut Vec<(brickworld::BrickId, f64)>,
-    g_m_s2: f64,
+    g_m_per_s2: f64,
     score: &mut HouseScore,
 ) {
     use brickworld::{Body, Event as E};
     match e {
         E::Released {
             brick,
-            velocity_m_s: v,
+            velocity_m_per_s: v,
         } => released.push((*brick, (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())),
         E::Grabbed { brick } => released.retain(|(b, _)| b != brick),
         E::Impact {
-            a, b, speed_m_s, ..
+            a,
+            b,
+            speed_m_per_s,
+            ..
         } => {
             for body in [a, b] {
                 if let Body::Brick(id) = body
                     && let Some(i) = released.iter().position(|(r, _)| r == id)
                 {
                     let (_, v0) = released.swap_remove(i);
-                    let fall = if g_m_s2 > 0.0 {
-                        (speed_m_s * speed_m_s - v0 * v0) / (2.0 * g_m_s2)
+                    let fall = if g_m_per_s2 > 0.0 {
+                        (speed_m_per_s * speed_m_per_s - v0 * v0) / (2.0 * g_m_per_s2)
                     } else {
                         0.0
                     };
@@ -226,7 +230,7 @@ impl Scene for BrickScene {
     fn set_switch(&mut self, name: &str, value: f64) -> Result<(), String> {
         let w = &mut self.world;
         match name {
-            "gravity_m_s2" => w.set_gravity(value),
+            "gravity_m_per_s2" => w.set_gravity(value),
             "restitution" => w.set_restitution(value),
             "friction" => w.set_friction(value),
             "inertia" => {
@@ -269,7 +273,7 @@ impl Scene for BrickScene {
         let r = self.world.step(&ci);
         for e in &r.events {
             out.events.push(Event::new(event_name(e), event_detail(e)));
-            let g = self.world.params().gravity_m_s2;
+            let g = self.world.params().gravity_m_per_s2;
             track_drops(e, &mut self.released, g, &mut self.score);
         }
         self.force_n = if self.rejected { [0.0; 3] } else { r.force_n };
@@ -277,7 +281,7 @@ impl Scene for BrickScene {
             .update(input.tick, self.force_n, self.world.score().filled);
         self.penetration_m = r.proxy_penetration_m;
         out.force_n = self.force_n;
-        out.stiffness_n_per_m = r.stiffness_n_m;
+        out.stiffness_n_per_m = r.stiffness_n_per_m;
     }
 
     fn state(&self, out: &mut Vec<f64>) {

@@ -95,7 +95,8 @@ pub const NANO_SWITCHES: [SwitchSpec; 8] = [
         "atom–substrate strength × this",
     ),
     SwitchSpec::number("atom_mass_kg", 0.0, 1.0, "mass of every movable atom, kg"),
-    SwitchSpec::number("gravity_m_s2", 0.0, 1000.0, "gravity, m/s² (0: off)"),
+    SwitchSpec::number("gravity_m_per_s2", 0.0, 1000.0, "gravity, m/s² (0: off)")
+        .or_old_name("gravity_m_s2"),
     SwitchSpec::on_off("inertia", "the carried atoms' inertial force −m a"),
 ];
 
@@ -254,7 +255,7 @@ impl Scene for NanoScene {
             "atom_atom_scale" => scales[3] = value,
             "atom_substrate_scale" => scales[4] = value,
             "atom_mass_kg" => base.atoms.mass_kg = value,
-            "gravity_m_s2" => base.gravity_m_s2 = value,
+            "gravity_m_per_s2" => base.gravity_m_per_s2 = value,
             "inertia" => base.inertia = value != 0.0,
             other => return Err(format!("the nanoworld scene has no switch `{other}`")),
         }
