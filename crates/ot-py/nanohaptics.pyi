@@ -217,10 +217,16 @@ class NanoWorld:
     adhesion, tenfold pull-off, atom transfer, a house blueprint.
 
     start: (3,) initial cursor position (m). params: "game" (default),
-    "physical", or a dict with the scene-table layout (see nano_params()).
+    "physical", or a dict with the scene-table layout (see nano_params();
+    no "max_force_n": the limit comes from the device). device: None (the
+    Falcon as the presets map it: 8 nN, 20 N/m game; 80 nN, 30 N/m physical)
+    or {"max_force_n", "max_stiffness_n_per_m"} in world units.
     """
 
-    def __init__(self, start: ArrayLike, *, params: NanoParams = None) -> None: ...
+    def __init__(self, start: ArrayLike, *, params: NanoParams = None, device: Optional[dict] = None) -> None: ...
+    @property
+    def device(self) -> dict:
+        """The device limits in world units: {"max_force_n", "max_stiffness_n_per_m"}."""
     def step(self, position: ArrayLike, dt_s: float = 1e-3) -> dict:
         """One tick: {"force": (3,) N, "unlimited_force": (3,) N,
         "saturated": bool, "events": list[dict]}."""
@@ -295,6 +301,7 @@ def force_distance_curve(
     near_gap_m: float = 0.0,
     steps: Optional[int] = None,
     dt_s: float = 1e-3,
+    device: Optional[dict] = None,
 ) -> dict:
     """Approach-retract curve of the bare tip: {"approach_gap", "approach_force",
     "retract_gap", "retract_force" ((steps+1,) m and N), "snap_index",
@@ -309,8 +316,11 @@ class BrickWorld:
     a cursor proxy (god-object), grab/throw/rotate, a blueprint score.
 
     params: None or a dict (scene-table layout; missing fields take defaults).
-    device: "falcon" (3000 N/m, 9 N) or {"max_stiffness_n_m", "max_force_n"}.
-    Buttons: None, {"center", "rotate_x", "rotate_y", "rotate_z"} or 4 bools.
+    device: "falcon" (8 N, 3000 N/m) or {"max_force_n", "max_stiffness_n_per_m"}
+    (the old key "max_stiffness_n_m" is still accepted).
+    Buttons (the hand's grip): None, {"hold", "turn_x", "turn_y", "turn_z"}
+    (the older {"center", "rotate_x", "rotate_y", "rotate_z"} still accepted)
+    or 4 bools in that order.
     """
 
     def __init__(self, params: Optional[dict] = None, *, device: Union[str, dict, None] = None) -> None: ...

@@ -192,3 +192,24 @@ def test_bad_arguments_raise_value_error_naming_them():
     with pytest.raises(ValueError):
         w.run([[0, 0, 0.1], [0, 0, 5.0]])
     assert w.tick == 0  # a rejected batch steps nothing
+
+
+def test_issue12_grip_keys_old_unit_names_and_falcon_limits():
+    # The hand's grip commands by their new names and by the old button names: same session.
+    a = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}]})
+    b = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}]})
+    down = np.linspace((0.0, 0.0, 0.2), (0.0, 0.0, 2 * HZ + 0.002), 200)
+    a.run(down)
+    b.run(down)
+    ra = a.step(down[-1], {"hold": True})
+    rb = b.step(down[-1], {"center": True})
+    assert [e["type"] for e in ra["events"]][0] == "grabbed"
+    assert ra["force_n"] == rb["force_n"] and a.held_brick == b.held_brick == 0
+    # Parameter dicts with the old unit spelling load to the same parameters.
+    old = nh.BrickWorld({"gravity_m_s2": 3.7, "proxy_stiffness_n_m": 800.0, "throw_min_speed_m_s": 0.4})
+    new = nh.BrickWorld({"gravity_m_per_s2": 3.7, "proxy_stiffness_n_per_m": 800.0, "throw_min_speed_m_per_s": 0.4})
+    assert old.params == new.params and new.params["gravity_m_per_s2"] == 3.7
+    # The Falcon: 8 N, 3000 N/m; the old device key is still accepted.
+    assert nh.BrickWorld().device == {"max_force_n": 8.0, "max_stiffness_n_per_m": 3000.0}
+    d = nh.BrickWorld(device={"max_force_n": 5.0, "max_stiffness_n_m": 2000.0}).device
+    assert d == {"max_force_n": 5.0, "max_stiffness_n_per_m": 2000.0}

@@ -11,6 +11,37 @@ use proptest::prelude::*;
 use world_form::Limits;
 
 #[test]
+fn old_unit_spellings_still_load_and_device_limits_are_checked_by_name() {
+    let new = Params::from_toml(
+        "gravity_m_per_s2 = 3.7\nproxy_stiffness_n_per_m = 800.0\nthrow_min_speed_m_per_s = 0.4",
+    )
+    .unwrap();
+    let old = Params::from_toml(
+        "gravity_m_s2 = 3.7\nproxy_stiffness_n_m = 800.0\nthrow_min_speed_m_s = 0.4",
+    )
+    .unwrap();
+    assert_eq!(old, new);
+    assert_eq!(old.gravity_m_per_s2, 3.7);
+    assert_eq!(old.proxy_stiffness_n_per_m, 800.0);
+    assert_eq!(old.throw_min_speed_m_per_s, 0.4);
+    let props: brickworld::BrickProps = toml::from_str("velocity_m_s = [1.0, 0.0, 0.0]").unwrap();
+    assert_eq!(props.velocity_m_per_s, [1.0, 0.0, 0.0]);
+    // The Falcon is 8 N everywhere (CHAI3D's figure).
+    assert_eq!(Limits::FALCON.max_force_n, 8.0);
+    let bad = Limits {
+        max_force_n: f64::NAN,
+        ..Limits::FALCON
+    };
+    assert_eq!(
+        World::new(&Params::default(), &bad)
+            .err()
+            .unwrap()
+            .to_string(),
+        "parameter `device.max_force_n` = NaN is out of range: allowed (0, 100000]"
+    );
+}
+
+#[test]
 fn bad_parameters_name_the_field_and_range() {
     let mut p = Params::default();
     p.restitution = 1.5;

@@ -47,9 +47,10 @@ fn json(detail: &str) -> serde_json::Value {
 #[test]
 fn switching_gravity_off_mid_carry_removes_the_weight_and_replays_bit_exactly() {
     // The default script carries the first brick from 1.529 s to 3.575 s; from 2.104 s to
-    // 3.004 s it moves horizontally. Gravity goes off at 2.5 s and back on at 2.8 s.
+    // 3.004 s it moves horizontally. Gravity goes off at 2.5 s and back on at 2.8 s (the second
+    // switch by its old name, `gravity_m_s2`: accepted, recorded under the new one).
     let extra = "[[switch]]\nt_s = 2.5\nname = \"gravity_m_per_s2\"\nvalue = 0.0\n\n\
-                 [[switch]]\nt_s = 2.8\nname = \"gravity_m_per_s2\"\nvalue = 9.81\n";
+                 [[switch]]\nt_s = 2.8\nname = \"gravity_m_s2\"\nvalue = 9.81\n";
     let p = tmp("gravity.mcap");
     let a = run(
         "brickworld.toml",
@@ -64,6 +65,10 @@ fn switching_gravity_off_mid_carry_removes_the_weight_and_replays_bit_exactly() 
     assert_eq!(
         json(&sets[0].2),
         serde_json::json!({"name": "gravity_m_per_s2", "value": 0.0})
+    );
+    assert_eq!(
+        json(&sets[1].2),
+        serde_json::json!({"name": "gravity_m_per_s2", "value": 9.81})
     );
     // The weight of the 0.5 kg brick, −M g = −4.905 N, is felt before and after, not between.
     let fz = |t: usize| a.world_force_n[t][2];

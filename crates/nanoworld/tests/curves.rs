@@ -34,7 +34,7 @@ fn game_curve(steps: usize) -> (Params, ForceCurve) {
 
 fn law(p: &Params, k: PairKind) -> nanoworld::PairLaw {
     let w = World::new(
-        &p,
+        p,
         &p.default_limits(),
         nalgebra::Vector3::new(0.0, 0.0, 5e-9),
     )

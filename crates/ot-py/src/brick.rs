@@ -356,7 +356,7 @@ impl BrickWorld {
                 } else if n.shape == [path.len(), 4] {
                     n.data
                         .chunks_exact(4)
-                        .map(|c| buttons_of([c[0] != 0.0, c[1] != 0.0, c[2] != 0.0, c[3] != 0.0]))
+                        .map(|c| grip_of([c[0] != 0.0, c[1] != 0.0, c[2] != 0.0, c[3] != 0.0]))
                         .collect()
                 } else {
                     return Err(PyValueError::new_err(format!(
