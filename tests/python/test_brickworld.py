@@ -60,9 +60,10 @@ def test_proxy_spring_against_the_ground():
     assert rep["force_n"][2] == pytest.approx(k * (pz + 0.001), rel=1e-9)
     assert rep["force_n"][0] == 0.0 and rep["force_n"][1] == 0.0
     assert rep["stiffness_n_per_m"] == k
-    # Deeper: the force is scaled down to the Falcon's 9 N, direction kept, flagged.
+    # Deeper: the force is scaled down to the Falcon's 8 N (9 N before issue 12), direction
+    # kept, flagged.
     deep = w.step((0.0, 0.0, -0.05))
-    assert deep["saturated"] and deep["force_n"][2] == pytest.approx(9.0, rel=1e-12)
+    assert deep["saturated"] and deep["force_n"][2] == pytest.approx(8.0, rel=1e-12)
     assert deep["spring_force_n"][2] == pytest.approx(k * (w.proxy_position[2] + 0.05), rel=1e-9)
 
 
