@@ -217,10 +217,16 @@ class NanoWorld:
     adhesion, tenfold pull-off, atom transfer, a house blueprint.
 
     start: (3,) initial cursor position (m). params: "game" (default),
-    "physical", or a dict with the scene-table layout (see nano_params()).
+    "physical", or a dict with the scene-table layout (see nano_params();
+    no "max_force_n": the limit comes from the device). device: None (the
+    Falcon as the presets map it: 8 nN, 20 N/m game; 80 nN, 30 N/m physical)
+    or {"max_force_n", "max_stiffness_n_per_m"} in world units.
     """
 
-    def __init__(self, start: ArrayLike, *, params: NanoParams = None) -> None: ...
+    def __init__(self, start: ArrayLike, *, params: NanoParams = None, device: Optional[dict] = None) -> None: ...
+    @property
+    def device(self) -> dict:
+        """The device limits in world units: {"max_force_n", "max_stiffness_n_per_m"}."""
     def step(self, position: ArrayLike, dt_s: float = 1e-3) -> dict:
         """One tick: {"force": (3,) N, "unlimited_force": (3,) N,
         "saturated": bool, "events": list[dict]}."""
@@ -295,6 +301,7 @@ def force_distance_curve(
     near_gap_m: float = 0.0,
     steps: Optional[int] = None,
     dt_s: float = 1e-3,
+    device: Optional[dict] = None,
 ) -> dict:
     """Approach-retract curve of the bare tip: {"approach_gap", "approach_force",
     "retract_gap", "retract_force" ((steps+1,) m and N), "snap_index",
@@ -309,8 +316,11 @@ class BrickWorld:
     a cursor proxy (god-object), grab/throw/rotate, a blueprint score.
 
     params: None or a dict (scene-table layout; missing fields take defaults).
-    device: "falcon" (3000 N/m, 9 N) or {"max_stiffness_n_m", "max_force_n"}.
-    Buttons: None, {"center", "rotate_x", "rotate_y", "rotate_z"} or 4 bools.
+    device: "falcon" (8 N, 3000 N/m) or {"max_force_n", "max_stiffness_n_per_m"}
+    (the old key "max_stiffness_n_m" is still accepted).
+    Buttons (the hand's grip): None, {"hold", "turn_x", "turn_y", "turn_z"}
+    (the older {"center", "rotate_x", "rotate_y", "rotate_z"} still accepted)
+    or 4 bools in that order.
     """
 
     def __init__(self, params: Optional[dict] = None, *, device: Union[str, dict, None] = None) -> None: ...
@@ -319,7 +329,7 @@ class BrickWorld:
         center_m: ArrayLike,
         rotation_deg: Optional[ArrayLike] = None,
         *,
-        velocity_m_s: Optional[ArrayLike] = None,
+        velocity_m_per_s: Optional[ArrayLike] = None,
         mass_kg: Optional[float] = None,
         friction: Optional[float] = None,
         restitution: Optional[float] = None,
@@ -328,8 +338,8 @@ class BrickWorld:
         m/s, its own mass kg / friction / restitution); returns its id."""
     def step(self, position_m: ArrayLike, buttons: Buttons = None) -> dict:
         """One tick: {"tick", "force_n", "saturated", "spring_force_n",
-        "stiffness_n_m", "weight_force_n", "inertia_force_n",
-        "acceleration_m_s2", "proxy_penetration_m", "events"}."""
+        "stiffness_n_per_m", "weight_force_n", "inertia_force_n",
+        "acceleration_m_per_s2", "proxy_penetration_m", "events"}."""
     def run(self, positions_m: ArrayLike, buttons: Union[Buttons, ArrayLike] = None) -> dict:
         """One tick per row of (T, 3) positions; buttons None, one set, or (T, 4).
         Per-tick arrays: force, spring_force, weight_force, inertia_force (T, 3) N,
@@ -341,11 +351,11 @@ class BrickWorld:
     def run_wall_script(self, start_m: ArrayLike, max_ticks: int = 40000, settle_ticks: int = 1000) -> dict:
         """Run the scripted wall builder; same arrays as run()."""
     def brick(self, id: int) -> dict:
-        """One brick: position_m, orientation_xyzw, half_extents_m, velocity_m_s, held, sleeping."""
+        """One brick: position_m, orientation_xyzw, half_extents_m, velocity_m_per_s, held, sleeping."""
     @property
     def bricks(self) -> dict:
         """Same keys as brick(): id (B,), position_m (B, 3) m, orientation_xyzw
-        (B, 4), half_extents_m (B, 3) m, velocity_m_s (B, 3) m/s, held (B,),
+        (B, 4), half_extents_m (B, 3) m, velocity_m_per_s (B, 3) m/s, held (B,),
         sleeping (B,)."""
     @property
     def proxy_position(self) -> F64Array: ...
@@ -373,7 +383,7 @@ class BrickWorld:
     def tick(self) -> int: ...
     @property
     def time(self) -> float: ...
-    def set_gravity(self, g_m_s2: float) -> None: ...
+    def set_gravity(self, g_m_per_s2: float) -> None: ...
     def set_restitution(self, e: float) -> None: ...
     def set_friction(self, mu: float) -> None: ...
     def set_inertia(self, on: bool) -> None: ...

@@ -38,7 +38,7 @@ def test_bounce_height_ratio_is_e_squared():
     for _ in range(4000):
         w.step(PARK)
         b = w.brick(0)
-        bottom, vz = b["position_m"][2] - HZ, b["velocity_m_s"][2]
+        bottom, vz = b["position_m"][2] - HZ, b["velocity_m_per_s"][2]
         hit = hit or vz > 0.0
         if hit:
             apex = max(apex, bottom)
@@ -50,7 +50,7 @@ def test_bounce_height_ratio_is_e_squared():
 def test_proxy_spring_against_the_ground():
     w = nh.BrickWorld()
     r = w.params["proxy_radius_m"]
-    k = w.params["proxy_stiffness_n_m"]
+    k = w.params["proxy_stiffness_n_per_m"]
     w.step((0.0, 0.0, 0.1))
     rep = w.step((0.0, 0.0, -0.001))
     # The proxy stays on the surface (within a few µm of skin); the device feels
@@ -59,10 +59,11 @@ def test_proxy_spring_against_the_ground():
     assert pz == pytest.approx(r, abs=5e-6)
     assert rep["force_n"][2] == pytest.approx(k * (pz + 0.001), rel=1e-9)
     assert rep["force_n"][0] == 0.0 and rep["force_n"][1] == 0.0
-    assert rep["stiffness_n_m"] == k
-    # Deeper: the force is scaled down to the Falcon's 9 N, direction kept, flagged.
+    assert rep["stiffness_n_per_m"] == k
+    # Deeper: the force is scaled down to the Falcon's 8 N (9 N before issue 12), direction
+    # kept, flagged.
     deep = w.step((0.0, 0.0, -0.05))
-    assert deep["saturated"] and deep["force_n"][2] == pytest.approx(9.0, rel=1e-12)
+    assert deep["saturated"] and deep["force_n"][2] == pytest.approx(8.0, rel=1e-12)
     assert deep["spring_force_n"][2] == pytest.approx(k * (w.proxy_position[2] + 0.05), rel=1e-9)
 
 
@@ -87,16 +88,16 @@ def test_weight_of_a_carried_brick_is_m_g():
     r = _grab_and_lift(w)
     assert any(e["type"] == "grabbed" and e["brick"] == 0 for _, e in r["events"])
     assert r["held"][-1] == 0 and w.held_brick == 0
-    m, g = w.params["brick_mass_kg"], w.params["gravity_m_s2"]
+    m, g = w.params["brick_mass_kg"], w.params["gravity_m_per_s2"]
     # Held still in free space: only the weight, −M g along z (inertia is zero at rest).
     np.testing.assert_allclose(r["weight_force"][-1], [0, 0, -m * g], rtol=1e-12)
     np.testing.assert_allclose(r["force"][-1], [0, 0, -m * g], rtol=1e-9, atol=1e-9)
     # Run-time switches change what is felt.
     w.set_brick_mass(0.8)
     assert w.step((0, 0, 0.3), {"center": True})["force_n"][2] == pytest.approx(-0.8 * g, rel=1e-9)
-    w.set_brick_mass(1.0)  # 9.81 N: more than the Falcon's 9 N, scaled down and flagged
-    over = w.step((0, 0, 0.3), {"center": True})
-    assert over["saturated"] and over["force_n"][2] == pytest.approx(-9.0, rel=1e-12)
+    w.set_brick_mass(1.0)  # 9.81 N: more than the Falcon's 8 N, scaled down and flagged
+    over = w.step((0, 0, 0.3), {"hold": True})  # the grip's own name; "center" still works
+    assert over["saturated"] and over["force_n"][2] == pytest.approx(-8.0, rel=1e-12)
     assert over["weight_force_n"][2] == pytest.approx(-9.81, rel=1e-12)
     w.set_gravity(0.0)
     assert w.step((0, 0, 0.3), {"center": True})["force_n"] == pytest.approx([0, 0, 0], abs=1e-9)
@@ -107,7 +108,7 @@ def test_weight_of_a_carried_brick_is_m_g():
 
 
 def test_inertia_of_a_carried_brick_is_minus_m_a():
-    w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}], "gravity_m_s2": 0.0})
+    w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}], "gravity_m_per_s2": 0.0})
     _grab_and_lift(w, hold_ticks=50)
     # Accelerate the carried brick along x with a = 2 m/s²: x = a t²/2.
     a, dt = 2.0, w.params["dt_s"]
@@ -172,10 +173,10 @@ def test_run_equals_repeated_step():
 def test_bad_arguments_raise_value_error_naming_them():
     cases = [
         (lambda: nh.BrickWorld({"restitution": 1.5}), "parameter `restitution` = 1.5 is out of range: allowed [0, 1]"),
-        (lambda: nh.BrickWorld(device="phantom"), 'device = "phantom": allowed "falcon" or a dict with max_stiffness_n_m and max_force_n'),
+        (lambda: nh.BrickWorld(device="phantom"), 'device = "phantom": allowed "falcon" or a dict with max_force_n and max_stiffness_n_per_m'),
         (lambda: nh.BrickWorld().step((0, 0, 3.0)), "cursor input `position_m[2]` = 3 m is outside the workspace: allowed [-2, 2] m"),
         (lambda: nh.BrickWorld().step((0, 0)), "position_m: expected shape (3,), got (2,)"),
-        (lambda: nh.BrickWorld().step((0, 0, 0.1), {"centre": True}), "buttons: unknown button \"centre\": allowed [\"center\", \"rotate_x\", \"rotate_y\", \"rotate_z\"]"),
+        (lambda: nh.BrickWorld().step((0, 0, 0.1), {"centre": True}), "buttons: unknown button \"centre\": allowed [\"hold\", \"turn_x\", \"turn_y\", \"turn_z\"] or [\"center\", \"rotate_x\", \"rotate_y\", \"rotate_z\"]"),
         (lambda: nh.BrickWorld().brick(3), "unknown brick id 3"),
         (lambda: nh.BrickWorld().set_restitution(-0.1), "parameter `restitution` = -0.1 is out of range: allowed [0, 1]"),
         (lambda: nh.BrickWorld().run([[0, 0, 0.1], [0, 0, float("nan")]]), "positions_m[1, 2] = NaN is out of range: allowed finite (m)"),
@@ -192,3 +193,24 @@ def test_bad_arguments_raise_value_error_naming_them():
     with pytest.raises(ValueError):
         w.run([[0, 0, 0.1], [0, 0, 5.0]])
     assert w.tick == 0  # a rejected batch steps nothing
+
+
+def test_issue12_grip_keys_old_unit_names_and_falcon_limits():
+    # The hand's grip commands by their new names and by the old button names: same session.
+    a = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}]})
+    b = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}]})
+    down = np.linspace((0.0, 0.0, 0.2), (0.0, 0.0, 2 * HZ + 0.002), 200)
+    a.run(down)
+    b.run(down)
+    ra = a.step(down[-1], {"hold": True})
+    rb = b.step(down[-1], {"center": True})
+    assert [e["type"] for e in ra["events"]][0] == "grabbed"
+    assert ra["force_n"] == rb["force_n"] and a.held_brick == b.held_brick == 0
+    # Parameter dicts with the old unit spelling load to the same parameters.
+    old = nh.BrickWorld({"gravity_m_s2": 3.7, "proxy_stiffness_n_m": 800.0, "throw_min_speed_m_s": 0.4})
+    new = nh.BrickWorld({"gravity_m_per_s2": 3.7, "proxy_stiffness_n_per_m": 800.0, "throw_min_speed_m_per_s": 0.4})
+    assert old.params == new.params and new.params["gravity_m_per_s2"] == 3.7
+    # The Falcon: 8 N, 3000 N/m; the old device key is still accepted.
+    assert nh.BrickWorld().device == {"max_force_n": 8.0, "max_stiffness_n_per_m": 3000.0}
+    d = nh.BrickWorld(device={"max_force_n": 5.0, "max_stiffness_n_m": 2000.0}).device
+    assert d == {"max_force_n": 5.0, "max_stiffness_n_per_m": 2000.0}

@@ -121,7 +121,7 @@ def test_tiny_dt_while_carrying_is_refused_and_the_smallest_is_finite():
     for dz in (0.0, 0.1, 0.4):
         r = w.step(c + (0.0, 0.0, dz), dt_s=1e-9)
         assert np.all(np.isfinite(r["force"])) and np.all(np.isfinite(r["unlimited_force"]))
-        assert np.linalg.norm(r["force"]) <= w.params["max_force_n"] * (1 + 1e-12)
+        assert np.linalg.norm(r["force"]) <= w.device["max_force_n"] * (1 + 1e-12)
         # 0.1 m in 1 ns: m·a = 1e-8 N on the atom, more than the tip's 3 nN hold: it is thrown
         # off the tip (and the force stays finite, unsaturated).
         thrown = [e for e in r["events"] if e["type"] == "atoms_thrown_off"]
@@ -163,7 +163,7 @@ def test_bricks_and_brick_use_the_same_keys():
     bw = nh.BrickWorld({"bricks": [{"center_m": [0.0, 0.0, 0.03]}]})
     one = bw.brick(0)
     many = bw.bricks
-    for k in ("position_m", "orientation_xyzw", "half_extents_m", "velocity_m_s", "held", "sleeping"):
+    for k in ("position_m", "orientation_xyzw", "half_extents_m", "velocity_m_per_s", "held", "sleeping"):
         assert k in one and k in many, k
         assert np.array_equal(np.asarray(many[k])[0], np.asarray(one[k])), k
     assert isinstance(bw.awake_brick_count, int)
@@ -171,7 +171,7 @@ def test_bricks_and_brick_use_the_same_keys():
 
 def test_add_brick_with_velocity_and_friction_slides_v2_over_2_mu_g():
     bw = nh.BrickWorld()
-    i = bw.add_brick((0.0, 0.0, 0.03), velocity_m_s=(1.0, 0.0, 0.0), friction=0.0, mass_kg=2.0)
+    i = bw.add_brick((0.0, 0.0, 0.03), velocity_m_per_s=(1.0, 0.0, 0.0), friction=0.0, mass_kg=2.0)
     out = bw.run(np.tile([1.5, 1.5, 1.0], (1500, 1)))
     x = out["brick_position_m"][-1, i, 0]
     assert x == pytest.approx(1.0 / (2 * 0.3 * 9.81), rel=0.02)  # mean friction (0.6 + 0) / 2

@@ -147,7 +147,7 @@ def test_house_session_builds_the_house_and_replays_bit_for_bit():
     for slot, atom in enumerate(h["filled"]):
         assert np.linalg.norm(w1.atoms[atom] - h["slots"][slot]) <= h["tolerance_m"]
     # The device force never exceeds the limit.
-    fmax = w1.params["max_force_n"]
+    fmax = w1.device["max_force_n"]
     assert np.all(np.linalg.norm(r1["force"], axis=1) <= fmax * (1 + 1e-12))
     assert np.all(np.isfinite(r1["force"]))
     # Same inputs, same bits.
@@ -243,3 +243,26 @@ def test_step_and_curve_errors_name_the_argument():
     with pytest.raises(ValueError):
         world.run([[0, 0, 5e-9], [0, 0, float("inf")]])
     assert world.tick == before
+
+
+def test_issue12_limits_come_from_the_device():
+    start = (3e-9, 3e-9, 2e-9)
+    assert nh.NanoWorld(start).device == {"max_force_n": 8e-9, "max_stiffness_n_per_m": 20.0}
+    assert nh.NanoWorld(start, params="physical").device == {"max_force_n": 8e-8, "max_stiffness_n_per_m": 30.0}
+    w = nh.NanoWorld(start, device={"max_force_n": 1e-11, "max_stiffness_n_per_m": 20.0})
+    r = w.step((3e-9, 3e-9, 0.7e-9))
+    assert r["saturated"] and np.linalg.norm(r["force"]) == pytest.approx(1e-11, rel=1e-12)
+    p = nh.nano_params()
+    assert "max_force_n" not in p
+    p["max_force_n"] = 1e-8
+    with pytest.raises(ValueError) as e:
+        nh.NanoWorld(start, params=p)
+    assert "`max_force_n` is no longer a nanoworld parameter: the limit now comes from the device" in str(e.value)
+    # A stiffest spring beyond the device's stiffness is refused by name.
+    with pytest.raises(ValueError) as e:
+        nh.NanoWorld(start, device={"max_force_n": 8e-9, "max_stiffness_n_per_m": 1.0})
+    assert str(e.value).startswith("interaction.game.pairs.tip_substrate.stiffness_n_per_m = 2e0 is out of range")
+    # The old unit spelling of gravity still loads.
+    q = nh.nano_params()
+    q["gravity_m_s2"] = q.pop("gravity_m_per_s2")
+    assert nh.NanoWorld(start, params=q).params["gravity_m_per_s2"] == 9.81

@@ -55,7 +55,7 @@ def test_a_switch_in_a_stepped_session_changes_the_world_and_is_recorded(tmp_pat
         assert str(e.value) == (
             "tick 1: the nanoworld scene has no switch `gravity` (its switches: adhesion_scale, "
             "tip_substrate_scale, tip_atom_scale, atom_atom_scale, atom_substrate_scale, "
-            "atom_mass_kg, gravity_m_s2, inertia)"
+            "atom_mass_kg, gravity_m_per_s2, inertia)"
         )
         with pytest.raises(ValueError, match=r"switch `inertia` = 0.5 is out of range"):
             s.switch("inertia", 0.5)

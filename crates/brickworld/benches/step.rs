@@ -1,8 +1,9 @@
 //! Criterion benchmarks of one world tick (1 ms) with 100 bricks, 50 of them in stacks.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
-use brickworld::{BrickPlacement, Buttons, DeviceLimits, Params, World};
+use brickworld::{BrickPlacement, Grip, Params, World};
 use criterion::{Criterion, criterion_group, criterion_main};
+use world_form::Limits;
 
 /// 5 stacks of 10 bricks plus 50 loose bricks on a grid, settled for 2 s.
 fn scene(sleeping: bool) -> World {
@@ -30,9 +31,9 @@ fn scene(sleeping: bool) -> World {
             rotation_deg: [0.0, 0.0, 0.0],
         });
     }
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).expect("valid scene");
+    let mut w = World::new(&p, &Limits::FALCON).expect("valid scene");
     for _ in 0..2000 {
-        let i = w.input([0.0, 0.0, 0.5], Buttons::default()).unwrap();
+        let i = w.input([0.0, 0.0, 0.5], Grip::default()).unwrap();
         w.step(&i);
     }
     w
@@ -47,7 +48,7 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 t += 1;
                 let x = 0.2 * ((t as f64) * 1e-3).sin();
-                let i = w.input([x, 0.0, 0.5], Buttons::default()).unwrap();
+                let i = w.input([x, 0.0, 0.5], Grip::default()).unwrap();
                 w.step(&i)
             })
         });

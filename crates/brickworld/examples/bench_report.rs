@@ -8,9 +8,8 @@ use std::fmt::Write as _;
 use bench_harness::plot::{Axis, Chart, Series};
 use bench_harness::plotters::prelude::*;
 use bench_harness::{Align, Report, Summary, Table, Timings};
-use brickworld::{
-    AccelEstimator, BrickId, BrickPlacement, Buttons, DeviceLimits, MotionEstimator, Params, World,
-};
+use brickworld::{AccelEstimator, BrickId, BrickPlacement, Grip, MotionEstimator, Params, World};
+use world_form::Limits;
 
 const PARK: [f64; 3] = [0.0, 0.0, 0.5];
 
@@ -22,7 +21,7 @@ fn at(c: [f64; 3]) -> BrickPlacement {
 }
 
 fn step_idle(w: &mut World, pos: [f64; 3]) -> brickworld::StepReport {
-    let i = w.input(pos, Buttons::default()).unwrap();
+    let i = w.input(pos, Grip::default()).unwrap();
     w.step(&i)
 }
 
@@ -46,7 +45,7 @@ fn scene(n_bricks: usize, p: &Params) -> World {
             ]));
         }
     }
-    World::new(p, DeviceLimits::NOVINT_FALCON).expect("valid scene")
+    World::new(&p, &Limits::FALCON).expect("valid scene")
 }
 
 /// One tick's cost, in µs: thread CPU time (what the tick costs) and wall time (what it took
@@ -58,7 +57,7 @@ struct Timing {
 }
 
 /// Times `n` ticks; `input(k)` gives the k-th sample (built outside the timed step).
-fn measure(w: &mut World, n: usize, input: impl Fn(usize) -> ([f64; 3], Buttons)) -> Timing {
+fn measure(w: &mut World, n: usize, input: impl Fn(usize) -> ([f64; 3], Grip)) -> Timing {
     let mut t = Timings::with_capacity(n);
     for k in 0..n {
         let (pos, b) = input(k);
@@ -75,10 +74,7 @@ fn measure(w: &mut World, n: usize, input: impl Fn(usize) -> ([f64; 3], Buttons)
 /// Times `n` ticks with the cursor sweeping in free space above the scene.
 fn time_ticks(w: &mut World, n: usize) -> Timing {
     measure(w, n, |k| {
-        (
-            [0.3 * (k as f64 * 2e-3).sin(), 0.0, 0.7],
-            Buttons::default(),
-        )
+        ([0.3 * (k as f64 * 2e-3).sin(), 0.0, 0.7], Grip::default())
     })
 }
 
@@ -91,7 +87,7 @@ fn stack_error(p: &Params) -> (f64, f64) {
         .map(|i| at([0.0, 0.0, h[2] * (2 * i + 1) as f64]))
         .collect();
     let top0 = p.bricks[9].center_m[2];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     for _ in 0..2000 {
         step_idle(&mut w, [1.0, 1.0, 1.0]);
     }
@@ -120,7 +116,7 @@ fn press_error(p: &Params, speed: f64) -> f64 {
     let h = p.brick_half_extents_m;
     let r = p.proxy_radius_m;
     p.bricks = vec![at([0.0, 0.0, h[2]])];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     for _ in 0..1500 {
         step_idle(&mut w, [1.0, 1.0, 1.0]);
     }
@@ -147,17 +143,17 @@ fn bounce(e: f64) -> f64 {
     };
     let hz = p.brick_half_extents_m[2];
     p.bricks = vec![at([0.0, 0.0, hz + 0.5])];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     let (mut hit, mut apex) = (false, 0.0_f64);
     for _ in 0..4000 {
         step_idle(&mut w, [1.0, 1.0, 1.0]);
         let b = w.brick(BrickId(0)).unwrap();
-        if b.velocity_m_s[2] > 0.0 {
+        if b.velocity_m_per_s[2] > 0.0 {
             hit = true;
         }
         if hit {
             apex = apex.max(b.position_m[2] - hz);
-            if b.velocity_m_s[2] < 0.0 && apex > 0.0 {
+            if b.velocity_m_per_s[2] < 0.0 && apex > 0.0 {
                 break;
             }
         }
@@ -186,7 +182,7 @@ fn slide(mu: f64, theta_deg: f64) -> f64 {
         center_m: c,
         rotation_deg: [0.0, theta_deg, 0.0],
     }];
-    let mut w = World::new(p, DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
     for _ in 0..1000 {
         step_idle(&mut w, [1.5, 1.5, 1.5]);
     }
@@ -317,9 +313,9 @@ fn main() {
                 [above[0], above[1], above[2] + 0.03 - 1e-4 * i as f64],
             );
         }
-        let b = Buttons {
-            center: true,
-            ..Buttons::default()
+        let b = Grip {
+            hold: true,
+            ..Grip::default()
         };
         w.step(&w.input([above[0], above[1], above[2] - 0.002], b).unwrap());
         assert_eq!(
@@ -574,7 +570,7 @@ fn wall_params() -> Params {
 
 /// Runs the scripted wall session; returns (simulated s, score, cursor path, world).
 fn build_wall() -> (f64, brickworld::Score, Vec<[f64; 3]>, World) {
-    let mut w = World::new(wall_params(), DeviceLimits::NOVINT_FALCON).unwrap();
+    let mut w = World::new(&wall_params(), &Limits::FALCON).unwrap();
     let mut script = brickworld::script::WallScript::new(&w, [0.3, -0.4, 0.35]).unwrap();
     let mut traj = Vec::new();
     let mut ticks = 0usize;

@@ -1,13 +1,24 @@
-//! The house-building task: slots a brick must fill, and the score.
+//! The house-building task: the slots a brick must fill, which brick fills each, and the score.
 
 use rapier3d_f64::math::{Rotation, Vector};
+use serde::Serialize;
 
-use crate::params::{Blueprint, BrickPlacement};
+use crate::bricks::{BrickSet, quat};
+use crate::event::{BrickId, Event};
+use crate::params::{Blueprint, BrickPlacement, Params};
 
-/// Orientation of a [`BrickPlacement`] (rotation vector in degrees) as a unit quaternion.
-pub fn placement_rotation(p: &BrickPlacement) -> Rotation {
-    let v = Vector::from_array(p.rotation_deg) * (std::f64::consts::PI / 180.0);
-    Rotation::from_scaled_axis(v)
+/// A brick slower than this (m/s) counts as resting for the blueprint.
+pub const RESTING_SPEED_M_PER_S: f64 = 0.05;
+
+/// A blueprint slot and whether it is filled.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SlotView {
+    /// Target centre, m.
+    pub position_m: [f64; 3],
+    /// Target orientation `[x, y, z, w]`.
+    pub orientation_xyzw: [f64; 4],
+    /// The brick filling it, if any.
+    pub filled_by: Option<BrickId>,
 }
 
 /// Angle (rad) between two orientations of the same cuboid, taking its symmetries into account:
@@ -40,7 +51,7 @@ pub fn fills(
     if d > bp.position_tolerance_m {
         return None;
     }
-    let ang = cuboid_orientation_error_rad(placement_rotation(slot), rotation);
+    let ang = cuboid_orientation_error_rad(slot.rotation(), rotation);
     (ang <= bp.angle_tolerance_deg.to_radians()).then_some(d)
 }
 
@@ -64,15 +75,98 @@ impl Score {
     }
 }
 
+/// Which brick fills each slot of [`Params::blueprint`] (a resting brick not in the hand).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Slots {
+    filled_by: Vec<Option<BrickId>>,
+}
+
+impl Slots {
+    /// Every slot of `blueprint` empty.
+    pub(crate) fn new(blueprint: &Blueprint) -> Slots {
+        Slots {
+            filled_by: vec![None; blueprint.slots.len()],
+        }
+    }
+
+    /// Re-assigns each slot to the closest resting brick (not `held`) that fills it, and reports
+    /// the slots that were vacated and filled.
+    pub(crate) fn update(
+        &mut self,
+        params: &Params,
+        bricks: &BrickSet,
+        held: Option<BrickId>,
+        events: &mut Vec<Event>,
+    ) {
+        if self.filled_by.is_empty() {
+            return;
+        }
+        for (si, slot) in params.blueprint.slots.iter().enumerate() {
+            let mut best: Option<(f64, BrickId)> = None;
+            for bi in 0..bricks.len() {
+                let id = BrickId(bi as u32);
+                if Some(id) == held {
+                    continue;
+                }
+                let rb = &bricks.phys.bodies[bricks.body(id)];
+                if rb.linvel().length() > RESTING_SPEED_M_PER_S {
+                    continue;
+                }
+                if let Some(d) = fills(&params.blueprint, slot, rb.translation(), *rb.rotation())
+                    && best.is_none_or(|(bd, _)| d < bd)
+                {
+                    best = Some((d, id));
+                }
+            }
+            let now = best.map(|(_, id)| id);
+            let before = self.filled_by[si];
+            if now != before {
+                if let Some(b) = before {
+                    events.push(Event::SlotVacated { slot: si, brick: b });
+                }
+                if let Some(b) = now {
+                    events.push(Event::SlotFilled { slot: si, brick: b });
+                }
+                self.filled_by[si] = now;
+            }
+        }
+    }
+
+    /// The slots of `blueprint` and their state, in order.
+    pub(crate) fn views<'a>(
+        &'a self,
+        blueprint: &'a Blueprint,
+    ) -> impl Iterator<Item = SlotView> + 'a {
+        blueprint
+            .slots
+            .iter()
+            .zip(&self.filled_by)
+            .map(|(s, f)| SlotView {
+                position_m: s.center_m,
+                orientation_xyzw: quat(s.rotation()),
+                filled_by: *f,
+            })
+    }
+
+    /// The house-task score.
+    pub(crate) fn score(&self) -> Score {
+        Score {
+            filled: self.filled_by.iter().filter(|s| s.is_some()).count(),
+            total: self.filled_by.len(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn rot(deg: [f64; 3]) -> Rotation {
-        placement_rotation(&BrickPlacement {
+        BrickPlacement {
             center_m: [0.0; 3],
             rotation_deg: deg,
-        })
+        }
+        .rotation()
     }
 
     #[test]

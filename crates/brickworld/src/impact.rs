@@ -10,18 +10,24 @@
 //! Physically the four corners hit at once and, by symmetry, the brick rebounds without spin at
 //! `e v`. This hook reproduces that: on the step of an impact — a manifold of several points, none
 //! of which carried an impulse on the previous step, approaching faster than
-//! [`IMPACT_MIN_SPEED_M_S`] — it replaces the points by one point at their centroid, so the
+//! [`IMPACT_MIN_SPEED_M_PER_S`] — it replaces the points by one point at their centroid, so the
 //! single-point restitution pass (exact) applies the whole impulse through the centroid. Resting
 //! and sliding contacts (which carried impulse) and slow approaches are left untouched, so stacks
 //! keep their full four-point support.
 
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
-    ContactModificationContext, PhysicsHooks, RigidBodyHandle, SolverContact,
+    ColliderHandle, ContactModificationContext, PairContacts, PhysicsHooks, PhysicsWorld,
+    RigidBodyHandle, RigidBodyType, SolverContact,
 };
 
 /// Approach speed (m/s) below which a new contact is treated as a gentle placement, not an impact.
-pub const IMPACT_MIN_SPEED_M_S: f64 = 0.05;
+pub const IMPACT_MIN_SPEED_M_PER_S: f64 = 0.05;
+
+/// Horizontal distance (m) from a body's centre of mass within which a support load counts as
+/// central (no moment), so that an impact may pass through the body's supports merged at their
+/// centroid (see [`ImpactHook`]).
+pub const CENTRAL_LOAD_M: f64 = 1e-3;
 
 /// The hook, with the bodies that take part in an impact this step.
 ///
@@ -32,7 +38,7 @@ pub const IMPACT_MIN_SPEED_M_S: f64 = 0.05;
 /// the brick on top is kicked sideways (a centred 0.5 m drop was kicked at 0.06 m/s and came to
 /// rest 0.5 mm off centre, a 1.5 m drop 17 mm). So on an impact step every support manifold
 /// (normal within 45° of vertical) of a body in `impacted` is also merged to its centroid. A
-/// body is in `impacted` (see `World::impacted_bodies`) when the impact's load passes through
+/// body is in `impacted` (see [`ImpactHook::for_step`]) when the impact's load passes through
 /// its centre of mass — then the load has no moment and a support without lever arm is exact —
 /// and the rule follows such central supports down (and up) the stack. An off-centre load keeps
 /// every support point: its lever arms are physical (a brick landing across two others).
@@ -40,6 +46,92 @@ pub const IMPACT_MIN_SPEED_M_S: f64 = 0.05;
 pub struct ImpactHook {
     /// Bodies taking part in an impact on this step.
     pub impacted: Vec<RigidBodyHandle>,
+}
+
+impl ImpactHook {
+    /// The bodies of an impact about to be solved (see [`ImpactHook`]): a body touched by a
+    /// support contact (within 45° of vertical) approaching faster than
+    /// [`IMPACT_MIN_SPEED_M_PER_S`] at its centroid — a new contact, or a resting one that the body
+    /// above has just driven down — whose load passes through the body's centre of mass
+    /// (within [`CENTRAL_LOAD_M`]), and, through such central supports, the bodies below and
+    /// above it. An off-centre load keeps every support point: its lever arms are physical.
+    /// `phys` is the world before the step.
+    pub fn for_step(phys: &PhysicsWorld) -> ImpactHook {
+        let body_of = |c: ColliderHandle| {
+            let h = phys.colliders.get(c)?.parent()?;
+            let rb = phys.bodies.get(h)?;
+            (rb.body_type() == RigidBodyType::Dynamic).then_some(h)
+        };
+        // Whether a load through `point` passes (within CENTRAL_LOAD_M) through the vertical of
+        // the body's centre of mass: then it has no moment and a centroid support is exact.
+        let central = |h: RigidBodyHandle, point: Vector| {
+            phys.bodies.get(h).is_some_and(|rb| {
+                let c = rb.center_of_mass();
+                (point.x - c.x).hypot(point.y - c.y) <= CENTRAL_LOAD_M
+            })
+        };
+        let mut seeds: Vec<RigidBodyHandle> = Vec::new();
+        // Supports between two bodies: (body, other, contact centroid), either way round.
+        let mut links: Vec<(RigidBodyHandle, RigidBodyHandle, Vector)> = Vec::new();
+        for pair in phys.narrow_phase.contact_pairs() {
+            let PairContacts::Rigid(rc) = &pair.contacts else {
+                continue;
+            };
+            let (b1, b2) = (body_of(pair.collider1), body_of(pair.collider2));
+            let (Some(c1), Some(c2)) = (
+                phys.colliders.get(pair.collider1),
+                phys.colliders.get(pair.collider2),
+            ) else {
+                continue;
+            };
+            if b1.is_none() && b2.is_none() {
+                continue;
+            }
+            let vel = |h: Option<RigidBodyHandle>, p: Vector| {
+                h.and_then(|h| phys.bodies.get(h))
+                    .map_or(Vector::ZERO, |rb| rb.velocity_at_point(p))
+            };
+            for m in &rc.manifolds {
+                if m.points.is_empty() || !is_support(m.data.normal) {
+                    continue;
+                }
+                let n = m.data.normal;
+                let mut centroid = Vector::ZERO;
+                for p in &m.points {
+                    centroid += (c1.position() * p.local_p1 + c2.position() * p.local_p2) * 0.5;
+                }
+                centroid /= m.points.len() as f64;
+                // Approach of the contact as a whole (at its centroid): a rocking body's corners
+                // approach while its centroid does not, and that is no impact.
+                let fast =
+                    (vel(b1, centroid) - vel(b2, centroid)).dot(n) >= IMPACT_MIN_SPEED_M_PER_S;
+                if fast {
+                    for h in [b1, b2].into_iter().flatten() {
+                        if central(h, centroid) && !seeds.contains(&h) {
+                            seeds.push(h);
+                        }
+                    }
+                }
+                if let (Some(a), Some(b)) = (b1, b2) {
+                    links.push((a, b, centroid));
+                    links.push((b, a, centroid));
+                }
+            }
+        }
+        // Follow central supports through the stack.
+        loop {
+            let mut grew = false;
+            for (a, b, at) in &links {
+                if seeds.contains(a) && !seeds.contains(b) && central(*b, *at) {
+                    seeds.push(*b);
+                    grew = true;
+                }
+            }
+            if !grew {
+                return ImpactHook { impacted: seeds };
+            }
+        }
+    }
 }
 
 impl PhysicsHooks for ImpactHook {
@@ -79,7 +171,7 @@ impl PhysicsHooks for ImpactHook {
         };
         // The normal points from body 1 toward body 2: approaching when (v1 - v2)·n > 0.
         let approach = (vel(rb1, a1) - vel(rb2, a2)).dot(*m.normal);
-        if approach < IMPACT_MIN_SPEED_M_S {
+        if approach < IMPACT_MIN_SPEED_M_PER_S {
             return;
         }
         merge(m.solver_contacts);

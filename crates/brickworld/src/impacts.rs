@@ -3,7 +3,7 @@
 //!
 //! A contact pair (two colliders) that carries normal impulse after a step and carried none
 //! after the previous one is a new contact. It is an impact when its bodies approached faster
-//! than [`IMPACT_MIN_SPEED_M_S`] along the contact normal just before the step (velocities
+//! than [`IMPACT_MIN_SPEED_M_PER_S`] along the contact normal just before the step (velocities
 //! taken before the step, at the manifold's centroid); its impulse is the sum of the normal
 //! impulses of all its points over the step, N·s. Resting contacts (which carry impulse every
 //! step) and gentle placements raise nothing; a bouncing brick raises one impact per bounce
@@ -12,8 +12,8 @@
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{ColliderHandle, PairContacts, PhysicsWorld, RigidBodyHandle};
 
-use crate::impact::IMPACT_MIN_SPEED_M_S;
-use crate::world::{Body, Event};
+use crate::event::{Body, Event};
+use crate::impact::IMPACT_MIN_SPEED_M_PER_S;
 
 /// Tracks the contact pairs that carried impulse, step to step.
 #[derive(Debug, Default, Clone)]
@@ -117,7 +117,7 @@ impl ImpactTracker {
             let approach = (self.velocity_at(phys, c1.parent(), centroid)
                 - self.velocity_at(phys, c2.parent(), centroid))
             .dot(normal);
-            if approach >= IMPACT_MIN_SPEED_M_S {
+            if approach >= IMPACT_MIN_SPEED_M_PER_S {
                 found.push((
                     k,
                     pair.collider1,
@@ -137,7 +137,7 @@ impl ImpactTracker {
                 a: body_of(a),
                 b: body_of(b),
                 impulse_n_s: impulse,
-                speed_m_s: speed,
+                speed_m_per_s: speed,
                 point_m: p.to_array(),
             });
         }

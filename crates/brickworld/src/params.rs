@@ -5,7 +5,9 @@
 //! Run-time switches (gravity, restitution, friction, inertia, brick mass) are changed through
 //! the validated setters on [`crate::World`], which reuse the same range checks.
 
+use rapier3d_f64::math::{Rotation, Vector};
 use serde::{Deserialize, Serialize};
+use world_form::Limits;
 
 use crate::error::ParamError;
 
@@ -18,7 +20,8 @@ pub struct Params {
     /// Range `[1e-4, 1e-2]`.
     pub dt_s: f64,
     /// Magnitude of gravity in m/s² (0 switches gravity off). Range `[0, 100]`.
-    pub gravity_m_s2: f64,
+    #[serde(alias = "gravity_m_s2")]
+    pub gravity_m_per_s2: f64,
     /// Coefficient of restitution of every contact (0 = no bounce). Range `[0, 1]`.
     pub restitution: f64,
     /// Coulomb friction coefficient of every contact (0 = frictionless). Range `[0, 10]`.
@@ -32,14 +35,16 @@ pub struct Params {
     /// Half-extents of a brick along its local x, y, z axes in m. Each in `[1e-3, 1]`.
     pub brick_half_extents_m: [f64; 3],
     /// Stiffness of the proxy spring `F = -k d n` in N/m. Range `(0, device max stiffness]`.
-    pub proxy_stiffness_n_m: f64,
+    #[serde(alias = "proxy_stiffness_n_m")]
+    pub proxy_stiffness_n_per_m: f64,
     /// Radius of the cursor sphere (the god-object) in m. Range `[1e-4, 0.1]`.
     pub proxy_radius_m: f64,
     /// A brick can be grabbed when the cursor sphere is within this gap of its surface, in m.
     /// Range `[0, 0.1]`.
     pub grab_distance_m: f64,
     /// A release faster than this is reported as a throw, in m/s. Range `[0, 100]`.
-    pub throw_min_speed_m_s: f64,
+    #[serde(alias = "throw_min_speed_m_s")]
+    pub throw_min_speed_m_per_s: f64,
     /// Cursor inputs must satisfy `|x|, |y|, |z| <= workspace_half_extent_m` (m). Range `(0, 100]`.
     pub workspace_half_extent_m: f64,
     /// Largest number of bricks the world may hold. Range `[0, 10000]`.
@@ -66,17 +71,17 @@ impl Default for Params {
     fn default() -> Self {
         Self {
             dt_s: 1e-3,
-            gravity_m_s2: 9.81,
+            gravity_m_per_s2: 9.81,
             restitution: 0.2,
             friction: 0.6,
             inertia: true,
             accel_estimator: AccelEstimator::Paper,
             brick_mass_kg: 0.5,
             brick_half_extents_m: [0.1, 0.05, 0.03],
-            proxy_stiffness_n_m: 1000.0,
+            proxy_stiffness_n_per_m: 1000.0,
             proxy_radius_m: 0.005,
             grab_distance_m: 0.005,
-            throw_min_speed_m_s: 0.2,
+            throw_min_speed_m_per_s: 0.2,
             workspace_half_extent_m: 2.0,
             max_bricks: 200,
             solver_iterations: 4,
@@ -145,12 +150,21 @@ pub struct BrickPlacement {
     pub rotation_deg: [f64; 3],
 }
 
+impl BrickPlacement {
+    /// The orientation (rotation vector in degrees) as a unit quaternion.
+    pub fn rotation(&self) -> Rotation {
+        let v = Vector::from_array(self.rotation_deg) * (std::f64::consts::PI / 180.0);
+        Rotation::from_scaled_axis(v)
+    }
+}
+
 /// Properties of one brick that may differ from the world's ([`crate::World::add_brick_with`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct BrickProps {
     /// Initial linear velocity, m/s. Each component in `[-100, 100]`.
-    pub velocity_m_s: [f64; 3],
+    #[serde(alias = "velocity_m_s")]
+    pub velocity_m_per_s: [f64; 3],
     /// Mass, kg in `[1e-3, 100]`; `None`: [`Params::brick_mass_kg`].
     pub mass_kg: Option<f64>,
     /// Friction coefficient in `[0, 10]`; `None`: [`Params::friction`]. A contact uses the
@@ -194,35 +208,6 @@ impl Default for Blueprint {
             position_tolerance_m: 0.01,
             angle_tolerance_deg: 5.0,
         }
-    }
-}
-
-/// Limits of the haptic device the world renders to (CHAI3D-style device specification).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DeviceLimits {
-    /// Largest stiffness the device renders stably, N/m.
-    pub max_stiffness_n_m: f64,
-    /// Largest force magnitude the device can produce, N.
-    pub max_force_n: f64,
-}
-
-impl DeviceLimits {
-    /// Nominal Novint Falcon figures: about 9 N peak force; a few kN/m of stable stiffness.
-    pub const NOVINT_FALCON: DeviceLimits = DeviceLimits {
-        max_stiffness_n_m: 3000.0,
-        max_force_n: 9.0,
-    };
-
-    /// Checks both limits are finite and positive.
-    pub fn validate(&self) -> Result<(), ParamError> {
-        range(
-            "device.max_stiffness_n_m",
-            self.max_stiffness_n_m,
-            Lo::Open(0.0),
-            1e7,
-        )?;
-        range("device.max_force_n", self.max_force_n, Lo::Open(0.0), 1e5)
     }
 }
 
@@ -288,7 +273,12 @@ impl Params {
     /// Checks every field against its documented range (device-independent part).
     pub fn validate(&self) -> Result<(), ParamError> {
         range("dt_s", self.dt_s, Lo::Closed(1e-4), 1e-2)?;
-        range("gravity_m_s2", self.gravity_m_s2, Lo::Closed(0.0), 100.0)?;
+        range(
+            "gravity_m_per_s2",
+            self.gravity_m_per_s2,
+            Lo::Closed(0.0),
+            100.0,
+        )?;
         range("restitution", self.restitution, Lo::Closed(0.0), 1.0)?;
         range("friction", self.friction, Lo::Closed(0.0), 10.0)?;
         if let AccelEstimator::SavitzkyGolay { window } = self.accel_estimator {
@@ -304,8 +294,8 @@ impl Params {
             )?;
         }
         range(
-            "proxy_stiffness_n_m",
-            self.proxy_stiffness_n_m,
+            "proxy_stiffness_n_per_m",
+            self.proxy_stiffness_n_per_m,
             Lo::Open(0.0),
             1e7,
         )?;
@@ -317,8 +307,8 @@ impl Params {
             0.1,
         )?;
         range(
-            "throw_min_speed_m_s",
-            self.throw_min_speed_m_s,
+            "throw_min_speed_m_per_s",
+            self.throw_min_speed_m_per_s,
             Lo::Closed(0.0),
             100.0,
         )?;
@@ -403,14 +393,20 @@ impl Params {
         Ok(())
     }
 
-    /// Checks the parameters that depend on the device (the proxy stiffness).
-    pub fn validate_for_device(&self, device: &DeviceLimits) -> Result<(), ParamError> {
-        device.validate()?;
+    /// Checks the parameters that depend on the device: the limits themselves (named
+    /// `device.max_force_n` / `device.max_stiffness_n_per_m`) and the proxy stiffness, which
+    /// must not exceed [`Limits::max_stiffness_n_per_m`].
+    pub fn validate_for_device(&self, limits: &Limits) -> Result<(), ParamError> {
+        limits.validate().map_err(|e| ParamError::OutOfRange {
+            field: format!("device.{}", e.field),
+            value: e.value,
+            range: format!("(0, {}]", e.max),
+        })?;
         range(
-            "proxy_stiffness_n_m",
-            self.proxy_stiffness_n_m,
+            "proxy_stiffness_n_per_m",
+            self.proxy_stiffness_n_per_m,
             Lo::Open(0.0),
-            device.max_stiffness_n_m,
+            limits.max_stiffness_n_per_m,
         )
     }
 }

@@ -4,13 +4,14 @@
 //! in order it enters the loading zone, waits for a brick, touches its top, grabs it, lifts it,
 //! carries it over the slot, turns it about z if the slot asks for it, lowers it to 1 mm above
 //! the slot, lets go, waits for it to rest and leaves the zone's reach. The cursor moves in
-//! straight lines at [`WallScript::SPEED_M_S`]. Deterministic: same world, same inputs.
+//! straight lines at [`WallScript::SPEED_M_PER_S`]. Deterministic: same world, same inputs.
 
-use crate::blueprint::{cuboid_orientation_error_rad, placement_rotation};
+use crate::blueprint::cuboid_orientation_error_rad;
 use crate::error::InputError;
-use crate::input::{Buttons, CursorInput};
+use crate::event::BrickId;
+use crate::input::{CursorInput, Grip};
 use crate::params::BrickPlacement;
-use crate::world::{BrickId, World};
+use crate::world::World;
 use rapier3d_f64::math::{Rotation, Vector};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,17 +24,17 @@ enum Phase {
     WaitBrick,
     /// Press down onto the brick's top.
     Touch(BrickId),
-    /// Centre button down.
+    /// Hold down.
     Grab(BrickId),
     /// Lift to carry height.
     Lift,
     /// Fly above the slot.
     ToSlot,
-    /// Press rotate-z for one tick, then release it.
+    /// Press turn-z for one tick, then release it.
     Turn(u8),
     /// Lower into the slot.
     Lower,
-    /// Centre button up; wait for the brick to rest.
+    /// Hold up; wait for the brick to rest.
     Release(u32),
     /// Back up to carry height.
     Up,
@@ -48,7 +49,7 @@ pub struct WallScript {
     next_slot: usize,
     phase: Phase,
     cursor: Vector,
-    buttons: Buttons,
+    grip: Grip,
     spawn: Vector,
     away: Vector,
     carry_z: f64,
@@ -57,7 +58,7 @@ pub struct WallScript {
 
 impl WallScript {
     /// Cursor speed along straight segments, m/s.
-    pub const SPEED_M_S: f64 = 0.5;
+    pub const SPEED_M_PER_S: f64 = 0.5;
     /// Height the cursor carries bricks at, m.
     pub const CARRY_Z_M: f64 = 0.35;
 
@@ -70,7 +71,7 @@ impl WallScript {
             next_slot: 0,
             phase: Phase::ToSpawn,
             cursor: Vector::from_array(start_m),
-            buttons: Buttons::default(),
+            grip: Grip::default(),
             spawn: Vector::new(z.spawn_m[0], z.spawn_m[1], Self::CARRY_Z_M),
             away: Vector::new(z.max_m[0] + 0.15, z.spawn_m[1], Self::CARRY_Z_M),
             carry_z: Self::CARRY_Z_M,
@@ -85,7 +86,7 @@ impl WallScript {
 
     fn go(&mut self, target: Vector, dt: f64) -> bool {
         let d = target - self.cursor;
-        let step = Self::SPEED_M_S * dt;
+        let step = Self::SPEED_M_PER_S * dt;
         if d.length() <= step {
             self.cursor = target;
             true
@@ -142,7 +143,7 @@ impl WallScript {
                 }
             }
             Phase::Grab(_) => {
-                self.buttons.center = true;
+                self.grip.hold = true;
                 if self.ticks_in_phase > 2 {
                     self.set(Phase::Lift);
                 }
@@ -163,18 +164,18 @@ impl WallScript {
             Phase::Turn(n) => {
                 // Turn about z until the held brick matches the slot's orientation (≤ 3 turns).
                 let held = world.held_brick().and_then(|id| world.brick(id).ok());
-                let target = placement_rotation(&self.slots[self.next_slot]);
+                let target = self.slots[self.next_slot].rotation();
                 let aligned = held.is_none_or(|b| {
                     let q = b.orientation_xyzw;
                     let q = Rotation::from_xyzw(q[0], q[1], q[2], q[3]);
                     cuboid_orientation_error_rad(target, q) < 0.1
                 });
-                if self.buttons.rotate_z {
-                    self.buttons.rotate_z = false;
+                if self.grip.turn_z {
+                    self.grip.turn_z = false;
                 } else if aligned || n >= 3 {
                     self.set(Phase::Lower);
                 } else {
-                    self.buttons.rotate_z = true;
+                    self.grip.turn_z = true;
                     self.phase = Phase::Turn(n + 1);
                 }
             }
@@ -194,7 +195,7 @@ impl WallScript {
                 }
             }
             Phase::Release(_) => {
-                self.buttons.center = false;
+                self.grip.hold = false;
                 if self.ticks_in_phase > 300 {
                     self.next_slot += 1;
                     self.set(Phase::Up);
@@ -208,6 +209,6 @@ impl WallScript {
             }
             Phase::Done => {}
         }
-        world.input(self.cursor.to_array(), self.buttons)
+        world.input(self.cursor.to_array(), self.grip)
     }
 }

@@ -4,11 +4,42 @@
 mod common;
 use brickworld::script::WallScript;
 use brickworld::{
-    AccelEstimator, BrickId, BrickPlacement, Buttons, DeviceLimits, Event, InputError, ParamError,
-    Params, World,
+    AccelEstimator, BrickId, BrickPlacement, Event, Grip, InputError, ParamError, Params, World,
 };
 use common::*;
 use proptest::prelude::*;
+use world_form::Limits;
+
+#[test]
+fn old_unit_spellings_still_load_and_device_limits_are_checked_by_name() {
+    let new = Params::from_toml(
+        "gravity_m_per_s2 = 3.7\nproxy_stiffness_n_per_m = 800.0\nthrow_min_speed_m_per_s = 0.4",
+    )
+    .unwrap();
+    let old = Params::from_toml(
+        "gravity_m_s2 = 3.7\nproxy_stiffness_n_m = 800.0\nthrow_min_speed_m_s = 0.4",
+    )
+    .unwrap();
+    assert_eq!(old, new);
+    assert_eq!(old.gravity_m_per_s2, 3.7);
+    assert_eq!(old.proxy_stiffness_n_per_m, 800.0);
+    assert_eq!(old.throw_min_speed_m_per_s, 0.4);
+    let props: brickworld::BrickProps = toml::from_str("velocity_m_s = [1.0, 0.0, 0.0]").unwrap();
+    assert_eq!(props.velocity_m_per_s, [1.0, 0.0, 0.0]);
+    // The Falcon is 8 N everywhere (CHAI3D's figure).
+    assert_eq!(Limits::FALCON.max_force_n, 8.0);
+    let bad = Limits {
+        max_force_n: f64::NAN,
+        ..Limits::FALCON
+    };
+    assert_eq!(
+        World::new(&Params::default(), &bad)
+            .err()
+            .unwrap()
+            .to_string(),
+        "parameter `device.max_force_n` = NaN is out of range: allowed (0, 100000]"
+    );
+}
 
 #[test]
 fn bad_parameters_name_the_field_and_range() {
@@ -25,11 +56,11 @@ fn bad_parameters_name_the_field_and_range() {
         "parameter `brick_half_extents_m[1]` = NaN is out of range: allowed [0.001, 1]"
     );
     let mut p = Params::default();
-    p.proxy_stiffness_n_m = 5000.0;
-    let e = World::new(p, DeviceLimits::NOVINT_FALCON).err().unwrap();
+    p.proxy_stiffness_n_per_m = 5000.0;
+    let e = World::new(&p, &Limits::FALCON).err().unwrap();
     assert_eq!(
         e.to_string(),
-        "parameter `proxy_stiffness_n_m` = 5000 is out of range: allowed (0, 3000]"
+        "parameter `proxy_stiffness_n_per_m` = 5000 is out of range: allowed (0, 3000]"
     );
     let mut p = Params::default();
     p.accel_estimator = AccelEstimator::SavitzkyGolay { window: 3 };
@@ -53,7 +84,7 @@ fn bad_parameters_name_the_field_and_range() {
 fn toml_parameters_parse_and_reject_unknown_fields() {
     let p = Params::from_toml(
         r#"
-        gravity_m_s2 = 1.62
+        gravity_m_per_s2 = 1.62
         restitution = 0.4
         accel_estimator = { savitzky_golay = { window = 21 } }
         [[bricks]]
@@ -63,7 +94,7 @@ fn toml_parameters_parse_and_reject_unknown_fields() {
         "#,
     )
     .unwrap();
-    assert_eq!(p.gravity_m_s2, 1.62);
+    assert_eq!(p.gravity_m_per_s2, 1.62);
     assert_eq!(
         p.accel_estimator,
         AccelEstimator::SavitzkyGolay { window: 21 }
@@ -100,14 +131,14 @@ fn parameters_round_trip_through_toml() {
 fn bad_cursor_input_and_switches_are_typed_errors() {
     let mut w = world(bare());
     assert_eq!(
-        w.input([0.0, f64::INFINITY, 0.0], Buttons::default()),
+        w.input([0.0, f64::INFINITY, 0.0], Grip::default()),
         Err(InputError::NotFinite {
             axis: 1,
             value: f64::INFINITY
         })
     );
     assert_eq!(
-        w.input([0.0, 0.0, 3.0], Buttons::default())
+        w.input([0.0, 0.0, 3.0], Grip::default())
             .unwrap_err()
             .to_string(),
         "cursor input `position_m[2]` = 3 m is outside the workspace: allowed [-2, 2] m"
@@ -115,7 +146,7 @@ fn bad_cursor_input_and_switches_are_typed_errors() {
     assert_eq!(
         w.set_gravity(-1.0).unwrap_err(),
         ParamError::OutOfRange {
-            field: "gravity_m_s2".into(),
+            field: "gravity_m_per_s2".into(),
             value: -1.0,
             range: "[0, 100]".into()
         }
@@ -248,10 +279,10 @@ fn rotate_buttons_turn_the_carried_brick_by_quarter_turns() {
     }
     let c = w.cursor_position_m();
     let q0 = w.brick(BrickId(0)).unwrap().orientation_xyzw;
-    let b = Buttons {
-        center: true,
-        rotate_z: true,
-        ..Buttons::default()
+    let b = Grip {
+        hold: true,
+        turn_z: true,
+        ..Grip::default()
     };
     let rep = w.step(&w.input(c, b).unwrap());
     assert!(rep.events.contains(&Event::Rotated {
@@ -292,7 +323,7 @@ proptest! {
         p.bricks = vec![at([0.0, 0.0, h[2]]), at([0.0, 0.0, 3.0 * h[2]])];
         let mut w = world(p);
         let r = w.params().proxy_radius_m;
-        let max_f = w.device().max_force_n;
+        let max_f = w.limits().max_force_n;
         for (x, y, z, c) in path {
             for _ in 0..10 {
                 let rep = hold(&mut w, [x, y, z], c);

@@ -105,7 +105,7 @@ fn resting_brick_and_brick_below_friction_angle_fall_asleep() {
 #[test]
 fn pressing_down_on_the_centre_does_not_walk_the_brick() {
     let mut p = bare();
-    p.proxy_stiffness_n_m = 3000.0;
+    p.proxy_stiffness_n_per_m = 3000.0;
     let h = p.brick_half_extents_m;
     p.bricks = vec![at([0.0, 0.0, h[2]])];
     let mut w = world(p);
@@ -115,7 +115,7 @@ fn pressing_down_on_the_centre_does_not_walk_the_brick() {
     let start = w.brick(BrickId(0)).unwrap().position_m;
     let top = start[2] + h[2];
     let r = w.params().proxy_radius_m;
-    let max_f = w.device().max_force_n;
+    let max_f = w.limits().max_force_n;
     let mut worst_lateral = 0.0_f64;
     let mut last = None;
     for i in 0..4000 {
@@ -157,7 +157,7 @@ fn centred_flat_drop_onto_a_brick_stays_centred() {
         for _ in 0..3000 {
             idle(&mut w, PARK);
             let b = w.brick(BrickId(1)).unwrap();
-            worst_v = worst_v.max(b.velocity_m_s[0].hypot(b.velocity_m_s[1]));
+            worst_v = worst_v.max(b.velocity_m_per_s[0].hypot(b.velocity_m_per_s[1]));
         }
         let b = w.brick(BrickId(1)).unwrap().position_m;
         let off = b[0].hypot(b[1]);
@@ -181,7 +181,7 @@ fn brick_with_initial_velocity_and_own_friction_slides_v2_over_2_mu_g() {
         .add_brick_with(
             at([0.0, 0.0, h[2]]),
             brickworld::BrickProps {
-                velocity_m_s: [1.0, 0.0, 0.0],
+                velocity_m_per_s: [1.0, 0.0, 0.0],
                 friction: Some(0.0),
                 mass_kg: Some(2.0),
                 ..Default::default()

@@ -21,7 +21,7 @@ fn bounce_ratio(e: f64, drop_m: f64) -> f64 {
         idle(&mut w, PARK);
         let b = w.brick(BrickId(0)).unwrap();
         let bottom = b.position_m[2] - hz;
-        let vz = b.velocity_m_s[2];
+        let vz = b.velocity_m_per_s[2];
         if !hit && vz > 0.0 {
             hit = true;
         }
@@ -296,7 +296,7 @@ fn thrown_brick_follows_projectile_motion_before_first_contact() {
     p.restitution = 0.0;
     let h = p.brick_half_extents_m;
     p.bricks = vec![at([0.0, 0.0, h[2]])];
-    let g = p.gravity_m_s2;
+    let g = p.gravity_m_per_s2;
     let mut w = world(p);
     for _ in 0..600 {
         idle(&mut w, PARK);
@@ -318,7 +318,9 @@ fn thrown_brick_follows_projectile_motion_before_first_contact() {
     }
     let rel = hold(&mut w, c, false);
     let released = rel.events.iter().find_map(|e| match e {
-        Event::Thrown { velocity_m_s, .. } => Some(*velocity_m_s),
+        Event::Thrown {
+            velocity_m_per_s, ..
+        } => Some(*velocity_m_per_s),
         _ => None,
     });
     let v0 = released.expect("a throw event");
@@ -331,7 +333,7 @@ fn thrown_brick_follows_projectile_motion_before_first_contact() {
     let b0 = w.brick(BrickId(0)).unwrap();
     let p0 = b0.position_m;
     // The release tick already integrated one step: the flight starts from its end state.
-    let v1 = b0.velocity_m_s;
+    let v1 = b0.velocity_m_per_s;
     assert!((v1[0] - v0[0]).abs() < 1e-9 && (v1[2] - (v0[2] - g * dt)).abs() < 1e-9);
     let mut worst = 0.0_f64;
     let mut t = 0.0;
@@ -386,7 +388,7 @@ fn weight_and_inertia_forces_are_m_g_and_minus_m_a() {
         p.brick_mass_kg = 0.3;
         let h = p.brick_half_extents_m;
         p.bricks = vec![at([0.0, 0.0, h[2]])];
-        let (m, g) = (p.brick_mass_kg, p.gravity_m_s2);
+        let (m, g) = (p.brick_mass_kg, p.gravity_m_per_s2);
         let mut w = world(p);
         for _ in 0..600 {
             idle(&mut w, PARK);
@@ -460,7 +462,7 @@ fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
     let mut p = bare();
     let h = p.brick_half_extents_m;
     p.bricks = vec![at([0.0, 0.0, h[2]]), at([0.5, 0.0, h[2]])];
-    let k = p.proxy_stiffness_n_m;
+    let k = p.proxy_stiffness_n_per_m;
     let mut w = world(p);
     for _ in 0..600 {
         idle(&mut w, PARK);
@@ -491,14 +493,14 @@ fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
     // The spring pushes the hand back up by k times the cursor's depth below the proxy.
     let depth = w.proxy_position_m()[2] - c[2];
     assert!((rep.spring_force_n[2] - k * depth).abs() < 1e-9 && depth > 0.02);
-    assert_eq!(rep.stiffness_n_m, k);
+    assert_eq!(rep.stiffness_n_per_m, k);
     // Standing on the ground, a quarter turn about y would stand the brick on its end through
     // the ground: refused, and nothing moves.
     let before = w.brick(BrickId(0)).unwrap();
-    let turn_y = brickworld::Buttons {
-        center: true,
-        rotate_y: true,
-        ..brickworld::Buttons::default()
+    let turn_y = brickworld::Grip {
+        hold: true,
+        turn_y: true,
+        ..brickworld::Grip::default()
     };
     let rep = w.step(&w.input(c, turn_y).unwrap());
     assert!(
@@ -533,10 +535,10 @@ fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
     for _ in 0..100 {
         hold(&mut w, c, true);
     }
-    let turn_z = brickworld::Buttons {
-        center: true,
-        rotate_z: true,
-        ..brickworld::Buttons::default()
+    let turn_z = brickworld::Grip {
+        hold: true,
+        turn_z: true,
+        ..brickworld::Grip::default()
     };
     let rep = w.step(&w.input(c, turn_z).unwrap());
     assert!(rep.events.contains(&Event::Rotated {

@@ -75,7 +75,7 @@ fn main() {
         last = Some(s);
     }
     let s = last.expect("three runs");
-    let mg = s.brick_mass_kg * s.gravity_m_s2;
+    let mg = s.brick_mass_kg * s.gravity_m_per_s2;
 
     // 2. Sound of the golden recordings.
     let mut rows = Table::new([
@@ -135,7 +135,7 @@ fn main() {
             .join(", "),
     );
     let throw =
-        s.brick_throw.distance_m / (s.brick_throw.release_speed_m_s * s.brick_throw.flight_s);
+        s.brick_throw.distance_m / (s.brick_throw.release_speed_m_per_s * s.brick_throw.flight_s);
     let mut acc = Table::new(["figure", "measured", "reference", "error"]);
     for r in [
         [
@@ -186,9 +186,12 @@ fn main() {
             "throw threshold of the 3 g atom (hand)".to_string(),
             format!(
                 "stays ≤ {:.2}, thrown ≥ {:.2} m/s²",
-                s.sweep.kept_below_m_s2, s.sweep.thrown_from_m_s2
+                s.sweep.kept_below_m_per_s2, s.sweep.thrown_from_m_per_s2
             ),
-            format!("hold/(m·scale) = {:.2} m/s²", s.sweep.predicted_hand_m_s2),
+            format!(
+                "hold/(m·scale) = {:.2} m/s²",
+                s.sweep.predicted_hand_m_per_s2
+            ),
             "bracketed".to_string(),
         ],
         [
@@ -204,8 +207,8 @@ fn main() {
     let _ = writeln!(
         md,
         "Target: {}.\n",
-        if s.sweep.kept_below_m_s2 < s.sweep.predicted_hand_m_s2
-            && s.sweep.thrown_from_m_s2 >= s.sweep.predicted_hand_m_s2
+        if s.sweep.kept_below_m_per_s2 < s.sweep.predicted_hand_m_per_s2
+            && s.sweep.thrown_from_m_per_s2 >= s.sweep.predicted_hand_m_per_s2
             && (s.hysteresis.ratio - 10.0).abs() < 1e-9
         {
             "every stated figure within its reference's error as listed (pull-off 10× exact, threshold bracketed) — **met**"

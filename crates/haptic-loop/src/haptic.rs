@@ -194,7 +194,8 @@ impl HapticLoop {
     /// [`TickResult::switches`] and a `switch.set` event).
     pub fn switch(&mut self, name: &str, value: f64) -> Result<(), SwitchError> {
         let kind = self.scene.kind();
-        switch::check(kind, self.scene.switches(), name, value)?;
+        // An old name is applied and recorded under the switch's own name.
+        let name = switch::check(kind, self.scene.switches(), name, value)?.name;
         self.scene
             .set_switch(name, value)
             .map_err(|message| SwitchError::Refused {

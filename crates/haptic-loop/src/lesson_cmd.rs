@@ -85,7 +85,7 @@ pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
         } else {
             "left the tip"
         },
-        si(s.atom_threshold_hand_m_s2, "m/s²")
+        si(s.atom_threshold_hand_m_per_s2, "m/s²")
     );
     println!(
         "report: {} ({} files)",

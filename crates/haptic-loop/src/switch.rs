@@ -12,8 +12,11 @@ use serde::Serialize;
 /// One switch a scene offers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SwitchSpec {
-    /// Name as written in scripts, with its unit as suffix (`gravity_m_s2`).
+    /// Name as written in scripts, with its unit as suffix (`gravity_m_per_s2`).
     pub name: &'static str,
+    /// An earlier name still accepted (`gravity_m_s2`, before the one unit spelling); the
+    /// switch is applied and recorded under [`SwitchSpec::name`].
+    pub old_name: Option<&'static str>,
     /// Smallest allowed value (inclusive).
     pub min: f64,
     /// Largest allowed value (inclusive).
@@ -29,6 +32,7 @@ impl SwitchSpec {
     pub const fn number(name: &'static str, min: f64, max: f64, doc: &'static str) -> Self {
         SwitchSpec {
             name,
+            old_name: None,
             min,
             max,
             boolean: false,
@@ -40,11 +44,26 @@ impl SwitchSpec {
     pub const fn on_off(name: &'static str, doc: &'static str) -> Self {
         SwitchSpec {
             name,
+            old_name: None,
             min: 0.0,
             max: 1.0,
             boolean: true,
             doc,
         }
+    }
+
+    /// The same switch, also accepted under `old` (a name scripts used before; the switch is
+    /// still applied and recorded under its own name).
+    pub const fn or_old_name(self, old: &'static str) -> Self {
+        SwitchSpec {
+            old_name: Some(old),
+            ..self
+        }
+    }
+
+    /// Whether `name` names this switch (its name or its old name).
+    pub fn is_named(&self, name: &str) -> bool {
+        self.name == name || self.old_name == Some(name)
     }
 
     /// The allowed values in words.
@@ -109,20 +128,22 @@ pub enum SwitchError {
     },
 }
 
-/// The detail of the `switch.set` event: `{"name":"gravity_m_s2","value":0.0}` (JSON; the
+/// The detail of the `switch.set` event: `{"name":"gravity_m_per_s2","value":0.0}` (JSON; the
 /// value's shortest round-trip decimal form).
 pub fn event_detail(s: &Switch) -> String {
     serde_json::to_string(s).unwrap_or_else(|_| format!("{{\"name\":\"{}\"}}", s.name))
 }
 
-/// Checks `name = value` against the switches `specs` of a scene of kind `kind`.
+/// Checks `name = value` against the switches `specs` of a scene of kind `kind`; `name` may be
+/// a switch's old name. Returns the switch, whose [`SwitchSpec::name`] is the one to apply and
+/// record.
 pub fn check(
     kind: &str,
     specs: &[SwitchSpec],
     name: &str,
     value: f64,
 ) -> Result<SwitchSpec, SwitchError> {
-    let Some(spec) = specs.iter().find(|s| s.name == name) else {
+    let Some(spec) = specs.iter().find(|s| s.is_named(name)) else {
         let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
         return Err(SwitchError::Unknown {
             kind: kind.to_string(),
@@ -149,7 +170,7 @@ mod tests {
     use super::*;
 
     const SPECS: [SwitchSpec; 2] = [
-        SwitchSpec::number("gravity_m_s2", 0.0, 100.0, "gravity"),
+        SwitchSpec::number("gravity_m_per_s2", 0.0, 100.0, "gravity").or_old_name("gravity_m_s2"),
         SwitchSpec::on_off("inertia", "inertial force"),
     ];
 
@@ -159,17 +180,17 @@ mod tests {
             check("brickworld", &SPECS, "gravity", 1.0)
                 .unwrap_err()
                 .to_string(),
-            "the brickworld scene has no switch `gravity` (its switches: gravity_m_s2, inertia)"
+            "the brickworld scene has no switch `gravity` (its switches: gravity_m_per_s2, inertia)"
         );
         assert_eq!(
             check("wall", &[], "gravity", 1.0).unwrap_err().to_string(),
             "the wall scene has no switch `gravity` (its switches: none)"
         );
         assert_eq!(
-            check("brickworld", &SPECS, "gravity_m_s2", 101.0)
+            check("brickworld", &SPECS, "gravity_m_per_s2", 101.0)
                 .unwrap_err()
                 .to_string(),
-            "switch `gravity_m_s2` = 101 is out of range (allowed: 0 ≤ value ≤ 100)"
+            "switch `gravity_m_per_s2` = 101 is out of range (allowed: 0 ≤ value ≤ 100)"
         );
         assert_eq!(
             check("brickworld", &SPECS, "inertia", 0.5)
@@ -177,8 +198,17 @@ mod tests {
                 .to_string(),
             "switch `inertia` = 0.5 is out of range (allowed: true / false (1 / 0))"
         );
-        assert!(check("brickworld", &SPECS, "gravity_m_s2", f64::NAN).is_err());
-        assert!(check("brickworld", &SPECS, "gravity_m_s2", 0.0).is_ok());
+        assert!(check("brickworld", &SPECS, "gravity_m_per_s2", f64::NAN).is_err());
+        assert!(check("brickworld", &SPECS, "gravity_m_per_s2", 0.0).is_ok());
         assert!(check("brickworld", &SPECS, "inertia", 1.0).is_ok());
+        // The old spelling still names the switch, which answers with its new name.
+        let spec = check("brickworld", &SPECS, "gravity_m_s2", 0.0).unwrap();
+        assert_eq!(spec.name, "gravity_m_per_s2");
+        assert_eq!(
+            check("brickworld", &SPECS, "gravity_m_s2", 101.0)
+                .unwrap_err()
+                .to_string(),
+            "switch `gravity_m_s2` = 101 is out of range (allowed: 0 ≤ value ≤ 100)"
+        );
     }
 }

@@ -79,7 +79,7 @@ fn scene_errors_name_the_field() {
     // 1 N → 1 N: the 1000 N/m proxy would be 20 000 N/m on the Falcon.
     let e = err(text.replace("force_scale = 0.125", "force_scale = 1.0"));
     assert!(e.starts_with("scene: brickworld.params: "), "{e}");
-    assert!(e.contains("proxy_stiffness_n_m"), "{e}");
+    assert!(e.contains("proxy_stiffness_n_per_m"), "{e}");
     assert!(
         err(text.replace("draw_ground_half_m = 1.0", "ground = 1.0"))
             .contains("unknown field `ground`")

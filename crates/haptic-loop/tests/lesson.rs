@@ -25,7 +25,7 @@ fn the_lesson_measures_what_it_says() {
     assert_eq!(s.macro_house.dropped, 0.0);
     assert_eq!(s.nano_house.dropped, 0.0);
     // Weight M g held still; gravity off removes it, inertia off leaves it.
-    let mg = s.brick_mass_kg * s.gravity_m_s2;
+    let mg = s.brick_mass_kg * s.gravity_m_per_s2;
     assert!(
         (s.lift_weight_n[0] + mg).abs() < 1e-6 * mg,
         "{}",
@@ -52,17 +52,17 @@ fn the_lesson_measures_what_it_says() {
     // throw) within the tick's resolution.
     let t = &s.brick_throw;
     assert!(t.thrown);
-    assert!((t.distance_m / (t.release_speed_m_s * t.flight_s) - 1.0).abs() < 0.02);
+    assert!((t.distance_m / (t.release_speed_m_per_s * t.flight_s) - 1.0).abs() < 0.02);
     // The atom stays; the heavy atom's measured threshold brackets hold / (m · scale).
     assert!(s.atom_stayed);
     assert!(s.atom_hold_n / s.atom_load_n > 1e14);
     let sw = &s.sweep;
-    assert!(sw.kept_below_m_s2 < sw.predicted_hand_m_s2);
-    assert!(sw.thrown_from_m_s2 >= sw.predicted_hand_m_s2);
+    assert!(sw.kept_below_m_per_s2 < sw.predicted_hand_m_per_s2);
+    assert!(sw.thrown_from_m_per_s2 >= sw.predicted_hand_m_per_s2);
     assert!(
         sw.runs
             .iter()
-            .all(|r| r.2 == (r.1 >= sw.predicted_hand_m_s2))
+            .all(|r| r.2 == (r.1 >= sw.predicted_hand_m_per_s2))
     );
     // The report and its figures are there.
     for f in &s.files {

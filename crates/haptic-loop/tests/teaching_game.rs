@@ -47,8 +47,9 @@ fn json(detail: &str) -> serde_json::Value {
 #[test]
 fn switching_gravity_off_mid_carry_removes_the_weight_and_replays_bit_exactly() {
     // The default script carries the first brick from 1.529 s to 3.575 s; from 2.104 s to
-    // 3.004 s it moves horizontally. Gravity goes off at 2.5 s and back on at 2.8 s.
-    let extra = "[[switch]]\nt_s = 2.5\nname = \"gravity_m_s2\"\nvalue = 0.0\n\n\
+    // 3.004 s it moves horizontally. Gravity goes off at 2.5 s and back on at 2.8 s (the second
+    // switch by its old name, `gravity_m_s2`: accepted, recorded under the new one).
+    let extra = "[[switch]]\nt_s = 2.5\nname = \"gravity_m_per_s2\"\nvalue = 0.0\n\n\
                  [[switch]]\nt_s = 2.8\nname = \"gravity_m_s2\"\nvalue = 9.81\n";
     let p = tmp("gravity.mcap");
     let a = run(
@@ -63,7 +64,11 @@ fn switching_gravity_off_mid_carry_removes_the_weight_and_replays_bit_exactly() 
     assert_eq!(sets[1].0, 2800);
     assert_eq!(
         json(&sets[0].2),
-        serde_json::json!({"name": "gravity_m_s2", "value": 0.0})
+        serde_json::json!({"name": "gravity_m_per_s2", "value": 0.0})
+    );
+    assert_eq!(
+        json(&sets[1].2),
+        serde_json::json!({"name": "gravity_m_per_s2", "value": 9.81})
     );
     // The weight of the 0.5 kg brick, −M g = −4.905 N, is felt before and after, not between.
     let fz = |t: usize| a.world_force_n[t][2];
@@ -126,7 +131,7 @@ fn a_script_switch_the_scene_lacks_is_refused_with_its_line() {
         e,
         format!(
             "s.toml:{line}:8: script: `switch[0].name`: the brickworld scene has no switch \
-             `gravity` (its switches: gravity_m_s2, restitution, friction, inertia, brick_mass_kg)"
+             `gravity` (its switches: gravity_m_per_s2, restitution, friction, inertia, brick_mass_kg)"
         )
     );
     let extra = "[[switch]]\nt_s = 1.0\nname = \"restitution\"\nvalue = 1.5\n";
@@ -160,9 +165,9 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
     // M v (1 + e) plus the weight's impulse over the tick, M g dt (e = 0.2, M = 0.5 kg).
     for i in ground
         .iter()
-        .filter(|i| i["speed_m_s"].as_f64().unwrap() > 0.5)
+        .filter(|i| i["speed_m_per_s"].as_f64().unwrap() > 0.5)
     {
-        let v = i["speed_m_s"].as_f64().unwrap();
+        let v = i["speed_m_per_s"].as_f64().unwrap();
         let want = 0.5 * v * 1.2 + 0.5 * 9.81 * 1e-3;
         let got = i["impulse_n_s"].as_f64().unwrap();
         assert!(
@@ -173,7 +178,7 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
     for i in &impacts {
         assert_eq!(i["type"], "impact");
         assert!(i["impulse_n_s"].as_f64().unwrap() > 0.0);
-        assert!(i["speed_m_s"].as_f64().unwrap() >= 0.05);
+        assert!(i["speed_m_per_s"].as_f64().unwrap() >= 0.05);
     }
     let n = a.state_fields.len();
     let col = |name: &str| a.state_fields.iter().position(|f| f == name).unwrap();

@@ -14,7 +14,7 @@ fn world(n: usize) -> World {
     p.initial_atoms_xy_m.clear();
     p.house = None;
     let c = n as f64 * p.substrate.spacing_m / 2.0;
-    World::new(p, Vector3::new(c, c, 2e-9)).expect("valid bench world")
+    World::new(&p, &p.default_limits(), Vector3::new(c, c, 2e-9)).expect("valid bench world")
 }
 
 /// A circle of radius 1 nm at 0.25 nm surface gap above the substrate centre, 1000 ticks.

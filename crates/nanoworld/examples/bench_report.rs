@@ -11,8 +11,8 @@ use bench_harness::plotters::prelude::{BLACK, BLUE, GREEN, RED, SeriesLabelPosit
 use bench_harness::{Align, Report, Summary, Table, Timings, span};
 use nalgebra::Vector3;
 use nanoworld::{
-    CurveSpec, ForceCurve, Interaction, PairKind, Params, TipInput, World, force_distance_curve,
-    house_script,
+    CurveSpec, ForceCurve, GAME_FALCON_LIMITS, Interaction, PairKind, Params, TipInput, World,
+    force_distance_curve, house_script,
 };
 
 type Res<T> = Result<T, Box<dyn Error>>;
@@ -59,7 +59,7 @@ fn tick_us(t: &Timings) -> Res<Summary> {
 fn time_world(n: usize, ticks: usize) -> Res<Timing> {
     let p = bare(Params::game_default(), n);
     let path = hover(&p, ticks);
-    let mut w = World::new(p, path[0].position_m)?;
+    let mut w = World::new(&p, &p.default_limits(), path[0].position_m)?;
     for i in path.iter().take(2000) {
         w.step(i, 1e-3)?;
     }
@@ -222,7 +222,7 @@ fn main() -> Res<()> {
     )?;
     // Physical mode at 10^5: the substrate is a Hamaker half-space, no sum over atoms.
     let pp = bare(Params::physical_default(), 317);
-    let mut pw = World::new(pp.clone(), Vector3::new(47e-9, 47e-9, 30e-9))?;
+    let mut pw = World::new(&pp, &pp.default_limits(), Vector3::new(47e-9, 47e-9, 30e-9))?;
     let zc = pp.substrate.atom_radius_m + pp.tip.radius_m + 2e-9;
     let mut pt = Timings::with_capacity(ticks);
     for k in 0..ticks {
@@ -245,8 +245,11 @@ fn main() -> Res<()> {
 
     // ---- physics checks against analytic values ------------------------------------------
     md.heading("Force–distance curves against the analytic values");
-    let mut g = bare(Params::game_default(), 1);
-    g.max_force_n = 1e-8;
+    let g = bare(Params::game_default(), 1);
+    let g_limits = world_form::Limits {
+        max_force_n: 1e-8,
+        ..GAME_FALCON_LIMITS
+    };
     let steps = 100_000;
     let gspec = CurveSpec {
         xy_m: [0.0, 0.0],
@@ -255,10 +258,10 @@ fn main() -> Res<()> {
         steps,
         dt_s: 1e-3,
     };
-    let (gc, gs) = span(|| force_distance_curve(&g, &gspec));
+    let (gc, gs) = span(|| force_distance_curve(&g, &g_limits, &gspec));
     let gc = gc?;
     let g_us = gs.wall_s * 1e6 / (2.0 * steps as f64 + 2.0);
-    let gw = World::new(g.clone(), Vector3::new(0.0, 0.0, 5e-9))?;
+    let gw = World::new(&g, &g_limits, Vector3::new(0.0, 0.0, 5e-9))?;
     let gl = *gw.laws().get(PairKind::TipSubstrate);
     let h = 2e-9 / steps as f64;
     let gi = gc.snap_index.ok_or("game snap")?;
@@ -296,7 +299,7 @@ fn main() -> Res<()> {
         steps: psteps,
         dt_s: 1e-3,
     };
-    let (pc, ps) = span(|| force_distance_curve(&ph, &pspec));
+    let (pc, ps) = span(|| force_distance_curve(&ph, &ph.default_limits(), &pspec));
     let pc = pc?;
     let p_us = ps.wall_s * 1e6 / (2.0 * psteps as f64 + 2.0);
     let ph_h = far / psteps as f64;
@@ -436,7 +439,11 @@ fn main() -> Res<()> {
     md.image("physical curve", "nanoworld-curve-physical.png");
 
     // ---- the scripted house session ------------------------------------------------------
-    let mut w = World::new(Params::game_default(), Vector3::new(4e-9, 4e-9, 4e-9))?;
+    let mut w = World::new(
+        &Params::game_default(),
+        &GAME_FALCON_LIMITS,
+        Vector3::new(4e-9, 4e-9, 4e-9),
+    )?;
     let script = house_script(&w, 2e-12)?;
     let mut t = Timings::with_capacity(script.len());
     let mut events = 0;

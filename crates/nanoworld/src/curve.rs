@@ -5,6 +5,7 @@ use nalgebra::Vector3;
 use crate::error::CurveError;
 use crate::params::Params;
 use crate::world::{Event, TipInput, World};
+use world_form::Limits;
 
 /// One vertical approach–retract sweep of the bare tip over the substrate.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,8 +44,12 @@ pub struct ForceCurve {
 }
 
 /// Sweep a bare tip (no movable atoms, no loading zone, no house) down and up over the
-/// substrate of `params` and record the device force.
-pub fn force_distance_curve(params: &Params, spec: &CurveSpec) -> Result<ForceCurve, CurveError> {
+/// substrate of `params` and record the device force (within `limits`, world units).
+pub fn force_distance_curve(
+    params: &Params,
+    limits: &Limits,
+    spec: &CurveSpec,
+) -> Result<ForceCurve, CurveError> {
     let bad = |field: &'static str, value: f64, allowed: &str| CurveError::OutOfRange {
         field,
         value,
@@ -80,7 +85,7 @@ pub fn force_distance_curve(params: &Params, spec: &CurveSpec) -> Result<ForceCu
     p.house = None;
     let top = p.substrate.atom_radius_m + p.tip.radius_m;
     let at = |gap: f64| Vector3::new(spec.xy_m[0], spec.xy_m[1], top + gap);
-    let mut world = World::new(p, at(spec.far_gap_m))?;
+    let mut world = World::new(&p, limits, at(spec.far_gap_m))?;
     let n = spec.steps;
     let mut c = ForceCurve {
         approach_gap_m: Vec::with_capacity(n + 1),

@@ -15,6 +15,17 @@ pub enum ParamError {
         /// The allowed range, in words and numbers.
         allowed: String,
     },
+    /// A field that is no longer a parameter: its value now comes from the device's
+    /// [`world_form::Limits`] handed to [`crate::World::new`].
+    #[error(
+        "`{field}` is no longer a nanoworld parameter: the limit now comes from the device \
+         (world_form::Limits given to World::new; in a scene file, the [device] model mapped by \
+         mapping.force_scale); remove it"
+    )]
+    MovedToDevice {
+        /// The removed field.
+        field: &'static str,
+    },
     /// A field that fixes the world's geometry was changed through [`crate::World::set_params`].
     #[error("{field} cannot change at run time (it fixes the geometry); build a new World instead")]
     NotChangeableAtRunTime {
@@ -28,7 +39,9 @@ impl ParamError {
     pub fn field(&self) -> &str {
         match self {
             ParamError::OutOfRange { field, .. } => field,
-            ParamError::NotChangeableAtRunTime { field } => field,
+            ParamError::NotChangeableAtRunTime { field } | ParamError::MovedToDevice { field } => {
+                field
+            }
         }
     }
 

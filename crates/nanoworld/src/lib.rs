@@ -16,7 +16,10 @@
 //!   k_c = A·R/(3·10^{3/2}·z0³) ≈ A·R/(95·z0³) it reproduces the paper's tenfold pull-off.
 //!
 //! Parameters ([`Params`], what never changes during a step) are apart from the state
-//! ([`World`]); one [`World::step`] per haptic tick reads both. SI units, f64, no wall
+//! ([`World`]); the world is built from them and the device's [`world_form::Limits`] (largest
+//! force N and stiffness N/m, in the world's units: [`GAME_FALCON_LIMITS`] /
+//! [`PHYSICAL_FALCON_LIMITS`] when no device mapping is at hand); one [`World::step`] per
+//! haptic tick reads both. SI units, f64, no wall
 //! clock, no threads, no hash-map order: same inputs give the same bits.
 //!
 //! **Not here**: devices, the fixed-rate loop, scene files, recording and replay, drawing,
@@ -26,9 +29,10 @@
 //!
 //! ```
 //! use nalgebra::Vector3;
-//! use nanoworld::{Params, TipInput, World};
+//! use nanoworld::{GAME_FALCON_LIMITS, Params, TipInput, World};
 //!
-//! let mut world = World::new(Params::game_default(), Vector3::new(3e-9, 3e-9, 2e-9))?;
+//! let start = Vector3::new(3e-9, 3e-9, 2e-9);
+//! let mut world = World::new(&Params::game_default(), &GAME_FALCON_LIMITS, start)?;
 //! let report = world.step(&TipInput { position_m: Vector3::new(3e-9, 3e-9, 0.7e-9) }, 1e-3)?;
 //! assert!(report.force_n.z < 0.0); // pulled towards the substrate before contact
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -53,8 +57,9 @@ pub use game::SubstrateForceCheck;
 pub use house::HouseStatus;
 pub use law::{PairKind, PairLaw, PairLaws};
 pub use params::{
-    AtomParams, GamePair, GameParams, HouseParams, Interaction, LoadingZone, MAX_MOVABLE_ATOMS,
-    MAX_SUBSTRATE_ATOMS, Pairs, Params, PhysicalParams, SubstrateParams, TipParams,
+    AtomParams, GAME_FALCON_LIMITS, GamePair, GameParams, HouseParams, Interaction, LoadingZone,
+    MAX_MOVABLE_ATOMS, MAX_SUBSTRATE_ATOMS, PHYSICAL_FALCON_LIMITS, Pairs, Params, PhysicalParams,
+    SubstrateParams, TipParams,
 };
 pub use script::{
     MAX_SCRIPT_SAMPLES, ScriptError, house_script, house_waypoints, polyline, polyline_len,

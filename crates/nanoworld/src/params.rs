@@ -2,11 +2,13 @@
 //!
 //! Every field is SI. [`Params`] deserializes from a TOML table with
 //! `deny_unknown_fields`; [`Params::validate`] returns a typed error naming the
-//! field and its allowed range. Interaction strengths, masses, gravity and the
-//! force limit may change at run time through [`crate::World::set_params`];
-//! geometry (substrate, radii, initial atoms) may not.
+//! field and its allowed range. Interaction strengths, masses and gravity may change at run
+//! time through [`crate::World::set_params`]; geometry (substrate, radii, initial atoms) may
+//! not. The largest force and stiffness the device renders are not parameters: they are the
+//! device's [`Limits`], handed to [`crate::World::new`] ([`Params::validate_for_device`]).
 
 use serde::Deserialize;
+use world_form::Limits;
 
 use crate::error::ParamError;
 
@@ -15,9 +17,26 @@ pub const MAX_SUBSTRATE_ATOMS: usize = 4_000_000;
 /// Largest number of movable atoms the world accepts.
 pub const MAX_MOVABLE_ATOMS: usize = 100_000;
 
+/// The Novint Falcon ([`Limits::FALCON`]: 8 N, 3000 N/m) as `scenes/nanoworld.toml` maps it
+/// into the game world (1 nN ↔ 1 N, `force_scale` 1e9; 0.15 nm ↔ 1 mm, `workspace_scale`
+/// 1.5e-7): 8 nN and 3000 / (1e9 · 1.5e-7) = 20 N/m. The limits to build a
+/// [`Params::game_default`] world with when no device mapping is at hand.
+pub const GAME_FALCON_LIMITS: Limits = Limits {
+    max_force_n: 8e-9,
+    max_stiffness_n_per_m: 20.0,
+};
+
+/// The Novint Falcon mapped into the physical world (10 pN ↔ 1 mN: `force_scale` 1e8; 1 nm ↔
+/// 1 mm, `workspace_scale` 1e-6): 80 nN and 3000 / (1e8 · 1e-6) = 30 N/m, above the
+/// preset's 4.7 N/m cantilever. For [`Params::physical_default`].
+pub const PHYSICAL_FALCON_LIMITS: Limits = Limits {
+    max_force_n: 8e-8,
+    max_stiffness_n_per_m: 30.0,
+};
+
 /// All parameters of a nano world.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "ParamsTable")]
 pub struct Params {
     /// The fixed (teal) substrate layer.
     pub substrate: SubstrateParams,
@@ -29,13 +48,10 @@ pub struct Params {
     pub interaction: Interaction,
     /// Gravitational acceleration along −z (m/s²); 0 switches weight off. Range [0, 1000].
     #[serde(default)]
-    pub gravity_m_s2: f64,
+    pub gravity_m_per_s2: f64,
     /// Include the inertial force −m·a of carried atoms (a from the last three cursor positions).
     #[serde(default)]
     pub inertia: bool,
-    /// Largest force magnitude the device may be sent (N, world units). Larger forces are
-    /// scaled down to it and flagged in [`crate::StepReport::saturated`]. Range (0, 1].
-    pub max_force_n: f64,
     /// Where new movable atoms appear; `None` switches spawning off.
     #[serde(default)]
     pub loading_zone: Option<LoadingZone>,
@@ -45,6 +61,64 @@ pub struct Params {
     /// The house blueprint; `None` switches scoring off.
     #[serde(default)]
     pub house: Option<HouseParams>,
+}
+
+/// The `[nanoworld.params]` table as written: [`Params`] plus the removed `max_force_n`, so
+/// that an old file that still sets it gets [`ParamError::MovedToDevice`] rather than
+/// "unknown field".
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParamsTable {
+    /// The fixed (teal) substrate layer.
+    substrate: SubstrateParams,
+    /// The AFM tip apex (the cursor).
+    tip: TipParams,
+    /// The movable (orange) atoms.
+    atoms: AtomParams,
+    /// Force laws: the teaching game's or real constants.
+    interaction: Interaction,
+    /// Gravitational acceleration along −z (m/s²); 0 switches weight off. Range [0, 1000].
+    #[serde(default)]
+    #[serde(alias = "gravity_m_s2")]
+    gravity_m_per_s2: f64,
+    /// Include the inertial force −m·a of carried atoms (a from the last three cursor positions).
+    #[serde(default)]
+    inertia: bool,
+    /// Where new movable atoms appear; `None` switches spawning off.
+    #[serde(default)]
+    loading_zone: Option<LoadingZone>,
+    /// Movable atoms present at the start, resting on the substrate at these (x, y) (m).
+    #[serde(default)]
+    initial_atoms_xy_m: Vec<[f64; 2]>,
+    /// The house blueprint; `None` switches scoring off.
+    #[serde(default)]
+    house: Option<HouseParams>,
+    /// Removed (the device's [`Limits::max_force_n`] replaces it); refused when present.
+    #[serde(default)]
+    max_force_n: Option<serde::de::IgnoredAny>,
+}
+
+impl TryFrom<ParamsTable> for Params {
+    type Error = ParamError;
+
+    fn try_from(t: ParamsTable) -> Result<Params, ParamError> {
+        if t.max_force_n.is_some() {
+            return Err(ParamError::MovedToDevice {
+                field: "max_force_n",
+            });
+        }
+        Ok(Params {
+            substrate: t.substrate,
+            tip: t.tip,
+            atoms: t.atoms,
+            interaction: t.interaction,
+            gravity_m_per_s2: t.gravity_m_per_s2,
+            inertia: t.inertia,
+            loading_zone: t.loading_zone,
+            initial_atoms_xy_m: t.initial_atoms_xy_m,
+            house: t.house,
+        })
+    }
 }
 
 /// A square lattice of fixed substrate atoms with centres at z = 0,
@@ -308,8 +382,7 @@ impl Params {
             self.atoms.max_count <= MAX_MOVABLE_ATOMS,
             || format!("0 <= value <= {MAX_MOVABLE_ATOMS}"),
         )?;
-        nonneg_up_to("gravity_m_s2", self.gravity_m_s2, 1000.0)?;
-        positive_up_to("max_force_n", self.max_force_n, 1.0)?;
+        nonneg_up_to("gravity_m_per_s2", self.gravity_m_per_s2, 1000.0)?;
         match &self.interaction {
             Interaction::Game(g) => {
                 check(
@@ -409,6 +482,65 @@ impl Params {
         Ok(())
     }
 
+    /// The stiffest spring the world renders, N/m, and the field that sets it: the largest
+    /// game-mode adhesion stiffness `k` (over the pair types), or the physical-mode cantilever
+    /// stiffness `k_c`.
+    pub fn max_render_stiffness(&self) -> (String, f64) {
+        match &self.interaction {
+            Interaction::Game(g) => {
+                let pairs = [
+                    ("tip_substrate", g.pairs.tip_substrate.stiffness_n_per_m),
+                    ("tip_atom", g.pairs.tip_atom.stiffness_n_per_m),
+                    ("atom_atom", g.pairs.atom_atom.stiffness_n_per_m),
+                    ("atom_substrate", g.pairs.atom_substrate.stiffness_n_per_m),
+                ];
+                let (name, k) =
+                    pairs.iter().fold(
+                        ("tip_substrate", 0.0),
+                        |a, b| if b.1 > a.1 { *b } else { a },
+                    );
+                (
+                    format!("interaction.game.pairs.{name}.stiffness_n_per_m"),
+                    k,
+                )
+            }
+            Interaction::Physical(ph) => (
+                "interaction.physical.cantilever_stiffness_n_per_m".to_string(),
+                ph.cantilever_stiffness_n_per_m,
+            ),
+        }
+    }
+
+    /// Checks what depends on the device: the limits themselves (named `device.max_force_n`,
+    /// `device.max_stiffness_n_per_m`) and that the stiffest spring the world renders
+    /// ([`Params::max_render_stiffness`]) is within [`Limits::max_stiffness_n_per_m`].
+    pub fn validate_for_device(&self, limits: &Limits) -> Result<(), ParamError> {
+        limits.validate().map_err(|e| {
+            ParamError::range(
+                format!("device.{}", e.field),
+                e.value,
+                format!("0 < value <= {:e} {}", e.max, e.unit),
+            )
+        })?;
+        let (field, k) = self.max_render_stiffness();
+        let cap = limits.max_stiffness_n_per_m;
+        check(&field, k, k <= cap, || {
+            format!(
+                "<= {} N/m, the device's stiffness limit in the world",
+                short(cap)
+            )
+        })
+    }
+
+    /// The Falcon mapped as the preset scenes map it: [`GAME_FALCON_LIMITS`] in game mode,
+    /// [`PHYSICAL_FALCON_LIMITS`] in physical mode (for a world built without a device).
+    pub fn default_limits(&self) -> Limits {
+        match self.interaction {
+            Interaction::Game(_) => GAME_FALCON_LIMITS,
+            Interaction::Physical(_) => PHYSICAL_FALCON_LIMITS,
+        }
+    }
+
     /// The teaching game with the paper's behaviour, in nanometre-sized SI values:
     /// a 40 × 40 substrate (0.3 nm spacing), 0.3 nm tip, 0.15 nm atoms, snap force 0.3 nN
     /// for tip pairs, pull-off 10×, atom–atom bonds twice and atom–substrate bonds half as
@@ -453,9 +585,8 @@ impl Params {
                     atom_substrate: pair(0.5),
                 },
             }),
-            gravity_m_s2: 9.81,
+            gravity_m_per_s2: 9.81,
             inertia: true,
-            max_force_n: 10e-9,
             loading_zone: Some(LoadingZone {
                 min_xy_m: [1.0e-9, 1.0e-9],
                 max_xy_m: [3.0e-9, 3.0e-9],
@@ -489,7 +620,6 @@ impl Params {
         p.tip.radius_m = r_tip;
         p.atoms.radius_m = 5e-9;
         p.atoms.mass_kg = 1.0e-21;
-        p.max_force_n = 100e-9;
         p.interaction = Interaction::Physical(PhysicalParams {
             hamaker_j: Pairs {
                 tip_substrate: a_ts,

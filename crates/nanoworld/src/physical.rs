@@ -185,7 +185,8 @@ mod tests {
         let mut p = Params::physical_default();
         p.loading_zone = None;
         p.initial_atoms_xy_m = vec![[20e-9, 20e-9], [38e-9, 22e-9], [45e-9, 40e-9]];
-        let mut w = World::new(p, Vector3::new(20e-9, 20e-9, 40e-9)).expect("valid");
+        let mut w =
+            World::new(&p, &p.default_limits(), Vector3::new(20e-9, 20e-9, 40e-9)).expect("valid");
         // Carry particle 0 below the tip with a lateral tilt.
         let tip = Vector3::new(21e-9, 19.5e-9, 33e-9);
         w.place_tip(tip);

@@ -6,6 +6,7 @@
 //! atoms spawn and transfer, and the force to render comes out with typed events.
 
 use nalgebra::Vector3;
+use world_form::Limits;
 
 use crate::error::{ParamError, StepError};
 use crate::house::{HouseChange, HouseStatus};
@@ -177,11 +178,12 @@ pub enum Event {
 /// What one tick produced.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepReport {
-    /// Force to render on the device (N, world frame), finite, |F| ≤ `max_force_n`.
+    /// Force to render on the device (N, world frame), finite, |F| ≤
+    /// [`Limits::max_force_n`].
     pub force_n: Vector3<f64>,
     /// The force before the device limit was applied (N).
     pub unlimited_force_n: Vector3<f64>,
-    /// Whether `force_n` was scaled down to `max_force_n`.
+    /// Whether `force_n` was scaled down to [`Limits::max_force_n`].
     pub saturated: bool,
     /// Events in the order they happened.
     pub events: Vec<Event>,
@@ -256,6 +258,8 @@ pub(crate) struct Disarm {
 #[derive(Debug, Clone)]
 pub struct World {
     pub(crate) params: Params,
+    /// What the device renders, in the world's units.
+    pub(crate) limits: Limits,
     pub(crate) laws: PairLaws,
     pub(crate) substrate: Substrate,
     pub(crate) atoms: Vec<MovableAtom>,
@@ -271,9 +275,17 @@ pub struct World {
 }
 
 impl World {
-    /// Build a world from validated parameters; the tip starts free at `start_m`.
-    pub fn new(params: Params, start_m: Vector3<f64>) -> Result<World, ParamError> {
+    /// Build a world from its parameters and the limits of the device it renders to (in the
+    /// world's units: N, N/m); the tip starts free at `start_m` (m). Fails with the first
+    /// out-of-range parameter or limit, naming it.
+    pub fn new(
+        params: &Params,
+        limits: &Limits,
+        start_m: Vector3<f64>,
+    ) -> Result<World, ParamError> {
         params.validate()?;
+        params.validate_for_device(limits)?;
+        let params = params.clone();
         for (k, v) in start_m.iter().enumerate() {
             if !v.is_finite() {
                 return Err(ParamError::range(
@@ -299,6 +311,7 @@ impl World {
             time_s: 0.0,
             house: HouseStatus::new(params.house.as_ref()),
             params,
+            limits: *limits,
         };
         let xy = w.params.initial_atoms_xy_m.clone();
         for a in xy {
@@ -330,10 +343,12 @@ impl World {
     }
 
     /// Replace the parameters at run time. Strengths, stiffnesses, pull-off ratio, masses,
-    /// gravity, inertia, force limit, loading zone and house may change; the mode and the
-    /// geometry (substrate, radii, contact gap) may not.
+    /// gravity, inertia, loading zone and house may change; the mode and the geometry
+    /// (substrate, radii, contact gap) may not, and the stiffest spring must stay within the
+    /// device's limits.
     pub fn set_params(&mut self, params: Params) -> Result<(), ParamError> {
         params.validate()?;
+        params.validate_for_device(&self.limits)?;
         let old = &self.params;
         if params.substrate != old.substrate {
             return Err(ParamError::NotChangeableAtRunTime { field: "substrate" });
@@ -418,7 +433,7 @@ impl World {
             }
         };
         self.update_house(&mut events);
-        let (force, saturated) = limit_force(unlimited, self.params.max_force_n);
+        let (force, saturated) = limit_force(unlimited, self.limits.max_force_n);
         Ok(StepReport {
             force_n: force,
             unlimited_force_n: unlimited,
@@ -448,7 +463,7 @@ impl World {
         if m == 0.0 {
             return Vector3::zeros();
         }
-        let mut f = Vector3::new(0.0, 0.0, -m * self.params.gravity_m_s2);
+        let mut f = Vector3::new(0.0, 0.0, -m * self.params.gravity_m_per_s2);
         if self.params.inertia
             && let [Some(c1), Some(c2)] = self.history
         {
@@ -658,6 +673,11 @@ impl World {
                 })
             },
         );
+    }
+
+    /// The device limits this world renders to, in the world's units.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
     }
 
     /// The parameters in force.

@@ -27,12 +27,18 @@ fn spec(far: f64, near: f64, steps: usize) -> CurveSpec {
 
 fn game_curve(steps: usize) -> (Params, ForceCurve) {
     let p = single_atom(Params::game_default());
-    let c = force_distance_curve(&p, &spec(2.0e-9, 0.0, steps)).expect("valid curve");
+    let c = force_distance_curve(&p, &p.default_limits(), &spec(2.0e-9, 0.0, steps))
+        .expect("valid curve");
     (p, c)
 }
 
 fn law(p: &Params, k: PairKind) -> nanoworld::PairLaw {
-    let w = World::new(p.clone(), nalgebra::Vector3::new(0.0, 0.0, 5e-9)).expect("valid");
+    let w = World::new(
+        p,
+        &p.default_limits(),
+        nalgebra::Vector3::new(0.0, 0.0, 5e-9),
+    )
+    .expect("valid");
     *w.laws().get(k)
 }
 
@@ -122,7 +128,7 @@ fn physical_jump_to_contact_and_dmt_pull_off_match_analytic() {
     let (p, a, r, z0, kc) = physical(Some(95.0));
     let steps = 40_000;
     let (far, near) = (10e-9, 0.0);
-    let c = force_distance_curve(&p, &spec(far, near, steps)).expect("valid");
+    let c = force_distance_curve(&p, &p.default_limits(), &spec(far, near, steps)).expect("valid");
     let h = (far - near) / steps as f64;
     // Jump-to-contact: tip gap z_jtc = (A·R/(3·k_c))^{1/3}; the base is then at 1.5·z_jtc
     // (the tip is deflected by F/k_c = z_jtc/2), and the force is A·R/(6·z_jtc²) = k_c·z_jtc/2.
@@ -163,7 +169,8 @@ fn physical_tenfold_pull_off_with_k_c_near_ar_over_95_z0_cubed() {
         let (p, _, _, _, kc) = physical(den);
         let steps = 600_000;
         let far = 3e-9;
-        let c = force_distance_curve(&p, &spec(far, 0.0, steps)).expect("valid");
+        let c =
+            force_distance_curve(&p, &p.default_limits(), &spec(far, 0.0, steps)).expect("valid");
         let h = far / steps as f64;
         let i = c.snap_index.expect("jumps");
         let j = c.pull_off_index.expect("pulls off");
@@ -171,7 +178,12 @@ fn physical_tenfold_pull_off_with_k_c_near_ar_over_95_z0_cubed() {
         let pull = c.retract_force_n[..j].iter().fold(0.0f64, |m, f| m.max(-f));
         let ratio = pull / snap;
         // Snap force measured low by ≤ 2·sqrt(2h/(3·z_jtc)) (fold), pull-off by ≤ k_c·h.
-        let w = World::new(p.clone(), nalgebra::Vector3::new(0.0, 0.0, 5e-9)).expect("valid");
+        let w = World::new(
+            &p,
+            &p.default_limits(),
+            nalgebra::Vector3::new(0.0, 0.0, 5e-9),
+        )
+        .expect("valid");
         let l = w.laws().get(PairKind::TipSubstrate);
         assert!(((l.pull_off_n / l.snap_force_n) - want).abs() < 1e-9 * want);
         let bound = 2.0 * (2.0 * h / (3.0 * l.snap_gap_m)).sqrt();
@@ -207,7 +219,8 @@ fn physical_hysteresis_area_matches_quasi_static_integral() {
     let exact = 0.5 * kc * ((h_po - z0).powi(2) - (h_jtc - z0).powi(2)) - (prim(d) - prim(d_jtc));
     let mut errs = Vec::new();
     for steps in [50_000, 100_000, 200_000] {
-        let cv = force_distance_curve(&p, &spec(3e-9, 0.0, steps)).expect("valid");
+        let cv =
+            force_distance_curve(&p, &p.default_limits(), &spec(3e-9, 0.0, steps)).expect("valid");
         errs.push((cv.hysteresis_j - exact).abs() / exact);
     }
     assert!(errs[2] < 1e-3, "{errs:?} (exact {exact:e} J)");

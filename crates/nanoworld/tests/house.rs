@@ -3,8 +3,8 @@
 
 use nalgebra::Vector3;
 use nanoworld::{
-    BodyContact, BodyKind, BodyView, BrokenLink, Event, Member, Params, StepReport, Target,
-    TipContact, World, house_script,
+    BodyContact, BodyKind, BodyView, BrokenLink, Event, GAME_FALCON_LIMITS, Member, Params,
+    StepReport, Target, TipContact, World, house_script,
 };
 
 fn run(world: &mut World, step_m: f64) -> Vec<StepReport> {
@@ -21,7 +21,7 @@ fn start() -> Vector3<f64> {
 
 #[test]
 fn scripted_session_builds_the_house() {
-    let mut w = World::new(Params::game_default(), start()).expect("valid");
+    let mut w = World::new(&Params::game_default(), &GAME_FALCON_LIMITS, start()).expect("valid");
     assert_eq!(w.house().score(), 0);
     let reports = run(&mut w, 2e-12);
     let events: Vec<Event> = reports.iter().flat_map(|r| r.events.clone()).collect();
@@ -73,14 +73,14 @@ fn scripted_session_builds_the_house() {
     // Force always finite and within the device limit.
     for r in &reports {
         assert!(r.force_n.iter().all(|v| v.is_finite()));
-        assert!(r.force_n.norm() <= w.params().max_force_n * (1.0 + 1e-12));
+        assert!(r.force_n.norm() <= w.limits().max_force_n * (1.0 + 1e-12));
     }
 }
 
 #[test]
 fn scripted_session_is_bit_reproducible() {
-    let mut a = World::new(Params::game_default(), start()).expect("valid");
-    let mut b = World::new(Params::game_default(), start()).expect("valid");
+    let mut a = World::new(&Params::game_default(), &GAME_FALCON_LIMITS, start()).expect("valid");
+    let mut b = World::new(&Params::game_default(), &GAME_FALCON_LIMITS, start()).expect("valid");
     let ra = run(&mut a, 3e-12);
     let rb = run(&mut b, 3e-12);
     assert_eq!(ra.len(), rb.len());
@@ -95,7 +95,7 @@ fn scripted_session_is_bit_reproducible() {
 #[test]
 fn atom_on_tip_transfers_onto_another_atom_and_tip_leaves_it() {
     let p = Params::game_default();
-    let mut w = World::new(p.clone(), start()).expect("valid");
+    let mut w = World::new(&p, &p.default_limits(), start()).expect("valid");
     let r = w.atoms()[0].position_m();
     let (rt, ra) = (p.tip.radius_m, p.atoms.radius_m);
     // Fetch one atom from the zone.

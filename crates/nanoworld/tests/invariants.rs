@@ -2,7 +2,7 @@
 //! and the force is continuous except at snap and release events.
 
 use nalgebra::Vector3;
-use nanoworld::{Event, PairKind, Params, TipInput, World};
+use nanoworld::{Event, GAME_FALCON_LIMITS, PairKind, Params, TipInput, World};
 use proptest::prelude::*;
 
 fn bare(mut p: Params, n: usize) -> Params {
@@ -21,7 +21,7 @@ proptest! {
     /// brute-force sum bit for bit.
     #[test]
     fn cell_list_equals_brute_force(x in -1e-9f64..13e-9, y in -1e-9f64..13e-9, z in 0.3e-9f64..1.5e-9) {
-        let w = World::new(bare(Params::game_default(), 40), Vector3::new(0.0, 0.0, 5e-9)).expect("valid");
+        let w = World::new(&bare(Params::game_default(), 40), &GAME_FALCON_LIMITS, Vector3::new(0.0, 0.0, 5e-9)).expect("valid");
         let c = w.substrate_force_check(Vector3::new(x, y, z)).expect("game mode");
         for k in 0..3 {
             prop_assert_eq!(c.cell_list_n[k].to_bits(), c.brute_force_n[k].to_bits());
@@ -37,9 +37,9 @@ proptest! {
     ) {
         let p = if physical { Params::physical_default() } else { Params::game_default() };
         let scale = if physical { 20e-9 } else { 1e-9 };
-        let max = p.max_force_n;
+        let max = p.default_limits().max_force_n;
         let start = Vector3::new(2e-9, 2e-9, 2e-9);
-        let mut w = World::new(p, start).expect("valid");
+        let mut w = World::new(&p, &p.default_limits(), start).expect("valid");
         let mut x = start;
         for (dx, dy, dz, kind) in steps {
             let d = Vector3::new(dx, dy, dz);
@@ -64,7 +64,7 @@ proptest! {
         x in 5e-9f64..7e-9, y in 5e-9f64..7e-9, tilt_x in -0.3f64..0.3, tilt_y in -0.3f64..0.3,
     ) {
         let p = bare(Params::game_default(), 40);
-        let w0 = World::new(p.clone(), Vector3::new(x, y, 2e-9)).expect("valid");
+        let w0 = World::new(&p, &p.default_limits(), Vector3::new(x, y, 2e-9)).expect("valid");
         let l = *w0.laws().get(PairKind::TipSubstrate);
         let (rt, rs) = (p.tip.radius_m, p.substrate.atom_radius_m);
         // At most 64 lattice atoms lie within reach (π((R+r+w+a)/a)² < 64).
@@ -115,7 +115,7 @@ proptest! {
         let p = if physical { Params::physical_default() } else { Params::game_default() };
         let (lo, span, zmax) = if physical { (5e-9, 40e-9, 45e-9) } else { (1e-9, 6e-9, 2.5e-9) };
         let zmin = p.substrate.atom_radius_m + p.tip.radius_m;
-        let mut w = World::new(p.clone(), Vector3::new(2e-9, 2e-9, zmax)).expect("valid");
+        let mut w = World::new(&p, &p.default_limits(), Vector3::new(2e-9, 2e-9, zmax)).expect("valid");
         let mut pts = vec![w.cursor_m()];
         for (a, b, c) in legs {
             pts.push(Vector3::new(lo + a * span, lo + b * span, zmin + c * (zmax - zmin)));

@@ -1,7 +1,9 @@
 //! Defects found by independent checks and fuzzing (issue 11, items 4, 5, 6, 8, 9).
 
 use nalgebra::Vector3;
-use nanoworld::{Event, Interaction, Params, StepError, Target, TipContact, TipInput, World};
+use nanoworld::{
+    Event, GAME_FALCON_LIMITS, Interaction, Params, StepError, Target, TipContact, TipInput, World,
+};
 
 fn at(x: f64, y: f64, z: f64) -> TipInput {
     TipInput {
@@ -23,7 +25,7 @@ fn snapped() -> (World, Vector3<f64>) {
     let p = bare_game();
     let a = p.substrate.spacing_m;
     let (x, y) = (20.0 * a, 20.0 * a);
-    let mut w = World::new(p, Vector3::new(x, y, 2e-9)).expect("valid");
+    let mut w = World::new(&p, &p.default_limits(), Vector3::new(x, y, 2e-9)).expect("valid");
     let mut z = 2e-9;
     while !matches!(w.tip_contact(), TipContact::Anchored(_)) {
         z -= 0.005e-9;
@@ -114,7 +116,7 @@ fn stiffness_above_pull_off_over_snap_gap_is_refused() {
     g.pairs.tip_substrate.stiffness_n_per_m = 19.0;
     let a = p.substrate.spacing_m;
     let (x, y) = (20.0 * a, 20.0 * a);
-    let mut w = World::new(p, Vector3::new(x, y, 2e-9)).expect("valid");
+    let mut w = World::new(&p, &p.default_limits(), Vector3::new(x, y, 2e-9)).expect("valid");
     let mut z = 2e-9;
     let mut snapped_at = None;
     for _ in 0..2000 {
@@ -140,7 +142,7 @@ fn large_steps_do_not_tunnel_through_atoms() {
     let rt = p.tip.radius_m;
     let (x, y) = (20.0 * a, 20.0 * a);
     for step in [1.15e-9, 1.4e-9, 1.8e-9, 5e-9, 1e-6] {
-        let mut w = World::new(p.clone(), Vector3::new(x, y, 1.5e-9)).expect("valid");
+        let mut w = World::new(&p, &p.default_limits(), Vector3::new(x, y, 1.5e-9)).expect("valid");
         // One jump from 1.5 nm above the substrate plane to `step` below the start.
         w.step(&at(x, y, 1.5e-9 - step), 1e-3).expect("valid");
         let tip = w.tip_position_m();
@@ -168,7 +170,7 @@ fn large_steps_do_not_tunnel_through_atoms() {
         unreachable!("game")
     };
     g.pairs.tip_substrate.strength_n_m2 = 0.0;
-    let mut w = World::new(p, Vector3::new(x - 3e-9, y, 0.0)).expect("valid");
+    let mut w = World::new(&p, &p.default_limits(), Vector3::new(x - 3e-9, y, 0.0)).expect("valid");
     let z = w.atoms()[0].position_m().z;
     w.step(&at(x - 3e-9, y, z), 1e-3).expect("valid");
     w.step(&at(x + 3e-9, y, z), 1e-3).expect("valid");
@@ -189,7 +191,8 @@ fn absurd_cursor_positions_are_refused() {
         (Params::game_default(), "game"),
         (Params::physical_default(), "physical"),
     ] {
-        let mut w = World::new(p, Vector3::new(3e-9, 3e-9, 40e-9)).expect("valid");
+        let mut w =
+            World::new(&p, &p.default_limits(), Vector3::new(3e-9, 3e-9, 40e-9)).expect("valid");
         let e = w
             .step(&at(1e308, 0.0, -1e308), 1e-3)
             .expect_err("absurd position");
@@ -206,7 +209,7 @@ fn absurd_cursor_positions_are_refused() {
             "{mode}: {:?}",
             r.force_n
         );
-        assert!(r.force_n.norm() <= w.params().max_force_n * (1.0 + 1e-12));
+        assert!(r.force_n.norm() <= w.limits().max_force_n * (1.0 + 1e-12));
         assert!(
             matches!(w.tip_contact(), TipContact::Free),
             "{mode}: {:?}",
@@ -219,14 +222,24 @@ fn absurd_cursor_positions_are_refused() {
 /// the shortest accepted one gives a finite force.
 #[test]
 fn tiny_time_steps_are_refused_and_the_shortest_accepted_is_finite() {
-    let mut w = World::new(Params::game_default(), Vector3::new(3e-9, 3e-9, 2e-9)).expect("valid");
+    let mut w = World::new(
+        &Params::game_default(),
+        &GAME_FALCON_LIMITS,
+        Vector3::new(3e-9, 3e-9, 2e-9),
+    )
+    .expect("valid");
     let e = w.step(&at(3e-9, 3e-9, 2e-9), 1e-300).expect_err("tiny dt");
     assert_eq!(
         e.to_string(),
         "dt_s = 1e-300 is out of range: allowed 1e-9 <= dt_s <= 1 s"
     );
     // Carry an atom (the house script's first pick-up) then step with the shortest dt.
-    let mut w = World::new(Params::game_default(), Vector3::new(4e-9, 4e-9, 4e-9)).expect("valid");
+    let mut w = World::new(
+        &Params::game_default(),
+        &GAME_FALCON_LIMITS,
+        Vector3::new(4e-9, 4e-9, 4e-9),
+    )
+    .expect("valid");
     let script = nanoworld::house_script(&w, 2e-12).expect("plannable");
     for i in &script {
         w.step(i, 1e-3).expect("valid");
@@ -240,7 +253,7 @@ fn tiny_time_steps_are_refused_and_the_shortest_accepted_is_finite() {
         let r = w.step(&at(c.x, c.y, c.z + dz), 1e-9).expect("valid");
         assert!(r.force_n.iter().all(|v| v.is_finite()), "{:?}", r.force_n);
         assert!(r.unlimited_force_n.iter().all(|v| v.is_finite()));
-        assert!(r.force_n.norm() <= w.params().max_force_n * (1.0 + 1e-12));
+        assert!(r.force_n.norm() <= w.limits().max_force_n * (1.0 + 1e-12));
         // 0.1 m in 1 ns from rest: a = 1e17 m/s², m·a = 1e-8 N on the atom, more than the
         // tip's 3 nN hold: the atom is thrown off the tip, and the force stays finite.
         let thrown = r.events.iter().find_map(|e| match e {
@@ -271,9 +284,10 @@ fn an_atom_is_thrown_off_exactly_above_the_pull_off_load() {
     for (factor, leaves) in [(0.999, false), (1.001, true)] {
         // A heavy "atom" (1 mg): the hold is reached at a = 3 mm/s², a jump of 3 nm in 1 ms.
         let mut p = Params::game_default();
-        p.gravity_m_s2 = 0.0;
+        p.gravity_m_per_s2 = 0.0;
         p.atoms.mass_kg = 1e-6;
-        let mut w = World::new(p, Vector3::new(4e-9, 4e-9, 4e-9)).expect("valid");
+        let mut w =
+            World::new(&p, &p.default_limits(), Vector3::new(4e-9, 4e-9, 4e-9)).expect("valid");
         let script = nanoworld::house_script(&w, 2e-12).expect("plannable");
         for i in &script {
             w.step(i, 1e-3).expect("valid");
@@ -306,7 +320,7 @@ fn force_at_is_a_pure_probe() {
     let p = bare_game();
     let a = p.substrate.spacing_m;
     let (x, y) = (20.0 * a, 20.0 * a);
-    let mut w = World::new(p, Vector3::new(x, y, 2e-9)).expect("valid");
+    let mut w = World::new(&p, &p.default_limits(), Vector3::new(x, y, 2e-9)).expect("valid");
     let probe = Vector3::new(x + 0.1e-9, y, 0.8e-9);
     let f = w.force_at(probe).expect("valid");
     assert_eq!(w.tick(), 0);
@@ -327,7 +341,12 @@ fn force_at_is_a_pure_probe() {
 /// before anything is allocated, naming the smallest step this house allows; that step works.
 #[test]
 fn a_house_script_step_too_small_for_memory_is_refused_with_the_bound() {
-    let w = World::new(Params::game_default(), Vector3::new(4e-9, 4e-9, 4e-9)).expect("valid");
+    let w = World::new(
+        &Params::game_default(),
+        &GAME_FALCON_LIMITS,
+        Vector3::new(4e-9, 4e-9, 4e-9),
+    )
+    .expect("valid");
     let e = nanoworld::house_script(&w, 1e-15).expect_err("1e-15 m steps");
     let nanoworld::ScriptError::TooManySamples {
         path_m, min_step_m, ..

@@ -3,7 +3,8 @@
 
 use nalgebra::Vector3;
 use nanoworld::{
-    CurveSpec, Interaction, ParamError, Params, StepError, TipInput, World, force_distance_curve,
+    CurveSpec, GAME_FALCON_LIMITS, Interaction, ParamError, Params, StepError, TipInput, World,
+    force_distance_curve,
 };
 
 fn start() -> Vector3<f64> {
@@ -29,7 +30,7 @@ fn defaults_are_valid() {
 fn snap_gap_beyond_activation_gap_is_rejected_by_name() {
     let mut p = Params::game_default();
     game(&mut p).pairs.tip_atom.snap_gap_m = 0.7e-9;
-    let e = World::new(p, start()).expect_err("invalid");
+    let e = World::new(&p, &p.default_limits(), start()).expect_err("invalid");
     assert_eq!(
         e.to_string(),
         "interaction.game.pairs.tip_atom.snap_gap_m = 7e-10 is out of range: allowed 0 < value < activation_gap_m = 6e-10"
@@ -42,11 +43,16 @@ fn nan_and_negative_values_are_rejected_not_clamped() {
     p.substrate.spacing_m = f64::NAN;
     let e = p.validate().expect_err("NaN");
     assert!(matches!(&e, ParamError::OutOfRange { field, .. } if field == "substrate.spacing_m"));
-    let mut p = Params::game_default();
-    p.max_force_n = -1.0;
+    let p = Params::game_default();
+    let bad = world_form::Limits {
+        max_force_n: -1.0,
+        ..GAME_FALCON_LIMITS
+    };
     assert_eq!(
-        p.validate().expect_err("negative").to_string(),
-        "max_force_n = -1e0 is out of range: allowed 0 < value <= 1e0"
+        World::new(&p, &bad, start())
+            .expect_err("negative")
+            .to_string(),
+        "device.max_force_n = -1e0 is out of range: allowed 0 < value <= 1e5 N"
     );
     let mut p = Params::game_default();
     game(&mut p).pull_off_ratio = 0.5;
@@ -67,8 +73,7 @@ fn nan_and_negative_values_are_rejected_not_clamped() {
 #[test]
 fn scene_table_parses_and_unknown_fields_are_rejected() {
     let toml_text = r#"
-        gravity_m_s2 = 9.81
-        max_force_n = 1e-8
+        gravity_m_per_s2 = 9.81
         [substrate]
         nx = 10
         ny = 10
@@ -95,11 +100,32 @@ fn scene_table_parses_and_unknown_fields_are_rejected() {
     let bad = toml_text.replace("radius_m = 3e-10", "radius_m = 3e-10\nradius_nm = 0.3");
     let e = toml::from_str::<Params>(&bad).expect_err("unknown field");
     assert!(e.to_string().contains("unknown field `radius_nm`"), "{e}");
+    // The force limit moved to the device: an old table that still sets it is refused, by name.
+    let old = toml_text.replace(
+        "gravity_m_per_s2 = 9.81",
+        "gravity_m_per_s2 = 9.81\nmax_force_n = 1e-8",
+    );
+    let e = toml::from_str::<Params>(&old).expect_err("removed field");
+    assert!(
+        e.to_string().contains(
+            "`max_force_n` is no longer a nanoworld parameter: the limit now comes from the \
+             device (world_form::Limits given to World::new; in a scene file, the [device] model \
+             mapped by mapping.force_scale); remove it"
+        ),
+        "{e}"
+    );
+    assert_eq!(
+        ParamError::MovedToDevice {
+            field: "max_force_n"
+        }
+        .field(),
+        "max_force_n"
+    );
 }
 
 #[test]
 fn bad_tick_input_is_a_typed_error() {
-    let mut w = World::new(Params::game_default(), start()).expect("valid");
+    let mut w = World::new(&Params::game_default(), &GAME_FALCON_LIMITS, start()).expect("valid");
     let e = w
         .step(
             &TipInput {
@@ -138,7 +164,8 @@ fn bad_curve_spec_is_a_typed_error() {
         steps: 100,
         dt_s: 1e-3,
     };
-    let e = force_distance_curve(&Params::game_default(), &spec).expect_err("near > far");
+    let e = force_distance_curve(&Params::game_default(), &GAME_FALCON_LIMITS, &spec)
+        .expect_err("near > far");
     assert_eq!(
         e.to_string(),
         "near_gap_m = 2e-9 is out of range: allowed finite and < far_gap_m = 1e-9 m"
@@ -148,7 +175,7 @@ fn bad_curve_spec_is_a_typed_error() {
 #[test]
 fn run_time_changes_are_validated_and_take_effect() {
     let p = Params::game_default();
-    let mut w = World::new(p.clone(), start()).expect("valid");
+    let mut w = World::new(&p, &p.default_limits(), start()).expect("valid");
     let mut geometry = p.clone();
     geometry.substrate.nx = 41;
     assert_eq!(
@@ -181,7 +208,12 @@ fn mass_is_felt_only_through_weight_and_inertia() {
     let mut p = Params::game_default();
     p.inertia = false;
     let spawn = p.loading_zone.as_ref().expect("zone").spawn_xy_m;
-    let mut w = World::new(p.clone(), Vector3::new(spawn[0], spawn[1], 3e-9)).expect("valid");
+    let mut w = World::new(
+        &p,
+        &p.default_limits(),
+        Vector3::new(spawn[0], spawn[1], 3e-9),
+    )
+    .expect("valid");
     let rest = w.rest_position(spawn);
     let mut last = None;
     let n = 3000;

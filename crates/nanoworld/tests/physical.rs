@@ -15,7 +15,8 @@ fn particle_is_picked_up_then_transferred_onto_a_bonded_pair() {
     };
     let z0 = ph.contact_gap_m;
     let (rt, ra) = (p.tip.radius_m, p.atoms.radius_m);
-    let mut w = World::new(p.clone(), Vector3::new(15e-9, 30e-9, 50e-9)).expect("valid");
+    let mut w =
+        World::new(&p, &p.default_limits(), Vector3::new(15e-9, 30e-9, 50e-9)).expect("valid");
     assert_eq!(w.atoms()[1].bonds(), &[2]);
     let (a, b) = (w.atoms()[0].position_m(), w.atoms()[1].position_m());
     // Resting on the plane at the contact gap z0.

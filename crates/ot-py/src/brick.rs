@@ -3,62 +3,67 @@
 
 use brickworld::script::WallScript;
 use brickworld::{
-    BrickId, BrickPlacement, BrickProps, Buttons, CursorInput, DeviceLimits, Params, StepReport,
-    World,
+    BrickId, BrickPlacement, BrickProps, CursorInput, Grip, Params, StepReport, World,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
+use world_form::Limits;
 
 use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, vector};
 use crate::json::{from_py, tagged_to_py, to_py};
 
+/// The grip commands by their names in `brickworld::Grip`.
+const GRIP_KEYS: [&str; 4] = ["hold", "turn_x", "turn_y", "turn_z"];
+/// The same commands by the Falcon button names this module has always accepted.
 const BUTTON_KEYS: [&str; 4] = ["center", "rotate_x", "rotate_y", "rotate_z"];
 
-fn buttons_of(b: [bool; 4]) -> Buttons {
-    Buttons {
-        center: b[0],
-        rotate_x: b[1],
-        rotate_y: b[2],
-        rotate_z: b[3],
+fn grip_of(b: [bool; 4]) -> Grip {
+    Grip {
+        hold: b[0],
+        turn_x: b[1],
+        turn_y: b[2],
+        turn_z: b[3],
     }
 }
 
-/// Buttons as Python passes them: None (all up), a dict with keys among
-/// center/rotate_x/rotate_y/rotate_z, or a sequence of four truth values.
-fn parse_buttons(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Buttons> {
+/// The hand's grip commands as Python passes them: None (all up), a dict with keys among
+/// hold/turn_x/turn_y/turn_z (or the older center/rotate_x/rotate_y/rotate_z, still
+/// accepted), or a sequence of four truth values in that order.
+fn parse_buttons(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Grip> {
     let Some(obj) = obj else {
-        return Ok(Buttons::default());
+        return Ok(Grip::default());
     };
     if obj.is_none() {
-        return Ok(Buttons::default());
+        return Ok(Grip::default());
     }
     if let Ok(d) = obj.cast::<PyDict>() {
         let mut b = [false; 4];
         for (k, v) in d.iter() {
             let key: String = k.extract().map_err(|_| {
                 PyValueError::new_err(format!(
-                    "{name}: keys must be strings among {BUTTON_KEYS:?}"
+                    "{name}: keys must be strings among {GRIP_KEYS:?} or {BUTTON_KEYS:?}"
                 ))
             })?;
-            let Some(i) = BUTTON_KEYS.iter().position(|n| *n == key) else {
+            let found = GRIP_KEYS.iter().position(|n| *n == key);
+            let Some(i) = found.or_else(|| BUTTON_KEYS.iter().position(|n| *n == key)) else {
                 return Err(PyValueError::new_err(format!(
-                    "{name}: unknown button {key:?}: allowed {BUTTON_KEYS:?}"
+                    "{name}: unknown button {key:?}: allowed {GRIP_KEYS:?} or {BUTTON_KEYS:?}"
                 )));
             };
             b[i] = v.is_truthy()?;
         }
-        return Ok(buttons_of(b));
+        return Ok(grip_of(b));
     }
     let n = numbers(obj, name)?;
     if n.shape != [4] {
         return Err(PyValueError::new_err(format!(
-            "{name}: expected a dict or 4 values (center, rotate_x, rotate_y, rotate_z), got {} values",
+            "{name}: expected a dict or 4 values (hold, turn_x, turn_y, turn_z), got {} values",
             n.data.len()
         )));
     }
-    Ok(buttons_of([
+    Ok(grip_of([
         n.data[0] != 0.0,
         n.data[1] != 0.0,
         n.data[2] != 0.0,
@@ -66,19 +71,19 @@ fn parse_buttons(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Buttons
     ]))
 }
 
-fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceLimits> {
+fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Limits> {
     let Some(obj) = obj else {
-        return Ok(DeviceLimits::NOVINT_FALCON);
+        return Ok(Limits::FALCON);
     };
     if let Ok(s) = obj.cast::<PyString>() {
         return match s.to_cow()?.as_ref() {
-            "falcon" => Ok(DeviceLimits::NOVINT_FALCON),
+            "falcon" => Ok(Limits::FALCON),
             other => Err(PyValueError::new_err(format!(
-                "device = {other:?}: allowed \"falcon\" or a dict with max_stiffness_n_m and max_force_n"
+                "device = {other:?}: allowed \"falcon\" or a dict with max_force_n and max_stiffness_n_per_m"
             ))),
         };
     }
-    let d: DeviceLimits = from_py(obj, "device")?;
+    let d: Limits = from_py(obj, "device")?;
     d.validate()
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(d)
@@ -132,7 +137,7 @@ fn ticks_to_py<'py>(
     )?;
     d.set_item(
         "acceleration",
-        array2_flat(py, flat(|r| r.acceleration_m_s2), 3)?,
+        array2_flat(py, flat(|r| r.acceleration_m_per_s2), 3)?,
     )?;
     let proxy: Vec<f64> = ticks.iter().flat_map(|t| t.proxy).collect();
     d.set_item("proxy", array2_flat(py, proxy, 3)?)?;
@@ -141,8 +146,8 @@ fn ticks_to_py<'py>(
     let buttons: Vec<bool> = inputs
         .iter()
         .flat_map(|i| {
-            let b = i.buttons();
-            [b.center, b.rotate_x, b.rotate_y, b.rotate_z]
+            let b = i.grip();
+            [b.hold, b.turn_x, b.turn_y, b.turn_z]
         })
         .collect();
     d.set_item(
@@ -151,7 +156,7 @@ fn ticks_to_py<'py>(
     )?;
     let sat: Vec<bool> = ticks.iter().map(|t| t.report.saturated).collect();
     d.set_item("saturated", PyArray1::from_vec(py, sat))?;
-    let k: Vec<f64> = ticks.iter().map(|t| t.report.stiffness_n_m).collect();
+    let k: Vec<f64> = ticks.iter().map(|t| t.report.stiffness_n_per_m).collect();
     d.set_item("stiffness", PyArray1::from_vec(py, k))?;
     let pen: Vec<f64> = ticks.iter().map(|t| t.report.proxy_penetration_m).collect();
     d.set_item("penetration", PyArray1::from_vec(py, pen))?;
@@ -215,13 +220,15 @@ fn record(world: &World, report: StepReport) -> Tick {
 /// Args:
 ///     params: None (defaults) or a dict with the scene-table layout; missing
 ///         fields take their defaults (see :attr:`params` for the full set:
-///         dt_s, gravity_m_s2, restitution, friction, inertia, brick_mass_kg,
+///         dt_s, gravity_m_per_s2, restitution, friction, inertia, brick_mass_kg,
 ///         brick_half_extents_m, loading_zone, blueprint, bricks, ...).
-///     device: "falcon" (Novint Falcon: 3000 N/m, 9 N) or a dict
-///         {"max_stiffness_n_m": ..., "max_force_n": ...}.
+///     device: "falcon" (Novint Falcon: 8 N, 3000 N/m, CHAI3D's figures) or
+///         a dict {"max_force_n": ..., "max_stiffness_n_per_m": ...} (the old
+///         key "max_stiffness_n_m" is still accepted).
 ///
-/// Units: m, kg, s, N; quaternions are [x, y, z, w]. Buttons are None, a
-/// dict with keys among center/rotate_x/rotate_y/rotate_z, or four truth
+/// Units: m, kg, s, N; quaternions are [x, y, z, w]. Buttons (the hand's grip
+/// commands) are None, a dict with keys among hold/turn_x/turn_y/turn_z (the
+/// older center/rotate_x/rotate_y/rotate_z are still accepted), or four truth
 /// values in that order.
 #[pyclass(module = "nanohaptics")]
 pub struct BrickWorld {
@@ -239,22 +246,22 @@ impl BrickWorld {
         };
         let dev = device_from_py(device)?;
         Ok(Self {
-            world: World::new(p, dev).map_err(err)?,
+            world: World::new(&p, &dev).map_err(err)?,
         })
     }
 
     /// Add a brick with its centre at ``center_m`` (3,) (m), turned by the
     /// rotation vector ``rotation_deg`` (axis · angle, degrees), moving at
-    /// ``velocity_m_s`` (3,) (m/s, each in [-100, 100]), with its own
+    /// ``velocity_m_per_s`` (3,) (m/s, each in [-100, 100]), with its own
     /// ``mass_kg`` ([1e-3, 100]), ``friction`` ([0, 10]) and ``restitution``
     /// ([0, 1]); None takes the world's value (a contact uses the mean of
     /// its two bodies' friction and restitution). Returns its id.
-    #[pyo3(signature = (center_m, rotation_deg=None, *, velocity_m_s=None, mass_kg=None, friction=None, restitution=None))]
+    #[pyo3(signature = (center_m, rotation_deg=None, *, velocity_m_per_s=None, mass_kg=None, friction=None, restitution=None))]
     fn add_brick(
         &mut self,
         center_m: &Bound<'_, PyAny>,
         rotation_deg: Option<&Bound<'_, PyAny>>,
-        velocity_m_s: Option<&Bound<'_, PyAny>>,
+        velocity_m_per_s: Option<&Bound<'_, PyAny>>,
         mass_kg: Option<f64>,
         friction: Option<f64>,
         restitution: Option<f64>,
@@ -264,8 +271,8 @@ impl BrickWorld {
             Some(r) if !r.is_none() => vector::<3>(r, "rotation_deg", "deg")?,
             _ => nalgebra::Vector3::zeros(),
         };
-        let v = match velocity_m_s {
-            Some(v) if !v.is_none() => vector::<3>(v, "velocity_m_s", "m/s")?,
+        let v = match velocity_m_per_s {
+            Some(v) if !v.is_none() => vector::<3>(v, "velocity_m_per_s", "m/s")?,
             _ => nalgebra::Vector3::zeros(),
         };
         let id = self
@@ -276,7 +283,7 @@ impl BrickWorld {
                     rotation_deg: [r.x, r.y, r.z],
                 },
                 BrickProps {
-                    velocity_m_s: [v.x, v.y, v.z],
+                    velocity_m_per_s: [v.x, v.y, v.z],
                     mass_kg,
                     friction,
                     restitution,
@@ -292,8 +299,8 @@ impl BrickWorld {
     /// Returns:
     ///     the step report as a dict: "tick", "force_n" (device force, N,
     ///     within the device limit), "saturated", "spring_force_n",
-    ///     "stiffness_n_m", "weight_force_n", "inertia_force_n",
-    ///     "acceleration_m_s2", "proxy_penetration_m" and "events" (dicts
+    ///     "stiffness_n_per_m", "weight_force_n", "inertia_force_n",
+    ///     "acceleration_m_per_s2", "proxy_penetration_m" and "events" (dicts
     ///     with a "type" key: "grabbed", "released", "thrown", "rotated",
     ///     "spawned", "touch_began", "slot_filled", ...).
     #[pyo3(signature = (position_m, buttons=None))]
@@ -341,7 +348,7 @@ impl BrickWorld {
         buttons: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let path = crate::convert::rows::<3>(positions_m, "positions_m", "m")?;
-        let per_tick: Vec<Buttons> = match buttons {
+        let per_tick: Vec<Grip> = match buttons {
             Some(b) if !b.is_none() && !b.is_instance_of::<PyDict>() => {
                 let n = numbers(b, "buttons")?;
                 if n.shape == [4] {
@@ -349,7 +356,7 @@ impl BrickWorld {
                 } else if n.shape == [path.len(), 4] {
                     n.data
                         .chunks_exact(4)
-                        .map(|c| buttons_of([c[0] != 0.0, c[1] != 0.0, c[2] != 0.0, c[3] != 0.0]))
+                        .map(|c| grip_of([c[0] != 0.0, c[1] != 0.0, c[2] != 0.0, c[3] != 0.0]))
                         .collect()
                 } else {
                     return Err(PyValueError::new_err(format!(
@@ -401,7 +408,7 @@ impl BrickWorld {
         let start = [s.x, s.y, s.z];
         let park = self
             .world
-            .input(start, Buttons::default())
+            .input(start, Grip::default())
             .map_err(|e| PyValueError::new_err(format!("start_m: {e}")))?;
         let mut script = WallScript::new(&self.world, start).ok_or_else(|| {
             PyValueError::new_err("loading_zone is missing: the wall script fetches bricks from it")
@@ -442,7 +449,7 @@ impl BrickWorld {
 
     /// Every brick, with the same keys as :meth:`brick`: {"id" (B,) int,
     /// "position_m" (B, 3) m, "orientation_xyzw" (B, 4) [x, y, z, w],
-    /// "half_extents_m" (B, 3) m, "velocity_m_s" (B, 3) m/s, "held" (B,)
+    /// "half_extents_m" (B, 3) m, "velocity_m_per_s" (B, 3) m/s, "held" (B,)
     /// bool, "sleeping" (B,) bool}, in id order.
     #[getter]
     fn bricks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -463,7 +470,10 @@ impl BrickWorld {
             "half_extents_m",
             array2_flat(py, f3(|v| v.half_extents_m), 3)?,
         )?;
-        d.set_item("velocity_m_s", array2_flat(py, f3(|v| v.velocity_m_s), 3)?)?;
+        d.set_item(
+            "velocity_m_per_s",
+            array2_flat(py, f3(|v| v.velocity_m_per_s), 3)?,
+        )?;
         let held: Vec<bool> = b.iter().map(|v| v.held).collect();
         d.set_item("held", PyArray1::from_vec(py, held))?;
         let sl: Vec<bool> = b.iter().map(|v| v.sleeping).collect();
@@ -472,7 +482,7 @@ impl BrickWorld {
     }
 
     /// One brick by id: {"id", "position_m", "orientation_xyzw",
-    /// "half_extents_m", "velocity_m_s", "held", "sleeping"}.
+    /// "half_extents_m", "velocity_m_per_s", "held", "sleeping"}.
     fn brick<'py>(&self, py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let b = brick_id(&self.world, id)?;
         to_py(py, &self.world.brick(b).map_err(err)?)
@@ -539,10 +549,10 @@ impl BrickWorld {
         to_py(py, self.world.params())
     }
 
-    /// The device limits: {"max_stiffness_n_m", "max_force_n"}.
+    /// The device limits: {"max_force_n", "max_stiffness_n_per_m"}.
     #[getter]
     fn device<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_py(py, self.world.device())
+        to_py(py, self.world.limits())
     }
 
     /// Ticks stepped so far.
@@ -558,8 +568,8 @@ impl BrickWorld {
     }
 
     /// Gravity magnitude (m/s², 0 switches it off), validated.
-    fn set_gravity(&mut self, g_m_s2: f64) -> PyResult<()> {
-        self.world.set_gravity(g_m_s2).map_err(err)
+    fn set_gravity(&mut self, g_m_per_s2: f64) -> PyResult<()> {
+        self.world.set_gravity(g_m_per_s2).map_err(err)
     }
 
     /// Restitution of every contact (0..1), validated.

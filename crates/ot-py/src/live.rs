@@ -155,7 +155,7 @@ impl Session {
     }
 
     /// Sets a run-time switch of the scene before the next tick (the
-    /// teaching game's menu: ``gravity_m_s2``, ``friction``, ``inertia``,
+    /// teaching game's menu: ``gravity_m_per_s2``, ``friction``, ``inertia``,
     /// ``adhesion_scale``, ``atom_mass_kg``, ...), recorded as that tick's
     /// input. ``value``: a number, or True / False for on/off switches.
     ///

@@ -12,7 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::convert::{SIGNAL_CHUNK_TICKS, array1, array2, int_in, rows, value_error, vector};
-use crate::params_dict::{params_from_py, params_to_py};
+use crate::params_dict::{limits_from_py, limits_to_py, params_from_py, params_to_py};
 
 fn pair_name(p: PairKind) -> &'static str {
     match p {
@@ -144,7 +144,13 @@ struct TickRecord {
 ///     start: (3,) initial cursor (tip) position (m).
 ///     params: "game" (the paper's laws, default), "physical" (real
 ///         constants: Hamaker forces, cantilever, DMT pull-off), or a dict
-///         with the scene-table layout (see :func:`nano_params`).
+///         with the scene-table layout (see :func:`nano_params`). It has no
+///         "max_force_n" any more: the limit comes from ``device``.
+///     device: None (the Novint Falcon mapped as the preset scenes map it:
+///         8 nN and 20 N/m for "game", 80 nN and 30 N/m for "physical") or a
+///         dict {"max_force_n": N, "max_stiffness_n_per_m": N/m} in world
+///         units. The force sent is scaled down to max_force_n; a stiffest
+///         spring above max_stiffness_n_per_m is refused.
 ///
 /// All positions are in m, forces in N (world units), times in s.
 #[pyclass(module = "nanohaptics")]
@@ -155,12 +161,17 @@ pub struct NanoWorld {
 #[pymethods]
 impl NanoWorld {
     #[new]
-    #[pyo3(signature = (start, *, params=None))]
-    fn new(start: &Bound<'_, PyAny>, params: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+    #[pyo3(signature = (start, *, params=None, device=None))]
+    fn new(
+        start: &Bound<'_, PyAny>,
+        params: Option<&Bound<'_, PyAny>>,
+        device: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         let start = vector::<3>(start, "start", "m")?;
         let p = params_from_py(params)?;
+        let limits = limits_from_py(device, &p)?;
         Ok(Self {
-            world: World::new(p, start).map_err(value_error)?,
+            world: World::new(&p, &limits, start).map_err(value_error)?,
         })
     }
 
@@ -169,7 +180,7 @@ impl NanoWorld {
     ///
     /// Returns:
     ///     dict with "force" (3,) N to send to the device (finite, within
-    ///     max_force_n), "unlimited_force" (3,) N before the device limit,
+    ///     device["max_force_n"]), "unlimited_force" (3,) N before the device limit,
     ///     "saturated" bool, and "events": a list of dicts with a "type" key
     ///     ("snap", "pull_off", "atom_attached", "atom_transferred", ...).
     #[pyo3(signature = (position, dt_s=1e-3))]
@@ -304,6 +315,13 @@ impl NanoWorld {
     #[getter]
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         params_to_py(py, self.world.params())
+    }
+
+    /// The device limits this world renders to, world units:
+    /// {"max_force_n": N, "max_stiffness_n_per_m": N/m}.
+    #[getter]
+    fn device<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        limits_to_py(py, self.world.limits())
     }
 
     /// Tip (apex) centre (3,) (m).
@@ -497,6 +515,7 @@ pub fn nano_params<'py>(py: Python<'py>, mode: &str) -> PyResult<Bound<'py, PyDi
 ///         < far_gap_m (negative: press).
 ///     steps: ticks per leg, 2 ..= 10**7 (default 2000).
 ///     dt_s: tick length (s), 0 < dt_s <= 1.
+///     device: the device limits, as for :class:`NanoWorld`.
 ///
 /// Returns:
 ///     dict with "approach_gap" and "approach_force" ((steps+1,) m and N,
@@ -506,7 +525,8 @@ pub fn nano_params<'py>(py: Python<'py>, mode: &str) -> PyResult<Bound<'py, PyDi
 ///     (J): the energy dissipated over the loop, −∮F dz. Force is the z
 ///     component sent to the device (negative: towards the substrate).
 #[pyfunction]
-#[pyo3(signature = (params=None, *, xy_m=None, far_gap_m=2e-9, near_gap_m=0.0, steps=None, dt_s=1e-3))]
+#[pyo3(signature = (params=None, *, xy_m=None, far_gap_m=2e-9, near_gap_m=0.0, steps=None, dt_s=1e-3, device=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn force_distance_curve<'py>(
     py: Python<'py>,
     params: Option<&Bound<'py, PyAny>>,
@@ -515,8 +535,10 @@ pub fn force_distance_curve<'py>(
     near_gap_m: f64,
     steps: Option<&Bound<'py, PyAny>>,
     dt_s: f64,
+    device: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = params_from_py(params)?;
+    let limits = limits_from_py(device, &p)?;
     let xy = match xy_m {
         Some(v) => vector::<2>(v, "xy_m", "m")?,
         None => nalgebra::Vector2::zeros(),
@@ -531,7 +553,9 @@ pub fn force_distance_curve<'py>(
         },
         dt_s,
     };
-    let c = py.detach(|| curve(&p, &spec)).map_err(value_error)?;
+    let c = py
+        .detach(|| curve(&p, &limits, &spec))
+        .map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("approach_gap", PyArray1::from_vec(py, c.approach_gap_m))?;
     d.set_item("approach_force", PyArray1::from_vec(py, c.approach_force_n))?;

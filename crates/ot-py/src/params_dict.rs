@@ -13,6 +13,7 @@ use nanoworld::{
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
+use world_form::Limits;
 
 /// `params` as Python passes it: "game", "physical", a dict, or None (game).
 pub(crate) fn params_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Params> {
@@ -37,6 +38,30 @@ pub(crate) fn params_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Params>
         ));
     }
     crate::json::from_py(obj, "params")
+}
+
+/// The device limits a nano world renders to, in world units: None takes the Falcon as the
+/// preset scenes map it (`params.default_limits()`: 8 nN and 20 N/m in game mode, 80 nN and
+/// 30 N/m in physical mode), or a dict {"max_force_n": N, "max_stiffness_n_per_m": N/m} (the
+/// old key "max_stiffness_n_m" is still accepted).
+pub(crate) fn limits_from_py(obj: Option<&Bound<'_, PyAny>>, params: &Params) -> PyResult<Limits> {
+    match obj {
+        Some(o) if !o.is_none() => {
+            let l: Limits = crate::json::from_py(o, "device")?;
+            l.validate()
+                .map_err(|e| PyValueError::new_err(format!("device: {e}")))?;
+            Ok(l)
+        }
+        _ => Ok(params.default_limits()),
+    }
+}
+
+/// Device limits as a dict {"max_force_n": N, "max_stiffness_n_per_m": N/m}.
+pub(crate) fn limits_to_py<'py>(py: Python<'py>, l: &Limits) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("max_force_n", l.max_force_n)?;
+    d.set_item("max_stiffness_n_per_m", l.max_stiffness_n_per_m)?;
+    Ok(d)
 }
 
 fn pairs<'py, T>(
@@ -128,9 +153,8 @@ pub(crate) fn params_to_py<'py>(py: Python<'py>, p: &Params) -> PyResult<Bound<'
     a.set_item("max_count", p.atoms.max_count)?;
     d.set_item("atoms", a)?;
     d.set_item("interaction", interaction(py, &p.interaction)?)?;
-    d.set_item("gravity_m_s2", p.gravity_m_s2)?;
+    d.set_item("gravity_m_per_s2", p.gravity_m_per_s2)?;
     d.set_item("inertia", p.inertia)?;
-    d.set_item("max_force_n", p.max_force_n)?;
     match &p.loading_zone {
         Some(z) => d.set_item("loading_zone", zone(py, z)?)?,
         None => d.set_item("loading_zone", py.None())?,

@@ -1,7 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use brickworld::{BrickPlacement, Buttons, DeviceLimits, Params, StepReport, World};
+use brickworld::{BrickPlacement, Grip, Params, StepReport, World};
+use world_form::Limits;
 
 /// Parameters with no loading zone and no blueprint: only what a test adds.
 pub fn bare() -> Params {
@@ -18,22 +19,22 @@ pub fn at(c: [f64; 3]) -> BrickPlacement {
 
 /// Builds a world with the Falcon limits.
 pub fn world(p: Params) -> World {
-    World::new(p, DeviceLimits::NOVINT_FALCON).expect("valid test params")
+    World::new(&p, &Limits::FALCON).expect("valid test params")
 }
 
 /// Steps with the cursor parked at `pos` (m), no buttons.
 pub fn idle(w: &mut World, pos: [f64; 3]) -> StepReport {
     let i = w
-        .input(pos, Buttons::default())
+        .input(pos, Grip::default())
         .expect("cursor inside workspace");
     w.step(&i)
 }
 
-/// Steps with the cursor at `pos` and the centre button as given.
-pub fn hold(w: &mut World, pos: [f64; 3], center: bool) -> StepReport {
-    let b = Buttons {
-        center,
-        ..Buttons::default()
+/// Steps with the cursor at `pos` and the grip's `hold` command as given.
+pub fn hold(w: &mut World, pos: [f64; 3], down: bool) -> StepReport {
+    let b = Grip {
+        hold: down,
+        ..Grip::default()
     };
     let i = w.input(pos, b).expect("cursor inside workspace");
     w.step(&i)

@@ -26,7 +26,7 @@
 //!
 //! [[switch]]                  # optional: the teaching game's menu, at a time
 //! t_s = 2.0
-//! name = "gravity_m_s2"       # one of the scene's switches (docs/haptic-loop.md)
+//! name = "gravity_m_per_s2"       # one of the scene's switches (docs/haptic-loop.md)
 //! value = 0.0                 # a number, or true / false for on/off switches
 //! ```
 

@@ -155,7 +155,7 @@ pub fn hysteresis(a: &SessionArrays) -> Option<Hysteresis> {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BrickThrow {
     /// Speed at release, m/s.
-    pub release_speed_m_s: f64,
+    pub release_speed_m_per_s: f64,
     /// Horizontal distance from the release point to the first impact, m.
     pub distance_m: f64,
     /// Flight time to the first impact, s.
@@ -167,7 +167,7 @@ pub struct BrickThrow {
 /// The first release of a run and the thrown brick's first impact after it.
 pub fn brick_throw(a: &SessionArrays) -> Option<BrickThrow> {
     let (tr, rel) = events(a, "brick.released").next()?;
-    let v = rel.get("velocity_m_s")?.as_array()?;
+    let v = rel.get("velocity_m_per_s")?.as_array()?;
     let v: Vec<f64> = v.iter().filter_map(serde_json::Value::as_f64).collect();
     let speed = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     let brick = rel.get("brick")?.clone();
@@ -183,7 +183,7 @@ pub fn brick_throw(a: &SessionArrays) -> Option<BrickThrow> {
     let p = hit.get("point_m")?.as_array()?;
     let (x1, y1) = (p.first()?.as_f64()?, p.get(1)?.as_f64()?);
     Some(BrickThrow {
-        release_speed_m_s: speed,
+        release_speed_m_per_s: speed,
         distance_m: (x1 - x0).hypot(y1 - y0),
         flight_s: ti - tr,
         thrown: events(a, "brick.thrown").next().is_some(),

@@ -82,13 +82,13 @@ pub struct ThrowSweep {
     /// The tip's hold (tip–atom pull-off force), N.
     pub hold_n: f64,
     /// Predicted hand acceleration to throw it off, m/s² (hold / mass / workspace scale).
-    pub predicted_hand_m_s2: f64,
+    pub predicted_hand_m_per_s2: f64,
     /// Each run: (swing time s, measured peak hand acceleration m/s², thrown off).
     pub runs: Vec<(f64, f64, bool)>,
     /// Largest hand acceleration that kept the atom, m/s².
-    pub kept_below_m_s2: f64,
+    pub kept_below_m_per_s2: f64,
     /// Smallest hand acceleration that threw it off, m/s².
-    pub thrown_from_m_s2: f64,
+    pub thrown_from_m_per_s2: f64,
 }
 
 /// Everything the report shows, measured.
@@ -106,7 +106,7 @@ pub struct LessonSummary {
     /// The brick's mass, kg, and gravity, m/s² (the scene's).
     pub brick_mass_kg: f64,
     /// Gravity of the brick world, m/s².
-    pub gravity_m_s2: f64,
+    pub gravity_m_per_s2: f64,
     /// Predicted peak inertial force of the carry, N: M · 5.7735 · D / T² (minimum-jerk move
     /// of D = 0.45 m in T = 0.9 s).
     pub lift_inertia_predicted_n: f64,
@@ -117,7 +117,7 @@ pub struct LessonSummary {
     /// The brick throw.
     pub brick_throw: BrickThrow,
     /// Peak hand acceleration of the throw motion, m/s² (device).
-    pub throw_hand_m_s2: f64,
+    pub throw_hand_m_per_s2: f64,
     /// Whether the real atom stayed on the tip through the same motion.
     pub atom_stayed: bool,
     /// Peak load on the atom in that motion (its inertia and weight), N.
@@ -129,7 +129,7 @@ pub struct LessonSummary {
     /// The atom's mass, kg.
     pub atom_mass_kg: f64,
     /// Hand acceleration that would throw the real atom off, m/s² (device).
-    pub atom_threshold_hand_m_s2: f64,
+    pub atom_threshold_hand_m_per_s2: f64,
     /// The heavy-atom throws that show the threshold.
     pub sweep: ThrowSweep,
     /// Sizes: brick edge lengths (m), cursor sphere radius (m), atom radius (m), tip radius (m).
@@ -209,7 +209,7 @@ pub fn run_lesson(
     let mut lifts = Vec::new();
     for (name, sw) in [
         ("lift", vec![]),
-        ("lift_gravity_off", vec![("gravity_m_s2", 0.0)]),
+        ("lift_gravity_off", vec![("gravity_m_per_s2", 0.0)]),
         ("lift_inertia_off", vec![("inertia", 0.0)]),
     ] {
         step(name);
@@ -244,7 +244,7 @@ pub fn run_lesson(
         step("heavy_atom_throw");
         let text = scripts::atom_throw(
             swing,
-            &[("gravity_m_s2", 0.0), ("atom_mass_kg", SWEEP_MASS_KG)],
+            &[("gravity_m_per_s2", 0.0), ("atom_mass_kg", SWEEP_MASS_KG)],
         );
         sweep_runs.push((
             swing,
@@ -257,7 +257,7 @@ pub fn run_lesson(
     let brick_params = brickworld::Params::default();
     let nano_params = nanoworld::Params::game_default();
     let m = brick_params.brick_mass_kg;
-    let g = brick_params.gravity_m_s2;
+    let g = brick_params.gravity_m_per_s2;
     let (hold_w, carry_w) = ((1.5, 2.1), (2.1, 3.0));
     let mut lift_weight_n = [0.0; 3];
     let mut lift_inertia_n = [0.0; 3];
@@ -279,7 +279,7 @@ pub fn run_lesson(
     let atom_m = nano_params.atoms.mass_kg;
     let atom_hand = measure::peak_hand_acceleration(&atom_throw_run.arrays);
     let atom_load =
-        atom_m * ((atom_hand * scale).powi(2) + nano_params.gravity_m_s2.powi(2)).sqrt();
+        atom_m * ((atom_hand * scale).powi(2) + nano_params.gravity_m_per_s2.powi(2)).sqrt();
     let carried_end = measure::last(&atom_throw_run.arrays, "carried_atoms").unwrap_or(0.0);
     let mut runs = Vec::new();
     for (swing, r) in &sweep_runs {
@@ -301,10 +301,10 @@ pub fn run_lesson(
     let sweep = ThrowSweep {
         mass_kg: SWEEP_MASS_KG,
         hold_n: hold,
-        predicted_hand_m_s2: hold / SWEEP_MASS_KG / scale,
+        predicted_hand_m_per_s2: hold / SWEEP_MASS_KG / scale,
         runs,
-        kept_below_m_s2: kept_below,
-        thrown_from_m_s2: thrown_from,
+        kept_below_m_per_s2: kept_below,
+        thrown_from_m_per_s2: thrown_from,
     };
     let e = brick_params.brick_half_extents_m;
     let mut summary = LessonSummary {
@@ -313,18 +313,18 @@ pub fn run_lesson(
         lift_weight_n,
         lift_inertia_n,
         brick_mass_kg: m,
-        gravity_m_s2: g,
+        gravity_m_per_s2: g,
         lift_inertia_predicted_n: m * 5.773_502_691_896_258 * 0.45 / (0.9 * 0.9),
         hysteresis,
         hysteresis_half,
         brick_throw,
-        throw_hand_m_s2: throw_hand,
+        throw_hand_m_per_s2: throw_hand,
         atom_stayed: carried_end >= 1.0,
         atom_load_n: atom_load,
         atom_inertia_n: atom_m * atom_hand * scale,
         atom_hold_n: hold,
         atom_mass_kg: atom_m,
-        atom_threshold_hand_m_s2: hold / atom_m / scale,
+        atom_threshold_hand_m_per_s2: hold / atom_m / scale,
         sweep,
         sizes_m: [
             ("brick, longest edge".into(), 2.0 * e[0].max(e[1]).max(e[2])),

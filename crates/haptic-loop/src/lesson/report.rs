@@ -244,7 +244,7 @@ pub fn write(
         series("thrown off", off, RED, Style::Dots),
     ];
     c.markers = vec![Marker {
-        x: sw.predicted_hand_m_s2,
+        x: sw.predicted_hand_m_per_s2,
         label: "predicted threshold".into(),
         color: GREY,
     }];
@@ -419,7 +419,7 @@ pub fn markdown(s: &LessonSummary) -> String {
          ![vertical force while lifting](lift_weight.png)\n\n![sideways force while carrying](lift_inertia.png)\n",
         s.brick_mass_kg,
         si(-s.lift_weight_n[0], "N"),
-        si(s.brick_mass_kg * s.gravity_m_s2, "N"),
+        si(s.brick_mass_kg * s.gravity_m_per_s2, "N"),
         si(s.lift_inertia_n[0], "N"),
         si(s.lift_inertia_predicted_n, "N"),
         si(-s.lift_weight_n[0], "N"),
@@ -461,8 +461,8 @@ pub fn markdown(s: &LessonSummary) -> String {
          off, and the threshold comes within reach: predicted {} of hand acceleration \
          (hold / mass / workspace scale). In {} throws, the atom stayed on up to {} and left \
          the tip from {}.\n\n![throw threshold](throw_threshold.png)\n",
-        si(s.throw_hand_m_s2, "m/s²"),
-        si(t.release_speed_m_s, "m/s"),
+        si(s.throw_hand_m_per_s2, "m/s²"),
+        si(t.release_speed_m_per_s, "m/s"),
         si(t.distance_m, "m"),
         t.flight_s,
         if t.thrown {
@@ -479,13 +479,13 @@ pub fn markdown(s: &LessonSummary) -> String {
         si(s.atom_mass_kg * 9.81, "N"),
         si(s.atom_hold_n, "N"),
         s.atom_hold_n / s.atom_load_n,
-        si(s.atom_threshold_hand_m_s2, "m/s²"),
+        si(s.atom_threshold_hand_m_per_s2, "m/s²"),
         sw.mass_kg,
         sw.mass_kg / s.atom_mass_kg,
-        si(sw.predicted_hand_m_s2, "m/s²"),
+        si(sw.predicted_hand_m_per_s2, "m/s²"),
         sw.runs.len(),
-        si(sw.kept_below_m_s2, "m/s²"),
-        si(sw.thrown_from_m_s2, "m/s²"),
+        si(sw.kept_below_m_per_s2, "m/s²"),
+        si(sw.thrown_from_m_per_s2, "m/s²"),
     );
     let _ = writeln!(
         m,

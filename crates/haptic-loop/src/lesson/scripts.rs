@@ -150,7 +150,7 @@ mod tests {
     #[test]
     fn every_lesson_script_is_a_valid_falcon_script() {
         let texts = [
-            brick_lift(&[("gravity_m_s2", 0.0)]).0,
+            brick_lift(&[("gravity_m_per_s2", 0.0)]).0,
             brick_throw(0.3).0,
             atom_throw(0.3, &[("atom_mass_kg", 1e-3)]),
             approach_retract(&[("adhesion_scale", 0.5)]),

@@ -2,10 +2,11 @@
 //! god-object cursor, grab / carry / rotate / throw, blueprint score.
 //!
 //! A thin adapter. `[brickworld.params]` is the world's own [`brickworld::Params`] table
-//! (every field has a default). The device limits handed to the world are the device's,
-//! mapped to the world (`k_max / (force_scale · workspace_scale)`, `F_max / force_scale`), so the
-//! world's proxy stiffness is checked against the real device. Buttons: Falcon centre → grab,
-//! plus / minus / forward → turn about x / y / z; Touch button1 → grab, button2 → turn about z.
+//! (every field has a default). The world is built with the device's limits mapped to the world
+//! ([`super::LoopConfig::world_limits`]), so its proxy stiffness is checked against the real
+//! device. The device's buttons become the hand's [`Grip`] commands: Falcon centre → `hold`,
+//! plus / minus / forward → `turn_x` / `turn_y` / `turn_z`; Touch button1 → `hold`, button2 →
+//! `turn_z`.
 //! The world's `dt_s` must equal the loop's tick.
 
 use super::check::{SceneError, check_positive, out_of_range};
@@ -14,8 +15,9 @@ use super::{
     Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
 };
 use crate::vec3::Vec3;
-use brickworld::{Buttons as BrickButtons, CursorInput, DeviceLimits, Params, World};
+use brickworld::{CursorInput, Grip, Params, World};
 use serde::Deserialize;
+use world_form::Limits;
 
 /// The brick world in the scene registry: `kind = "brickworld"`, table `[brickworld]`.
 pub const WORLD: WorldKind = WorldKind {
@@ -25,8 +27,7 @@ pub const WORLD: WorldKind = WorldKind {
         let p: BrickSection = world_table(text, "brickworld")?;
         let scene = BrickScene::new(
             p,
-            config.world_stiffness_cap_n_per_m(),
-            config.world_max_force_n(),
+            &config.world_limits(),
             config.dt_s(),
             &config.specs.button_strs(),
         )?;
@@ -53,7 +54,8 @@ fn default_ground() -> f64 {
 /// The brick-world scene.
 pub struct BrickScene {
     world: World,
-    /// Bit of the device button for centre, x, y, z turns (`None`: the device has none).
+    /// Bit of the device button for `hold`, `turn_x`, `turn_y`, `turn_z` (`None`: the device
+    /// has none).
     bits: [Option<u32>; 4],
     last_input: Option<CursorInput>,
     rejected: bool,
@@ -67,7 +69,8 @@ pub struct BrickScene {
 
 /// The macro world's switches (the paper's menu), named as in `[brickworld.params]`.
 pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
-    SwitchSpec::number("gravity_m_s2", 0.0, 100.0, "gravity, m/s² (0: off)"),
+    SwitchSpec::number("gravity_m_per_s2", 0.0, 100.0, "gravity, m/s² (0: off)")
+        .or_old_name("gravity_m_s2"),
     SwitchSpec::number("restitution", 0.0, 1.0, "restitution of every contact"),
     SwitchSpec::number(
         "friction",
@@ -80,12 +83,11 @@ pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
 ];
 
 impl BrickScene {
-    /// Builds the scene: `cap_n_per_m` and `max_force_world_n` are the device limits mapped to
-    /// the world, `dt_s` the tick, `buttons` the device's button names.
+    /// Builds the scene: `limits` are the device's limits mapped to the world, `dt_s` the
+    /// tick, `buttons` the device's button names.
     pub fn new(
         s: BrickSection,
-        cap_n_per_m: f64,
-        max_force_world_n: f64,
+        limits: &Limits,
         dt_s: f64,
         buttons: &[&str],
     ) -> Result<Self, SceneError> {
@@ -97,12 +99,8 @@ impl BrickScene {
             ));
         }
         check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;
-        let limits = DeviceLimits {
-            max_stiffness_n_m: cap_n_per_m,
-            max_force_n: max_force_world_n,
-        };
         let slots = s.params.blueprint.slots.len();
-        let world = World::new(s.params, limits).map_err(|e| SceneError::World {
+        let world = World::new(&s.params, limits).map_err(|e| SceneError::World {
             section: "brickworld.params".into(),
             field: Some(e.field().to_string()),
             message: e.to_string(),
@@ -125,7 +123,7 @@ impl BrickScene {
             force_n: [0.0; 3],
             penetration_m: 0.0,
             ground_half_m: s.draw_ground_half_m,
-            score: HouseScore::new(slots, max_force_world_n, dt_s),
+            score: HouseScore::new(slots, limits.max_force_n, dt_s),
             released: Vec::new(),
         })
     }
@@ -166,26 +164,29 @@ fn event_detail(e: &brickworld::Event) -> String {
 fn track_drops(
     e: &brickworld::Event,
     released: &mut Vec<(brickworld::BrickId, f64)>,
-    g_m_s2: f64,
+    g_m_per_s2: f64,
     score: &mut HouseScore,
 ) {
     use brickworld::{Body, Event as E};
     match e {
         E::Released {
             brick,
-            velocity_m_s: v,
+            velocity_m_per_s: v,
         } => released.push((*brick, (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())),
         E::Grabbed { brick } => released.retain(|(b, _)| b != brick),
         E::Impact {
-            a, b, speed_m_s, ..
+            a,
+            b,
+            speed_m_per_s,
+            ..
         } => {
             for body in [a, b] {
                 if let Body::Brick(id) = body
                     && let Some(i) = released.iter().position(|(r, _)| r == id)
                 {
                     let (_, v0) = released.swap_remove(i);
-                    let fall = if g_m_s2 > 0.0 {
-                        (speed_m_s * speed_m_s - v0 * v0) / (2.0 * g_m_s2)
+                    let fall = if g_m_per_s2 > 0.0 {
+                        (speed_m_per_s * speed_m_per_s - v0 * v0) / (2.0 * g_m_per_s2)
                     } else {
                         0.0
                     };
@@ -229,7 +230,7 @@ impl Scene for BrickScene {
     fn set_switch(&mut self, name: &str, value: f64) -> Result<(), String> {
         let w = &mut self.world;
         match name {
-            "gravity_m_s2" => w.set_gravity(value),
+            "gravity_m_per_s2" => w.set_gravity(value),
             "restitution" => w.set_restitution(value),
             "friction" => w.set_friction(value),
             "inertia" => {
@@ -244,13 +245,13 @@ impl Scene for BrickScene {
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         let pressed = |bit: Option<u32>| bit.is_some_and(|b| input.buttons.pressed(b));
-        let buttons = BrickButtons {
-            center: pressed(self.bits[0]),
-            rotate_x: pressed(self.bits[1]),
-            rotate_y: pressed(self.bits[2]),
-            rotate_z: pressed(self.bits[3]),
+        let grip = Grip {
+            hold: pressed(self.bits[0]),
+            turn_x: pressed(self.bits[1]),
+            turn_y: pressed(self.bits[2]),
+            turn_z: pressed(self.bits[3]),
         };
-        let cursor_input = match self.world.input(input.cursor_m, buttons) {
+        let cursor_input = match self.world.input(input.cursor_m, grip) {
             Ok(i) => {
                 self.rejected = false;
                 Some(i)
@@ -272,7 +273,7 @@ impl Scene for BrickScene {
         let r = self.world.step(&ci);
         for e in &r.events {
             out.events.push(Event::new(event_name(e), event_detail(e)));
-            let g = self.world.params().gravity_m_s2;
+            let g = self.world.params().gravity_m_per_s2;
             track_drops(e, &mut self.released, g, &mut self.score);
         }
         self.force_n = if self.rejected { [0.0; 3] } else { r.force_n };
@@ -280,7 +281,7 @@ impl Scene for BrickScene {
             .update(input.tick, self.force_n, self.world.score().filled);
         self.penetration_m = r.proxy_penetration_m;
         out.force_n = self.force_n;
-        out.stiffness_n_per_m = r.stiffness_n_m;
+        out.stiffness_n_per_m = r.stiffness_n_per_m;
     }
 
     fn state(&self, out: &mut Vec<f64>) {

@@ -5,6 +5,7 @@ use super::check::{SceneError, check_range, out_of_range};
 use crate::device::DeviceSpecs;
 use crate::vec3::{self, Vec3};
 use serde::Deserialize;
+use world_form::Limits;
 
 /// `[mapping]`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -191,16 +192,19 @@ impl LoopConfig {
         self.specs.max_force_n / self.mapping.force_scale
     }
 
-    /// The device's limits expressed in the world (force and stiffness through the mapping):
-    /// what every world is built with.
-    pub fn world_limits(&self) -> world_form::Limits {
-        self.specs
-            .limits()
-            .in_world(self.mapping.force_scale, self.mapping.workspace_scale)
-    }
-
     /// The largest world-frame stiffness that renders within the device's stiffness limit, N/m.
     pub fn world_stiffness_cap_n_per_m(&self) -> f64 {
         self.specs.max_stiffness_n_per_m / (self.mapping.force_scale * self.mapping.workspace_scale)
+    }
+
+    /// The device's limits mapped to the world, the [`Limits`] every world is built with:
+    /// [`LoopConfig::world_max_force_n`] (N) and [`LoopConfig::world_stiffness_cap_n_per_m`]
+    /// (N/m), i.e. `Limits::in_world(force_scale, workspace_scale)` of the device's limits: a
+    /// stiffness maps by `force_scale · workspace_scale`, a force by `force_scale` alone.
+    pub fn world_limits(&self) -> Limits {
+        Limits {
+            max_force_n: self.world_max_force_n(),
+            max_stiffness_n_per_m: self.world_stiffness_cap_n_per_m(),
+        }
     }
 }

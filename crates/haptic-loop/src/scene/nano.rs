@@ -6,10 +6,13 @@
 //! tick calls [`nanoworld::World::step`]. Its typed events become `nano.*` events (detail:
 //! the event's fields).
 //!
-//! Stiffness: the stiffest spring the world renders (the largest game-mode adhesion `k`, or
-//! the physical-mode cantilever `k_c`) must map within the device's limit; the scene file is
-//! refused otherwise (lower `mapping.force_scale` or `mapping.workspace_scale`). Each tick the
-//! scene reports the adhesion `k` of the anchored contact (game mode) or `k_c` (physical).
+//! Limits: the world is built with the device's limits mapped to the world
+//! ([`super::LoopConfig::world_limits`]); it scales its force down to their largest force, and
+//! refuses a stiffest spring ([`nanoworld::Params::max_render_stiffness`]: the largest
+//! game-mode adhesion `k`, or the physical-mode cantilever `k_c`) beyond their stiffness —
+//! checked when the scene loads, with a hint at the mapping (lower `mapping.force_scale` or
+//! `mapping.workspace_scale`). Each tick the scene reports the adhesion `k` of the anchored
+//! contact (game mode) or `k_c` (physical).
 
 use super::check::{SceneError, check_positive, out_of_range};
 use super::score::{self, HouseScore};
@@ -20,6 +23,7 @@ use crate::vec3::Vec3;
 use nalgebra::Vector3;
 use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};
 use serde::Deserialize;
+use world_form::Limits;
 
 /// The nano world in the scene registry: `kind = "nanoworld"`, table `[nanoworld]`.
 pub const WORLD: WorldKind = WorldKind {
@@ -27,12 +31,7 @@ pub const WORLD: WorldKind = WorldKind {
     check: |text| super::table::pick::<NanoSection>(text, "nanoworld").map(drop),
     build: |text, config| {
         let p: NanoSection = world_table(text, "nanoworld")?;
-        let scene = NanoScene::new(
-            p,
-            config.world_stiffness_cap_n_per_m(),
-            config.world_max_force_n(),
-            config.dt_s(),
-        )?;
+        let scene = NanoScene::new(p, &config.world_limits(), config.dt_s())?;
         Ok(Box::new(scene))
     },
 };
@@ -60,6 +59,8 @@ fn default_draw_radius() -> f64 {
 pub struct NanoScene {
     /// The parameters in force (the scene file's, with the switches applied).
     params: Params,
+    /// The device's limits mapped to the world.
+    limits: Limits,
     /// The scene file's parameters (switch scales apply to these).
     base: Params,
     /// Strength scales: all pairs, then tip–substrate, tip–atom, atom–atom, atom–substrate.
@@ -94,7 +95,8 @@ pub const NANO_SWITCHES: [SwitchSpec; 8] = [
         "atom–substrate strength × this",
     ),
     SwitchSpec::number("atom_mass_kg", 0.0, 1.0, "mass of every movable atom, kg"),
-    SwitchSpec::number("gravity_m_s2", 0.0, 1000.0, "gravity, m/s² (0: off)"),
+    SwitchSpec::number("gravity_m_per_s2", 0.0, 1000.0, "gravity, m/s² (0: off)")
+        .or_old_name("gravity_m_s2"),
     SwitchSpec::on_off("inertia", "the carried atoms' inertial force −m a"),
 ];
 
@@ -126,41 +128,10 @@ fn scaled(base: &Params, scales: [f64; 5]) -> Params {
     p
 }
 
-fn max_render_stiffness(p: &Params) -> (String, f64) {
-    match &p.interaction {
-        Interaction::Game(g) => {
-            let pairs = [
-                ("tip_substrate", g.pairs.tip_substrate.stiffness_n_per_m),
-                ("tip_atom", g.pairs.tip_atom.stiffness_n_per_m),
-                ("atom_atom", g.pairs.atom_atom.stiffness_n_per_m),
-                ("atom_substrate", g.pairs.atom_substrate.stiffness_n_per_m),
-            ];
-            let (name, k) =
-                pairs.iter().fold(
-                    ("tip_substrate", 0.0),
-                    |a, b| if b.1 > a.1 { *b } else { a },
-                );
-            (
-                format!("nanoworld.params.interaction.game.pairs.{name}.stiffness_n_per_m"),
-                k,
-            )
-        }
-        Interaction::Physical(ph) => (
-            "nanoworld.params.interaction.physical.cantilever_stiffness_n_per_m".to_string(),
-            ph.cantilever_stiffness_n_per_m,
-        ),
-    }
-}
-
 impl NanoScene {
-    /// Builds the scene from its section, the world stiffness cap (N/m), the device's largest
-    /// force mapped to the world (N, for the score's comfort limit) and the tick (s).
-    pub fn new(
-        s: NanoSection,
-        cap_n_per_m: f64,
-        max_force_world_n: f64,
-        dt_s: f64,
-    ) -> Result<Self, SceneError> {
+    /// Builds the scene from its section, the device's limits mapped to the world (N, N/m; the
+    /// largest force is also the score's comfort limit) and the tick (s).
+    pub fn new(s: NanoSection, limits: &Limits, dt_s: f64) -> Result<Self, SceneError> {
         let params = match (&s.preset, s.params) {
             (Some(name), None) => match name.as_str() {
                 "game" => Params::game_default(),
@@ -187,10 +158,11 @@ impl NanoScene {
             field: Some(e.field().to_string()),
             message: e.to_string(),
         })?;
-        let (field, k) = max_render_stiffness(&params);
+        let (field, k) = params.max_render_stiffness();
+        let cap_n_per_m = limits.max_stiffness_n_per_m;
         if k > cap_n_per_m {
             return Err(out_of_range(
-                &field,
+                &format!("nanoworld.params.{field}"),
                 k,
                 format!(
                     "≤ {cap_n_per_m} N/m, the device's stiffness limit mapped to the world \
@@ -198,18 +170,26 @@ impl NanoScene {
                 ),
             ));
         }
+        params
+            .validate_for_device(limits)
+            .map_err(|e| SceneError::World {
+                section: "nanoworld.params".into(),
+                field: Some(e.field().to_string()),
+                message: e.to_string(),
+            })?;
         check_positive("nanoworld.draw_radius_m", s.draw_radius_m, 1e-6)?;
         let slots = params.house.as_ref().map_or(0, |h| h.slots_m.len());
         Ok(NanoScene {
             base: params.clone(),
             params,
+            limits: *limits,
             scales: [1.0; 5],
             world: None,
             dt_s,
             draw_radius_m: s.draw_radius_m,
             saturated: false,
             force_n: [0.0; 3],
-            score: HouseScore::new(slots, max_force_world_n, dt_s),
+            score: HouseScore::new(slots, limits.max_force_n, dt_s),
         })
     }
 
@@ -275,14 +255,17 @@ impl Scene for NanoScene {
             "atom_atom_scale" => scales[3] = value,
             "atom_substrate_scale" => scales[4] = value,
             "atom_mass_kg" => base.atoms.mass_kg = value,
-            "gravity_m_s2" => base.gravity_m_s2 = value,
+            "gravity_m_per_s2" => base.gravity_m_per_s2 = value,
             "inertia" => base.inertia = value != 0.0,
             other => return Err(format!("the nanoworld scene has no switch `{other}`")),
         }
         let params = scaled(&base, scales);
         match self.world.as_mut() {
             Some(w) => w.set_params(params.clone()).map_err(|e| e.to_string())?,
-            None => params.validate().map_err(|e| e.to_string())?,
+            None => params
+                .validate()
+                .and_then(|()| params.validate_for_device(&self.limits))
+                .map_err(|e| e.to_string())?,
         }
         self.params = params;
         self.base = base;
@@ -293,7 +276,7 @@ impl Scene for NanoScene {
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         let cursor = Vector3::new(input.cursor_m[0], input.cursor_m[1], input.cursor_m[2]);
         if self.world.is_none() {
-            match World::new(self.params.clone(), cursor) {
+            match World::new(&self.params, &self.limits, cursor) {
                 Ok(w) => self.world = Some(w),
                 Err(e) => {
                     out.events.push(Event::new("nano.error", e.to_string()));

@@ -1,0 +1,411 @@
+//! The hand: the cursor proxy (god-object), the grip commands (grab, release, throw, turn),
+//! the force the device renders (proxy spring, weight and inertia of the carried brick,
+//! scaled down to the device's largest force) and the hand's push on the bricks it touches.
+
+use rapier3d_f64::math::{Pose, Rotation, Vector};
+use rapier3d_f64::parry::shape::{Ball, Cuboid};
+use rapier3d_f64::prelude::{QueryFilter, RigidBodyHandle, RigidBodyType};
+use world_form::Limits;
+
+use crate::bricks::BrickSet;
+use crate::estimator::MotionEstimator;
+use crate::event::{Axis, Body, BrickId, Event, Touch};
+use crate::impact::IMPACT_MIN_SPEED_M_PER_S;
+use crate::input::{CursorInput, Grip};
+use crate::params::{AccelEstimator, Params};
+use crate::proxy::{self, HeldShape};
+
+/// Range of [`crate::World::nearest_m`], m: farther solids count as none.
+pub const NEAREST_MAX_M: f64 = 1.0;
+
+/// The carried brick and how it sits in the hand.
+#[derive(Debug, Clone, Copy)]
+struct Held {
+    brick: BrickId,
+    /// Brick centre minus proxy centre, world frame, m.
+    offset: Vector,
+    /// Brick orientation.
+    rotation: Rotation,
+}
+
+/// The force one step of the hand sends to the device, and its parts (N, world frame).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Felt {
+    /// Spring + weight + inertia, scaled down to [`Limits::max_force_n`] if larger.
+    pub force: Vector,
+    /// Whether `force` was scaled down.
+    pub saturated: bool,
+    /// Proxy spring `k (p - c)`, N.
+    pub spring: Vector,
+    /// Weight of the carried brick, N.
+    pub weight: Vector,
+    /// Inertial force of the carried brick, N.
+    pub inertia: Vector,
+    /// Grip-point acceleration estimate, m/s².
+    pub acceleration: Vector,
+    /// Deepest penetration found before the proxy was pushed out, m.
+    pub penetration_m: f64,
+}
+
+/// The haptic cursor: proxy, device cursor, grip state, motion history and touches.
+pub(crate) struct Hand {
+    /// Centre of the cursor sphere (god-object), m.
+    proxy: Vector,
+    /// Last device cursor position, m.
+    cursor: Vector,
+    /// The grip commands of the last sample (for press and release edges).
+    grip: Grip,
+    /// Velocity and acceleration of the grip point from the proxy's history.
+    motion: MotionEstimator,
+    held: Option<Held>,
+    /// What the cursor (or carried brick) touches, sorted.
+    touching: Vec<Touch>,
+    /// The proxy's speed over the last tick, m/s (for cursor impacts).
+    proxy_speed: f64,
+    /// Whether a sample has arrived.
+    started: bool,
+}
+
+impl Hand {
+    /// A hand at the top centre of the workspace, holding nothing, until the first sample.
+    pub(crate) fn new(params: &Params) -> Hand {
+        let top = Vector::new(0.0, 0.0, params.workspace_half_extent_m);
+        Hand {
+            proxy: top,
+            cursor: top,
+            grip: Grip::default(),
+            motion: MotionEstimator::new(params.dt_s, params.accel_estimator),
+            held: None,
+            touching: Vec::new(),
+            proxy_speed: 0.0,
+            started: false,
+        }
+    }
+
+    /// Centre of the cursor sphere, m.
+    pub(crate) fn proxy(&self) -> Vector {
+        self.proxy
+    }
+
+    /// Last device cursor position, m.
+    pub(crate) fn cursor(&self) -> Vector {
+        self.cursor
+    }
+
+    /// The carried brick, if any.
+    pub(crate) fn held_brick(&self) -> Option<BrickId> {
+        self.held.map(|h| h.brick)
+    }
+
+    /// What the cursor (or carried brick) touches now, sorted.
+    pub(crate) fn touching(&self) -> &[Touch] {
+        &self.touching
+    }
+
+    /// Restarts the acceleration estimate with `kind`, from the proxy's current position.
+    pub(crate) fn set_accel_estimator(&mut self, dt_s: f64, kind: AccelEstimator) {
+        let newest = self.proxy.to_array();
+        self.motion = MotionEstimator::new(dt_s, kind);
+        self.motion.reset(newest);
+    }
+
+    /// One tick of the hand with the device sample `input`: grip edges (release before grab, so
+    /// one tick can't do both on one brick; then the turns), the god-object update, the force
+    /// for the device, touch events and the hand's push on dynamic bricks.
+    pub(crate) fn step(
+        &mut self,
+        input: &CursorInput,
+        tick: u64,
+        params: &Params,
+        limits: &Limits,
+        bricks: &mut BrickSet,
+        events: &mut Vec<Event>,
+    ) -> Felt {
+        let c = Vector::from_array(input.position_m());
+        self.cursor = c;
+        if !self.started {
+            // The first sample: the proxy comes down from the top of the workspace onto the
+            // cursor, so it starts outside every solid even if the cursor starts inside one.
+            self.proxy = Vector::new(c.x, c.y, params.workspace_half_extent_m);
+            self.started = true;
+        }
+        let grip = input.grip();
+        let prev = self.grip;
+        self.grip = grip;
+
+        // 1. Grip: release before grab so one tick can't do both on one brick.
+        if prev.hold && !grip.hold {
+            self.release(params, bricks, events);
+        }
+        if !prev.hold && grip.hold {
+            self.grab(params, bricks, events);
+        }
+        for (now, before, axis) in [
+            (grip.turn_x, prev.turn_x, Axis::X),
+            (grip.turn_y, prev.turn_y, Axis::Y),
+            (grip.turn_z, prev.turn_z, Axis::Z),
+        ] {
+            if now && !before {
+                self.turn(axis, params, bricks, events);
+            }
+        }
+
+        // 2. God-object update.
+        let ball = Ball::new(params.proxy_radius_m);
+        let held_shape = self.held_shape(params);
+        let exclude = self.held.map(|h| bricks.collider(h.brick));
+        let upd = {
+            let mut filter = QueryFilter::default();
+            if let Some(ex) = exclude {
+                filter = filter.exclude_collider(ex);
+            }
+            let qp = bricks.phys.query_pipeline_with_filter(filter);
+            proxy::update_proxy(&qp, &ball, &held_shape, self.proxy, c)
+        };
+        let moved = (upd.position - self.proxy).length() / params.dt_s;
+        let approach_speed = moved.max(self.proxy_speed);
+        self.proxy_speed = if tick == 0 { 0.0 } else { moved };
+        self.proxy = upd.position;
+        if tick == 0 {
+            self.motion.reset(self.proxy.to_array());
+        }
+        self.motion.push(self.proxy.to_array());
+        if let Some(h) = self.held {
+            let body = bricks.body(h.brick);
+            if let Some(rb) = bricks.phys.bodies.get_mut(body) {
+                rb.set_next_kinematic_position(Pose::from_parts(self.proxy + h.offset, h.rotation));
+            }
+        }
+
+        // 3. The force the device renders this tick: spring + weight + inertia, scaled down
+        //    to the device limit. The hand pushes the world with exactly the reaction of the
+        //    spring part of it (action = reaction at the coupling): a proxy pressed deep into a
+        //    brick pushes with at most the device's force, not with the stretched spring's.
+        let spring = (self.proxy - c) * params.proxy_stiffness_n_per_m;
+        let m = params.brick_mass_kg;
+        let accel = Vector::from_array(self.motion.acceleration());
+        let (weight, inertia) = if self.held.is_some() {
+            let w = Vector::new(0.0, 0.0, -m * params.gravity_m_per_s2);
+            let i = if params.inertia {
+                -accel * m
+            } else {
+                Vector::ZERO
+            };
+            (w, i)
+        } else {
+            (Vector::ZERO, Vector::ZERO)
+        };
+        let total = spring + weight + inertia;
+        let mag = total.length();
+        let scale = if mag > limits.max_force_n {
+            limits.max_force_n / mag
+        } else {
+            1.0
+        };
+        let (force, saturated) = (total * scale, scale < 1.0);
+        let felt_spring = spring * scale;
+
+        // 4. Touch bookkeeping and the hand's push on dynamic bricks.
+        let mut touching: Vec<Touch> = upd
+            .contacts
+            .iter()
+            .filter_map(|ct| bricks.touch_of(ct.collider))
+            .collect();
+        touching.sort();
+        touching.dedup();
+        for t in &self.touching {
+            if touching.binary_search(t).is_err() {
+                events.push(Event::TouchEnded { target: *t });
+            }
+        }
+        for t in &touching {
+            if self.touching.binary_search(t).is_err() {
+                events.push(Event::TouchBegan { target: *t });
+                if tick > 0 && approach_speed >= IMPACT_MIN_SPEED_M_PER_S {
+                    events.push(Event::Impact {
+                        a: Body::Cursor,
+                        b: Body::from(*t),
+                        impulse_n_s: params.brick_mass_kg * approach_speed,
+                        speed_m_per_s: approach_speed,
+                        point_m: self.proxy.to_array(),
+                    });
+                }
+            }
+        }
+        self.touching = touching;
+        let pushes: Vec<(RigidBodyHandle, Vector)> = upd
+            .contacts
+            .iter()
+            .filter_map(|ct| {
+                let co = bricks.phys.colliders.get(ct.collider)?;
+                let body = co.parent()?;
+                let rb = bricks.phys.bodies.get(body)?;
+                (rb.body_type() == RigidBodyType::Dynamic).then_some((body, ct.point))
+            })
+            .collect();
+        if !pushes.is_empty() && felt_spring.length_squared() > 0.0 {
+            // The hand pushes with the reaction of the spring it feels, shared by the contacts,
+            // at the contact points, as the impulse of that force over this tick. (A user force
+            // at a point would be the natural call, but rapier 0.36 does not resist the torque
+            // of user forces with contacts: 10 N pressed 5 cm off-centre launched a resting
+            // 0.5 kg brick 0.45 m up. Velocity impulses are resisted correctly.)
+            let share = -felt_spring * (params.dt_s / pushes.len() as f64);
+            for (body, point) in pushes {
+                if let Some(rb) = bricks.phys.bodies.get_mut(body) {
+                    rb.apply_impulse_at_point(share, point, true);
+                }
+            }
+        }
+        Felt {
+            force,
+            saturated,
+            spring,
+            weight,
+            inertia,
+            acceleration: accel,
+            penetration_m: upd.penetration_before_m,
+        }
+    }
+
+    /// Distance from the cursor sphere's surface to the nearest solid other than the carried
+    /// brick, m: 0 when touching, `f64::INFINITY` beyond [`NEAREST_MAX_M`].
+    pub(crate) fn nearest_m(&self, params: &Params, bricks: &BrickSet) -> f64 {
+        let mut filter = QueryFilter::default();
+        if let Some(h) = self.held {
+            filter = filter.exclude_collider(bricks.collider(h.brick));
+        }
+        let r = params.proxy_radius_m;
+        let qp = bricks.phys.query_pipeline_with_filter(filter);
+        match qp.project_point(self.proxy, NEAREST_MAX_M + r, true) {
+            Some((_, proj)) if proj.is_inside => 0.0,
+            Some((_, proj)) => ((proj.point - self.proxy).length() - r).max(0.0),
+            None => f64::INFINITY,
+        }
+    }
+
+    fn held_shape(&self, params: &Params) -> Option<HeldShape> {
+        self.held.map(|h| {
+            let e = params.brick_half_extents_m;
+            HeldShape {
+                cuboid: Cuboid::new(Vector::from_array(e)),
+                offset: h.offset,
+                rotation: h.rotation,
+            }
+        })
+    }
+
+    /// `hold` pressed: carry the nearest brick within reach (ties: the lower id).
+    fn grab(&mut self, params: &Params, bricks: &mut BrickSet, events: &mut Vec<Event>) {
+        if self.held.is_some() {
+            return;
+        }
+        let reach = Ball::new(params.proxy_radius_m + params.grab_distance_m + 2.0 * proxy::SKIN_M);
+        let pose = Pose::from_translation(self.proxy);
+        let mut best: Option<(f64, BrickId)> = None;
+        {
+            let qp = bricks.phys.query_pipeline();
+            for (handle, co) in qp.intersect_shape(pose, &reach) {
+                if let Some(Touch::Brick(id)) = bricks.touch_of(handle) {
+                    let d = (co.position().translation - self.proxy).length();
+                    if best.is_none_or(|(bd, bid)| d < bd || (d == bd && id < bid)) {
+                        best = Some((d, id));
+                    }
+                }
+            }
+        }
+        let Some((_, id)) = best else {
+            events.push(Event::GrabMissed);
+            return;
+        };
+        bricks.wake_neighbours(bricks.collider(id));
+        if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(id)) {
+            let pos = *rb.position();
+            rb.set_body_type(RigidBodyType::KinematicPositionBased, true);
+            rb.set_linvel(Vector::ZERO, true);
+            rb.set_angvel(Vector::ZERO, true);
+            self.held = Some(Held {
+                brick: id,
+                offset: pos.translation - self.proxy,
+                rotation: pos.rotation,
+            });
+            events.push(Event::Grabbed { brick: id });
+        }
+    }
+
+    /// `hold` released: the brick leaves the hand with the grip point's velocity (a throw when
+    /// faster than [`Params::throw_min_speed_m_per_s`]).
+    fn release(&mut self, params: &Params, bricks: &mut BrickSet, events: &mut Vec<Event>) {
+        let Some(h) = self.held.take() else {
+            return;
+        };
+        let v = Vector::from_array(self.motion.velocity());
+        if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
+            rb.set_body_type(RigidBodyType::Dynamic, true);
+            rb.set_linvel(v, true);
+            rb.set_angvel(Vector::ZERO, true);
+        }
+        bricks.wake_neighbours(bricks.collider(h.brick));
+        events.push(Event::Released {
+            brick: h.brick,
+            velocity_m_per_s: v.to_array(),
+        });
+        if v.length() >= params.throw_min_speed_m_per_s {
+            events.push(Event::Thrown {
+                brick: h.brick,
+                velocity_m_per_s: v.to_array(),
+            });
+        }
+    }
+
+    /// A turn command: the carried brick turns by +90° about a world axis through the grip
+    /// point, unless the turned brick would overlap something.
+    fn turn(
+        &mut self,
+        axis: Axis,
+        params: &Params,
+        bricks: &mut BrickSet,
+        events: &mut Vec<Event>,
+    ) {
+        let Some(h) = self.held else {
+            return;
+        };
+        let a = match axis {
+            Axis::X => Vector::X,
+            Axis::Y => Vector::Y,
+            Axis::Z => Vector::Z,
+        };
+        let r = Rotation::from_axis_angle(a, std::f64::consts::FRAC_PI_2);
+        let offset = r * h.offset;
+        let rotation = (r * h.rotation).normalize();
+        let collider = bricks.collider(h.brick);
+        let e = params.brick_half_extents_m;
+        let cuboid = Cuboid::new(Vector::from_array(e));
+        let pose = Pose::from_parts(self.proxy + offset, rotation);
+        let blocked = {
+            let qp = bricks
+                .phys
+                .query_pipeline_with_filter(QueryFilter::default().exclude_collider(collider));
+            qp.intersect_shape(pose, &cuboid).next().is_some()
+        };
+        if blocked {
+            events.push(Event::RotationBlocked {
+                brick: h.brick,
+                axis,
+            });
+            return;
+        }
+        bricks.wake_neighbours(collider);
+        if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
+            rb.set_position(pose, true);
+        }
+        self.held = Some(Held {
+            brick: h.brick,
+            offset,
+            rotation,
+        });
+        events.push(Event::Rotated {
+            brick: h.brick,
+            axis,
+        });
+    }
+}
