@@ -572,12 +572,12 @@ fn drive(lp: &mut HapticLoop, specs: &DeviceSpecs, start: [f64; 3], ticks: u64) 
             );
         }
         let f = norm(t.device_force_n);
-        if f > specs.max_force_n * (1.0 + 1e-9) {
+        if f > specs.limits.max_force_n * (1.0 + 1e-9) {
             return Outcome::Finding(
                 "over-limit",
                 format!(
                     "tick {k}: device force {f} N over the limit {} N",
-                    specs.max_force_n
+                    specs.limits.max_force_n
                 ),
             );
         }
@@ -659,7 +659,9 @@ fn run_bridge(input: &[u8]) -> Outcome {
                     },
                     false,
                 );
-                if !finite3(t.device_force_n) || norm(t.device_force_n) > falcon().max_force_n {
+                if !finite3(t.device_force_n)
+                    || norm(t.device_force_n) > falcon().limits.max_force_n
+                {
                     return Outcome::Finding(
                         "non-finite",
                         format!(

@@ -365,7 +365,7 @@ impl HapticLoop {
                 .push(Event::new("force.invalid", "mapped force overflows"));
             f = [0.0; 3];
         }
-        let max = self.config.specs.max_force_n;
+        let max = self.config.specs.limits.max_force_n;
         let mag = vec3::norm(f);
         let mut k_gain = if force_ok && vec3::is_finite(f) {
             self.out.stiffness_n_per_m * gain * self.config.mapping.workspace_scale
@@ -466,7 +466,7 @@ stiffness_n_per_m = 5000.0
         // 5 mm -> 15 N requested, clamped to 8 N, still along +z.
         let r = l.tick(at(-0.005), false).clone();
         assert_eq!(r.status, status::CLAMPED);
-        assert!(vec3::norm(r.device_force_n) <= FALCON.max_force_n);
+        assert!(vec3::norm(r.device_force_n) <= FALCON.limits.max_force_n);
         assert!((r.device_force_n[2] - 8.0).abs() < 1e-12);
         assert_eq!(r.events[0].name, "force.clamped");
         // The clamp event fires once per episode.
@@ -554,7 +554,7 @@ stiffness_n_per_m = 5000.0
                 let invalid = HapticLoop::check_sample(&FALCON, &s).is_some();
                 let r = l.tick(s, false);
                 prop_assert!(vec3::is_finite(r.device_force_n));
-                prop_assert!(vec3::norm(r.device_force_n) <= FALCON.max_force_n);
+                prop_assert!(vec3::norm(r.device_force_n) <= FALCON.limits.max_force_n);
                 if invalid {
                     prop_assert_eq!(r.device_force_n, [0.0; 3]);
                     prop_assert!(r.status & status::INPUT_INVALID != 0);

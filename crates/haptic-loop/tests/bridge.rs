@@ -129,9 +129,9 @@ fn five_percent_loss_and_2_ms_jitter_are_survived_and_replay_bit_for_bit() {
         dev.ticks
     );
     for (f, s) in a.device_force_n.iter().zip(&a.status) {
-        assert!(vec3::is_finite(*f) && vec3::norm(*f) <= FALCON.max_force_n);
+        assert!(vec3::is_finite(*f) && vec3::norm(*f) <= FALCON.limits.max_force_n);
         if s & status::WATCHDOG != 0 {
-            assert!(vec3::norm(*f) < FALCON.max_force_n);
+            assert!(vec3::norm(*f) < FALCON.limits.max_force_n);
         }
     }
     assert!(dev.forces_within_limits && dev.replies > 0);

@@ -244,8 +244,8 @@ impl Session {
         let s = &self.stepper()?.haptic_loop().config().specs;
         let d = PyDict::new(py);
         d.set_item("name", s.name.as_ref())?;
-        d.set_item("max_force_n", s.max_force_n)?;
-        d.set_item("max_stiffness_n_per_m", s.max_stiffness_n_per_m)?;
+        d.set_item("max_force_n", s.limits.max_force_n)?;
+        d.set_item("max_stiffness_n_per_m", s.limits.max_stiffness_n_per_m)?;
         d.set_item("workspace_radius_m", s.workspace_radius_m)?;
         let b: Vec<&str> = s.button_names.iter().map(|b| b.as_ref()).collect();
         d.set_item("buttons", b)?;

@@ -242,7 +242,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         for r in got {
             rep.replies += 1;
             let mag = vec3::norm(r.force_n);
-            if !vec3::is_finite(r.force_n) || mag > specs.max_force_n {
+            if !vec3::is_finite(r.force_n) || mag > specs.limits.max_force_n {
                 rep.forces_within_limits = false;
             }
             rep.max_force_n = rep.max_force_n.max(mag);

@@ -161,8 +161,8 @@ impl Packet {
                 header(v, 1);
                 v.extend_from_slice(&rate_hz.to_le_bytes());
                 for x in [
-                    specs.max_force_n,
-                    specs.max_stiffness_n_per_m,
+                    specs.limits.max_force_n,
+                    specs.limits.max_stiffness_n_per_m,
                     specs.workspace_radius_m,
                 ] {
                     v.extend_from_slice(&x.to_le_bytes());
@@ -260,8 +260,10 @@ impl Packet {
                 r.end("hello")?;
                 let specs = DeviceSpecs {
                     name: Cow::Owned(name),
-                    max_force_n,
-                    max_stiffness_n_per_m,
+                    limits: world_form::Limits {
+                        max_force_n,
+                        max_stiffness_n_per_m,
+                    },
                     workspace_radius_m,
                     button_names: Cow::Owned(buttons),
                 };
@@ -452,7 +454,7 @@ mod tests {
         assert_eq!(e(&v), "unknown packet type 9");
         assert_eq!(e(b"GET / HT"), "bad magic [47, 45, 54, 20] (expected NHDB)");
         let mut bad = FALCON;
-        bad.max_force_n = f64::INFINITY;
+        bad.limits.max_force_n = f64::INFINITY;
         assert_eq!(
             e(&Packet::Hello {
                 rate_hz: 1000,

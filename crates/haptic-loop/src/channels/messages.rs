@@ -341,8 +341,8 @@ impl DescriptionMsg {
             state_fields: loaded.scene.state_fields(),
             start_time_ns,
             device_link: link.to_string(),
-            device_max_force_n: specs.max_force_n,
-            device_max_stiffness_n_per_m: specs.max_stiffness_n_per_m,
+            device_max_force_n: specs.limits.max_force_n,
+            device_max_stiffness_n_per_m: specs.limits.max_stiffness_n_per_m,
             device_workspace_radius_m: specs.workspace_radius_m,
             device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
         }
@@ -352,8 +352,10 @@ impl DescriptionMsg {
     pub fn device_specs(&self) -> crate::device::DeviceSpecs {
         crate::device::DeviceSpecs {
             name: self.device_model.clone().into(),
-            max_force_n: self.device_max_force_n,
-            max_stiffness_n_per_m: self.device_max_stiffness_n_per_m,
+            limits: world_form::Limits {
+                max_force_n: self.device_max_force_n,
+                max_stiffness_n_per_m: self.device_max_stiffness_n_per_m,
+            },
             workspace_radius_m: self.device_workspace_radius_m,
             button_names: self
                 .device_buttons

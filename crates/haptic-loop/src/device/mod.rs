@@ -26,10 +26,9 @@ use std::borrow::Cow;
 pub struct DeviceSpecs {
     /// Model name as written in scene files and recordings.
     pub name: Cow<'static, str>,
-    /// Largest force the device renders, N (the force vector is scaled down to this norm).
-    pub max_force_n: f64,
-    /// Largest stable stiffness at a 1 kHz servo rate, N/m.
-    pub max_stiffness_n_per_m: f64,
+    /// What the device renders: largest force, N (the force vector is scaled down to this
+    /// norm), and largest stable stiffness at a 1 kHz servo rate, N/m.
+    pub limits: Limits,
     /// Radius of the sphere, centred on the device origin, that the stylus can reach, m.
     pub workspace_radius_m: f64,
     /// Button names, bit `i` of [`Buttons`] is `button_names[i]` (at most 32).
@@ -50,8 +49,7 @@ pub enum DeviceModel {
 /// Novint Falcon specifications.
 pub const FALCON: DeviceSpecs = DeviceSpecs {
     name: Cow::Borrowed("falcon"),
-    max_force_n: Limits::FALCON.max_force_n,
-    max_stiffness_n_per_m: Limits::FALCON.max_stiffness_n_per_m,
+    limits: Limits::FALCON,
     workspace_radius_m: 0.04,
     button_names: Cow::Borrowed(&[
         Cow::Borrowed("centre"),
@@ -64,8 +62,7 @@ pub const FALCON: DeviceSpecs = DeviceSpecs {
 /// Touch / Omni class specifications (conservative end of the published ranges).
 pub const TOUCH: DeviceSpecs = DeviceSpecs {
     name: Cow::Borrowed("touch"),
-    max_force_n: Limits::TOUCH.max_force_n,
-    max_stiffness_n_per_m: Limits::TOUCH.max_stiffness_n_per_m,
+    limits: Limits::TOUCH,
     workspace_radius_m: 0.075,
     button_names: Cow::Borrowed(&[Cow::Borrowed("button1"), Cow::Borrowed("button2")]),
 };
@@ -98,15 +95,6 @@ impl DeviceModel {
 }
 
 impl DeviceSpecs {
-    /// What the device can render (largest force, N; largest stable stiffness, N/m), in the
-    /// device's own frame.
-    pub fn limits(&self) -> Limits {
-        Limits {
-            max_force_n: self.max_force_n,
-            max_stiffness_n_per_m: self.max_stiffness_n_per_m,
-        }
-    }
-
     /// Bit index of a named button, or an error naming the allowed buttons.
     pub fn button_index(&self, name: &str) -> Result<u32, DeviceError> {
         self.button_names
@@ -139,10 +127,10 @@ impl DeviceSpecs {
                 })
             }
         };
-        range("max_force_n", self.max_force_n, 0.0, 1e3)?;
+        range("max_force_n", self.limits.max_force_n, 0.0, 1e3)?;
         range(
             "max_stiffness_n_per_m",
-            self.max_stiffness_n_per_m,
+            self.limits.max_stiffness_n_per_m,
             0.0,
             1e6,
         )?;
@@ -354,8 +342,9 @@ mod tests {
     #[test]
     fn falcon_specs_match_the_issue() {
         let s = DeviceModel::Falcon.specs();
-        assert_eq!(s.max_force_n, 8.0);
-        assert_eq!(s.max_stiffness_n_per_m, 3000.0);
+        assert_eq!(s.limits, Limits::FALCON);
+        assert_eq!(s.limits.max_force_n, 8.0);
+        assert_eq!(s.limits.max_stiffness_n_per_m, 3000.0);
         assert_eq!(s.workspace_radius_m, 0.04);
         assert_eq!(s.button_index("centre"), Ok(0));
         assert_eq!(s.button_index("forward"), Ok(3));

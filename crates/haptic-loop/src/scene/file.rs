@@ -230,7 +230,7 @@ stiffness_n_per_m = 2000.0
         assert_eq!(s.config.display_every, 20);
         assert_eq!(s.config.specs.name, "falcon");
         let t = load_scene(WALL, Some(DeviceModel::Touch)).unwrap();
-        assert_eq!(t.config.specs.max_force_n, 3.3);
+        assert_eq!(t.config.specs.limits.max_force_n, 3.3);
     }
 
     #[test]

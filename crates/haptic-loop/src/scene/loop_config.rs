@@ -189,12 +189,13 @@ impl LoopConfig {
 
     /// The device's largest force expressed in the world, N (`max_force_n / force_scale`).
     pub fn world_max_force_n(&self) -> f64 {
-        self.specs.max_force_n / self.mapping.force_scale
+        self.specs.limits.max_force_n / self.mapping.force_scale
     }
 
     /// The largest world-frame stiffness that renders within the device's stiffness limit, N/m.
     pub fn world_stiffness_cap_n_per_m(&self) -> f64 {
-        self.specs.max_stiffness_n_per_m / (self.mapping.force_scale * self.mapping.workspace_scale)
+        self.specs.limits.max_stiffness_n_per_m
+            / (self.mapping.force_scale * self.mapping.workspace_scale)
     }
 
     /// The device's limits mapped to the world, the [`Limits`] every world is built with:
