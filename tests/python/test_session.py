@@ -25,16 +25,7 @@ def same(a, b, skip=TIMING):
             assert a[k] == b[k], k
 
 
-# RE-RECORD PENDING (issue 12, one unit spelling): recordings/brickworld.mcap was recorded with
-# the brick events' old field names (`velocity_m_s`, `speed_m_s`); a run now writes
-# `velocity_m_per_s` / `speed_m_per_s`, so its events differ (physics does not). The integrator
-# re-records it once after merging and then removes this mark.
-RERECORD = pytest.mark.xfail(strict=True, reason="brickworld.mcap awaits re-recording (issue 12 unit names)")
-
-
-@pytest.mark.parametrize(
-    "scene", ["wall", "nanoworld", pytest.param("brickworld", marks=RERECORD), "optical_tweezers"]
-)
+@pytest.mark.parametrize("scene", ["wall", "nanoworld", "brickworld", "optical_tweezers"])
 def test_golden_recordings_are_recomputed_bit_for_bit(scene):
     golden = nh.read_recording(RECORDINGS / f"{scene}.mcap")
     n = len(golden["tick"])

@@ -226,12 +226,6 @@ fn damaged_files_give_clear_errors() {
     );
 }
 
-/// RE-RECORD PENDING (issue 12, one unit spelling): goldens recorded before the rename, whose
-/// brick events say `speed_m_s` / `velocity_m_s` where a replay now writes `speed_m_per_s` /
-/// `velocity_m_per_s`. Physics is unchanged; only those event bytes differ. The integrator
-/// re-records them once after merging and then empties this list.
-const AWAITING_RERECORD: [&str; 1] = ["brickworld.mcap"];
-
 #[test]
 fn golden_recordings_replay_bit_exactly() {
     let dir = root().join("recordings");
@@ -241,16 +235,6 @@ fn golden_recordings_replay_bit_exactly() {
         if p.extension().is_some_and(|x| x == "mcap") {
             let rec = read_recording_file(&p, false).unwrap();
             let v = verify(&rec).unwrap();
-            let name = p.file_name().and_then(|s| s.to_str()).unwrap_or_default();
-            if AWAITING_RERECORD.contains(&name) {
-                // Until re-recorded: the first difference is in the events' unit names.
-                let d = v
-                    .divergence
-                    .as_ref()
-                    .expect("re-recorded: empty AWAITING_RERECORD");
-                assert_eq!(d.channel, "/events", "{name}: {d:?}");
-                continue;
-            }
             assert!(v.ok(), "{}: {:?}", p.display(), v.divergence);
             assert!(v.ticks > 0);
             let a = SessionArrays::from_recording(&rec).unwrap();
