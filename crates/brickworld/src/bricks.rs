@@ -371,7 +371,9 @@ impl BrickSet {
         }
         let dt = params.dt_s;
         for b in &mut self.bricks {
-            let Some(rb) = self.phys.bodies.get_mut(b.body) else {
+            // Read through `get`: `get_mut` would flag every brick as changed by the user, and
+            // rapier would re-process all of them (sleeping ones too) on every step.
+            let Some(rb) = self.phys.bodies.get(b.body) else {
                 continue;
             };
             if rb.is_sleeping() || rb.body_type() != RigidBodyType::Dynamic {
@@ -394,7 +396,9 @@ impl BrickSet {
             let r = (reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2]).sqrt();
             let change = (v - v0).length() + (w - w0).length() * r;
             if change >= SLEEP_MAX_ACCEL_M_PER_S2 * elapsed.max(dt) {
-                rb.wake_up(true);
+                if let Some(rb) = self.phys.bodies.get_mut(b.body) {
+                    rb.wake_up(true);
+                }
                 b.slow_since = Some((tick, v, w));
             }
         }

@@ -57,11 +57,13 @@ impl ImpactHook {
     /// above it. An off-centre load keeps every support point: its lever arms are physical.
     /// `phys` is the world before the step.
     pub fn for_step(phys: &PhysicsWorld) -> ImpactHook {
-        let body_of = |c: ColliderHandle| {
-            let h = phys.colliders.get(c)?.parent()?;
-            let rb = phys.bodies.get(h)?;
-            (rb.body_type() == RigidBodyType::Dynamic).then_some(h)
-        };
+        // Most steps of a resting or sleeping world have no fast support contact at all: find
+        // that out cheaply first (a contact between bodies that do not move cannot approach),
+        // and only then build the support links the impact would follow.
+        if !Self::any_fast_support(phys) {
+            return ImpactHook::default();
+        }
+        let body_of = |c: ColliderHandle| dynamic_body(phys, c);
         // Whether a load through `point` passes (within CENTRAL_LOAD_M) through the vertical of
         // the body's centre of mass: then it has no moment and a centroid support is exact.
         let central = |h: RigidBodyHandle, point: Vector| {
@@ -96,11 +98,7 @@ impl ImpactHook {
                     continue;
                 }
                 let n = m.data.normal;
-                let mut centroid = Vector::ZERO;
-                for p in &m.points {
-                    centroid += (c1.position() * p.local_p1 + c2.position() * p.local_p2) * 0.5;
-                }
-                centroid /= m.points.len() as f64;
+                let centroid = manifold_centroid(c1, c2, &m.points);
                 // Approach of the contact as a whole (at its centroid): a rocking body's corners
                 // approach while its centroid does not, and that is no impact.
                 let fast =
@@ -132,6 +130,74 @@ impl ImpactHook {
             }
         }
     }
+}
+
+impl ImpactHook {
+    /// Whether any support contact (within 45° of vertical) approaches faster than
+    /// [`IMPACT_MIN_SPEED_M_PER_S`] at its centroid: the seed test of [`ImpactHook::for_step`],
+    /// skipping contacts whose bodies are all at rest (zero linear and angular velocity, or not
+    /// dynamic: then the approach is exactly zero).
+    fn any_fast_support(phys: &PhysicsWorld) -> bool {
+        let moving = |h: Option<RigidBodyHandle>| {
+            h.and_then(|h| phys.bodies.get(h))
+                .is_some_and(|rb| rb.linvel() != Vector::ZERO || rb.angvel() != Vector::ZERO)
+        };
+        for pair in phys.narrow_phase.contact_pairs() {
+            let PairContacts::Rigid(rc) = &pair.contacts else {
+                continue;
+            };
+            let (b1, b2) = (
+                dynamic_body(phys, pair.collider1),
+                dynamic_body(phys, pair.collider2),
+            );
+            if !moving(b1) && !moving(b2) {
+                continue;
+            }
+            let (Some(c1), Some(c2)) = (
+                phys.colliders.get(pair.collider1),
+                phys.colliders.get(pair.collider2),
+            ) else {
+                continue;
+            };
+            let vel = |h: Option<RigidBodyHandle>, p: Vector| {
+                h.and_then(|h| phys.bodies.get(h))
+                    .map_or(Vector::ZERO, |rb| rb.velocity_at_point(p))
+            };
+            for m in &rc.manifolds {
+                if m.points.is_empty() || !is_support(m.data.normal) {
+                    continue;
+                }
+                let centroid = manifold_centroid(c1, c2, &m.points);
+                if (vel(b1, centroid) - vel(b2, centroid)).dot(m.data.normal)
+                    >= IMPACT_MIN_SPEED_M_PER_S
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// The dynamic body a collider is attached to (`None`: fixed, kinematic or unattached).
+fn dynamic_body(phys: &PhysicsWorld, c: ColliderHandle) -> Option<RigidBodyHandle> {
+    let h = phys.colliders.get(c)?.parent()?;
+    let rb = phys.bodies.get(h)?;
+    (rb.body_type() == RigidBodyType::Dynamic).then_some(h)
+}
+
+/// Centroid of a manifold's points, world frame, m (each point the midpoint of its two
+/// colliders' witness points).
+fn manifold_centroid(
+    c1: &rapier3d_f64::prelude::Collider,
+    c2: &rapier3d_f64::prelude::Collider,
+    points: &[rapier3d_f64::prelude::TrackedContact<rapier3d_f64::prelude::ContactData>],
+) -> Vector {
+    let mut centroid = Vector::ZERO;
+    for p in points {
+        centroid += (c1.position() * p.local_p1 + c2.position() * p.local_p2) * 0.5;
+    }
+    centroid / points.len() as f64
 }
 
 impl PhysicsHooks for ImpactHook {

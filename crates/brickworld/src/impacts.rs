@@ -91,17 +91,11 @@ impl ImpactTracker {
                 continue;
             };
             let mut impulse = 0.0;
-            let mut centroid = Vector::ZERO;
             let mut points = 0usize;
-            let mut normal = Vector::ZERO;
             for m in &rc.manifolds {
                 for p in &m.points {
                     impulse += p.data.impulse;
-                    centroid += (c1.position() * p.local_p1 + c2.position() * p.local_p2) * 0.5;
                     points += 1;
-                }
-                if !m.points.is_empty() {
-                    normal = m.data.normal;
                 }
             }
             if impulse <= 0.0 || points == 0 {
@@ -110,7 +104,19 @@ impl ImpactTracker {
             let k = key(pair.collider1, pair.collider2);
             self.cur.push(k);
             if self.prev.binary_search(&k).is_ok() {
+                // A contact that carried impulse last step too (resting, sliding, asleep):
+                // no impact, and no need for its geometry.
                 continue;
+            }
+            let mut centroid = Vector::ZERO;
+            let mut normal = Vector::ZERO;
+            for m in &rc.manifolds {
+                for p in &m.points {
+                    centroid += (c1.position() * p.local_p1 + c2.position() * p.local_p2) * 0.5;
+                }
+                if !m.points.is_empty() {
+                    normal = m.data.normal;
+                }
             }
             let centroid = centroid / points as f64;
             // The normal points from body 1 toward body 2: approaching when (v1 − v2)·n > 0.
