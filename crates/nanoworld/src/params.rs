@@ -7,7 +7,7 @@
 //! not. The largest force and stiffness the device renders are not parameters: they are the
 //! device's [`Limits`], handed to [`crate::World::new`] ([`Params::validate_for_device`]).
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use world_form::Limits;
 
 use crate::error::ParamError;
@@ -35,7 +35,7 @@ pub const PHYSICAL_FALCON_LIMITS: Limits = Limits {
 };
 
 /// All parameters of a nano world.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "ParamsTable")]
 pub struct Params {
     /// The fixed (teal) substrate layer.
@@ -123,7 +123,7 @@ impl TryFrom<ParamsTable> for Params {
 
 /// A square lattice of fixed substrate atoms with centres at z = 0,
 /// at (i·spacing, j·spacing) for 0 ≤ i < nx, 0 ≤ j < ny.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SubstrateParams {
     /// Atoms along x. Range [1, 4·10⁶], nx·ny ≤ 4·10⁶.
@@ -137,7 +137,7 @@ pub struct SubstrateParams {
 }
 
 /// The AFM tip apex, a sphere.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TipParams {
     /// Apex radius (m). Range (0, 1e-6].
@@ -145,7 +145,7 @@ pub struct TipParams {
 }
 
 /// The movable atoms (in physical mode: nanoparticles), spheres.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AtomParams {
     /// Radius (m). Range (0, 1e-6].
@@ -158,7 +158,7 @@ pub struct AtomParams {
 
 /// Axis-aligned rectangle in the substrate plane; while the tip is above it and no
 /// uncarried atom lies in it, one atom appears resting at `spawn_xy_m`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadingZone {
     /// Lower corner (x, y) (m).
@@ -170,7 +170,7 @@ pub struct LoadingZone {
 }
 
 /// The house blueprint: slots that must each hold an uncarried movable atom.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HouseParams {
     /// Slot centres (m).
@@ -180,7 +180,7 @@ pub struct HouseParams {
 }
 
 /// Which force laws the world uses.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
 pub enum Interaction {
     /// The teaching game's laws: F = A/z² inside an activation gap, snap inside a snap gap,
@@ -192,7 +192,7 @@ pub enum Interaction {
 }
 
 /// One value per pair of body types.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Pairs<T> {
     /// Tip ↔ substrate atom (physical mode: tip ↔ substrate plane).
@@ -206,7 +206,7 @@ pub struct Pairs<T> {
 }
 
 /// Game-mode parameters.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GameParams {
     /// Pull-off force over snap force (the paper: 10). Range [1, 1000].
@@ -216,7 +216,7 @@ pub struct GameParams {
 }
 
 /// Game-mode law of one pair type. Surface gap z = centre distance − radii.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GamePair {
     /// A in F = A·(1/z² − 1/w²) (N·m²); 0 switches the pair off. Range [0, 1e-20].
@@ -232,7 +232,7 @@ pub struct GamePair {
 }
 
 /// Physical-mode parameters (real constants).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PhysicalParams {
     /// Hamaker constant per pair (J); 0 switches the pair off. Range [0, 1e-17].

@@ -250,3 +250,16 @@ fn mass_is_felt_only_through_weight_and_inertia() {
         "{dw:e} vs {expect:e}"
     );
 }
+
+/// Params are serde both ways (the world form): both presets written as TOML read back to the
+/// same bits, and the written text uses the one unit spelling.
+#[test]
+fn params_round_trip_through_toml() {
+    for p in [Params::game_default(), Params::physical_default()] {
+        let text = toml::to_string(&p).expect("serializes");
+        assert!(text.contains("gravity_m_per_s2"), "{text}");
+        assert!(!text.contains("max_force_n"), "{text}");
+        let back: Params = toml::from_str(&text).expect("reads back");
+        assert_eq!(back, p);
+    }
+}
