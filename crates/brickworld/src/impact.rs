@@ -63,7 +63,6 @@ impl ImpactHook {
         if !Self::any_fast_support(phys) {
             return ImpactHook::default();
         }
-        let body_of = |c: ColliderHandle| dynamic_body(phys, c);
         // Whether a load through `point` passes (within CENTRAL_LOAD_M) through the vertical of
         // the body's centre of mass: then it has no moment and a centroid support is exact.
         let central = |h: RigidBodyHandle, point: Vector| {
@@ -75,47 +74,20 @@ impl ImpactHook {
         let mut seeds: Vec<RigidBodyHandle> = Vec::new();
         // Supports between two bodies: (body, other, contact centroid), either way round.
         let mut links: Vec<(RigidBodyHandle, RigidBodyHandle, Vector)> = Vec::new();
-        for pair in phys.narrow_phase.contact_pairs() {
-            let PairContacts::Rigid(rc) = &pair.contacts else {
-                continue;
-            };
-            let (b1, b2) = (body_of(pair.collider1), body_of(pair.collider2));
-            let (Some(c1), Some(c2)) = (
-                phys.colliders.get(pair.collider1),
-                phys.colliders.get(pair.collider2),
-            ) else {
-                continue;
-            };
-            if b1.is_none() && b2.is_none() {
-                continue;
-            }
-            let vel = |h: Option<RigidBodyHandle>, p: Vector| {
-                h.and_then(|h| phys.bodies.get(h))
-                    .map_or(Vector::ZERO, |rb| rb.velocity_at_point(p))
-            };
-            for m in &rc.manifolds {
-                if m.points.is_empty() || !is_support(m.data.normal) {
-                    continue;
-                }
-                let n = m.data.normal;
-                let centroid = manifold_centroid(c1, c2, &m.points);
-                // Approach of the contact as a whole (at its centroid): a rocking body's corners
-                // approach while its centroid does not, and that is no impact.
-                let fast =
-                    (vel(b1, centroid) - vel(b2, centroid)).dot(n) >= IMPACT_MIN_SPEED_M_PER_S;
-                if fast {
-                    for h in [b1, b2].into_iter().flatten() {
-                        if central(h, centroid) && !seeds.contains(&h) {
-                            seeds.push(h);
-                        }
+        for_each_support(phys, false, |s| {
+            if s.approach_m_per_s >= IMPACT_MIN_SPEED_M_PER_S {
+                for h in [s.body1, s.body2].into_iter().flatten() {
+                    if central(h, s.centroid) && !seeds.contains(&h) {
+                        seeds.push(h);
                     }
                 }
-                if let (Some(a), Some(b)) = (b1, b2) {
-                    links.push((a, b, centroid));
-                    links.push((b, a, centroid));
-                }
             }
-        }
+            if let (Some(a), Some(b)) = (s.body1, s.body2) {
+                links.push((a, b, s.centroid));
+                links.push((b, a, s.centroid));
+            }
+            true
+        });
         // Follow central supports through the stack.
         loop {
             let mut grew = false;
@@ -133,49 +105,76 @@ impl ImpactHook {
 }
 
 impl ImpactHook {
-    /// Whether any support contact (within 45° of vertical) approaches faster than
-    /// [`IMPACT_MIN_SPEED_M_PER_S`] at its centroid: the seed test of [`ImpactHook::for_step`],
-    /// skipping contacts whose bodies are all at rest (zero linear and angular velocity, or not
-    /// dynamic: then the approach is exactly zero).
+    /// Whether any support contact approaches faster than [`IMPACT_MIN_SPEED_M_PER_S`] at its
+    /// centroid: the seed test of [`ImpactHook::for_step`], skipping contacts whose bodies are
+    /// all at rest (then the approach is exactly zero).
     fn any_fast_support(phys: &PhysicsWorld) -> bool {
-        let moving = |h: Option<RigidBodyHandle>| {
-            h.and_then(|h| phys.bodies.get(h))
-                .is_some_and(|rb| rb.linvel() != Vector::ZERO || rb.angvel() != Vector::ZERO)
+        let mut fast = false;
+        for_each_support(phys, true, |s| {
+            fast = s.approach_m_per_s >= IMPACT_MIN_SPEED_M_PER_S;
+            !fast
+        });
+        fast
+    }
+}
+
+/// One support manifold (normal within 45° of vertical) of a contact with a dynamic body.
+struct Support {
+    /// The dynamic bodies on either side (`None`: fixed or kinematic).
+    body1: Option<RigidBodyHandle>,
+    body2: Option<RigidBodyHandle>,
+    /// Centroid of the manifold's points, world frame, m.
+    centroid: Vector,
+    /// Approach of the contact as a whole at its centroid, along the normal from body 1 to
+    /// body 2, m/s (a rocking body's corners approach while its centroid does not, and that is
+    /// no impact).
+    approach_m_per_s: f64,
+}
+
+/// Calls `f` on every support manifold of the contacts before the step, in the narrow phase's
+/// order, until `f` returns false. With `skip_still`, contacts whose bodies have zero linear
+/// and angular velocity (or are not dynamic) are skipped: their approach is exactly zero.
+fn for_each_support(phys: &PhysicsWorld, skip_still: bool, mut f: impl FnMut(Support) -> bool) {
+    let moving = |h: Option<RigidBodyHandle>| {
+        h.and_then(|h| phys.bodies.get(h))
+            .is_some_and(|rb| rb.linvel() != Vector::ZERO || rb.angvel() != Vector::ZERO)
+    };
+    let vel = |h: Option<RigidBodyHandle>, p: Vector| {
+        h.and_then(|h| phys.bodies.get(h))
+            .map_or(Vector::ZERO, |rb| rb.velocity_at_point(p))
+    };
+    for pair in phys.narrow_phase.contact_pairs() {
+        let PairContacts::Rigid(rc) = &pair.contacts else {
+            continue;
         };
-        for pair in phys.narrow_phase.contact_pairs() {
-            let PairContacts::Rigid(rc) = &pair.contacts else {
-                continue;
-            };
-            let (b1, b2) = (
-                dynamic_body(phys, pair.collider1),
-                dynamic_body(phys, pair.collider2),
-            );
-            if !moving(b1) && !moving(b2) {
+        let (b1, b2) = (
+            dynamic_body(phys, pair.collider1),
+            dynamic_body(phys, pair.collider2),
+        );
+        if b1.is_none() && b2.is_none() || skip_still && !moving(b1) && !moving(b2) {
+            continue;
+        }
+        let (Some(c1), Some(c2)) = (
+            phys.colliders.get(pair.collider1),
+            phys.colliders.get(pair.collider2),
+        ) else {
+            continue;
+        };
+        for m in &rc.manifolds {
+            if m.points.is_empty() || !is_support(m.data.normal) {
                 continue;
             }
-            let (Some(c1), Some(c2)) = (
-                phys.colliders.get(pair.collider1),
-                phys.colliders.get(pair.collider2),
-            ) else {
-                continue;
-            };
-            let vel = |h: Option<RigidBodyHandle>, p: Vector| {
-                h.and_then(|h| phys.bodies.get(h))
-                    .map_or(Vector::ZERO, |rb| rb.velocity_at_point(p))
-            };
-            for m in &rc.manifolds {
-                if m.points.is_empty() || !is_support(m.data.normal) {
-                    continue;
-                }
-                let centroid = manifold_centroid(c1, c2, &m.points);
-                if (vel(b1, centroid) - vel(b2, centroid)).dot(m.data.normal)
-                    >= IMPACT_MIN_SPEED_M_PER_S
-                {
-                    return true;
-                }
+            let centroid = manifold_centroid(c1, c2, &m.points);
+            let approach_m_per_s = (vel(b1, centroid) - vel(b2, centroid)).dot(m.data.normal);
+            if !f(Support {
+                body1: b1,
+                body2: b2,
+                centroid,
+                approach_m_per_s,
+            }) {
+                return;
             }
         }
-        false
     }
 }
 
