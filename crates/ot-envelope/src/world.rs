@@ -607,22 +607,22 @@ mod tests {
         Limits::FALCON.in_world(1e6, 1e-3)
     }
 
+    /// The error text of building a world from `p` with the Falcon's limits in the OT scene.
+    fn refused(p: Params) -> String {
+        World::new(&p, &limits()).err().unwrap().to_string()
+    }
+
     #[test]
     fn the_paper_period_and_step_bound() {
         let p = Params::paper();
         // 2π·√(1e-15 kg · (300 nm)² / (4e-15 J)) = 0.942 µs
         assert!((p.small_oscillation_period_s() - 0.942_477_796e-6).abs() < 1e-15);
-        let e = World::new(
-            &Params {
-                dt_s: 5e-6,
-                ..Params::paper()
-            },
-            &limits(),
-        )
-        .err()
-        .unwrap();
+        let e = refused(Params {
+            dt_s: 5e-6,
+            ..Params::paper()
+        });
         assert_eq!(
-            e.to_string(),
+            e,
             "`dt_s` = 0.000005 is out of range (allowed: 0 < dt_s ≤ 1.885e-6 s, two periods of \
              the particle's small oscillation)"
         );
@@ -630,30 +630,20 @@ mod tests {
 
     #[test]
     fn a_spring_stiffer_than_the_device_is_refused() {
-        let e = World::new(
-            &Params {
-                stiffness_n_per_m: 5.0,
-                ..Params::paper()
-            },
-            &limits(),
-        )
-        .err()
-        .unwrap();
+        let e = refused(Params {
+            stiffness_n_per_m: 5.0,
+            ..Params::paper()
+        });
         assert_eq!(
-            e.to_string(),
+            e,
             "`stiffness_n_per_m` = 5 is out of range (allowed: 0 < stiffness_n_per_m ≤ 3)"
         );
-        let e = World::new(
-            &Params {
-                depth_j: f64::NAN,
-                ..Params::paper()
-            },
-            &limits(),
-        )
-        .err()
-        .unwrap();
+        let e = refused(Params {
+            depth_j: f64::NAN,
+            ..Params::paper()
+        });
         assert_eq!(
-            e.to_string(),
+            e,
             "`depth_j` = NaN is out of range (allowed: 0 < depth_j ≤ 0.000001)"
         );
     }
