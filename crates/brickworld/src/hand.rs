@@ -8,11 +8,11 @@ use rapier3d_f64::prelude::{QueryFilter, RigidBodyHandle, RigidBodyType};
 use world_form::Limits;
 
 use crate::bricks::BrickSet;
-use crate::estimator::MotionEstimator;
+use crate::estimator::{AdaptiveWindow, MotionEstimator};
 use crate::event::{Axis, Body, BrickId, Event, Touch};
 use crate::impact::IMPACT_MIN_SPEED_M_PER_S;
 use crate::input::{CursorInput, Grip};
-use crate::params::{AccelEstimator, Params};
+use crate::params::{AccelEstimator, Inertia, Params};
 use crate::proxy::{self, HeldShape};
 
 /// Range of [`crate::World::nearest_m`], m: farther solids count as none.
@@ -26,6 +26,9 @@ struct Held {
     offset: Vector,
     /// Brick orientation.
     rotation: Rotation,
+    /// Whether the brick is a dynamic body joined by the virtual coupling (else it is carried
+    /// kinematically, the paper's way).
+    coupled: bool,
 }
 
 /// The force one step of the hand sends to the device, and its parts (N, world frame).
@@ -39,8 +42,11 @@ pub(crate) struct Felt {
     pub spring: Vector,
     /// Weight of the carried brick, N.
     pub weight: Vector,
-    /// Inertial force of the carried brick, N.
+    /// Inertial force of the carried brick (the paper's `−M a`), N.
     pub inertia: Vector,
+    /// The virtual coupling's pull on the hand (the reaction of its pull on the brick), N,
+    /// before the scale-down.
+    pub coupling: Vector,
     /// Grip-point acceleration estimate, m/s².
     pub acceleration: Vector,
     /// Deepest penetration found before the proxy was pushed out, m.
@@ -57,6 +63,10 @@ pub(crate) struct Hand {
     grip: Grip,
     /// Velocity and acceleration of the grip point from the proxy's history.
     motion: MotionEstimator,
+    /// Velocity of the grip point for the coupling's damper (adaptive window).
+    grip_velocity: AdaptiveWindow,
+    /// The coupling damper's filtered relative velocity (grip point minus brick), m/s.
+    damper: Vector,
     held: Option<Held>,
     /// What the cursor (or carried brick) touches, sorted.
     touching: Vec<Touch>,
@@ -75,6 +85,12 @@ impl Hand {
             cursor: top,
             grip: Grip::default(),
             motion: MotionEstimator::new(params.dt_s, params.accel_estimator),
+            grip_velocity: AdaptiveWindow::new(
+                params.dt_s,
+                params.coupling.velocity_band_m,
+                params.coupling.velocity_max_window,
+            ),
+            damper: Vector::ZERO,
             held: None,
             touching: Vec::new(),
             proxy_speed: 0.0,
@@ -150,9 +166,9 @@ impl Hand {
             }
         }
 
-        // 2. God-object update.
+        // 2. God-object update (a coupled brick is a body of its own, not part of the proxy).
         let ball = Ball::new(params.proxy_radius_m);
-        let held_shape = self.held_shape(params);
+        let held_shape = self.held.filter(|h| !h.coupled).and(self.held_shape(params));
         let exclude = self.held.map(|h| bricks.collider(h.brick));
         let upd = {
             let mut filter = QueryFilter::default();
@@ -170,7 +186,8 @@ impl Hand {
             self.motion.reset(self.proxy.to_array());
         }
         self.motion.push(self.proxy.to_array());
-        if let Some(h) = self.held {
+        self.grip_velocity.push(self.proxy.to_array());
+        if let Some(h) = self.held.filter(|h| !h.coupled) {
             let body = bricks.body(h.brick);
             if let Some(rb) = bricks.phys.bodies.get_mut(body) {
                 rb.set_next_kinematic_position(Pose::from_parts(self.proxy + h.offset, h.rotation));
@@ -184,18 +201,24 @@ impl Hand {
         let spring = (self.proxy - c) * params.proxy_stiffness_n_per_m;
         let m = params.brick_mass_kg;
         let accel = Vector::from_array(self.motion.acceleration());
-        let (weight, inertia) = if self.held.is_some() {
-            let w = Vector::new(0.0, 0.0, -m * params.gravity_m_per_s2);
-            let i = if params.inertia {
-                -accel * m
-            } else {
-                Vector::ZERO
-            };
-            (w, i)
-        } else {
-            (Vector::ZERO, Vector::ZERO)
+        let (weight, inertia, coupling) = match self.held {
+            Some(h) if h.coupled => {
+                let (pull, d) = self.coupling_pull(&h, params, limits, bricks);
+                self.damper = d;
+                (Vector::ZERO, Vector::ZERO, -pull)
+            }
+            Some(_) => {
+                let w = Vector::new(0.0, 0.0, -m * params.gravity_m_per_s2);
+                let i = if params.inertia == Inertia::Paper {
+                    -accel * m
+                } else {
+                    Vector::ZERO
+                };
+                (w, i, Vector::ZERO)
+            }
+            None => (Vector::ZERO, Vector::ZERO, Vector::ZERO),
         };
-        let total = spring + weight + inertia;
+        let total = spring + weight + inertia + coupling;
         let mag = total.length();
         let scale = if mag > limits.max_force_n {
             limits.max_force_n / mag
@@ -204,6 +227,13 @@ impl Hand {
         };
         let (force, saturated) = (total * scale, scale < 1.0);
         let felt_spring = spring * scale;
+        if let Some(h) = self.held.filter(|h| h.coupled) {
+            // The brick gets exactly the reaction of what the hand feels of the coupling: the
+            // same force both ways, the scale-down included.
+            if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
+                rb.apply_impulse(-coupling * (scale * params.dt_s), true);
+            }
+        }
 
         // 4. Touch bookkeeping and the hand's push on dynamic bricks.
         let mut touching: Vec<Touch> = upd
@@ -262,6 +292,7 @@ impl Hand {
             spring,
             weight,
             inertia,
+            coupling,
             acceleration: accel,
             penetration_m: upd.penetration_before_m,
         }
@@ -281,6 +312,99 @@ impl Hand {
             Some((_, proj)) => ((proj.point - self.proxy).length() - r).max(0.0),
             None => f64::INFINITY,
         }
+    }
+
+    /// Stiffness of the coupling spring, N/m (world units): a fraction of the device's
+    /// largest stable stiffness.
+    pub(crate) fn coupling_stiffness(params: &Params, limits: &Limits) -> f64 {
+        params.coupling.stiffness_fraction * limits.max_stiffness_n_per_m
+    }
+
+    /// Stiffness of the carried brick's coupling felt this tick, N/m (0 when nothing is
+    /// carried through it).
+    pub(crate) fn felt_coupling_stiffness(&self, params: &Params, limits: &Limits) -> f64 {
+        if self.held.is_some_and(|h| h.coupled) {
+            Self::coupling_stiffness(params, limits)
+        } else {
+            0.0
+        }
+    }
+
+    /// The coupling's pull on the brick this tick, N, and the new state of its damper.
+    ///
+    /// A spring `k` from the grip point (`proxy + offset`) to the brick's centre, in parallel
+    /// with a damper `b = 2 ζ √(k M)` that acts through a series spring `k_s = k_max − k`
+    /// (a Maxwell element): at low frequency it damps the brick in the hand, and a sudden change
+    /// of relative velocity `Δv` (the brick set down, a step of the hand) makes its force rise at
+    /// `k_s Δv` per second, never as a jump. The whole coupling is then never stiffer than the
+    /// device's `k_max`. The damper's filtered relative velocity `d` follows
+    /// `τ ḋ = v_rel − d`, `τ = b / k_s`, by backward Euler; the relative velocity uses the
+    /// adaptive-window estimate of the grip point's velocity. The force is explicit in the
+    /// positions, `F = k (x_t − x) + b d`, so its change per tick is at most
+    /// `(k |v_rel| + k_s |Δv_rel|) h ≤ k_max v h`; rapier's symplectic Euler keeps the spring
+    /// stable while `k h² / M < 4`, and `k` is capped at `M / h²` (a 1 g brick at 1 kHz: 1000
+    /// N/m) so it always is.
+    fn coupling_pull(
+        &self,
+        h: &Held,
+        params: &Params,
+        limits: &Limits,
+        bricks: &BrickSet,
+    ) -> (Vector, Vector) {
+        let Some(rb) = bricks.phys.bodies.get(bricks.body(h.brick)) else {
+            return (Vector::ZERO, Vector::ZERO);
+        };
+        let m = rb.mass();
+        if m.is_nan() || m <= 0.0 {
+            return (Vector::ZERO, Vector::ZERO);
+        }
+        let k = Self::coupling_stiffness(params, limits);
+        let k_series = limits.max_stiffness_n_per_m - k;
+        let b = 2.0 * params.coupling.damping_ratio * (k * m).sqrt();
+        let dt = params.dt_s;
+        let x = rb.translation();
+        let v = rb.linvel();
+        let target = self.proxy + h.offset;
+        let v_rel = Vector::from_array(self.grip_velocity.velocity()) - v;
+        let d = if b > 0.0 && k_series > 0.0 {
+            let r = dt * k_series / b;
+            (self.damper + v_rel * r) / (1.0 + r)
+        } else {
+            Vector::ZERO
+        };
+        let k_eff = k.min(m / (dt * dt));
+        ((target - x) * k_eff + d * b, d)
+    }
+
+    /// Applies a change of the `inertia` switch to a carried brick: it becomes a coupled body
+    /// or a kinematically carried one, where it is.
+    pub(crate) fn set_inertia(&mut self, mode: Inertia, bricks: &mut BrickSet) {
+        let Some(h) = self.held else {
+            return;
+        };
+        let coupled = mode == Inertia::Coupling;
+        if coupled == h.coupled {
+            return;
+        }
+        if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
+            if coupled {
+                rb.set_body_type(RigidBodyType::Dynamic, true);
+                rb.lock_rotations(true, true);
+                rb.set_linvel(Vector::ZERO, true);
+                rb.set_angvel(Vector::ZERO, true);
+            } else {
+                rb.lock_rotations(false, true);
+                rb.set_body_type(RigidBodyType::KinematicPositionBased, true);
+            }
+            let offset = rb.translation() - self.proxy;
+            self.held = Some(Held {
+                offset,
+                coupled,
+                ..h
+            });
+        }
+        self.grip_velocity.reset(self.proxy.to_array());
+        self.damper = Vector::ZERO;
     }
 
     fn held_shape(&self, params: &Params) -> Option<HeldShape> {
@@ -318,16 +442,26 @@ impl Hand {
             return;
         };
         bricks.wake_neighbours(bricks.collider(id));
+        let coupled = params.inertia == Inertia::Coupling;
         if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(id)) {
             let pos = *rb.position();
-            rb.set_body_type(RigidBodyType::KinematicPositionBased, true);
-            rb.set_linvel(Vector::ZERO, true);
-            rb.set_angvel(Vector::ZERO, true);
+            if coupled {
+                // A dynamic body that keeps its orientation in the hand; the coupling holds it.
+                rb.lock_rotations(true, true);
+                rb.set_angvel(Vector::ZERO, true);
+            } else {
+                rb.set_body_type(RigidBodyType::KinematicPositionBased, true);
+                rb.set_linvel(Vector::ZERO, true);
+                rb.set_angvel(Vector::ZERO, true);
+            }
             self.held = Some(Held {
                 brick: id,
                 offset: pos.translation - self.proxy,
                 rotation: pos.rotation,
+                coupled,
             });
+            self.grip_velocity.reset(self.proxy.to_array());
+            self.damper = Vector::ZERO;
             events.push(Event::Grabbed { brick: id });
         }
     }
@@ -338,11 +472,17 @@ impl Hand {
         let Some(h) = self.held.take() else {
             return;
         };
-        let v = Vector::from_array(self.motion.velocity());
+        let mut v = Vector::from_array(self.motion.velocity());
         if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
-            rb.set_body_type(RigidBodyType::Dynamic, true);
-            rb.set_linvel(v, true);
-            rb.set_angvel(Vector::ZERO, true);
+            if h.coupled {
+                // A coupled brick leaves the hand with its own velocity: nothing to estimate.
+                rb.lock_rotations(false, true);
+                v = rb.linvel();
+            } else {
+                rb.set_body_type(RigidBodyType::Dynamic, true);
+                rb.set_linvel(v, true);
+                rb.set_angvel(Vector::ZERO, true);
+            }
         }
         bricks.wake_neighbours(bricks.collider(h.brick));
         events.push(Event::Released {
@@ -399,9 +539,9 @@ impl Hand {
             rb.set_position(pose, true);
         }
         self.held = Some(Held {
-            brick: h.brick,
             offset,
             rotation,
+            ..h
         });
         events.push(Event::Rotated {
             brick: h.brick,

@@ -56,12 +56,12 @@ pub use bricks::{
     BoxView, BrickView, GROUND_HALF_EXTENT_M, SLEEP_MAX_ACCEL_M_PER_S2, SLEEP_SPEED_M_PER_S,
 };
 pub use error::{InputError, ParamError, WorldError};
-pub use estimator::MotionEstimator;
+pub use estimator::{AdaptiveWindow, MotionEstimator};
 pub use event::{Axis, Body, BrickId, Event, Touch};
 pub use hand::NEAREST_MAX_M;
 pub use input::{CursorInput, Grip};
 pub use params::{
-    AccelEstimator, Blueprint, BrickPlacement, BrickProps, LoadingZone, Obstacle, Params,
-    ParamsFromTomlError,
+    AccelEstimator, Blueprint, BrickPlacement, BrickProps, Coupling, Inertia, LoadingZone,
+    Obstacle, Params, ParamsFromTomlError,
 };
 pub use world::{StepReport, World};

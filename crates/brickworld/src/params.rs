@@ -26,9 +26,15 @@ pub struct Params {
     pub restitution: f64,
     /// Coulomb friction coefficient of every contact (0 = frictionless). Range `[0, 10]`.
     pub friction: f64,
-    /// Whether the inertial force `-M a` of a held brick is sent to the device.
-    pub inertia: bool,
-    /// How the cursor acceleration for the inertial force is estimated.
+    /// How the carried brick's inertia reaches the hand: `"coupling"` (the default: the brick
+    /// is a rigid body joined to the hand by a spring-damper the device can hold, so weight,
+    /// inertia and contacts arrive through it), `"paper"` (the paper's `F = −M a` from a
+    /// stencil of sampled positions; unstable on a real device, see `docs/brickworld.md`) or
+    /// `"off"` (weight only). `true` / `false` are read as `"coupling"` / `"off"`.
+    pub inertia: Inertia,
+    /// The virtual coupling of a carried brick (used when `inertia = "coupling"`).
+    pub coupling: Coupling,
+    /// How the cursor acceleration for the paper's inertial force is estimated.
     pub accel_estimator: AccelEstimator,
     /// Mass of one brick in kg. Range `[1e-3, 100]`.
     pub brick_mass_kg: f64,
@@ -74,7 +80,8 @@ impl Default for Params {
             gravity_m_per_s2: 9.81,
             restitution: 0.2,
             friction: 0.6,
-            inertia: true,
+            inertia: Inertia::Coupling,
+            coupling: Coupling::default(),
             accel_estimator: AccelEstimator::Paper,
             brick_mass_kg: 0.5,
             brick_half_extents_m: [0.1, 0.05, 0.03],
@@ -91,6 +98,91 @@ impl Default for Params {
             blueprint: Blueprint::default(),
             bricks: Vec::new(),
             obstacles: Vec::new(),
+        }
+    }
+}
+
+/// How the carried brick's inertia reaches the hand (the `inertia` switch: 0 is `Off`, 1 the
+/// scene's chosen method).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Inertia {
+    /// Weight only: the brick is carried rigidly (kinematic) and no inertial force is felt.
+    Off,
+    /// The paper's method: the brick is carried rigidly and `F = −M a` is computed from the
+    /// grip point's sampled positions ([`Params::accel_estimator`]). Displays `M` times the
+    /// mapping's force and workspace scales at the device; unstable there above a fraction of
+    /// the device's own mass (measured in `docs/brickworld.md`).
+    Paper,
+    /// Virtual coupling (Colgate 1995): the brick is a rigid body joined to the hand by a
+    /// spring-damper no stiffer than the device allows; weight, inertia and contacts are felt
+    /// through it alone.
+    Coupling,
+}
+
+impl Inertia {
+    /// The name as written in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Inertia::Off => "off",
+            Inertia::Paper => "paper",
+            Inertia::Coupling => "coupling",
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Inertia {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = Inertia;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"coupling\", \"paper\", \"off\", true or false")
+            }
+            fn visit_bool<E: serde::de::Error>(self, v: bool) -> Result<Inertia, E> {
+                Ok(if v { Inertia::Coupling } else { Inertia::Off })
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Inertia, E> {
+                match v {
+                    "coupling" => Ok(Inertia::Coupling),
+                    "paper" => Ok(Inertia::Paper),
+                    "off" => Ok(Inertia::Off),
+                    other => Err(E::invalid_value(serde::de::Unexpected::Str(other), &self)),
+                }
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// The virtual coupling that carries a brick (`[coupling]`): a spring-damper between the
+/// hand's grip point and the brick, integrated implicitly with the brick's mass, so it is
+/// stable for any brick mass and no contact reaches the hand stiffer than the spring.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Coupling {
+    /// Spring stiffness as a fraction of the device's largest stable stiffness (in world units,
+    /// [`Limits::max_stiffness_n_per_m`]). Range `(0, 1]`.
+    pub stiffness_fraction: f64,
+    /// Damping ratio of the coupling with the carried brick's mass, `b = 2 ζ √(k M)`; the
+    /// damper acts through a series spring of the stiffness left to the device
+    /// (`k_max − k`), so its force never jumps. Range `[0, 2]`.
+    pub damping_ratio: f64,
+    /// Band of the adaptive-window velocity the damper uses, m: one encoder count mapped to the
+    /// world (0 for exact positions). Range `[0, 0.1]`.
+    pub velocity_band_m: f64,
+    /// Longest window of that velocity estimate, ticks. Range `[1, 200]`.
+    pub velocity_max_window: usize,
+}
+
+impl Default for Coupling {
+    fn default() -> Self {
+        Coupling {
+            stiffness_fraction: 0.5,
+            damping_ratio: 0.5,
+            // One Falcon count (0.0635 mm) at the default ×20 mapping.
+            velocity_band_m: 0.001_27,
+            velocity_max_window: 40,
         }
     }
 }
@@ -281,6 +373,21 @@ impl Params {
         )?;
         range("restitution", self.restitution, Lo::Closed(0.0), 1.0)?;
         range("friction", self.friction, Lo::Closed(0.0), 10.0)?;
+        let c = &self.coupling;
+        range(
+            "coupling.stiffness_fraction",
+            c.stiffness_fraction,
+            Lo::Open(0.0),
+            1.0,
+        )?;
+        range("coupling.damping_ratio", c.damping_ratio, Lo::Closed(0.0), 2.0)?;
+        range(
+            "coupling.velocity_band_m",
+            c.velocity_band_m,
+            Lo::Closed(0.0),
+            0.1,
+        )?;
+        count("coupling.velocity_max_window", c.velocity_max_window, 1, 200)?;
         if let AccelEstimator::SavitzkyGolay { window } = self.accel_estimator {
             count("accel_estimator.savitzky_golay.window", window, 5, 201)?;
         }

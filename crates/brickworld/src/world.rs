@@ -14,7 +14,7 @@ use crate::hand::Hand;
 use crate::impact::ImpactHook;
 use crate::impacts::ImpactTracker;
 use crate::input::{CursorInput, Grip};
-use crate::params::{AccelEstimator, BrickPlacement, BrickProps, Lo, Params, range};
+use crate::params::{AccelEstimator, BrickPlacement, BrickProps, Inertia, Lo, Params, range};
 use crate::spawner::Spawner;
 
 /// What one step produced for the device and the logs.
@@ -34,8 +34,11 @@ pub struct StepReport {
     pub stiffness_n_per_m: f64,
     /// Weight of the carried brick `-M g z`, N (zero when nothing is carried or gravity is off).
     pub weight_force_n: [f64; 3],
-    /// Inertial force of the carried brick `-M a`, N (zero when nothing is carried or inertia is off).
+    /// Inertial force of the carried brick `-M a`, N (the paper's method only; zero otherwise).
     pub inertia_force_n: [f64; 3],
+    /// The virtual coupling's pull on the hand, N (`inertia = "coupling"` only: the carried
+    /// brick's weight, inertia and contacts as they reach the hand; zero otherwise).
+    pub coupling_force_n: [f64; 3],
     /// Grip-point acceleration estimate used for the inertial force, m/s².
     pub acceleration_m_per_s2: [f64; 3],
     /// Deepest penetration of the cursor sphere or carried brick into anything at the start of the
@@ -139,9 +142,11 @@ impl World {
         Ok(())
     }
 
-    /// Switches the inertial force `-M a` of a carried brick on or off.
-    pub fn set_inertia(&mut self, on: bool) {
-        self.params.inertia = on;
+    /// Sets how a carried brick's inertia is felt ([`Inertia`]); a brick in the hand changes
+    /// between coupled and rigidly carried where it is.
+    pub fn set_inertia(&mut self, mode: Inertia) {
+        self.params.inertia = mode;
+        self.hand.set_inertia(mode, &mut self.bricks);
     }
 
     /// Sets the mass of every brick, kg in `[1e-3, 100]` (inertia tensor scales with it).
@@ -294,9 +299,11 @@ impl World {
                 0.0
             } else {
                 params.proxy_stiffness_n_per_m
-            },
+            }
+            .max(self.hand.felt_coupling_stiffness(params, &self.limits)),
             weight_force_n: arr(felt.weight),
             inertia_force_n: arr(felt.inertia),
+            coupling_force_n: arr(felt.coupling),
             acceleration_m_per_s2: arr(felt.acceleration),
             proxy_penetration_m: felt.penetration_m,
             events,

@@ -292,7 +292,10 @@ fn grab_brick(w: &mut brickworld::World) {
 
 #[test]
 fn thrown_brick_follows_projectile_motion_before_first_contact() {
+    // The paper's rigid carry: the brick leaves with the estimated cursor velocity
+    // (tests/coupling.rs throws through the coupling).
     let mut p = bare();
+    p.inertia = brickworld::Inertia::Paper;
     p.restitution = 0.0;
     let h = p.brick_half_extents_m;
     p.bricks = vec![at([0.0, 0.0, h[2]])];
@@ -378,12 +381,13 @@ fn thrown_brick_follows_projectile_motion_before_first_contact() {
 }
 
 #[test]
-fn weight_and_inertia_forces_are_m_g_and_minus_m_a() {
+fn paper_weight_and_inertia_forces_are_m_g_and_minus_m_a() {
     for est in [
         brickworld::AccelEstimator::Paper,
         brickworld::AccelEstimator::SavitzkyGolay { window: 21 },
     ] {
         let mut p = bare();
+        p.inertia = brickworld::Inertia::Paper;
         p.accel_estimator = est;
         p.brick_mass_kg = 0.3;
         let h = p.brick_half_extents_m;
@@ -437,7 +441,7 @@ fn weight_and_inertia_forces_are_m_g_and_minus_m_a() {
             assert!((rep.inertia_force_n[k] + m * a[k]).abs() < 1e-6);
         }
         // Inertia switched off: only the weight remains.
-        w.set_inertia(false);
+        w.set_inertia(brickworld::Inertia::Off);
         let t = 61.0 * dt;
         let pos = [
             c0[0] + 0.5 * a[0] * t * t,
@@ -459,7 +463,10 @@ fn weight_and_inertia_forces_are_m_g_and_minus_m_a() {
 
 #[test]
 fn carried_brick_cannot_enter_the_ground_or_other_bricks() {
+    // The paper's rigid carry, where the carried brick is part of the proxy
+    // (tests/coupling.rs presses a coupled brick into the ground).
     let mut p = bare();
+    p.inertia = brickworld::Inertia::Paper;
     let h = p.brick_half_extents_m;
     p.bricks = vec![at([0.0, 0.0, h[2]]), at([0.5, 0.0, h[2]])];
     let k = p.proxy_stiffness_n_per_m;

@@ -582,9 +582,31 @@ impl BrickWorld {
         self.world.set_friction(mu).map_err(err)
     }
 
-    /// Whether the inertial force -M a of a carried brick is felt.
-    fn set_inertia(&mut self, on: bool) {
-        self.world.set_inertia(on)
+    /// How a carried brick's inertia is felt: ``"coupling"`` (a spring-damper the device can
+    /// hold; ``True`` means this), ``"paper"`` (the paper's ``-M a`` from sampled positions) or
+    /// ``"off"`` (``False``: weight only).
+    fn set_inertia(&mut self, mode: &Bound<'_, PyAny>) -> PyResult<()> {
+        let m = if let Ok(on) = mode.extract::<bool>() {
+            if on {
+                brickworld::Inertia::Coupling
+            } else {
+                brickworld::Inertia::Off
+            }
+        } else {
+            match mode.extract::<String>().as_deref() {
+                Ok("coupling") => brickworld::Inertia::Coupling,
+                Ok("paper") => brickworld::Inertia::Paper,
+                Ok("off") => brickworld::Inertia::Off,
+                _ => {
+                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                        "inertia = {} is not allowed (allowed: \"coupling\", \"paper\", \"off\", True, False)",
+                        mode.repr().map(|r| r.to_string()).unwrap_or_default()
+                    )));
+                }
+            }
+        };
+        self.world.set_inertia(m);
+        Ok(())
     }
 
     /// Mass of every brick (kg), validated.

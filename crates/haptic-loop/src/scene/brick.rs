@@ -65,6 +65,9 @@ pub struct BrickScene {
     score: HouseScore,
     /// Bricks let go by the hand that have not hit anything since.
     released: Vec<(brickworld::BrickId, f64)>,
+    /// What the `inertia` switch's 1 means: the scene's method (`coupling` unless the scene
+    /// chose `paper`).
+    inertia_on: brickworld::Inertia,
 }
 
 /// The macro world's switches (the paper's menu), named as in `[brickworld.params]`.
@@ -78,7 +81,10 @@ pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
         10.0,
         "friction coefficient of every contact",
     ),
-    SwitchSpec::on_off("inertia", "the carried brick's inertial force −M a"),
+    SwitchSpec::on_off(
+        "inertia",
+        "the carried brick's inertia (0: weight only; 1: the scene's method, the coupling by default)",
+    ),
     SwitchSpec::number("brick_mass_kg", 1e-3, 100.0, "mass of every brick, kg"),
 ];
 
@@ -100,6 +106,10 @@ impl BrickScene {
         }
         check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;
         let slots = s.params.blueprint.slots.len();
+        let inertia_on = match s.params.inertia {
+            brickworld::Inertia::Paper => brickworld::Inertia::Paper,
+            _ => brickworld::Inertia::Coupling,
+        };
         let world = World::new(&s.params, limits).map_err(|e| SceneError::World {
             section: "brickworld.params".into(),
             field: Some(e.field().to_string()),
@@ -125,6 +135,7 @@ impl BrickScene {
             ground_half_m: s.draw_ground_half_m,
             score: HouseScore::new(slots, limits.max_force_n, dt_s),
             released: Vec::new(),
+            inertia_on,
         })
     }
 
@@ -234,7 +245,11 @@ impl Scene for BrickScene {
             "restitution" => w.set_restitution(value),
             "friction" => w.set_friction(value),
             "inertia" => {
-                w.set_inertia(value != 0.0);
+                w.set_inertia(if value != 0.0 {
+                    self.inertia_on
+                } else {
+                    brickworld::Inertia::Off
+                });
                 Ok(())
             }
             "brick_mass_kg" => w.set_brick_mass(value),

@@ -10,7 +10,10 @@ Python client, plus adapters for real devices through their Python SDKs:
 * :class:`TouchDevice` — 3D Systems Touch / Phantom Omni through
   ``pyOpenHaptics`` (OpenHaptics HD API);
 * :class:`ForceDimensionDevice` — Force Dimension devices and the Novint
-  Falcon through ``forcedimension_core`` (Force Dimension SDK).
+  Falcon through ``forcedimension_core`` (Force Dimension SDK);
+* :class:`HaplyInverse3Device` — a Haply Inverse3 (and optionally its
+  VerseGrip handle for buttons) through ``HaplyHardwareAPI`` (Haply's Python
+  API over USB serial).
 
 The SDKs are imported only when an adapter is created. Every adapter renders,
 between packets and at its own servo rate, ``F = F0 − K (p − p0)`` from the
@@ -40,6 +43,7 @@ __all__ = [
     "Device",
     "TouchDevice",
     "ForceDimensionDevice",
+    "HaplyInverse3Device",
     "encode_hello",
     "encode_sample",
     "decode",
@@ -433,3 +437,191 @@ class ForceDimensionDevice(Device):
     def close(self) -> None:
         self._dhd.setForce([0.0, 0.0, 0.0], ID=self._id)
         self._dhd.close(ID=self._id)
+
+
+class HaplyInverse3Device(Device):
+    """A Haply Inverse3 through ``HaplyHardwareAPI`` (Haply's Python API, over
+    USB serial), optionally with a VerseGrip handle on its own serial port for
+    buttons.
+
+    The Inverse3 is force in, position out: ``Inverse3.end_effector_force(f)``
+    sends a force (N, 3 values) and returns the cursor's position (m) and
+    velocity (m/s), and the device keeps that force until the next command. So
+    this adapter runs its own servo thread that makes exactly one
+    ``end_effector_force`` call per servo period (``servo_hz``), sending the
+    local force ``F0 − K (p − p0)`` of the last answer evaluated at the
+    position the previous call returned (zero once answers are older than
+    ``hold_s``); :meth:`read` returns the newest position and :meth:`render`
+    hands over the answer. :meth:`close` stops the thread and sends a zero
+    force (without it the device would keep the last one).
+
+    Frame: the API reports the cursor in the Inverse3's base frame (right
+    handed, +x right, +y forward, +z up, origin on the mounting plate), where
+    the reachable workspace lies off to one side of the base. The bridge wants
+    a frame centred on the workspace, so this adapter subtracts
+    ``workspace_centre_m`` (base frame, m) from every position; forces need no
+    change (a pure translation). The default centre depends on ``handedness``
+    ("right" or "left": the arm is mirrored in x) and is an estimate from
+    Haply's own examples, not a Haply figure: measure yours with
+    :attr:`raw_position_m` while holding the cursor in the middle of its reach.
+
+    Buttons: with ``handle_port`` (a serial port, or "auto" for the first of
+    ``HaplyHardwareAPI.detect_handles()``) a second thread polls
+    ``Handle.GetVersegripStatus()["buttons"]``; bit i is ``buttons[i]`` and
+    higher bits are dropped (the simulator rejects bits the hello did not
+    name). Haply advises against serving a handle and an Inverse3 from one
+    thread. Without a handle the device announces no buttons.
+    """
+
+    #: Centre of reach in the base frame (m): the ``center_workspace`` of Haply's Python sample
+    #: 10_follow_trajectory.py, mirrored in x for a left-handed device. An estimate, not a
+    #: published figure (Haply's samples use several centres).
+    DEFAULT_CENTRE_M = {"right": (0.03, -0.13, 0.20), "left": (-0.03, -0.13, 0.20)}
+
+    def __init__(self, port: Optional[str] = None, *, handle_port: Optional[str] = None,
+                 handedness: str = "right", workspace_centre_m: Optional[Sequence[float]] = None,
+                 hold_s: float = 0.01, max_force_n: float = 3.0, max_stiffness_n_per_m: float = 1000.0,
+                 workspace_radius_m: float = 0.10, servo_hz: int = 1000,
+                 buttons: Sequence[str] = ("a", "b", "c"), name: str = "inverse3"):
+        if handedness not in self.DEFAULT_CENTRE_M:
+            raise ValueError(f'handedness = "{handedness}": expected "right" or "left"')
+        centre = self.DEFAULT_CENTRE_M[handedness] if workspace_centre_m is None else workspace_centre_m
+        centre = tuple(float(v) for v in centre)
+        if len(centre) != 3 or not all(math.isfinite(v) for v in centre):
+            raise ValueError(f"workspace_centre_m: expected 3 finite numbers in metres, got {centre}")
+        if not (servo_hz > 0 and math.isfinite(servo_hz)):
+            raise ValueError(f"servo_hz = {servo_hz}: expected a positive rate in Hz")
+        try:
+            import HaplyHardwareAPI as api
+        except ImportError as e:  # pragma: no cover - depends on the machine
+            raise ImportError(
+                "HaplyInverse3Device needs Haply's Python API: "
+                "pip install HaplyHardwareAPI (see docs/device-bridge.md)"
+            ) from e
+        self._api = api
+        self.handedness = handedness
+        self.centre_m: Tuple[float, float, float] = centre  # type: ignore[assignment]
+        self.hold_s = hold_s
+        self._period = 1.0 / servo_hz
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._error: Optional[BaseException] = None
+        self._reply: Optional[ForceReply] = None
+        self._p0 = (0.0, 0.0, 0.0)
+        self._reply_at = 0.0
+        self._buttons = 0
+        self._closed = False
+        self._servo_thread: Optional[threading.Thread] = None
+        self._handle_thread: Optional[threading.Thread] = None
+        self._handle = self._handle_stream = None
+
+        if port is None:
+            found = list(api.detect_inverse3s())
+            if not found:
+                raise ConnectionError(
+                    "no Haply Inverse3 found (HaplyHardwareAPI.detect_inverse3s() is empty): is it "
+                    "plugged in and powered, and may this user open serial ports (Linux: group dialout)?")
+            port = found[0]
+        if handle_port == "auto":
+            handles = list(api.detect_handles())
+            if not handles:
+                raise ConnectionError("no Haply handle found (HaplyHardwareAPI.detect_handles() is empty)")
+            handle_port = handles[0]
+        self.port, self.handle_port = port, handle_port
+        # The Inverse3 object keeps a pointer to its stream: keep the stream alive as long.
+        self._stream = api.SerialStream(port)
+        self._inverse3 = api.Inverse3(self._stream)
+        self.device_info = dict(self._inverse3.device_wakeup_dict())
+        position, _velocity = self._inverse3.end_effector_force([0.0, 0.0, 0.0])
+        self._raw = (float(position[0]), float(position[1]), float(position[2]))
+
+        names: List[str] = []
+        if handle_port is not None:
+            self._handle_stream = api.SerialStream(handle_port)
+            self._handle = api.Handle(self._handle_stream)
+            names = [str(b) for b in buttons][:32]
+        self._button_mask = (1 << len(names)) - 1
+        self._specs = Specs(name, float(max_force_n), float(max_stiffness_n_per_m),
+                            float(workspace_radius_m), names, rate_hz=int(round(servo_hz)))
+
+        self._servo_thread = threading.Thread(target=self._servo, name="inverse3-servo", daemon=True)
+        self._servo_thread.start()
+        if self._handle is not None:
+            self._handle_thread = threading.Thread(target=self._poll_handle, name="inverse3-handle", daemon=True)
+            self._handle_thread.start()
+
+    def _servo(self) -> None:
+        """One ``end_effector_force`` call per servo period: the force of the last
+        answer at the position the previous call returned."""
+        fmax = self._specs.max_force_n
+        c = self.centre_m
+        next_t = time.perf_counter()
+        try:
+            while not self._stop.is_set():
+                with self._lock:
+                    raw = self._raw
+                    fresh = time.perf_counter() - self._reply_at <= self.hold_s
+                    p = (raw[0] - c[0], raw[1] - c[1], raw[2] - c[2])
+                    f = local_force(self._reply if fresh else None, self._p0, p, fmax)
+                position, _velocity = self._inverse3.end_effector_force([f[0], f[1], f[2]])
+                with self._lock:
+                    self._raw = (float(position[0]), float(position[1]), float(position[2]))
+                next_t += self._period
+                delay = next_t - time.perf_counter()
+                if delay > 0:
+                    time.sleep(delay)
+                else:
+                    next_t = time.perf_counter()  # late: no burst of catch-up commands
+        except BaseException as e:  # reported by the next read()
+            self._error = e
+
+    def _poll_handle(self) -> None:
+        try:
+            while not self._stop.is_set():
+                status = self._handle.GetVersegripStatus()
+                b = int(status.get("buttons", 0)) & self._button_mask
+                with self._lock:
+                    self._buttons = b
+                time.sleep(0.001)
+        except BaseException as e:
+            self._error = e
+
+    @property
+    def raw_position_m(self) -> Tuple[float, float, float]:
+        """The newest cursor position in the Inverse3's base frame (m), before
+        the centre is subtracted: hold the cursor in the middle of its reach and
+        read this to find your ``workspace_centre_m``."""
+        with self._lock:
+            return self._raw
+
+    def specs(self) -> Specs:
+        return self._specs
+
+    def read(self):
+        if self._error is not None:
+            raise IOError(f"Haply Inverse3 on {self.port}: {self._error!r}") from self._error
+        c = self.centre_m
+        with self._lock:
+            raw, b = self._raw, self._buttons
+        return (raw[0] - c[0], raw[1] - c[1], raw[2] - c[2]), b
+
+    def render(self, reply, position_m):
+        with self._lock:
+            self._reply, self._p0 = reply, tuple(position_m)
+            self._reply_at = time.perf_counter() if reply is not None else 0.0
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        with self._lock:
+            self._reply, self._reply_at = None, 0.0
+        self._stop.set()
+        for t in (self._servo_thread, self._handle_thread):
+            if t is not None:
+                t.join(timeout=6.0)  # a call in progress ends within the API's 5 s serial timeout
+        try:
+            # The device holds the last force it was sent: send zero from here, after the servo stopped.
+            self._inverse3.end_effector_force([0.0, 0.0, 0.0])
+        finally:
+            self._handle = self._handle_stream = None
