@@ -178,11 +178,11 @@ pub struct Coupling {
 impl Default for Coupling {
     fn default() -> Self {
         Coupling {
-            stiffness_fraction: 0.5,
-            damping_ratio: 0.5,
+            stiffness_fraction: 0.35,
+            damping_ratio: 0.9,
             // One Falcon count (0.0635 mm) at the default ×20 mapping.
             velocity_band_m: 0.001_27,
-            velocity_max_window: 40,
+            velocity_max_window: 5,
         }
     }
 }

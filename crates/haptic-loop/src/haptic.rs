@@ -54,6 +54,11 @@ pub mod status {
     pub const FORCE_INVALID: u8 = 16;
     /// The device sample was stale beyond the grace time: the watchdog reduced the force.
     pub const WATCHDOG: u8 = 32;
+    /// The passivity controller added damping: the rendering had returned more energy than
+    /// it took, beyond the reserve.
+    pub const PASSIVITY: u8 = 64;
+    /// The force-rate limit held the change of force back.
+    pub const RATE_LIMITED: u8 = 128;
 }
 
 /// What one tick produced.
@@ -97,6 +102,13 @@ pub struct HapticLoop {
     out: SceneOutput,
     result: TickResult,
     pending: Vec<Switch>,
+    /// The passivity observer's energy tank, J: the reserve, minus the energy the device has
+    /// delivered to the hand, plus what it took back, never above the reserve.
+    tank_j: f64,
+    /// The last valid device position, m, device frame (for the observer's displacement).
+    last_position_m: Option<Vec3>,
+    passivity_active: bool,
+    rate_limiting: bool,
 }
 
 /// `k a aᵀ` for a unit axis `a`, `k I` without one (row-major).
@@ -134,7 +146,6 @@ impl HapticLoop {
     pub fn new(config: LoopConfig, scene: Box<dyn Scene>) -> Self {
         let origin = config.mapping.origin_m;
         HapticLoop {
-            config,
             scene,
             next_tick: 0,
             last_cursor_m: origin,
@@ -146,6 +157,11 @@ impl HapticLoop {
             out: SceneOutput::default(),
             result: TickResult::default(),
             pending: Vec::new(),
+            tank_j: config.safety.passivity_reserve_j.unwrap_or(0.0),
+            last_position_m: None,
+            passivity_active: false,
+            rate_limiting: false,
+            config,
         }
     }
 
@@ -238,6 +254,23 @@ impl HapticLoop {
         let tick = self.next_tick;
         self.next_tick += 1;
         let watchdog = self.watchdog_factor(sample.age_ticks);
+        // The force held over the last tick (zero after a missed deadline) and the displacement
+        // it acted over: the passivity observer's energy flow (device frame, J).
+        let f_prev = self.result.device_force_n;
+        let dp = match (self.last_position_m, Self::check_sample(&self.config.specs, &sample)) {
+            (Some(p0), None) if sample.age_ticks == 0 => Some(vec3::sub(sample.position_m, p0)),
+            _ => None,
+        };
+        if let Some(reserve) = self.config.safety.passivity_reserve_j {
+            if let Some(d) = dp {
+                self.tank_j = (self.tank_j - vec3::dot(f_prev, d)).min(reserve);
+            }
+        }
+        if dp.is_some() || self.last_position_m.is_none() {
+            if HapticLoop::check_sample(&self.config.specs, &sample).is_none() {
+                self.last_position_m = Some(sample.position_m);
+            }
+        }
         let r = &mut self.result;
         r.tick = tick;
         r.status = 0;
@@ -391,6 +424,66 @@ impl HapticLoop {
         } else {
             self.clamping = false;
         }
+        // 4. The safety layer at the device port (only on a force the loop did not zero).
+        if force_ok && tick == 0 {
+            r.events.push(Event::new(
+                "safety.config",
+                self.config
+                    .safety
+                    .describe(self.config.specs.limits.max_stiffness_n_per_m),
+            ));
+        }
+        let dt = self.config.dt_s();
+        let mut passivity_now = false;
+        if let (Some(_), Some(d), true) = (self.config.safety.passivity_reserve_j, dp, force_ok) {
+            let v = vec3::scale(d, 1.0 / dt);
+            let v2 = vec3::dot(v, v);
+            if self.tank_j < 0.0 && v2 > 0.0 {
+                // Damping that removes the deficit over the next tick if the motion goes on.
+                let alpha = -self.tank_j / (dt * v2);
+                f = vec3::sub(f, vec3::scale(v, alpha));
+                let n = vec3::norm(f);
+                if n > max {
+                    f = vec3::scale(f, max / n);
+                    while vec3::norm(f) > max {
+                        f = vec3::scale(f, 1.0 - f64::EPSILON);
+                    }
+                }
+                r.status |= status::PASSIVITY;
+                passivity_now = true;
+                if !self.passivity_active {
+                    r.events.push(Event::new(
+                        "safety.passivity",
+                        format!(
+                            "the rendering returned {:.3e} J more than it took (reserve {} J): \
+                             damping {alpha:.3} N·s/m added",
+                            -self.tank_j,
+                            self.config.safety.passivity_reserve_j.unwrap_or(0.0)
+                        ),
+                    ));
+                }
+            }
+        }
+        self.passivity_active = passivity_now;
+        let mut limiting_now = false;
+        if let (Some(rate), true) = (self.config.safety.max_force_rate_n_per_s, force_ok) {
+            let step = rate * dt;
+            let delta = vec3::sub(f, f_prev);
+            let n = vec3::norm(delta);
+            if n > step {
+                f = vec3::add(f_prev, vec3::scale(delta, step / n));
+                r.status |= status::RATE_LIMITED;
+                limiting_now = true;
+                if !self.rate_limiting {
+                    r.events.push(Event::new(
+                        "safety.rate_limited",
+                        format!("force change of {n:.3} N in one tick held to {step:.3} N"),
+                    ));
+                }
+            }
+        }
+        self.rate_limiting = limiting_now;
+        k_gain = k_gain.min(self.config.specs.limits.max_stiffness_n_per_m);
         r.device_force_n = f;
         r.device_stiffness_n_per_m = stiffness_matrix(
             if k_gain.is_finite() { k_gain } else { 0.0 },

@@ -31,9 +31,9 @@ fn default_script_builds_the_wall_and_replays_bit_exactly() {
         *a.state_column("slots_filled").unwrap().last().unwrap(),
         4.0
     );
-    // Carrying a brick level (the cursor's height the same over the paper's five-sample
-    // stencil a = B4 − 2 B2 + B0), the vertical force is its weight alone: −M g scaled by
-    // 0.125 = −0.613 N, whatever the horizontal motion (its inertia is horizontal).
+    // Carrying a brick level, the vertical force is its weight: −M g scaled by 0.125 =
+    // −0.613 N, through the coupling (the brick rings on its spring after each grab and each
+    // change of height; on average over the level ticks, within 1 %).
     let holding = a.state_column("holding").unwrap();
     let level: Vec<usize> = (4..a.tick.len())
         .filter(|&i| {
@@ -44,13 +44,9 @@ fn default_script_builds_the_wall_and_replays_bit_exactly() {
         })
         .collect();
     assert!(level.len() > 1000, "{} level ticks", level.len());
-    for &i in &level {
-        let fz = a.device_force_n[i][2];
-        assert!(
-            (fz + 0.5 * 9.81 * 0.125).abs() < 1e-9,
-            "tick {i}: Fz {fz} N"
-        );
-    }
+    let mean = level.iter().map(|&i| a.device_force_n[i][2]).sum::<f64>() / level.len() as f64;
+    let weight = 0.5 * 9.81 * 0.125;
+    assert!((mean + weight).abs() < 0.01 * weight, "mean Fz {mean} N");
     for i in 0..a.tick.len() {
         let f = a.device_force_n[i];
         assert!((f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt() <= 8.0);

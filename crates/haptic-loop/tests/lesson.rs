@@ -24,19 +24,23 @@ fn the_lesson_measures_what_it_says() {
     assert_eq!(s.nano_house.filled, 7.0);
     assert_eq!(s.macro_house.dropped, 0.0);
     assert_eq!(s.nano_house.dropped, 0.0);
-    // Weight M g held still; gravity off removes it, inertia off leaves it.
+    // Weight M g held still (through the coupling: settled within 0.1 %); gravity off
+    // removes it, inertia off leaves it.
     let mg = s.brick_mass_kg * s.gravity_m_per_s2;
     assert!(
-        (s.lift_weight_n[0] + mg).abs() < 1e-6 * mg,
+        (s.lift_weight_n[0] + mg).abs() < 1e-3 * mg,
         "{}",
         s.lift_weight_n[0]
     );
-    assert!(s.lift_weight_n[1].abs() < 1e-9);
+    assert!(s.lift_weight_n[1].abs() < 1e-3 * mg);
     assert!((s.lift_weight_n[2] + mg).abs() < 1e-6 * mg);
-    // Inertia: the minimum-jerk peak M·5.77·D/T², within the 3-point estimate's 0.5 %.
+    // Inertia: the minimum-jerk peak of the hand, M·5.77·D/T², reached through the coupling:
+    // the brick lags the hand on its spring and overshoots it by 7.5 % at the peak (the
+    // coupling's own dynamics; the felt force is exactly the brick's −M a, brickworld's
+    // tests/coupling.rs).
     let rel = s.lift_inertia_n[0] / s.lift_inertia_predicted_n - 1.0;
     assert!(
-        rel.abs() < 5e-3,
+        rel > 0.0 && rel < 0.10,
         "inertia {} vs {}",
         s.lift_inertia_n[0],
         s.lift_inertia_predicted_n

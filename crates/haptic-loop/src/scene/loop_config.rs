@@ -42,6 +42,17 @@ pub struct LoopSection {
     /// Time after the last sample at which the force has ramped to zero, s. Allowed: more than
     /// `watchdog_grace_s` plus one tick, at most 1.
     pub watchdog_timeout_s: f64,
+    /// The passivity observer and controller at the device port (Hannaford and Ryu 2002): on
+    /// by default.
+    pub passivity: bool,
+    /// Energy the rendering may return to the hand beyond what it took, J (device side): the
+    /// observer's reserve. Allowed: 0–10.
+    pub passivity_reserve_j: f64,
+    /// The force-rate limit at the device port (OpenHaptics' impulse limit): on by default.
+    pub force_rate_limit: bool,
+    /// Largest change of the device force, N/s; default the device's largest stiffness times
+    /// 1 m/s (a Falcon: 3000 N/s, 3 N per 1 ms tick). Allowed: 1–10⁹.
+    pub max_force_rate_n_per_s: Option<f64>,
 }
 
 impl Default for LoopSection {
@@ -51,7 +62,47 @@ impl Default for LoopSection {
             engage_s: 0.25,
             watchdog_grace_s: 0.003,
             watchdog_timeout_s: 0.010,
+            passivity: true,
+            passivity_reserve_j: DEFAULT_PASSIVITY_RESERVE_J,
+            force_rate_limit: true,
+            max_force_rate_n_per_s: None,
         }
+    }
+}
+
+/// Default [`LoopSection::passivity_reserve_j`], J: 20 mJ, more than a brick lowered 1 m
+/// at the default brick-world mapping returns (2.45 J × 0.125 / 20 = 15 mJ), far less than a
+/// buzz at a Falcon's 8 N puts in per second (0.1–1 J).
+pub const DEFAULT_PASSIVITY_RESERVE_J: f64 = 0.02;
+
+/// The safety layer at the device port ([`crate::haptic::HapticLoop`] applies it after the
+/// clamp): which parts are on and their settings, as the loop uses them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Safety {
+    /// The passivity observer's reserve, J, or `None` when the observer is off.
+    pub passivity_reserve_j: Option<f64>,
+    /// The largest force change per second, N/s, or `None` when the limit is off.
+    pub max_force_rate_n_per_s: Option<f64>,
+}
+
+impl Safety {
+    /// Nothing on: the force leaves the clamp unchanged.
+    pub const OFF: Safety = Safety {
+        passivity_reserve_j: None,
+        max_force_rate_n_per_s: None,
+    };
+
+    /// The settings in words, for the recording's first tick (`safety.config`).
+    pub fn describe(&self, max_stiffness_n_per_m: f64) -> String {
+        let po = match self.passivity_reserve_j {
+            Some(r) => format!("passivity observer on (reserve {r} J)"),
+            None => "passivity observer off".into(),
+        };
+        let rate = match self.max_force_rate_n_per_s {
+            Some(r) => format!("force-rate limit on ({r} N/s)"),
+            None => "force-rate limit off".into(),
+        };
+        format!("{po}; {rate}; stiffness cap {max_stiffness_n_per_m} N/m")
     }
 }
 
@@ -111,6 +162,8 @@ pub struct LoopConfig {
     pub watchdog_grace_ticks: u32,
     /// Ticks after the last fresh sample at which the force has ramped to zero (> grace).
     pub watchdog_timeout_ticks: u32,
+    /// The safety layer at the device port.
+    pub safety: Safety,
 }
 
 impl LoopConfig {
@@ -161,6 +214,14 @@ impl LoopConfig {
             ));
         }
         check_range("display.scale", d.scale, 1e-3, 1e12)?;
+        check_range("loop.passivity_reserve_j", l.passivity_reserve_j, 0.0, 10.0)?;
+        let rate_default = specs.limits.max_stiffness_n_per_m * 1.0;
+        let rate = l.max_force_rate_n_per_s.unwrap_or(rate_default);
+        check_range("loop.max_force_rate_n_per_s", rate, 1.0, 1e9)?;
+        let safety = Safety {
+            passivity_reserve_j: l.passivity.then_some(l.passivity_reserve_j),
+            max_force_rate_n_per_s: l.force_rate_limit.then_some(rate),
+        };
         Ok(LoopConfig {
             rate_hz: l.rate_hz,
             engage_ticks: (l.engage_s * f64::from(l.rate_hz)).round() as u64,
@@ -174,6 +235,7 @@ impl LoopConfig {
             specs,
             watchdog_grace_ticks: grace_ticks as u32,
             watchdog_timeout_ticks: timeout_ticks as u32,
+            safety,
         })
     }
 
