@@ -88,8 +88,10 @@ impl Mechanics {
         limits: Limits::TOUCH,
         workspace_radius_m: 0.075,
     };
-    /// Force Dimension delta.3: 20 N continuous, resolution < 0.02 mm, 14.5 N/mm closed-loop
-    /// stiffness, up to 4 kHz; moving mass ≈ 0.25 kg and friction ≈ 0.5 N·s/m estimated.
+    /// Force Dimension delta.3: 20 N continuous, resolution < 0.02 mm, up to 4 kHz (Force
+    /// Dimension's sheet); stiffness cap 5000 N/m as CHAI3D's driver renders it at a 1 kHz loop
+    /// (the sheet's 14.5 N/mm is the device's own closed-loop figure, not a virtual wall's);
+    /// moving mass ≈ 0.25 kg and friction ≈ 0.5 N·s/m estimated.
     pub const DELTA3: Mechanics = Mechanics {
         name: "delta3",
         moving_mass_kg: 0.25,
@@ -99,12 +101,14 @@ impl Mechanics {
         servo_rate_hz: 4000.0,
         limits: Limits {
             max_force_n: 20.0,
-            max_stiffness_n_per_m: 14500.0,
+            max_stiffness_n_per_m: 5000.0,
         },
         workspace_radius_m: 0.13,
     };
-    /// Haply Inverse3: about 10 N peak (3.3 N continuous), resolution ≈ 0.01 mm, 4 kHz; a
-    /// stiffness cap of 4000 N/m and moving mass ≈ 0.1 kg estimated.
+    /// Haply Inverse3: servo up to 8 kHz (Haply's `Inverse3.h`; 4 kHz used), 10 N (a
+    /// third-party CHAI3D driver's figure), 1000 N/m (the stiffness of Haply's own Python wall
+    /// sample at 1 kHz); resolution ≈ 0.01 mm, moving mass ≈ 0.1 kg and friction estimated
+    /// (not published).
     pub const INVERSE3: Mechanics = Mechanics {
         name: "inverse3",
         moving_mass_kg: 0.1,
@@ -114,7 +118,7 @@ impl Mechanics {
         servo_rate_hz: 4000.0,
         limits: Limits {
             max_force_n: 10.0,
-            max_stiffness_n_per_m: 4000.0,
+            max_stiffness_n_per_m: 1000.0,
         },
         workspace_radius_m: 0.2,
     };

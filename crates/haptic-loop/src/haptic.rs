@@ -509,6 +509,12 @@ impl HapticLoop {
         }
     }
 
+    /// The passivity observer's energy tank, J (device side): the reserve minus the energy the
+    /// device has returned to the hand beyond what it took; the controller acts below 0.
+    pub fn passivity_tank_j(&self) -> f64 {
+        self.tank_j
+    }
+
     /// The result of the last tick.
     pub fn last_result(&self) -> &TickResult {
         &self.result

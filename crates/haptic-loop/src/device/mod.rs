@@ -5,6 +5,7 @@
 //! button bitmask, and accepts a force command (N, device frame). What a real device can render
 //! is described by its [`DeviceSpecs`].
 
+pub mod modelled;
 pub mod operator;
 pub mod script;
 
@@ -12,6 +13,7 @@ use crate::vec3::Vec3;
 use serde::{Deserialize, Serialize};
 use world_form::Limits;
 
+pub use modelled::ModelledDevice;
 pub use operator::SimulatedOperator;
 pub use script::OperatorParams;
 pub use script::{Script, ScriptError, ScriptedDevice};
