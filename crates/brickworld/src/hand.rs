@@ -168,7 +168,10 @@ impl Hand {
 
         // 2. God-object update (a coupled brick is a body of its own, not part of the proxy).
         let ball = Ball::new(params.proxy_radius_m);
-        let held_shape = self.held.filter(|h| !h.coupled).and(self.held_shape(params));
+        let held_shape = self
+            .held
+            .filter(|h| !h.coupled)
+            .and(self.held_shape(params));
         let exclude = self.held.map(|h| bricks.collider(h.brick));
         let upd = {
             let mut filter = QueryFilter::default();

@@ -380,14 +380,24 @@ impl Params {
             Lo::Open(0.0),
             1.0,
         )?;
-        range("coupling.damping_ratio", c.damping_ratio, Lo::Closed(0.0), 2.0)?;
+        range(
+            "coupling.damping_ratio",
+            c.damping_ratio,
+            Lo::Closed(0.0),
+            2.0,
+        )?;
         range(
             "coupling.velocity_band_m",
             c.velocity_band_m,
             Lo::Closed(0.0),
             0.1,
         )?;
-        count("coupling.velocity_max_window", c.velocity_max_window, 1, 200)?;
+        count(
+            "coupling.velocity_max_window",
+            c.velocity_max_window,
+            1,
+            200,
+        )?;
         if let AccelEstimator::SavitzkyGolay { window } = self.accel_estimator {
             count("accel_estimator.savitzky_golay.window", window, 5, 201)?;
         }

@@ -60,13 +60,23 @@ fn a_brick_held_still_weighs_m_g_within_1_percent() {
         let rep = hold(&mut w, c, true);
         let g = w.params().gravity_m_per_s2;
         let rel = (-rep.force_n[2] - m * g) / (m * g);
-        println!("held still, M = {m} kg: felt {:.6} N vs M g {:.6} N ({rel:+.2e})", -rep.force_n[2], m * g);
+        println!(
+            "held still, M = {m} kg: felt {:.6} N vs M g {:.6} N ({rel:+.2e})",
+            -rep.force_n[2],
+            m * g
+        );
         assert!(rel.abs() < 0.01, "M = {m}: {rel}");
         assert!(rep.force_n[0].abs() < 1e-6 && rep.force_n[1].abs() < 1e-6);
-        assert_eq!(rep.weight_force_n, [0.0; 3], "the weight arrives through the coupling");
+        assert_eq!(
+            rep.weight_force_n, [0.0; 3],
+            "the weight arrives through the coupling"
+        );
         assert_eq!(rep.coupling_force_n, rep.force_n);
         // The felt stiffness is the coupling's, half the device's largest.
-        assert_eq!(rep.stiffness_n_per_m, 0.35 * Limits::FALCON.max_stiffness_n_per_m);
+        assert_eq!(
+            rep.stiffness_n_per_m,
+            0.35 * Limits::FALCON.max_stiffness_n_per_m
+        );
     }
 }
 
@@ -200,9 +210,15 @@ fn a_coupled_throw_leaves_with_the_brick_s_own_velocity() {
     for k in 0..3 {
         assert!((v0[k] - v[k]).abs() < 0.01 * 1.2, "{v0:?} vs hand {v:?}");
         // The release tick's own step added at most the coupling's last impulse.
-        assert!((v0[k] - before[k]).abs() < 0.05, "{v0:?} vs brick {before:?}");
+        assert!(
+            (v0[k] - before[k]).abs() < 0.05,
+            "{v0:?} vs brick {before:?}"
+        );
     }
-    assert_eq!(rel.force_n, [0.0; 3], "nothing held, nothing touched: no force");
+    assert_eq!(
+        rel.force_n, [0.0; 3],
+        "nothing held, nothing touched: no force"
+    );
     // Flight: gravity only (no contact within 0.1 s).
     let b0 = w.brick(BrickId(0)).unwrap();
     for _ in 0..100 {

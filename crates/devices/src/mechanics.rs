@@ -155,7 +155,12 @@ impl Mechanics {
             }
         };
         let m = self.moving_mass_kg;
-        check("moving_mass_kg", m, m > 0.0 && m <= 10.0, "0 < moving_mass_kg ≤ 10 kg")?;
+        check(
+            "moving_mass_kg",
+            m,
+            m > 0.0 && m <= 10.0,
+            "0 < moving_mass_kg ≤ 10 kg",
+        )?;
         let b = self.viscous_n_s_per_m;
         check(
             "viscous_n_s_per_m",

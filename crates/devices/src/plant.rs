@@ -116,7 +116,11 @@ impl Plant {
     /// down to the largest force (direction kept), each component rounded to the force
     /// resolution.
     pub fn rendered_force(&self, hold: &Hold, p: Vec3) -> Vec3 {
-        let d = [p[0] - hold.p0_m[0], p[1] - hold.p0_m[1], p[2] - hold.p0_m[2]];
+        let d = [
+            p[0] - hold.p0_m[0],
+            p[1] - hold.p0_m[1],
+            p[2] - hold.p0_m[2],
+        ];
         let k = &hold.stiffness_n_per_m;
         let mut f = [0.0; 3];
         for (i, fi) in f.iter_mut().enumerate() {
@@ -152,8 +156,8 @@ impl Plant {
                 let t = (p * inner + s + 1) as f64 * h;
                 let (xi, vi) = intent(t);
                 for a in 0..3 {
-                    let v_new = (m * self.v[a] + h * (k * (xi[a] - self.x[a]) + b * vi[a] + f[a]))
-                        / denom;
+                    let v_new =
+                        (m * self.v[a] + h * (k * (xi[a] - self.x[a]) + b * vi[a] + f[a])) / denom;
                     let dx = h * v_new;
                     self.energy_to_hand_j += f[a] * dx;
                     self.x[a] += dx;
@@ -197,7 +201,11 @@ mod tests {
         let grip = Grip::LOOSE;
         let x0 = 0.005;
         let mut p = Plant::new(mech, grip, [x0, 0.0, 0.0]);
-        let (m, k, b) = (mech.moving_mass_kg, grip.stiffness_n_per_m, grip.damping_n_s_per_m);
+        let (m, k, b) = (
+            mech.moving_mass_kg,
+            grip.stiffness_n_per_m,
+            grip.damping_n_s_per_m,
+        );
         let c = b + mech.viscous_n_s_per_m;
         let w0 = (k / m).sqrt();
         let z = c / (2.0 * (k * m).sqrt());
@@ -262,14 +270,21 @@ mod tests {
         let (slow, fast) = (shortfall(1000.0), shortfall(4000.0));
         assert!(slow > 0.0 && slow < 0.2, "{slow}");
         let order = (slow / fast).log(4.0);
-        assert!((order - 1.0).abs() < 0.15, "order {order} ({slow} vs {fast})");
+        assert!(
+            (order - 1.0).abs() < 0.15,
+            "order {order} ({slow} vs {fast})"
+        );
     }
 
     #[test]
     fn the_stylus_stops_at_the_workspace_sphere() {
         let mut p = Plant::new(Mechanics::FALCON, Grip::FIRM, [0.0; 3]);
         for _ in 0..500 {
-            p.advance(T, |_| ([0.1, 0.0, 0.0], [0.0; 3]), &Hold::constant([0.0; 3]));
+            p.advance(
+                T,
+                |_| ([0.1, 0.0, 0.0], [0.0; 3]),
+                &Hold::constant([0.0; 3]),
+            );
         }
         assert!((p.position_m()[0] - 0.04).abs() < 1e-12);
         assert!(p.velocity_m_per_s()[0] <= 0.0);

@@ -102,14 +102,19 @@ pub struct HapticLoop {
     out: SceneOutput,
     result: TickResult,
     pending: Vec<Switch>,
-    /// The passivity observer's energy tank, J: the reserve, minus the energy the device has
-    /// delivered to the hand, plus what it took back, never above the reserve.
+    /// The passivity observer (Hannaford and Ryu 2002), J: the reserve plus the energy the
+    /// rendering has taken from the hand minus what it returned. A spring pressed stores what
+    /// it took and may return it; the controller acts only below 0.
     tank_j: f64,
     /// The last valid device position, m, device frame (for the observer's displacement).
     last_position_m: Option<Vec3>,
     passivity_active: bool,
     rate_limiting: bool,
 }
+
+/// Largest damping the passivity controller adds, N·s/m (device side): the damping of a loose
+/// grip (2 N·s/m), the least a hand brings to absorb it.
+pub const PASSIVITY_MAX_DAMPING_N_S_PER_M: f64 = 2.0;
 
 /// `k a aᵀ` for a unit axis `a`, `k I` without one (row-major).
 fn stiffness_matrix(k: f64, axis: Option<Vec3>) -> [f64; 9] {
@@ -157,7 +162,10 @@ impl HapticLoop {
             out: SceneOutput::default(),
             result: TickResult::default(),
             pending: Vec::new(),
-            tank_j: config.safety.passivity_reserve_j.unwrap_or(0.0),
+            tank_j: config
+                .safety
+                .passivity_reserve_j
+                .unwrap_or(crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J),
             last_position_m: None,
             passivity_active: false,
             rate_limiting: false,
@@ -257,14 +265,17 @@ impl HapticLoop {
         // The force held over the last tick (zero after a missed deadline) and the displacement
         // it acted over: the passivity observer's energy flow (device frame, J).
         let f_prev = self.result.device_force_n;
-        let dp = match (self.last_position_m, Self::check_sample(&self.config.specs, &sample)) {
+        let dp = match (
+            self.last_position_m,
+            Self::check_sample(&self.config.specs, &sample),
+        ) {
             (Some(p0), None) if sample.age_ticks == 0 => Some(vec3::sub(sample.position_m, p0)),
             _ => None,
         };
-        if let Some(reserve) = self.config.safety.passivity_reserve_j {
-            if let Some(d) = dp {
-                self.tank_j = (self.tank_j - vec3::dot(f_prev, d)).min(reserve);
-            }
+        // The observer always observes (its reading is reported); the controller acts only
+        // when the scene has it on.
+        if let Some(d) = dp {
+            self.tank_j -= vec3::dot(f_prev, d);
         }
         if dp.is_some() || self.last_position_m.is_none() {
             if HapticLoop::check_sample(&self.config.specs, &sample).is_none() {
@@ -439,8 +450,10 @@ impl HapticLoop {
             let v = vec3::scale(d, 1.0 / dt);
             let v2 = vec3::dot(v, v);
             if self.tank_j < 0.0 && v2 > 0.0 {
-                // Damping that removes the deficit over the next tick if the motion goes on.
-                let alpha = -self.tank_j / (dt * v2);
+                // Damping that removes the deficit over the next tick if the motion goes on,
+                // at most the damping a ZOH-rendered damper keeps passive with the loosest hand
+                // (Colgate: b_hand > K T / 2 + α): larger, the controller itself chatters.
+                let alpha = (-self.tank_j / (dt * v2)).min(PASSIVITY_MAX_DAMPING_N_S_PER_M);
                 f = vec3::sub(f, vec3::scale(v, alpha));
                 let n = vec3::norm(f);
                 if n > max {

@@ -202,7 +202,10 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
     assert!(last[col("complete_s")] > 0.0);
     // Proximity: 0 while touching, positive in free space.
     let near = a.state_column("nearest_m").unwrap();
-    println!("nearest min {}", near.iter().cloned().fold(f64::INFINITY, f64::min));
+    println!(
+        "nearest min {}",
+        near.iter().cloned().fold(f64::INFINITY, f64::min)
+    );
     assert!(near.iter().all(|d| *d >= 0.0));
     // (the cursor sphere rests within its 2 µm contact skin of what it touches)
     assert!(near.iter().any(|d| *d < 1e-5));
