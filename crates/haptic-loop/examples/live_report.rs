@@ -61,6 +61,7 @@ fn run_case(c: &Case) -> (SessionReport, FakeReport) {
         model: DeviceModel::Falcon,
         script: Script::from_toml(&text, &FALCON).unwrap(),
         hand: None,
+        physical: None,
         loss: c.loss,
         jitter_s: c.jitter_s,
         latency_s: 0.0,

@@ -157,9 +157,18 @@ struct FakeArgs {
     /// `hand:mass_kg=0.3,stiffness_n_per_m=300,...` (also spelled `--hand`).
     #[arg(long, alias = "hand", default_value = "hand")]
     operator: String,
-    /// Device model announced in the hello: falcon or touch.
+    /// Device model: falcon, touch, delta3 or inverse3 (delta3 and inverse3 are always
+    /// modelled devices; see --grip).
     #[arg(long, default_value = "falcon")]
     model: String,
+    /// Play a modelled device (moving mass, encoder counts, force held over each period) held
+    /// by a hand: `loose` (300 N/m, 2 N·s/m), `firm` (1000 N/m, 8 N·s/m) or
+    /// `k=N/m,b=N·s/m[,m=kg]` (docs/devices.md). Replaces --operator.
+    #[arg(long)]
+    grip: Option<String>,
+    /// With --grip: an ideal device (no encoder counts, no force resolution).
+    #[arg(long)]
+    ideal: bool,
     /// Probability that a sample is lost, 0–1.
     #[arg(long, default_value_t = 0.0)]
     loss: f64,
@@ -201,7 +210,25 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
                 a.target
             )
         })?;
-    let model = DeviceModel::from_name(&a.model).map_err(|e| format!("--model: {e}"))?;
+    let mech = haptic_devices::Mechanics::preset(&a.model).map_err(|e| format!("--model: {e}"))?;
+    // Scripts name the buttons of the device they were written for: a Falcon's, or a Touch's.
+    let model = DeviceModel::from_name(&a.model).unwrap_or(DeviceModel::Falcon);
+    let grip = match (&a.grip, DeviceModel::from_name(&a.model).is_ok()) {
+        (Some(g), _) => Some(haptic_devices::Grip::parse(g).map_err(|e| format!("--grip: {e}"))?),
+        (None, false) => Some(haptic_devices::Grip::LOOSE),
+        (None, true) => None,
+    };
+    if a.ideal && grip.is_none() {
+        return Err("--ideal needs --grip (it removes a modelled device's encoder counts)".into());
+    }
+    let physical = grip.map(|g| {
+        let m = if a.ideal {
+            mech.without_quantization()
+        } else {
+            mech
+        };
+        (m, g)
+    });
     let (text, origin) = match &a.script {
         Some(p) => (
             haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?,
@@ -258,6 +285,7 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
         model,
         script,
         hand,
+        physical,
         loss,
         jitter_s: jitter * 1e-3,
         latency_s: latency * 1e-3,
@@ -286,6 +314,21 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
             r.max_force_n,
             if r.forces_within_limits { "yes" } else { "NO" }
         );
+        println!(
+            "  force changes above 1 N between periods: {} (largest {:.3} N)",
+            r.jumps_over_1n, r.max_jump_n
+        );
+        if let Some((m, g)) = physical {
+            println!(
+                "  modelled {} held {} ({} N/m, {} N·s/m){}: the motors did {:+.4} J of work on the hand",
+                m.name,
+                g.label(),
+                g.stiffness_n_per_m,
+                g.damping_n_s_per_m,
+                if a.ideal { ", ideal sensing" } else { "" },
+                r.energy_to_hand_j
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

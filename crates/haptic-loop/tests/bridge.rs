@@ -58,6 +58,7 @@ fn fake(addr: SocketAddr) -> FakeConfig {
         model: DeviceModel::Falcon,
         script: Script::from_toml(&text, &FALCON).unwrap(),
         hand: None,
+        physical: None,
         loss: 0.0,
         jitter_s: 0.0,
         latency_s: 0.0,

@@ -10,8 +10,8 @@
 use super::protocol::{Packet, Sample};
 use crate::device::script::Script;
 use crate::device::{
-    DeviceError, DeviceModel, ForceCommand, HapticDevice, OperatorParams, ScriptedDevice,
-    SimulatedOperator, TickTime,
+    DeviceError, DeviceModel, ForceCommand, HapticDevice, ModelledDevice, OperatorParams,
+    ScriptedDevice, SimulatedOperator, TickTime,
 };
 use crate::pacing::{Pacer, Percentiles};
 use crate::vec3;
@@ -34,6 +34,9 @@ pub struct FakeConfig {
     pub script: Script,
     /// A simulated hand pushed by the rendered force (`None`: a rigid stylus).
     pub hand: Option<OperatorParams>,
+    /// A modelled device held by a hand (`haptic_devices`): moving mass, encoder counts, the
+    /// force held over the period. Takes the place of `model`'s specifications and of `hand`.
+    pub physical: Option<(haptic_devices::Mechanics, haptic_devices::Grip)>,
     /// Probability that a sample is lost, 0–1.
     pub loss: f64,
     /// Extra delay of each sample, uniform in 0–`jitter_s`, s (samples may overtake each other).
@@ -69,6 +72,13 @@ pub struct FakeReport {
     pub round_trip: Percentiles,
     /// Largest force received, N.
     pub max_force_n: f64,
+    /// Periods whose force changed by more than 1 N from the period before (a buzz shows
+    /// here).
+    pub jumps_over_1n: u64,
+    /// Largest change of force between two periods, N.
+    pub max_jump_n: f64,
+    /// Work the device's motors did on the hand, J (modelled device only; 0 otherwise).
+    pub energy_to_hand_j: f64,
     /// Force received after the outage began, as (ms after the last sample sent, N), one entry
     /// per reply until it reached zero.
     pub outage_force: Vec<(f64, f64)>,
@@ -84,7 +94,10 @@ struct Reply {
 
 /// Runs the fake device to the end; `stop` ends it early.
 pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeReport, DeviceError> {
-    let specs = cfg.model.specs().clone();
+    let specs = match &cfg.physical {
+        Some((mech, _)) => crate::device::modelled::specs_of(mech, cfg.model.specs()),
+        None => cfg.model.specs().clone(),
+    };
     let link = |what: &str, e: std::io::Error| DeviceError::Link(format!("{what}: {e}"));
     let bind: SocketAddr = if cfg.target.is_ipv4() {
         "0.0.0.0:0"
@@ -164,7 +177,10 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         })
         .map_err(|e| link("cannot start the receiver", e))?;
     // 3. The servo loop.
-    let mut dev: Box<dyn HapticDevice> = match cfg.hand {
+    let mut modelled = cfg
+        .physical
+        .map(|(mech, grip)| ModelledDevice::new(cfg.script.clone(), mech, grip, cfg.model.specs()));
+    let mut other: Box<dyn HapticDevice> = match cfg.hand {
         Some(p) => Box::new(SimulatedOperator::new(cfg.script.clone(), specs.clone(), p)),
         None => Box::new(ScriptedDevice::new(cfg.script.clone(), specs.clone())),
     };
@@ -190,6 +206,10 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         pacer.wait_for(k);
         rep.ticks += 1;
         let t = TickTime::new(k, rate_hz);
+        let dev: &mut dyn HapticDevice = match modelled.as_mut() {
+            Some(m) => m,
+            None => other.as_mut(),
+        };
         dev.set_force(&ForceCommand {
             force_n: force,
             ..Default::default()
@@ -234,6 +254,20 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
                 last_sent = Some(at);
             }
         }
+        // A modelled device renders an answer when it arrives, as a driver's servo thread
+        // does: wait for the answer to this period's sample for up to half a period, so the
+        // force of sample k is held over [k, k + 1] (plus the round trip), not a period late.
+        if modelled.is_some() && sent_at.contains_key(&k) {
+            let until = Instant::now() + Duration::from_nanos(500_000_000 / u64::from(rate_hz));
+            while Instant::now() < until
+                && !replies
+                    .lock()
+                    .map(|v| v.iter().any(|r| r.seq == k))
+                    .unwrap_or(true)
+            {
+                std::hint::spin_loop();
+            }
+        }
         // Replies that arrived since the last period.
         let got: Vec<Reply> = replies
             .lock()
@@ -255,6 +289,11 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
                     rep.outage_force.push((ms, mag));
                 }
             }
+            let jump = vec3::norm(vec3::sub(r.force_n, force));
+            rep.max_jump_n = rep.max_jump_n.max(jump);
+            if jump > 1.0 {
+                rep.jumps_over_1n += 1;
+            }
             force = r.force_n;
         }
         // Forget sends never answered (lost replies) after a second.
@@ -269,5 +308,6 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     done.store(true, Ordering::Relaxed);
     let _ = thread.join();
     rep.round_trip = Percentiles::of(&rtt);
+    rep.energy_to_hand_j = modelled.map_or(0.0, |m| m.plant().energy_to_hand_j());
     Ok(rep)
 }
