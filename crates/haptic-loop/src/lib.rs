@@ -33,6 +33,7 @@ pub mod arrays;
 pub mod bridge;
 pub mod builtin;
 pub mod channels;
+pub mod closed_loop;
 pub mod device;
 pub mod haptic;
 pub mod lesson;

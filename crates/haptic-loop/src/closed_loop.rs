@@ -1,0 +1,206 @@
+//! A scene in closed loop with a modelled device held by a hand, and the criteria that say
+//! whether the rendering is stable there (issue 22).
+//!
+//! [`run`] plays a scene's script through a [`ModelledDevice`] (the script is the operator's
+//! intent; the device has a moving mass, encoder counts and a force held over the tick; the
+//! hand is a spring-damper) and measures what a hand would feel:
+//! - force changes above [`JUMP_N`] in one tick that no declared event (grab, release,
+//!   impact, snap, pull-off) explains within [`EVENT_WINDOW_S`];
+//! - the fraction of the felt force's power above [`BUZZ_HZ`];
+//! - the passivity observer's lowest reading.
+//!
+//! A run is [`Report::stable`] when it has no such jump, at most [`MAX_HF_FRACTION`] of its
+//! power above [`BUZZ_HZ`] and an observer that never went below minus its reserve.
+
+use crate::device::modelled::specs_of;
+use crate::device::{DeviceModel, HapticDevice, ModelledDevice, Script, ScriptError, TickTime};
+use crate::haptic::{HapticLoop, status};
+use crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
+use crate::scene::{SceneError, load_scene_for};
+use haptic_devices::{Grip, Mechanics};
+use rustfft::{FftPlanner, num_complex::Complex};
+
+/// A force change larger than this in one tick is a jump, N.
+pub const JUMP_N: f64 = 1.0;
+/// How long after a declared event a jump is explained by it, s.
+pub const EVENT_WINDOW_S: f64 = 0.05;
+/// Frequency above which the felt force's power counts as buzz, Hz.
+pub const BUZZ_HZ: f64 = 50.0;
+/// Largest fraction of the power allowed above [`BUZZ_HZ`].
+pub const MAX_HF_FRACTION: f64 = 0.10;
+
+/// Events after which a jump of the felt force is expected.
+pub const DECLARED_EVENTS: [&str; 9] = [
+    "brick.grabbed",
+    "brick.released",
+    "brick.impact",
+    "brick.thrown",
+    "nano.snap",
+    "nano.pull_off",
+    "nano.atom_transferred",
+    "nano.atom_picked_up",
+    "nano.atom_attached",
+];
+
+/// What one closed-loop run showed.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Report {
+    /// Ticks run.
+    pub ticks: u64,
+    /// Ticks whose force changed by more than [`JUMP_N`], not explained by a declared event.
+    pub undeclared_jumps: u64,
+    /// Largest force change in one tick, N.
+    pub max_jump_n: f64,
+    /// Fraction of the felt force's power (each axis, about its mean) above [`BUZZ_HZ`].
+    pub hf_fraction: f64,
+    /// Lowest reading of the passivity observer, J.
+    pub min_observer_j: f64,
+    /// The observer's reserve, J.
+    pub reserve_j: f64,
+    /// Ticks on which the safety layer acted (passivity controller or rate limit).
+    pub safety_ticks: u64,
+    /// Work the device's motors did on the hand, J.
+    pub energy_to_hand_j: f64,
+    /// Largest force sent, N.
+    pub peak_force_n: f64,
+}
+
+impl Report {
+    /// No undeclared jump, little power above [`BUZZ_HZ`], the observer within its reserve.
+    pub fn stable(&self) -> bool {
+        self.undeclared_jumps == 0
+            && self.hf_fraction <= MAX_HF_FRACTION
+            && self.min_observer_j >= -self.reserve_j
+    }
+}
+
+/// Why a closed-loop run could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum ClosedLoopError {
+    /// The scene refused the device (e.g. a spring stiffer than the device allows).
+    #[error("scene: {0}")]
+    Scene(#[from] SceneError),
+    /// The script does not fit the device.
+    #[error("script: {0}")]
+    Script(#[from] ScriptError),
+}
+
+/// Plays `scene_text` with `script_text` (its buttons named for a Falcon) through the device
+/// `mech` held with `grip`, for the script's duration (or `seconds`).
+pub fn run(
+    scene_text: &str,
+    script_text: &str,
+    mech: Mechanics,
+    grip: Grip,
+    seconds: Option<f64>,
+) -> Result<Report, ClosedLoopError> {
+    let falcon = DeviceModel::Falcon.specs().clone();
+    let specs = specs_of(&mech, &falcon);
+    let loaded = load_scene_for(scene_text, specs.clone())?;
+    let script = Script::from_toml(script_text, &specs)?;
+    let rate = loaded.config.rate_hz;
+    let ticks = (seconds.unwrap_or(script.duration_s) * f64::from(rate)).round() as u64;
+    let reserve_j = loaded
+        .config
+        .safety
+        .passivity_reserve_j
+        .unwrap_or(DEFAULT_PASSIVITY_RESERVE_J);
+    let window = (EVENT_WINDOW_S * f64::from(rate)).round() as u64;
+    let mut lp = HapticLoop::new(loaded.config, loaded.scene);
+    let mut dev = ModelledDevice::new(script, mech, grip, &falcon);
+    let mut forces: Vec<[f64; 3]> = Vec::with_capacity(ticks as usize);
+    let mut last_declared: Option<u64> = None;
+    let mut rep = Report {
+        ticks,
+        undeclared_jumps: 0,
+        max_jump_n: 0.0,
+        hf_fraction: 0.0,
+        min_observer_j: f64::INFINITY,
+        reserve_j,
+        safety_ticks: 0,
+        energy_to_hand_j: 0.0,
+        peak_force_n: 0.0,
+    };
+    let mut prev = [0.0; 3];
+    for i in 0..ticks {
+        let sample = match dev.sample(TickTime::new(i, rate)) {
+            Ok(s) => s,
+            Err(_) => break,
+        };
+        let r = lp.tick(sample, false);
+        if r
+            .events
+            .iter()
+            .any(|e| DECLARED_EVENTS.contains(&e.name.as_str()))
+        {
+            last_declared = Some(i);
+        }
+        if r.status & (status::PASSIVITY | status::RATE_LIMITED) != 0 {
+            rep.safety_ticks += 1;
+        }
+        let f = r.device_force_n;
+        let jump = crate::vec3::norm(crate::vec3::sub(f, prev));
+        rep.max_jump_n = rep.max_jump_n.max(jump);
+        rep.peak_force_n = rep.peak_force_n.max(crate::vec3::norm(f));
+        if jump > JUMP_N && !last_declared.is_some_and(|t| i - t <= window) {
+            rep.undeclared_jumps += 1;
+        }
+        prev = f;
+        forces.push(f);
+        rep.min_observer_j = rep.min_observer_j.min(lp.passivity_tank_j());
+        let cmd = lp.command(i);
+        if dev.set_force(&cmd).is_err() {
+            break;
+        }
+    }
+    rep.hf_fraction = hf_fraction(&forces, f64::from(rate), BUZZ_HZ);
+    rep.energy_to_hand_j = dev.plant().energy_to_hand_j();
+    Ok(rep)
+}
+
+/// Fraction of the power of the force series `f` (each axis, its mean removed) above
+/// `cut_hz`, for samples at `rate_hz` (0 for a constant series).
+pub fn hf_fraction(f: &[[f64; 3]], rate_hz: f64, cut_hz: f64) -> f64 {
+    let n = f.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let mut planner = FftPlanner::<f64>::new();
+    let fft = planner.plan_fft_forward(n);
+    let (mut total, mut high) = (0.0, 0.0);
+    for a in 0..3 {
+        let mean = f.iter().map(|v| v[a]).sum::<f64>() / n as f64;
+        let mut buf: Vec<Complex<f64>> =
+            f.iter().map(|v| Complex::new(v[a] - mean, 0.0)).collect();
+        fft.process(&mut buf);
+        for (k, c) in buf.iter().enumerate().take(n / 2 + 1).skip(1) {
+            let p = c.norm_sqr();
+            total += p;
+            if k as f64 * rate_hz / n as f64 > cut_hz {
+                high += p;
+            }
+        }
+    }
+    if total > 0.0 { high / total } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 20 Hz sine has no power above 50 Hz; a 100 Hz one has all of it; their sum, in
+    /// proportion to the squared amplitudes.
+    #[test]
+    fn hf_fraction_splits_the_power_at_the_cut() {
+        let rate = 1000.0;
+        let wave = |hz: f64, a: f64, i: usize| a * (2.0 * std::f64::consts::PI * hz * i as f64 / rate).sin();
+        let lo: Vec<[f64; 3]> = (0..1000).map(|i| [wave(20.0, 1.0, i), 0.0, 0.0]).collect();
+        let hi: Vec<[f64; 3]> = (0..1000).map(|i| [0.0, wave(100.0, 1.0, i), 0.0]).collect();
+        let mix: Vec<[f64; 3]> = (0..1000)
+            .map(|i| [wave(20.0, 2.0, i) + wave(100.0, 1.0, i), 5.0, 0.0])
+            .collect();
+        assert!(hf_fraction(&lo, rate, 50.0) < 1e-20);
+        assert!((hf_fraction(&hi, rate, 50.0) - 1.0).abs() < 1e-12);
+        assert!((hf_fraction(&mix, rate, 50.0) - 0.2).abs() < 1e-12);
+    }
+}
