@@ -178,24 +178,24 @@ impl AdaptiveWindow {
         self.samples.push_back(p);
     }
 
-    /// The window the last [`Self::velocity`] would use, ticks (0 with fewer than two samples).
-    pub fn window(&self) -> usize {
+    /// The window of axis `axis` (0, 1, 2), ticks (0 with fewer than two samples): the
+    /// longest over which the line through the newest and the oldest sample stays within the
+    /// band of every sample between. Each axis has its own window, so the axes stay
+    /// independent (a vertical sag does not shorten a horizontal window).
+    pub fn window(&self, axis: usize) -> usize {
         let len = self.samples.len();
         if len < 2 {
             return 0;
         }
-        let newest = self.samples[len - 1];
+        let newest = self.samples[len - 1][axis];
         let mut best = 1;
         'grow: for n in 2..len {
-            let old = self.samples[len - 1 - n];
+            let old = self.samples[len - 1 - n][axis];
             for i in 1..n {
-                let mid = self.samples[len - 1 - i];
-                let f = i as f64 / n as f64;
-                for a in 0..3 {
-                    let line = newest[a] - (newest[a] - old[a]) * f;
-                    if (mid[a] - line).abs() > self.band_m {
-                        break 'grow;
-                    }
+                let mid = self.samples[len - 1 - i][axis];
+                let line = newest - (newest - old) * (i as f64 / n as f64);
+                if (mid - line).abs() > self.band_m {
+                    break 'grow;
                 }
             }
             best = n;
@@ -205,18 +205,16 @@ impl AdaptiveWindow {
 
     /// Velocity of the newest sample, m/s (zero with fewer than two samples).
     pub fn velocity(&self) -> [f64; 3] {
-        let n = self.window();
-        if n == 0 {
-            return [0.0; 3];
-        }
         let len = self.samples.len();
-        let (new, old) = (self.samples[len - 1], self.samples[len - 1 - n]);
-        let t = n as f64 * self.dt;
-        [
-            (new[0] - old[0]) / t,
-            (new[1] - old[1]) / t,
-            (new[2] - old[2]) / t,
-        ]
+        let mut v = [0.0; 3];
+        for (a, va) in v.iter_mut().enumerate() {
+            let n = self.window(a);
+            if n > 0 {
+                let (new, old) = (self.samples[len - 1][a], self.samples[len - 1 - n][a]);
+                *va = (new - old) / (n as f64 * self.dt);
+            }
+        }
+        v
     }
 }
 
@@ -291,7 +289,7 @@ mod tests {
             w.push([0.3 * k as f64 * dt, 0.0, 0.0]);
         }
         assert!((w.velocity()[0] - 0.3).abs() < 1e-12);
-        assert_eq!(w.window(), 25);
+        assert_eq!(w.window(0), 25);
         // A slow 20 mm/s drift seen through 1.27 mm counts: a one-tick difference gives
         // 1.27 m/s spikes; the adaptive window stays within band / window of the truth.
         let q = 1.27e-3;

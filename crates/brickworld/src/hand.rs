@@ -336,15 +336,16 @@ impl Hand {
     /// The coupling's pull on the brick this tick, N, and the new state of its damper.
     ///
     /// A spring `k` from the grip point (`proxy + offset`) to the brick's centre, in parallel
-    /// with a damper `b = 2 ζ √(k M)` that acts through a series spring `k_s = k_max − k`
-    /// (a Maxwell element): at low frequency it damps the brick in the hand, and a sudden change
-    /// of relative velocity `Δv` (the brick set down, a step of the hand) makes its force rise at
-    /// `k_s Δv` per second, never as a jump. The whole coupling is then never stiffer than the
-    /// device's `k_max`. The damper's filtered relative velocity `d` follows
+    /// with a damper `b = 2 ζ √(k M)` that acts through a series spring
+    /// `k_s = (max_fraction − stiffness_fraction) k_max` (a Maxwell element): at low frequency
+    /// it damps the brick in the hand, and a sudden change of relative velocity `Δv` (the brick
+    /// set down, a step of the hand) makes its force rise at `k_s Δv` per second, never as a
+    /// jump. The whole coupling is never stiffer than `max_fraction · k_max`. The damper's
+    /// filtered relative velocity `d` follows
     /// `τ ḋ = v_rel − d`, `τ = b / k_s`, by backward Euler; the relative velocity uses the
     /// adaptive-window estimate of the grip point's velocity. The force is explicit in the
     /// positions, `F = k (x_t − x) + b d`, so its change per tick is at most
-    /// `(k |v_rel| + k_s |Δv_rel|) h ≤ k_max v h`; rapier's symplectic Euler keeps the spring
+    /// `(k |v_rel| + k_s |Δv_rel|) h ≤ max_fraction · k_max v h`; rapier's symplectic Euler keeps the spring
     /// stable while `k h² / M < 4`, and `k` is capped at `M / h²` (a 1 g brick at 1 kHz: 1000
     /// N/m) so it always is.
     fn coupling_pull(
@@ -362,7 +363,8 @@ impl Hand {
             return (Vector::ZERO, Vector::ZERO);
         }
         let k = Self::coupling_stiffness(params, limits);
-        let k_series = limits.max_stiffness_n_per_m - k;
+        let c = &params.coupling;
+        let k_series = (c.max_fraction - c.stiffness_fraction) * limits.max_stiffness_n_per_m;
         let b = 2.0 * params.coupling.damping_ratio * (k * m).sqrt();
         let dt = params.dt_s;
         let x = rb.translation();

@@ -165,9 +165,14 @@ pub struct Coupling {
     /// [`Limits::max_stiffness_n_per_m`]). Range `(0, 1]`.
     pub stiffness_fraction: f64,
     /// Damping ratio of the coupling with the carried brick's mass, `b = 2 ζ √(k M)`; the
-    /// damper acts through a series spring of the stiffness left to the device
-    /// (`k_max − k`), so its force never jumps. Range `[0, 2]`.
+    /// damper acts through a series spring `(max_fraction − stiffness_fraction) k_max`, so its
+    /// force never jumps. Range `[0, 2]`.
     pub damping_ratio: f64,
+    /// The coupling's stiffness at high frequency (its spring plus the damper's series spring),
+    /// as a fraction of the device's largest stable stiffness: what a fast jolt meets. Range
+    /// `(stiffness_fraction, 1]`; below 1 it leaves the device a stability margin of
+    /// `1 / max_fraction` against its rated stiffness.
+    pub max_fraction: f64,
     /// Band of the adaptive-window velocity the damper uses, m: one encoder count mapped to the
     /// world (0 for exact positions). Range `[0, 0.1]`.
     pub velocity_band_m: f64,
@@ -178,7 +183,8 @@ pub struct Coupling {
 impl Default for Coupling {
     fn default() -> Self {
         Coupling {
-            stiffness_fraction: 0.35,
+            stiffness_fraction: 0.3,
+            max_fraction: 0.6,
             damping_ratio: 0.9,
             // One Falcon count (0.0635 mm) at the default ×20 mapping.
             velocity_band_m: 0.001_27,
@@ -378,6 +384,12 @@ impl Params {
             "coupling.stiffness_fraction",
             c.stiffness_fraction,
             Lo::Open(0.0),
+            1.0,
+        )?;
+        range(
+            "coupling.max_fraction",
+            c.max_fraction,
+            Lo::Open(c.stiffness_fraction),
             1.0,
         )?;
         range(

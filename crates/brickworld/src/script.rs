@@ -54,6 +54,10 @@ pub struct WallScript {
     away: Vector,
     carry_z: f64,
     ticks_in_phase: u32,
+    /// Where the cursor goes to set the brick down, fixed when lowering starts (a brick in the
+    /// coupling sags and stops on its slot before the hand does: a target that followed it
+    /// would recede for ever).
+    lower_target: Option<Vector>,
 }
 
 impl WallScript {
@@ -76,6 +80,7 @@ impl WallScript {
             away: Vector::new(z.max_m[0] + 0.15, z.spawn_m[1], Self::CARRY_Z_M),
             carry_z: Self::CARRY_Z_M,
             ticks_in_phase: 0,
+            lower_target: None,
         })
     }
 
@@ -180,17 +185,21 @@ impl WallScript {
                 }
             }
             Phase::Lower => {
-                let slot = Vector::from_array(self.slots[self.next_slot].center_m);
-                // Grip point sits above the brick centre by (h_z + r + skin) when grabbed on top.
-                let held = world.held_brick().and_then(|id| world.brick(id).ok());
-                let offset = held
-                    .map(|b| {
-                        Vector::from_array(world.proxy_position_m())
-                            - Vector::from_array(b.position_m)
-                    })
-                    .unwrap_or(Vector::new(0.0, 0.0, h[2] + r));
-                let t = slot + offset + Vector::new(0.0, 0.0, 1e-3);
+                let t = *self.lower_target.get_or_insert_with(|| {
+                    let slot = Vector::from_array(self.slots[self.next_slot].center_m);
+                    // Grip point above the brick centre as the brick hangs now (h_z + r + skin
+                    // when grabbed on top, plus the coupling's sag).
+                    let held = world.held_brick().and_then(|id| world.brick(id).ok());
+                    let offset = held
+                        .map(|b| {
+                            Vector::from_array(world.proxy_position_m())
+                                - Vector::from_array(b.position_m)
+                        })
+                        .unwrap_or(Vector::new(0.0, 0.0, h[2] + r));
+                    slot + offset + Vector::new(0.0, 0.0, 1e-3)
+                });
                 if self.go(t, dt) {
+                    self.lower_target = None;
                     self.set(Phase::Release(0));
                 }
             }

@@ -72,10 +72,10 @@ fn a_brick_held_still_weighs_m_g_within_1_percent() {
             "the weight arrives through the coupling"
         );
         assert_eq!(rep.coupling_force_n, rep.force_n);
-        // The felt stiffness is the coupling's, half the device's largest.
+        // The felt stiffness is the coupling's, 0.3 of the device's largest.
         assert_eq!(
             rep.stiffness_n_per_m,
-            0.35 * Limits::FALCON.max_stiffness_n_per_m
+            0.3 * Limits::FALCON.max_stiffness_n_per_m
         );
     }
 }
@@ -127,8 +127,8 @@ fn carry_2_hz(band_m: f64) -> (f64, f64) {
     // The coupling's impedance Z(iω) = k + iω b k_s / (iω b + k_s) (spring, and the damper
     // through its series spring); felt force over hand motion: M ω² Z / (Z − M ω²).
     let k_max = Limits::FALCON.max_stiffness_n_per_m;
-    let k = 0.35 * k_max;
-    let ks = k_max - k;
+    let k = 0.3 * k_max;
+    let ks = (0.6 - 0.3) * k_max;
     let b = 2.0 * w.params().coupling.damping_ratio * (k * m).sqrt();
     // iω b k_s / (k_s + iω b) = (ω² b² k_s + iω b k_s²) / (k_s² + ω² b²)
     let den_m = ks * ks + (om * b).powi(2);
@@ -177,7 +177,9 @@ fn a_brick_set_down_at_half_a_metre_per_second_is_felt_no_stiffer_than_the_devic
         k_max * v
     );
     assert!(first_contact.is_some());
-    assert!(worst_rate <= k_max * v, "{worst_rate}");
+    // No faster than the coupling's high-frequency stiffness allows (0.6 k_max), let alone
+    // the device's.
+    assert!(worst_rate <= 0.6 * k_max * v, "{worst_rate}");
     assert!(sink < 1e-3);
 }
 

@@ -1,5 +1,6 @@
 //! Prints one closed-loop run tick by tick as CSV (scene, preset, grip as arguments):
-//! `cargo run --release -p haptic-loop --example haptic-loop-closed-loop-trace -- wall falcon firm`.
+//! `cargo run --release -p haptic-loop --example haptic-loop-closed-loop-trace -- wall falcon firm
+//! [counts|ideal] [safety|nosafety] [impedance scale]`.
 #![allow(clippy::unwrap_used)]
 use haptic_devices::{Grip, Mechanics};
 use haptic_loop::device::{HapticDevice, ModelledDevice, Script, TickTime};
@@ -21,6 +22,17 @@ fn main() {
             "[loop]\n",
             "[loop]\npassivity = false\nforce_rate_limit = false\n",
         );
+    }
+    if let Some(scale) = a.get(6).and_then(|s| s.parse::<f64>().ok()) {
+        // Scale the device-side impedance by `scale` (as the Z-width report's margins do).
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("force_scale"))
+            .unwrap()
+            .to_string();
+        let fs: f64 = line.split('=').nth(1).unwrap().trim().parse().unwrap();
+        text = text.replace(&line, &format!("force_scale = {:?}", fs * scale));
+        mech.limits.max_stiffness_n_per_m *= scale;
     }
     let falcon = haptic_loop::device::DeviceModel::Falcon.specs().clone();
     let specs = haptic_loop::device::modelled::specs_of(&mech, &falcon);

@@ -63,6 +63,9 @@ pub struct Report {
     pub energy_to_hand_j: f64,
     /// Largest force sent, N.
     pub peak_force_n: f64,
+    /// Largest local stiffness sent with the force (a diagonal entry), N/m: the stiffest
+    /// spring the world rendered at the device.
+    pub max_stiffness_n_per_m: f64,
 }
 
 impl Report {
@@ -120,6 +123,7 @@ pub fn run(
         safety_ticks: 0,
         energy_to_hand_j: 0.0,
         peak_force_n: 0.0,
+        max_stiffness_n_per_m: 0.0,
     };
     let mut prev = [0.0; 3];
     for i in 0..ticks {
@@ -128,8 +132,7 @@ pub fn run(
             Err(_) => break,
         };
         let r = lp.tick(sample, false);
-        if r
-            .events
+        if r.events
             .iter()
             .any(|e| DECLARED_EVENTS.contains(&e.name.as_str()))
         {
@@ -138,6 +141,8 @@ pub fn run(
         if r.status & (status::PASSIVITY | status::RATE_LIMITED) != 0 {
             rep.safety_ticks += 1;
         }
+        let k = &r.device_stiffness_n_per_m;
+        rep.max_stiffness_n_per_m = rep.max_stiffness_n_per_m.max(k[0]).max(k[4]).max(k[8]);
         let f = r.device_force_n;
         let jump = crate::vec3::norm(crate::vec3::sub(f, prev));
         rep.max_jump_n = rep.max_jump_n.max(jump);
@@ -170,8 +175,7 @@ pub fn hf_fraction(f: &[[f64; 3]], rate_hz: f64, cut_hz: f64) -> f64 {
     let (mut total, mut high) = (0.0, 0.0);
     for a in 0..3 {
         let mean = f.iter().map(|v| v[a]).sum::<f64>() / n as f64;
-        let mut buf: Vec<Complex<f64>> =
-            f.iter().map(|v| Complex::new(v[a] - mean, 0.0)).collect();
+        let mut buf: Vec<Complex<f64>> = f.iter().map(|v| Complex::new(v[a] - mean, 0.0)).collect();
         fft.process(&mut buf);
         for (k, c) in buf.iter().enumerate().take(n / 2 + 1).skip(1) {
             let p = c.norm_sqr();
@@ -193,7 +197,9 @@ mod tests {
     #[test]
     fn hf_fraction_splits_the_power_at_the_cut() {
         let rate = 1000.0;
-        let wave = |hz: f64, a: f64, i: usize| a * (2.0 * std::f64::consts::PI * hz * i as f64 / rate).sin();
+        let wave = |hz: f64, a: f64, i: usize| {
+            a * (2.0 * std::f64::consts::PI * hz * i as f64 / rate).sin()
+        };
         let lo: Vec<[f64; 3]> = (0..1000).map(|i| [wave(20.0, 1.0, i), 0.0, 0.0]).collect();
         let hi: Vec<[f64; 3]> = (0..1000).map(|i| [0.0, wave(100.0, 1.0, i), 0.0]).collect();
         let mix: Vec<[f64; 3]> = (0..1000)

@@ -32,7 +32,13 @@ const SCENES: [(&str, &str); 4] = [
 /// Runs a scene; a device softer than the brick world was written for gets its proxy spring
 /// at 80 % of its own cap (the 1000 N/m proxy exceeds a Touch's 160 N/m in that world).
 /// `None` when the scene refuses the device (the optical tweezers' 0.8 N/m spring on a Touch).
-fn play(scene: &str, script: &str, mech: Mechanics, grip: Grip, edit: &dyn Fn(String) -> String) -> Option<Report> {
+fn play(
+    scene: &str,
+    script: &str,
+    mech: Mechanics,
+    grip: Grip,
+    edit: &dyn Fn(String) -> String,
+) -> Option<Report> {
     let text = edit(read(scene));
     let script = read(script);
     match run(&text, &script, mech, grip, None) {
@@ -41,7 +47,10 @@ fn play(scene: &str, script: &str, mech: Mechanics, grip: Grip, edit: &dyn Fn(St
             let cap = mech.limits.max_stiffness_n_per_m / (0.125 * 20.0);
             let t = text.replace(
                 "[brickworld.params]\n",
-                &format!("[brickworld.params]\nproxy_stiffness_n_per_m = {}\n", 0.8 * cap),
+                &format!(
+                    "[brickworld.params]\nproxy_stiffness_n_per_m = {}\n",
+                    0.8 * cap
+                ),
             );
             Some(run(&t, &script, mech, grip, None).unwrap())
         }
@@ -56,7 +65,11 @@ fn line(label: &str, r: &Report) -> String {
     format!(
         "{label:<48} jumps>1N outside events {:>5}, max jump {:.3} N, power above 50 Hz {:.4}, \
          observer min {:+.4} J, safety ticks {:>5}, motors' work on the hand {:+.4} J",
-        r.undeclared_jumps, r.max_jump_n, r.hf_fraction, r.min_observer_j, r.safety_ticks,
+        r.undeclared_jumps,
+        r.max_jump_n,
+        r.hf_fraction,
+        r.min_observer_j,
+        r.safety_ticks,
         r.energy_to_hand_j
     )
 }
@@ -69,7 +82,11 @@ fn every_scene_is_stable_through_every_device_and_grip() {
         for mech in PRESETS {
             for grip in [Grip::LOOSE, Grip::FIRM] {
                 for quantized in [true, false] {
-                    let m = if quantized { mech } else { mech.without_quantization() };
+                    let m = if quantized {
+                        mech
+                    } else {
+                        mech.without_quantization()
+                    };
                     let Some(r) = play(scene, script, m, grip, &|t| t) else {
                         continue;
                     };
@@ -99,10 +116,16 @@ fn every_scene_is_stable_through_every_device_and_grip() {
 #[test]
 fn the_papers_inertia_buzzes_where_the_coupling_does_not() {
     let no_safety = |t: String| {
-        t.replace("[loop]\n", "[loop]\npassivity = false\nforce_rate_limit = false\n")
+        t.replace(
+            "[loop]\n",
+            "[loop]\npassivity = false\nforce_rate_limit = false\n",
+        )
     };
     let paper = |t: String| {
-        t.replace("[brickworld.params]\n", "[brickworld.params]\ninertia = \"paper\"\n")
+        t.replace(
+            "[brickworld.params]\n",
+            "[brickworld.params]\ninertia = \"paper\"\n",
+        )
     };
     let cases: [(&str, &dyn Fn(String) -> String, bool); 4] = [
         ("paper, safety off", &|t| paper(no_safety(t)), false),
@@ -122,7 +145,10 @@ fn the_papers_inertia_buzzes_where_the_coupling_does_not() {
         println!("{}", line(label, &r));
         assert_eq!(r.stable(), smooth, "{label}: {r:?}");
         if !smooth {
-            assert!(r.undeclared_jumps > 1000 && r.hf_fraction > 0.5, "{label}: a buzz");
+            assert!(
+                r.undeclared_jumps > 1000 && r.hf_fraction > 0.5,
+                "{label}: a buzz"
+            );
         }
     }
 }

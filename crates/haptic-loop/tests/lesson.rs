@@ -24,28 +24,33 @@ fn the_lesson_measures_what_it_says() {
     assert_eq!(s.nano_house.filled, 7.0);
     assert_eq!(s.macro_house.dropped, 0.0);
     assert_eq!(s.nano_house.dropped, 0.0);
-    // Weight M g held still (through the coupling: settled within 0.1 %); gravity off
-    // removes it, inertia off leaves it.
+    // Weight M g held still (through the coupling, which still rings a little 0.2 s after the
+    // lift: within issue 22's 1 %); gravity off removes it, inertia off leaves it.
     let mg = s.brick_mass_kg * s.gravity_m_per_s2;
     assert!(
-        (s.lift_weight_n[0] + mg).abs() < 1e-3 * mg,
+        (s.lift_weight_n[0] + mg).abs() < 1e-2 * mg,
         "{}",
         s.lift_weight_n[0]
     );
-    assert!(s.lift_weight_n[1].abs() < 1e-3 * mg);
-    assert!((s.lift_weight_n[2] + mg).abs() < 1e-6 * mg);
+    assert!(s.lift_weight_n[1].abs() < 1e-2 * mg);
+    assert!(
+        (s.lift_weight_n[2] + mg).abs() < 1e-6 * mg,
+        "inertia off: carried rigidly"
+    );
     // Inertia: the minimum-jerk peak of the hand, M·5.77·D/T², reached through the coupling:
-    // the brick lags the hand on its spring and overshoots it by 7.5 % at the peak (the
-    // coupling's own dynamics; the felt force is exactly the brick's −M a, brickworld's
-    // tests/coupling.rs).
+    // the brick lags the hand on its spring (3.3 Hz with this 0.5 kg brick on a Falcon) and
+    // swings past it, 18 % at the peak (the felt force is exactly the brick's −M a,
+    // brickworld's tests/coupling.rs).
     let rel = s.lift_inertia_n[0] / s.lift_inertia_predicted_n - 1.0;
     assert!(
-        rel > 0.0 && rel < 0.10,
+        rel > 0.0 && rel < 0.25,
         "inertia {} vs {}",
         s.lift_inertia_n[0],
         s.lift_inertia_predicted_n
     );
-    assert!((s.lift_inertia_n[1] / s.lift_inertia_n[0] - 1.0).abs() < 1e-9);
+    // Gravity off leaves the sideways inertia (the coupled brick's axes are independent up to
+    // rapier's rounding: 3e-9 relative).
+    assert!((s.lift_inertia_n[1] / s.lift_inertia_n[0] - 1.0).abs() < 1e-7);
     assert!(s.lift_inertia_n[2] < 1e-9);
     // The tenfold pull-off, and halving the adhesion halves both forces.
     assert!((s.hysteresis.ratio - 10.0).abs() < 1e-9);
@@ -56,7 +61,9 @@ fn the_lesson_measures_what_it_says() {
     // throw) within the tick's resolution.
     let t = &s.brick_throw;
     assert!(t.thrown);
-    assert!((t.distance_m / (t.release_speed_m_per_s * t.flight_s) - 1.0).abs() < 0.02);
+    // (Measured from the hand at release; the brick trails the hand on the coupling by about
+    // 3 cm, 2.4 % of the 1.14 m range.)
+    assert!((t.distance_m / (t.release_speed_m_per_s * t.flight_s) - 1.0).abs() < 0.03);
     // The atom stays; the heavy atom's measured threshold brackets hold / (m · scale).
     assert!(s.atom_stayed);
     assert!(s.atom_hold_n / s.atom_load_n > 1e14);

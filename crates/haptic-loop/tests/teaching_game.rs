@@ -55,7 +55,7 @@ fn switching_gravity_off_mid_carry_removes_the_weight_and_replays_bit_exactly() 
     let a = run(
         "brickworld.toml",
         Some(script_plus("brickworld.script.toml", extra)),
-        3.0,
+        3.2,
         Some(p.clone()),
     );
     let sets: Vec<_> = a.events.iter().filter(|e| e.1 == "switch.set").collect();
@@ -70,19 +70,26 @@ fn switching_gravity_off_mid_carry_removes_the_weight_and_replays_bit_exactly() 
         json(&sets[1].2),
         serde_json::json!({"name": "gravity_m_per_s2", "value": 9.81})
     );
-    // The weight of the 0.5 kg brick, −M g = −4.905 N, is felt before and after, not between.
-    // Through the coupling a sudden change of gravity sets the brick ringing on its spring
-    // (6.7 Hz, damping ratio ≈ 0.3 with this rigid operator): the mean over the last 100 ms
-    // before the next change, within 2 % of the weight.
-    let mean = |a0: usize, a1: usize| {
-        (a0..a1).map(|t| a.world_force_n[t][2]).sum::<f64>() / (a1 - a0) as f64
-    };
-    let w = -0.5 * 9.81;
-    let (before, off, on) = (mean(2400, 2500), mean(2700, 2800), mean(2950, 3000));
-    assert!((before - w).abs() < 0.1, "before: {before}");
-    assert!(off.abs() < 0.1, "gravity off: {off}");
-    // (gravity back on 150 ms before the carry ends: still ringing, within 3 %)
-    assert!((on - w).abs() < 0.15, "back on: {on}");
+    // The weight of the 0.5 kg brick, −M g = −4.905 N, goes away and comes back. Compared with
+    // the same run without the switches: identical to the bit before 2.5 s; then the coupling
+    // lets the weight go as a step response (the brick rings on its spring at 4.3 Hz with an
+    // effective damping ratio ≈ 0.2: this rigid operator adds none), so over the last 100 ms
+    // before the second change, and 200–300 ms after it, the difference is the weight, then
+    // nothing, within 25 %.
+    let plain = run("brickworld.toml", None, 3.2, None);
+    let diff = |t: usize| a.world_force_n[t][2] - plain.world_force_n[t][2];
+    assert!(
+        (0..2500).all(|t| diff(t) == 0.0),
+        "before the switch: the same bits"
+    );
+    let mean = |a0: usize, a1: usize| (a0..a1).map(diff).sum::<f64>() / (a1 - a0) as f64;
+    let w = 0.5 * 9.81;
+    let (off, on) = (mean(2700, 2800), mean(3000, 3100));
+    assert!(
+        (off - w).abs() < 0.25 * w,
+        "gravity off: the weight is gone ({off} N)"
+    );
+    assert!(on.abs() < 0.25 * w, "back on: the weight is back ({on} N)");
     // The switch is an input of the recording, and replay applies it on the same tick.
     let rec = read_recording_file(&p, false).unwrap();
     let sw: Vec<_> = rec
@@ -191,10 +198,10 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
     let col = |name: &str| a.state_fields.iter().position(|f| f == name).unwrap();
     let last = &a.state[a.state.len() - n..];
     assert_eq!(last[col("slots_filled")], 4.0);
-    // The default script was written for the rigid carry; through the coupling the drop rule
-    // counts two of its set-downs as drops (noted in issue 22's closing note, not analysed).
+    // Nothing dropped: bricks set down and let go, then struck by the next brick, have not
+    // fallen (the rule reads heights, not the speed of an impact they did not make).
     let dropped = last[col("dropped")];
-    assert_eq!(dropped, 2.0);
+    assert_eq!(dropped, 0.0);
     // The score's rule: 100 × 4/4 − 10 per drop − 5 × seconds above the comfort limit (half
     // of 8 N).
     let over = last[col("comfort_exceeded_s")];

@@ -154,7 +154,8 @@ pub fn hysteresis(a: &SessionArrays) -> Option<Hysteresis> {
 /// A brick throw measured: release velocity and where the brick first landed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BrickThrow {
-    /// Speed at release, m/s.
+    /// Horizontal speed at release, m/s (the brick's own velocity through the coupling; the
+    /// range is this speed times the flight time).
     pub release_speed_m_per_s: f64,
     /// Horizontal distance from the release point to the first impact, m.
     pub distance_m: f64,
@@ -169,7 +170,7 @@ pub fn brick_throw(a: &SessionArrays) -> Option<BrickThrow> {
     let (tr, rel) = events(a, "brick.released").next()?;
     let v = rel.get("velocity_m_per_s")?.as_array()?;
     let v: Vec<f64> = v.iter().filter_map(serde_json::Value::as_f64).collect();
-    let speed = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let speed = v.iter().take(2).map(|x| x * x).sum::<f64>().sqrt();
     let brick = rel.get("brick")?.clone();
     let r = f64::from(a.rate_hz);
     let i = (tr * r).round() as usize;

@@ -412,7 +412,9 @@ pub fn markdown(s: &LessonSummary) -> String {
         "## Lifting a brick: weight and inertia\n\n\
          Holding the {} kg brick still, the hand feels {} downwards (M g = {}). Carrying it \
          0.45 m sideways in 0.9 s, it feels up to {} sideways: the brick's inertia −M a \
-         (predicted for this minimum-jerk move: {}).\n\n\
+         (predicted for this minimum-jerk move of the hand: {}). The brick hangs in the hand on \
+         a spring the device can hold (the virtual coupling), so it lags the hand and swings \
+         a little past it: its peak is {:.0} % above the hand's.\n\n\
          The same hand motion with the paper's menu switches:\n\n\
          | run | weight felt | peak inertial force |\n|---|---|---|\n\
          | normal | {} | {} |\n| gravity off | {} | {} |\n| inertia off | {} | {} |\n\n\
@@ -422,6 +424,7 @@ pub fn markdown(s: &LessonSummary) -> String {
         si(s.brick_mass_kg * s.gravity_m_per_s2, "N"),
         si(s.lift_inertia_n[0], "N"),
         si(s.lift_inertia_predicted_n, "N"),
+        100.0 * (s.lift_inertia_n[0] / s.lift_inertia_predicted_n - 1.0),
         si(-s.lift_weight_n[0], "N"),
         si(s.lift_inertia_n[0], "N"),
         si(-s.lift_weight_n[1], "N"),

@@ -168,40 +168,31 @@ fn event_detail(e: &brickworld::Event) -> String {
     serde_json::to_string(e).unwrap_or_default()
 }
 
-/// Counts drops for the score: a brick let go by the hand that fell [`DROP_HEIGHT_M`] or more
-/// before its first impact, the height from the speeds under gravity g:
-/// `h = (v_impact² − v_release²) / (2 g)` (a brick pressed down and let go just above its
-/// place falls less than a millimetre; a thrown brick's speed is mostly horizontal).
+/// Counts drops for the score: a brick let go by the hand whose centre is [`DROP_HEIGHT_M`]
+/// or more below where it was let go at its first impact (a brick set down and let go rests
+/// where it was; one struck later by another brick has not fallen; a thrown brick falls).
+/// `height_of` reads a brick's centre height now, m.
 fn track_drops(
     e: &brickworld::Event,
     released: &mut Vec<(brickworld::BrickId, f64)>,
-    g_m_per_s2: f64,
+    height_of: impl Fn(brickworld::BrickId) -> Option<f64>,
     score: &mut HouseScore,
 ) {
     use brickworld::{Body, Event as E};
     match e {
-        E::Released {
-            brick,
-            velocity_m_per_s: v,
-        } => released.push((*brick, (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())),
+        E::Released { brick, .. } => {
+            if let Some(z) = height_of(*brick) {
+                released.push((*brick, z));
+            }
+        }
         E::Grabbed { brick } => released.retain(|(b, _)| b != brick),
-        E::Impact {
-            a,
-            b,
-            speed_m_per_s,
-            ..
-        } => {
+        E::Impact { a, b, .. } => {
             for body in [a, b] {
                 if let Body::Brick(id) = body
                     && let Some(i) = released.iter().position(|(r, _)| r == id)
                 {
-                    let (_, v0) = released.swap_remove(i);
-                    let fall = if g_m_per_s2 > 0.0 {
-                        (speed_m_per_s * speed_m_per_s - v0 * v0) / (2.0 * g_m_per_s2)
-                    } else {
-                        0.0
-                    };
-                    if fall >= DROP_HEIGHT_M {
+                    let (_, z0) = released.swap_remove(i);
+                    if height_of(*id).is_some_and(|z| z0 - z >= DROP_HEIGHT_M) {
                         score.drop_one();
                     }
                 }
@@ -288,8 +279,13 @@ impl Scene for BrickScene {
         let r = self.world.step(&ci);
         for e in &r.events {
             out.events.push(Event::new(event_name(e), event_detail(e)));
-            let g = self.world.params().gravity_m_per_s2;
-            track_drops(e, &mut self.released, g, &mut self.score);
+            let world = &self.world;
+            track_drops(
+                e,
+                &mut self.released,
+                |id| world.brick(id).ok().map(|v| v.position_m[2]),
+                &mut self.score,
+            );
         }
         self.force_n = if self.rejected { [0.0; 3] } else { r.force_n };
         self.score

@@ -1,0 +1,271 @@
+//! Z-width of every device preset, and the stiffness margin of every world on it, measured
+//! in closed loop with a modelled device held by a hand (issue 22). Writes
+//! `docs/bench/zwidth.md` (or `--out FILE`) and `docs/figures/zwidth-<device>.png`.
+//!
+//! 1. **Z-width** (Colgate and Brown 1994): the virtual wall `F = −K x − B ẋ` of the `wall`
+//!    world, swept over K (100–100 000 N/m, a quarter decade apart) and B (0–16 N·s/m), safety
+//!    layer off (the rendering's own region), on each preset held loosely (300 N/m, 2 N·s/m)
+//!    and firmly (1000 N/m, 8 N·s/m), with encoder counts. The hand approaches, presses 3 mm
+//!    (about 0.9 N), holds 1.5 s and lets go. A run is stable by
+//!    [`haptic_loop::closed_loop::Report::stable`].
+//! 2. **Margins**: each world's default scene and script, its device-side impedance scaled by
+//!    `s` (the mapping's force scale and the device's stiffness cap both × s, so the world
+//!    renders the same springs, `s` times stiffer at the hand), safety layer off, loose grip
+//!    with counts: the largest `s` still stable is the world's stiffness margin on that device.
+#![allow(clippy::unwrap_used)]
+
+use bench_harness::plot::{Axis, Chart, Series};
+use bench_harness::plotters::prelude::RGBColor;
+use bench_harness::report::out_arg;
+use bench_harness::{Report, Table};
+use haptic_devices::{Grip, Mechanics, PRESETS};
+use haptic_loop::closed_loop::run;
+
+const SCRIPT: &str = r#"
+[script]
+name = "z-width: press and hold"
+duration_s = 3.0
+[[waypoint]]
+t_s = 0.0
+position_mm = [0.0, 0.0, 6.0]
+[[waypoint]]
+t_s = 0.5
+position_mm = [0.0, 0.0, -2.0]
+[[waypoint]]
+t_s = 2.0
+position_mm = [0.0, 0.0, -2.0]
+[[waypoint]]
+t_s = 2.5
+position_mm = [0.0, 0.0, 6.0]
+"#;
+
+fn wall(k: f64, b: f64) -> String {
+    format!(
+        "[scene]\nname = \"z-width wall\"\nkind = \"wall\"\n[device]\nmodel = \"falcon\"\n\
+         [loop]\nengage_s = 0.0\npassivity = false\nforce_rate_limit = false\n\
+         [wall]\nnormal = [0.0, 0.0, 1.0]\npoint_m = [0.0, 0.0, 0.0]\n\
+         stiffness_n_per_m = {k:?}\ndamping_n_s_per_m = {b:?}\ncursor_radius_m = 0.001\n"
+    )
+}
+
+/// The device with its stiffness cap raised out of the way (the plant's physics does not
+/// read it; the loop and the worlds would refuse or cap stiffer springs).
+fn uncapped(m: Mechanics, factor: f64) -> Mechanics {
+    let mut u = m;
+    u.limits.max_stiffness_n_per_m = m.limits.max_stiffness_n_per_m * factor;
+    u
+}
+
+const KS: usize = 13;
+const BS: [f64; 6] = [0.0, 1.0, 2.0, 4.0, 8.0, 16.0];
+const SCALES: [f64; 8] = [1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0];
+
+fn k_of(i: usize) -> f64 {
+    100.0 * 10f64.powf(i as f64 / 4.0)
+}
+
+fn main() {
+    let mut md = Report::start(
+        "zwidth",
+        "haptic-loop — Z-width and stiffness margins in closed loop",
+    )
+    .unwrap()
+    .output(out_arg());
+    let root = md.root().to_path_buf();
+    let scenes = root.join("scenes");
+    let read = |n: &str| std::fs::read_to_string(scenes.join(n)).unwrap();
+    md.para(
+        "Closed loop: the script is the operator's intent; a hand (loose 300 N/m, 2 N·s/m; firm \
+         1000 N/m, 8 N·s/m) holds a modelled device (moving mass, viscous friction, encoder \
+         counts, force resolution, the force held over each 1 ms tick and rendered at the \
+         device's servo rate; `haptic_devices`, presets and sources in `docs/devices.md`). \
+         Stable: no force change above 1 N in one tick outside declared events, at most 10 % of \
+         the force's power above 50 Hz, and the passivity observer above minus its 20 mJ \
+         reserve. Safety layer off: these are the renderings' own regions.",
+    );
+
+    // 1. Z-width per device and grip.
+    let mut zt = Table::new([
+        "device",
+        "grip",
+        "largest stable K at B = 0 (N/m)",
+        "at B = 2",
+        "at B = 8",
+        "rated k_max (N/m)",
+        "margin at B = 0",
+    ]);
+    for mech in PRESETS {
+        let dev = uncapped(mech, 1e4);
+        let mut charts_pts = (Vec::new(), Vec::new(), Vec::new());
+        for grip in [Grip::LOOSE, Grip::FIRM] {
+            let mut largest = [0.0f64; BS.len()];
+            for (bi, b) in BS.iter().enumerate() {
+                let mut all_below = true;
+                for ki in 0..KS {
+                    let k = k_of(ki);
+                    let r = run(&wall(k, *b), SCRIPT, dev, grip, None).unwrap();
+                    let ok = r.stable();
+                    if grip == Grip::LOOSE {
+                        if ok {
+                            charts_pts.0.push((k, *b));
+                        } else {
+                            charts_pts.1.push((k, *b));
+                        }
+                    }
+                    if ok && all_below {
+                        largest[bi] = k;
+                    } else {
+                        all_below = false;
+                    }
+                }
+            }
+            if grip == Grip::FIRM {
+                charts_pts.2 = BS
+                    .iter()
+                    .zip(largest)
+                    .filter(|(_, k)| *k > 0.0)
+                    .map(|(b, k)| (k, *b))
+                    .collect();
+            }
+            let rated = mech.limits.max_stiffness_n_per_m;
+            zt.row([
+                mech.name.to_string(),
+                grip.label(),
+                format!("{:.0}", largest[0]),
+                format!("{:.0}", largest[2]),
+                format!("{:.0}", largest[4]),
+                format!("{rated:.0}"),
+                format!("{:.2}×", largest[0] / rated),
+            ])
+            .unwrap();
+        }
+        let (stable, unstable, firm) = charts_pts;
+        let mut chart = Chart::new(
+            &format!(
+                "Z-width of the {} (wall K, B; hand loose; counts)",
+                mech.name
+            ),
+            Axis::log("K, wall stiffness (N/m)", 70.0, 1.5e5),
+            Axis::linear("B, wall damping (N·s/m)", -1.0, 17.0),
+        )
+        .with(Series::dots(
+            "stable, loose grip",
+            stable,
+            RGBColor(40, 150, 60),
+            5,
+        ))
+        .with(Series::dots(
+            "unstable, loose grip",
+            unstable,
+            RGBColor(210, 50, 40),
+            5,
+        ))
+        .with(Series::line("stability edge, firm grip", firm, RGBColor(40, 80, 200)).width(2));
+        let rated = mech.limits.max_stiffness_n_per_m;
+        chart = chart.with(
+            Series::line(
+                &format!("rated k_max {rated:.0} N/m"),
+                vec![(rated, -1.0), (rated, 17.0)],
+                RGBColor(120, 120, 120),
+            )
+            .width(1),
+        );
+        let file = format!("zwidth-{}.png", mech.name);
+        chart.save(&md.figure(&file), (900, 560)).unwrap();
+        md.image(&format!("Z-width of the {}", mech.name), &file);
+    }
+    md.heading("Z-width: largest stable wall stiffness");
+    md.table(&zt);
+
+    // 2. Each world's stiffness margin on each device.
+    let worlds = [
+        ("wall", "wall.toml", "wall.script.toml"),
+        ("bricks", "brickworld.toml", "brickworld.script.toml"),
+        ("atoms", "nanoworld.toml", "nanoworld.script.toml"),
+        (
+            "optical tweezers",
+            "optical_tweezers.toml",
+            "optical_tweezers.script.toml",
+        ),
+    ];
+    let mut mt = Table::new([
+        "world",
+        "device",
+        "stiffest spring at the hand, default (N/m)",
+        "stable up to s =",
+        "stiffness margin",
+    ]);
+    for (world, scene, script) in worlds {
+        let text = read(scene);
+        let stext = read(script);
+        let fs_line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("force_scale"))
+            .unwrap()
+            .to_string();
+        let fs: f64 = fs_line.split('=').nth(1).unwrap().trim().parse().unwrap();
+        let edit = |t: &str, s: f64| {
+            t.replace(&fs_line, &format!("force_scale = {:?}", fs * s))
+                .replace(
+                    "[loop]\n",
+                    "[loop]\npassivity = false\nforce_rate_limit = false\n",
+                )
+        };
+        for mech in PRESETS {
+            let mut k0 = None;
+            let mut margin = None;
+            for s in SCALES {
+                let r = match run(
+                    &edit(&text, s),
+                    &stext,
+                    uncapped(mech, s),
+                    Grip::LOOSE,
+                    None,
+                ) {
+                    Ok(r) => r,
+                    Err(_) => break,
+                };
+                if s == 1.0 {
+                    k0 = Some(r.max_stiffness_n_per_m);
+                }
+                if !r.stable() {
+                    break;
+                }
+                margin = Some(s);
+            }
+            let Some(k0) = k0 else {
+                mt.row([
+                    world.to_string(),
+                    mech.name.to_string(),
+                    "refused (spring above the device's cap)".into(),
+                    "–".into(),
+                    "–".into(),
+                ])
+                .unwrap();
+                continue;
+            };
+            mt.row([
+                world.to_string(),
+                mech.name.to_string(),
+                format!("{k0:.0}"),
+                margin.map_or("unstable at 1".into(), |m| format!("{m}")),
+                margin.map_or("none".into(), |m| {
+                    if m == SCALES[SCALES.len() - 1] {
+                        format!("≥ {m}×")
+                    } else {
+                        format!("{m}×")
+                    }
+                }),
+            ])
+            .unwrap();
+        }
+    }
+    md.heading("Each world's stiffness margin (loose grip, counts, safety layer off)");
+    md.para(
+        "The world's device-side impedance scaled by s until the closed loop is no longer \
+         stable; the defaults sit at s = 1. The stiffest spring column is the largest local \
+         stiffness the world sent with its force in the default run.",
+    );
+    md.table(&mt);
+    md.finish().unwrap();
+}
