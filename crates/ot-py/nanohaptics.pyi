@@ -386,7 +386,8 @@ class BrickWorld:
     def set_gravity(self, g_m_per_s2: float) -> None: ...
     def set_restitution(self, e: float) -> None: ...
     def set_friction(self, mu: float) -> None: ...
-    def set_inertia(self, on: bool) -> None: ...
+    def set_inertia(self, mode: Union[bool, Literal["coupling", "paper", "off"]]) -> None:
+        """How a carried brick's inertia is felt: "coupling" (True), "paper" or "off" (False)."""
     def set_brick_mass(self, kg: float) -> None: ...
 
 # ---------------------------------------------------------------- haptic loop sessions
@@ -491,6 +492,72 @@ class Session:
         workspace_radius_m, buttons)."""
     def close(self) -> dict:
         """End the session; the per-tick arrays of run_scene with stats."""
+
+# ---------------------------------------------------------------- a device and a hand in the loop
+
+class DeviceModel:
+    """A haptic device held by a hand: moving mass, viscous friction, encoder counts, force
+    resolution, the force held over each tick at the device's servo rate, and a hand that
+    follows the intended path as a spring-damper (docs/devices.md)."""
+
+    def __init__(
+        self,
+        model: Literal["falcon", "touch", "delta3", "inverse3"] = "falcon",
+        *,
+        grip: str = "loose",
+        counts: bool = True,
+        start: Optional[ArrayLike] = None,
+    ) -> None: ...
+    def advance(
+        self,
+        dt_s: float,
+        force: ArrayLike,
+        intent_position: ArrayLike,
+        intent_velocity: Optional[ArrayLike] = None,
+        stiffness: Optional[ArrayLike] = None,
+    ) -> None:
+        """Hold `force` (3,) N (and the local `stiffness` (3, 3) N/m) for dt_s s while the
+        hand pulls toward `intent_position` (3,) m moving at `intent_velocity` (3,) m/s."""
+    @property
+    def reading(self) -> F64Array:
+        """What the encoders report, (3,) m."""
+    @property
+    def position(self) -> F64Array:
+        """True end-effector position, (3,) m."""
+    @property
+    def velocity(self) -> F64Array:
+        """True end-effector velocity, (3,) m/s."""
+    @property
+    def energy_to_hand_j(self) -> float:
+        """Work the motors did on the hand, J."""
+    @property
+    def time_s(self) -> float:
+        """Time advanced so far, s."""
+    @property
+    def specs(self) -> dict:
+        """The device's figures and the grip's."""
+
+def check_closed_loop(
+    scene: Union[PathLike, dict],
+    *,
+    script: Optional[PathLike] = None,
+    model: Literal["falcon", "touch", "delta3", "inverse3"] = "falcon",
+    grip: str = "loose",
+    counts: bool = True,
+    seconds: Optional[float] = None,
+) -> dict:
+    """Play a scene's script through a modelled device held by a hand; "stable" and the
+    figures behind it (undeclared_jumps, hf_fraction, min_observer_j, ...)."""
+
+def closed_loop(
+    session: Session,
+    device: DeviceModel,
+    path: Callable[[float], Tuple[ArrayLike, ArrayLike]],
+    seconds: float,
+    buttons: Optional[Callable[[float], Any]] = None,
+) -> dict:
+    """Drive `session` with `device` held by a hand following path(t) -> (position, velocity);
+    per-tick arrays time_s, reading_m, position_m, force_n and energy_to_hand_j."""
 
 bridge: ModuleType
 """The device bridge: protocol client (BridgeClient, run) and adapters for a

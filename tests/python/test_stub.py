@@ -30,7 +30,7 @@ def test_stub_and_module_export_the_same_names():
     stub = _stub()
     exported = {k for k in dir(nh) if not k.startswith("_")} - {"nanohaptics"}
     assert exported == set(stub) - ALIASES - {"__version__"}
-    for cls in ("GaussianTrap", "NanoWorld", "BrickWorld", "Session"):
+    for cls in ("GaussianTrap", "NanoWorld", "BrickWorld", "Session", "DeviceModel"):
         members = {k for k in dir(getattr(nh, cls)) if not k.startswith("_")}
         in_stub = {n.name for n in stub[cls].body if isinstance(n, ast.FunctionDef)} - {"__init__"}
         assert members == in_stub, cls
@@ -41,7 +41,7 @@ def test_stub_signatures_match_the_module():
     for name, node in stub.items():
         if isinstance(node, ast.FunctionDef):
             assert _params(node) == list(inspect.signature(getattr(nh, name)).parameters), name
-    for cls in ("GaussianTrap", "NanoWorld", "BrickWorld", "Session"):
+    for cls in ("GaussianTrap", "NanoWorld", "BrickWorld", "Session", "DeviceModel"):
         for node in stub[cls].body:
             if not isinstance(node, ast.FunctionDef) or any(
                 isinstance(d, ast.Name) and d.id == "property" for d in node.decorator_list

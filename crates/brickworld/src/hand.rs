@@ -63,9 +63,9 @@ pub(crate) struct Hand {
     grip: Grip,
     /// Velocity and acceleration of the grip point from the proxy's history.
     motion: MotionEstimator,
-    /// Velocity of the grip point for the coupling's damper (adaptive window).
+    /// Velocity of the grip point for a rigidly carried brick's release (adaptive window).
     grip_velocity: AdaptiveWindow,
-    /// The coupling damper's filtered relative velocity (grip point minus brick), m/s.
+    /// The coupling dashpot's share of the grip point's lead on the brick, m.
     damper: Vector,
     held: Option<Held>,
     /// What the cursor (or carried brick) touches, sorted.
@@ -87,8 +87,8 @@ impl Hand {
             motion: MotionEstimator::new(params.dt_s, params.accel_estimator),
             grip_velocity: AdaptiveWindow::new(
                 params.dt_s,
-                params.coupling.velocity_band_m,
-                params.coupling.velocity_max_window,
+                params.release_velocity_band_m,
+                params.release_velocity_max_window,
             ),
             damper: Vector::ZERO,
             held: None,
@@ -340,14 +340,16 @@ impl Hand {
     /// `k_s = (max_fraction − stiffness_fraction) k_max` (a Maxwell element): at low frequency
     /// it damps the brick in the hand, and a sudden change of relative velocity `Δv` (the brick
     /// set down, a step of the hand) makes its force rise at `k_s Δv` per second, never as a
-    /// jump. The whole coupling is never stiffer than `max_fraction · k_max`. The damper's
-    /// filtered relative velocity `d` follows
-    /// `τ ḋ = v_rel − d`, `τ = b / k_s`, by backward Euler; the relative velocity uses the
-    /// adaptive-window estimate of the grip point's velocity. The force is explicit in the
-    /// positions, `F = k (x_t − x) + b d`, so its change per tick is at most
-    /// `(k |v_rel| + k_s |Δv_rel|) h ≤ max_fraction · k_max v h`; rapier's symplectic Euler keeps the spring
-    /// stable while `k h² / M < 4`, and `k` is capped at `M / h²` (a 1 g brick at 1 kHz: 1000
-    /// N/m) so it always is.
+    /// jump. The whole coupling is never stiffer than `max_fraction · k_max`.
+    ///
+    /// The Maxwell element is written in positions, so no velocity is estimated from encoder
+    /// counts: with `x_r = x_t − x` the grip point's lead on the brick and `e` the dashpot's
+    /// share of it, `b ė = k_s (x_r − e)` (backward Euler, stable for any `b`, `k_s`) and the
+    /// damper pulls with `k_s (x_r − e)`. The force is explicit in the positions,
+    /// `F = k x_r + k_s (x_r − e)`, so its change per tick is at most
+    /// `(k + k_s) |Δx_r| ≤ max_fraction · k_max · v h`; rapier's symplectic Euler keeps the
+    /// spring stable while `k h² / M < 4`, and the springs are capped at `M / h²` (a 1 g brick
+    /// at 1 kHz: 1000 N/m) so they always are.
     fn coupling_pull(
         &self,
         h: &Held,
@@ -362,23 +364,21 @@ impl Hand {
         if m.is_nan() || m <= 0.0 {
             return (Vector::ZERO, Vector::ZERO);
         }
+        let dt = params.dt_s;
+        let cap = m / (dt * dt);
         let k = Self::coupling_stiffness(params, limits);
         let c = &params.coupling;
         let k_series = (c.max_fraction - c.stiffness_fraction) * limits.max_stiffness_n_per_m;
-        let b = 2.0 * params.coupling.damping_ratio * (k * m).sqrt();
-        let dt = params.dt_s;
-        let x = rb.translation();
-        let v = rb.linvel();
-        let target = self.proxy + h.offset;
-        let v_rel = Vector::from_array(self.grip_velocity.velocity()) - v;
-        let d = if b > 0.0 && k_series > 0.0 {
+        let b = 2.0 * c.damping_ratio * (k * m).sqrt();
+        let lead = self.proxy + h.offset - rb.translation();
+        let (damper, e) = if b > 0.0 && k_series > 0.0 {
             let r = dt * k_series / b;
-            (self.damper + v_rel * r) / (1.0 + r)
+            let e = (self.damper + lead * r) / (1.0 + r);
+            ((lead - e) * k_series.min(cap), e)
         } else {
-            Vector::ZERO
+            (Vector::ZERO, Vector::ZERO)
         };
-        let k_eff = k.min(m / (dt * dt));
-        ((target - x) * k_eff + d * b, d)
+        (lead * k.min(cap) + damper, e)
     }
 
     /// Applies a change of the `inertia` switch to a carried brick: it becomes a coupled body
@@ -477,7 +477,7 @@ impl Hand {
         let Some(h) = self.held.take() else {
             return;
         };
-        let mut v = Vector::from_array(self.motion.velocity());
+        let mut v = Vector::from_array(self.grip_velocity.velocity());
         if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
             if h.coupled {
                 // A coupled brick leaves the hand with its own velocity: nothing to estimate.
@@ -525,7 +525,13 @@ impl Hand {
         let collider = bricks.collider(h.brick);
         let e = params.brick_half_extents_m;
         let cuboid = Cuboid::new(Vector::from_array(e));
-        let pose = Pose::from_parts(self.proxy + offset, rotation);
+        // A coupled brick turns about the grip point where it hangs now: its lead on the brick
+        // (the sag under its weight) is kept, so the felt force does not jump.
+        let lead = match bricks.phys.bodies.get(bricks.body(h.brick)) {
+            Some(rb) if h.coupled => self.proxy + h.offset - rb.translation(),
+            _ => Vector::ZERO,
+        };
+        let pose = Pose::from_parts(self.proxy + offset - lead, rotation);
         let blocked = {
             let qp = bricks
                 .phys

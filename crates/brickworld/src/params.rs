@@ -34,6 +34,14 @@ pub struct Params {
     pub inertia: Inertia,
     /// The virtual coupling of a carried brick (used when `inertia = "coupling"`).
     pub coupling: Coupling,
+    /// A rigidly carried brick (`inertia = "paper"` or `"off"`) leaves the hand with the grip
+    /// point's velocity, estimated from its sampled positions by adaptive windowing (FOAW,
+    /// [`crate::AdaptiveWindow`]): its band, m, one encoder count mapped to the world (the
+    /// default: a Falcon's 0.0635 mm at ×20; 0 for exact positions). Range `[0, 0.1]`. (A
+    /// coupled brick leaves with its own velocity: nothing is estimated.)
+    pub release_velocity_band_m: f64,
+    /// Longest window of that estimate, ticks. Range `[1, 200]`.
+    pub release_velocity_max_window: usize,
     /// How the cursor acceleration for the paper's inertial force is estimated.
     pub accel_estimator: AccelEstimator,
     /// Mass of one brick in kg. Range `[1e-3, 100]`.
@@ -82,6 +90,8 @@ impl Default for Params {
             friction: 0.6,
             inertia: Inertia::Coupling,
             coupling: Coupling::default(),
+            release_velocity_band_m: 0.001_27,
+            release_velocity_max_window: 25,
             accel_estimator: AccelEstimator::Paper,
             brick_mass_kg: 0.5,
             brick_half_extents_m: [0.1, 0.05, 0.03],
@@ -173,11 +183,6 @@ pub struct Coupling {
     /// `(stiffness_fraction, 1]`; below 1 it leaves the device a stability margin of
     /// `1 / max_fraction` against its rated stiffness.
     pub max_fraction: f64,
-    /// Band of the adaptive-window velocity the damper uses, m: one encoder count mapped to the
-    /// world (0 for exact positions). Range `[0, 0.1]`.
-    pub velocity_band_m: f64,
-    /// Longest window of that velocity estimate, ticks. Range `[1, 200]`.
-    pub velocity_max_window: usize,
 }
 
 impl Default for Coupling {
@@ -186,9 +191,6 @@ impl Default for Coupling {
             stiffness_fraction: 0.3,
             max_fraction: 0.6,
             damping_ratio: 0.9,
-            // One Falcon count (0.0635 mm) at the default ×20 mapping.
-            velocity_band_m: 0.001_27,
-            velocity_max_window: 5,
         }
     }
 }
@@ -399,14 +401,14 @@ impl Params {
             2.0,
         )?;
         range(
-            "coupling.velocity_band_m",
-            c.velocity_band_m,
+            "release_velocity_band_m",
+            self.release_velocity_band_m,
             Lo::Closed(0.0),
             0.1,
         )?;
         count(
-            "coupling.velocity_max_window",
-            c.velocity_max_window,
+            "release_velocity_max_window",
+            self.release_velocity_max_window,
             1,
             200,
         )?;

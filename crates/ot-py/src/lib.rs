@@ -20,6 +20,7 @@
 
 pub mod brick;
 mod convert;
+pub mod device_model;
 pub mod envelope;
 mod interrupt;
 mod json;
@@ -55,6 +56,8 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(session::render_audio, m)?)?;
     m.add_function(wrap_pyfunction!(session::resolve_scene, m)?)?;
     m.add_class::<live::Session>()?;
+    m.add_class::<device_model::DeviceModel>()?;
+    m.add_function(wrap_pyfunction!(device_model::check_closed_loop, m)?)?;
     // The device bridge's client and the device adapters are Python (they import the devices'
     // Python SDKs); the source ships inside the extension and becomes `nanohaptics.bridge`.
     let py = m.py();
@@ -84,6 +87,19 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     for name in ["sweep", "grid", "run_seed"] {
         m.add(name, sweeps.getattr(name)?)?;
     }
+    // The loop closed around a Session through a DeviceModel (`nanohaptics.closed_loop`),
+    // re-exported as nanohaptics.closed_loop.
+    let closed = PyModule::from_code(
+        py,
+        pyo3::ffi::c_str!(include_str!("../python/nanohaptics/closed_loop.py")),
+        c"nanohaptics/closed_loop.py",
+        c"nanohaptics.closed_loop",
+    )?;
+    m.add_submodule(&closed)?;
+    py.import("sys")?
+        .getattr("modules")?
+        .set_item("nanohaptics.closed_loop", &closed)?;
+    m.add("closed_loop", closed.getattr("closed_loop")?)?;
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

@@ -173,9 +173,9 @@ fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<(Overrides, Ove
 
 /// A scene resolved on this side (files read, overrides applied and validated): its TOML
 /// text, its script's TOML text and the device model it runs with.
-struct Resolved {
-    source: SceneSource,
-    script: String,
+pub(crate) struct Resolved {
+    pub(crate) source: SceneSource,
+    pub(crate) script: String,
     file: SceneFile,
     model: DeviceModel,
 }
@@ -210,7 +210,7 @@ fn scene_source(scene: &Bound<'_, PyAny>) -> PyResult<(SceneSource, Option<Strin
 
 /// `scene` (a path, a built-in name, or a dict of `resolve_scene`) and `script`, with
 /// `overrides` applied; every field checked as a scene file's is (names, types, ranges).
-fn resolve(
+pub(crate) fn resolve(
     scene: &Bound<'_, PyAny>,
     script: Option<&Bound<'_, PyAny>>,
     overrides: Option<&Bound<'_, PyAny>>,
