@@ -23,7 +23,7 @@ if [ "$assemble_only" = 0 ] && [ ! -x .venv-bench/bin/python ]; then
 fi
 export NANOHAPTICS_PYTHON="$PWD/.venv-bench/bin/python"
 
-order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live brickworld nanoworld teaching-game render sweeps fuzz)
+order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live zwidth brickworld nanoworld teaching-game render sweeps fuzz)
 for crate in "${order[@]}"; do
   if [ "$assemble_only" = 0 ] && [ -f "crates/$crate/examples/bench_report.rs" ]; then
     echo "==> $crate-report"
@@ -33,6 +33,8 @@ done
 if [ "$assemble_only" = 0 ]; then
   echo "==> haptic-loop-live-report (4 real-time sessions, about 3.5 minutes)"
   cargo run --release -q -p haptic-loop --example haptic-loop-live-report -- --out docs/bench/haptic-loop-live.md > /dev/null
+  echo "==> haptic-loop-zwidth-report (Z-width and margins in closed loop, about 10 s)"
+  cargo run --release -q -p haptic-loop --example haptic-loop-zwidth-report -- --out docs/bench/zwidth.md > /dev/null
   echo "==> haptic-loop-teaching-report (the lesson and the sound, three runs each)"
   cargo run --release -q -p haptic-loop --example haptic-loop-teaching-report -- --out docs/bench/teaching-game.md > /dev/null
   echo "==> ot-envelope figures (paper Figs. 2, 3, 4, 7, 8)"

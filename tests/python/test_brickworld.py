@@ -83,8 +83,23 @@ def _grab_and_lift(w, lift_z=0.3, hold_ticks=600):
     return w.run(path, buttons)
 
 
-def test_weight_of_a_carried_brick_is_m_g():
+def test_a_brick_carried_through_the_coupling_weighs_m_g():
+    # The default: the brick hangs on the virtual coupling; held still, the hand feels M g
+    # through it (issue 22: within 1 %), and no separate weight or inertia term.
     w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}]})
+    assert w.params["inertia"] == "coupling"
+    r = _grab_and_lift(w, hold_ticks=2000)
+    m, g = w.params["brick_mass_kg"], w.params["gravity_m_per_s2"]
+    assert r["force"][-1][2] == pytest.approx(-m * g, rel=0.01)
+    np.testing.assert_array_equal(r["coupling_force"][-1], r["force"][-1])
+    np.testing.assert_array_equal(r["weight_force"][-1], [0, 0, 0])
+    # The coupling's stiffness (0.3 of the Falcon's 3000 N/m) is what the device renders.
+    assert r["stiffness"][-1] == pytest.approx(900.0)
+
+
+def test_weight_of_a_carried_brick_is_m_g():
+    # The paper's rigid carry: weight −M g and inertia −M a as separate terms.
+    w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}], "inertia": "paper"})
     r = _grab_and_lift(w)
     assert any(e["type"] == "grabbed" and e["brick"] == 0 for _, e in r["events"])
     assert r["held"][-1] == 0 and w.held_brick == 0
@@ -108,7 +123,7 @@ def test_weight_of_a_carried_brick_is_m_g():
 
 
 def test_inertia_of_a_carried_brick_is_minus_m_a():
-    w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}], "gravity_m_per_s2": 0.0})
+    w = nh.BrickWorld({"bricks": [{"center_m": [0, 0, HZ]}], "gravity_m_per_s2": 0.0, "inertia": "paper"})
     _grab_and_lift(w, hold_ticks=50)
     # Accelerate the carried brick along x with a = 2 m/s²: x = a t²/2.
     a, dt = 2.0, w.params["dt_s"]

@@ -136,6 +136,10 @@ fn ticks_to_py<'py>(
         array2_flat(py, flat(|r| r.inertia_force_n), 3)?,
     )?;
     d.set_item(
+        "coupling_force",
+        array2_flat(py, flat(|r| r.coupling_force_n), 3)?,
+    )?;
+    d.set_item(
         "acceleration",
         array2_flat(py, flat(|r| r.acceleration_m_per_s2), 3)?,
     )?;
@@ -299,7 +303,8 @@ impl BrickWorld {
     /// Returns:
     ///     the step report as a dict: "tick", "force_n" (device force, N,
     ///     within the device limit), "saturated", "spring_force_n",
-    ///     "stiffness_n_per_m", "weight_force_n", "inertia_force_n",
+    ///     "stiffness_n_per_m", "weight_force_n", "inertia_force_n" (the paper's
+    ///     inertia), "coupling_force_n" (the virtual coupling's pull on the hand),
     ///     "acceleration_m_per_s2", "proxy_penetration_m" and "events" (dicts
     ///     with a "type" key: "grabbed", "released", "thrown", "rotated",
     ///     "spawned", "touch_began", "slot_filled", ...).
@@ -330,7 +335,7 @@ impl BrickWorld {
     ///
     /// Returns:
     ///     dict of per-tick arrays: "force", "spring_force", "weight_force",
-    ///     "inertia_force" (T, 3) N, "acceleration" (T, 3) m/s², "proxy"
+    ///     "inertia_force", "coupling_force" (T, 3) N, "acceleration" (T, 3) m/s², "proxy"
     ///     (T, 3) m (after the tick), "cursor" (T, 3) m, "buttons" (T, 4)
     ///     bool, "saturated" (T,) bool, "stiffness" (T,) N/m, "penetration"
     ///     (T,) m, "held" (T,) int (brick id or -1), "filled" (T,) int
