@@ -470,7 +470,7 @@ class Session:
         """Local stiffness sent with the last force, (3, 3) N/m."""
     @property
     def status(self) -> int:
-        """Status bits of the last tick (1 clamped, 2 input invalid, ..., 32 watchdog)."""
+        """Status bits of the last tick (1 clamped, 2 input invalid, ..., 32 watchdog, 64 passivity, 128 rate limit)."""
     @property
     def events(self) -> list:
         """Events of the last tick: [(name, detail)]."""

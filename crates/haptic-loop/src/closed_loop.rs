@@ -147,7 +147,7 @@ pub fn run(
         let jump = crate::vec3::norm(crate::vec3::sub(f, prev));
         rep.max_jump_n = rep.max_jump_n.max(jump);
         rep.peak_force_n = rep.peak_force_n.max(crate::vec3::norm(f));
-        if jump > JUMP_N && !last_declared.is_some_and(|t| i - t <= window) {
+        if jump > JUMP_N && last_declared.is_none_or(|t| i - t > window) {
             rep.undeclared_jumps += 1;
         }
         prev = f;

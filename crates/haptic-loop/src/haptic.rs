@@ -277,10 +277,12 @@ impl HapticLoop {
         if let Some(d) = dp {
             self.tank_j -= vec3::dot(f_prev, d);
         }
-        if dp.is_some() || self.last_position_m.is_none() {
-            if HapticLoop::check_sample(&self.config.specs, &sample).is_none() {
-                self.last_position_m = Some(sample.position_m);
-            }
+        // (a fresh valid sample gave `dp`; the first valid one starts the observer)
+        if dp.is_some()
+            || (self.last_position_m.is_none()
+                && HapticLoop::check_sample(&self.config.specs, &sample).is_none())
+        {
+            self.last_position_m = Some(sample.position_m);
         }
         let r = &mut self.result;
         r.tick = tick;

@@ -127,7 +127,8 @@ fn the_papers_inertia_buzzes_where_the_coupling_does_not() {
             "[brickworld.params]\ninertia = \"paper\"\n",
         )
     };
-    let cases: [(&str, &dyn Fn(String) -> String, bool); 4] = [
+    type Edit<'a> = &'a dyn Fn(String) -> String;
+    let cases: [(&str, Edit, bool); 4] = [
         ("paper, safety off", &|t| paper(no_safety(t)), false),
         ("paper, safety on", &paper, false),
         ("coupling, safety off", &no_safety, true),

@@ -187,7 +187,8 @@ impl Session {
     }
 
     /// Status bits of the last tick (1 clamped, 2 input invalid, 4 deadline
-    /// missed, 8 stiffness over cap, 16 force invalid, 32 watchdog).
+    /// missed, 8 stiffness over cap, 16 force invalid, 32 watchdog, 64 passivity
+    /// controller, 128 force-rate limit).
     #[getter]
     fn status(&self) -> PyResult<u8> {
         Ok(self.stepper()?.haptic_loop().last_result().status)

@@ -85,7 +85,7 @@ pub struct ForceReply {
     /// Local stiffness, N/m, device frame, row-major 3×3.
     pub stiffness_n_per_m: [f64; 9],
     /// Status bits of the tick (1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over
-    /// cap, 16 force invalid, 32 watchdog).
+    /// cap, 16 force invalid, 32 watchdog, 64 passivity controller, 128 force-rate limit).
     pub status: u8,
 }
 

@@ -130,9 +130,10 @@ recording_channels! {
         engagement: f64 => engagement = r.engagement,
         /// Status bits (`haptic::status`): 1 clamped, 2 input invalid, 4 deadline missed, 8
         /// scene stiffness over the cap, 16 scene force not finite, 32 watchdog (stale device
-        /// samples reduced the force).
+        /// samples reduced the force), 64 the passivity controller added damping, 128 the
+        /// force-rate limit held the change back.
         #[msg = "bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid,"]
-        #[msg = "32 watchdog"]
+        #[msg = "32 watchdog, 64 passivity controller, 128 force-rate limit"]
         status: u8 => status = r.status,
         /// Watchdog factor applied to the force, 0–1 (1: device samples fresh).
         #[msg = "watchdog factor applied to the force (1: device samples fresh)"]
@@ -442,7 +443,7 @@ mod tests {
              float64[3] device_force_n\n\
              float64 engagement\n\
              # bits: 1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over cap, 16 force invalid,\n\
-             # 32 watchdog\n\
+             # 32 watchdog, 64 passivity controller, 128 force-rate limit\n\
              uint8 status\n\
              # watchdog factor applied to the force (1: device samples fresh)\n\
              float64 watchdog\n\
