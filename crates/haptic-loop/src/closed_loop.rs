@@ -66,6 +66,9 @@ pub struct Report {
     /// Largest local stiffness sent with the force (a diagonal entry), N/m: the stiffest
     /// spring the world rendered at the device.
     pub max_stiffness_n_per_m: f64,
+    /// When the scene's house task was completed, s (its `complete_s` state field: −1 while
+    /// not complete; `None` for a scene without a house task).
+    pub house_complete_s: Option<f64>,
 }
 
 impl Report {
@@ -124,6 +127,7 @@ pub fn run(
         energy_to_hand_j: 0.0,
         peak_force_n: 0.0,
         max_stiffness_n_per_m: 0.0,
+        house_complete_s: None,
     };
     let mut prev = [0.0; 3];
     for i in 0..ticks {
@@ -159,6 +163,16 @@ pub fn run(
         }
     }
     rep.hf_fraction = hf_fraction(&forces, f64::from(rate), BUZZ_HZ);
+    if let Some(i) = lp
+        .scene()
+        .state_fields()
+        .iter()
+        .position(|f| f == "complete_s")
+    {
+        let mut state = Vec::new();
+        lp.scene_state(&mut state);
+        rep.house_complete_s = state.get(i).copied();
+    }
     rep.energy_to_hand_j = dev.plant().energy_to_hand_j();
     Ok(rep)
 }

@@ -77,6 +77,7 @@ fn line(label: &str, r: &Report) -> String {
 #[test]
 fn every_scene_is_stable_through_every_device_and_grip() {
     let mut failures = Vec::new();
+    let mut unbuilt = Vec::new();
     let mut runs = 0;
     for (scene, script) in SCENES {
         for mech in PRESETS {
@@ -97,9 +98,17 @@ fn every_scene_is_stable_through_every_device_and_grip() {
                         grip.label(),
                         if quantized { "counts" } else { "ideal" }
                     );
-                    println!("{}", line(&label, &r));
+                    println!(
+                        "{}, house complete at {:?} s",
+                        line(&label, &r),
+                        r.house_complete_s
+                    );
                     if !r.stable() {
-                        failures.push(label);
+                        failures.push(label.clone());
+                    }
+                    // Both house tasks still complete with a hand in the loop.
+                    if r.house_complete_s.is_some_and(|t| t < 0.0) {
+                        unbuilt.push(label);
                     }
                 }
             }
@@ -108,6 +117,17 @@ fn every_scene_is_stable_through_every_device_and_grip() {
     // 4 scenes × 4 devices × 2 grips × 2 sensings, less the optical tweezers on a Touch.
     assert_eq!(runs, 60);
     assert!(failures.is_empty(), "unstable runs: {failures:#?}");
+    // The one exception: a Touch renders 400 N/m, so the brick world's coupling is 48 N/m in
+    // the world and the 0.5 kg brick hangs 10 cm under a hand whose script was written for a
+    // Falcon; held loosely, its set-downs miss the slots (held firmly, the house completes).
+    assert_eq!(
+        unbuilt,
+        [
+            "brickworld.toml touch loose counts",
+            "brickworld.toml touch loose ideal"
+        ],
+        "houses not completed"
+    );
 }
 
 /// Issue 22's case: a brick carried on a Falcon held loosely, with encoder counts. The paper's
