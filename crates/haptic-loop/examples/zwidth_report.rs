@@ -202,6 +202,7 @@ fn main() {
         "stable up to s =",
         "stiffness margin",
     ]);
+    let mut world_figs = Vec::new();
     for (world, scene, script) in worlds {
         let text = read(scene);
         let stext = read(script);
@@ -218,7 +219,9 @@ fn main() {
                     "[loop]\npassivity = false\nforce_rate_limit = false\n",
                 )
         };
-        for mech in PRESETS {
+        let (mut ok_pts, mut bad_pts) = (Vec::new(), Vec::new());
+        for (di, mech) in PRESETS.into_iter().enumerate() {
+            let row = (di + 1) as f64;
             let mut k0 = None;
             let mut margin = None;
             for s in SCALES {
@@ -238,9 +241,12 @@ fn main() {
                 if std::env::var_os("ZWIDTH_VERBOSE").is_some() {
                     eprintln!("{world} {} s = {s}: {r:?}", mech.name);
                 }
+                let k = k0.unwrap_or(0.0) * s;
                 if !r.stable() {
+                    bad_pts.push((k, row));
                     break;
                 }
+                ok_pts.push((k, row));
                 margin = Some(s);
             }
             let Some(k0) = k0 else {
@@ -269,8 +275,24 @@ fn main() {
             ])
             .unwrap();
         }
+        let file = format!("zwidth-world-{}.png", world.replace(' ', "-"));
+        Chart::new(
+            &format!(
+                "The {world} on each device: its stiffest spring × s (loose grip, counts)"
+            ),
+            Axis::log("stiffest spring at the hand, N/m", 100.0, 2e5),
+            Axis::linear("device: 1 falcon, 2 touch, 3 delta3, 4 inverse3", 0.5, 4.5),
+        )
+        .with(Series::dots("stable", ok_pts, RGBColor(40, 150, 60), 6))
+        .with(Series::dots("unstable", bad_pts, RGBColor(210, 50, 40), 6))
+        .save(&md.figure(&file), (900, 360))
+        .unwrap();
+        world_figs.push((world, file));
     }
     md.heading("Each world's stiffness margin (loose grip, counts, safety layer off)");
+    for (world, file) in &world_figs {
+        md.image(&format!("stiffness margin of the {world} on every device"), file);
+    }
     md.para(
         "The world's device-side impedance scaled by s until the closed loop is no longer \
          stable; the defaults sit at s = 1. The stiffest spring column is the largest local \
