@@ -27,8 +27,8 @@ impl Hold {
     }
 }
 
-/// Longest integration substep inside a servo period, s.
-const MAX_SUBSTEP_S: f64 = 50e-6;
+/// Longest integration substep, ns.
+const MAX_SUBSTEP_NS: u64 = 50_000;
 
 /// A device held by a hand, integrated in time.
 ///
@@ -47,7 +47,10 @@ pub struct Plant {
     grip: Grip,
     x: Vec3,
     v: Vec3,
-    time_s: f64,
+    /// Time integrated so far, ns (an integer clock: servo instants never drift).
+    clock_ns: u64,
+    /// The device's next servo instant, ns.
+    next_servo_ns: u64,
     energy_to_hand_j: f64,
     last_force_n: Vec3,
 }
@@ -64,7 +67,8 @@ impl Plant {
             grip,
             x: start_m,
             v: [0.0; 3],
-            time_s: 0.0,
+            clock_ns: 0,
+            next_servo_ns: 0,
             energy_to_hand_j: 0.0,
             last_force_n: [0.0; 3],
         }
@@ -97,7 +101,7 @@ impl Plant {
 
     /// Time integrated so far, s.
     pub fn time_s(&self) -> f64 {
-        self.time_s
+        self.clock_ns as f64 * 1e-9
     }
 
     /// Work the device's motors have done on the stylus and hand since the start, J (positive:
@@ -139,34 +143,44 @@ impl Plant {
 
     /// Advances by one tick of `dt_s` under `hold`. `intent(t)` gives the operator's intended
     /// position (m) and velocity (m/s) at `t` seconds after the start of this tick.
+    ///
+    /// The device renders on its own servo clock: at each of its servo instants (every
+    /// `1 / servo_rate_hz`, counted in whole nanoseconds from the start) it reads its encoders
+    /// and renders the latest hold; a loop faster than the servo has its answers sampled, a
+    /// slower one has each answer rendered over several servo periods.
     pub fn advance(&mut self, dt_s: f64, intent: impl Fn(f64) -> (Vec3, Vec3), hold: &Hold) {
-        let periods = (dt_s * self.mech.servo_rate_hz).round().max(1.0) as usize;
-        let h_servo = dt_s / periods as f64;
-        let inner = (h_servo / MAX_SUBSTEP_S).ceil().max(1.0) as usize;
-        let h = h_servo / inner as f64;
+        let dt_ns = (dt_s * 1e9).round().max(1.0) as u64;
+        let servo_ns = (1e9 / self.mech.servo_rate_hz).round().max(1.0) as u64;
+        let n = dt_ns.div_ceil(MAX_SUBSTEP_NS).max(1);
         let m = self.mech.moving_mass_kg + self.grip.mass_kg;
         let k = self.grip.stiffness_n_per_m;
         let b = self.grip.damping_n_s_per_m;
         let c = self.mech.viscous_n_s_per_m;
-        let denom = m + h * (b + c) + h * h * k;
-        for p in 0..periods {
-            let f = self.rendered_force(hold, self.reading_m());
-            self.last_force_n = f;
-            for s in 0..inner {
-                let t = (p * inner + s + 1) as f64 * h;
-                let (xi, vi) = intent(t);
-                for a in 0..3 {
-                    let v_new =
-                        (m * self.v[a] + h * (k * (xi[a] - self.x[a]) + b * vi[a] + f[a])) / denom;
-                    let dx = h * v_new;
-                    self.energy_to_hand_j += f[a] * dx;
-                    self.x[a] += dx;
-                    self.v[a] = v_new;
+        let start = self.clock_ns;
+        for s in 0..n {
+            let t0 = start + s * dt_ns / n;
+            let t1 = start + (s + 1) * dt_ns / n;
+            if t0 >= self.next_servo_ns {
+                self.last_force_n = self.rendered_force(hold, self.reading_m());
+                while self.next_servo_ns <= t0 {
+                    self.next_servo_ns += servo_ns;
                 }
-                self.end_stop();
             }
+            let f = self.last_force_n;
+            let h = (t1 - t0) as f64 * 1e-9;
+            let denom = m + h * (b + c) + h * h * k;
+            let (xi, vi) = intent((t1 - start) as f64 * 1e-9);
+            for a in 0..3 {
+                let v_new =
+                    (m * self.v[a] + h * (k * (xi[a] - self.x[a]) + b * vi[a] + f[a])) / denom;
+                let dx = h * v_new;
+                self.energy_to_hand_j += f[a] * dx;
+                self.x[a] += dx;
+                self.v[a] = v_new;
+            }
+            self.end_stop();
         }
-        self.time_s += dt_s;
+        self.clock_ns = start + dt_ns;
     }
 
     fn end_stop(&mut self) {
@@ -274,6 +288,28 @@ mod tests {
             (order - 1.0).abs() < 0.15,
             "order {order} ({slow} vs {fast})"
         );
+    }
+
+    /// A 10 kHz loop on a 1 kHz device: the device samples the latest answer once per its
+    /// own servo period, so ten answers make one rendered force.
+    #[test]
+    fn a_loop_faster_than_the_servo_is_sampled_at_the_servo_rate() {
+        let mut p = Plant::new(
+            Mechanics::FALCON.without_quantization(),
+            Grip::FIRM,
+            [0.0; 3],
+        );
+        let mut rendered = Vec::new();
+        for i in 0..100 {
+            let hold = Hold::constant([0.0, 0.0, 0.01 * i as f64]);
+            p.advance(1e-4, |_| ([0.0; 3], [0.0; 3]), &hold);
+            rendered.push(p.last_force_n()[2]);
+        }
+        // Ticks 0–9 render the answer of tick 0, ticks 10–19 that of tick 10, ...
+        for (i, f) in rendered.iter().enumerate() {
+            assert_eq!(*f, 0.01 * (i / 10 * 10) as f64, "tick {i}");
+        }
+        assert_eq!(p.time_s(), 0.01);
     }
 
     #[test]

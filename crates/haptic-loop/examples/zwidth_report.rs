@@ -277,9 +277,7 @@ fn main() {
         }
         let file = format!("zwidth-world-{}.png", world.replace(' ', "-"));
         Chart::new(
-            &format!(
-                "The {world} on each device: its stiffest spring × s (loose grip, counts)"
-            ),
+            &format!("The {world} on each device: its stiffest spring × s (loose grip, counts)"),
             Axis::log("stiffest spring at the hand, N/m", 100.0, 2e5),
             Axis::linear("device: 1 falcon, 2 touch, 3 delta3, 4 inverse3", 0.5, 4.5),
         )
@@ -291,7 +289,10 @@ fn main() {
     }
     md.heading("Each world's stiffness margin (loose grip, counts, safety layer off)");
     for (world, file) in &world_figs {
-        md.image(&format!("stiffness margin of the {world} on every device"), file);
+        md.image(
+            &format!("stiffness margin of the {world} on every device"),
+            file,
+        );
     }
     md.para(
         "The world's device-side impedance scaled by s until the closed loop is no longer \

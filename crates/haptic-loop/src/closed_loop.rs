@@ -84,7 +84,7 @@ impl Report {
 #[derive(Debug, thiserror::Error)]
 pub enum ClosedLoopError {
     /// The scene refused the device (e.g. a spring stiffer than the device allows).
-    #[error("scene: {0}")]
+    #[error("{0}")]
     Scene(#[from] SceneError),
     /// The script does not fit the device.
     #[error("script: {0}")]

@@ -22,11 +22,16 @@ fn read(name: &str) -> String {
     std::fs::read_to_string(root().join("scenes").join(name)).unwrap()
 }
 
-const SCENES: [(&str, &str); 4] = [
+const SCENES: [(&str, &str); 5] = [
     ("wall.toml", "wall.script.toml"),
     ("nanoworld.toml", "nanoworld.script.toml"),
     ("brickworld.toml", "brickworld.script.toml"),
     ("optical_tweezers.toml", "optical_tweezers.script.toml"),
+    // The 10 kHz loop on devices whose servo runs at 1 or 4 kHz: they sample its answers.
+    (
+        "optical_tweezers_10khz.toml",
+        "optical_tweezers.script.toml",
+    ),
 ];
 
 /// Runs a scene; a device softer than the brick world was written for gets its proxy spring
@@ -114,8 +119,8 @@ fn every_scene_is_stable_through_every_device_and_grip() {
             }
         }
     }
-    // 4 scenes × 4 devices × 2 grips × 2 sensings, less the optical tweezers on a Touch.
-    assert_eq!(runs, 60);
+    // 5 scenes × 4 devices × 2 grips × 2 sensings, less the optical tweezers on a Touch.
+    assert_eq!(runs, 72);
     assert!(failures.is_empty(), "unstable runs: {failures:#?}");
     // The one exception: a Touch renders 400 N/m, so the brick world's coupling is 48 N/m in
     // the world and the 0.5 kg brick hangs 10 cm under a hand whose script was written for a
