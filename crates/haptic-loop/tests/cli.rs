@@ -250,6 +250,79 @@ fn a_bridged_live_session_against_fake_device_replays_bit_for_bit() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("identical bit for bit"));
 }
 
+/// Issue 22 over the bridge: a modelled Falcon held loosely carries the first brick of the
+/// brick script for real (4 s, real time) with no force change above 1 N between periods,
+/// the motors taking energy from the hand rather than giving it, and the session replays bit
+/// for bit. Bad model and grip arguments are named.
+#[test]
+fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let rec = tmp("modelled.mcap");
+    let sim = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args([
+            "run",
+            "scenes/brickworld.toml",
+            "--device",
+            &format!("udp:127.0.0.1:{port}"),
+            "--realtime",
+            "--out",
+            rec.to_str().unwrap(),
+            "--wait-s",
+            "30",
+            "--json",
+        ])
+        .current_dir(root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let dev = nh(&[
+        "fake-device",
+        &format!("udp:127.0.0.1:{port}"),
+        "--script",
+        "scenes/brickworld.script.toml",
+        "--model",
+        "falcon",
+        "--grip",
+        "loose",
+        "--seconds",
+        "4",
+        "--json",
+    ]);
+    let d = json(&dev);
+    let s = json(&sim.wait_with_output().unwrap());
+    assert_eq!(s["end"], "device_ended");
+    assert_eq!(d["jumps_over_1n"], 0, "{d}");
+    assert!(d["max_jump_n"].as_f64().unwrap() < 1.0);
+    assert!(d["energy_to_hand_j"].as_f64().unwrap() < 0.0, "{d}");
+    let o = nh(&["replay", rec.to_str().unwrap(), "--verify"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    for (args, err) in [
+        (
+            vec!["--model", "omega"],
+            "error: --model: unknown device model `omega` (allowed: falcon, touch, delta3, inverse3)",
+        ),
+        (
+            vec!["--grip", "k=0"],
+            "error: --grip: grip `k` = 0 is out of range (allowed: 0 < k ≤ 10000 N/m)",
+        ),
+        (
+            vec!["--ideal"],
+            "error: --ideal needs --grip (it removes a modelled device's encoder counts)",
+        ),
+    ] {
+        let mut a = vec!["fake-device", "udp:127.0.0.1:1"];
+        a.extend(args);
+        let o = nh(&a);
+        assert_eq!(o.status.code(), Some(1));
+        assert_eq!(String::from_utf8_lossy(&o.stderr).trim(), err);
+    }
+}
+
 /// From a folder with no scenes: built-in scenes by name, `scenes export`, and the exported
 /// copy (a file on disk) overriding the built-in.
 #[test]
