@@ -641,6 +641,90 @@ stiffness_n_per_m = 5000.0
         assert_eq!(names.last().unwrap().0, "deadline.missed");
     }
 
+    /// The force-rate limit: a step into the wall that asks 6 N at once is rendered as 3 N
+    /// (the Falcon's 3000 N/m × 1 m/s × 1 ms), then 6 N, with one event; off, at once.
+    #[test]
+    fn the_force_rate_limit_holds_a_step_to_k_max_times_one_metre_per_second() {
+        let mut l = looped(WALL);
+        l.tick(at(0.001), false);
+        let r = l.tick(at(-0.002), false).clone();
+        assert_eq!(r.device_force_n, [0.0, 0.0, 3.0]);
+        assert_eq!(r.status, status::RATE_LIMITED);
+        let ev = r
+            .events
+            .iter()
+            .find(|e| e.name == "safety.rate_limited")
+            .unwrap();
+        assert_eq!(
+            ev.detail,
+            "force change of 6.000 N in one tick held to 3.000 N"
+        );
+        let r = l.tick(at(-0.002), false).clone();
+        assert!((r.device_force_n[2] - 6.0).abs() < 1e-12);
+        assert_eq!(r.status, 0);
+        let mut off =
+            looped(&WALL.replace("engage_s = 0.0", "engage_s = 0.0\nforce_rate_limit = false"));
+        off.tick(at(0.001), false);
+        assert!((off.tick(at(-0.002), false).device_force_n[2] - 6.0).abs() < 1e-12);
+    }
+
+    /// The passivity observer and controller: a stylus that starts deep in the wall and is
+    /// pushed out by it takes energy the wall never took from it. Past the 20 mJ reserve the
+    /// controller adds damping against the motion, α = −E / (T v²), at most 2 N·s/m; the
+    /// observer reads the energy exactly; off, the force is the wall's.
+    #[test]
+    fn the_passivity_controller_damps_energy_returned_beyond_the_reserve() {
+        let path = |n: usize| -0.005 + 5e-5 * n as f64; // out at 0.05 m/s
+        let run = |text: &str| {
+            let mut l = looped(text);
+            let mut out = Vec::new();
+            for n in 0..100 {
+                let r = l.tick(at(path(n)), false).clone();
+                out.push((r, l.passivity_tank_j()));
+            }
+            out
+        };
+        let on = run(WALL);
+        let off = run(&WALL.replace("engage_s = 0.0", "engage_s = 0.0\npassivity = false"));
+        // The observer, on or off: 0.02 J minus Σ F_(n−1) · (p_n − p_(n−1)).
+        let mut e = 0.02;
+        for n in 1..100 {
+            e -= off[n - 1].0.device_force_n[2] * (path(n) - path(n - 1));
+            assert!((off[n].1 - e).abs() < 1e-12, "tick {n}");
+        }
+        let first = on
+            .iter()
+            .position(|(r, _)| r.status & status::PASSIVITY != 0)
+            .unwrap();
+        assert!(on[first - 1].1 >= 0.0 && on[first].1 < 0.0);
+        assert!(
+            on[first]
+                .0
+                .events
+                .iter()
+                .any(|e| e.name == "safety.passivity")
+        );
+        let mut acted = 0;
+        for n in first..100 {
+            let (r, tank) = &on[n];
+            if r.status & status::PASSIVITY == 0 {
+                assert!(*tank >= 0.0, "tick {n}: a deficit left alone");
+                continue;
+            }
+            acted += 1;
+            // The reading at tick n holds the work of tick n − 1's force: the deficit the
+            // controller damps, against the motion (+z at 0.05 m/s), at most 2 N·s/m.
+            let alpha = (-tank / (1e-3 * 0.05 * 0.05)).min(2.0);
+            let wall = off[n].0.device_force_n[2];
+            let cut = wall - r.device_force_n[2];
+            assert!((cut - alpha * 0.05).abs() < 1e-9, "tick {n}: cut {cut} N");
+        }
+        assert!(acted > 10);
+        for (n, (r, _)) in off.iter().enumerate() {
+            assert_eq!(r.status & status::PASSIVITY, 0, "tick {n}");
+        }
+    }
+
     use proptest::prelude::*;
 
     fn coord() -> impl Strategy<Value = f64> {
