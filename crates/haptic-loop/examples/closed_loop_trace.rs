@@ -25,14 +25,7 @@ fn main() {
     }
     if let Some(scale) = a.get(6).and_then(|s| s.parse::<f64>().ok()) {
         // Scale the device-side impedance by `scale` (as the Z-width report's margins do).
-        let line = text
-            .lines()
-            .find(|l| l.trim_start().starts_with("force_scale"))
-            .unwrap()
-            .to_string();
-        let fs: f64 = line.split('=').nth(1).unwrap().trim().parse().unwrap();
-        text = text.replace(&line, &format!("force_scale = {:?}", fs * scale));
-        mech.limits.max_stiffness_n_per_m *= scale;
+        (text, mech) = haptic_loop::closed_loop::scale_impedance(&text, mech, scale);
     }
     let falcon = haptic_loop::device::DeviceModel::Falcon.specs().clone();
     let specs = haptic_loop::device::modelled::specs_of(&mech, &falcon);

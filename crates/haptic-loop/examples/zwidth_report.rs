@@ -19,7 +19,7 @@ use bench_harness::plotters::prelude::RGBColor;
 use bench_harness::report::out_arg;
 use bench_harness::{Report, Table};
 use haptic_devices::{Grip, Mechanics, PRESETS};
-use haptic_loop::closed_loop::run;
+use haptic_loop::closed_loop::{run, scale_impedance};
 
 const SCRIPT: &str = r#"
 [script]
@@ -206,18 +206,15 @@ fn main() {
     for (world, scene, script) in worlds {
         let text = read(scene);
         let stext = read(script);
-        let fs_line = text
-            .lines()
-            .find(|l| l.trim_start().starts_with("force_scale"))
-            .unwrap()
-            .to_string();
-        let fs: f64 = fs_line.split('=').nth(1).unwrap().trim().parse().unwrap();
-        let edit = |t: &str, s: f64| {
-            t.replace(&fs_line, &format!("force_scale = {:?}", fs * s))
-                .replace(
+        let edit = |s: f64, mech: Mechanics| {
+            let (t, m) = scale_impedance(&text, mech, s);
+            (
+                t.replace(
                     "[loop]\n",
                     "[loop]\npassivity = false\nforce_rate_limit = false\n",
-                )
+                ),
+                m,
+            )
         };
         let (mut ok_pts, mut bad_pts) = (Vec::new(), Vec::new());
         for (di, mech) in PRESETS.into_iter().enumerate() {
@@ -225,13 +222,8 @@ fn main() {
             let mut k0 = None;
             let mut margin = None;
             for s in SCALES {
-                let r = match run(
-                    &edit(&text, s),
-                    &stext,
-                    uncapped(mech, s),
-                    Grip::LOOSE,
-                    None,
-                ) {
+                let (t, m) = edit(s, mech);
+                let r = match run(&t, &stext, m, Grip::LOOSE, None) {
                     Ok(r) => r,
                     Err(_) => break,
                 };

@@ -177,6 +177,35 @@ pub fn run(
     Ok(rep)
 }
 
+/// A scene and a device with the device-side impedance scaled by `s` (> 0): the mapping's
+/// `force_scale` times `s` (every force and stiffness the world renders reaches the hand `s`
+/// times stronger) and the device's stiffness cap times `s` (so the world, which checks its
+/// springs against the cap mapped into its units, renders the same springs). How far `s` can
+/// go before the closed loop is unstable is the world's stiffness margin on that device.
+pub fn scale_impedance(scene_text: &str, mech: Mechanics, s: f64) -> (String, Mechanics) {
+    let line = scene_text
+        .lines()
+        .find(|l| l.trim_start().starts_with("force_scale"))
+        .map(str::to_string);
+    let fs = line
+        .as_deref()
+        .and_then(|l| l.split('=').nth(1))
+        .and_then(|v| v.split('#').next())
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .unwrap_or(1.0);
+    let scaled = format!("force_scale = {:?}", fs * s);
+    let text = match line {
+        Some(l) => scene_text.replacen(&l, &scaled, 1),
+        None if scene_text.contains("[mapping]\n") => {
+            scene_text.replacen("[mapping]\n", &format!("[mapping]\n{scaled}\n"), 1)
+        }
+        None => format!("{scene_text}\n[mapping]\n{scaled}\n"),
+    };
+    let mut m = mech;
+    m.limits.max_stiffness_n_per_m *= s;
+    (text, m)
+}
+
 /// Fraction of the power of the force series `f` (each axis, its mean removed) above
 /// `cut_hz`, for samples at `rate_hz` (0 for a constant series).
 pub fn hf_fraction(f: &[[f64; 3]], rate_hz: f64, cut_hz: f64) -> f64 {
@@ -208,6 +237,21 @@ mod tests {
 
     /// A 20 Hz sine has no power above 50 Hz; a 100 Hz one has all of it; their sum, in
     /// proportion to the squared amplitudes.
+    #[test]
+    fn impedance_scales_the_force_scale_and_the_cap() {
+        let (t, m) = scale_impedance(
+            "[mapping]\nforce_scale = 0.125   # note\n",
+            Mechanics::FALCON,
+            2.0,
+        );
+        assert_eq!(t, "[mapping]\nforce_scale = 0.25\n");
+        assert_eq!(m.limits.max_stiffness_n_per_m, 6000.0);
+        let (t, _) = scale_impedance("[mapping]\nworkspace_scale = 2.0\n", Mechanics::FALCON, 3.0);
+        assert_eq!(t, "[mapping]\nforce_scale = 3.0\nworkspace_scale = 2.0\n");
+        let (t, _) = scale_impedance("[scene]\n", Mechanics::FALCON, 3.0);
+        assert_eq!(t, "[scene]\n\n[mapping]\nforce_scale = 3.0\n");
+    }
+
     #[test]
     fn hf_fraction_splits_the_power_at_the_cut() {
         let rate = 1000.0;

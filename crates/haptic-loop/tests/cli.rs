@@ -24,6 +24,32 @@ fn nh(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// `nanohaptics run SCENE` waiting for a bridged device on loopback `port`, in real time,
+/// recording to `rec`, with `extra` arguments; stdout (its JSON summary) piped.
+fn bridged_run(scene: &str, port: u16, rec: &Path, extra: &[&str]) -> std::process::Child {
+    let device = format!("udp:127.0.0.1:{port}");
+    let mut args = vec![
+        "run",
+        scene,
+        "--device",
+        &device,
+        "--realtime",
+        "--out",
+        rec.to_str().unwrap(),
+        "--wait-s",
+        "30",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args(args)
+        .current_dir(root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 fn json(o: &Output) -> serde_json::Value {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     serde_json::from_slice(&o.stdout).unwrap()
@@ -207,26 +233,12 @@ fn a_bridged_live_session_against_fake_device_replays_bit_for_bit() {
         .unwrap()
         .port();
     let rec = tmp("live.mcap");
-    let sim = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
-        .args([
-            "run",
-            "scenes/wall.toml",
-            "--device",
-            &format!("udp:127.0.0.1:{port}"),
-            "--realtime",
-            "--live",
-            &format!("ws:127.0.0.1:{ws}"),
-            "--out",
-            rec.to_str().unwrap(),
-            "--wait-s",
-            "30",
-            "--json",
-        ])
-        .current_dir(root())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let sim = bridged_run(
+        "scenes/wall.toml",
+        port,
+        &rec,
+        &["--live", &format!("ws:127.0.0.1:{ws}")],
+    );
     let dev = nh(&[
         "fake-device",
         &format!("udp:127.0.0.1:{port}"),
@@ -262,24 +274,7 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
         .unwrap()
         .port();
     let rec = tmp("modelled.mcap");
-    let sim = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
-        .args([
-            "run",
-            "scenes/brickworld.toml",
-            "--device",
-            &format!("udp:127.0.0.1:{port}"),
-            "--realtime",
-            "--out",
-            rec.to_str().unwrap(),
-            "--wait-s",
-            "30",
-            "--json",
-        ])
-        .current_dir(root())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let sim = bridged_run("scenes/brickworld.toml", port, &rec, &[]);
     let dev = nh(&[
         "fake-device",
         &format!("udp:127.0.0.1:{port}"),

@@ -310,6 +310,18 @@ pub enum DeviceError {
     Link(String),
 }
 
+/// A headless device is sampled one tick after another: `time` must be tick `next`.
+pub(crate) fn in_order(time: TickTime, next: u64) -> Result<(), DeviceError> {
+    if time.index == next {
+        Ok(())
+    } else {
+        Err(DeviceError::OutOfOrder {
+            got: time.index,
+            expected: next,
+        })
+    }
+}
+
 /// The generic haptic device (after CHAI3D's `cGenericHapticDevice`).
 ///
 /// The runner calls [`HapticDevice::open`] once, then per tick [`HapticDevice::sample`] (in

@@ -8,7 +8,9 @@
 //! show a rendering's instability: a buzz, a limit cycle, energy pumped into the hand.
 
 use super::script::Script;
-use super::{DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime};
+use super::{
+    DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime, in_order,
+};
 use crate::vec3::Vec3;
 use haptic_devices::{Grip, Hold, Mechanics, Plant};
 use std::borrow::Cow;
@@ -64,12 +66,7 @@ impl HapticDevice for ModelledDevice {
     }
 
     fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
-        if time.index != self.next_tick {
-            return Err(DeviceError::OutOfOrder {
-                got: time.index,
-                expected: self.next_tick,
-            });
-        }
+        in_order(time, self.next_tick)?;
         if time.index > 0 {
             let t0 = time.time_s - time.dt_s;
             let script = &self.script;

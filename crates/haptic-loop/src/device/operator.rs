@@ -16,7 +16,9 @@
 //! sphere (its outward velocity is removed at the boundary), as a real linkage cannot.
 
 use super::script::{OperatorParams, Script};
-use super::{DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime};
+use super::{
+    DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime, in_order,
+};
 use crate::vec3::{self, Vec3};
 
 /// A scripted intent played through a simulated hand.
@@ -103,12 +105,7 @@ impl HapticDevice for SimulatedOperator {
     }
 
     fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
-        if time.index != self.next_tick {
-            return Err(DeviceError::OutOfOrder {
-                got: time.index,
-                expected: self.next_tick,
-            });
-        }
+        in_order(time, self.next_tick)?;
         if time.index > 0 {
             // Advance from the previous tick to this one under the last rendered force.
             self.step(time);
