@@ -50,6 +50,7 @@ pub mod source;
 pub mod stepper;
 pub mod switch;
 pub mod textpos;
+pub mod totals;
 pub use render::vec3;
 
 pub use device::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};

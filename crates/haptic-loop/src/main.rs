@@ -29,6 +29,7 @@ use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions, SessionReport,
     run_session, run_session_until,
 };
+use haptic_loop::totals::Totals;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -351,30 +352,26 @@ fn parse_operator(s: &str) -> Result<OperatorChoice, String> {
 
 /// The house task's score at the end of a session (brick and nano worlds), from the last
 /// tick's state: `score`, slots filled, `dropped`, `comfort_exceeded_s`, `complete_s`.
-fn house_score(a: &SessionArrays) -> serde_json::Value {
-    let last = |f: &str| a.state_column(f).and_then(|c| c.last().copied());
-    let Some(score) = last("score") else {
+fn house_score(t: &Totals) -> serde_json::Value {
+    let Some(score) = t.last("score") else {
         return serde_json::Value::Null;
     };
-    let filled = last("slots_filled").or_else(|| last("house_score"));
+    let filled = t.last("slots_filled").or_else(|| t.last("house_score"));
     serde_json::json!({
         "score": score,
         "slots_filled": filled,
-        "dropped": last("dropped"),
-        "comfort_exceeded_s": last("comfort_exceeded_s"),
-        "complete_s": last("complete_s"),
+        "dropped": t.last("dropped"),
+        "comfort_exceeded_s": t.last("comfort_exceeded_s"),
+        "complete_s": t.last("complete_s"),
         "rule": "100 × filled / slots − 10 per dropped brick or atom − 5 per second above half \
                  the device's largest force; never below 0",
     })
 }
 
+/// The run summary, from the session's running totals (constant memory: the run keeps no
+/// per-tick arrays).
 fn summary_json(r: &SessionReport) -> serde_json::Value {
-    let a = &r.arrays;
-    let peak = a
-        .device_force_n
-        .iter()
-        .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
-        .fold(0.0, f64::max);
+    let t = &r.totals;
     serde_json::json!({
         "scene": r.description.scene_name,
         "kind": r.description.scene_kind,
@@ -384,18 +381,18 @@ fn summary_json(r: &SessionReport) -> serde_json::Value {
         "mode": r.description.mode,
         "ticks": r.stats.ticks,
         "duration_s": r.stats.ticks as f64 / f64::from(r.description.rate_hz),
-        "peak_device_force_n": peak,
-        "clamped_ticks": a.status.iter().filter(|s| **s & 1 != 0).count(),
-        "events": a.events.len(),
+        "peak_device_force_n": t.peak_device_force_n,
+        "clamped_ticks": t.clamped_ticks,
+        "events": t.events,
         "tick_stats": r.stats,
         "written": r.written,
         "end": r.end,
         "device_link": r.description.device_link,
         "link": r.link.iter().map(|(k, v)| (k.to_string(), *v)).collect::<BTreeMap<String, u64>>(),
-        "watchdog_ticks": a.status.iter().filter(|s| **s & 32 != 0).count(),
+        "watchdog_ticks": t.watchdog_ticks,
         "live": r.live,
         "sinks": r.sinks,
-        "house_score": house_score(a),
+        "house_score": house_score(t),
     })
 }
 
@@ -543,6 +540,9 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
     opts.seconds = seconds;
     opts.realtime = realtime;
     opts.out = out;
+    // The summary comes from the running totals: no per-tick arrays, so memory stays flat
+    // however long the session runs.
+    opts.arrays = false;
     let pb = (!json).then(|| progress_bar(0, "run"));
     let stop = interrupt_flag()?;
     let report = run_session_until(
@@ -789,6 +789,7 @@ fn cmd_demo(scenes: Option<&Path>, out: &Path, json: bool) -> Result<ExitCode, S
         };
         let mut opts = SessionOptions::new(source.map_err(|e: SessionError| e.to_string())?);
         opts.out = Some(rec.clone());
+        opts.arrays = false;
         let pb = (!json).then(|| progress_bar(0, &stem));
         let report = run_session(&opts, &mut |done, total| {
             if let Some(pb) = &pb {

@@ -82,6 +82,106 @@ impl Percentiles {
     }
 }
 
+/// A streaming distribution of durations in constant memory (about 60 KB), for sessions of any
+/// length: values below 256 ns are counted exactly; above, each power of two is split into 128
+/// buckets, so a reported percentile is within 1/128 (0.8 %) of the nearest-rank sample, never
+/// above the largest sample. The largest sample and the mean are exact.
+#[derive(Clone, Debug)]
+pub struct DurationHistogram {
+    counts: Vec<u64>,
+    n: u64,
+    sum: u128,
+    max: u64,
+}
+
+/// Sub-buckets per power of two above [`EXACT`] (relative bucket width 1/128).
+const SUB: u64 = 128;
+/// Values below this are counted exactly.
+const EXACT: u64 = 2 * SUB;
+
+impl Default for DurationHistogram {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl DurationHistogram {
+    /// An empty histogram.
+    pub fn new() -> Self {
+        // Exact buckets, then 128 per power of two from 2^8 to 2^63.
+        DurationHistogram {
+            counts: vec![0; (EXACT + (64 - 8) * SUB) as usize],
+            n: 0,
+            sum: 0,
+            max: 0,
+        }
+    }
+
+    fn bucket(v: u64) -> usize {
+        if v < EXACT {
+            return v as usize;
+        }
+        let e = 63 - u64::from(v.leading_zeros()); // 2^e <= v < 2^(e+1), e >= 8
+        let sub = (v >> (e - 7)) - SUB; // the 7 bits below the leading one
+        (EXACT + (e - 8) * SUB + sub) as usize
+    }
+
+    /// The smallest value of bucket `b`.
+    fn floor(b: usize) -> u64 {
+        let b = b as u64;
+        if b < EXACT {
+            return b;
+        }
+        let e = (b - EXACT) / SUB + 8;
+        let sub = (b - EXACT) % SUB;
+        (SUB + sub) << (e - 7)
+    }
+
+    /// Counts one duration, ns.
+    pub fn record(&mut self, ns: u64) {
+        self.counts[Self::bucket(ns)] += 1;
+        self.n += 1;
+        self.sum += u128::from(ns);
+        self.max = self.max.max(ns);
+    }
+
+    /// Number of durations counted.
+    pub fn len(&self) -> u64 {
+        self.n
+    }
+
+    /// True when nothing was counted.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// Nearest-rank percentiles (zeros when empty): each the smallest value of the bucket that
+    /// holds the nearest-rank sample (exact below 256 ns), the exact maximum and mean.
+    pub fn percentiles(&self) -> Percentiles {
+        if self.n == 0 {
+            return Percentiles::default();
+        }
+        let rank = |q: f64| {
+            let want = ((q * self.n as f64).ceil() as u64).clamp(1, self.n);
+            let mut seen = 0;
+            for (b, c) in self.counts.iter().enumerate() {
+                seen += c;
+                if seen >= want {
+                    return Self::floor(b).min(self.max);
+                }
+            }
+            self.max
+        };
+        Percentiles {
+            p50_ns: rank(0.5),
+            p99_ns: rank(0.99),
+            p999_ns: rank(0.999),
+            max_ns: self.max,
+            mean_ns: self.sum as f64 / self.n as f64,
+        }
+    }
+}
+
 /// Tick-time statistics of a session.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct TickStats {
@@ -111,6 +211,53 @@ mod tests {
         );
         assert_eq!(p.mean_ns, 500.5);
         assert_eq!(Percentiles::of(&[]), Percentiles::default());
+    }
+
+    #[test]
+    fn histogram_is_exact_below_256_ns_and_within_1_in_128_above() {
+        let mut h = DurationHistogram::new();
+        for v in 1..=200u64 {
+            h.record(v);
+        }
+        assert_eq!(
+            h.percentiles(),
+            Percentiles::of(&(1..=200).collect::<Vec<_>>())
+        );
+        // Spread over nine decades: every percentile within 1/128 below the exact one.
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut v = Vec::new();
+        let mut h = DurationHistogram::new();
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let s = 100 + (x % 1_000_000_000) / (1 + (x >> 40) % 1000);
+            v.push(s);
+            h.record(s);
+        }
+        let (a, b) = (h.percentiles(), Percentiles::of(&v));
+        for (got, want) in [
+            (a.p50_ns, b.p50_ns),
+            (a.p99_ns, b.p99_ns),
+            (a.p999_ns, b.p999_ns),
+        ] {
+            assert!(
+                got <= want && (want - got) as f64 <= want as f64 / 128.0,
+                "{got} vs {want}"
+            );
+        }
+        assert_eq!(a.max_ns, b.max_ns);
+        assert!((a.mean_ns - b.mean_ns).abs() <= 1e-9 * b.mean_ns);
+        assert_eq!(h.len(), 100_000);
+        // Bucket edges round-trip, up to the largest u64.
+        for v in [255u64, 256, 257, 511, 512, 1 << 40, u64::MAX] {
+            let f = DurationHistogram::floor(DurationHistogram::bucket(v));
+            assert!(f <= v && (v - f) as f64 <= v as f64 / 128.0, "{v}: {f}");
+        }
+        assert_eq!(
+            DurationHistogram::new().percentiles(),
+            Percentiles::default()
+        );
     }
 
     #[test]

@@ -18,7 +18,7 @@
 use crate::channels::messages::DescriptionMsg;
 use crate::device::{DeviceError, HapticDevice, TickTime};
 use crate::haptic::HapticLoop;
-use crate::pacing::{Pacer, Percentiles, TickStats};
+use crate::pacing::{DurationHistogram, Pacer, Percentiles, TickStats};
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use crate::switch::{Switch, SwitchError};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -73,7 +73,7 @@ pub enum EndReason {
 pub struct Runner<'s> {
     sinks: Vec<&'s mut dyn Sink>,
     stop: Option<&'s AtomicBool>,
-    sink_ns: Vec<Vec<u64>>,
+    sink_ns: Vec<DurationHistogram>,
     switches: Vec<(u64, Switch)>,
 }
 
@@ -93,7 +93,7 @@ impl<'s> Runner<'s> {
         Runner {
             sinks,
             stop: None,
-            sink_ns: vec![Vec::new(); n],
+            sink_ns: vec![DurationHistogram::new(); n],
             switches: Vec::new(),
         }
     }
@@ -135,14 +135,12 @@ impl<'s> Runner<'s> {
         }
         let rate = lp.config().rate_hz;
         let period_ns = lp.config().period_ns();
-        let cap = ticks.unwrap_or(0) as usize;
-        let mut compute = Vec::with_capacity(cap.min(1 << 24));
+        // Constant memory whatever the session's length (a soak runs for hours).
+        let mut compute = DurationHistogram::new();
         let timed = !matches!(pacing, Pacing::Batch | Pacing::Recorded(_));
-        let mut jitter = Vec::with_capacity(if timed { cap.min(1 << 24) } else { 0 });
-        // Per-sink timings grow with the run: reserve them up front so no tick reallocates.
+        let mut jitter = DurationHistogram::new();
         for t in &mut self.sink_ns {
-            t.clear();
-            t.reserve(cap.min(1 << 24));
+            *t = DurationHistogram::new();
         }
         let mut missed_count = 0;
         let start = Instant::now();
@@ -208,12 +206,12 @@ impl<'s> Runner<'s> {
             for (s, times) in self.sinks.iter_mut().zip(self.sink_ns.iter_mut()) {
                 let t = Instant::now();
                 s.tick(&view)?;
-                times.push(t.elapsed().as_nanos() as u64);
+                times.record(t.elapsed().as_nanos() as u64);
             }
             // The hand-off to the sinks belongs to the tick's cost.
-            compute.push(t0.elapsed().as_nanos() as u64);
+            compute.record(t0.elapsed().as_nanos() as u64);
             if timed && n > 0 {
-                jitter.push(late.unsigned_abs());
+                jitter.record(late.unsigned_abs());
             }
             n += 1;
             if n % 100 == 0 || ticks == Some(n) {
@@ -222,8 +220,8 @@ impl<'s> Runner<'s> {
         }
         let stats = TickStats {
             ticks: n,
-            compute: Percentiles::of(&compute),
-            jitter: Percentiles::of(&jitter),
+            compute: compute.percentiles(),
+            jitter: jitter.percentiles(),
             missed: missed_count,
             wall_s: start.elapsed().as_secs_f64(),
         };
@@ -241,7 +239,7 @@ impl<'s> Runner<'s> {
             .zip(&self.sink_ns)
             .map(|(s, t)| SinkTime {
                 sink: s.name(),
-                tick: Percentiles::of(t),
+                tick: t.percentiles(),
             })
             .collect()
     }

@@ -28,6 +28,7 @@ use crate::sink::{Sink, SinkError};
 use crate::source::{DeviceSource, open_device};
 pub use crate::textpos::Location;
 use crate::textpos::field_position;
+use crate::totals::Totals;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -365,6 +366,9 @@ pub struct SessionReport {
     pub description: DescriptionMsg,
     /// Per-tick arrays (empty when turned off).
     pub arrays: SessionArrays,
+    /// Running totals (peak force, clamped and watchdog ticks, events, last state), kept
+    /// whether or not the arrays are.
+    pub totals: Totals,
     /// Tick-time statistics.
     pub stats: TickStats,
     /// What the writer did, when recording.
@@ -608,12 +612,13 @@ fn run_with_device(
     };
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let mut arrays = SessionArrays::new(rate, fields);
+    let mut totals = Totals::default();
     let mut recorder = opts.out.clone().map(RecorderSink::new);
     let mut live = match &opts.live {
         Some(c) => Some(LiveSink::new(c.clone())?),
         None => None,
     };
-    let mut sinks: Vec<&mut dyn Sink> = Vec::new();
+    let mut sinks: Vec<&mut dyn Sink> = vec![&mut totals];
     if opts.arrays {
         sinks.push(&mut arrays);
     }
@@ -645,6 +650,7 @@ fn run_with_device(
     Ok(SessionReport {
         description,
         arrays,
+        totals,
         stats,
         written: recorder.and_then(|r| r.summary().cloned()),
         end: match end {

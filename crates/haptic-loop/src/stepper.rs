@@ -22,7 +22,7 @@ use crate::arrays::SessionArrays;
 use crate::channels::messages::{self, DescriptionMsg};
 use crate::device::{DeviceModel, DeviceSample, ForceCommand};
 use crate::haptic::{HapticLoop, TickResult};
-use crate::pacing::{Percentiles, TickStats};
+use crate::pacing::{DurationHistogram, Percentiles, TickStats};
 use crate::record::WriteSummary;
 use crate::record::sink::RecorderSink;
 use crate::scene::load_scene;
@@ -81,7 +81,7 @@ pub struct Stepper {
     description: DescriptionMsg,
     arrays: Option<SessionArrays>,
     recorder: Option<RecorderSink>,
-    compute: Vec<u64>,
+    compute: DurationHistogram,
     started: Instant,
 }
 
@@ -122,7 +122,7 @@ impl Stepper {
             description,
             arrays,
             recorder,
-            compute: Vec::new(),
+            compute: DurationHistogram::new(),
             started: Instant::now(),
         })
     }
@@ -148,7 +148,7 @@ impl Stepper {
             sinks.push(r);
         }
         deliver(&mut sinks, &view)?;
-        self.compute.push(t0.elapsed().as_nanos() as u64);
+        self.compute.record(t0.elapsed().as_nanos() as u64);
         Ok(self.lp.last_result())
     }
 
@@ -185,7 +185,7 @@ impl Stepper {
     pub fn finish(mut self) -> Result<StepperReport, SessionError> {
         let stats = TickStats {
             ticks: self.lp.next_tick(),
-            compute: Percentiles::of(&self.compute),
+            compute: self.compute.percentiles(),
             jitter: Percentiles::default(),
             missed: 0,
             wall_s: self.started.elapsed().as_secs_f64(),

@@ -416,25 +416,49 @@ fn an_unwritable_recording_path_is_a_typed_error() {
     );
 }
 
-/// Without a recording nothing is encoded: the arrays are the only sink (filled straight from
+/// Without a recording nothing is encoded: the arrays are the only sink besides the running
+/// totals (filled straight from
 /// each tick), and they equal, column by column, what a recorded run of the same session reads
 /// back from its file (bar the wall-clock columns).
 #[test]
 fn an_unrecorded_session_runs_only_the_arrays_and_matches_its_recording() {
     let mut o = wall_opts(None);
-    o.seconds = Some(0.5);
+    o.seconds = Some(2.0);
     o.start_time_ns = Some(1_700_000_000_000_000_000);
     let plain = run_session(&o, &mut |_, _| {}).unwrap();
     let sinks: Vec<&str> = plain.sinks.iter().map(|s| s.sink).collect();
-    assert_eq!(sinks, ["arrays"]);
-    let p = tmp("wall-half-second.mcap");
+    assert_eq!(sinks, ["totals", "arrays"]);
+    // The running totals (what `nanohaptics run` summarises, in constant memory) are the
+    // arrays' own figures.
+    let (t, a) = (&plain.totals, &plain.arrays);
+    let peak = a
+        .device_force_n
+        .iter()
+        .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
+        .fold(0.0, f64::max);
+    assert!(peak > 0.5, "the wall press pushes back: {peak} N");
+    assert_eq!(t.peak_device_force_n, peak);
+    assert_eq!(t.ticks, 2000);
+    assert_eq!(t.events, a.events.len() as u64);
+    assert_eq!(
+        t.clamped_ticks,
+        a.status.iter().filter(|s| **s & 1 != 0).count() as u64
+    );
+    assert_eq!(
+        t.watchdog_ticks,
+        a.status.iter().filter(|s| **s & 32 != 0).count() as u64
+    );
+    let n = t.state_fields.len();
+    assert!(n > 0);
+    assert_eq!(t.last_state[..], a.state[a.state.len() - n..]);
+    let p = tmp("wall-two-seconds.mcap");
     o.out = Some(p.clone());
     let recorded = run_session(&o, &mut |_, _| {}).unwrap();
     let sinks: Vec<&str> = recorded.sinks.iter().map(|s| s.sink).collect();
-    assert_eq!(sinks, ["arrays", "recorder"]);
+    assert_eq!(sinks, ["totals", "arrays", "recorder"]);
     let back = read_arrays(&p, false).unwrap();
     assert_eq!(back, recorded.arrays);
-    assert_eq!(plain.arrays.tick.len(), 500);
+    assert_eq!(plain.arrays.tick.len(), 2000);
     let (a, b) = (plain.arrays.columns(), back.columns());
     assert_eq!(a.len(), b.len());
     for ((info, x), (_, y)) in a.into_iter().zip(b) {
