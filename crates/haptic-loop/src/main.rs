@@ -273,13 +273,14 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
             let s: f64 = s.parse().map_err(|_| bad())?;
             let d: f64 = d.parse().map_err(|_| bad())?;
             Ok::<_, String>((
-                check("outage start", s, 0.0, 3600.0)?,
-                check("outage seconds", d, 0.0, 3600.0)?,
+                check("outage start", s, 0.0, 86400.0)?,
+                check("outage seconds", d, 0.0, 86400.0)?,
             ))
         })
         .transpose()?;
     if let Some(s) = a.seconds {
-        check("seconds", s, 1e-3, 3600.0)?;
+        // Up to a day: a soak plays for hours.
+        check("seconds", s, 1e-3, 86400.0)?;
     }
     let cfg = FakeConfig {
         target,

@@ -29,8 +29,8 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// The brick-world script repeated back to back (with a 1 s pause between plays) until it
-/// covers `seconds`.
+/// The brick-world script repeated back to back (with a 1 s move back to the start between
+/// plays) until it covers `seconds` (a script ends by 3600 s: later entries are left out).
 fn repeated_script(seconds: f64) -> String {
     let text = std::fs::read_to_string(root().join("scenes/brickworld.script.toml")).unwrap();
     let mut v: toml::Table = toml::from_str(&text).unwrap();
@@ -52,6 +52,7 @@ fn repeated_script(seconds: f64) -> String {
                 w.insert("t_s".into(), ((t * 1e6).round() / 1e6).into());
                 toml::Value::Table(w)
             })
+            .filter(|w| w["t_s"].as_float().unwrap() <= seconds.min(3600.0))
             .collect()
     };
     let mut all_w = Vec::new();
