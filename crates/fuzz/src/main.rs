@@ -22,8 +22,7 @@
 //! the batch is re-run one input per process to name the culprit. Every finding's input is
 //! written to the findings folder. Exit status: 0 when there are no findings, 1 otherwise.
 
-mod mutate;
-mod targets;
+use nanohaptics_fuzz::targets;
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;

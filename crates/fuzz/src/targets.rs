@@ -14,7 +14,15 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// The targets, by name.
-pub const TARGETS: &[&str] = &["scene", "script", "recording", "verify", "bridge", "cli"];
+pub const TARGETS: &[&str] = &[
+    "scene",
+    "script",
+    "recording",
+    "verify",
+    "bridge",
+    "params",
+    "cli",
+];
 
 /// What one input did.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,7 +54,7 @@ fn falcon() -> &'static DeviceSpecs {
 }
 
 /// A short deterministic recording of the wall scene (the seed of `recording` and `verify`).
-fn seed_recording(dir: &Path) -> Result<Vec<u8>, String> {
+pub fn seed_recording(dir: &Path) -> Result<Vec<u8>, String> {
     let p = dir.join("seed.mcap");
     let mut o = SessionOptions::new(
         SceneSource::resolve(Path::new("wall")).map_err(|e| format!("seed scene: {e}"))?,
@@ -121,6 +129,7 @@ impl Target {
                 t.seed_rec = Some(read_recording(&b, false).map_err(|e| e.to_string())?);
                 t.seeds = vec![b];
             }
+            "params" => t.seeds = crate::params::seeds(),
             "bridge" => {
                 let sample = Sample {
                     seq: 7,
@@ -179,7 +188,7 @@ impl Target {
         let n = 1 + r.below(if self.name == "cli" { 2 } else { 4 });
         for _ in 0..n {
             match self.name {
-                "scene" | "script" => mutate::mutate_text(&mut r, &mut b, &self.seeds),
+                "scene" | "script" | "params" => mutate::mutate_text(&mut r, &mut b, &self.seeds),
                 "recording" | "verify" => mutate_recording(&mut r, &mut b),
                 "cli" => mutate_argv(&mut r, &mut b),
                 _ => mutate::mutate_bytes(&mut r, &mut b, &self.seeds),
@@ -196,6 +205,7 @@ impl Target {
             "recording" => self.run_recording(input),
             "verify" => self.run_verify(input, index),
             "bridge" => run_bridge(input),
+            "params" => crate::params::run_params(input),
             "selftest" => selftest(index, self.timeout),
             _ => self.run_cli(input),
         }
@@ -365,7 +375,7 @@ impl Target {
     /// byte count.
     pub fn show(&self, input: &[u8]) -> String {
         match self.name {
-            "scene" | "script" => String::from_utf8_lossy(input).into_owned(),
+            "scene" | "script" | "params" => String::from_utf8_lossy(input).into_owned(),
             "cli" => {
                 let a: Vec<String> = argv(input)
                     .iter()
@@ -585,7 +595,8 @@ fn drive(lp: &mut HapticLoop, specs: &DeviceSpecs, start: [f64; 3], ticks: u64) 
     Outcome::Accepted
 }
 
-fn run_scene(input: &[u8]) -> Outcome {
+/// A scene file for a Falcon; an accepted scene is ticked 40 times along a path.
+pub fn run_scene(input: &[u8]) -> Outcome {
     let text = String::from_utf8_lossy(input);
     match load_scene_for(&text, falcon().clone()) {
         Err(_) => Outcome::Refused,
@@ -596,7 +607,8 @@ fn run_scene(input: &[u8]) -> Outcome {
     }
 }
 
-fn run_script(input: &[u8]) -> Outcome {
+/// A script file; an accepted script is sampled at 51 times (finite positions and velocities).
+pub fn run_script(input: &[u8]) -> Outcome {
     let text = String::from_utf8_lossy(input);
     match Script::from_toml(&text, falcon()) {
         Err(_) => Outcome::Refused,
@@ -619,7 +631,9 @@ fn run_script(input: &[u8]) -> Outcome {
     }
 }
 
-fn run_bridge(input: &[u8]) -> Outcome {
+/// A bridge datagram: decode, re-encode, decode; samples and announced specifications drive the
+/// wall scene (finite forces within the limit).
+pub fn run_bridge(input: &[u8]) -> Outcome {
     let Ok(p) = Packet::decode(input) else {
         return Outcome::Refused;
     };

@@ -124,17 +124,19 @@ fn style() -> Style {
     }
 }
 
-/// A camera that holds the scene's first picture and every `extra` point (the cursor's world
-/// positions over a recording, so the cursor never leaves the image); top view for a flat
-/// world unless `view` says otherwise.
+/// A camera that frames the action: the scene's bodies (not its backdrops — the ground, a wall
+/// plate, a substrate: `render::is_backdrop`) and every `extra` point (the cursor's world
+/// positions over a recording, so the cursor never leaves the image); the whole picture when
+/// only backdrops are drawn. Top view for a flat world unless `view` says otherwise.
 fn camera_for(
     prims: &[Primitive],
     extra: &[[f64; 3]],
     view: Option<View>,
     width: u32,
 ) -> Result<Camera, RenderError> {
-    let (mut lo, mut hi) = render::bounds(prims)
-        .or_else(|| extra.first().map(|p| (*p, *p)))
+    let (mut lo, mut hi) = render::action_bounds(prims)
+        .or_else(|| (!extra.is_empty()).then(|| (extra[0], extra[0])))
+        .or_else(|| render::bounds(prims))
         .unwrap_or(([0.0; 3], [0.0; 3]));
     for p in extra {
         for i in 0..3 {
@@ -714,27 +716,88 @@ fn final_picture_view(
     view: Option<View>,
     width: u32,
 ) -> Result<u64, RenderCmdError> {
+    let f = final_frame(rec_path, view, width)?;
+    f.frame.finish()?.save_png(out)?;
+    Ok(f.ticks)
+}
+
+/// The last picture of a recording, ready to draw.
+pub struct FinalPicture {
+    /// The picture.
+    pub frame: Frame,
+    /// Ticks recomputed.
+    pub ticks: u64,
+    /// The box the camera frames (m): the end state's bodies, not its backdrops.
+    pub action_m: ([f64; 3], [f64; 3]),
+}
+
+/// Share of the picture's shorter side left around the end state's bodies (for their labels).
+const FINAL_MARGIN: f64 = 0.25;
+
+/// The last picture of a recording: the recomputed end state framed on its bodies (not the
+/// backdrops: `render::action_bounds`; the whole scene when the cursor is its only body), with
+/// the cursor's path as a faint trail; with the ticks recomputed.
+pub fn final_frame(
+    rec_path: &Path,
+    view: Option<View>,
+    width: u32,
+) -> Result<FinalPicture, RenderCmdError> {
     check_width(width)?;
     let rec = read_recording_file(rec_path, false)?;
     let d = &rec.description;
     let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
     let config = loaded.config.clone();
     let kind = loaded.scene.kind();
-    let mut prims = Vec::new();
-    loaded.scene.draw(&mut prims);
-    let first: Vec<Primitive> = prims.clone();
     let (lp, ticks) = replay_into(&rec, Vec::new())?;
-    let cam = camera_for(&first, &cursor_path(&rec, &config)?, view, width)?;
+    let path = cursor_path(&rec, &config)?;
+    let mut prims = Vec::new();
+    lp.scene().draw(&mut prims);
+    // Framed on the end state's bodies (the cursor among them), with room for their labels;
+    // a scene whose only body is the cursor (the wall) shows its backdrop whole.
+    let bodies = prims
+        .iter()
+        .filter(|p| {
+            !render::is_backdrop(p) && matches!(p, Primitive::Sphere { .. } | Primitive::Box { .. })
+        })
+        .count();
+    let (lo, hi) = (if bodies >= 2 {
+        render::action_bounds(&prims)
+    } else {
+        None
+    })
+    .or_else(|| render::bounds(&prims))
+    .unwrap_or(([0.0; 3], [0.0; 3]));
+    let flat = (hi[2] - lo[2]) < 0.05 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let view = view.unwrap_or(if flat {
+        View::Top
+    } else {
+        View::oblique_default()
+    });
+    let cam = Camera::fit(view, lo, hi, width, width * 3 / 4, FINAL_MARGIN)?;
     let mut frame = Frame::new(cam, style())?;
+    // The trail: one point per 10 ms is finer than a pixel at any speed a hand moves.
+    if path.len() > 1 {
+        let step = (path.len() / 2000).max(1);
+        prims.insert(
+            0,
+            Primitive::Polyline {
+                points_m: path.iter().step_by(step).copied().collect(),
+                closed: false,
+                color: Rgba([0.55, 0.75, 1.0, 0.35]),
+            },
+        );
+    }
     let t = ticks as f64 / f64::from(config.rate_hz);
-    draw(
+    draw_prims(
         &mut frame,
-        lp.scene(),
-        &mut prims,
+        &prims,
         &format!("{kind}  t = {t:.3} s (end of recording)"),
     )?;
-    frame.finish()?.save_png(out)?;
-    Ok(ticks)
+    Ok(FinalPicture {
+        frame,
+        ticks,
+        action_m: (lo, hi),
+    })
 }
 
 /// `nanohaptics render` as the program runs it: prints what was written.
@@ -764,6 +827,70 @@ mod tests {
 
     fn root() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    }
+
+    /// The end picture of every demo scene frames the action: the box of its bodies (not the
+    /// ground, plate or substrate) is in the picture and fills at least 45 % of its width or
+    /// height, and no label covers a body or leaves the picture
+    /// (the optical tweezers' particle sat at the right edge under its label, 90 % empty).
+    #[test]
+    fn every_end_picture_frames_its_bodies_and_no_label_covers_one() {
+        use haptic_loop::session::{SceneSource, SessionOptions, run_session};
+        let dir = std::env::temp_dir().join(format!("nanohaptics-frame-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        for b in haptic_loop::builtin::SCENES {
+            let rec = dir.join(format!("{}.mcap", b.name));
+            let mut o = SessionOptions::new(SceneSource::builtin(b.name).expect("built in"));
+            o.out = Some(rec.clone());
+            o.arrays = false;
+            run_session(&o, &mut |_, _| {}).expect("demo session");
+            let pic = final_frame(&rec, None, 800).expect("end picture");
+            let frame = &pic.frame;
+            let (w, h) = (800.0_f64, 600.0_f64);
+            let bodies = frame.body_rects();
+            assert!(!bodies.is_empty(), "{}: no bodies", b.name);
+            // The action box's eight corners, projected.
+            let (lo, hi) = pic.action_m;
+            let mut u = [
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ];
+            for k in 0..8 {
+                let c = [0, 1, 2].map(|i| if k & (1 << i) == 0 { lo[i] } else { hi[i] });
+                let q = frame.camera().project(c);
+                u = [
+                    u[0].min(q.x_px),
+                    u[1].min(q.y_px),
+                    u[2].max(q.x_px),
+                    u[3].max(q.y_px),
+                ];
+            }
+            assert!(
+                u[0] >= 0.0 && u[1] >= 0.0 && u[2] <= w && u[3] <= h,
+                "{}: the action leaves the picture: {u:?}",
+                b.name
+            );
+            let share = ((u[2] - u[0]) / w).max((u[3] - u[1]) / h);
+            assert!(
+                share >= 0.45,
+                "{}: the action fills {share:.2} of the picture",
+                b.name
+            );
+            for l in frame.label_rects().expect("labels") {
+                assert!(
+                    l[0] >= 0.0 && l[1] >= 0.0 && l[2] <= w && l[3] <= h,
+                    "{}: a label leaves the picture: {l:?}",
+                    b.name
+                );
+                for r in &bodies {
+                    let hit = l[0] < r[2] && r[0] < l[2] && l[1] < r[3] && r[1] < l[3];
+                    assert!(!hit, "{}: label {l:?} covers body {r:?}", b.name);
+                }
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

@@ -357,10 +357,14 @@ pub fn closest_on_segment(a: &V2, b: &V2, p: &V2) -> V2 {
     a + d * t
 }
 
-/// Closest point of the polygon's boundary to `p`, and its distance.
+/// Closest point of the polygon's boundary to `p`, and its distance; an empty polygon has no
+/// boundary: `(p, ∞)`.
 pub fn nearest_on_boundary(poly: &[V2], p: &V2) -> (V2, f64) {
     let n = poly.len();
-    let mut best = (poly[0], f64::INFINITY);
+    let Some(&first) = poly.first() else {
+        return (*p, f64::INFINITY);
+    };
+    let mut best = (first, f64::INFINITY);
     for i in 0..n {
         let q = closest_on_segment(&poly[i], &poly[(i + 1) % n], p);
         let d = (q - p).norm();
@@ -474,5 +478,28 @@ impl PolygonIndex {
             }
         }
         inside
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An empty envelope (a degenerate map: a tick of 1e-15 s moves nothing) has no boundary:
+    /// it is infinitely far from any point, and from any non-empty polygon (found by the
+    /// `params` fuzz target, which panicked here).
+    #[test]
+    fn an_empty_polygon_is_infinitely_far() {
+        let p = V2::new(1.0, 2.0);
+        assert_eq!(nearest_on_boundary(&[], &p), (p, f64::INFINITY));
+        let square = [
+            V2::new(0.0, 0.0),
+            V2::new(1.0, 0.0),
+            V2::new(1.0, 1.0),
+            V2::new(0.0, 1.0),
+        ];
+        assert_eq!(hausdorff(&square, &[], 0.1), f64::INFINITY);
+        assert_eq!(hausdorff(&[], &[], 0.1), 0.0);
+        assert_eq!(nearest_on_boundary(&square, &V2::new(0.5, 2.0)).1, 1.0);
     }
 }

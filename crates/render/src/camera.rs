@@ -165,6 +165,31 @@ pub fn bounds(prims: &[Primitive]) -> Option<(Vec3, Vec3)> {
     (lo[0] <= hi[0]).then_some((lo, hi))
 }
 
+/// True for a backdrop: a box that is a slab (its smallest half extent under a tenth of its
+/// largest) — the ground, a wall plate, a substrate. Backdrops are drawn but do not choose the
+/// framing of a picture, and labels may lie over them.
+pub fn is_backdrop(p: &Primitive) -> bool {
+    match p {
+        Primitive::Box { half_extents_m, .. } => {
+            let lo = half_extents_m.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = half_extents_m.iter().copied().fold(0.0, f64::max);
+            lo < 0.1 * hi
+        }
+        _ => false,
+    }
+}
+
+/// The box (m) of the action: [`bounds`] of every primitive but the backdrops
+/// ([`is_backdrop`]) and the labels; `None` when only those are drawn.
+pub fn action_bounds(prims: &[Primitive]) -> Option<(Vec3, Vec3)> {
+    let action: Vec<Primitive> = prims
+        .iter()
+        .filter(|p| !is_backdrop(p) && !matches!(p, Primitive::Label { .. }))
+        .cloned()
+        .collect();
+    bounds(&action)
+}
+
 /// A point after projection.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Projected {

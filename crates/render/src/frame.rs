@@ -6,6 +6,7 @@ use crate::error::{RenderError, finite, finite3};
 use crate::image::Image;
 use crate::order::{Item, Shape, back_to_front};
 use crate::primitive::{Primitive, Rgba};
+use crate::text;
 use crate::vec3::{Vec3, add, axes, scale, sub};
 use crate::vec3::{box_corners, normq};
 
@@ -285,23 +286,8 @@ impl Frame {
                 _ => {}
             }
         }
-        for p in &self.items {
-            if let Primitive::Label {
-                position_m,
-                text,
-                color,
-            } = p
-            {
-                let q = self.camera.project(*position_m);
-                self.draw_text(
-                    pm,
-                    text,
-                    q.x_px as f32 + 4.0,
-                    q.y_px as f32 - 4.0,
-                    *color,
-                    0.0,
-                )?;
-            }
+        for (text, x, y, color) in self.placed_labels()? {
+            self.draw_text(pm, &text, x as f32, y as f32, color, 0.0)?;
         }
         if let Some((t, c)) = &self.title {
             let size = self.style.font_size_px;
@@ -311,6 +297,96 @@ impl Frame {
             self.draw_scale_bar(pm, sb)?;
         }
         Ok(())
+    }
+
+    /// Screen rectangles (x0, y0, x1, y1 px) of the bodies labels must not cover: every solid
+    /// but the backdrops ([`crate::camera::is_backdrop`]).
+    pub fn body_rects(&self) -> Vec<[f64; 4]> {
+        self.items
+            .iter()
+            .filter(|p| !crate::camera::is_backdrop(p))
+            .filter_map(|p| self.solid_item(p))
+            .filter(|it| !it.flat)
+            .map(|it| it.rect)
+            .collect()
+    }
+
+    /// Screen rectangles (x0, y0, x1, y1 px) of the labels as drawn.
+    pub fn label_rects(&self) -> Result<Vec<[f64; 4]>, RenderError> {
+        let size = f64::from(self.style.font_size_px);
+        Ok(self
+            .placed_labels()?
+            .into_iter()
+            .map(|(t, x, y, _)| {
+                let w = f64::from(
+                    text::layout(&t, 0.0, 0.0, self.style.font_size_px)
+                        .map(|l| l.width_px)
+                        .unwrap_or(0.0),
+                );
+                [x, y - 0.8 * size, x + w, y + 0.25 * size]
+            })
+            .collect())
+    }
+
+    /// Where each label goes: its baseline start (px). The first of eight places around its
+    /// anchor (right above, right below, left above, left below, then twice as far) where its
+    /// text stays in the picture and covers no body and no label placed before it; the first
+    /// place when none is free.
+    fn placed_labels(&self) -> Result<Vec<(String, f64, f64, Rgba)>, RenderError> {
+        let bodies = self.body_rects();
+        let size = f64::from(self.style.font_size_px);
+        let (fw, fh) = (
+            f64::from(self.camera.width_px()),
+            f64::from(self.camera.height_px()),
+        );
+        let mut placed: Vec<[f64; 4]> = Vec::new();
+        let mut out = Vec::new();
+        let hits =
+            |r: &[f64; 4], o: &[f64; 4]| r[0] < o[2] && o[0] < r[2] && r[1] < o[3] && o[1] < r[3];
+        for p in &self.items {
+            let Primitive::Label {
+                position_m,
+                text: t,
+                color,
+            } = p
+            else {
+                continue;
+            };
+            let q = self.camera.project(*position_m);
+            let w = f64::from(text::layout(t, 0.0, 0.0, self.style.font_size_px)?.width_px);
+            // The bodies at the anchor push the label out past their own rectangle.
+            let reach = bodies
+                .iter()
+                .filter(|b| b[0] <= q.x_px && q.x_px <= b[2] && b[1] <= q.y_px && q.y_px <= b[3])
+                .map(|b| (b[2] - b[0]).max(b[3] - b[1]) / 2.0)
+                .fold(0.0, f64::max);
+            let mut best = None;
+            for k in 0..8 {
+                let d =
+                    4.0 + reach * if k < 4 { 1.0 } else { 2.0 } + if k < 4 { 0.0 } else { size };
+                let (sx, sy) = [(1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (-1.0, 1.0)][k % 4];
+                let x = if sx > 0.0 { q.x_px + d } else { q.x_px - d - w };
+                let y = if sy < 0.0 {
+                    q.y_px - d
+                } else {
+                    q.y_px + d + 0.8 * size
+                };
+                let r = [x, y - 0.8 * size, x + w, y + 0.25 * size];
+                if best.is_none() {
+                    best = Some((x, y, r));
+                }
+                let inside = r[0] >= 0.0 && r[1] >= 0.0 && r[2] <= fw && r[3] <= fh;
+                if inside && !bodies.iter().chain(&placed).any(|b| hits(&r, b)) {
+                    best = Some((x, y, r));
+                    break;
+                }
+            }
+            if let Some((x, y, r)) = best {
+                placed.push(r);
+                out.push((t.clone(), x, y, *color));
+            }
+        }
+        Ok(out)
     }
 
     fn solid_item(&self, p: &Primitive) -> Option<Item> {

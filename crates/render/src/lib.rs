@@ -44,7 +44,7 @@ pub mod primitive;
 mod text;
 pub mod vec3;
 
-pub use camera::{Camera, MAX_SIDE_PX, Projected, View, bounds};
+pub use camera::{Camera, MAX_SIDE_PX, Projected, View, action_bounds, bounds, is_backdrop};
 pub use error::RenderError;
 pub use frame::{Frame, Style, format_length, nice_length_m};
 pub use gif::{BAD_PIXEL_ERROR, BAD_PIXEL_SHARE, GifWriter, Palette, frame_delays_cs};
