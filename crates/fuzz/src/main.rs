@@ -46,14 +46,20 @@ struct Args {
     start: u64,
     replay_index: Option<u64>,
     run_file: Option<PathBuf>,
+    /// `--ci`: the cli target, a fixed input count.
     ci: bool,
+    /// `--all`: every target.
+    all: bool,
+    /// `--write-seeds DIR`: write the seed corpora and stop.
+    write_seeds: Option<PathBuf>,
 }
 
 fn usage() -> String {
     format!(
         "usage: nanohaptics-fuzz --target T [--inputs N] [--seconds S] [--seed N] [--batch B] \
          [--timeout-ms M] [--findings DIR] [--json]\n       nanohaptics-fuzz --ci \
-         [--seconds S]\n       nanohaptics-fuzz --target T --seed N --replay-index I | \
+         [--seconds S]\n       nanohaptics-fuzz --all [--inputs N]\n       nanohaptics-fuzz \
+         --write-seeds DIR\n       nanohaptics-fuzz --target T --seed N --replay-index I | \
          --run-file FILE\ntargets: {}",
         TARGETS.join(", ")
     )
@@ -74,6 +80,8 @@ fn parse_args() -> Result<Args, String> {
         replay_index: None,
         run_file: None,
         ci: false,
+        all: false,
+        write_seeds: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(f) = it.next() {
@@ -108,12 +116,17 @@ fn parse_args() -> Result<Args, String> {
             "--run-file" => a.run_file = Some(PathBuf::from(val("--run-file")?)),
             "--json" => a.json = true,
             "--worker" => a.worker = true,
-            "--ci" | "--all" => a.ci = true,
+            "--ci" => a.ci = true,
+            "--all" => {
+                a.ci = true;
+                a.all = true;
+            }
+            "--write-seeds" => a.write_seeds = Some(PathBuf::from(val("--write-seeds")?)),
             "-h" | "--help" => return Err(usage()),
             other => return Err(format!("unknown option `{other}`\n{}", usage())),
         }
     }
-    if !a.ci && a.target.is_none() {
+    if !a.ci && a.target.is_none() && a.write_seeds.is_none() {
         return Err(format!("give --target or --ci\n{}", usage()));
     }
     if a.inputs == u64::MAX && a.seconds.is_none() && !a.ci {
@@ -483,9 +496,14 @@ fn real_main() -> Result<ExitCode, String> {
         println!("outcome: {o:?}");
         return Ok(ExitCode::SUCCESS);
     }
-    let list: Vec<String> = match (&a.target, a.ci) {
-        (Some(t), false) => vec![t.clone()],
-        _ => TARGETS.iter().map(|t| t.to_string()).collect(),
+    if let Some(dir) = &a.write_seeds {
+        return write_seeds(dir);
+    }
+    // CI runs only what libFuzzer cannot (the program as a process); --all runs every target.
+    let list: Vec<String> = match (&a.target, a.ci, a.all) {
+        (Some(t), false, _) => vec![t.clone()],
+        (_, _, true) => TARGETS.iter().map(|t| t.to_string()).collect(),
+        _ => vec!["cli".to_string()],
     };
     let mut any = false;
     for target in &list {
@@ -506,6 +524,34 @@ fn real_main() -> Result<ExitCode, String> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// Writes every in-process target's seeds into `dir/<target>/seed-<k>`: the starting corpus of
+/// the libFuzzer targets (`fuzz/`). The `verify` seeds carry the libFuzzer target's mode byte.
+fn write_seeds(dir: &std::path::Path) -> Result<ExitCode, String> {
+    for name in TARGETS.iter().filter(|t| **t != "cli") {
+        let t = Target::new(name, Duration::from_secs(10))?;
+        let d = dir.join(name);
+        std::fs::create_dir_all(&d).map_err(|e| format!("{}: {e}", d.display()))?;
+        let mut seeds: Vec<Vec<u8>> = t.seeds().to_vec();
+        if *name == "verify" {
+            // Even first byte: a change to the seed recording's outputs; odd: raw bytes.
+            let raw: Vec<Vec<u8>> = seeds.iter().map(|s| [&[1u8][..], s].concat()).collect();
+            seeds = vec![
+                vec![0u8; 10],
+                vec![0, 7, 0, 0, 0, 2, 0, 0, 0, 0],
+                vec![2, 3, 0, 0, 0, 3],
+            ];
+            seeds.extend(raw);
+        }
+        for (k, s) in seeds.iter().enumerate() {
+            let p = d.join(format!("seed-{k}"));
+            std::fs::write(&p, s).map_err(|e| format!("{}: {e}", p.display()))?;
+        }
+        println!("{name}: {} seeds in {}", seeds.len(), d.display());
+    }
+    let _ = std::fs::remove_dir_all(targets::work_dir());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn main() -> ExitCode {

@@ -11,12 +11,12 @@ impl Rng {
     /// any one can be regenerated alone).
     pub fn for_input(seed: u64, index: u64) -> Self {
         let mut r = Rng(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        r.next();
+        r.next_u64();
         r
     }
 
     /// Next 64 random bits.
-    pub fn next(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -26,7 +26,7 @@ impl Rng {
 
     /// Uniform in `0..n` (`n > 0`).
     pub fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
+        (self.next_u64() % n.max(1) as u64) as usize
     }
 
     /// One element of `v` (non-empty).
@@ -86,13 +86,13 @@ pub fn mutate_bytes(r: &mut Rng, b: &mut Vec<u8>, others: &[Vec<u8>]) {
         }
         2 if n > 0 => {
             let i = r.below(n);
-            b[i] = r.next() as u8;
+            b[i] = r.next_u64() as u8;
         }
         3 => {
             let i = r.below(n + 1);
             let k = 1 + r.below(8);
             for _ in 0..k {
-                b.insert(i, r.next() as u8);
+                b.insert(i, r.next_u64() as u8);
             }
         }
         4 if n > 0 => {
@@ -128,7 +128,7 @@ pub fn mutate_bytes(r: &mut Rng, b: &mut Vec<u8>, others: &[Vec<u8>]) {
             let v = *r.pick(EXTREME_F64);
             b[i..i + 8].copy_from_slice(&v.to_le_bytes());
         }
-        _ => b.push(r.next() as u8),
+        _ => b.push(r.next_u64() as u8),
     }
 }
 
@@ -227,8 +227,8 @@ mod tests {
 
     #[test]
     fn inputs_are_reproducible_one_by_one() {
-        let a: Vec<u64> = (0..3).map(|_| Rng::for_input(7, 41).next()).collect();
+        let a: Vec<u64> = (0..3).map(|_| Rng::for_input(7, 41).next_u64()).collect();
         assert_eq!(a[0], a[1]);
-        assert_ne!(Rng::for_input(7, 41).next(), Rng::for_input(7, 42).next());
+        assert_ne!(Rng::for_input(7, 41).next_u64(), Rng::for_input(7, 42).next_u64());
     }
 }

@@ -181,6 +181,11 @@ impl Target {
         Ok(t)
     }
 
+    /// The seed inputs, unmutated.
+    pub fn seeds(&self) -> &[Vec<u8>] {
+        &self.seeds
+    }
+
     /// Input `index` of a campaign with `seed`: a seed with 1–4 mutations.
     pub fn input(&self, seed: u64, index: u64) -> Vec<u8> {
         let mut r = Rng::for_input(seed, index);

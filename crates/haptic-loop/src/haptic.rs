@@ -431,8 +431,17 @@ impl HapticLoop {
             }
             self.clamping = true;
             f = vec3::scale(f, max / mag);
+            // Rounding may leave the norm an ulp or two above the limit: step it down. A limit
+            // whose squares are subnormal (below 1e-154 N: no device's) loses the norm's
+            // precision; the steps are bounded and such a force then goes to zero.
+            let mut steps = 0;
             while vec3::norm(f) > max {
+                if steps == 8 {
+                    f = [0.0; 3];
+                    break;
+                }
                 f = vec3::scale(f, 1.0 - f64::EPSILON);
+                steps += 1;
             }
         } else {
             self.clamping = false;
@@ -585,6 +594,23 @@ stiffness_n_per_m = 5000.0
         assert_eq!(r.events[0].name, "force.clamped");
         // The clamp event fires once per episode.
         assert!(l.tick(at(-0.006), false).events.is_empty());
+    }
+
+    /// A force limit of 4e-159 N (the libFuzzer bridge target's find: clamping to it stepped
+    /// the force down one ulp at a time, 12 s for 20 ticks) still clamps, in a bounded number
+    /// of steps, to a force within the limit.
+    #[test]
+    fn a_limit_with_subnormal_squares_still_clamps() {
+        let mut specs = FALCON.clone();
+        specs.limits.max_force_n = 3.7555737088373936e-159;
+        let s = crate::scene::load_scene_for(WALL, specs).unwrap();
+        let mut l = HapticLoop::new(s.config, s.scene);
+        for k in 1..=20 {
+            let r = l.tick(at(-0.0001 * f64::from(k)), false).clone();
+            assert!(vec3::norm(r.device_force_n) <= 3.7555737088373936e-159);
+            assert!(r.device_force_n.iter().all(|x| x.is_finite()));
+            assert_eq!(r.status & status::CLAMPED, status::CLAMPED);
+        }
     }
 
     #[test]

@@ -727,7 +727,9 @@ pub struct FinalPicture {
     pub frame: Frame,
     /// Ticks recomputed.
     pub ticks: u64,
-    /// The box the camera frames (m): the end state's bodies, not its backdrops.
+    /// The box the camera frames (m): the end state's bodies, not its backdrops (the framing
+    /// test checks it).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub action_m: ([f64; 3], [f64; 3]),
 }
 

@@ -400,18 +400,131 @@ pub fn first_crossing(poly: &[V2], a: &V2, b: &V2) -> Option<f64> {
 /// Largest distance from any point of `a`'s boundary (vertices and edges,
 /// sampled every `step`) to the boundary of `b`: one side of the Hausdorff
 /// distance between two closed polygons.
+///
+/// `b`'s edges are bucketed in a square grid and each sample searches rings of cells outward
+/// until no unsearched edge can be nearer, so the result is exactly the brute-force minimum
+/// over all edges (the same distances, the same minimum) in time about linear in the samples
+/// (a 60-fold deeper trap's envelopes took 100 s to compare edge by edge).
 pub fn directed_hausdorff(a: &[V2], b: &[V2], step: f64) -> f64 {
     let n = a.len();
+    let nearest = EdgeGrid::new(b);
     let mut worst: f64 = 0.0;
     for i in 0..n {
         let (p, q) = (a[i], a[(i + 1) % n]);
         let k = (((q - p).norm() / step).ceil() as usize).max(1);
         for s in 0..k {
             let x = p + (q - p) * (s as f64 / k as f64);
-            worst = worst.max(nearest_on_boundary(b, &x).1);
+            worst = worst.max(nearest.distance(&x));
         }
     }
     worst
+}
+
+/// A closed polygon's edges bucketed in a square grid, for the exact distance from many points
+/// to its boundary.
+struct EdgeGrid<'a> {
+    poly: &'a [V2],
+    lo: V2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    /// Edge indices per cell, row-major.
+    cells: Vec<Vec<usize>>,
+}
+
+impl<'a> EdgeGrid<'a> {
+    fn new(poly: &'a [V2]) -> Self {
+        let n = poly.len();
+        let (mut lo, mut hi) = match poly.first() {
+            Some(p) => (*p, *p),
+            None => (V2::zeros(), V2::zeros()),
+        };
+        for p in poly {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let mean = (0..n)
+            .map(|i| (poly[(i + 1) % n] - poly[i]).norm())
+            .sum::<f64>()
+            / n.max(1) as f64;
+        let span = (hi - lo).max().max(f64::MIN_POSITIVE);
+        let cell = (2.0 * mean).max(span / 256.0).max(f64::MIN_POSITIVE);
+        let nx = (((hi.x - lo.x) / cell) as usize + 1).min(256);
+        let ny = (((hi.y - lo.y) / cell) as usize + 1).min(256);
+        let mut g = EdgeGrid {
+            poly,
+            lo,
+            cell,
+            nx,
+            ny,
+            cells: vec![Vec::new(); nx * ny],
+        };
+        for i in 0..n {
+            let (p, q) = (poly[i], poly[(i + 1) % n]);
+            let (x0, y0) = g.bucket(&p.inf(&q));
+            let (x1, y1) = g.bucket(&p.sup(&q));
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    g.cells[y * nx + x].push(i);
+                }
+            }
+        }
+        g
+    }
+
+    fn bucket(&self, p: &V2) -> (usize, usize) {
+        let c = |v: f64, lo: f64, n: usize| {
+            let k = ((v - lo) / self.cell).floor();
+            if k.is_nan() || k < 0.0 {
+                0
+            } else {
+                (k as usize).min(n - 1)
+            }
+        };
+        (c(p.x, self.lo.x, self.nx), c(p.y, self.lo.y, self.ny))
+    }
+
+    /// Distance from `p` to the boundary (∞ for an empty polygon), exactly
+    /// [`nearest_on_boundary`]'s.
+    fn distance(&self, p: &V2) -> f64 {
+        let n = self.poly.len();
+        if n == 0 {
+            return f64::INFINITY;
+        }
+        // Cells are clamped to the grid, so a point outside it searches from the nearest cell;
+        // the rings' distance bound counts from the point itself.
+        let (cx, cy) = self.bucket(p);
+        let outside = {
+            let hi = self.lo + V2::new(self.nx as f64, self.ny as f64) * self.cell;
+            let dx = (self.lo.x - p.x).max(p.x - hi.x).max(0.0);
+            let dy = (self.lo.y - p.y).max(p.y - hi.y).max(0.0);
+            dx.max(dy)
+        };
+        let mut best = f64::INFINITY;
+        let max_ring = self.nx.max(self.ny);
+        for r in 0..=max_ring {
+            let (x0, x1) = (cx.saturating_sub(r), (cx + r).min(self.nx - 1));
+            let (y0, y1) = (cy.saturating_sub(r), (cy + r).min(self.ny - 1));
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    // Only the ring's own cells (the inside was searched before).
+                    if x.abs_diff(cx) != r && y.abs_diff(cy) != r {
+                        continue;
+                    }
+                    for &i in &self.cells[y * self.nx + x] {
+                        let q = closest_on_segment(&self.poly[i], &self.poly[(i + 1) % n], p);
+                        best = best.min((q - p).norm());
+                    }
+                }
+            }
+            // Every edge not yet seen lies in cells of ring r + 1 or beyond: at least r cells
+            // away along one axis, and never nearer than the grid itself.
+            if best <= outside.max(r as f64 * self.cell) {
+                break;
+            }
+        }
+        best
+    }
 }
 
 /// Symmetric Hausdorff distance between the boundaries of two closed polygons.
@@ -501,5 +614,38 @@ mod tests {
         assert_eq!(hausdorff(&square, &[], 0.1), f64::INFINITY);
         assert_eq!(hausdorff(&[], &[], 0.1), 0.0);
         assert_eq!(nearest_on_boundary(&square, &V2::new(0.5, 2.0)).1, 1.0);
+    }
+
+    /// The bucketed distance is the brute-force minimum over every edge, bit for bit, for
+    /// points inside, on and far outside a long wiggly polygon.
+    #[test]
+    fn the_edge_grid_gives_the_brute_force_distance_exactly() {
+        let poly: Vec<V2> = (0..2000)
+            .map(|k| {
+                let t = k as f64 / 2000.0 * std::f64::consts::TAU;
+                let r = 1.0 + 0.3 * (7.0 * t).sin() + 0.05 * (91.0 * t).cos();
+                V2::new(3e-7 * r * t.cos(), 1e-7 * r * t.sin())
+            })
+            .collect();
+        let g = EdgeGrid::new(&poly);
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..3000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let u = (x >> 11) as f64 / (1u64 << 53) as f64;
+            let v = (x & 0xFFFF) as f64 / 65535.0;
+            let p = V2::new((u - 0.5) * 2e-6, (v - 0.5) * 8e-7);
+            assert_eq!(g.distance(&p), nearest_on_boundary(&poly, &p).1);
+        }
+        for p in &poly[..50] {
+            assert_eq!(g.distance(p), 0.0);
+        }
+        let other: Vec<V2> = poly.iter().map(|p| p * 1.01).collect();
+        let brute = other
+            .iter()
+            .map(|p| nearest_on_boundary(&poly, p).1)
+            .fold(0.0, f64::max);
+        assert!(directed_hausdorff(&other, &poly, 1e9) == brute);
     }
 }

@@ -458,10 +458,22 @@ mod tests {
         assert_eq!(
             e(&Packet::Hello {
                 rate_hz: 1000,
+                specs: bad.clone()
+            }
+            .encode()),
+            "device specs: `max_force_n` = inf is out of range (allowed: 0.001 ≤ max_force_n ≤ 1000)"
+        );
+        // A force limit of 4e-159 N (found by the libFuzzer bridge target: its squares are
+        // subnormal, and clamping to it took 12 s for 20 ticks) is no haptic device.
+        bad.limits.max_force_n = 3.7555737088373936e-159;
+        assert_eq!(
+            e(&Packet::Hello {
+                rate_hz: 1000,
                 specs: bad
             }
             .encode()),
-            "device specs: `max_force_n` = inf is out of range (allowed: 0 < max_force_n ≤ 1000)"
+            "device specs: `max_force_n` = 3.7555737088373936e-159 is out of range (allowed: \
+             0.001 ≤ max_force_n ≤ 1000)"
         );
     }
 

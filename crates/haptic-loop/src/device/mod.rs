@@ -118,25 +118,32 @@ impl DeviceSpecs {
     /// Checks specifications announced by a device (e.g. over the bridge): every number finite
     /// and in range, at most 32 buttons, names of 1–32 printable ASCII characters.
     pub fn validate(&self) -> Result<(), DeviceError> {
+        // Lower bounds a haptic device meets by far (1 mN, 1 mN/m): below them the squares of
+        // the force are subnormal and clamping to the limit loses its precision.
         let range = |field: &'static str, v: f64, lo: f64, hi: f64| {
-            if v.is_finite() && v > lo && v <= hi {
+            if v.is_finite() && v >= lo && v <= hi {
                 Ok(())
             } else {
+                let value = if v != 0.0 && v.is_finite() && !(1e-4..1e9).contains(&v.abs()) {
+                    format!("{v:e}")
+                } else {
+                    format!("{v}")
+                };
                 Err(DeviceError::BadSpec {
                     field,
-                    value: format!("{v}"),
-                    allowed: format!("{lo} < {field} ≤ {hi}"),
+                    value,
+                    allowed: format!("{lo} ≤ {field} ≤ {hi}"),
                 })
             }
         };
-        range("max_force_n", self.limits.max_force_n, 0.0, 1e3)?;
+        range("max_force_n", self.limits.max_force_n, 1e-3, 1e3)?;
         range(
             "max_stiffness_n_per_m",
             self.limits.max_stiffness_n_per_m,
-            0.0,
+            1e-3,
             1e6,
         )?;
-        range("workspace_radius_m", self.workspace_radius_m, 0.0, 10.0)?;
+        range("workspace_radius_m", self.workspace_radius_m, 1e-4, 10.0)?;
         let name_ok = |s: &str| {
             (1..=32).contains(&s.len()) && s.bytes().all(|b| b.is_ascii_graphic() || b == b' ')
         };
