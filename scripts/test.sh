@@ -16,7 +16,7 @@ cargo clippy --workspace --all-targets --release -- -D warnings
 step "cargo test (release profile)"
 cargo test --workspace --release
 
-step "fuzz targets: a fixed number of inputs each, about 15 s (docs/fuzzing.md)"
+step "fuzz: the program as a process (the in-tree driver's cli target, a fixed input set; libFuzzer runs in .ci/run, docs/fuzzing.md)"
 cargo build --release -q -p haptic-loop --bin nanohaptics
 cargo run --release -q -p nanohaptics-fuzz -- --ci
 
