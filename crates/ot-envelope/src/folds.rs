@@ -15,6 +15,7 @@ type V2 = Vector2<f64>;
 pub(crate) type Key = (u64, u64);
 
 /// The traced image curves of one sampled map.
+#[derive(Clone)]
 pub(crate) struct Traced {
     /// Fold-curve images first, the region edge's image last.
     pub curves: Vec<Curve>,
@@ -241,11 +242,6 @@ impl TraceJob {
             refinements: 0,
             stage: TraceStage::Crossings { next: 0 },
         }
-    }
-
-    /// Force evaluations spent so far (the map's included).
-    pub(crate) fn evals(&self) -> u64 {
-        self.evals
     }
 
     /// The traced curves (once [`TraceJob::run`] has returned true).

@@ -58,6 +58,7 @@ pub mod paper;
 pub mod reference;
 pub mod region;
 pub mod sample;
+pub mod spread;
 pub mod steer;
 pub mod tick;
 pub mod world;

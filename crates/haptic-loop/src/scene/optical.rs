@@ -107,6 +107,14 @@ pub struct OtParams {
     /// (1–10); absent: chosen from `envelope_tol_nm` and the tick.
     #[serde(default)]
     pub envelope_margin_waists: Option<f64>,
+    /// Spread each envelope rebuild over ticks, serving the last envelope translated meanwhile
+    /// (default true; false: a rebuild runs whole in the tick that needs it).
+    #[serde(default = "yes")]
+    pub spread_build: bool,
+    /// Force evaluations of a spread rebuild per tick (1–1e6; default
+    /// `ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK`, 256).
+    #[serde(default)]
+    pub envelope_build_evals_per_tick: Option<u64>,
 }
 
 fn yes() -> bool {
@@ -183,6 +191,27 @@ impl OtParams {
         if let Some(m) = p.envelope_margin_waists {
             check_range("optical_tweezers.envelope_margin_waists", m, 1.0, 10.0)?;
         }
+        if let Some(b) = p.envelope_build_evals_per_tick {
+            check_range(
+                "optical_tweezers.envelope_build_evals_per_tick",
+                b as f64,
+                1.0,
+                1e6,
+            )?;
+        }
+        let build_evals = match (p.spread_build, p.envelope_build_evals_per_tick) {
+            (true, b) => Some(b.unwrap_or(ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK)),
+            (false, None) => None,
+            (false, Some(_)) => {
+                return Err(SceneError::World {
+                    section: "optical_tweezers".into(),
+                    field: Some("envelope_build_evals_per_tick".into()),
+                    message: "`envelope_build_evals_per_tick` sets the spread rebuild that \
+                              `spread_build = false` switches off: give one of them, not both"
+                        .into(),
+                });
+            }
+        };
         let params = Params {
             depth_j: p.depth_nj * 1e-9,
             waists_m: [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
@@ -201,6 +230,7 @@ impl OtParams {
             envelope_tol_m: tol,
             envelope_cell_waists: p.envelope_cell_waists,
             envelope_margin_waists: p.envelope_margin_waists,
+            envelope_build_evals_per_tick: build_evals,
         };
         // A haptic tick must be cheap: refuse a tick longer than two small oscillations, in
         // the scene's unit (the world's own check would speak in seconds).
