@@ -10,7 +10,11 @@
 //! * `--realtime`: `scenes/optical_tweezers_10khz.toml` paced in real time for 60 s: missed
 //!   deadlines;
 //! * `--hausdorff-every N`: check every N-th grabbed tick (default 50; 1 = every tick);
-//! * `--only old|new --seconds S`: one session and nothing else (for `valgrind --tool=callgrind`).
+//! * `--only old|new --seconds S`: one session and nothing else (for `valgrind --tool=callgrind`);
+//! * `--scene PATH`: the batch sessions' scene, relative to the repository (default
+//!   `scenes/optical_tweezers.toml`; the Hausdorff check replays the world's steering: the
+//!   envelope built at load, kept fresh between grabs, spread rebuilds, and checks every tick
+//!   served while a spread build is under way).
 //!
 //! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
 
@@ -220,7 +224,9 @@ fn main() -> Result<(), BoxError> {
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
-    let text = std::fs::read_to_string(root().join("scenes/optical_tweezers.toml"))?;
+    // the batch sessions' scene (`--scene scenes/optical_tweezers_10khz.toml`: the 10 kHz one)
+    let scene = flag("--scene").unwrap_or_else(|| "scenes/optical_tweezers.toml".into());
+    let text = std::fs::read_to_string(root().join(scene))?;
     let old = old_text(&text);
     let seconds: f64 = flag("--seconds").map_or(Ok(60.0), |s| s.parse())?;
     if let Some(which) = flag("--only") {
