@@ -730,6 +730,37 @@ mod tests {
     }
 
     #[test]
+    fn the_spread_build_fields_are_checked_and_reach_the_world() {
+        assert_eq!(
+            build_error("envelope_build_evals_per_tick = 0"),
+            "scene: `optical_tweezers.envelope_build_evals_per_tick` = 0 is out of range \
+             (allowed: 1 ≤ optical_tweezers.envelope_build_evals_per_tick ≤ 1e6)"
+        );
+        assert_eq!(
+            build_error("spread_build = false\nenvelope_build_evals_per_tick = 64"),
+            "scene: optical_tweezers: `envelope_build_evals_per_tick` sets the spread rebuild \
+             that `spread_build = false` switches off: give one of them, not both"
+        );
+        let l = limits();
+        let world = |extra: &str| params(extra).world_params(&l).unwrap();
+        assert_eq!(
+            world("tick_map_tol_nm = 0.01").envelope_build_evals_per_tick,
+            Some(ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK)
+        );
+        assert_eq!(
+            world("envelope_build_evals_per_tick = 64").envelope_build_evals_per_tick,
+            Some(64)
+        );
+        assert_eq!(
+            world("spread_build = false").envelope_build_evals_per_tick,
+            None
+        );
+        // the first envelope is built when the scene loads
+        let s = OpticalScene::new(params("tick_map_tol_nm = 0.01"), &l).unwrap();
+        assert_eq!((s.tick_stats().rebuilds, s.tick_stats().ticks), (1, 0));
+    }
+
+    #[test]
     fn budget_fields_are_validated_with_their_range() {
         let err = build_error;
         assert_eq!(
