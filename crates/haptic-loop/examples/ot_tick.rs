@@ -10,7 +10,11 @@
 //! * `--realtime`: `scenes/optical_tweezers_10khz.toml` paced in real time for 60 s: missed
 //!   deadlines;
 //! * `--hausdorff-every N`: check every N-th grabbed tick (default 50; 1 = every tick);
-//! * `--only old|new --seconds S`: one session and nothing else (for `valgrind --tool=callgrind`).
+//! * `--only old|new --seconds S`: one session and nothing else (for `valgrind --tool=callgrind`);
+//! * `--scene PATH`: the batch sessions' scene, relative to the repository (default
+//!   `scenes/optical_tweezers.toml`; the Hausdorff check replays the world's steering: the
+//!   envelope built at load, kept fresh between grabs, spread rebuilds, and checks every tick
+//!   served while a spread build is under way).
 //!
 //! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
 
@@ -106,7 +110,13 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
     });
     tp.warm_start = !old;
     tp.cell_waists = Some(cell);
+    tp.build_evals_per_tick = match (p.spread_build, p.envelope_build_evals_per_tick) {
+        (false, _) => None,
+        (true, b) => Some(b.unwrap_or(ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK)),
+    };
     let mut c = TickController::new(tp)?;
+    // as the world: the first envelope for the particle at rest, before the first grab
+    c.prebuild(&prop, &Vector2::zeros())?;
     let a = &r.arrays;
     let col = |n: &str| a.state_column(n).ok_or(format!("no column {n}"));
     let (px, py, vx, vy) = (
@@ -118,12 +128,28 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
     let (tx, ty, g) = (col("trap_x_m")?, col("trap_y_m")?, col("grabbed")?);
     let start = Vector2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
     let (mut worst, mut worst_cold, mut n, mut grabbed, mut mismatch) = (0.0f64, 0.0f64, 0, 0, 0);
+    let (mut worst_spread, mut n_spread, mut max_slice) = (0.0f64, 0, 0u64);
     for i in 0..a.tick.len() {
+        let v_before = if i == 0 {
+            Vector2::zeros()
+        } else {
+            Vector2::new(vx[i - 1], vy[i - 1])
+        };
         if g[i] != 1.0 {
+            // as the world between grabs: keep the envelope fresh
+            if !old {
+                c.prepare(&prop, &v_before)?;
+            }
             continue;
         }
         if i == 0 || g[i - 1] != 1.0 {
-            c.reset();
+            // as the world on grab: continue from the trap the particle sits in
+            let trap = if i == 0 {
+                start
+            } else {
+                Vector2::new(tx[i - 1], ty[i - 1])
+            };
+            c.continue_from(&trap);
         }
         let s = if i == 0 {
             ParticleState {
@@ -142,7 +168,10 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
             mismatch += 1;
         }
         grabbed += 1;
-        if grabbed % every == 0 {
+        max_slice = max_slice.max(out.slice_evals);
+        // every tick served while a spread build is under way is checked
+        let spreading = c.building() || out.slice_evals > 0;
+        if grabbed % every == 0 || spreading {
             // converged dynamics over a wider region than the scene's
             let reference = working_envelope_with(
                 &truth,
@@ -164,17 +193,25 @@ fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String
                     ..Default::default()
                 },
             )?;
-            worst = worst.max(hausdorff(c.envelope(), &reference.polygon, 0.05e-9));
+            let h = hausdorff(c.envelope(), &reference.polygon, 0.05e-9);
+            worst = worst.max(h);
             worst_cold = worst_cold.max(hausdorff(&cold.polygon, &reference.polygon, 0.05e-9));
             n += 1;
+            if spreading {
+                worst_spread = worst_spread.max(h);
+                n_spread += 1;
+            }
         }
     }
     Ok(format!(
         "envelope Hausdorff from converged dynamics (tol 0.02 nm reference), {n} of {grabbed} grabbed ticks: \
          tick envelope (warm or rebuilt) {:.3} nm, a full rebuild at the same tick {:.3} nm; \
+         of which the {n_spread} ticks served during a spread build (all checked): {:.3} nm; \
+         most force evaluations of a build slice in a grabbed tick: {max_slice}; \
          reconstruction mismatches with the recorded trap: {mismatch}; {:?}",
         worst * 1e9,
         worst_cold * 1e9,
+        worst_spread * 1e9,
         c.stats()
     ))
 }
@@ -187,7 +224,9 @@ fn main() -> Result<(), BoxError> {
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
-    let text = std::fs::read_to_string(root().join("scenes/optical_tweezers.toml"))?;
+    // the batch sessions' scene (`--scene scenes/optical_tweezers_10khz.toml`: the 10 kHz one)
+    let scene = flag("--scene").unwrap_or_else(|| "scenes/optical_tweezers.toml".into());
+    let text = std::fs::read_to_string(root().join(scene))?;
     let old = old_text(&text);
     let seconds: f64 = flag("--seconds").map_or(Ok(60.0), |s| s.parse())?;
     if let Some(which) = flag("--only") {

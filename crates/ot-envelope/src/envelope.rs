@@ -15,7 +15,7 @@
 //!    ([`crate::geometry::outer_boundary`]).
 
 use crate::error::{Result, finite_vec, positive};
-use crate::folds::{hermite_polylines, trace};
+use crate::folds::{Traced, hermite_polylines, trace};
 use crate::geometry::{self, try_outer_boundary};
 use crate::region::{DEFAULT_MARGIN_WAISTS, OffsetRegion, free_drift};
 use crate::sample::{SampledMap, coarse_companion};
@@ -137,7 +137,20 @@ pub(crate) fn envelope_and_folds(
     folds: Option<&mut Vec<(V2, V2)>>,
 ) -> Result<Envelope> {
     let tol = positive("tol [m]", tol)?;
-    let mut traced = trace(prop, map, tol)?;
+    let traced = trace(prop, map, tol)?;
+    envelope_from_traced(prop, map, traced, tol, folds)
+}
+
+/// The last stage of a build: the fold points (into `folds`), the Hermite
+/// polylines of the traced curves and the outer boundary of their
+/// arrangement. Evaluates nothing.
+pub(crate) fn envelope_from_traced(
+    prop: &Propagator<2>,
+    map: &SampledMap,
+    mut traced: Traced,
+    tol: f64,
+    folds: Option<&mut Vec<(V2, V2)>>,
+) -> Result<Envelope> {
     if let Some(f) = folds {
         f.clear();
         for c in traced.curves.iter().filter(|c| c.edge_dir.is_none()) {

@@ -4,7 +4,7 @@
 //! cubic Hermite polylines of the images (with the region's edge image).
 
 use crate::error::Result;
-use crate::sample::SampledMap;
+use crate::sample::{SampledMap, Slice};
 use nalgebra::{Matrix2, Vector2};
 use ot_physics::Propagator;
 use std::collections::BTreeSet;
@@ -15,6 +15,7 @@ type V2 = Vector2<f64>;
 pub(crate) type Key = (u64, u64);
 
 /// The traced image curves of one sampled map.
+#[derive(Clone)]
 pub(crate) struct Traced {
     /// Fold-curve images first, the region edge's image last.
     pub curves: Vec<Curve>,
@@ -139,6 +140,7 @@ impl Ctx<'_> {
 }
 
 /// One image curve under construction.
+#[derive(Clone)]
 pub(crate) struct Curve {
     pub(crate) pts: Vec<CurvePoint>,
     closed: bool,
@@ -176,197 +178,326 @@ const MAX_REFINE: usize = 4096;
 /// Trace every fold curve of `map` and the region edge, refined so that
 /// consecutive image tangents turn by at most 25° (`tol` in m).
 pub(crate) fn trace(prop: &Propagator<2>, map: &SampledMap, tol: f64) -> Result<Traced> {
-    let [nx, ny] = map.n;
-    let mut ctx = Ctx {
-        prop,
-        v0: map.v0,
-        w: prop.model().well.waists(),
-        evals: map.evals,
-        iters: 2,
-    };
-    let det: Vec<f64> = map.jac.iter().map(|j| j.determinant()).collect();
-    let pos = |i: usize, j: usize| det[i * ny + j] >= 0.0;
-    // Edge ids: horizontal (i,j)-(i+1,j) then vertical (i,j)-(i,j+1).
-    let nh = (nx - 1) * ny;
-    let hid = |i: usize, j: usize| i * ny + j;
-    let vid = |i: usize, j: usize| nh + i * (ny - 1) + j;
-    let n_edges = nh + nx * (ny - 1);
-    let mut cross_of: Vec<Option<usize>> = vec![None; n_edges];
-    let mut pts: Vec<CurvePoint> = Vec::new();
-    for i in 0..nx {
-        for j in 0..ny {
-            let d0 = det[i * ny + j];
-            if i + 1 < nx && pos(i, j) != pos(i + 1, j) {
-                let p = ctx.crossing(
-                    &map.offset(i, j),
-                    d0,
-                    &map.offset(i + 1, j),
-                    det[(i + 1) * ny + j],
-                )?;
-                cross_of[hid(i, j)] = Some(pts.len());
-                pts.push(p);
-            }
-            if j + 1 < ny && pos(i, j) != pos(i, j + 1) {
-                let p = ctx.crossing(
-                    &map.offset(i, j),
-                    d0,
-                    &map.offset(i, j + 1),
-                    det[i * ny + j + 1],
-                )?;
-                cross_of[vid(i, j)] = Some(pts.len());
-                pts.push(p);
-            }
+    let mut job = TraceJob::new(prop, map);
+    job.run(prop, map, tol, &mut Slice::unlimited())?;
+    Ok(job.finish())
+}
+
+/// Where a [`TraceJob`] stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TraceStage {
+    /// Placing the crossings of the grid edges leaving vertex `next`.
+    Crossings { next: usize },
+    /// Refining fold curve `curve` from its point `k`.
+    Refine { curve: usize, k: usize },
+    /// Complete.
+    Done,
+}
+
+/// The tracing of [`trace`] as a resumable job. Work items: the crossings of
+/// one grid vertex's two edges (≤ 2 regula-falsi steps each), then one fold
+/// point inserted by refinement (≤ 5 evaluations); the marching-squares
+/// linking between the two stages evaluates nothing. Items run in the
+/// one-shot order, so the finished trace is the one-shot trace bit for bit.
+#[derive(Clone)]
+pub(crate) struct TraceJob {
+    v0: V2,
+    w: V2,
+    evals: u64,
+    det: Vec<f64>,
+    cross_of: Vec<Option<usize>>,
+    pts: Vec<CurvePoint>,
+    curves: Vec<Curve>,
+    fold_curves: usize,
+    edge_only: BTreeSet<Key>,
+    refinements: usize,
+    stage: TraceStage,
+}
+
+impl std::fmt::Debug for TraceJob {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TraceJob")
+            .field("stage", &self.stage)
+            .field("evals", &self.evals)
+            .finish_non_exhaustive()
+    }
+}
+
+impl TraceJob {
+    /// A job over the complete `map`; traces nothing yet.
+    pub(crate) fn new(prop: &Propagator<2>, map: &SampledMap) -> Self {
+        let [nx, ny] = map.n;
+        let nh = (nx - 1) * ny;
+        let n_edges = nh + nx * (ny - 1);
+        Self {
+            v0: map.v0,
+            w: prop.model().well.waists(),
+            evals: map.evals,
+            det: map.jac.iter().map(|j| j.determinant()).collect(),
+            cross_of: vec![None; n_edges],
+            pts: Vec::new(),
+            curves: Vec::new(),
+            fold_curves: 0,
+            edge_only: BTreeSet::new(),
+            refinements: 0,
+            stage: TraceStage::Crossings { next: 0 },
         }
     }
-    // Marching squares: link crossings through cells.
-    let mut links: Vec<Vec<usize>> = vec![Vec::new(); pts.len()];
-    let link = |a: Option<usize>, b: Option<usize>, links: &mut Vec<Vec<usize>>| {
-        if let (Some(a), Some(b)) = (a, b) {
-            links[a].push(b);
-            links[b].push(a);
+
+    /// The traced curves (once [`TraceJob::run`] has returned true).
+    pub(crate) fn finish(self) -> Traced {
+        Traced {
+            curves: self.curves,
+            fold_curves: self.fold_curves,
+            edge_only: self.edge_only,
+            evals: self.evals,
         }
-    };
-    for i in 0..nx - 1 {
-        for j in 0..ny - 1 {
-            let (bo, to, le, ri) = (
-                cross_of[hid(i, j)],
-                cross_of[hid(i, j + 1)],
-                cross_of[vid(i, j)],
-                cross_of[vid(i + 1, j)],
-            );
-            let es: Vec<Option<usize>> = [bo, ri, to, le]
-                .into_iter()
-                .filter(|e| e.is_some())
-                .collect();
-            match es.len() {
-                2 => link(es[0], es[1], &mut links),
-                4 => {
-                    let centre = det[i * ny + j]
-                        + det[(i + 1) * ny + j]
-                        + det[i * ny + j + 1]
-                        + det[(i + 1) * ny + j + 1];
-                    if (centre >= 0.0) == pos(i, j) {
-                        link(bo, ri, &mut links);
-                        link(le, to, &mut links);
-                    } else {
-                        link(bo, le, &mut links);
-                        link(ri, to, &mut links);
-                    }
+    }
+
+    /// Runs work items while `slice` is open; true once the trace is complete.
+    pub(crate) fn run(
+        &mut self,
+        prop: &Propagator<2>,
+        map: &SampledMap,
+        tol: f64,
+        slice: &mut Slice,
+    ) -> Result<bool> {
+        let mut ctx = Ctx {
+            prop,
+            v0: self.v0,
+            w: self.w,
+            evals: self.evals,
+            iters: 2,
+        };
+        let r = self.run_with(&mut ctx, map, tol, slice);
+        self.evals = ctx.evals;
+        r
+    }
+
+    fn run_with(
+        &mut self,
+        ctx: &mut Ctx<'_>,
+        map: &SampledMap,
+        tol: f64,
+        slice: &mut Slice,
+    ) -> Result<bool> {
+        let [nx, ny] = map.n;
+        let nh = (nx - 1) * ny;
+        let hid = |i: usize, j: usize| i * ny + j;
+        let vid = |i: usize, j: usize| nh + i * (ny - 1) + j;
+        if let TraceStage::Crossings { mut next } = self.stage {
+            let det = &self.det;
+            let pos = |i: usize, j: usize| det[i * ny + j] >= 0.0;
+            while next < nx * ny {
+                let (i, j) = (next / ny, next % ny);
+                let cx = i + 1 < nx && pos(i, j) != pos(i + 1, j);
+                let cy = j + 1 < ny && pos(i, j) != pos(i, j + 1);
+                if (cx || cy) && !slice.open() {
+                    self.stage = TraceStage::Crossings { next };
+                    return Ok(false);
                 }
-                _ => {}
-            }
-        }
-    }
-    // Chains: open ones from their ends first, then closed loops.
-    let mut curves: Vec<Curve> = Vec::new();
-    let mut used = vec![false; pts.len()];
-    let walk = |s: usize, used: &mut Vec<bool>| -> (Vec<usize>, bool) {
-        let mut chain = vec![s];
-        used[s] = true;
-        let mut cur = s;
-        loop {
-            let next = links[cur].iter().copied().find(|&x| !used[x]);
-            match next {
-                Some(x) => {
-                    used[x] = true;
-                    chain.push(x);
-                    cur = x;
+                let before = ctx.evals;
+                let d0 = det[i * ny + j];
+                if cx {
+                    let p = ctx.crossing(
+                        &map.offset(i, j),
+                        d0,
+                        &map.offset(i + 1, j),
+                        det[(i + 1) * ny + j],
+                    )?;
+                    self.cross_of[hid(i, j)] = Some(self.pts.len());
+                    self.pts.push(p);
                 }
-                None => break,
+                if cy {
+                    let p = ctx.crossing(
+                        &map.offset(i, j),
+                        d0,
+                        &map.offset(i, j + 1),
+                        det[i * ny + j + 1],
+                    )?;
+                    self.cross_of[vid(i, j)] = Some(self.pts.len());
+                    self.pts.push(p);
+                }
+                slice.spend(ctx.evals - before);
+                next += 1;
             }
+            self.link(map);
+            self.stage = TraceStage::Refine { curve: 0, k: 0 };
         }
-        let closed = chain.len() > 2 && links[cur].contains(&s);
-        (chain, closed)
-    };
-    let order: Vec<usize> = (0..pts.len())
-        .filter(|&k| links[k].len() <= 1)
-        .chain((0..pts.len()).filter(|&k| links[k].len() > 1))
-        .collect();
-    for s in order {
-        if used[s] {
-            continue;
-        }
-        let (chain, closed) = walk(s, &mut used);
-        curves.push(Curve {
-            pts: chain.iter().map(|&k| pts[k]).collect(),
-            closed,
-            edge_dir: None,
-        });
-    }
-    let fold_curves = curves.len();
-    // The region edge, counter-clockwise, with its fold crossings inserted.
-    let mut edge = Curve {
-        pts: Vec::new(),
-        closed: true,
-        edge_dir: Some(Vec::new()),
-    };
-    let mut edge_only: BTreeSet<(u64, u64)> = BTreeSet::new();
-    {
-        let mut ring: Vec<(usize, usize)> = Vec::new();
-        ring.extend((0..nx - 1).map(|i| (i, 0)));
-        ring.extend((0..ny - 1).map(|j| (nx - 1, j)));
-        ring.extend((1..nx).rev().map(|i| (i, ny - 1)));
-        ring.extend((1..ny).rev().map(|j| (0, j)));
-        let m = ring.len();
-        let dirs = edge.edge_dir.as_mut().expect("edge curve has directions");
-        for k in 0..m {
-            let (i, j) = ring[k];
-            let (i2, j2) = ring[(k + 1) % m];
-            let dir = V2::new(i2 as f64 - i as f64, j2 as f64 - j as f64);
-            let d = map.disp[map.idx(i, j)];
-            edge.pts.push(CurvePoint {
-                o: map.offset(i, j),
-                d,
-                j: map.jac[map.idx(i, j)],
-            });
-            dirs.push(dir);
-            edge_only.insert((d.x.to_bits(), d.y.to_bits()));
-            let e = if j2 == j {
-                hid(i.min(i2), j)
-            } else {
-                vid(i, j.min(j2))
-            };
-            if let Some(c) = cross_of[e] {
-                edge.pts.push(pts[c]);
-                dirs.push(dir);
-            }
-        }
-    }
-    curves.push(edge);
-    // Refine fold curves where the image tangent turns too fast.
-    let mut refinements = 0;
-    for c in curves.iter_mut().filter(|c| c.edge_dir.is_none()) {
-        let mut k = 0;
-        while k + 1 < c.pts.len() + usize::from(c.closed) && refinements < MAX_REFINE {
-            let n = c.pts.len();
-            let (a, b) = (c.pts[k], c.pts[(k + 1) % n]);
-            let chord = b.d - a.d;
-            let l = chord.norm();
-            let scaled = (b.o - a.o).component_div(&ctx.w).norm();
-            if l > tol && scaled > 1e-6 {
-                let (ta, tb) = tangents(c, k, &chord);
-                if ta.dot(&chord) < COS_MAX_TURN * l || tb.dot(&chord) < COS_MAX_TURN * l {
-                    let m = ctx.fold_between(&a, &b)?;
-                    c.pts.insert(k + 1, m);
-                    refinements += 1;
+        // Refine fold curves where the image tangent turns too fast.
+        if let TraceStage::Refine { mut curve, mut k } = self.stage {
+            while curve < self.curves.len() {
+                let c = &mut self.curves[curve];
+                if c.edge_dir.is_some() {
+                    curve += 1;
+                    k = 0;
                     continue;
                 }
+                if !(k + 1 < c.pts.len() + usize::from(c.closed) && self.refinements < MAX_REFINE) {
+                    curve += 1;
+                    k = 0;
+                    continue;
+                }
+                let n = c.pts.len();
+                let (a, b) = (c.pts[k], c.pts[(k + 1) % n]);
+                let chord = b.d - a.d;
+                let l = chord.norm();
+                let scaled = (b.o - a.o).component_div(&ctx.w).norm();
+                if l > tol && scaled > 1e-6 {
+                    let (ta, tb) = tangents(c, k, &chord);
+                    if ta.dot(&chord) < COS_MAX_TURN * l || tb.dot(&chord) < COS_MAX_TURN * l {
+                        if !slice.open() {
+                            self.stage = TraceStage::Refine { curve, k };
+                            return Ok(false);
+                        }
+                        let before = ctx.evals;
+                        let m = ctx.fold_between(&a, &b)?;
+                        slice.spend(ctx.evals - before);
+                        c.pts.insert(k + 1, m);
+                        self.refinements += 1;
+                        continue;
+                    }
+                }
+                k += 1;
             }
-            k += 1;
+            // Crossing points on the region edge are fold points too.
+            for c in self.curves.iter().filter(|c| c.edge_dir.is_none()) {
+                for p in [c.pts.first(), c.pts.last()].into_iter().flatten() {
+                    self.edge_only.remove(&(p.d.x.to_bits(), p.d.y.to_bits()));
+                }
+            }
+            self.stage = TraceStage::Done;
         }
+        Ok(true)
     }
-    // Crossing points on the region edge are fold points too.
-    for c in curves.iter().filter(|c| c.edge_dir.is_none()) {
-        for p in [c.pts.first(), c.pts.last()].into_iter().flatten() {
-            edge_only.remove(&(p.d.x.to_bits(), p.d.y.to_bits()));
+
+    /// Marching squares: links the crossings through the cells into fold
+    /// curves and appends the region edge's curve (no evaluations).
+    fn link(&mut self, map: &SampledMap) {
+        let [nx, ny] = map.n;
+        let nh = (nx - 1) * ny;
+        let hid = |i: usize, j: usize| i * ny + j;
+        let vid = |i: usize, j: usize| nh + i * (ny - 1) + j;
+        let det = &self.det;
+        let pos = |i: usize, j: usize| det[i * ny + j] >= 0.0;
+        let cross_of = &self.cross_of;
+        let pts = &self.pts;
+        // Marching squares: link crossings through cells.
+        let mut links: Vec<Vec<usize>> = vec![Vec::new(); pts.len()];
+        let link = |a: Option<usize>, b: Option<usize>, links: &mut Vec<Vec<usize>>| {
+            if let (Some(a), Some(b)) = (a, b) {
+                links[a].push(b);
+                links[b].push(a);
+            }
+        };
+        for i in 0..nx - 1 {
+            for j in 0..ny - 1 {
+                let (bo, to, le, ri) = (
+                    cross_of[hid(i, j)],
+                    cross_of[hid(i, j + 1)],
+                    cross_of[vid(i, j)],
+                    cross_of[vid(i + 1, j)],
+                );
+                let es: Vec<Option<usize>> = [bo, ri, to, le]
+                    .into_iter()
+                    .filter(|e| e.is_some())
+                    .collect();
+                match es.len() {
+                    2 => link(es[0], es[1], &mut links),
+                    4 => {
+                        let centre = det[i * ny + j]
+                            + det[(i + 1) * ny + j]
+                            + det[i * ny + j + 1]
+                            + det[(i + 1) * ny + j + 1];
+                        if (centre >= 0.0) == pos(i, j) {
+                            link(bo, ri, &mut links);
+                            link(le, to, &mut links);
+                        } else {
+                            link(bo, le, &mut links);
+                            link(ri, to, &mut links);
+                        }
+                    }
+                    _ => {}
+                }
+            }
         }
+        // Chains: open ones from their ends first, then closed loops.
+        let curves = &mut self.curves;
+        let mut used = vec![false; pts.len()];
+        let walk = |s: usize, used: &mut Vec<bool>| -> (Vec<usize>, bool) {
+            let mut chain = vec![s];
+            used[s] = true;
+            let mut cur = s;
+            loop {
+                let next = links[cur].iter().copied().find(|&x| !used[x]);
+                match next {
+                    Some(x) => {
+                        used[x] = true;
+                        chain.push(x);
+                        cur = x;
+                    }
+                    None => break,
+                }
+            }
+            let closed = chain.len() > 2 && links[cur].contains(&s);
+            (chain, closed)
+        };
+        let order: Vec<usize> = (0..pts.len())
+            .filter(|&k| links[k].len() <= 1)
+            .chain((0..pts.len()).filter(|&k| links[k].len() > 1))
+            .collect();
+        for s in order {
+            if used[s] {
+                continue;
+            }
+            let (chain, closed) = walk(s, &mut used);
+            curves.push(Curve {
+                pts: chain.iter().map(|&k| pts[k]).collect(),
+                closed,
+                edge_dir: None,
+            });
+        }
+        self.fold_curves = curves.len();
+        // The region edge, counter-clockwise, with its fold crossings inserted.
+        let mut edge = Curve {
+            pts: Vec::new(),
+            closed: true,
+            edge_dir: Some(Vec::new()),
+        };
+        let edge_only = &mut self.edge_only;
+        {
+            let mut ring: Vec<(usize, usize)> = Vec::new();
+            ring.extend((0..nx - 1).map(|i| (i, 0)));
+            ring.extend((0..ny - 1).map(|j| (nx - 1, j)));
+            ring.extend((1..nx).rev().map(|i| (i, ny - 1)));
+            ring.extend((1..ny).rev().map(|j| (0, j)));
+            let m = ring.len();
+            let dirs = edge.edge_dir.as_mut().expect("edge curve has directions");
+            for k in 0..m {
+                let (i, j) = ring[k];
+                let (i2, j2) = ring[(k + 1) % m];
+                let dir = V2::new(i2 as f64 - i as f64, j2 as f64 - j as f64);
+                let d = map.disp[map.idx(i, j)];
+                edge.pts.push(CurvePoint {
+                    o: map.offset(i, j),
+                    d,
+                    j: map.jac[map.idx(i, j)],
+                });
+                dirs.push(dir);
+                edge_only.insert((d.x.to_bits(), d.y.to_bits()));
+                let e = if j2 == j {
+                    hid(i.min(i2), j)
+                } else {
+                    vid(i, j.min(j2))
+                };
+                if let Some(c) = cross_of[e] {
+                    edge.pts.push(pts[c]);
+                    dirs.push(dir);
+                }
+            }
+        }
+        curves.push(edge);
     }
-    Ok(Traced {
-        curves,
-        fold_curves,
-        edge_only,
-        evals: ctx.evals,
-    })
 }
 
 /// Cubic Hermite polylines of the image curves, subdivided until each piece

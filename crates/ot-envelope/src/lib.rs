@@ -15,6 +15,10 @@
 //! * [`tick::TickController`]: the same law warm-started from the previous
 //!   tick's envelope (translate, check fold points, rebuild on failure),
 //!   allocation-free in steady state — the haptic loop's tick;
+//! * [`spread::EnvelopeBuild`]: a full envelope build split into slices of
+//!   counted work (force evaluations), resumed tick after tick while the
+//!   tick serves the last build translated; finished, it is the one-shot
+//!   build bit for bit;
 //! * [`world::World`]: the optical-tweezers world itself — SI [`world::Params`], built with
 //!   the device's `world_form::Limits`, stepped with an [`world::Input`] (cursor, button) to a
 //!   [`world::StepReport`] (force, stiffness felt, typed events);
@@ -58,6 +62,7 @@ pub mod paper;
 pub mod reference;
 pub mod region;
 pub mod sample;
+pub mod spread;
 pub mod steer;
 pub mod tick;
 pub mod world;

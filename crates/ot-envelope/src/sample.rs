@@ -104,6 +104,87 @@ impl SampledMap {
         region: &OffsetRegion,
         cell_waists: Option<f64>,
     ) -> Result<Self> {
+        let mut job = MapJob::new(prop, coarse.copied(), v0, region, cell_waists)?;
+        job.run(prop, &mut Slice::unlimited())?;
+        Ok(job.map)
+    }
+
+    /// Flat index of vertex `(i, j)`.
+    /// Flat index of vertex `(i, j)`.
+    #[inline]
+    pub fn idx(&self, i: usize, j: usize) -> usize {
+        i * self.n[1] + j
+    }
+
+    /// Offset of vertex `(i, j)` (m).
+    #[inline]
+    pub fn offset(&self, i: usize, j: usize) -> Vector2<f64> {
+        self.region.lo + Vector2::new(self.h.x * i as f64, self.h.y * j as f64)
+    }
+
+    /// `det(∂ displacement / ∂ offset)` at vertex `(i, j)`.
+    #[inline]
+    pub fn det(&self, i: usize, j: usize) -> f64 {
+        self.jac[self.idx(i, j)].determinant()
+    }
+}
+
+/// A budget of force evaluations for one slice of a resumable build: work
+/// items run while the slice is open, and an item once started is finished,
+/// so a slice spends at most its budget plus one item's cost. Counting
+/// evaluations, not time, keeps a spread build's result and its split over
+/// ticks a function of the inputs only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Slice {
+    /// Evaluations this slice may start work with.
+    pub(crate) budget: u64,
+    /// Evaluations spent so far.
+    pub(crate) spent: u64,
+}
+
+impl Slice {
+    /// A slice of `budget` force evaluations.
+    pub(crate) fn new(budget: u64) -> Self {
+        Self { budget, spent: 0 }
+    }
+    /// A slice that never closes (a one-shot build).
+    pub(crate) fn unlimited() -> Self {
+        Self::new(u64::MAX)
+    }
+    /// Whether another work item may start.
+    pub(crate) fn open(&self) -> bool {
+        self.spent < self.budget
+    }
+    /// Charge `evals` force evaluations.
+    pub(crate) fn spend(&mut self, evals: u64) {
+        self.spent = self.spent.saturating_add(evals);
+    }
+}
+
+/// The grid sampling of [`SampledMap::build_with`] as a resumable job: one
+/// work item per vertex (then per interior-error probe), in the one-shot
+/// build's order, so the finished map is the one-shot map bit for bit.
+#[derive(Debug, Clone)]
+pub(crate) struct MapJob {
+    /// The map being filled (complete once [`MapJob::run`] returns true).
+    pub(crate) map: SampledMap,
+    coarse: Option<Propagator<2>>,
+    /// Next vertex to sample (flat index).
+    next: usize,
+    /// Interior-error probe vertices (computed once the grid is sampled).
+    probes: Option<Vec<(usize, usize)>>,
+    next_probe: usize,
+}
+
+impl MapJob {
+    /// Validates the settings and lays out the grid; samples nothing yet.
+    pub(crate) fn new(
+        prop: &Propagator<2>,
+        coarse: Option<Propagator<2>>,
+        v0: &Vector2<f64>,
+        region: &OffsetRegion,
+        cell_waists: Option<f64>,
+    ) -> Result<Self> {
         finite_vec("velocity [m/s]", v0.as_slice())?;
         let model = prop.model();
         let s = match cell_waists {
@@ -133,69 +214,87 @@ impl SampledMap {
                 allowed: "large enough for at most 4e6 grid vertices",
             });
         }
-        let mut disp = Vec::with_capacity(n[0] * n[1]);
-        let mut jac = Vec::with_capacity(n[0] * n[1]);
-        let mut evals = 0;
-        for i in 0..n[0] {
-            for j in 0..n[1] {
-                let o = region.lo + Vector2::new(h.x * i as f64, h.y * j as f64);
-                let edge = i == 0 || j == 0 || i + 1 == n[0] || j + 1 == n[1];
-                let p = if edge { prop } else { coarse.unwrap_or(prop) };
-                let f: OffsetFlow<2> = p.flow_offset_jacobian(&o, v0)?;
-                disp.push(f.displacement);
-                jac.push(f.d_offset);
-                evals += f.evals;
-            }
-        }
-        let mut interior_error = 0.0;
-        if coarse.is_some() && n[0] > 2 && n[1] > 2 {
-            let free = crate::region::free_drift(prop.model(), v0, prop.dt());
-            let mut inner: Vec<(f64, usize, usize)> = (1..n[0] - 1)
-                .flat_map(|i| (1..n[1] - 1).map(move |j| (i, j)))
-                .map(|(i, j)| ((disp[i * n[1] + j] - free).norm(), i, j))
-                .collect();
-            inner.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-            // probes: the 8 vertices where the well acts most, and every
-            // fourth vertex of the interior lattice
-            let lattice = (1..n[0] - 1)
-                .step_by(4)
-                .flat_map(|i| (1..n[1] - 1).step_by(4).map(move |j| (0.0, i, j)));
-            let probes: Vec<(f64, usize, usize)> =
-                inner.iter().take(8).copied().chain(lattice).collect();
-            for &(_, i, j) in &probes {
-                let o = region.lo + Vector2::new(h.x * i as f64, h.y * j as f64);
-                let (d, _, e) = prop.flow(&o, v0)?;
-                evals += e;
-                interior_error = f64::max(interior_error, 2.0 * (d - disp[i * n[1] + j]).norm());
-            }
-        }
         Ok(Self {
-            region: *region,
-            n,
-            h,
-            v0: *v0,
-            disp,
-            jac,
-            evals,
-            interior_error,
+            map: SampledMap {
+                region: *region,
+                n,
+                h,
+                v0: *v0,
+                disp: Vec::with_capacity(n[0] * n[1]),
+                jac: Vec::with_capacity(n[0] * n[1]),
+                evals: 0,
+                interior_error: 0.0,
+            },
+            coarse,
+            next: 0,
+            probes: None,
+            next_probe: 0,
         })
     }
 
-    /// Flat index of vertex `(i, j)`.
-    #[inline]
-    pub fn idx(&self, i: usize, j: usize) -> usize {
-        i * self.n[1] + j
-    }
-
-    /// Offset of vertex `(i, j)` (m).
-    #[inline]
-    pub fn offset(&self, i: usize, j: usize) -> Vector2<f64> {
-        self.region.lo + Vector2::new(self.h.x * i as f64, self.h.y * j as f64)
-    }
-
-    /// `det(∂ displacement / ∂ offset)` at vertex `(i, j)`.
-    #[inline]
-    pub fn det(&self, i: usize, j: usize) -> f64 {
-        self.jac[self.idx(i, j)].determinant()
+    /// Runs work items while `slice` is open; true once the map is complete.
+    pub(crate) fn run(&mut self, prop: &Propagator<2>, slice: &mut Slice) -> Result<bool> {
+        let m = &mut self.map;
+        let n = m.n;
+        while self.next < n[0] * n[1] {
+            if !slice.open() {
+                return Ok(false);
+            }
+            let (i, j) = (self.next / n[1], self.next % n[1]);
+            let o = m.region.lo + Vector2::new(m.h.x * i as f64, m.h.y * j as f64);
+            let edge = i == 0 || j == 0 || i + 1 == n[0] || j + 1 == n[1];
+            let p = if edge {
+                prop
+            } else {
+                self.coarse.as_ref().unwrap_or(prop)
+            };
+            let f: OffsetFlow<2> = p.flow_offset_jacobian(&o, &m.v0)?;
+            m.disp.push(f.displacement);
+            m.jac.push(f.d_offset);
+            m.evals += f.evals;
+            slice.spend(f.evals);
+            self.next += 1;
+        }
+        if self.coarse.is_none() || n[0] <= 2 || n[1] <= 2 {
+            return Ok(true);
+        }
+        let probes = match &self.probes {
+            Some(p) => p,
+            None => {
+                let free = crate::region::free_drift(prop.model(), &m.v0, prop.dt());
+                let disp = &m.disp;
+                let mut inner: Vec<(f64, usize, usize)> = (1..n[0] - 1)
+                    .flat_map(|i| (1..n[1] - 1).map(move |j| (i, j)))
+                    .map(|(i, j)| ((disp[i * n[1] + j] - free).norm(), i, j))
+                    .collect();
+                inner.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+                // probes: the 8 vertices where the well acts most, and every
+                // fourth vertex of the interior lattice
+                let lattice = (1..n[0] - 1)
+                    .step_by(4)
+                    .flat_map(|i| (1..n[1] - 1).step_by(4).map(move |j| (i, j)));
+                self.probes.insert(
+                    inner
+                        .iter()
+                        .take(8)
+                        .map(|p| (p.1, p.2))
+                        .chain(lattice)
+                        .collect(),
+                )
+            }
+        };
+        while self.next_probe < probes.len() {
+            if !slice.open() {
+                return Ok(false);
+            }
+            let (i, j) = probes[self.next_probe];
+            let o = m.region.lo + Vector2::new(m.h.x * i as f64, m.h.y * j as f64);
+            let (d, _, e) = prop.flow(&o, &m.v0)?;
+            m.evals += e;
+            slice.spend(e);
+            m.interior_error = f64::max(m.interior_error, 2.0 * (d - m.disp[i * n[1] + j]).norm());
+            self.next_probe += 1;
+        }
+        Ok(true)
     }
 }

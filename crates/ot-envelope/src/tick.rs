@@ -2,34 +2,56 @@
 //! working envelope of the previous full build is translated by the change
 //! of the free drift, a few of its fold points are re-mapped and checked
 //! against it, and the clipped target is solved by Newton continued from the
-//! previous trap or seeded from the fold points. The full build (grid, fold
-//! tracing, outer boundary) runs only when the velocity has moved more than
-//! [`TickParams::warm_dv`] from the build's, when a check fails, or when no
-//! seed converges. A warm tick allocates nothing once the buffers have grown.
+//! previous trap or seeded from the fold points.
+//!
+//! The next full build (grid, fold tracing, outer boundary) is spread over
+//! ticks ([`crate::spread`]): once the velocity has moved more than
+//! [`TickParams::spread_dv`] from the last build's, a build for the current
+//! velocity starts, and each tick runs one slice of at most
+//! [`TickParams::build_evals_per_tick`] force evaluations of it (plus one
+//! work item) while the last build is served, translated; the finished
+//! build is swapped in at the start of the next tick. A build runs whole
+//! within one tick only when the served envelope would no longer be
+//! trusted: the velocity has moved more than [`TickParams::warm_dv`] from
+//! the served build's, a fold check fails, or no seed converges. The first
+//! build can be made before the first tick ([`TickController::prebuild`],
+//! [`TickController::prepare`]). A warm tick allocates nothing once the
+//! buffers have grown.
 //!
 //! Everything the warm start depends on is deterministic state (the tick
 //! inputs seen so far): same inputs, same bits, on replay too.
 
 use crate::clip::clip_to_polygon;
-use crate::envelope::envelope_and_folds;
 use crate::error::{Result, finite_vec, positive};
 use crate::geometry::{closest_on_segment, nearest_on_boundary};
 use crate::inverse::{Choice, DEFAULT_RESIDUAL, Newton, TrapSolver};
 use crate::region::{OffsetRegion, free_drift};
-use crate::sample::{SampledMap, coarse_companion};
+use crate::sample::SampledMap;
+use crate::spread::{BuiltEnvelope, EnvelopeBuild};
 use crate::steer::{ParticleState, SteerParams};
 use nalgebra::Vector2;
 use ot_physics::Propagator;
 
 type V2 = Vector2<f64>;
 
-/// Default velocity change (m/s) before a rebuild: 10 nm/µs.
-pub const DEFAULT_WARM_DV: f64 = 0.01;
+/// Default velocity change (m/s) from the build in service past which the
+/// translated envelope is no longer served and a whole rebuild runs: 30
+/// nm/µs (at the scene's tick and grid, the translation is then within
+/// 0.08 nm of converged dynamics; the spread build starts at
+/// [`DEFAULT_SPREAD_DV`]).
+pub const DEFAULT_WARM_DV: f64 = 0.03;
 /// Default distance (m) a re-mapped fold point may lie from the translated
 /// envelope: 0.1 nm.
 pub const DEFAULT_VERIFY_TOL: f64 = 1e-10;
 /// Default fold points re-mapped per warm tick.
 pub const DEFAULT_VERIFY_POINTS: usize = 3;
+/// Default velocity change (m/s) from the last build at which a spread
+/// rebuild starts: 5 nm/µs, half of [`DEFAULT_WARM_DV`].
+pub const DEFAULT_SPREAD_DV: f64 = 0.005;
+/// Default force evaluations of a spread build per tick: 256 (at the
+/// scene's RK4×2 tick map, 32 grid vertices; a build at the budget grid
+/// takes about 10 ticks).
+pub const DEFAULT_BUILD_EVALS_PER_TICK: u64 = 256;
 /// Fold points tried as Newton seeds when continuation fails.
 const FOLD_SEEDS: usize = 3;
 
@@ -47,6 +69,12 @@ pub struct TickParams {
     pub verify_tol: f64,
     /// Fold points re-mapped per warm tick (≥ 1).
     pub verify_points: usize,
+    /// Velocity change from the last build at which a spread rebuild starts
+    /// (m/s, > 0, ≤ `warm_dv`).
+    pub spread_dv: f64,
+    /// Force evaluations of a spread build per tick (≥ 1); `None`: no
+    /// spread build, a rebuild runs whole in the tick that needs it.
+    pub build_evals_per_tick: Option<u64>,
     /// Grid spacing of a full build (waists per cell; `None`:
     /// [`crate::sample::default_cell_waists`]); [`crate::grid::choose_grid`]
     /// sizes it from the envelope tolerance.
@@ -62,6 +90,8 @@ impl TickParams {
             warm_dv: DEFAULT_WARM_DV,
             verify_tol: DEFAULT_VERIFY_TOL,
             verify_points: DEFAULT_VERIFY_POINTS,
+            spread_dv: DEFAULT_SPREAD_DV,
+            build_evals_per_tick: Some(DEFAULT_BUILD_EVALS_PER_TICK),
             cell_waists: None,
         }
     }
@@ -71,6 +101,21 @@ impl TickParams {
         self.steer.validate()?;
         positive("warm_dv [m/s]", self.warm_dv)?;
         positive("verify_tol [m]", self.verify_tol)?;
+        positive("spread_dv [m/s]", self.spread_dv)?;
+        if self.spread_dv > self.warm_dv {
+            return Err(crate::error::EnvelopeError::OutOfRange {
+                field: "spread_dv [m/s]",
+                value: self.spread_dv,
+                allowed: "≤ warm_dv",
+            });
+        }
+        if self.build_evals_per_tick == Some(0) {
+            return Err(crate::error::EnvelopeError::OutOfRange {
+                field: "build_evals_per_tick",
+                value: 0.0,
+                allowed: "≥ 1 (or none: no spread build)",
+            });
+        }
         if let Some(c) = self.cell_waists {
             positive("cell_waists [waists]", c)?;
         }
@@ -90,8 +135,16 @@ impl TickParams {
 pub struct TickStats {
     /// Ticks stepped.
     pub ticks: u64,
-    /// Full envelope builds.
+    /// Full envelope builds put in service (whole or spread; the prebuild included).
     pub rebuilds: u64,
+    /// Of which built in slices over several ticks.
+    pub spread_builds: u64,
+    /// Slices of spread builds run.
+    pub build_slices: u64,
+    /// Most force evaluations one slice spent.
+    pub max_slice_evals: u64,
+    /// Spread builds dropped unfinished for a whole build.
+    pub dropped_builds: u64,
     /// Of which forced by a failed fold check.
     pub verify_failures: u64,
     /// Ticks solved by Newton continued from the previous trap.
@@ -117,8 +170,10 @@ pub struct TickOutput {
     pub force: V2,
     /// How the trap offset was chosen.
     pub choice: Choice,
-    /// Whether the envelope was fully rebuilt this tick.
+    /// Whether a whole envelope build ran in this tick.
     pub rebuilt: bool,
+    /// Force evaluations a spread build spent in this tick (0: none ran).
+    pub slice_evals: u64,
 }
 
 /// Edges examined on each side of a fold point's vertex by the warm check.
@@ -166,6 +221,8 @@ pub struct TickController {
     poly: Vec<V2>,
     /// Rotating start of the fold points checked.
     verify_next: usize,
+    /// The spread build under way.
+    pending: Option<EnvelopeBuild>,
     stats: TickStats,
 }
 
@@ -187,6 +244,7 @@ impl TickController {
             map: None,
             poly: Vec::new(),
             verify_next: 0,
+            pending: None,
             stats: TickStats::default(),
         })
     }
@@ -194,6 +252,49 @@ impl TickController {
     /// Forget the previous trap position (on grab); the last build stays.
     pub fn reset(&mut self) {
         self.prev_trap = None;
+    }
+
+    /// Continue the next tick's solve from the trap at `trap` (world, m): on
+    /// grab, the trap the particle sits in.
+    pub fn continue_from(&mut self, trap: &V2) {
+        self.prev_trap = Some(*trap);
+    }
+
+    /// Builds the envelope for velocity `v0` (m/s) now, whole (before the
+    /// first tick: the first grabbed tick is then warm). Does nothing when
+    /// warm start is off.
+    pub fn prebuild(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<()> {
+        finite_vec("velocity [m/s]", v0.as_slice())?;
+        if self.params.warm_start {
+            self.pending = None;
+            self.rebuild(prop, v0)?;
+        }
+        Ok(())
+    }
+
+    /// Between grabs: keeps the last build fresh for a particle of velocity
+    /// `v0` (m/s) with the spread build of a tick (one slice, started when
+    /// the velocity has moved more than `spread_dv` from the last build's),
+    /// so the next grab finds a warm envelope. Returns the force
+    /// evaluations spent. Does nothing without warm start or spread builds.
+    pub fn prepare(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<u64> {
+        finite_vec("velocity [m/s]", v0.as_slice())?;
+        if !self.params.warm_start || self.params.build_evals_per_tick.is_none() {
+            return Ok(0);
+        }
+        let spent = self.advance_pending(prop)?;
+        self.maybe_start(prop, v0)?;
+        Ok(spent)
+    }
+
+    /// The velocity (m/s) of the build in service (`None`: none yet).
+    pub fn build_velocity(&self) -> Option<V2> {
+        self.base_valid.then_some(self.base_v0)
+    }
+
+    /// Whether a spread build is under way.
+    pub fn building(&self) -> bool {
+        self.pending.is_some()
     }
 
     /// This tick's working envelope (m, counter-clockwise).
@@ -211,15 +312,74 @@ impl TickController {
         &self.params
     }
 
+    /// A whole build for `v0`, put in service now.
     fn rebuild(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<()> {
-        let region = OffsetRegion::around_drift(prop, v0, self.params.steer.margin_waists)?;
-        let coarse = coarse_companion(prop, v0);
-        let map =
-            SampledMap::build_with(prop, coarse.as_ref(), v0, &region, self.params.cell_waists)?;
-        let env = envelope_and_folds(prop, &map, self.params.steer.tol, Some(&mut self.all_folds))?;
-        self.base_poly = env.polygon;
-        self.base_free = env.free_displacement;
-        self.base_v0 = *v0;
+        if self.pending.take().is_some() {
+            self.stats.dropped_builds += 1;
+        }
+        let mut b = EnvelopeBuild::new(
+            prop,
+            v0,
+            self.params.steer.margin_waists,
+            self.params.cell_waists,
+            self.params.steer.tol,
+        )?;
+        b.advance(prop, None)?;
+        if let Some(built) = b.take() {
+            self.install(built);
+        }
+        Ok(())
+    }
+
+    /// One slice of the spread build under way; a finished build is put in
+    /// service. Returns the force evaluations spent.
+    fn advance_pending(&mut self, prop: &Propagator<2>) -> Result<u64> {
+        let Some(b) = self.pending.as_mut() else {
+            return Ok(0);
+        };
+        let r = match b.advance(prop, self.params.build_evals_per_tick) {
+            Ok(r) => r,
+            Err(e) => {
+                self.pending = None;
+                return Err(e);
+            }
+        };
+        self.stats.build_slices += 1;
+        self.stats.max_slice_evals = self.stats.max_slice_evals.max(r.evals);
+        if r.done {
+            if let Some(built) = b.take() {
+                self.install(built);
+                self.stats.spread_builds += 1;
+            }
+            self.pending = None;
+        }
+        Ok(r.evals)
+    }
+
+    /// Starts a spread build for `v0` when none is under way, spread builds
+    /// are on, and the build in service is missing or `spread_dv` away.
+    fn maybe_start(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<()> {
+        if self.pending.is_none()
+            && self.params.build_evals_per_tick.is_some()
+            && (!self.base_valid || (v0 - self.base_v0).norm() > self.params.spread_dv)
+        {
+            self.pending = Some(EnvelopeBuild::new(
+                prop,
+                v0,
+                self.params.steer.margin_waists,
+                self.params.cell_waists,
+                self.params.steer.tol,
+            )?);
+        }
+        Ok(())
+    }
+
+    /// Puts a finished build in service.
+    fn install(&mut self, built: BuiltEnvelope) {
+        self.base_poly = built.envelope.polygon;
+        self.base_free = built.envelope.free_displacement;
+        self.base_v0 = built.envelope.v0;
+        self.all_folds = built.folds;
         self.keys.clear();
         self.keys.extend(
             self.base_poly
@@ -239,11 +399,10 @@ impl TickController {
         }
         self.poly.clear();
         self.poly.extend_from_slice(&self.base_poly);
-        self.map = Some(map);
+        self.map = Some(built.map);
         self.base_valid = true;
         self.verify_next = 0;
         self.stats.rebuilds += 1;
-        Ok(())
     }
 
     /// Translate the base envelope to `v0` and check it at a few fold
@@ -321,7 +480,14 @@ impl TickController {
         self.stats.ticks += 1;
         let v0 = particle.velocity;
         let mut rebuilt = false;
-        if !self.warm(prop, &v0)? {
+        let slice_evals = if self.params.warm_start {
+            self.advance_pending(prop)?
+        } else {
+            0
+        };
+        if self.warm(prop, &v0)? {
+            self.maybe_start(prop, &v0)?;
+        } else {
             self.rebuild(prop, &v0)?;
             rebuilt = true;
         }
@@ -355,8 +521,13 @@ impl TickController {
             found = self.quick_solve(&nw, &target, prev.as_ref(), &shift)?;
         }
         if found.is_none() {
-            // the full solve on a fresh grid
-            if !rebuilt {
+            // the full solve on a grid for this velocity (the build in
+            // service when it is for this very velocity)
+            let fresh = self.base_valid
+                && self.map.as_ref().is_some_and(|m| {
+                    m.v0.x.to_bits() == v0.x.to_bits() && m.v0.y.to_bits() == v0.y.to_bits()
+                });
+            if !rebuilt && !fresh {
                 self.rebuild(prop, &v0)?;
                 rebuilt = true;
             }
@@ -400,6 +571,7 @@ impl TickController {
             force: -excess * self.params.steer.stiffness,
             choice,
             rebuilt,
+            slice_evals,
         })
     }
 }

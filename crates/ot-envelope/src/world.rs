@@ -108,6 +108,9 @@ pub struct Params {
     /// Half-width of the envelope's offset region beyond the drift path, waists (`None`: chosen
     /// from `envelope_tol_m`).
     pub envelope_margin_waists: Option<f64>,
+    /// Force evaluations of a spread envelope build per step (1 to 1e6; `None`: a rebuild runs
+    /// whole in the step that needs it). See [`crate::tick`] and [`crate::spread`].
+    pub envelope_build_evals_per_tick: Option<u64>,
 }
 
 impl Params {
@@ -135,6 +138,7 @@ impl Params {
             envelope_tol_m: crate::DEFAULT_TOL,
             envelope_cell_waists: None,
             envelope_margin_waists: None,
+            envelope_build_evals_per_tick: Some(crate::tick::DEFAULT_BUILD_EVALS_PER_TICK),
         }
     }
 
@@ -199,6 +203,9 @@ impl Params {
         }
         if let Some(m) = self.envelope_margin_waists {
             closed("envelope_margin_waists", m, 1.0, 10.0)?;
+        }
+        if let Some(b) = self.envelope_build_evals_per_tick {
+            closed("envelope_build_evals_per_tick", b as f64, 1.0, 1e6)?;
         }
         Ok(())
     }
@@ -379,7 +386,8 @@ pub struct World {
 
 impl World {
     /// Builds the world: checks `params` against `limits`, builds the trap model, the tick map
-    /// (measuring its error) and the envelope grid.
+    /// (measuring its error), the envelope grid and (with warm start) the first working envelope,
+    /// for the particle at rest, so that the first grabbed step is warm.
     pub fn new(params: &Params, limits: &Limits) -> Result<World, WorldError> {
         limits.validate()?;
         params.validate(limits)?;
@@ -425,7 +433,10 @@ impl World {
         });
         tick.warm_start = p.warm_start;
         tick.cell_waists = Some(cell);
-        let controller = TickController::new(tick)?;
+        tick.build_evals_per_tick = p.envelope_build_evals_per_tick;
+        let mut controller = TickController::new(tick)?;
+        // the first envelope, for the particle at rest, before the first grab
+        controller.prebuild(&prop, &V2::zeros())?;
         let start = V2::new(p.start_m[0], p.start_m[1]);
         Ok(World {
             params: p.clone(),
@@ -472,7 +483,8 @@ impl World {
             let gap_m = (self.cursor - self.position).norm();
             if gap_m <= self.params.particle_radius_m + self.params.cursor_radius_m {
                 self.grabbed = true;
-                self.controller.reset();
+                // continue from the trap the particle sits in
+                self.controller.continue_from(&self.trap);
                 events.push(Event::Grab { gap_m });
             } else {
                 events.push(Event::GrabMissed { gap_m });
@@ -507,6 +519,12 @@ impl World {
             }
         } else {
             self.envelope.clear();
+            // keep the envelope fresh for the next grab (one bounded slice)
+            if let Err(e) = self.controller.prepare(&self.prop, &self.velocity) {
+                events.push(Event::ControllerError {
+                    message: e.to_string(),
+                });
+            }
         }
         let excess_m = self.excess.norm();
         let clipping = excess_m > 0.0;

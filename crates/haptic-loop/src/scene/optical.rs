@@ -107,6 +107,14 @@ pub struct OtParams {
     /// (1–10); absent: chosen from `envelope_tol_nm` and the tick.
     #[serde(default)]
     pub envelope_margin_waists: Option<f64>,
+    /// Spread each envelope rebuild over ticks, serving the last envelope translated meanwhile
+    /// (default true; false: a rebuild runs whole in the tick that needs it).
+    #[serde(default = "yes")]
+    pub spread_build: bool,
+    /// Force evaluations of a spread rebuild per tick (1–1e6; default
+    /// `ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK`, 256).
+    #[serde(default)]
+    pub envelope_build_evals_per_tick: Option<u64>,
 }
 
 fn yes() -> bool {
@@ -183,6 +191,27 @@ impl OtParams {
         if let Some(m) = p.envelope_margin_waists {
             check_range("optical_tweezers.envelope_margin_waists", m, 1.0, 10.0)?;
         }
+        if let Some(b) = p.envelope_build_evals_per_tick {
+            check_range(
+                "optical_tweezers.envelope_build_evals_per_tick",
+                b as f64,
+                1.0,
+                1e6,
+            )?;
+        }
+        let build_evals = match (p.spread_build, p.envelope_build_evals_per_tick) {
+            (true, b) => Some(b.unwrap_or(ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK)),
+            (false, None) => None,
+            (false, Some(_)) => {
+                return Err(SceneError::World {
+                    section: "optical_tweezers".into(),
+                    field: Some("envelope_build_evals_per_tick".into()),
+                    message: "`envelope_build_evals_per_tick` sets the spread rebuild that \
+                              `spread_build = false` switches off: give one of them, not both"
+                        .into(),
+                });
+            }
+        };
         let params = Params {
             depth_j: p.depth_nj * 1e-9,
             waists_m: [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
@@ -201,6 +230,7 @@ impl OtParams {
             envelope_tol_m: tol,
             envelope_cell_waists: p.envelope_cell_waists,
             envelope_margin_waists: p.envelope_margin_waists,
+            envelope_build_evals_per_tick: build_evals,
         };
         // A haptic tick must be cheap: refuse a tick longer than two small oscillations, in
         // the scene's unit (the world's own check would speak in seconds).
@@ -697,6 +727,37 @@ mod tests {
         assert_eq!(loaded.config.rate_hz, 10_000);
         assert_eq!(loaded.config.period_ns(), 100_000);
         assert_eq!(loaded.scene.kind(), "optical_tweezers");
+    }
+
+    #[test]
+    fn the_spread_build_fields_are_checked_and_reach_the_world() {
+        assert_eq!(
+            build_error("envelope_build_evals_per_tick = 0"),
+            "scene: `optical_tweezers.envelope_build_evals_per_tick` = 0 is out of range \
+             (allowed: 1 ≤ optical_tweezers.envelope_build_evals_per_tick ≤ 1e6)"
+        );
+        assert_eq!(
+            build_error("spread_build = false\nenvelope_build_evals_per_tick = 64"),
+            "scene: optical_tweezers: `envelope_build_evals_per_tick` sets the spread rebuild \
+             that `spread_build = false` switches off: give one of them, not both"
+        );
+        let l = limits();
+        let world = |extra: &str| params(extra).world_params(&l).unwrap();
+        assert_eq!(
+            world("tick_map_tol_nm = 0.01").envelope_build_evals_per_tick,
+            Some(ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK)
+        );
+        assert_eq!(
+            world("envelope_build_evals_per_tick = 64").envelope_build_evals_per_tick,
+            Some(64)
+        );
+        assert_eq!(
+            world("spread_build = false").envelope_build_evals_per_tick,
+            None
+        );
+        // the first envelope is built when the scene loads
+        let s = OpticalScene::new(params("tick_map_tol_nm = 0.01"), &l).unwrap();
+        assert_eq!((s.tick_stats().rebuilds, s.tick_stats().ticks), (1, 0));
     }
 
     #[test]
