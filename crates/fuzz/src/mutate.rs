@@ -229,6 +229,9 @@ mod tests {
     fn inputs_are_reproducible_one_by_one() {
         let a: Vec<u64> = (0..3).map(|_| Rng::for_input(7, 41).next_u64()).collect();
         assert_eq!(a[0], a[1]);
-        assert_ne!(Rng::for_input(7, 41).next_u64(), Rng::for_input(7, 42).next_u64());
+        assert_ne!(
+            Rng::for_input(7, 41).next_u64(),
+            Rng::for_input(7, 42).next_u64()
+        );
     }
 }
