@@ -12,8 +12,9 @@
 //! It checks that the resident memory of the simulator stays flat (the last tenth of the
 //! session within 4 MiB of the level after the first tenth), that the tick compute time does
 //! not drift (the median of the last tenth within 25 % + 5 µs of the median of the first tenth,
-//! after the first 5 s), that no tick is lost from the recording, and that the recording replays
-//! bit for bit. The figures are printed and written to `target/soak/soak-<seconds>s.json`.
+//! after the first 5 s), that every tick the simulator ran is in the recording (at least 95 % of
+//! the planned ones: a bridged session ticks on the device's samples), and that the recording
+//! replays bit for bit. The figures are printed and written to `target/soak/soak-<seconds>s.json`.
 //! Without the flag the test says how to run it and returns. `NANOHAPTICS_BIN` runs another
 //! build of the program (e.g. a copy kept aside while the tree changes during an hour's soak).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -236,7 +237,15 @@ fn soak_bridged_session_with_loss_and_jitter() {
     let dropped = fake_report["dropped"].as_f64().unwrap();
     let loss = dropped / (sent + dropped);
     assert!((0.04..0.06).contains(&loss), "device loss {loss}");
-    assert_eq!(ticks, (seconds * 1000.0).round() as u64, "ticks recorded");
+    // Every tick the simulator ran is in the recording. A bridged session ticks on the
+    // device's samples: on a loaded machine a late tick takes the newest sample (the others
+    // are superseded), so it may run a little fewer ticks than the device's seconds.
+    assert_eq!(Some(ticks), summary["ticks"].as_u64(), "ticks recorded");
+    let planned = (seconds * 1000.0).round() as u64;
+    assert!(
+        ticks * 100 >= planned * 95,
+        "{ticks} ticks of {planned} planned"
+    );
     assert!(
         late_max <= early + 4 * 1024,
         "resident memory grew: {early} KiB at 10 %, {late_max} KiB in the last tenth"
