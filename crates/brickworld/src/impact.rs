@@ -86,6 +86,9 @@ pub struct ImpactHook {
     /// Where the colliders of the awake dynamic bodies are and how fast they can close a gap,
     /// by collider index, taken before the step (see [`ImpactHook::filter_contact_pair`]).
     reach: Vec<Option<Reach>>,
+    /// Keep every contact rapier computes (the idle ones too): the crate's tests compare the
+    /// two ways.
+    pub(crate) keep_idle: bool,
 }
 
 /// A collider of an awake dynamic body before the step: its world AABB and the largest speed of
@@ -159,6 +162,7 @@ impl ImpactHook {
                 impacted: Vec::new(),
                 dt_s,
                 reach,
+                keep_idle: false,
             };
         }
         // Whether a load through `point` passes (within CENTRAL_LOAD_M) through the vertical of
@@ -200,6 +204,7 @@ impl ImpactHook {
                     impacted: seeds,
                     dt_s,
                     reach,
+                    keep_idle: false,
                 };
             }
         }
@@ -357,6 +362,9 @@ impl PhysicsHooks for ImpactHook {
     /// act. Positions and velocities are those before the step.
     fn filter_contact_pair(&self, ctx: &PairFilterContext) -> Option<SolverFlags> {
         let keep = Some(SolverFlags::COMPUTE_RIGID_IMPULSES);
+        if self.keep_idle {
+            return keep;
+        }
         let (Some(a), Some(b)) = (
             self.reach(ctx, ctx.collider1, ctx.rigid_body1),
             self.reach(ctx, ctx.collider2, ctx.rigid_body2),
@@ -409,9 +417,10 @@ impl PhysicsHooks for ImpactHook {
             }
         }
         // No impact: drop the speculative contacts that cannot act over this step.
-        if m.solver_contacts
-            .iter()
-            .all(|c| c.dist <= SPECULATIVE_KEEP_M)
+        if self.keep_idle
+            || m.solver_contacts
+                .iter()
+                .all(|c| c.dist <= SPECULATIVE_KEEP_M)
         {
             return;
         }
