@@ -104,6 +104,8 @@ struct Reach {
     v: Vector,
     /// Largest speed of a point of the collider through the rotation alone, m/s.
     spin: f64,
+    /// Angular speed of the body, rad/s.
+    w: f64,
 }
 
 impl Reach {
@@ -127,6 +129,7 @@ impl Reach {
             maxs: aabb.maxs,
             v: rb.linvel(),
             spin,
+            w,
         }
     }
 
@@ -139,6 +142,7 @@ impl Reach {
             maxs: aabb.maxs,
             v: Vector::ZERO,
             spin: 0.0,
+            w: 0.0,
         }
     }
 }
@@ -157,7 +161,7 @@ impl ImpactHook {
         // and only then build the support links the impact would follow.
         let dt_s = phys.integration_parameters.dt;
         let reach = Self::reach_table(phys);
-        if !Self::any_fast_support(phys) {
+        if !Self::any_fast_support(phys, &reach) {
             return ImpactHook {
                 impacted: Vec::new(),
                 dt_s,
@@ -176,7 +180,7 @@ impl ImpactHook {
         let mut seeds: Vec<RigidBodyHandle> = Vec::new();
         // Supports between two bodies: (body, other, contact centroid), either way round.
         let mut links: Vec<(RigidBodyHandle, RigidBodyHandle, Vector)> = Vec::new();
-        for_each_support(phys, false, |s| {
+        for_each_support(phys, None, |s| {
             if s.approach_m_per_s >= IMPACT_MIN_SPEED_M_PER_S {
                 for h in [s.body1, s.body2].into_iter().flatten() {
                     if central(h, s.centroid) && !seeds.contains(&h) {
@@ -264,9 +268,9 @@ impl ImpactHook {
     /// Whether any support contact approaches faster than [`IMPACT_MIN_SPEED_M_PER_S`] at its
     /// centroid: the seed test of [`ImpactHook::for_step`], skipping contacts whose bodies are
     /// all at rest (then the approach is exactly zero).
-    fn any_fast_support(phys: &PhysicsWorld) -> bool {
+    fn any_fast_support(phys: &PhysicsWorld, reach: &[Option<Reach>]) -> bool {
         let mut fast = false;
-        for_each_support(phys, true, |s| {
+        for_each_support(phys, Some(reach), |s| {
             fast = s.approach_m_per_s >= IMPACT_MIN_SPEED_M_PER_S;
             !fast
         });
@@ -288,12 +292,30 @@ struct Support {
 }
 
 /// Calls `f` on every support manifold of the contacts before the step, in the narrow phase's
-/// order, until `f` returns false. With `skip_still`, contacts whose bodies have zero linear
-/// and angular velocity (or are not dynamic) are skipped: their approach is exactly zero.
-fn for_each_support(phys: &PhysicsWorld, skip_still: bool, mut f: impl FnMut(Support) -> bool) {
-    let moving = |h: Option<RigidBodyHandle>| {
-        h.and_then(|h| phys.bodies.get(h))
-            .is_some_and(|rb| rb.linvel() != Vector::ZERO || rb.angvel() != Vector::ZERO)
+/// order, until `f` returns false. With `skip_slow` (the step's [`Reach`] table), contacts
+/// whose bodies move too slowly for any point of theirs to approach at
+/// [`IMPACT_MIN_SPEED_M_PER_S`] are skipped.
+fn for_each_support(
+    phys: &PhysicsWorld,
+    skip_slow: Option<&[Option<Reach>]>,
+    mut f: impl FnMut(Support) -> bool,
+) {
+    // Bound on the speed, m/s, of any point within the prediction distance of collider `c` of
+    // body `h` moving with it (0 for no dynamic body: its velocity counts as zero below).
+    let prediction = phys.integration_parameters.prediction_distance();
+    let speed_bound = |table: &[Option<Reach>], c: ColliderHandle, h: Option<RigidBodyHandle>| {
+        let Some(rb) = h.and_then(|h| phys.bodies.get(h)) else {
+            return 0.0;
+        };
+        let (i, generation) = c.0.into_raw_parts();
+        let r = match table.get(i as usize) {
+            Some(Some(r)) if r.generation == generation => *r,
+            _ => match phys.colliders.get(c) {
+                Some(co) => Reach::of(co, rb, generation),
+                None => return f64::INFINITY,
+            },
+        };
+        r.v.length() + r.spin + r.w * prediction
     };
     let vel = |h: Option<RigidBodyHandle>, p: Vector| {
         h.and_then(|h| phys.bodies.get(h))
@@ -307,8 +329,17 @@ fn for_each_support(phys: &PhysicsWorld, skip_still: bool, mut f: impl FnMut(Sup
             dynamic_body(phys, pair.collider1),
             dynamic_body(phys, pair.collider2),
         );
-        if b1.is_none() && b2.is_none() || skip_still && !moving(b1) && !moving(b2) {
+        if b1.is_none() && b2.is_none() {
             continue;
+        }
+        // A manifold's centroid lies within the prediction distance of both colliders, so its
+        // approach is at most the sum of the two bounds: below the impact speed, skip it.
+        if let Some(table) = skip_slow {
+            if speed_bound(table, pair.collider1, b1) + speed_bound(table, pair.collider2, b2)
+                < IMPACT_MIN_SPEED_M_PER_S
+            {
+                continue;
+            }
         }
         let (Some(c1), Some(c2)) = (
             phys.colliders.get(pair.collider1),
