@@ -350,7 +350,7 @@ mod tests {
         let mut w = World::new(p, &Limits::FALCON).unwrap();
         w.keep_idle_contacts = keep_idle;
         for (pl, props) in extra {
-            w.add_brick_with(*pl, props.clone()).unwrap();
+            w.add_brick_with(*pl, *props).unwrap();
         }
         let input = w.input([1.5, 1.5, 1.5], Grip::default()).unwrap();
         for _ in 0..ticks {
