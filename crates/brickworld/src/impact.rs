@@ -310,6 +310,8 @@ fn for_each_support(
         let (i, generation) = c.0.into_raw_parts();
         let r = match table.get(i as usize) {
             Some(Some(r)) if r.generation == generation => *r,
+            // Not in the table (asleep, or woken since): a body at rest moves no point.
+            _ if rb.linvel() == Vector::ZERO && rb.angvel() == Vector::ZERO => return 0.0,
             _ => match phys.colliders.get(c) {
                 Some(co) => Reach::of(co, rb, generation),
                 None => return f64::INFINITY,
