@@ -197,7 +197,9 @@ impl BrickSet {
                 .friction(props.friction.unwrap_or(params.friction))
                 .restitution(props.restitution.unwrap_or(params.restitution))
                 .user_data(TAG_BRICK | id.0 as u128)
-                .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS),
+                .active_hooks(
+                    ActiveHooks::FILTER_CONTACT_PAIRS | ActiveHooks::MODIFY_SOLVER_CONTACTS,
+                ),
             Some(body),
         );
         if let Some(rb) = self.phys.bodies.get_mut(body) {

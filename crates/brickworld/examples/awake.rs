@@ -1,0 +1,58 @@
+//! The cost of a world where everything is awake: one and two layers of 100 bricks with
+//! sleeping off, and a 200-brick wall knocked over. Prints thread-CPU p50 / p99 / max per tick.
+//! Run: `cargo run --release -p brickworld --example brickworld-awake [-- ticks]`.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use brickworld::Params;
+use common::{PARK, Timing, layers, step_idle, time_parked, tower};
+
+fn line(name: &str, t: &Timing) {
+    println!(
+        "{name:<48} awake {:>3}  CPU p50 {:>7.1}  p99 {:>7.1}  max {:>7.1} µs",
+        t.awake,
+        t.cpu.median(),
+        t.cpu.p99(),
+        t.cpu.max()
+    );
+}
+
+fn main() {
+    let n: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(3000);
+    // Optional second argument: run only the scenes whose name contains it.
+    let only = std::env::args().nth(2).unwrap_or_default();
+    let off = Params {
+        sleeping: false,
+        ..Params::default()
+    };
+    for (name, k) in [
+        ("100 bricks, one layer, sleeping off", 1),
+        ("200 bricks, two layers, sleeping off", 2),
+    ] {
+        if !name.contains(&only) {
+            continue;
+        }
+        let mut w = layers(&off, k, 0.005);
+        for _ in 0..500 {
+            step_idle(&mut w, PARK);
+        }
+        line(name, &time_parked(&mut w, n));
+    }
+    for (name, p) in [
+        (
+            "200-brick wall knocked over, sleeping on",
+            Params::default(),
+        ),
+        ("200-brick wall knocked over, sleeping off", off.clone()),
+    ] {
+        if !name.contains(&only) {
+            continue;
+        }
+        let mut w = tower(&p, 20, 10, 1.0);
+        line(name, &time_parked(&mut w, n));
+    }
+}
