@@ -49,3 +49,32 @@ fn an_overdamped_trap_has_no_oscillation_to_bound() {
     let prop = Propagator::new(model, Method::Rk4 { substeps: 8 }, 1e-4).expect("tick map");
     assert!(check_tick_length(&prop).is_ok());
 }
+
+#[test]
+fn a_tangle_of_fold_images_is_refused_before_its_crossing_search() {
+    // Δt = 5 µs (3.1 periods, within the tick bound) with 8 RK4 substeps: ω·h = 2.5 rad, the
+    // polynomial map folds where the flow does not, and its fold images cross ~5·10⁷ times
+    // (about a minute of search). 41 substeps (ω·h = 0.48) give the true, untangled envelope.
+    let e = working_envelope(&paper_tick(5e-6), &Vector2::zeros(), None)
+        .expect_err("a tangle of fold images");
+    assert_eq!(
+        e.to_string(),
+        "physics: envelope boundary: segment pairs to test = 5.3854177e7 is out of range: \
+         allowed ≤ 2e6 (the images of the map's folds are tangled: take a shorter tick, a \
+         slower particle or a tick map with more substeps)"
+    );
+    let model = ot_physics::paper::model().expect("paper model");
+    let fine = Propagator::new(model, Method::Rk4 { substeps: 41 }, 5e-6).expect("tick map");
+    let we = working_envelope(&fine, &Vector2::zeros(), None).expect("envelope");
+    assert_eq!(we.polygon.len(), 792);
+    // The free drift (zero here) is reachable; from rest, energy conservation keeps the
+    // particle within twice its offset from the trap centre: every displacement is within
+    // twice the farthest offset of the region, per axis.
+    assert!(we.contains(&Vector2::zeros()));
+    for p in &we.polygon {
+        for i in 0..2 {
+            let o = we.region.lo[i].abs().max(we.region.hi[i].abs());
+            assert!(p[i].abs() <= 2.0 * o, "{p:?}");
+        }
+    }
+}
