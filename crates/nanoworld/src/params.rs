@@ -57,6 +57,7 @@ pub struct Params {
     pub loading_zone: Option<LoadingZone>,
     /// Movable atoms present at the start, resting on the substrate at these (x, y) (m).
     #[serde(default)]
+    #[serde(deserialize_with = "world_form::exact::vec_of_arrays")]
     pub initial_atoms_xy_m: Vec<[f64; 2]>,
     /// The house blueprint; `None` switches scoring off.
     #[serde(default)]
@@ -89,6 +90,7 @@ struct ParamsTable {
     loading_zone: Option<LoadingZone>,
     /// Movable atoms present at the start, resting on the substrate at these (x, y) (m).
     #[serde(default)]
+    #[serde(deserialize_with = "world_form::exact::vec_of_arrays")]
     initial_atoms_xy_m: Vec<[f64; 2]>,
     /// The house blueprint; `None` switches scoring off.
     #[serde(default)]
@@ -162,10 +164,13 @@ pub struct AtomParams {
 #[serde(deny_unknown_fields)]
 pub struct LoadingZone {
     /// Lower corner (x, y) (m).
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub min_xy_m: [f64; 2],
     /// Upper corner (x, y) (m); each component > the lower one.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub max_xy_m: [f64; 2],
     /// Where a new atom appears (x, y) (m); inside the zone and over the substrate.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub spawn_xy_m: [f64; 2],
 }
 
@@ -174,6 +179,7 @@ pub struct LoadingZone {
 #[serde(deny_unknown_fields)]
 pub struct HouseParams {
     /// Slot centres (m).
+    #[serde(deserialize_with = "world_form::exact::vec_of_arrays")]
     pub slots_m: Vec<[f64; 3]>,
     /// An atom fills a slot when its centre is within this distance (m). Range (0, 1e-6].
     pub tolerance_m: f64,
