@@ -237,6 +237,37 @@ def _auto_chunksize(executor: Any, n: int) -> int:
     return max(1, n // (8 * threads))
 
 
+class _SigintFlag:
+    """While the main thread waits for a pool, SIGINT sets a flag the wait loop checks instead
+    of raising where it lands: a KeyboardInterrupt raised inside a weakref or ``__del__``
+    callback that the main thread happens to run (garbage from a previous Dask cluster, a
+    finished thread leaving ``threading._dangling``) is printed and lost, and the sweep would
+    run to the end. Installed only when SIGINT has Python's default handler and this is the
+    main thread (a SIGINT the process ignores stays ignored); restored on exit."""
+
+    def __init__(self) -> None:
+        self.raised = False
+        self._previous: Any = None
+
+    def __enter__(self) -> "_SigintFlag":
+        import signal
+        import threading
+
+        if threading.current_thread() is threading.main_thread() and \
+                signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def _handle(self, signum, frame) -> None:
+        self.raised = True
+
+    def __exit__(self, *exc) -> None:
+        if self._previous is not None:
+            import signal
+
+            signal.signal(signal.SIGINT, self._previous)
+
+
 def _shutdown(pool: Any, wait: bool) -> None:
     if isinstance(pool, cf.ThreadPoolExecutor):
         pool.shutdown(wait=wait, cancel_futures=True)
@@ -374,18 +405,21 @@ def sweep(
             if chunksize is None:
                 chunksize = _auto_chunksize(executor, len(jobs))
             chunks = [jobs[k:k + chunksize] for k in range(0, len(jobs), chunksize)]
-            futures = {pool.submit(_execute_many, c): c for c in chunks}
-            pending = set(futures)
-            while pending:
-                done, pending = cf.wait(pending, timeout=0.25, return_when=cf.FIRST_COMPLETED)
-                for f in done:
-                    try:
-                        got = f.result()
-                    except Exception as e:
-                        raise RuntimeError(f"sweep: {e}") from e
-                    for idx, scal, arr in got:
-                        results[idx] = (scal, arr)
-                    bar.update(len(got))
+            with _SigintFlag() as sigint:
+                futures = {pool.submit(_execute_many, c): c for c in chunks}
+                pending = set(futures)
+                while pending:
+                    if sigint.raised:
+                        raise KeyboardInterrupt
+                    done, pending = cf.wait(pending, timeout=0.25, return_when=cf.FIRST_COMPLETED)
+                    for f in done:
+                        try:
+                            got = f.result()
+                        except Exception as e:
+                            raise RuntimeError(f"sweep: {e}") from e
+                        for idx, scal, arr in got:
+                            results[idx] = (scal, arr)
+                        bar.update(len(got))
     except KeyboardInterrupt:
         interrupted = True
         if pool is not None:
