@@ -429,8 +429,8 @@ impl Params {
             (s.nx - 1) as f64 * s.spacing_m,
             (s.ny - 1) as f64 * s.spacing_m,
         );
-        let over_substrate =
-            |v: [f64; 2]| v[0] >= 0.0 && v[0] <= x_max && v[1] >= 0.0 && v[1] <= y_max;
+        // One axis at a time, so that the error names the component that is out of range.
+        let over_axis = |v: f64, k: usize| v >= 0.0 && v <= if k == 0 { x_max } else { y_max };
         let sub_range = || format!("inside the substrate, 0..={x_max:e} x 0..={y_max:e} m");
         if let Some(z) = &self.loading_zone {
             for k in 0..2 {
@@ -446,7 +446,7 @@ impl Params {
                 check(
                     &format!("loading_zone.spawn_xy_m[{k}]"),
                     z.spawn_xy_m[k],
-                    z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && over_substrate(z.spawn_xy_m),
+                    z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && over_axis(z.spawn_xy_m[k], k),
                     || format!("inside the zone [{lo:e}, {hi:e}] and {}", sub_range()),
                 )?;
             }
@@ -463,7 +463,7 @@ impl Params {
                 check(
                     &format!("initial_atoms_xy_m[{i}][{k}]"),
                     a[k],
-                    over_substrate(*a),
+                    over_axis(a[k], k),
                     sub_range,
                 )?;
             }

@@ -251,3 +251,82 @@ pub fn working_envelope_3d<'py>(
         ],
     )
 }
+
+/// Largest number of polygon vertices × angles [`polygon_radius`] takes in one call.
+const MAX_RADIUS_PAIRS: usize = 100_000_000;
+
+/// The farthest crossing of the ray from `centre` at each angle of `angles` with the closed
+/// polygon `poly` (same unit as the points; 0 where the ray meets no edge): the edge
+/// `a + s·(b − a)`, `0 ≤ s < 1`, met at `t > 0` along the unit direction.
+fn radius_of(poly: &[SVector<f64, 2>], centre: &SVector<f64, 2>, angles: &[f64]) -> Vec<f64> {
+    let rel: Vec<SVector<f64, 2>> = poly.iter().map(|p| p - centre).collect();
+    angles
+        .iter()
+        .map(|&th| {
+            let (dy, dx) = th.sin_cos();
+            let mut best = 0.0_f64;
+            for (k, a) in rel.iter().enumerate() {
+                let b = rel[(k + 1) % rel.len()];
+                let (ex, ey) = (b.x - a.x, b.y - a.y);
+                // ray t·d meets the edge a + s·e: solve [d, −e] (t, s) = a
+                let den = dx * (-ey) - dy * (-ex);
+                if den == 0.0 {
+                    continue;
+                }
+                let t = (a.x * (-ey) - a.y * (-ex)) / den;
+                let s = (dx * a.y - dy * a.x) / den;
+                if (0.0..1.0).contains(&s) && t > 0.0 && t > best {
+                    best = t;
+                }
+            }
+            best
+        })
+        .collect()
+}
+
+/// The radial function of a polygon about a point: for each angle of ``angles`` (rad,
+/// counter-clockwise from +x), the distance from ``centre`` (2,) to the farthest crossing of
+/// that ray with the closed polygon ``polygon`` (K, 2) (0 where the ray meets no edge; same
+/// unit as the points). A working envelope contains its free drift, so its radial function
+/// about it describes it fully (a ray that grazes a fold still sees the outer boundary).
+///
+/// Returns:
+///     (M,) float64 array. The GIL is released: threads computing radial functions of
+///     different envelopes run in parallel.
+#[pyfunction]
+pub fn polygon_radius<'py>(
+    py: Python<'py>,
+    polygon: &Bound<'py, PyAny>,
+    centre: &Bound<'py, PyAny>,
+    angles: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let poly = crate::convert::rows::<2>(polygon, "polygon", "m")?;
+    if poly.len() < 3 {
+        return Err(PyValueError::new_err(format!(
+            "polygon: expected at least 3 vertices, got {}",
+            poly.len()
+        )));
+    }
+    let centre = vector::<2>(centre, "centre", "m")?;
+    let a = crate::convert::numbers(angles, "angles")?;
+    if a.shape.len() != 1 {
+        return Err(PyValueError::new_err(
+            "angles: expected a 1-dimensional array of angles (rad)",
+        ));
+    }
+    if let Some(k) = a.data.iter().position(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "angles[{k}] = {:e} is out of range: allowed finite (rad)",
+            a.data[k]
+        )));
+    }
+    if poly.len().saturating_mul(a.data.len()) > MAX_RADIUS_PAIRS {
+        return Err(PyValueError::new_err(format!(
+            "polygon × angles: {} vertices × {} angles is out of range: allowed at most {MAX_RADIUS_PAIRS} pairs",
+            poly.len(),
+            a.data.len()
+        )));
+    }
+    let r = py.detach(|| radius_of(&poly, &centre, &a.data));
+    Ok(PyArray1::from_vec(py, r))
+}
