@@ -459,11 +459,11 @@ impl Params {
         )?;
         let min_sep = 2.0 * self.atoms.radius_m * (1.0 - 1e-9);
         for (i, a) in self.initial_atoms_xy_m.iter().enumerate() {
-            for k in 0..2 {
+            for (k, &c) in a.iter().enumerate() {
                 check(
                     &format!("initial_atoms_xy_m[{i}][{k}]"),
-                    a[k],
-                    over_axis(a[k], k),
+                    c,
+                    over_axis(c, k),
                     sub_range,
                 )?;
             }
