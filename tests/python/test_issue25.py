@@ -160,6 +160,9 @@ def test_integer_and_text_arguments_are_named():
         with pytest.raises(kind) as e:
             call()
         assert str(e.value) == message
+    # The named extractors keep the signatures' defaults visible.
+    assert str(__import__("inspect").signature(nh.nano_params)) == "(mode='game')"
+    assert nh.nano_params()["substrate"]["nx"] == 40
 
 
 # ---------------------------------------------------------------- polygon_radius

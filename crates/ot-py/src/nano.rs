@@ -490,7 +490,7 @@ impl NanoWorld {
 /// Args:
 ///     mode: "game" (the paper's laws) or "physical" (real constants).
 #[pyfunction]
-#[pyo3(signature = (mode=String::from("game")))]
+#[pyo3(signature = (mode=String::from("game")), text_signature = "(mode='game')")]
 pub fn nano_params<'py>(
     py: Python<'py>,
     #[pyo3(from_py_with = crate::convert::mode_arg)] mode: String,
