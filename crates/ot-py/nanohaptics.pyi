@@ -176,6 +176,10 @@ def working_envelope(
     """(K, 2) polygon of reachable displacements (m), counter-clockwise, first
     vertex not repeated; tol (m) default 0.5e-9."""
 
+def polygon_radius(polygon: ArrayLike, centre: ArrayLike, angles: ArrayLike) -> F64Array:
+    """(M,) distance from centre (2,) to the farthest crossing of the ray at each angle (rad)
+    with the closed polygon (K, 2); 0 where a ray meets none. Releases the GIL."""
+
 def clip_command(
     trap: GaussianTrap,
     velocity: ArrayLike,

@@ -36,18 +36,10 @@ THETA = np.linspace(0.0, 2 * np.pi, ANGLES, endpoint=False)
 
 def radial(poly: np.ndarray, centre: np.ndarray) -> np.ndarray:
     """Distance (m) from ``centre`` to the polygon boundary along each angle of THETA (the
-    farthest crossing, so a ray that grazes a fold still sees the outer boundary)."""
-    p = poly - centre
-    a, b = p, np.roll(p, -1, axis=0)
-    d = np.stack([np.cos(THETA), np.sin(THETA)], axis=1)  # (M, 2)
-    e = b - a  # (K, 2)
-    # ray t·d meets the edge a + s·e: solve [d, −e] (t, s) = a
-    den = d[:, None, 0] * (-e[None, :, 1]) - d[:, None, 1] * (-e[None, :, 0])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (a[None, :, 0] * (-e[None, :, 1]) - a[None, :, 1] * (-e[None, :, 0])) / den
-        s = (d[:, None, 0] * a[None, :, 1] - d[:, None, 1] * a[None, :, 0]) / den
-    ok = (den != 0) & (s >= 0) & (s < 1) & (t > 0)
-    return np.where(ok, t, 0.0).max(axis=1)
+    farthest crossing, so a ray that grazes a fold still sees the outer boundary):
+    :func:`nanohaptics.polygon_radius`, which releases the GIL (the numpy version of this
+    held it for twice as long as the envelope took, and serialised the threads)."""
+    return nh.polygon_radius(poly, centre, THETA)
 
 
 def envelope_run(run: dict, seed: int) -> dict:

@@ -183,7 +183,7 @@ def test_add_brick_with_velocity_and_friction_slides_v2_over_2_mu_g():
     assert str(e.value) == "parameter `brick.restitution` = 2 is out of range: allowed [0, 1]"
 
 
-def test_long_batches_stop_on_ctrl_c():
+def test_long_batches_stop_on_ctrl_c(sigint_raises):
     zone = {"min_m": [-0.6, -0.3], "max_m": [-0.3, 0.3], "height_m": 0.5, "spawn_m": [-0.45, 0.0]}
     bw = nh.BrickWorld({"loading_zone": zone})
     bw.add_brick((0.0, 0.0, 0.03))
@@ -214,7 +214,7 @@ def test_trap_waist_and_dt_never_give_nan():
 # ---------------------------------------------------------------- item 20: long work stops on Ctrl-C
 
 
-def test_a_long_session_stops_on_ctrl_c_with_a_complete_recording(tmp_path):
+def test_a_long_session_stops_on_ctrl_c_with_a_complete_recording(tmp_path, sigint_raises):
     out = tmp_path / "interrupted.mcap"
     threading.Timer(0.5, _thread.interrupt_main).start()
     t0 = time.perf_counter()
@@ -248,14 +248,14 @@ def test_tick_map_substeps_are_bounded_where_every_call_runs_hundreds_of_flows()
 
 
 
-def test_a_long_envelope_stops_on_ctrl_c():
-    # Δt = 10 µs at the paper's constants: about two minutes of crossing search when left
-    # alone; Ctrl-C stops it at the next segment.
-    trap = nh.paper_trap()
+def test_a_long_envelope_stops_on_ctrl_c(sigint_raises):
+    # A 3D envelope of 40962 rays marched in steps of 0.01 waist: tens of seconds when left
+    # alone; Ctrl-C stops it at the next flow.
+    t3 = nh.GaussianTrap(1e-15, (600e-9, 300e-9), 1e-15, axial_waist=1.5e-6)
     threading.Timer(0.5, _thread.interrupt_main).start()
     t0 = time.perf_counter()
     with pytest.raises(KeyboardInterrupt):
-        nh.working_envelope(trap, (0.0, 0.0), 1e-5)
+        nh.working_envelope_3d(t3, (0.0, 0.0, 0.0), nh.PAPER_DT, level=6, step=0.01)
     assert time.perf_counter() - t0 < 60.0
     # The next call is not affected.
-    assert len(nh.working_envelope(trap, (0.0, 0.0), nh.PAPER_DT)) > 10
+    assert len(nh.working_envelope(nh.paper_trap(), (0.0, 0.0), nh.PAPER_DT)) > 10

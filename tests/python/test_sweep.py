@@ -228,7 +228,7 @@ def test_recordings_of_a_sweep_replay_its_arrays(tmp_path, serial):
     assert_identical(df.drop(columns=["recording"]), serial[0].iloc[:2])
 
 
-def test_ctrl_c_returns_the_runs_that_finished():
+def test_ctrl_c_returns_the_runs_that_finished(sigint_raises):
     started = threading.Event()
 
     def run(r, seed):

@@ -47,6 +47,7 @@ pub struct Params {
     /// Mass of one brick in kg. Range `[1e-3, 100]`.
     pub brick_mass_kg: f64,
     /// Half-extents of a brick along its local x, y, z axes in m. Each in `[1e-3, 1]`.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub brick_half_extents_m: [f64; 3],
     /// Stiffness of the proxy spring `F = -k d n` in N/m. Range `(0, device max stiffness]`.
     #[serde(alias = "proxy_stiffness_n_m")]
@@ -218,12 +219,15 @@ pub enum AccelEstimator {
 #[serde(deny_unknown_fields)]
 pub struct LoadingZone {
     /// Lower corner (x, y) of the zone in m.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub min_m: [f64; 2],
     /// Upper corner (x, y) of the zone in m; must exceed `min_m` on both axes.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub max_m: [f64; 2],
     /// Height of the zone above the ground in m (the cursor must be below it). Range `(0, 10]`.
     pub height_m: f64,
     /// Where the spawned brick's centre appears (x, y) in m; it rests flat on the ground.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub spawn_m: [f64; 2],
 }
 
@@ -244,9 +248,11 @@ impl Default for LoadingZone {
 #[serde(deny_unknown_fields)]
 pub struct BrickPlacement {
     /// Centre of the brick in the world frame, m.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub center_m: [f64; 3],
     /// Rotation vector (axis · angle) in degrees.
     #[serde(default)]
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub rotation_deg: [f64; 3],
 }
 
@@ -264,6 +270,7 @@ impl BrickPlacement {
 pub struct BrickProps {
     /// Initial linear velocity, m/s. Each component in `[-100, 100]`.
     #[serde(alias = "velocity_m_s")]
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub velocity_m_per_s: [f64; 3],
     /// Mass, kg in `[1e-3, 100]`; `None`: [`Params::brick_mass_kg`].
     pub mass_kg: Option<f64>,
@@ -280,11 +287,14 @@ pub struct BrickProps {
 #[serde(deny_unknown_fields)]
 pub struct Obstacle {
     /// Centre in the world frame, m.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub center_m: [f64; 3],
     /// Half-extents along the box's local axes, m. Each in `[1e-3, 100]`.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub half_extents_m: [f64; 3],
     /// Rotation vector (axis · angle) in degrees.
     #[serde(default)]
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub rotation_deg: [f64; 3],
 }
 

@@ -57,6 +57,7 @@ pub struct Params {
     pub loading_zone: Option<LoadingZone>,
     /// Movable atoms present at the start, resting on the substrate at these (x, y) (m).
     #[serde(default)]
+    #[serde(deserialize_with = "world_form::exact::vec_of_arrays")]
     pub initial_atoms_xy_m: Vec<[f64; 2]>,
     /// The house blueprint; `None` switches scoring off.
     #[serde(default)]
@@ -89,6 +90,7 @@ struct ParamsTable {
     loading_zone: Option<LoadingZone>,
     /// Movable atoms present at the start, resting on the substrate at these (x, y) (m).
     #[serde(default)]
+    #[serde(deserialize_with = "world_form::exact::vec_of_arrays")]
     initial_atoms_xy_m: Vec<[f64; 2]>,
     /// The house blueprint; `None` switches scoring off.
     #[serde(default)]
@@ -162,10 +164,13 @@ pub struct AtomParams {
 #[serde(deny_unknown_fields)]
 pub struct LoadingZone {
     /// Lower corner (x, y) (m).
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub min_xy_m: [f64; 2],
     /// Upper corner (x, y) (m); each component > the lower one.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub max_xy_m: [f64; 2],
     /// Where a new atom appears (x, y) (m); inside the zone and over the substrate.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub spawn_xy_m: [f64; 2],
 }
 
@@ -174,6 +179,7 @@ pub struct LoadingZone {
 #[serde(deny_unknown_fields)]
 pub struct HouseParams {
     /// Slot centres (m).
+    #[serde(deserialize_with = "world_form::exact::vec_of_arrays")]
     pub slots_m: Vec<[f64; 3]>,
     /// An atom fills a slot when its centre is within this distance (m). Range (0, 1e-6].
     pub tolerance_m: f64,
@@ -423,8 +429,8 @@ impl Params {
             (s.nx - 1) as f64 * s.spacing_m,
             (s.ny - 1) as f64 * s.spacing_m,
         );
-        let over_substrate =
-            |v: [f64; 2]| v[0] >= 0.0 && v[0] <= x_max && v[1] >= 0.0 && v[1] <= y_max;
+        // One axis at a time, so that the error names the component that is out of range.
+        let over_axis = |v: f64, k: usize| v >= 0.0 && v <= if k == 0 { x_max } else { y_max };
         let sub_range = || format!("inside the substrate, 0..={x_max:e} x 0..={y_max:e} m");
         if let Some(z) = &self.loading_zone {
             for k in 0..2 {
@@ -440,7 +446,7 @@ impl Params {
                 check(
                     &format!("loading_zone.spawn_xy_m[{k}]"),
                     z.spawn_xy_m[k],
-                    z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && over_substrate(z.spawn_xy_m),
+                    z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && over_axis(z.spawn_xy_m[k], k),
                     || format!("inside the zone [{lo:e}, {hi:e}] and {}", sub_range()),
                 )?;
             }
@@ -453,11 +459,11 @@ impl Params {
         )?;
         let min_sep = 2.0 * self.atoms.radius_m * (1.0 - 1e-9);
         for (i, a) in self.initial_atoms_xy_m.iter().enumerate() {
-            for k in 0..2 {
+            for (k, &c) in a.iter().enumerate() {
                 check(
                     &format!("initial_atoms_xy_m[{i}][{k}]"),
-                    a[k],
-                    over_substrate(*a),
+                    c,
+                    over_axis(c, k),
                     sub_range,
                 )?;
             }

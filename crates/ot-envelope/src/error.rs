@@ -22,6 +22,24 @@ pub enum EnvelopeError {
     /// The clarabel subproblem of the constrained solver failed.
     #[error("convex subproblem failed: {0}")]
     Subproblem(String),
+    /// A tick longer than [`crate::envelope::MAX_OSCILLATIONS_PER_TICK`] periods of the well's
+    /// fastest small oscillation (a particle with inertia): the map folds once more per
+    /// half period, and the envelope's boundary search grows without bound with the folds.
+    #[error(
+        "dt [s] = {dt:e} is out of range: allowed ≤ {max_dt:.4e} s, {periods} periods of the \
+         well's fastest oscillation (ω = {omega:.4e} rad/s); a longer tick folds the map so \
+         often that the envelope's boundary search grows without bound"
+    )]
+    TickTooLong {
+        /// The tick asked for (s).
+        dt: f64,
+        /// The longest tick allowed for this trap (s).
+        max_dt: f64,
+        /// The periods of the fastest oscillation allowed in one tick.
+        periods: u32,
+        /// The fastest small-oscillation angular frequency, `sqrt(κ_max / m)` (rad/s).
+        omega: f64,
+    },
     /// The 3D surface method's assumption does not hold for this map.
     #[error("3D envelope needs a star-shaped critical surface: {0}")]
     NotStarShaped(String),

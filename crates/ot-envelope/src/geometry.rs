@@ -33,6 +33,12 @@ impl Dsu {
     }
 }
 
+/// Most segment pairs [`try_outer_boundary`] tests for crossings (pairs sharing a bucket of
+/// its grid): about a second of work. A working envelope at the paper's constants needs at
+/// most some 10⁴ (ticks up to 4 oscillation periods, an accurate tick map); a tangle of fold
+/// images from a tick map too coarse for a long tick needs 10⁷ and more.
+pub const MAX_SEGMENT_PAIRS: u64 = 2_000_000;
+
 /// The outer boundary of the union of `polylines` (each closed when its flag
 /// is true): the loop that separates the unbounded face of their planar
 /// arrangement from the rest. Returned counter-clockwise, first vertex not
@@ -42,16 +48,28 @@ impl Dsu {
 /// Returns an empty vector when there are no segments. Under a raised
 /// [`ot_physics::cancel`] flag it returns an empty vector early: use
 /// [`try_outer_boundary`] to tell the two apart.
+/// It tests every candidate pair of segments, however many ([`try_outer_boundary`] bounds
+/// them).
 pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
-    try_outer_boundary(polylines, snap).unwrap_or_default()
+    boundary(polylines, snap, u64::MAX).unwrap_or_default()
 }
 
-/// [`outer_boundary`] that stops with [`ot_physics::PhysicsError::Interrupted`] when the
+/// [`outer_boundary`] that stops with [`ot_physics::PhysicsError::OutOfRange`] when the
+/// crossing search would test more than [`MAX_SEGMENT_PAIRS`] segment pairs, and with
+/// [`ot_physics::PhysicsError::Interrupted`] when the
 /// thread's [`ot_physics::cancel`] flag is raised (it checks once per segment of the
 /// crossing search, its costly part: a tangled arrangement at a long Δt takes minutes).
 pub fn try_outer_boundary(
     polylines: &[(Vec<V2>, bool)],
     snap: f64,
+) -> Result<Vec<V2>, ot_physics::PhysicsError> {
+    boundary(polylines, snap, MAX_SEGMENT_PAIRS)
+}
+
+fn boundary(
+    polylines: &[(Vec<V2>, bool)],
+    snap: f64,
+    max_pairs: u64,
 ) -> Result<Vec<V2>, ot_physics::PhysicsError> {
     // 1. vertices (bit-identical points merged) and segments.
     let mut pts: Vec<V2> = Vec::new();
@@ -111,6 +129,21 @@ pub fn try_outer_boundary(
                 grid[i * nby + j].push(k);
             }
         }
+    }
+    // The crossing search tests every pair of segments sharing a bucket: bound it before
+    // it starts (a tangle of fold images costs minutes, and its boundary is no envelope one
+    // can use).
+    let pairs: u64 = grid
+        .iter()
+        .map(|l| (l.len() as u64) * (l.len() as u64).saturating_sub(1) / 2)
+        .sum();
+    if pairs > max_pairs {
+        return Err(ot_physics::PhysicsError::OutOfRange {
+            field: "envelope boundary: segment pairs to test",
+            value: pairs as f64,
+            allowed: "≤ 2e6 (the images of the map's folds are tangled: take a shorter tick, \
+                      a slower particle or a tick map with more substeps)",
+        });
     }
     let mut dsu = Dsu((0..pts.len()).collect());
     // (segment, parameter, vertex) insertions

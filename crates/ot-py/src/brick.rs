@@ -406,8 +406,8 @@ impl BrickWorld {
         &mut self,
         py: Python<'py>,
         start_m: &Bound<'py, PyAny>,
-        max_ticks: usize,
-        settle_ticks: usize,
+        #[pyo3(from_py_with = crate::convert::max_ticks_arg)] max_ticks: usize,
+        #[pyo3(from_py_with = crate::convert::settle_ticks_arg)] settle_ticks: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let s = vector::<3>(start_m, "start_m", "m")?;
         let start = [s.x, s.y, s.z];

@@ -9,6 +9,7 @@ use nalgebra::SVector;
 use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyInt, PyString};
 
 /// Ticks a batch call runs without the GIL before it checks for signals
 /// (Ctrl-C): about 10 ms to 1 s of work, so an interrupt is honoured promptly.
@@ -148,11 +149,29 @@ pub(crate) fn point_or_rows<const D: usize>(
     Ok((to_vectors(&n.data), single))
 }
 
-/// A Python integer in `lo ..= hi`.
+/// A Python integer in `lo ..= hi`: TypeError naming `name` for a non-integer (a bool is
+/// not a count), ValueError naming it and the range for an integer outside it (however
+/// large: no OverflowError).
 pub(crate) fn int_in(obj: &Bound<'_, PyAny>, name: &str, lo: i128, hi: i128) -> PyResult<i128> {
-    let v: i128 = obj
-        .extract()
-        .map_err(|_| PyTypeError::new_err(format!("{name}: expected an integer")))?;
+    if obj.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected an integer, got bool"
+        )));
+    }
+    let v: i128 = match obj.extract() {
+        Ok(v) => v,
+        Err(_) if obj.is_instance_of::<PyInt>() => {
+            return Err(PyValueError::new_err(format!(
+                "{name} = {obj} is out of range: allowed {lo} ..= {hi}"
+            )));
+        }
+        Err(_) => {
+            return Err(PyTypeError::new_err(format!(
+                "{name}: expected an integer, got {}",
+                type_name(obj)
+            )));
+        }
+    };
     if (lo..=hi).contains(&v) {
         Ok(v)
     } else {
@@ -160,6 +179,61 @@ pub(crate) fn int_in(obj: &Bound<'_, PyAny>, name: &str, lo: i128, hi: i128) -> 
             "{name} = {v} is out of range: allowed {lo} ..= {hi}"
         )))
     }
+}
+
+/// The Python type name of `obj` (`int`, `str`, ...), for messages.
+pub(crate) fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "object".to_string())
+}
+
+/// A Python `str` argument: TypeError naming `name` otherwise.
+pub(crate) fn text(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<String> {
+    match obj.cast::<PyString>() {
+        Ok(s) => Ok(s.to_cow()?.into_owned()),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{name}: expected a str, got {}",
+            type_name(obj)
+        ))),
+    }
+}
+
+/// Most ticks a batch argument (`max_ticks`, `settle_ticks`) may ask for: 10^12 (over 30
+/// years at 1 kHz).
+pub(crate) const MAX_BATCH_TICKS: i128 = 1_000_000_000_000;
+
+/// `max_ticks` of `BrickWorld.run_wall_script`: a whole number 0 ..= 10^12.
+pub(crate) fn max_ticks_arg(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    Ok(int_in(obj, "max_ticks", 0, MAX_BATCH_TICKS)? as usize)
+}
+
+/// `settle_ticks` of `BrickWorld.run_wall_script`: a whole number 0 ..= 10^12.
+pub(crate) fn settle_ticks_arg(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    Ok(int_in(obj, "settle_ticks", 0, MAX_BATCH_TICKS)? as usize)
+}
+
+/// `mode` of `nano_params`: a str.
+pub(crate) fn mode_arg(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    text(obj, "mode")
+}
+
+/// `sample_rate` of `render_audio`: a whole number of Hz, 8000 ..= 192000.
+pub(crate) fn sample_rate_arg(obj: &Bound<'_, PyAny>) -> PyResult<i64> {
+    int_in(obj, "sample_rate", 8_000, 192_000)
+        .map(|v| v as i64)
+        .map_err(|e| {
+            Python::attach(|py| {
+                if e.is_instance_of::<PyValueError>(py) {
+                    PyValueError::new_err(format!(
+                        "sample_rate = {obj} is out of range: allowed 8000–192000 Hz"
+                    ))
+                } else {
+                    e
+                }
+            })
+        })
 }
 
 /// N vectors as an `(N, D)` float64 array.

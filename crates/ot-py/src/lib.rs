@@ -51,6 +51,7 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(envelope::working_envelope, m)?)?;
     m.add_function(wrap_pyfunction!(envelope::clip_command, m)?)?;
     m.add_function(wrap_pyfunction!(envelope::working_envelope_3d, m)?)?;
+    m.add_function(wrap_pyfunction!(envelope::polygon_radius, m)?)?;
     m.add_function(wrap_pyfunction!(session::run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(session::read_recording, m)?)?;
     m.add_function(wrap_pyfunction!(session::render_audio, m)?)?;

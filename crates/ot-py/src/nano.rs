@@ -490,9 +490,12 @@ impl NanoWorld {
 /// Args:
 ///     mode: "game" (the paper's laws) or "physical" (real constants).
 #[pyfunction]
-#[pyo3(signature = (mode="game"))]
-pub fn nano_params<'py>(py: Python<'py>, mode: &str) -> PyResult<Bound<'py, PyDict>> {
-    match mode {
+#[pyo3(signature = (mode=String::from("game")), text_signature = "(mode='game')")]
+pub fn nano_params<'py>(
+    py: Python<'py>,
+    #[pyo3(from_py_with = crate::convert::mode_arg)] mode: String,
+) -> PyResult<Bound<'py, PyDict>> {
+    match mode.as_str() {
         "game" => params_to_py(py, &nanoworld::Params::game_default()),
         "physical" => params_to_py(py, &nanoworld::Params::physical_default()),
         other => Err(PyValueError::new_err(format!(

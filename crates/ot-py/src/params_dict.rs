@@ -15,7 +15,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use world_form::Limits;
 
-/// `params` as Python passes it: "game", "physical", a dict, or None (game).
+/// `params` as Python passes it: "game", "physical", a dict, or None (game). A dict is
+/// validated whole ([`Params::validate`]: the error names the field's dotted path).
 pub(crate) fn params_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Params> {
     let Some(obj) = obj else {
         return Ok(Params::game_default());
@@ -37,7 +38,11 @@ pub(crate) fn params_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Params>
             "params: allowed \"game\", \"physical\" or a dict of the scene table",
         ));
     }
-    crate::json::from_py(obj, "params")
+    let p: Params = crate::json::from_py(obj, "params")?;
+    // Validated whole, here, for every entry point that takes a params dict (NanoWorld,
+    // set_params, force_distance_curve): a field the call does not use is no less wrong.
+    p.validate().map_err(crate::convert::value_error)?;
+    Ok(p)
 }
 
 /// The device limits a nano world renders to, in world units: None takes the Falcon as the

@@ -460,7 +460,7 @@ pub fn render_audio<'py>(
     py: Python<'py>,
     path: &Bound<'py, PyAny>,
     proximity: bool,
-    sample_rate: i64,
+    #[pyo3(from_py_with = crate::convert::sample_rate_arg)] sample_rate: i64,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray1<f32>>, u32)> {
     let p = path_arg(path, "path")?;

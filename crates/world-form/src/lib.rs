@@ -22,6 +22,8 @@
 //! );
 //! ```
 
+pub mod exact;
+
 use serde::{Deserialize, Serialize};
 
 /// What a haptic device can render, expressed where a world uses it (CHAI3D's

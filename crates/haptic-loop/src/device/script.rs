@@ -136,6 +136,7 @@ pub enum OperatorKind {
 #[serde(deny_unknown_fields)]
 struct WaypointFile {
     t_s: f64,
+    #[serde(deserialize_with = "world_form::exact::array")]
     position_mm: [f64; 3],
 }
 

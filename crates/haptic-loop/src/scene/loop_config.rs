@@ -16,6 +16,7 @@ pub struct MappingSection {
     /// Device newtons per world newton. Allowed: 1e-6–1e18.
     pub force_scale: f64,
     /// World point under the device origin, m.
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub origin_m: [f64; 3],
 }
 

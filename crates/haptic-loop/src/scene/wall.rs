@@ -31,9 +31,11 @@ pub const WORLD: WorldKind = WorldKind {
 #[serde(deny_unknown_fields)]
 pub struct WallParams {
     /// Outward normal of the wall (normalised on load; must be non-zero).
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub normal: Vec3,
     /// A point on the wall surface, world frame, m.
     #[serde(default)]
+    #[serde(deserialize_with = "world_form::exact::array")]
     pub point_m: Vec3,
     /// Wall stiffness, world frame, N/m. Allowed: 0 < k ≤ 1e12 (capped at the device limit).
     pub stiffness_n_per_m: f64,
