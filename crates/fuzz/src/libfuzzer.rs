@@ -6,9 +6,11 @@
 //! altered recording that verifies; and for recordings read from raw bytes, nothing accepted
 //! whose CRCs and summary were not checked.
 
-use crate::targets::{Outcome, run_bridge, run_scene, run_script, seed_recording, work_dir};
+use crate::targets::{
+    Outcome, OutputChange, run_bridge, run_scene, run_script, seed_recording, verified_outputs,
+    verify_changed, work_dir,
+};
 use haptic_loop::SessionArrays;
-use haptic_loop::channels::messages::Channel;
 use haptic_loop::record::{Recording, read_recording};
 use std::sync::OnceLock;
 
@@ -96,10 +98,8 @@ pub fn verify(data: &[u8]) {
         );
         return;
     }
-    let mut rec = seed().clone();
-    let outputs: Vec<usize> = (0..rec.messages.len())
-        .filter(|&i| rec.messages[i].channel.verified())
-        .collect();
+    let seed = seed();
+    let outputs = verified_outputs(seed);
     let num = |k: usize| {
         let mut b = [0u8; 4];
         for (j, x) in rest.iter().skip(k).take(4).enumerate() {
@@ -108,37 +108,14 @@ pub fn verify(data: &[u8]) {
         u32::from_le_bytes(b) as usize
     };
     let i = outputs[num(0) % outputs.len()];
-    let op = rest.get(4).copied().unwrap_or(0) % 4;
-    let m = &mut rec.messages[i];
-    let topic = m.channel.topic();
-    let what = match op {
-        0 | 1 if !m.data.is_empty() => {
-            let k = num(5) % m.data.len();
-            let x = rest.get(9).copied().unwrap_or(1).max(1);
-            m.data[k] ^= x;
-            format!("byte {k} of a {topic} message xored with {x}")
-        }
-        2 => {
-            rec.messages.remove(i);
-            format!("a {topic} message removed")
-        }
-        _ => {
-            let dup = m.clone();
-            rec.messages.insert(i, dup);
-            format!("a {topic} message repeated")
-        }
+    let len = seed.messages[i].data.len();
+    let change = match rest.get(4).copied().unwrap_or(0) % 4 {
+        0 | 1 if len > 0 => OutputChange::Xor {
+            byte: num(5) % len,
+            mask: rest.get(9).copied().unwrap_or(1).max(1),
+        },
+        2 => OutputChange::Remove,
+        _ => OutputChange::Repeat,
     };
-    if rec
-        .messages
-        .iter()
-        .all(|m| m.channel != Channel::DeviceInput)
-    {
-        return;
-    }
-    if let Ok(v) = haptic_loop::replay::verify(&rec) {
-        assert!(
-            !v.ok(),
-            "finding (accepted-modified): a recording with {what} verified"
-        );
-    }
+    check(verify_changed(seed, i, change));
 }

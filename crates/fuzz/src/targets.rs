@@ -258,45 +258,18 @@ impl Target {
         let Some(seed) = &self.seed_rec else {
             return Outcome::Refused;
         };
-        let mut rec = seed.clone();
         let mut r = Rng::for_input(u64::from_le_bytes(pad8(input)), index);
-        let outputs: Vec<usize> = (0..rec.messages.len())
-            .filter(|&i| rec.messages[i].channel.verified())
-            .collect();
+        let outputs = verified_outputs(seed);
         let i = *r.pick(&outputs);
-        let m = &mut rec.messages[i];
-        let what = match r.below(3) {
-            0 if !m.data.is_empty() => {
-                let k = r.below(m.data.len());
-                m.data[k] ^= 1 << r.below(8);
-                format!("bit flipped in byte {k} of {}", m.channel.topic())
-            }
-            1 => {
-                let t = m.channel.topic();
-                rec.messages.remove(i);
-                format!("a {t} message removed")
-            }
-            _ => {
-                let dup = m.clone();
-                let t = dup.channel.topic();
-                rec.messages.insert(i, dup);
-                format!("a {t} message repeated")
-            }
+        let change = match r.below(3) {
+            0 if !seed.messages[i].data.is_empty() => OutputChange::Xor {
+                byte: r.below(seed.messages[i].data.len()),
+                mask: 1 << r.below(8),
+            },
+            1 => OutputChange::Remove,
+            _ => OutputChange::Repeat,
         };
-        if rec
-            .messages
-            .iter()
-            .all(|m| m.channel != Channel::DeviceInput)
-        {
-            return Outcome::Refused;
-        }
-        match haptic_loop::replay::verify(&rec) {
-            Ok(v) if v.ok() => Outcome::Finding(
-                "accepted-modified",
-                format!("a recording with {what} verified"),
-            ),
-            _ => Outcome::Refused,
-        }
+        verify_changed(seed, i, change)
     }
 
     fn run_cli(&self, input: &[u8]) -> Outcome {
@@ -598,6 +571,65 @@ fn drive(lp: &mut HapticLoop, specs: &DeviceSpecs, start: [f64; 3], ticks: u64) 
         }
     }
     Outcome::Accepted
+}
+
+/// One change to a recorded output message (the `verify` targets' alteration).
+pub enum OutputChange {
+    /// Byte `byte` of the message xored with `mask` (≠ 0).
+    Xor {
+        /// Byte index, < the message's length.
+        byte: usize,
+        /// Bits to flip.
+        mask: u8,
+    },
+    /// The message removed.
+    Remove,
+    /// The message repeated.
+    Repeat,
+}
+
+/// Indices of `rec`'s verified (output) messages.
+pub fn verified_outputs(rec: &Recording) -> Vec<usize> {
+    (0..rec.messages.len())
+        .filter(|&i| rec.messages[i].channel.verified())
+        .collect()
+}
+
+/// `seed` with message `i` changed, verified: a finding when it still verifies; refused when
+/// it does not (or has no device input left to re-run).
+pub fn verify_changed(seed: &Recording, i: usize, change: OutputChange) -> Outcome {
+    let mut rec = seed.clone();
+    let m = &mut rec.messages[i];
+    let topic = m.channel.topic();
+    let what = match change {
+        OutputChange::Xor { byte, mask } => {
+            m.data[byte] ^= mask;
+            format!("byte {byte} of a {topic} message xored with {mask}")
+        }
+        OutputChange::Remove => {
+            rec.messages.remove(i);
+            format!("a {topic} message removed")
+        }
+        OutputChange::Repeat => {
+            let dup = m.clone();
+            rec.messages.insert(i, dup);
+            format!("a {topic} message repeated")
+        }
+    };
+    if rec
+        .messages
+        .iter()
+        .all(|m| m.channel != Channel::DeviceInput)
+    {
+        return Outcome::Refused;
+    }
+    match haptic_loop::replay::verify(&rec) {
+        Ok(v) if v.ok() => Outcome::Finding(
+            "accepted-modified",
+            format!("a recording with {what} verified"),
+        ),
+        _ => Outcome::Refused,
+    }
 }
 
 /// A scene file for a Falcon; an accepted scene is ticked 40 times along a path.
