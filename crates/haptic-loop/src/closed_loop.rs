@@ -148,9 +148,9 @@ pub fn run(
         let k = &r.device_stiffness_n_per_m;
         rep.max_stiffness_n_per_m = rep.max_stiffness_n_per_m.max(k[0]).max(k[4]).max(k[8]);
         let f = r.device_force_n;
-        let jump = crate::vec3::norm(crate::vec3::sub(f, prev));
+        let jump = haptic_types::vec3::norm(haptic_types::vec3::sub(f, prev));
         rep.max_jump_n = rep.max_jump_n.max(jump);
-        rep.peak_force_n = rep.peak_force_n.max(crate::vec3::norm(f));
+        rep.peak_force_n = rep.peak_force_n.max(haptic_types::vec3::norm(f));
         if jump > JUMP_N && last_declared.is_none_or(|t| i - t > window) {
             rep.undeclared_jumps += 1;
         }

@@ -37,56 +37,10 @@
 use crate::device::{Buttons, DeviceSample, DeviceSpecs, ForceCommand};
 pub use crate::scene::loop_config::{LoopConfig, Mapping};
 use crate::scene::{Event, Scene, SceneInput, SceneOutput};
-use crate::switch::{self, Switch, SwitchError};
-use crate::vec3::{self, Vec3};
+use haptic_types::switch::{self, Switch, SwitchError};
+use haptic_types::vec3::{self, Vec3};
 
-/// Status bits of a tick (`TickResult::status`).
-pub mod status {
-    /// The force was scaled down to the device maximum.
-    pub const CLAMPED: u8 = 1;
-    /// The device input was invalid; zero force.
-    pub const INPUT_INVALID: u8 = 2;
-    /// The real-time deadline was missed; zero force.
-    pub const DEADLINE_MISSED: u8 = 4;
-    /// The scene rendered a stiffness above the cap; zero force.
-    pub const STIFFNESS_OVER_CAP: u8 = 8;
-    /// The scene returned a non-finite force; zero force.
-    pub const FORCE_INVALID: u8 = 16;
-    /// The device sample was stale beyond the grace time: the watchdog reduced the force.
-    pub const WATCHDOG: u8 = 32;
-    /// The passivity controller added damping: the rendering had returned more energy than
-    /// it took, beyond the reserve.
-    pub const PASSIVITY: u8 = 64;
-    /// The force-rate limit held the change of force back.
-    pub const RATE_LIMITED: u8 = 128;
-}
-
-/// What one tick produced.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct TickResult {
-    /// Tick index.
-    pub tick: u64,
-    /// Cursor given to the scene, world frame, m.
-    pub cursor_m: Vec3,
-    /// Buttons given to the scene.
-    pub buttons: Buttons,
-    /// Force the scene returned, world frame, N.
-    pub world_force_n: Vec3,
-    /// Force sent to the device, device frame, N (finite, norm ≤ device maximum).
-    pub device_force_n: Vec3,
-    /// Soft-engagement factor applied, 0–1.
-    pub engagement: f64,
-    /// Watchdog factor applied, 0–1 (1 while device samples are fresh).
-    pub watchdog: f64,
-    /// Local stiffness sent with the force, N/m, device frame, row-major 3×3.
-    pub device_stiffness_n_per_m: [f64; 9],
-    /// Status bits, see [`status`].
-    pub status: u8,
-    /// Events of this tick: loop events, button events, scene events.
-    pub events: Vec<Event>,
-    /// Switches applied before this tick's step (an input of the tick; usually empty).
-    pub switches: Vec<Switch>,
-}
+pub use haptic_types::tick::{TickResult, status};
 
 /// The haptic loop around one scene.
 pub struct HapticLoop {
@@ -213,7 +167,7 @@ impl HapticLoop {
         }
     }
 
-    /// Sets a run-time switch of the scene (see [`crate::switch`]): checked against the
+    /// Sets a run-time switch of the scene (see [`haptic_types::switch`]): checked against the
     /// scene's switches, applied at once, and recorded as an input of the next tick (its
     /// [`TickResult::switches`] and a `switch.set` event).
     pub fn switch(&mut self, name: &str, value: f64) -> Result<(), SwitchError> {

@@ -48,10 +48,8 @@ pub mod sink;
 pub mod sound;
 pub mod source;
 pub mod stepper;
-pub mod switch;
-pub mod textpos;
 pub mod totals;
-pub use render::vec3;
+pub use haptic_types::{switch, textpos, vec3};
 
 pub use device::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};
 pub use haptic::{HapticLoop, LoopConfig, TickResult};

@@ -40,9 +40,9 @@ impl From<LiveError> for SinkError {
     }
 }
 use crate::scene::{Event, Primitive};
-use crate::vec3::Vec3;
 use foxglove::schemas::{FrameTransform, Log, SceneUpdate};
 use foxglove::{Context, PartialMetadata, RawChannel, Schema, WebSocketServerHandle};
+use haptic_types::vec3::Vec3;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -252,7 +252,7 @@ fn publish(
                 "cursor_m": xyz(s.cursor_m),
                 "world_force_n": xyz(s.world_force_n),
                 "device_force_n": xyz(s.device_force_n),
-                "device_force_norm_n": crate::vec3::norm(s.device_force_n),
+                "device_force_norm_n": haptic_types::vec3::norm(s.device_force_n),
                 "engagement": s.engagement,
                 "watchdog": s.watchdog,
                 "status": s.status,

@@ -20,7 +20,7 @@ use crate::device::{DeviceError, HapticDevice, TickTime};
 use crate::haptic::HapticLoop;
 use crate::pacing::{DurationHistogram, Pacer, Percentiles, TickStats};
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
-use crate::switch::{Switch, SwitchError};
+use haptic_types::switch::{Switch, SwitchError};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 

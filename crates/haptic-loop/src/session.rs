@@ -26,9 +26,9 @@ use crate::runner::{EndReason, Pacing, RunError, Runner};
 use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
 use crate::sink::{Sink, SinkError};
 use crate::source::{DeviceSource, open_device};
-pub use crate::textpos::Location;
-use crate::textpos::field_position;
 use crate::totals::Totals;
+pub use haptic_types::textpos::Location;
+use haptic_types::textpos::field_position;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -211,7 +211,7 @@ pub fn read_toml_text(path: &Path) -> Result<String, SessionError> {
     String::from_utf8(bytes).map_err(|e| {
         let ok = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(&e.as_bytes()[..ok]).into_owned();
-        let at = crate::textpos::position(&text, ok);
+        let at = haptic_types::textpos::position(&text, ok);
         io(format!(
             "not UTF-8 text: byte {ok} (line {}, column {}) is not valid UTF-8 (a TOML file is text)",
             at.line, at.column
@@ -473,7 +473,9 @@ fn script_switches(
 ) -> Result<Vec<(u64, Switch)>, SessionError> {
     let mut out = Vec::with_capacity(script.switches.len());
     for sw in script.switches.iter() {
-        if let Err(e) = crate::switch::check(scene.kind(), scene.switches(), &sw.name, sw.value) {
+        if let Err(e) =
+            haptic_types::switch::check(scene.kind(), scene.switches(), &sw.name, sw.value)
+        {
             let i = sw.index;
             let field = match e {
                 crate::scene::SwitchError::Unknown { .. } => format!("switch[{i}].name"),

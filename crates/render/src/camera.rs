@@ -6,8 +6,8 @@
 //! metre in any plane facing the camera is `pixels_per_m` pixels everywhere on the image and a
 //! scale bar is exact.
 
+use crate::Primitive;
 use crate::error::{RenderError, finite, finite3};
-use crate::primitive::Primitive;
 use crate::vec3::{Vec3, add, axes, cross, dot, normalize, scale, sub};
 
 /// Largest image side the renderer makes, px.
@@ -461,7 +461,7 @@ mod tests {
 
     #[test]
     fn fitted_primitives_land_inside_the_margin() {
-        use crate::primitive::Rgba;
+        use crate::Rgba;
         let c = Rgba([1.0, 0.0, 0.0, 1.0]);
         let h = std::f64::consts::FRAC_1_SQRT_2;
         let prims = vec![

@@ -6,11 +6,12 @@ use tiny_skia::{
     SpreadMode, Stroke, StrokeDash, Transform,
 };
 
+use crate::ToSkia;
 use crate::error::RenderError;
 use crate::frame::{Frame, ScaleBar, format_length};
-use crate::primitive::{Primitive, Rgba};
 use crate::text;
 use crate::vec3::{Vec3, add, axes, box_corners, dot, normalize, normq, scale};
+use crate::{Primitive, Rgba};
 
 impl Frame {
     /// Light direction (unit, world frame): from the viewer's upper left.

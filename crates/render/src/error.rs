@@ -79,22 +79,31 @@ pub enum RenderError {
     },
 }
 
+impl From<haptic_types::ValueError> for RenderError {
+    fn from(e: haptic_types::ValueError) -> Self {
+        match e {
+            haptic_types::ValueError::NotFinite { field, value } => {
+                RenderError::NotFinite { field, value }
+            }
+            haptic_types::ValueError::OutOfRange {
+                field,
+                value,
+                allowed,
+            } => RenderError::OutOfRange {
+                field,
+                value,
+                allowed,
+            },
+        }
+    }
+}
+
 /// Checks that `value` is finite.
 pub(crate) fn finite(field: impl FnOnce() -> String, value: f64) -> Result<f64, RenderError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(RenderError::NotFinite {
-            field: field(),
-            value,
-        })
-    }
+    Ok(haptic_types::value::finite(field, value)?)
 }
 
 /// Checks that every component of a point is finite.
 pub(crate) fn finite3(field: &str, p: [f64; 3]) -> Result<(), RenderError> {
-    for (i, v) in p.iter().enumerate() {
-        finite(|| format!("{field}[{i}]"), *v)?;
-    }
-    Ok(())
+    Ok(haptic_types::value::finite3(field, p)?)
 }

@@ -1,14 +1,15 @@
 //! A frame: primitives added in world coordinates, drawn back to front with shading into an
 //! [`Image`].
 
+use crate::ToSkia;
 use crate::camera::Camera;
 use crate::error::{RenderError, finite, finite3};
 use crate::image::Image;
 use crate::order::{Item, Shape, back_to_front};
-use crate::primitive::{Primitive, Rgba};
 use crate::text;
 use crate::vec3::{Vec3, add, axes, scale, sub};
 use crate::vec3::{box_corners, normq};
+use crate::{Primitive, Rgba};
 
 /// How a frame looks apart from its primitives.
 #[derive(Clone, Copy, Debug, PartialEq)]

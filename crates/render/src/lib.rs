@@ -10,8 +10,8 @@
 //! [`GifWriter`] turns a sequence of images into an animated GIF at a given frame rate.
 //!
 //! **What it is not.** It knows nothing of worlds, scenes, recordings or the command line:
-//! `haptic-loop` adapts its `scene::Primitive` (whose variants and fields [`Primitive`]
-//! mirrors) and owns MCAP reading and the `nanohaptics render` command. No perspective, no
+//! the primitives are `haptic-types`' (every scene draws with them); `haptic-loop`
+//! owns MCAP reading and the `nanohaptics render` command. No perspective, no
 //! lighting model beyond one directional light with ambient, no interpenetrating solids (they
 //! are ordered by centre depth).
 //!
@@ -40,17 +40,28 @@ pub mod frame;
 pub mod gif;
 pub mod image;
 mod order;
-pub mod primitive;
 mod text;
-pub mod vec3;
 
 pub use camera::{Camera, MAX_SIDE_PX, Projected, View, action_bounds, bounds, is_backdrop};
 pub use error::RenderError;
 pub use frame::{Frame, Style, format_length, nice_length_m};
 pub use gif::{BAD_PIXEL_ERROR, BAD_PIXEL_SHARE, GifWriter, Palette, frame_delays_cs};
+pub use haptic_types::vec3;
+pub use haptic_types::{Primitive, Rgba, Vec3};
 pub use image::Image;
-pub use primitive::{Primitive, Rgba};
-pub use vec3::Vec3;
+
+/// An [`Rgba`] as tiny-skia's colour (channels clamped to 0–1).
+pub(crate) trait ToSkia {
+    /// The colour for tiny-skia.
+    fn skia(self) -> tiny_skia::Color;
+}
+
+impl ToSkia for Rgba {
+    fn skia(self) -> tiny_skia::Color {
+        let [r, g, b, a] = self.0.map(|c| c.clamp(0.0, 1.0) as f32);
+        tiny_skia::Color::from_rgba(r, g, b, a).unwrap_or(tiny_skia::Color::BLACK)
+    }
+}
 
 /// The user guide's examples (`docs/render.md`), compiled and run as doc-tests.
 #[cfg(doctest)]

@@ -14,7 +14,7 @@ use crate::device::{
     ScriptedDevice, SimulatedOperator, TickTime,
 };
 use crate::pacing::{Pacer, Percentiles};
-use crate::vec3;
+use haptic_types::vec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;

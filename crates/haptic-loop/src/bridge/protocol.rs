@@ -13,7 +13,7 @@
 //! | 5    | bye     | either        | reason u8 (0: end of session, 1: error)                             |
 
 use crate::device::DeviceSpecs;
-use crate::vec3::Vec3;
+use haptic_types::vec3::Vec3;
 use std::borrow::Cow;
 
 /// The magic bytes every packet starts with.

@@ -15,7 +15,7 @@
 //! - the documentation tables of `docs/recording-format.md` ([`super::doc`]).
 
 use super::cdr::CdrField;
-use crate::vec3::Vec3;
+use haptic_types::vec3::Vec3;
 
 /// One field of a declared message.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

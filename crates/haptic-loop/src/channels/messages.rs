@@ -8,7 +8,7 @@ use super::declare::{ColumnData, ColumnField, recording_channels};
 use crate::device::DeviceSample;
 use crate::haptic::TickResult;
 use crate::scene::{Event, Switch};
-use crate::vec3::Vec3;
+use haptic_types::vec3::Vec3;
 
 recording_channels! {
     channel Description = "/scene/description", Input, "once, tick 0",

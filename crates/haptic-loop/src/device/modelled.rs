@@ -11,8 +11,8 @@ use super::script::Script;
 use super::{
     DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime, in_order,
 };
-use crate::vec3::Vec3;
 use haptic_devices::{Grip, Hold, Mechanics, Plant};
+use haptic_types::vec3::Vec3;
 use std::borrow::Cow;
 
 /// A scripted hand holding a modelled device.

@@ -19,7 +19,7 @@ use super::script::{OperatorParams, Script};
 use super::{
     DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime, in_order,
 };
-use crate::vec3::{self, Vec3};
+use haptic_types::vec3::{self, Vec3};
 
 /// A scripted intent played through a simulated hand.
 #[derive(Clone, Debug)]

@@ -33,7 +33,7 @@
 use super::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
-use crate::vec3::{self, Vec3};
+use haptic_types::vec3::{self, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// Errors in a script file; each names the field and the allowed range.
@@ -69,7 +69,7 @@ pub enum ScriptError {
         /// Field path, e.g. `switch[0].name`.
         field: String,
         /// What the scene allows.
-        source: crate::switch::SwitchError,
+        source: haptic_types::switch::SwitchError,
     },
     /// A button the device does not have.
     #[error("script: `{field}`: {source}")]
@@ -84,8 +84,8 @@ pub enum ScriptError {
 impl ScriptError {
     /// Where in the script's `text` the error is: the TOML reader's position, or the named
     /// field's value (`None` when neither is known).
-    pub fn position(&self, text: &str) -> Option<crate::textpos::Position> {
-        use crate::textpos::{field_position, position};
+    pub fn position(&self, text: &str) -> Option<haptic_types::textpos::Position> {
+        use haptic_types::textpos::{field_position, position};
         match self {
             ScriptError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
             ScriptError::OutOfRange { field, .. }

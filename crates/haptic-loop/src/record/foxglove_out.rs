@@ -6,13 +6,13 @@
 //! time from the session start, never the wall clock.
 
 use crate::scene::{Event, Primitive, Rgba};
-use crate::vec3::{self, Vec3};
 use foxglove::Encode;
 use foxglove::schemas::{
     ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Log,
     Point3, Pose, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, TextPrimitive, Timestamp,
     Vector3, line_primitive, log,
 };
+use haptic_types::vec3::{self, Vec3};
 
 /// Frame of the world in the Foxglove channels.
 pub const WORLD_FRAME: &str = "world";

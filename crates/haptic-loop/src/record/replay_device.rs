@@ -5,7 +5,7 @@ use crate::channels::messages::{Channel, DeviceInputMsg};
 use crate::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
-use crate::vec3::Vec3;
+use haptic_types::vec3::Vec3;
 
 /// Inputs of a recording played back as a device.
 #[derive(Clone, Debug)]

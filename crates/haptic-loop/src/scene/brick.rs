@@ -14,8 +14,8 @@ use super::score::{self, DROP_HEIGHT_M, HouseScore};
 use super::{
     Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
 };
-use crate::vec3::Vec3;
 use brickworld::{CursorInput, Grip, Params, World};
+use haptic_types::vec3::Vec3;
 use serde::Deserialize;
 use world_form::Limits;
 

@@ -1,7 +1,7 @@
 //! Range checks and the scene error: a leaf every scene module uses (it imports no other
 //! scene module).
 
-use crate::textpos::{Position, field_position, position};
+use haptic_types::textpos::{Position, field_position, position};
 
 /// Errors in a scene file.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -3,7 +3,7 @@
 
 use super::check::{SceneError, check_range, out_of_range};
 use crate::device::DeviceSpecs;
-use crate::vec3::{self, Vec3};
+use haptic_types::vec3::{self, Vec3};
 use serde::Deserialize;
 use world_form::Limits;
 

@@ -18,11 +18,11 @@ pub mod table;
 pub mod wall;
 
 use crate::device::Buttons;
-use crate::vec3::Vec3;
+use haptic_types::vec3::Vec3;
 
-pub use crate::switch::{Switch, SwitchError, SwitchSpec};
 pub use check::SceneError;
 pub use file::{SceneFile, load_scene, load_scene_for};
+pub use haptic_types::switch::{Switch, SwitchError, SwitchSpec};
 pub use loop_config::{LoopConfig, Mapping};
 
 /// What the loop tells the scene each tick.
@@ -40,24 +40,7 @@ pub struct SceneInput {
     pub input_valid: bool,
 }
 
-/// An event raised during a tick (logged, shown in Foxglove as a log line).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Event {
-    /// Dotted event name, e.g. `wall.contact_begin`.
-    pub name: String,
-    /// Human-readable detail (may be empty).
-    pub detail: String,
-}
-
-impl Event {
-    /// A new event.
-    pub fn new(name: impl Into<String>, detail: impl Into<String>) -> Self {
-        Event {
-            name: name.into(),
-            detail: detail.into(),
-        }
-    }
-}
+pub use haptic_types::Event;
 
 /// What a scene answers each tick.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -84,10 +67,9 @@ impl SceneOutput {
     }
 }
 
-/// Drawable primitives and colours are the renderer's own types (world
-/// frame, metres; RGBA in 0–1), so a scene's drawing goes to the renderer
-/// and to the Foxglove channels without conversion.
-pub use render::{Primitive, Rgba};
+/// Drawable primitives and colours (world frame, metres; RGBA in 0–1), shared with the renderer
+/// and the Foxglove channels, so a scene's drawing goes to both without conversion.
+pub use haptic_types::{Primitive, Rgba};
 
 /// A world as the haptic loop sees it.
 ///

@@ -19,7 +19,7 @@ use super::score::{self, HouseScore};
 use super::{
     Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
 };
-use crate::vec3::Vec3;
+use haptic_types::vec3::Vec3;
 use nalgebra::Vector3;
 use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};
 use serde::Deserialize;

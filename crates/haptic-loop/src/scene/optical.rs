@@ -15,7 +15,7 @@
 
 use super::check::{SceneError, check_positive, check_range, out_of_range};
 use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, WorldKind, world_table};
-use crate::vec3::Vec3;
+use haptic_types::vec3::Vec3;
 use nalgebra::Vector2;
 use ot_envelope::ClipMode;
 use ot_envelope::world::{Input, Params, TickMap, World, WorldError};

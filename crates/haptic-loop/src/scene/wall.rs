@@ -11,7 +11,7 @@
 
 use super::check::{SceneError, check_positive, check_range, out_of_range};
 use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, WorldKind, world_table};
-use crate::vec3::{self, Vec3};
+use haptic_types::vec3::{self, Vec3};
 use serde::{Deserialize, Serialize};
 use world_form::Limits;
 

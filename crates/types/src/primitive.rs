@@ -1,11 +1,10 @@
 //! What can be drawn: the primitives, world frame, metres.
 //!
-//! The first six variants mirror `haptic_loop::scene::Primitive` field for field (same names,
-//! same units, `[f64; 3]` points, `[x, y, z, w]` quaternions, RGBA in 0–1), so an adapter is a
-//! one-to-one `match`. [`Primitive::Cursor`] and [`Primitive::Slot`] are extras for the
-//! haptic cursor and blueprint slots.
+//! Every scene draws with these (`[f64; 3]` points, `[x, y, z, w]` quaternions, RGBA in 0–1);
+//! the renderer, the recording's Foxglove scene messages and the live views take them as they
+//! are. [`Primitive::Cursor`] and [`Primitive::Slot`] are the haptic cursor and blueprint slots.
 
-use crate::error::{RenderError, finite, finite3};
+use crate::value::{ValueError, finite, finite3};
 use crate::vec3::Vec3;
 
 /// An RGBA colour, each channel in 0–1 (straight, not premultiplied alpha).
@@ -35,27 +34,23 @@ impl Rgba {
     }
 
     /// Multiplies the RGB channels by `k` (≥ 0, results capped at 1); alpha unchanged.
-    pub(crate) fn times(self, k: f64) -> Rgba {
+    pub fn times(self, k: f64) -> Rgba {
         let [r, g, b, a] = self.0;
         Rgba([(r * k).min(1.0), (g * k).min(1.0), (b * k).min(1.0), a])
     }
 
     /// Mixes the RGB channels toward white by `t` (0 = unchanged, 1 = white).
-    pub(crate) fn toward_white(self, t: f64) -> Rgba {
+    pub fn toward_white(self, t: f64) -> Rgba {
         let [r, g, b, a] = self.0;
         Rgba([r + (1.0 - r) * t, g + (1.0 - g) * t, b + (1.0 - b) * t, a])
     }
 
-    pub(crate) fn skia(self) -> tiny_skia::Color {
-        let [r, g, b, a] = self.0.map(|c| c.clamp(0.0, 1.0) as f32);
-        tiny_skia::Color::from_rgba(r, g, b, a).unwrap_or(tiny_skia::Color::BLACK)
-    }
-
-    pub(crate) fn validate(self, field: &str) -> Result<(), RenderError> {
+    /// Checks every channel is finite and in 0–1 (`field` names the colour in the error).
+    pub fn validate(self, field: &str) -> Result<(), ValueError> {
         for (i, c) in self.0.iter().enumerate() {
             finite(|| format!("{field}[{i}]"), *c)?;
             if !(0.0..=1.0).contains(c) {
-                return Err(RenderError::OutOfRange {
+                return Err(ValueError::OutOfRange {
                     field: format!("{field}[{i}]"),
                     value: *c,
                     allowed: "[0, 1]",
@@ -150,10 +145,10 @@ pub enum Primitive {
     },
 }
 
-fn positive(field: &str, v: f64, allow_zero: bool) -> Result<(), RenderError> {
+fn positive(field: &str, v: f64, allow_zero: bool) -> Result<(), ValueError> {
     finite(|| field.to_string(), v)?;
     if v < 0.0 || (!allow_zero && v == 0.0) {
-        return Err(RenderError::OutOfRange {
+        return Err(ValueError::OutOfRange {
             field: field.to_string(),
             value: v,
             allowed: if allow_zero {
@@ -166,13 +161,13 @@ fn positive(field: &str, v: f64, allow_zero: bool) -> Result<(), RenderError> {
     Ok(())
 }
 
-fn quaternion(field: &str, q: [f64; 4]) -> Result<(), RenderError> {
+fn quaternion(field: &str, q: [f64; 4]) -> Result<(), ValueError> {
     for (i, v) in q.iter().enumerate() {
         finite(|| format!("{field}[{i}]"), *v)?;
     }
     let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
     if !(0.5..=2.0).contains(&n) {
-        return Err(RenderError::OutOfRange {
+        return Err(ValueError::OutOfRange {
             field: format!("{field} (norm)"),
             value: n,
             allowed: "[0.5, 2] (a unit quaternion [x, y, z, w], normalised when drawn)",
@@ -198,7 +193,7 @@ impl Primitive {
 
     /// Checks every number: finite points, positive sizes, colours in 0–1, quaternions near
     /// unit length.
-    pub fn validate(&self) -> Result<(), RenderError> {
+    pub fn validate(&self) -> Result<(), ValueError> {
         let k = self.kind();
         let f = |name: &str| format!("{k}.{name}");
         match self {
