@@ -11,7 +11,7 @@ use crate::targets::{
     verify_changed, work_dir,
 };
 use haptic_loop::SessionArrays;
-use haptic_loop::record::{Recording, read_recording};
+use recording::{Recording, read_recording};
 use std::sync::OnceLock;
 
 fn check(o: Outcome) {

@@ -3,12 +3,12 @@
 
 use crate::mutate::{self, Rng};
 use haptic_loop::bridge::protocol::{Packet, Sample};
-use haptic_loop::channels::messages::Channel;
 use haptic_loop::device::Script;
-use haptic_loop::record::{Recording, read_recording};
 use haptic_loop::scene::load_scene_for;
 use haptic_loop::session::{SceneSource, SessionOptions, run_session};
 use haptic_loop::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticLoop, SessionArrays};
+use recording::channels::messages::Channel;
+use recording::{Recording, read_recording};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

@@ -3,11 +3,12 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use haptic_loop::channels::messages::ForceMsg;
 use haptic_loop::device::{Buttons, DeviceSample};
+use haptic_loop::encode::LoopEncoder;
 use haptic_loop::haptic::HapticLoop;
-use haptic_loop::record::TickEncoder;
 use haptic_loop::scene::load_scene;
+use recording::TickEncoder;
+use recording::channels::messages::ForceMsg;
 use std::hint::black_box;
 
 const SCENE: &str = include_str!("../../../scenes/wall.toml");
@@ -26,7 +27,7 @@ fn bench(c: &mut Criterion) {
     });
     let s = load_scene(SCENE, None).unwrap();
     let mut lp = HapticLoop::new(s.config, s.scene);
-    let mut enc = TickEncoder::new(&lp, 0);
+    let mut enc = LoopEncoder::new(&lp, 0);
     let mut msgs = Vec::with_capacity(16);
     c.bench_function("wall tick + encode all channels", |b| {
         b.iter(|| {

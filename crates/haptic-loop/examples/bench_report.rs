@@ -11,9 +11,9 @@ use bench_harness::plot::{Axis, Chart, Series};
 use bench_harness::plotters::prelude::{BLUE, GREEN, RED, RGBColor, SeriesLabelPosition};
 use bench_harness::{Report, Summary, Table, span};
 use haptic_loop::device::OperatorParams;
-use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
+use recording::read_recording_file;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

@@ -7,9 +7,9 @@ use bench_harness::report::out_arg;
 use bench_harness::{Report, Summary, Table, span};
 
 use haptic_loop::lesson::{LessonOptions, LessonSummary, run_lesson};
-use haptic_loop::record::read_recording_file;
 use haptic_loop::session::SessionArrays;
 use haptic_loop::sound::session_sound;
+use recording::read_recording_file;
 use std::fmt::Write;
 
 /// Runs `f` and returns its value with the thread-CPU time it took, s.

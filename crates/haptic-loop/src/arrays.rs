@@ -1,13 +1,13 @@
 //! Per-tick arrays of a session (struct of arrays), filled straight from the loop as a sink of
 //! the runner, or decoded from a recording.
 
-use crate::channels::cdr::CdrError;
-use crate::channels::messages::{
+use crate::haptic::HapticLoop;
+use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use recording::channels::cdr::CdrError;
+use recording::channels::messages::{
     Channel, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TickColumns, TimingMsg,
 };
-use crate::haptic::HapticLoop;
-use crate::record::{Recording, RecordingError};
-use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use recording::{Recording, RecordingError};
 
 /// Per-tick arrays of a session: the columns declared with the recording's messages
 /// ([`TickColumns`], reached through `Deref`: `a.tick`, `a.device_force_n`, `a.state`, …) and

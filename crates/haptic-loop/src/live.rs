@@ -20,8 +20,8 @@
 
 use crate::haptic::HapticLoop;
 use crate::pacing::TickStats;
-use crate::record::foxglove_out;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use recording::foxglove_out;
 
 /// Why the live view could not start or publish.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -20,10 +20,8 @@ mod render_cmd;
 
 use clap::{Parser, Subcommand};
 use haptic_loop::bridge::BridgeConfig;
-use haptic_loop::channels::messages::Channel;
 use haptic_loop::device::{DeviceModel, OperatorParams};
 use haptic_loop::live::LiveConfig;
-use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions, SessionReport,
@@ -31,6 +29,8 @@ use haptic_loop::session::{
 };
 use haptic_loop::totals::Totals;
 use indicatif::{ProgressBar, ProgressStyle};
+use recording::channels::messages::Channel;
+use recording::read_recording_file;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

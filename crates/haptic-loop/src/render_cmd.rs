@@ -5,14 +5,14 @@
 use std::path::{Path, PathBuf};
 
 use haptic_loop::device::{DeviceError, HapticDevice, TickTime};
-use haptic_loop::record::ReplayDevice;
-use haptic_loop::record::{RecordingError, read_recording_file};
+use haptic_loop::replay_device::ReplayDevice;
 use haptic_loop::runner::{Pacing, Runner};
 use haptic_loop::scene::optical::RecordedPicture;
 use haptic_loop::scene::{SceneError, load_scene, load_scene_for};
 use haptic_loop::session::SessionError;
 use haptic_loop::sink::{Sink, SinkError, TickView};
 use haptic_loop::{HapticLoop, LoopConfig, Scene};
+use recording::{RecordingError, read_recording_file};
 use render::{Camera, Frame, GifWriter, Image, Palette, Primitive, RenderError, Rgba, Style, View};
 
 /// Arguments of `nanohaptics render`.
@@ -163,7 +163,7 @@ fn camera_for(
 
 /// World positions of the cursor over a recording, read from its device inputs (no physics).
 fn cursor_path(
-    rec: &haptic_loop::record::Recording,
+    rec: &recording::Recording,
     config: &LoopConfig,
 ) -> Result<Vec<[f64; 3]>, RenderCmdError> {
     let mut dev = ReplayDevice::from_recording(rec, config.specs.clone(), config.period_ns())?;
@@ -501,7 +501,7 @@ impl Sink for FramesSink<'_> {
 
 /// Replays a recording through the runner with `sinks` and returns the loop at its end.
 fn replay_into(
-    rec: &haptic_loop::record::Recording,
+    rec: &recording::Recording,
     sinks: Vec<&mut dyn Sink>,
 ) -> Result<(HapticLoop, u64), RenderCmdError> {
     let d = &rec.description;
@@ -510,7 +510,7 @@ fn replay_into(
     let mut dev = ReplayDevice::from_recording(rec, config.specs.clone(), config.period_ns())?;
     let ticks = dev.ticks();
     let flags = dev.deadline_flags();
-    let switches = haptic_loop::record::switch_schedule(rec, config.period_ns())?;
+    let switches = recording::switch_schedule(rec, config.period_ns())?;
     let mut lp = HapticLoop::new(config, loaded.scene);
     Runner::new(sinks)
         .with_switches(switches)
@@ -624,7 +624,7 @@ fn recording_frames(
 /// reads; `None` for other scenes (they are recomputed).
 fn recorded_picture(
     loaded: &haptic_loop::scene::file::LoadedScene,
-    d: &haptic_loop::channels::messages::DescriptionMsg,
+    d: &recording::channels::messages::DescriptionMsg,
 ) -> Option<RecordedPicture> {
     if d.scene_kind != "optical_tweezers" {
         return None;
@@ -638,16 +638,16 @@ fn recorded_picture(
 /// `/foxglove/scene` (written at display rate; `every` is a multiple of the display cadence).
 /// Returns the number of ticks in the recording.
 fn draw_recorded(
-    rec: &haptic_loop::record::Recording,
+    rec: &recording::Recording,
     pic: &RecordedPicture,
     every: u64,
     display_scale: f64,
     sink: &mut FramesSink<'_>,
 ) -> Result<u64, RenderCmdError> {
     use foxglove::Decode;
-    use haptic_loop::channels::messages::{ForceMsg, StateMsg};
-    use haptic_loop::record::Channel;
-    let bad = |m: &haptic_loop::record::reader::RecordedMessage, detail: String| {
+    use recording::Channel;
+    use recording::channels::messages::{ForceMsg, StateMsg};
+    let bad = |m: &recording::reader::RecordedMessage, detail: String| {
         RenderCmdError::Recording(RecordingError::BadMessage {
             topic: m.channel.topic().to_string(),
             log_time_ns: m.log_time_ns,

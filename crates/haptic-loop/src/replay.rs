@@ -6,14 +6,15 @@
 //! (state, force, events, Foxglove channels) and compares it byte for byte with the recorded
 //! one. The first difference names its tick and channel.
 
-use crate::channels::messages::{Channel, ForceMsg, StateMsg};
+use crate::encode::LoopEncoder;
 use crate::haptic::HapticLoop;
-use crate::record::ReplayDevice;
-use crate::record::{OutMsg, Recording, RecordingError, TickEncoder};
+use crate::replay_device::ReplayDevice;
 use crate::runner::{Pacing, Runner};
 use crate::scene::load_scene_for;
 use crate::session::SessionError;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use recording::channels::messages::{Channel, ForceMsg, StateMsg};
+use recording::{OutMsg, Recording, RecordingError};
 
 /// The first difference between a recording and its replay.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -101,7 +102,7 @@ fn describe(channel: Channel, rec: &[u8], rep: &[u8], n_fields: usize) -> String
 pub struct VerifySink<'r> {
     expected: Vec<Vec<(Channel, &'r [u8])>>,
     n_fields: usize,
-    enc: Option<TickEncoder>,
+    enc: Option<LoopEncoder>,
     msgs: Vec<OutMsg>,
     /// Output messages compared.
     pub compared: u64,
@@ -115,7 +116,7 @@ impl Sink for VerifySink<'_> {
     }
 
     fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SinkError> {
-        self.enc = Some(TickEncoder::new(lp, info.description.start_time_ns));
+        self.enc = Some(LoopEncoder::new(lp, info.description.start_time_ns));
         Ok(())
     }
 
@@ -229,7 +230,7 @@ pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
         compared: 0,
         divergence: None,
     };
-    let switches = crate::record::switch_schedule(rec, period)?;
+    let switches = recording::switch_schedule(rec, period)?;
     Runner::new(vec![&mut sink]).with_switches(switches).run(
         &mut lp,
         &mut dev,

@@ -12,16 +12,13 @@
 //! ```
 
 use crate::bridge::BridgeConfig;
-use crate::channels::messages::{self, DescriptionMsg};
 use crate::device::TickTime;
 use crate::device::script::{OperatorKind, Script};
 use crate::device::{DeviceError, DeviceModel, OperatorParams, ScriptError};
 use crate::haptic::HapticLoop;
 use crate::live::{LiveConfig, LiveError, LiveSink};
 use crate::pacing::TickStats;
-use crate::record::sink::RecorderSink;
-use crate::record::writer::RecordError;
-use crate::record::{RecordingError, WriteSummary};
+use crate::record_sink::RecorderSink;
 use crate::runner::{EndReason, Pacing, RunError, Runner};
 use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
 use crate::sink::{Sink, SinkError};
@@ -29,11 +26,14 @@ use crate::source::{DeviceSource, open_device};
 use crate::totals::Totals;
 pub use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
+use recording::channels::messages::{self, DescriptionMsg};
+use recording::writer::RecordError;
+use recording::{RecordingError, WriteSummary};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 pub use crate::arrays::SessionArrays;
-pub use crate::record::sink::stats_metadata;
+pub use crate::record_sink::stats_metadata;
 
 /// Errors of a session.
 #[derive(Debug, thiserror::Error)]
@@ -598,9 +598,8 @@ fn run_with_device(
         Some((s, t, _)) => (s.name.clone(), t.clone()),
         None => (String::new(), String::new()),
     };
-    let mut description = DescriptionMsg::new(
+    let mut description = loaded.description(
         &opts.scene.text,
-        &loaded,
         mode,
         &source.link_name(),
         opts.start_time_ns.unwrap_or_else(now_unix_ns),
@@ -668,6 +667,6 @@ fn run_with_device(
 
 /// Reads a recording file into arrays (`salvage`: accept a truncated file's complete part).
 pub fn read_arrays(path: &Path, salvage: bool) -> Result<SessionArrays, SessionError> {
-    let rec = crate::record::read_recording_file(path, salvage)?;
+    let rec = recording::read_recording_file(path, salvage)?;
     Ok(SessionArrays::from_recording(&rec)?)
 }

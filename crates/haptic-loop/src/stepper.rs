@@ -19,15 +19,15 @@
 //! ```
 
 use crate::arrays::SessionArrays;
-use crate::channels::messages::{self, DescriptionMsg};
 use crate::device::{DeviceModel, DeviceSample, ForceCommand};
 use crate::haptic::{HapticLoop, TickResult};
 use crate::pacing::{DurationHistogram, Percentiles, TickStats};
-use crate::record::WriteSummary;
-use crate::record::sink::RecorderSink;
+use crate::record_sink::RecorderSink;
 use crate::scene::load_scene;
 use crate::session::{SceneSource, SessionError, now_unix_ns};
 use crate::sink::{SessionInfo, Sink, TickView, deliver};
+use recording::WriteSummary;
+use recording::channels::messages::{self, DescriptionMsg};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -96,9 +96,8 @@ impl Stepper {
             return Err(SessionError::StateField(bad.clone()));
         }
         let rate = loaded.config.rate_hz;
-        let description = DescriptionMsg::new(
+        let description = loaded.description(
             &opts.scene.text,
-            &loaded,
             "stepped",
             &opts.link,
             opts.start_time_ns.unwrap_or_else(now_unix_ns),

@@ -97,7 +97,7 @@ fn replay_of_a_recording_of_another_scene_version_exits_2_naming_tick_and_channe
             .status
             .success()
     );
-    let mut rec_data = haptic_loop::record::read_recording_file(&rec, false).unwrap();
+    let mut rec_data = recording::read_recording_file(&rec, false).unwrap();
     rec_data.description.scene_toml = text.replace("engage_s = 0.25", "engage_s = 0.3");
     let v = haptic_loop::replay::verify(&rec_data).unwrap();
     let d = v.divergence.unwrap();
@@ -106,7 +106,7 @@ fn replay_of_a_recording_of_another_scene_version_exits_2_naming_tick_and_channe
 
     // Through the program: the edited recording written back to a file.
     let edited = tmp("edited-rewritten.mcap");
-    haptic_loop::record::rewrite(&rec_data, &edited).unwrap();
+    recording::rewrite(&rec_data, &edited).unwrap();
     let o = nh(&["replay", edited.to_str().unwrap(), "--verify"]);
     assert_eq!(o.status.code(), Some(2));
     let out = String::from_utf8_lossy(&o.stdout);
@@ -202,9 +202,9 @@ fn sigkill_mid_session_loses_at_most_the_last_second() {
     child.kill().unwrap();
     let elapsed = t0.elapsed().as_secs_f64();
     child.wait().unwrap();
-    let e = haptic_loop::record::read_recording_file(&rec, false).unwrap_err();
+    let e = recording::read_recording_file(&rec, false).unwrap_err();
     assert!(e.to_string().starts_with("truncated recording"), "{e}");
-    let part = haptic_loop::record::read_recording_file(&rec, true).unwrap();
+    let part = recording::read_recording_file(&rec, true).unwrap();
     let v = haptic_loop::replay::verify(&part).unwrap();
     assert!(v.ok());
     // At most `elapsed` seconds of ticks can have run; the file keeps all but the last second
@@ -522,7 +522,7 @@ fn ctrl_c_stops_a_session_cleanly_with_a_complete_recording() {
     assert!(k.success());
     let o = child.wait_with_output().unwrap();
     assert_eq!(o.status.code(), Some(130));
-    let r = haptic_loop::record::read_recording_file(&rec, false).expect("a complete file");
+    let r = recording::read_recording_file(&rec, false).expect("a complete file");
     let v = haptic_loop::replay::verify(&r).unwrap();
     assert!(v.ok());
     assert!(v.ticks > 0 && v.ticks < 3_600_000, "{} ticks", v.ticks);

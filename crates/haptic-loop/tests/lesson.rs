@@ -107,7 +107,6 @@ fn the_lesson_measures_what_it_says() {
         );
     }
     // The house sessions replay bit for bit.
-    let rec =
-        haptic_loop::record::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();
+    let rec = recording::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }

@@ -3,10 +3,10 @@
 //! spring on the excess, release on button up, replay is bit-exact; bad parameters are refused.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::scene::load_scene;
 use haptic_loop::session::{SceneSource, SessionOptions, run_session};
+use recording::read_recording_file;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {

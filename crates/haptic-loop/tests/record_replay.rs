@@ -2,15 +2,15 @@
 //! and the golden recordings under `recordings/`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::channels::messages::{
-    Channel, DescriptionMsg, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, SwitchMsg, TimingMsg,
-};
-use haptic_loop::record::writer::channel_schema;
-use haptic_loop::record::{RecordingError, read_recording, read_recording_file};
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionArrays, SessionOptions, read_arrays, run_session,
 };
+use recording::channels::messages::{
+    Channel, DescriptionMsg, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, SwitchMsg, TimingMsg,
+};
+use recording::writer::channel_schema;
+use recording::{RecordingError, read_recording, read_recording_file};
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -103,7 +103,7 @@ fn same_inputs_same_bits_across_runs() {
     run_session(&pinned(&b), &mut |_, _| {}).unwrap();
     let ra = read_recording_file(&a, false).unwrap();
     let rb = read_recording_file(&b, false).unwrap();
-    let outputs = |r: &haptic_loop::record::Recording| {
+    let outputs = |r: &recording::Recording| {
         r.messages
             .iter()
             .filter(|m| m.channel != Channel::Timing)

@@ -3,9 +3,9 @@
 //! salvage that recovers nothing is an error, and a full disk keeps the OS error.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::record::{RecordingError, read_recording, read_recording_file};
 use haptic_loop::replay::verify;
 use haptic_loop::session::{SceneSource, SessionOptions, run_session};
+use recording::{RecordingError, read_recording, read_recording_file};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -403,7 +403,7 @@ fn a_salvage_that_recovers_no_tick_is_an_error() {
     assert_eq!(part.integrity.ticks, 2000);
     assert!(verify(&part).unwrap().ok());
     let q = tmp("salvaged.mcap");
-    haptic_loop::record::rewrite(&part, &q).unwrap();
+    recording::rewrite(&part, &q).unwrap();
     let back = read_recording_file(&q, false).unwrap();
     assert_eq!(back.integrity.ticks, 2000);
     assert!(back.integrity.ticks_match_metadata && back.integrity.summary);

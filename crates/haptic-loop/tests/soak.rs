@@ -19,8 +19,8 @@
 //! build of the program (e.g. a copy kept aside while the tree changes during an hour's soak).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::channels::messages::{Channel, TimingMsg};
-use haptic_loop::record::reader::read_recording_file;
+use recording::channels::messages::{Channel, TimingMsg};
+use recording::reader::read_recording_file;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

@@ -2,11 +2,11 @@
 //! inputs, records, and replays bit for bit.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
 use haptic_loop::stepper::{Stepper, StepperOptions};
 use haptic_loop::{Buttons, DeviceSample};
+use recording::read_recording_file;
 use std::path::Path;
 
 #[test]

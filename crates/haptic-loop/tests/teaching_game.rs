@@ -3,12 +3,12 @@
 //! the house score.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::channels::messages::Channel;
-use haptic_loop::record::read_recording_file;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionArrays, SessionOptions, run_session,
 };
+use recording::channels::messages::Channel;
+use recording::read_recording_file;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {

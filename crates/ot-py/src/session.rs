@@ -3,10 +3,8 @@
 
 use haptic_loop::DeviceModel;
 use haptic_loop::bridge::BridgeConfig;
-use haptic_loop::channels::declare::ColumnData;
 use haptic_loop::device::OperatorParams;
 use haptic_loop::device::Script;
-use haptic_loop::record::RecordingError;
 use haptic_loop::scene::overrides::{override_scene, override_script};
 use haptic_loop::scene::{SceneFile, load_scene};
 use haptic_loop::session::{
@@ -17,6 +15,8 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
+use recording::RecordingError;
+use recording::channels::declare::ColumnData;
 use std::path::PathBuf;
 
 use crate::convert::array2_flat;
@@ -45,7 +45,7 @@ pub(crate) fn path_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<PathBuf> 
 }
 
 /// Per-tick arrays as a dict of numpy arrays: every declared column
-/// (`haptic_loop::channels::messages::TickColumns`) by its element type (integers as int64,
+/// (`recording::channels::messages::TickColumns`) by its element type (integers as int64,
 /// `float64[3]` as (T, 3), `float64[9]` as (T, 3, 3), the scene state as (T, F)), plus
 /// `rate_hz`, `state_fields`, `time_s` and `events`.
 pub(crate) fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<Bound<'py, PyDict>> {
@@ -472,7 +472,7 @@ pub fn render_audio<'py>(
     }
     let rate = sample_rate as u32;
     let s = py.detach(|| -> PyResult<_> {
-        let rec = haptic_loop::record::read_recording_file(&p, false)
+        let rec = recording::read_recording_file(&p, false)
             .map_err(|e| session_error(SessionError::from(e)))?;
         let arrays = haptic_loop::session::SessionArrays::from_recording(&rec)
             .map_err(|e| session_error(SessionError::from(e)))?;

@@ -394,7 +394,7 @@ pub struct Runs {
 
 /// The sound of a recording, with the proximity tone.
 fn sound_of(rec: &Path, sample_rate_hz: u32) -> Result<crate::sound::SessionSound, String> {
-    let r = crate::record::read_recording_file(rec, false).map_err(|e| e.to_string())?;
+    let r = recording::read_recording_file(rec, false).map_err(|e| e.to_string())?;
     let a = SessionArrays::from_recording(&r).map_err(|e| e.to_string())?;
     crate::sound::session_sound(&a, &r.description.scene_kind, true, sample_rate_hz)
         .map_err(|e| e.to_string())

@@ -15,9 +15,9 @@
 //! damaged file is an error, never an abort or a panic: no size read from the file is allocated
 //! before it is checked against the bytes that hold it.
 
-use super::parse::{self, ChunkIndexRec, FrameError, Framed, MessageRec, op, op_name};
 use crate::channels::FORMAT_VERSION;
 use crate::channels::messages::{Channel, DescriptionMsg, DeviceInputMsg};
+use crate::parse::{self, ChunkIndexRec, FrameError, Framed, MessageRec, op, op_name};
 use std::collections::BTreeMap;
 use std::path::Path;
 

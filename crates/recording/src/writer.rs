@@ -9,8 +9,9 @@
 //! most the last second. The thread compresses single-threaded (`compression_threads(0)`) to
 //! leave the other core to the loop.
 
-use super::{OutMsg, TickMessages, foxglove_out};
 use crate::channels::messages::{self, Channel, DescriptionMsg};
+use crate::encode::{OutMsg, TickMessages};
+use crate::foxglove_out;
 use foxglove::schemas::{FrameTransform, Log, SceneUpdate};
 use std::collections::BTreeMap;
 use std::fs::File;

@@ -5,10 +5,8 @@
 use super::FORMAT_VERSION;
 use super::cdr::{CdrError, CdrField, CdrReader, CdrWriter};
 use super::declare::{ColumnData, ColumnField, recording_channels};
-use crate::device::DeviceSample;
-use crate::haptic::TickResult;
-use crate::scene::{Event, Switch};
 use haptic_types::vec3::Vec3;
+use haptic_types::{DeviceSample, DeviceSpecs, Event, Switch, TickResult};
 
 recording_channels! {
     channel Description = "/scene/description", Input, "once, tick 0",
@@ -317,41 +315,9 @@ pub fn valid_field_name(name: &str) -> bool {
 }
 
 impl DescriptionMsg {
-    /// The description of a session of `loaded` (built from `scene_toml`) in `mode`, with the
-    /// device connected by `link`, started at `start_time_ns`; no script (set `script_name`,
-    /// `script_toml` and `operator` for a scripted session).
-    pub fn new(
-        scene_toml: &str,
-        loaded: &crate::scene::file::LoadedScene,
-        mode: &str,
-        link: &str,
-        start_time_ns: u64,
-    ) -> Self {
-        let specs = &loaded.config.specs;
-        DescriptionMsg {
-            format: FORMAT_VERSION.to_string(),
-            scene_name: loaded.file.scene.name.clone(),
-            scene_kind: loaded.scene.kind().to_string(),
-            scene_toml: scene_toml.to_string(),
-            device_model: specs.name.to_string(),
-            rate_hz: loaded.config.rate_hz,
-            mode: mode.to_string(),
-            script_name: String::new(),
-            script_toml: String::new(),
-            operator: link.to_string(),
-            state_fields: loaded.scene.state_fields(),
-            start_time_ns,
-            device_link: link.to_string(),
-            device_max_force_n: specs.limits.max_force_n,
-            device_max_stiffness_n_per_m: specs.limits.max_stiffness_n_per_m,
-            device_workspace_radius_m: specs.workspace_radius_m,
-            device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
-        }
-    }
-
     /// The device specifications this session ran with.
-    pub fn device_specs(&self) -> crate::device::DeviceSpecs {
-        crate::device::DeviceSpecs {
+    pub fn device_specs(&self) -> DeviceSpecs {
+        DeviceSpecs {
             name: self.device_model.clone().into(),
             limits: world_form::Limits {
                 max_force_n: self.device_max_force_n,

@@ -1,10 +1,11 @@
 //! The MCAP recorder as a sink of the runner: encodes each tick's messages and hands them to
 //! the writer thread (never blocking the tick).
 
-use super::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
+use crate::encode::LoopEncoder;
 use crate::haptic::HapticLoop;
 use crate::pacing::TickStats;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use recording::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -12,7 +13,7 @@ use std::path::PathBuf;
 pub struct RecorderSink {
     path: PathBuf,
     recorder: Option<Recorder>,
-    enc: Option<TickEncoder>,
+    enc: Option<LoopEncoder>,
     mode: String,
     summary: Option<WriteSummary>,
 }
@@ -66,7 +67,7 @@ impl Sink for RecorderSink {
             )
             .map_err(SinkError::new)?,
         );
-        self.enc = Some(TickEncoder::new(lp, info.description.start_time_ns));
+        self.enc = Some(LoopEncoder::new(lp, info.description.start_time_ns));
         self.mode = info.description.mode.clone();
         Ok(())
     }

@@ -5,7 +5,6 @@
 //! one metre), so nanoscale worlds are visible in Foxglove's 3D panel. Timestamps are the tick
 //! time from the session start, never the wall clock.
 
-use crate::scene::{Event, Primitive, Rgba};
 use foxglove::Encode;
 use foxglove::schemas::{
     ArrowPrimitive, Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Log,
@@ -13,6 +12,7 @@ use foxglove::schemas::{
     Vector3, line_primitive, log,
 };
 use haptic_types::vec3::{self, Vec3};
+use haptic_types::{Event, Primitive, Rgba};
 
 /// Frame of the world in the Foxglove channels.
 pub const WORLD_FRAME: &str = "world";

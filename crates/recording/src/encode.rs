@@ -1,25 +1,15 @@
-//! MCAP recording: per-tick message encoding, a writer thread that never stalls a tick, and a
-//! reader that gives clear errors on corrupt or truncated files.
-//!
-//! Layout and schemas: `docs/recording-format.md`.
+//! The messages of one tick, encoded (the same code for recording and for replay, so replay
+//! compares exactly what was written), and two edits of a whole recording: its switch schedule
+//! and a rewrite as a new complete file.
 
-pub mod foxglove_out;
-pub mod parse;
-pub mod reader;
-pub mod replay_device;
-pub mod sink;
-pub mod writer;
-
-pub use crate::channels::messages::Channel;
+use crate::channels::messages::Channel;
 use crate::channels::messages::{
     DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, SwitchMsg, TimingMsg,
 };
-use crate::device::DeviceSample;
-use crate::haptic::{HapticLoop, TickResult};
-use crate::scene::Primitive;
-pub use reader::{Integrity, Recording, RecordingError, read_recording, read_recording_file};
-pub use replay_device::ReplayDevice;
-pub use writer::{Recorder, RecorderSetup, WriteSummary};
+use crate::foxglove_out;
+use crate::reader::{Recording, RecordingError};
+use crate::writer::{self, Recorder, RecorderSetup, WriteSummary};
+use haptic_types::{DeviceSample, Primitive, Switch, TickResult};
 
 /// One encoded message of a tick.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,29 +33,32 @@ pub struct TickMessages {
 
 /// Encodes the messages of each tick (the same code for recording and for replay, so replay
 /// compares exactly what was written).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct TickEncoder {
     start_ns: u64,
     period_ns: u64,
     display_every: u64,
     display_scale: f64,
-    state: Vec<f64>,
     prims: Vec<Primitive>,
 }
 
 impl TickEncoder {
-    /// An encoder for the loop `l` of a session that started at `start_ns` (ns since the Unix
-    /// epoch; log times are `start_ns + tick · period`).
-    pub fn new(l: &HapticLoop, start_ns: u64) -> Self {
-        let c = l.config();
+    /// An encoder for a session that started at `start_ns` (ns since the Unix epoch; log times
+    /// are `start_ns + tick · period_ns`), drawing the scene every `display_every` ticks (≥ 1)
+    /// at `display_scale` (display units per metre).
+    pub fn new(start_ns: u64, period_ns: u64, display_every: u32, display_scale: f64) -> Self {
         TickEncoder {
             start_ns,
-            period_ns: c.period_ns(),
-            display_every: u64::from(c.display_every),
-            display_scale: c.display_scale,
-            state: Vec::new(),
+            period_ns,
+            display_every: u64::from(display_every.max(1)),
+            display_scale,
             prims: Vec::new(),
         }
+    }
+
+    /// True when tick `tick` carries the scene's drawing (`/foxglove/scene`, `/foxglove/tf`).
+    pub fn draws(&self, tick: u64) -> bool {
+        tick % self.display_every == 0
     }
 
     /// Log time of tick `tick`, ns since the Unix epoch.
@@ -99,14 +92,20 @@ impl TickEncoder {
     }
 
     /// Appends the verified outputs of tick `r` (state, force, events, Foxglove channels) to
-    /// `out`, in their fixed order.
-    pub fn outputs(&mut self, r: &TickResult, l: &HapticLoop, out: &mut Vec<OutMsg>) {
+    /// `out`, in their fixed order: `state` is the scene's state fields of the tick; `draw`
+    /// appends the scene's drawing to the vector it is given, and is called only on ticks
+    /// that [`TickEncoder::draws`].
+    pub fn outputs(
+        &mut self,
+        r: &TickResult,
+        state: &[f64],
+        draw: &mut dyn FnMut(&mut Vec<Primitive>),
+        out: &mut Vec<OutMsg>,
+    ) {
         let t_ns = self.log_time_ns(r.tick);
-        self.state.clear();
-        l.scene_state(&mut self.state);
         out.push(OutMsg {
             channel: Channel::State,
-            data: StateMsg::from_tick(r, &self.state).encode(),
+            data: StateMsg::from_tick(r, state).encode(),
         });
         out.push(OutMsg {
             channel: Channel::Force,
@@ -118,9 +117,9 @@ impl TickEncoder {
                 data: EventsMsg::from_tick(r.tick, &r.events).encode(),
             });
         }
-        if r.tick % self.display_every == 0 {
+        if self.draws(r.tick) {
             self.prims.clear();
-            l.scene().draw(&mut self.prims);
+            draw(&mut self.prims);
             let u = foxglove_out::scene_update(&self.prims, self.display_scale, t_ns);
             out.push(OutMsg {
                 channel: Channel::FoxgloveScene,
@@ -146,7 +145,7 @@ impl TickEncoder {
 pub fn switch_schedule(
     rec: &Recording,
     period_ns: u64,
-) -> Result<Vec<(u64, crate::scene::Switch)>, RecordingError> {
+) -> Result<Vec<(u64, Switch)>, RecordingError> {
     let start = rec.description.start_time_ns;
     let mut out = Vec::new();
     for m in rec.messages.iter().filter(|m| m.channel == Channel::Switch) {

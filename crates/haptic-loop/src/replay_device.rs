@@ -1,11 +1,11 @@
 //! The replay device: plays back the device inputs of a recording, tick by tick.
 
-use super::{Recording, RecordingError};
-use crate::channels::messages::{Channel, DeviceInputMsg};
 use crate::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
 use haptic_types::vec3::Vec3;
+use recording::channels::messages::{Channel, DeviceInputMsg};
+use recording::{Recording, RecordingError};
 
 /// Inputs of a recording played back as a device.
 #[derive(Clone, Debug)]
