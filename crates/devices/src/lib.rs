@@ -1,26 +1,33 @@
-//! # haptic-devices — a haptic device and the hand that holds it, as physics
+//! # haptic-devices — every device that can drive a session, and the hand that holds it
 //!
 //! Every world of nanohaptics renders a force to a device; whether that rendering is *stable*
 //! depends on what the device and the hand are: a moving mass with a little friction, an
 //! encoder that reports positions in counts, a force held constant over each tick (zero-order
 //! hold), and a hand that grips the stylus with some stiffness and damping. An ideal, massless
-//! scripted hand cannot show instability; this crate is the model that can.
+//! scripted hand cannot show instability; this crate holds the model that can, and every
+//! device source the loop is driven by.
 //!
 //! What it is for:
-//! - [`Mechanics`]: a device's moving mass (kg), viscous friction (N·s/m), encoder quantum (m),
-//!   force resolution (N), servo rate (Hz) and [`Limits`](world_form::Limits), with presets for
-//!   the Novint Falcon, the 3D Systems Touch, the Force Dimension delta.3 and the Haply Inverse3
-//!   ([`Mechanics::preset`]), each figure cited in `docs/devices.md`;
-//! - [`Grip`]: the hand as a spring-damper to the operator's intended path, from
-//!   [`Grip::LOOSE`] (300 N/m, 2 N·s/m) to [`Grip::FIRM`] (1000 N/m, 8 N·s/m), parsed from
-//!   `loose`, `firm` or `k=…,b=…[,m=…]`;
-//! - [`Plant`]: the device and the hand integrated between two ticks of a haptic loop under a
-//!   held force command, reporting encoder-quantized positions and the energy the device put
-//!   into the hand.
+//! - **device physics**: [`Mechanics`], a device's moving mass (kg), viscous friction (N·s/m),
+//!   encoder quantum (m), force resolution (N), servo rate (Hz) and
+//!   [`Limits`](world_form::Limits), with presets for the Novint Falcon, the 3D Systems Touch,
+//!   the Force Dimension delta.3 and the Haply Inverse3 ([`Mechanics::preset`], each figure
+//!   cited in `docs/devices.md`); [`Grip`], the hand as a spring-damper to the operator's
+//!   intended path, from [`Grip::LOOSE`] (300 N/m, 2 N·s/m) to [`Grip::FIRM`] (1000 N/m,
+//!   8 N·s/m); [`Plant`], the device and the hand integrated between two ticks under a held
+//!   force command, reporting encoder-quantized positions;
+//! - **devices** (each a [`HapticDevice`](haptic_types::HapticDevice)): [`script`], TOML
+//!   waypoints played by a rigid stylus ([`ScriptedDevice`]); [`operator`], a simulated
+//!   mass–spring–damper hand following the script ([`SimulatedOperator`]); [`modelled`], a
+//!   [`Plant`] held by a [`Grip`] following the script ([`ModelledDevice`]); [`bridge`], a
+//!   device in another process over UDP ([`UdpDevice`]) and the `fake-device` stand-in;
+//! - [`source`]: the one list of device sources a session can be driven by;
+//! - [`pacing`]: real-time pacing of ticks and the tick-time statistics (constant-memory
+//!   histograms, percentiles).
 //!
-//! What it is not: no I/O, no scripts, no haptic loop, no worlds. The loop's device trait, the
-//! scripted operator that feeds a [`Plant`] its intended path and the UDP bridge live in
-//! `haptic-loop`; this crate knows nothing of them (arrows point one way).
+//! What it is not: no haptic loop, no worlds, no recording. The device interface itself (the
+//! trait, samples, force commands, specifications) is `haptic-types`'; the engine
+//! (`haptic-loop`) drives these devices and knows them only through that interface.
 //!
 //! ```
 //! use haptic_devices::{Grip, Mechanics, Plant, Hold};
@@ -38,13 +45,31 @@
 //! assert_eq!(counts, counts.round());
 //! ```
 
+pub mod bridge;
 mod grip;
 mod mechanics;
+pub mod modelled;
+pub mod operator;
+pub mod pacing;
 mod plant;
+pub mod script;
+pub mod source;
 
 pub use grip::{Grip, GripError};
 pub use mechanics::{Mechanics, MechanicsError, PRESETS};
 pub use plant::{Hold, Plant};
+
+pub use bridge::{BridgeConfig, UdpDevice};
+pub use modelled::ModelledDevice;
+pub use operator::SimulatedOperator;
+pub use script::{OperatorParams, Script, ScriptError, ScriptedDevice};
+pub use source::{DeviceSource, open_device};
+
+/// The device interface these devices implement (defined in `haptic-types`).
+pub use haptic_types::device::{
+    Buttons, DeviceError, DeviceModel, DeviceSample, DeviceSpecs, FALCON, ForceCommand,
+    HapticDevice, TOUCH, TickTime,
+};
 
 /// A 3-vector, SI units as named where it is used.
 pub type Vec3 = [f64; 3];

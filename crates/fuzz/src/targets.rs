@@ -2,8 +2,8 @@
 //! finding (besides a panic, an abort or a hang, which the driver catches).
 
 use crate::mutate::{self, Rng};
-use haptic_loop::bridge::protocol::{Packet, Sample};
-use haptic_loop::device::Script;
+use haptic_devices::Script;
+use haptic_devices::bridge::protocol::{Packet, Sample};
 use haptic_loop::scene::load_scene_for;
 use haptic_loop::session::{SceneSource, SessionOptions, run_session};
 use haptic_loop::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticLoop, SessionArrays};

@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use haptic_loop::device::{Buttons, DeviceSample};
+use haptic_devices::{Buttons, DeviceSample};
 use haptic_loop::encode::LoopEncoder;
 use haptic_loop::haptic::HapticLoop;
 use haptic_loop::scene::load_scene;

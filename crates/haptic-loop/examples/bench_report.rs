@@ -10,7 +10,7 @@
 use bench_harness::plot::{Axis, Chart, Series};
 use bench_harness::plotters::prelude::{BLUE, GREEN, RED, RGBColor, SeriesLabelPosition};
 use bench_harness::{Report, Summary, Table, span};
-use haptic_loop::device::OperatorParams;
+use haptic_devices::OperatorParams;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
 use recording::read_recording_file;

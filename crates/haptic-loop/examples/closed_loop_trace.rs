@@ -3,7 +3,7 @@
 //! [counts|ideal] [safety|nosafety] [impedance scale]`.
 #![allow(clippy::unwrap_used)]
 use haptic_devices::{Grip, Mechanics};
-use haptic_loop::device::{HapticDevice, ModelledDevice, Script, TickTime};
+use haptic_devices::{HapticDevice, ModelledDevice, Script, TickTime};
 use haptic_loop::haptic::HapticLoop;
 use haptic_loop::scene::load_scene_for;
 
@@ -27,8 +27,8 @@ fn main() {
         // Scale the device-side impedance by `scale` (as the Z-width report's margins do).
         (text, mech) = haptic_loop::closed_loop::scale_impedance(&text, mech, scale);
     }
-    let falcon = haptic_loop::device::DeviceModel::Falcon.specs().clone();
-    let specs = haptic_loop::device::modelled::specs_of(&mech, &falcon);
+    let falcon = haptic_devices::DeviceModel::Falcon.specs().clone();
+    let specs = haptic_devices::modelled::specs_of(&mech, &falcon);
     let l = load_scene_for(&text, specs.clone()).unwrap();
     let stext = std::fs::read_to_string(root.join(format!("{scene}.script.toml"))).unwrap();
     let script = Script::from_toml(&stext, &specs).unwrap();

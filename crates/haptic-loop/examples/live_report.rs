@@ -14,9 +14,9 @@
 use bench_harness::report::out_arg;
 use bench_harness::{Report, Table};
 
-use haptic_loop::bridge::BridgeConfig;
-use haptic_loop::bridge::fake::{FakeConfig, FakeReport, run_fake};
-use haptic_loop::device::{DeviceModel, FALCON, Script};
+use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
+use haptic_devices::{DeviceModel, FALCON, Script};
 use haptic_loop::haptic::status;
 use haptic_loop::live::LiveConfig;
 use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};

@@ -12,11 +12,11 @@
 //! A run is [`Report::stable`] when it has no such jump, at most [`MAX_HF_FRACTION`] of its
 //! power above [`BUZZ_HZ`] and an observer that never went below minus its reserve.
 
-use crate::device::modelled::specs_of;
-use crate::device::{DeviceModel, HapticDevice, ModelledDevice, Script, ScriptError, TickTime};
 use crate::haptic::{HapticLoop, status};
 use crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
 use crate::scene::{SceneError, load_scene_for};
+use haptic_devices::modelled::specs_of;
+use haptic_devices::{DeviceModel, HapticDevice, ModelledDevice, Script, ScriptError, TickTime};
 use haptic_devices::{Grip, Mechanics};
 use rustfft::{FftPlanner, num_complex::Complex};
 

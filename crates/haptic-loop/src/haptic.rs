@@ -34,9 +34,9 @@
 //! The world force, the sent force and the status of every tick are returned in
 //! [`TickResult`]; the sent force is always finite and of norm ≤ the device maximum.
 
-use crate::device::{Buttons, DeviceSample, DeviceSpecs, ForceCommand};
 pub use crate::scene::loop_config::{LoopConfig, Mapping};
 use crate::scene::{Event, Scene, SceneInput, SceneOutput};
+use haptic_devices::{Buttons, DeviceSample, DeviceSpecs, ForceCommand};
 use haptic_types::switch::{self, Switch, SwitchError};
 use haptic_types::vec3::{self, Vec3};
 
@@ -507,8 +507,8 @@ impl HapticLoop {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::FALCON;
     use crate::scene::load_scene;
+    use haptic_devices::FALCON;
 
     const WALL: &str = r#"
 [scene]

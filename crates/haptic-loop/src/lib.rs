@@ -30,15 +30,12 @@
 //! `nanohaptics.bridge` has adapters for the Touch and Force Dimension / Falcon SDKs).
 
 pub mod arrays;
-pub mod bridge;
 pub mod builtin;
 pub mod closed_loop;
-pub mod device;
 pub mod encode;
 pub mod haptic;
 pub mod lesson;
 pub mod live;
-pub mod pacing;
 pub mod record_sink;
 pub mod replay;
 pub mod replay_device;
@@ -47,12 +44,11 @@ pub mod scene;
 pub mod session;
 pub mod sink;
 pub mod sound;
-pub mod source;
 pub mod stepper;
 pub mod totals;
 pub use haptic_types::{switch, textpos, vec3};
 
-pub use device::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};
 pub use haptic::{HapticLoop, LoopConfig, TickResult};
+pub use haptic_types::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};
 pub use scene::{Event, Primitive, Scene, SceneInput, SceneOutput};
 pub use session::{SessionArrays, SessionOptions};

@@ -19,8 +19,8 @@
 //! dropped and counted (`dropped` in `/live/state` and in the summary).
 
 use crate::haptic::HapticLoop;
-use crate::pacing::TickStats;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_devices::pacing::TickStats;
 use recording::foxglove_out;
 
 /// Why the live view could not start or publish.
@@ -64,8 +64,9 @@ impl LiveConfig {
     /// Parses `ws:HOST:PORT`, or `ws:PORT` for loopback (the `--live` option), with the default
     /// rates (50 Hz scene, 200 Hz plots).
     pub fn parse(spec: &str) -> Result<Self, LiveError> {
-        let bind = crate::bridge::parse_endpoint(spec, "ws", "--live", "ws:127.0.0.1:8765")
-            .map_err(LiveError::Option)?;
+        let bind =
+            haptic_devices::bridge::parse_endpoint(spec, "ws", "--live", "ws:127.0.0.1:8765")
+                .map_err(LiveError::Option)?;
         Ok(LiveConfig {
             bind,
             display_hz: 50,

@@ -19,8 +19,8 @@ mod lesson_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
-use haptic_loop::bridge::BridgeConfig;
-use haptic_loop::device::{DeviceModel, OperatorParams};
+use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::{DeviceModel, OperatorParams};
 use haptic_loop::live::LiveConfig;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
@@ -200,7 +200,7 @@ struct FakeArgs {
 const FAKE_SCRIPT: &str = include_str!("../../../scenes/wall.script.toml");
 
 fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
-    use haptic_loop::bridge::fake::{FakeConfig, run_fake};
+    use haptic_devices::bridge::fake::{FakeConfig, run_fake};
     let target = a
         .target
         .strip_prefix("udp:")
@@ -240,7 +240,7 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
             "built-in fake-device script".into(),
         ),
     };
-    let script = haptic_loop::device::Script::from_toml(&text, model.specs()).map_err(|e| {
+    let script = haptic_devices::Script::from_toml(&text, model.specs()).map_err(|e| {
         let at = haptic_loop::session::Location {
             file: origin,
             at: e.position(&text),
@@ -660,7 +660,7 @@ fn cmd_info(rec: &Path, salvage: bool, json: bool) -> Result<ExitCode, String> {
     let d = &r.description;
     let ticks = a.tick.len() as u64;
     let duration = ticks as f64 / f64::from(d.rate_hz);
-    let pct = haptic_loop::pacing::Percentiles::of(&a.compute_ns);
+    let pct = haptic_devices::pacing::Percentiles::of(&a.compute_ns);
     let session = r.metadata.get("session").cloned().unwrap_or_default();
     let channels: Vec<_> = r
         .channels

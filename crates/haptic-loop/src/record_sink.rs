@@ -3,8 +3,8 @@
 
 use crate::encode::LoopEncoder;
 use crate::haptic::HapticLoop;
-use crate::pacing::TickStats;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_devices::pacing::TickStats;
 use recording::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
 use std::collections::BTreeMap;
 use std::path::PathBuf;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use haptic_loop::device::{DeviceError, HapticDevice, TickTime};
+use haptic_devices::{DeviceError, HapticDevice, TickTime};
 use haptic_loop::replay_device::ReplayDevice;
 use haptic_loop::runner::{Pacing, Runner};
 use haptic_loop::scene::optical::RecordedPicture;

@@ -1,6 +1,6 @@
 //! The replay device: plays back the device inputs of a recording, tick by tick.
 
-use crate::device::{
+use haptic_devices::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
 use haptic_types::vec3::Vec3;

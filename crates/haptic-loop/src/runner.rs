@@ -15,10 +15,10 @@
 //! Adding a sink is one new file implementing [`Sink`](crate::sink::Sink) and one line where the
 //! session builds its list of sinks (`session::run_session`).
 
-use crate::device::{DeviceError, HapticDevice, TickTime};
 use crate::haptic::HapticLoop;
-use crate::pacing::{DurationHistogram, Pacer, Percentiles, TickStats};
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_devices::pacing::{DurationHistogram, Pacer, Percentiles, TickStats};
+use haptic_devices::{DeviceError, HapticDevice, TickTime};
 use haptic_types::switch::{Switch, SwitchError};
 use recording::channels::messages::DescriptionMsg;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -11,19 +11,19 @@
 //! println!("{} ticks, peak force {peak} N", report.arrays.tick.len());
 //! ```
 
-use crate::bridge::BridgeConfig;
-use crate::device::TickTime;
-use crate::device::script::{OperatorKind, Script};
-use crate::device::{DeviceError, DeviceModel, OperatorParams, ScriptError};
 use crate::haptic::HapticLoop;
 use crate::live::{LiveConfig, LiveError, LiveSink};
-use crate::pacing::TickStats;
 use crate::record_sink::RecorderSink;
 use crate::runner::{EndReason, Pacing, RunError, Runner};
 use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
 use crate::sink::{Sink, SinkError};
-use crate::source::{DeviceSource, open_device};
 use crate::totals::Totals;
+use haptic_devices::TickTime;
+use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::pacing::TickStats;
+use haptic_devices::script::{OperatorKind, Script};
+use haptic_devices::source::{DeviceSource, open_device};
+use haptic_devices::{DeviceError, DeviceModel, OperatorParams, ScriptError};
 pub use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
 use recording::channels::messages::{self, DescriptionMsg};
@@ -436,7 +436,7 @@ pub fn script_source(
 fn load_script(
     opts: &SessionOptions,
     file: &SceneFile,
-    specs: &crate::device::DeviceSpecs,
+    specs: &haptic_devices::DeviceSpecs,
 ) -> Result<(Script, String, String), SessionError> {
     let (text, origin) = script_source(opts, file)?;
     let script = Script::from_toml(&text, specs).map_err(|error| SessionError::ScriptFile {
@@ -570,7 +570,7 @@ fn run_with_device(
     opts: &SessionOptions,
     source: &DeviceSource,
     script: Option<(Script, String, String)>,
-    dev: &mut dyn crate::device::HapticDevice,
+    dev: &mut dyn haptic_devices::HapticDevice,
     progress: &mut dyn FnMut(u64, u64),
     stop: Option<&AtomicBool>,
 ) -> Result<SessionReport, SessionError> {

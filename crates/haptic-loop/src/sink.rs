@@ -5,9 +5,9 @@
 //! Adding a sink is one new file implementing [`Sink`] and one line where the session builds its
 //! list of sinks (`session::run_session`).
 
-use crate::device::DeviceSample;
 use crate::haptic::{HapticLoop, LoopConfig, TickResult};
-use crate::pacing::TickStats;
+use haptic_devices::DeviceSample;
+use haptic_devices::pacing::TickStats;
 use recording::channels::messages::DescriptionMsg;
 
 /// One tick as the sinks see it.

@@ -19,13 +19,13 @@
 //! ```
 
 use crate::arrays::SessionArrays;
-use crate::device::{DeviceModel, DeviceSample, ForceCommand};
 use crate::haptic::{HapticLoop, TickResult};
-use crate::pacing::{DurationHistogram, Percentiles, TickStats};
 use crate::record_sink::RecorderSink;
 use crate::scene::load_scene;
 use crate::session::{SceneSource, SessionError, now_unix_ns};
 use crate::sink::{SessionInfo, Sink, TickView, deliver};
+use haptic_devices::pacing::{DurationHistogram, Percentiles, TickStats};
+use haptic_devices::{DeviceModel, DeviceSample, ForceCommand};
 use recording::WriteSummary;
 use recording::channels::messages::{self, DescriptionMsg};
 use std::path::PathBuf;

@@ -4,10 +4,10 @@
 //! ramps the force to zero within 10 ms of the last sample and engages softly again.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::bridge::BridgeConfig;
-use haptic_loop::bridge::fake::{FakeConfig, FakeReport, run_fake};
-use haptic_loop::bridge::protocol::{Packet, Sample};
-use haptic_loop::device::{DeviceModel, FALCON, Script};
+use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
+use haptic_devices::bridge::protocol::{Packet, Sample};
+use haptic_devices::{DeviceModel, FALCON, Script};
 use haptic_loop::haptic::status;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};

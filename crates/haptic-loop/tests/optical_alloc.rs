@@ -3,7 +3,7 @@
 #![allow(unsafe_code)] // a counting GlobalAlloc is unsafe by definition
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::device::Buttons;
+use haptic_devices::Buttons;
 use haptic_loop::scene::optical::OpticalScene;
 use haptic_loop::scene::{Scene, SceneFile, SceneInput, SceneOutput};
 use std::alloc::{GlobalAlloc, Layout, System};

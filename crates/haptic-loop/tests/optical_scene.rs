@@ -90,7 +90,7 @@ fn scene_errors_name_the_field() {
 /// slows down under the force keeps it closer still.
 #[test]
 fn feedback_keeps_the_cursor_near_the_particle() {
-    use haptic_loop::device::OperatorParams;
+    use haptic_devices::OperatorParams;
     use haptic_loop::session::OperatorChoice;
     let drag = "[script]\nname = 'drag'\nduration_s = 1.2\n\
                 [[button]]\nt_s = 0.3\nname = 'centre'\ndown = true\n\

@@ -395,7 +395,7 @@ fn touch_device_caps_at_its_own_limits() {
         .fold(0.0, f64::max);
     assert_eq!(peak, 3.3);
     // Buttons of the Falcon script do not exist on a Touch: the script is refused by name.
-    let e = haptic_loop::device::Script::from_toml(
+    let e = haptic_devices::Script::from_toml(
         &std::fs::read_to_string(root().join("scenes/wall.script.toml")).unwrap(),
         haptic_loop::DeviceModel::Touch.specs(),
     );

@@ -1,10 +1,10 @@
 //! Sessions of the haptic loop (`haptic-loop`): run a scene with a script and
 //! get per-tick arrays back; read an MCAP recording into the same arrays.
 
+use haptic_devices::OperatorParams;
+use haptic_devices::Script;
+use haptic_devices::bridge::BridgeConfig;
 use haptic_loop::DeviceModel;
-use haptic_loop::bridge::BridgeConfig;
-use haptic_loop::device::OperatorParams;
-use haptic_loop::device::Script;
 use haptic_loop::scene::overrides::{override_scene, override_script};
 use haptic_loop::scene::{SceneFile, load_scene};
 use haptic_loop::session::{

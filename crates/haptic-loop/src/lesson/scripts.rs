@@ -145,7 +145,7 @@ pub fn approach_retract(switches: &[(&str, f64)]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::{FALCON, Script};
+    use haptic_devices::{FALCON, Script};
 
     #[test]
     fn every_lesson_script_is_a_valid_falcon_script() {

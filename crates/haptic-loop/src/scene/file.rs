@@ -38,7 +38,7 @@ use super::check::SceneError;
 use super::loop_config::{DisplaySection, LoopConfig, LoopSection, MappingSection};
 use super::registry;
 use super::table;
-use crate::device::{DeviceModel, DeviceSpecs};
+use haptic_devices::{DeviceModel, DeviceSpecs};
 use serde::Deserialize;
 
 /// `[scene]`.

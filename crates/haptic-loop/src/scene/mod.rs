@@ -17,7 +17,7 @@ pub mod score;
 pub mod table;
 pub mod wall;
 
-use crate::device::Buttons;
+use haptic_devices::Buttons;
 use haptic_types::vec3::Vec3;
 
 pub use check::SceneError;

@@ -632,7 +632,7 @@ mod tests {
             tick: 0,
             dt_s: 1e-3,
             cursor_m: [0.0; 3],
-            buttons: crate::device::Buttons(0),
+            buttons: haptic_devices::Buttons(0),
             input_valid: true,
         };
         s.step(&input, &mut out);

@@ -23,8 +23,8 @@
 
 use super::check::SceneError;
 use super::file::SceneFile;
-use crate::device::DeviceSpecs;
-use crate::device::script::{Script, ScriptError};
+use haptic_devices::DeviceSpecs;
+use haptic_devices::script::{Script, ScriptError};
 use toml::{Table, Value};
 
 /// Errors of an override.

@@ -7,7 +7,7 @@ use super::declare::{FieldInfo, MessageInfo};
 use super::messages::{Channel, MESSAGES};
 
 /// The line that opens the generated part of `docs/recording-format.md`.
-pub const BEGIN: &str = "<!-- BEGIN generated from crates/haptic-loop/src/channels/messages.rs: do not edit by hand -->";
+pub const BEGIN: &str = "<!-- BEGIN generated from crates/recording/src/channels/messages.rs: do not edit by hand -->";
 /// The line that closes it.
 pub const END: &str = "<!-- END generated -->";
 

@@ -8,12 +8,10 @@
 //! the send of a sample to the arrival of its answer.
 
 use super::protocol::{Packet, Sample};
-use crate::device::script::Script;
-use crate::device::{
-    DeviceError, DeviceModel, ForceCommand, HapticDevice, ModelledDevice, OperatorParams,
-    ScriptedDevice, SimulatedOperator, TickTime,
-};
 use crate::pacing::{Pacer, Percentiles};
+use crate::script::Script;
+use crate::{ModelledDevice, OperatorParams, ScriptedDevice, SimulatedOperator};
+use haptic_types::device::{DeviceError, DeviceModel, ForceCommand, HapticDevice, TickTime};
 use haptic_types::vec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -36,7 +34,7 @@ pub struct FakeConfig {
     pub hand: Option<OperatorParams>,
     /// A modelled device held by a hand (`haptic_devices`): moving mass, encoder counts, the
     /// force held over the period. Takes the place of `model`'s specifications and of `hand`.
-    pub physical: Option<(haptic_devices::Mechanics, haptic_devices::Grip)>,
+    pub physical: Option<(crate::Mechanics, crate::Grip)>,
     /// Probability that a sample is lost, 0–1.
     pub loss: f64,
     /// Extra delay of each sample, uniform in 0–`jitter_s`, s (samples may overtake each other).
@@ -95,7 +93,7 @@ struct Reply {
 /// Runs the fake device to the end; `stop` ends it early.
 pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeReport, DeviceError> {
     let specs = match &cfg.physical {
-        Some((mech, _)) => crate::device::modelled::specs_of(mech, cfg.model.specs()),
+        Some((mech, _)) => crate::modelled::specs_of(mech, cfg.model.specs()),
         None => cfg.model.specs().clone(),
     };
     let link = |what: &str, e: std::io::Error| DeviceError::Link(format!("{what}: {e}"));

@@ -1,10 +1,11 @@
 //! The device sources a session can be driven by, registered in one place: adding a device is
-//! one new file implementing [`HapticDevice`](crate::device::HapticDevice) and one arm here.
+//! one new file implementing [`HapticDevice`](haptic_types::device::HapticDevice) and one arm here.
 
 use crate::bridge::{BridgeConfig, UdpDevice};
-use crate::device::SimulatedOperator;
-use crate::device::script::Script;
-use crate::device::{DeviceError, DeviceModel, HapticDevice, OperatorParams, ScriptedDevice};
+use crate::operator::SimulatedOperator;
+use crate::script::Script;
+use crate::script::{OperatorParams, ScriptedDevice};
+use haptic_types::device::{DeviceError, DeviceModel, HapticDevice};
 
 /// Which device drives a session.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,17 +1,17 @@
 //! A scripted operator whose hand holds a modelled device: the closed loop of issue 22.
 //!
-//! The script is the operator's *intent*; a [`haptic_devices::Plant`] is the device (moving
+//! The script is the operator's *intent*; a [`crate::Plant`] is the device (moving
 //! mass, friction, encoder counts, force resolution, the command held at the device's servo
-//! rate) gripped by a hand ([`haptic_devices::Grip`]) that follows the intent. Each tick the
+//! rate) gripped by a hand ([`crate::Grip`]) that follows the intent. Each tick the
 //! loop reads the encoder, and the force it answers is held until the next tick. Unlike the
 //! rigid [`super::ScriptedDevice`] or the massless [`super::SimulatedOperator`], this device can
 //! show a rendering's instability: a buzz, a limit cycle, energy pumped into the hand.
 
-use super::script::Script;
-use super::{
+use crate::script::Script;
+use crate::{Grip, Hold, Mechanics, Plant};
+use haptic_types::device::{
     DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime, in_order,
 };
-use haptic_devices::{Grip, Hold, Mechanics, Plant};
 use haptic_types::vec3::Vec3;
 use std::borrow::Cow;
 

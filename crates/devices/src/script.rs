@@ -30,7 +30,7 @@
 //! value = 0.0                 # a number, or true / false for on/off switches
 //! ```
 
-use super::{
+use haptic_types::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
 use haptic_types::vec3::{self, Vec3};
@@ -548,7 +548,7 @@ impl OperatorParams {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::FALCON;
+    use haptic_types::device::FALCON;
 
     const S: &str = r#"
 [script]

@@ -12,7 +12,7 @@
 //! | 4    | force   | sim → device  | seq answered u64, tick u64, force 3 × f64 (N), stiffness 9 × f64 (N/m, row-major), status u8 |
 //! | 5    | bye     | either        | reason u8 (0: end of session, 1: error)                             |
 
-use crate::device::DeviceSpecs;
+use haptic_types::device::DeviceSpecs;
 use haptic_types::vec3::Vec3;
 use std::borrow::Cow;
 
@@ -376,7 +376,7 @@ impl Reader<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::{FALCON, TOUCH};
+    use haptic_types::device::{FALCON, TOUCH};
     use proptest::prelude::*;
 
     #[test]

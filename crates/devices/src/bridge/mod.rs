@@ -3,7 +3,7 @@
 //! samples over UDP and gets a force and a local stiffness back for each.
 //!
 //! - [`protocol`]: the versioned wire format (`docs/device-bridge.md` has the byte layout);
-//! - [`udp`]: the simulator's side, a [`HapticDevice`](crate::device::HapticDevice) with a
+//! - [`udp`]: the simulator's side, a [`HapticDevice`](haptic_types::device::HapticDevice) with a
 //!   watchdog-friendly sample clock and fault counters;
 //! - [`fake`]: a stand-in device process with injectable loss, jitter, latency and an outage.
 

@@ -11,7 +11,7 @@
 //! oversized datagrams, packets from a stranger, gaps in the sequence.
 
 use super::protocol::{ForceReply, Packet, Sample};
-use crate::device::{
+use haptic_types::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, FALCON, ForceCommand, HapticDevice, TickTime,
 };
 use std::collections::VecDeque;

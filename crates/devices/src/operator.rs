@@ -15,8 +15,8 @@
 //! The device's mechanical end stop is modelled too: the stylus cannot leave the workspace
 //! sphere (its outward velocity is removed at the boundary), as a real linkage cannot.
 
-use super::script::{OperatorParams, Script};
-use super::{
+use crate::script::{OperatorParams, Script};
+use haptic_types::device::{
     DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime, in_order,
 };
 use haptic_types::vec3::{self, Vec3};
@@ -126,7 +126,7 @@ impl HapticDevice for SimulatedOperator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::device::{FALCON, ForceCommand};
+    use haptic_types::device::{FALCON, ForceCommand};
 
     fn hold_script() -> Script {
         Script::from_toml(
