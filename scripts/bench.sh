@@ -36,7 +36,7 @@ if [ "$assemble_only" = 0 ]; then
   echo "==> haptic-loop-zwidth-report (Z-width and margins in closed loop, about 10 s)"
   cargo run --release -q -p haptic-loop --example haptic-loop-zwidth-report -- --out docs/bench/zwidth.md > /dev/null
   echo "==> haptic-loop-teaching-report (the lesson and the sound, three runs each)"
-  cargo run --release -q -p haptic-loop --example haptic-loop-teaching-report -- --out docs/bench/teaching-game.md > /dev/null
+  cargo run --release -q -p nanohaptics-lesson --example teaching-report -- --out docs/bench/teaching-game.md > /dev/null
   echo "==> ot-envelope figures (paper Figs. 2, 3, 4, 7, 8)"
   cargo run --release -q -p ot-envelope --example figures > /dev/null
 fi

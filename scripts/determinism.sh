@@ -33,14 +33,14 @@ GLIBC_TUNABLES=$OFF /lib64/ld-linux-x86-64.so.2 --list-diagnostics 2>/dev/null \
   | grep '^dl_hwcaps_subdirs_active' || true
 
 step "the default build, glibc's FMA/AVX2/AVX-512 paths on, then off"
-cargo build --release -q -p haptic-loop --bin nanohaptics
+cargo build --release -q -p nanohaptics-cli --bin nanohaptics
 verify_all target/release/nanohaptics
 verify_all target/release/nanohaptics GLIBC_TUNABLES=$OFF
 
 step "a build for baseline x86-64 and one for this CPU (target-cpu=native)"
-RUSTFLAGS="-C target-cpu=x86-64" cargo build --release -q -p haptic-loop --bin nanohaptics \
+RUSTFLAGS="-C target-cpu=x86-64" cargo build --release -q -p nanohaptics-cli --bin nanohaptics \
   --target-dir target/det-baseline
-RUSTFLAGS="-C target-cpu=native" cargo build --release -q -p haptic-loop --bin nanohaptics \
+RUSTFLAGS="-C target-cpu=native" cargo build --release -q -p nanohaptics-cli --bin nanohaptics \
   --target-dir target/det-native
 BASE=target/det-baseline/release/nanohaptics
 NATIVE=target/det-native/release/nanohaptics

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every test of nanohaptics on a fresh machine:
-#   formatting, clippy, the Rust workspace tests, then the Python wheel
+#   formatting, the layering check, clippy, the Rust workspace tests, then the Python wheel
 #   built by maturin into a fresh virtual environment and tested with pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,6 +10,9 @@ step() { printf '\n==> %s\n' "$*"; }
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
+step "layering: crate dependencies one way, no import circles, no upward imports"
+python3 scripts/layering.py
+
 step "cargo clippy (warnings are errors)"
 cargo clippy --workspace --all-targets --release -- -D warnings
 
@@ -17,7 +20,7 @@ step "cargo test (release profile)"
 cargo test --workspace --release
 
 step "fuzz: the program as a process (the in-tree driver's cli target, a fixed input set; libFuzzer runs in .ci/run, docs/fuzzing.md)"
-cargo build --release -q -p haptic-loop --bin nanohaptics
+cargo build --release -q -p nanohaptics-cli --bin nanohaptics
 cargo run --release -q -p nanohaptics-fuzz -- --ci
 
 if [ -d crates/ot-py ]; then

@@ -77,7 +77,7 @@ impl Grip {
     /// Parses `loose`, `firm` or `k=…,b=…[,m=…]` (N/m, N·s/m, kg; `b` and `m` default to 0).
     ///
     /// ```
-    /// use crate::Grip;
+    /// use haptic_devices::Grip;
     /// assert_eq!(Grip::parse("firm").unwrap(), Grip::FIRM);
     /// let g = Grip::parse("k=500,b=4").unwrap();
     /// assert_eq!((g.stiffness_n_per_m, g.damping_n_s_per_m), (500.0, 4.0));

@@ -11,5 +11,6 @@
 
 pub mod libfuzzer;
 pub mod mutate;
+pub mod outcome;
 pub mod params;
 pub mod targets;

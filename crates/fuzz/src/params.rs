@@ -3,7 +3,7 @@
 //! worlds reads the same text; a table it accepts builds a world that is stepped along a short
 //! path, and every force must be finite and within the device's limit.
 
-use crate::targets::Outcome;
+use crate::outcome::Outcome;
 use nalgebra::Vector3;
 use world_form::Limits;
 

@@ -24,17 +24,7 @@ pub const TARGETS: &[&str] = &[
     "cli",
 ];
 
-/// What one input did.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Outcome {
-    /// Accepted (and, where checked, its results were finite and within limits).
-    Accepted,
-    /// Refused with an error (the expected answer to most mutated inputs).
-    Refused,
-    /// A defect: its kind (`non-finite`, `accepted-modified`, `hang`, `bad-exit`, …) and what
-    /// happened.
-    Finding(&'static str, String),
-}
+pub use crate::outcome::Outcome;
 
 /// A target with its seeds, ready to make and run inputs.
 pub struct Target {

@@ -7,11 +7,11 @@
 //! one. The first difference names its tick and channel.
 
 use crate::encode::LoopEncoder;
+use crate::error::SessionError;
 use crate::haptic::HapticLoop;
 use crate::replay_device::ReplayDevice;
 use crate::runner::{Pacing, Runner};
 use crate::scene::load_scene_for;
-use crate::session::SessionError;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use recording::channels::messages::{Channel, ForceMsg, StateMsg};
 use recording::{OutMsg, Recording, RecordingError};

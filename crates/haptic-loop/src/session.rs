@@ -12,173 +12,28 @@
 //! ```
 
 use crate::haptic::HapticLoop;
-use crate::live::{LiveConfig, LiveError, LiveSink};
+use crate::live::{LiveConfig, LiveSummary};
 use crate::record_sink::RecorderSink;
-use crate::runner::{EndReason, Pacing, RunError, Runner};
+use crate::runner::{EndReason, Pacing, Runner};
 use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
-use crate::sink::{Sink, SinkError};
+use crate::sink::Sink;
 use crate::totals::Totals;
 use haptic_devices::TickTime;
 use haptic_devices::bridge::BridgeConfig;
 use haptic_devices::pacing::TickStats;
 use haptic_devices::script::{OperatorKind, Script};
 use haptic_devices::source::{DeviceSource, open_device};
-use haptic_devices::{DeviceError, DeviceModel, OperatorParams, ScriptError};
+use haptic_devices::{DeviceModel, OperatorParams, ScriptError};
 pub use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
+use recording::WriteSummary;
 use recording::channels::messages::{self, DescriptionMsg};
-use recording::writer::RecordError;
-use recording::{RecordingError, WriteSummary};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 pub use crate::arrays::SessionArrays;
+pub use crate::error::SessionError;
 pub use crate::record_sink::stats_metadata;
-
-/// Errors of a session.
-#[derive(Debug, thiserror::Error)]
-pub enum SessionError {
-    /// The scene (one without a file: the copy inside a recording, a built-in table).
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    /// The script (one without a file).
-    #[error(transparent)]
-    Script(#[from] ScriptError),
-    /// An error in a scene file, with where it is.
-    #[error("{at}: {error}")]
-    SceneFile {
-        /// File and, when known, line and column.
-        at: Location,
-        /// What is wrong.
-        error: Box<SceneError>,
-    },
-    /// An error in a script file, with where it is.
-    #[error("{at}: {error}")]
-    ScriptFile {
-        /// File and, when known, line and column.
-        at: Location,
-        /// What is wrong.
-        error: Box<ScriptError>,
-    },
-    /// The scene's default script cannot be read.
-    #[error(
-        "{at}: `scene.default_script` = \"{script}\": cannot read {path}: {message} (pass \
-         --script FILE, or keep the script next to the scene; `nanohaptics scenes export DIR` \
-         writes the built-in scenes with their scripts)"
-    )]
-    DefaultScript {
-        /// The scene file and the field's line and column.
-        at: Location,
-        /// The file name the scene gives.
-        script: String,
-        /// Where it was looked for.
-        path: String,
-        /// OS error.
-        message: String,
-    },
-    /// The device.
-    #[error("device: {0}")]
-    Device(#[from] DeviceError),
-    /// Writing the recording.
-    #[error(transparent)]
-    Record(#[from] RecordError),
-    /// Reading a recording.
-    #[error(transparent)]
-    Recording(#[from] RecordingError),
-    /// No script given and the scene names no default script.
-    #[error("no script: pass --script or set `scene.default_script` in the scene file")]
-    NoScript,
-    /// A file could not be read.
-    #[error("cannot read {path}: {message}")]
-    Io {
-        /// Path.
-        path: String,
-        /// OS error.
-        message: String,
-    },
-    /// Session length out of range.
-    #[error(
-        "session length {} s is out of range (allowed: 0 < seconds ≤ 3600)",
-        crate::scene::check::fmt_num(*.0)
-    )]
-    Seconds(f64),
-    /// A session shorter than one tick.
-    #[error(
-        "session length {} s is shorter than one tick ({} ms at {rate_hz} Hz): allowed \
-         {} ≤ seconds ≤ 3600",
-        crate::scene::check::fmt_num(*seconds),
-        1e3 / f64::from(*rate_hz),
-        crate::scene::check::fmt_num(0.5 / f64::from(*rate_hz))
-    )]
-    TooShort {
-        /// The length asked for, s.
-        seconds: f64,
-        /// The loop rate, Hz.
-        rate_hz: u32,
-    },
-    /// A scene reported a state field name that cannot be a message field.
-    #[error("scene state field `{0}` is not a lower-snake-case field name")]
-    StateField(String),
-    /// The live view could not start or publish.
-    #[error("live view: {0}")]
-    Live(String),
-    /// An option out of range or inconsistent with another.
-    #[error("{0}")]
-    Option(String),
-    /// A sink (live view, frames) failed.
-    #[error("{0}")]
-    Sink(String),
-    /// A switch that the scene refused at a tick (scheduled by a script or a recording).
-    #[error("tick {tick}: {error}")]
-    Switch {
-        /// The tick it was to apply to.
-        tick: u64,
-        /// Why it was refused.
-        error: crate::scene::SwitchError,
-    },
-}
-
-impl From<SinkError> for SessionError {
-    /// Gives a sink's error back its type: a recording's write error stays
-    /// [`SessionError::Record`] (with its OS error), a read error [`SessionError::Recording`].
-    fn from(e: SinkError) -> Self {
-        let e = match e.0.downcast::<SessionError>() {
-            Ok(s) => return *s,
-            Err(e) => e,
-        };
-        let e = match e.downcast::<RecordError>() {
-            Ok(r) => return SessionError::Record(*r),
-            Err(e) => e,
-        };
-        let e = match e.downcast::<RecordingError>() {
-            Ok(r) => return SessionError::Recording(*r),
-            Err(e) => e,
-        };
-        match e.downcast::<LiveError>() {
-            Ok(l) => (*l).into(),
-            Err(e) => SessionError::Sink(e.to_string()),
-        }
-    }
-}
-
-impl From<LiveError> for SessionError {
-    fn from(e: LiveError) -> Self {
-        match e {
-            LiveError::Option(m) => SessionError::Option(m),
-            LiveError::Serve(m) => SessionError::Live(m),
-        }
-    }
-}
-
-impl From<RunError> for SessionError {
-    fn from(e: RunError) -> Self {
-        match e {
-            RunError::Device(d) => SessionError::Device(d),
-            RunError::Sink(s) => s.into(),
-            RunError::Switch { tick, error } => SessionError::Switch { tick, error },
-        }
-    }
-}
 
 /// A scene file's text and the folder it came from (to find its default script).
 #[derive(Clone, Debug)]
@@ -574,6 +429,9 @@ fn run_with_device(
     progress: &mut dyn FnMut(u64, u64),
     stop: Option<&AtomicBool>,
 ) -> Result<SessionReport, SessionError> {
+    // The live view serves from the start: a viewer may connect before a bridged device's
+    // hello arrives.
+    let mut live = start_live(opts)?;
     dev.open()?;
     let specs = dev.specs().clone();
     let loaded =
@@ -615,10 +473,6 @@ fn run_with_device(
     let mut arrays = SessionArrays::new(rate, fields);
     let mut totals = Totals::default();
     let mut recorder = opts.out.clone().map(RecorderSink::new);
-    let mut live = match &opts.live {
-        Some(c) => Some(LiveSink::new(c.clone())?),
-        None => None,
-    };
     let mut sinks: Vec<&mut dyn Sink> = vec![&mut totals];
     if opts.arrays {
         sinks.push(&mut arrays);
@@ -626,6 +480,7 @@ fn run_with_device(
     if let Some(r) = recorder.as_mut() {
         sinks.push(r);
     }
+    #[cfg(feature = "live")]
     if let Some(l) = live.as_mut() {
         sinks.push(l);
     }
@@ -660,7 +515,7 @@ fn run_with_device(
             EndReason::Stopped => "stopped",
         },
         link: dev.link_counters(),
-        live: live.map(|l| l.summary()),
+        live: live_summary(live),
         sinks: sink_times,
     })
 }
@@ -669,4 +524,36 @@ fn run_with_device(
 pub fn read_arrays(path: &Path, salvage: bool) -> Result<SessionArrays, SessionError> {
     let rec = recording::read_recording_file(path, salvage)?;
     Ok(SessionArrays::from_recording(&rec)?)
+}
+
+/// The live view's sink (this build serves the live view: the `live` feature).
+#[cfg(feature = "live")]
+type Live = crate::live::LiveSink;
+/// Without the `live` feature there is no live view to serve.
+#[cfg(not(feature = "live"))]
+type Live = std::convert::Infallible;
+
+/// Starts the live view the options ask for (before the device is opened).
+fn start_live(opts: &SessionOptions) -> Result<Option<Live>, SessionError> {
+    match &opts.live {
+        #[cfg(feature = "live")]
+        Some(c) => Ok(Some(crate::live::LiveSink::new(c.clone())?)),
+        #[cfg(not(feature = "live"))]
+        Some(c) => Err(SessionError::Live(format!(
+            "cannot serve ws:{}: this build has no live view (build haptic-loop with its \
+             `live` feature, as the `nanohaptics` program is)",
+            c.bind
+        ))),
+        None => Ok(None),
+    }
+}
+
+#[cfg(feature = "live")]
+fn live_summary(live: Option<Live>) -> Option<LiveSummary> {
+    live.map(|l| l.summary())
+}
+
+#[cfg(not(feature = "live"))]
+fn live_summary(live: Option<Live>) -> Option<LiveSummary> {
+    live.map(|never| match never {})
 }

@@ -6,8 +6,8 @@
 //! - [`channels`]: every channel of a recording, its CDR message (declared once: schema text,
 //!   encoder, decoder and per-tick columns come from one declaration) and the format version;
 //! - [`encode`]: the messages of one tick ([`TickEncoder`]), the same code for recording and
-//!   for replay so that replay compares exactly what was written; a recording's switch
-//!   schedule and its rewrite as a new complete file;
+//!   for replay so that replay compares exactly what was written;
+//! - [`edit`]: a recording's switch schedule and its rewrite as a new complete file;
 //! - [`writer`]: a writer thread that never stalls a tick ([`Recorder`]);
 //! - [`reader`]: the strict reader ([`read_recording`]): CRCs, the summary against the records,
 //!   tick order and count, and salvage of a truncated file, with byte offsets in its errors;
@@ -19,6 +19,7 @@
 //! nothing of the engine that produces them. Layout and schemas: `docs/recording-format.md`.
 
 pub mod channels;
+pub mod edit;
 pub mod encode;
 pub mod foxglove_out;
 pub mod parse;
@@ -26,6 +27,7 @@ pub mod reader;
 pub mod writer;
 
 pub use channels::messages::{Channel, DescriptionMsg};
-pub use encode::{OutMsg, TickEncoder, TickMessages, rewrite, switch_schedule};
+pub use edit::{rewrite, switch_schedule};
+pub use encode::{OutMsg, TickEncoder, TickMessages};
 pub use reader::{Integrity, Recording, RecordingError, read_recording, read_recording_file};
 pub use writer::{Recorder, RecorderSetup, WriteSummary};

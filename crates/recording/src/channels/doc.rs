@@ -1,13 +1,14 @@
 //! The channel table and the per-message field tables of `docs/recording-format.md`, generated
 //! from the declarations (a test checks the file against them and names any field that is
-//! missing or extra; `NANOHAPTICS_BLESS=1 cargo test -p haptic-loop --release channels::doc`
+//! missing or extra; `NANOHAPTICS_BLESS=1 cargo test -p nanohaptics-recording --release channels::doc`
 //! rewrites the generated part).
 
 use super::declare::{FieldInfo, MessageInfo};
 use super::messages::{Channel, MESSAGES};
 
 /// The line that opens the generated part of `docs/recording-format.md`.
-pub const BEGIN: &str = "<!-- BEGIN generated from crates/recording/src/channels/messages.rs: do not edit by hand -->";
+pub const BEGIN: &str =
+    "<!-- BEGIN generated from crates/recording/src/channels/messages.rs: do not edit by hand -->";
 /// The line that closes it.
 pub const END: &str = "<!-- END generated -->";
 
@@ -179,7 +180,7 @@ mod tests {
         }
         panic!(
             "docs/recording-format.md disagrees with the channel declarations:\n  {}\n\
-             (regenerate: NANOHAPTICS_BLESS=1 cargo test -p haptic-loop --release --lib \
+             (regenerate: NANOHAPTICS_BLESS=1 cargo test -p nanohaptics-recording --release --lib \
              channels::doc)",
             bad.join("\n  ")
         );

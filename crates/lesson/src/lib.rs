@@ -1,4 +1,4 @@
-//! The macro-vs-nano lesson of the teaching game (`nanohaptics lesson --out DIR`).
+//! # nanohaptics-lesson: the macro-vs-nano lesson of the teaching game (`nanohaptics lesson --out DIR`)
 //!
 //! It runs the house task in both worlds with the same operator (a rigid stylus playing each
 //! world's house script), then the short experiments a teacher shows next to it — lifting a
@@ -8,12 +8,18 @@
 //! `DIR/lesson.md` with PNG figures, the two house sessions as recordings (`*.mcap`, open them
 //! in Foxglove or replay them) and a JSON file of every number (`lesson.json`). Every number
 //! in the report is measured from these runs or read from the scenes' parameters.
+//!
+//! What it is not: no physics and no loop of its own. It drives the engine (`haptic-loop`)
+//! through its sessions, draws its figures with `render`'s one chart engine, and knows the
+//! worlds only through their scenes' state fields and events.
 
 pub mod measure;
 pub mod report;
 pub mod scripts;
 
-use crate::session::{OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions};
+use haptic_loop::session::{
+    OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions,
+};
 use measure::{BrickThrow, HouseOutcome, Hysteresis};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -159,11 +165,12 @@ fn run(
     o.operator = OperatorChoice::Rigid;
     o.out = out;
     o.start_time_ns = Some(0);
-    let report =
-        crate::session::run_session(&o, &mut |_, _| {}).map_err(|error| LessonError::Run {
+    let report = haptic_loop::session::run_session(&o, &mut |_, _| {}).map_err(|error| {
+        LessonError::Run {
             run: name.to_string(),
             error: Box::new(error),
-        })?;
+        }
+    })?;
     Ok(Run {
         name,
         arrays: report.arrays,
@@ -393,10 +400,10 @@ pub struct Runs {
 }
 
 /// The sound of a recording, with the proximity tone.
-fn sound_of(rec: &Path, sample_rate_hz: u32) -> Result<crate::sound::SessionSound, String> {
+fn sound_of(rec: &Path, sample_rate_hz: u32) -> Result<haptic_loop::sound::SessionSound, String> {
     let r = recording::read_recording_file(rec, false).map_err(|e| e.to_string())?;
     let a = SessionArrays::from_recording(&r).map_err(|e| e.to_string())?;
-    crate::sound::session_sound(&a, &r.description.scene_kind, true, sample_rate_hz)
+    haptic_loop::sound::session_sound(&a, &r.description.scene_kind, true, sample_rate_hz)
         .map_err(|e| e.to_string())
 }
 

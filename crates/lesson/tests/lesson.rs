@@ -1,7 +1,7 @@
 //! The lesson's report: every figure it states is checked against the physics it claims.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_loop::lesson::{LessonOptions, run_lesson};
+use lesson::{LessonOptions, run_lesson};
 
 #[test]
 fn the_lesson_measures_what_it_says() {

@@ -1,7 +1,7 @@
 //! The lesson's report: `lesson.md` and its PNG figures, every number from the runs.
 
-use super::measure::{self, events, times};
-use super::{LessonError, LessonSummary, Run, Runs, write_file};
+use crate::measure::{self, events, times};
+use crate::{LessonError, LessonSummary, Run, Runs, write_file};
 use render::chart::{Band, Bar, BarChart, Chart, Figure, Marker, Scale, Series, Style};
 use std::fmt::Write;
 use std::path::Path;
@@ -333,7 +333,7 @@ fn house_chart(
 }
 
 fn lift_markers() -> Vec<Marker> {
-    let (_, t) = super::scripts::brick_lift(&[]);
+    let (_, t) = crate::scripts::brick_lift(&[]);
     [
         (t[0], "grab", GREEN),
         (t[1], "lifted", GREY),

@@ -6,9 +6,9 @@
 use bench_harness::report::out_arg;
 use bench_harness::{Report, Summary, Table, span};
 
-use haptic_loop::lesson::{LessonOptions, LessonSummary, run_lesson};
 use haptic_loop::session::SessionArrays;
 use haptic_loop::sound::session_sound;
+use lesson::{LessonOptions, LessonSummary, run_lesson};
 use recording::read_recording_file;
 use std::fmt::Write;
 
@@ -120,7 +120,7 @@ fn main() {
 
     let _ = writeln!(
         md,
-        "`cargo run --release -p haptic-loop --example haptic-loop-teaching-report`: thread CPU \
+        "`cargo run --release -p nanohaptics-lesson --example teaching-report`: thread CPU \
          time, median of three runs on the shared 2-core machine.\n\n\
          ### The lesson (`nanohaptics lesson`)\n\n\
          17 sessions (two house tasks, three lifts, two approach–retract cycles, two throws, seven \

@@ -1,7 +1,7 @@
-//! `nanohaptics lesson`: the macro-vs-nano lesson report (see `haptic_loop::lesson`).
+//! `nanohaptics lesson`: the macro-vs-nano lesson report (see `lesson`).
 
-use haptic_loop::lesson::{LessonOptions, report::si, run_lesson};
 use indicatif::{ProgressBar, ProgressStyle};
+use lesson::{LessonOptions, report::si, run_lesson};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -6,7 +6,7 @@
 //! two-minute version, `NANOHAPTICS_SOAK_S=3600` the hour of BENCHMARKS.md:
 //!
 //! ```text
-//! NANOHAPTICS_SOAK_S=120 cargo test --release -p haptic-loop --test soak -- --nocapture
+//! NANOHAPTICS_SOAK_S=120 cargo test --release -p nanohaptics-cli --test soak -- --nocapture
 //! ```
 //!
 //! It checks that the resident memory of the simulator stays flat (the last tenth of the

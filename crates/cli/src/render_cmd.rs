@@ -1074,8 +1074,8 @@ mod tests {
     /// A brick let go from higher lands with a larger impulse, and its sound is louder.
     #[test]
     fn a_brick_dropped_from_higher_sounds_louder() {
-        use haptic_loop::lesson::scripts::{BRICK_PICK_MM, ScriptText};
         use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
+        use lesson::scripts::{BRICK_PICK_MM, ScriptText};
         let dir = std::env::temp_dir().join(format!("nh-drops-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("dir");
         let [x0, y0, z0] = BRICK_PICK_MM;

@@ -1,6 +1,6 @@
 //! The lesson's numbers, measured from the per-tick arrays of its runs.
 
-use crate::session::SessionArrays;
+use haptic_loop::session::SessionArrays;
 use serde::Serialize;
 
 /// A run's event of one name: (time s, its JSON detail).
