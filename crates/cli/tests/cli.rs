@@ -6,6 +6,19 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
+/// Real-time tests (a session paced by the wall clock, a bridged device) run alone: the other
+/// tests of this file wait, so that a loaded 2-core machine does not make them late. The
+/// others run beside each other.
+static REALTIME: std::sync::RwLock<()> = std::sync::RwLock::new(());
+
+fn alone() -> std::sync::RwLockWriteGuard<'static, ()> {
+    REALTIME.write().unwrap_or_else(|e| e.into_inner())
+}
+
+fn beside_others() -> std::sync::RwLockReadGuard<'static, ()> {
+    REALTIME.read().unwrap_or_else(|e| e.into_inner())
+}
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
@@ -57,6 +70,7 @@ fn json(o: &Output) -> serde_json::Value {
 
 #[test]
 fn run_info_and_verify() {
+    let _shared = beside_others();
     let rec = tmp("run.mcap");
     let r = rec.to_str().unwrap();
     let run = json(&nh(&[
@@ -80,6 +94,7 @@ fn run_info_and_verify() {
 
 #[test]
 fn replay_of_a_recording_of_another_scene_version_exits_2_naming_tick_and_channel() {
+    let _shared = beside_others();
     // Re-record with a different scene text stored in the description: the file is internally
     // inconsistent, exactly what --verify must catch.
     let rec = tmp("edited.mcap");
@@ -132,6 +147,7 @@ fn replay_of_a_recording_of_another_scene_version_exits_2_naming_tick_and_channe
 
 #[test]
 fn bad_input_is_an_error_naming_the_field() {
+    let _shared = beside_others();
     let scene = tmp("bad.toml");
     std::fs::write(
         &scene,
@@ -167,6 +183,7 @@ fn bad_input_is_an_error_naming_the_field() {
 
 #[test]
 fn demo_runs_every_scene_and_verifies() {
+    let _shared = beside_others();
     let out = tmp("demo");
     let j = json(&nh(&["demo", "--out", out.to_str().unwrap(), "--json"]));
     assert_eq!(j["all_verified"], true);
@@ -182,6 +199,7 @@ fn demo_runs_every_scene_and_verifies() {
 /// flushed every session second, so the file holds whole seconds, at most one second behind.
 #[test]
 fn sigkill_mid_session_loses_at_most_the_last_second() {
+    let _quiet = alone();
     let rec = tmp("crash.mcap");
     let t0 = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
@@ -222,6 +240,7 @@ fn sigkill_mid_session_loses_at_most_the_last_second() {
 /// fake device with 5% loss; the recording verifies.
 #[test]
 fn a_bridged_live_session_against_fake_device_replays_bit_for_bit() {
+    let _quiet = alone();
     let port = std::net::UdpSocket::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()
@@ -268,6 +287,7 @@ fn a_bridged_live_session_against_fake_device_replays_bit_for_bit() {
 /// for bit. Bad model and grip arguments are named.
 #[test]
 fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
+    let _quiet = alone();
     let port = std::net::UdpSocket::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()
@@ -322,6 +342,7 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
 /// copy (a file on disk) overriding the built-in.
 #[test]
 fn builtin_scenes_work_from_any_directory_and_exported_copies_override_them() {
+    let _shared = beside_others();
     let dir = tmp("elsewhere");
     std::fs::create_dir_all(&dir).unwrap();
     let run = |args: &[&str]| {
@@ -382,6 +403,7 @@ fn error_in(dir: &Path, args: &[&str]) -> String {
 
 #[test]
 fn file_errors_say_file_line_column_and_what_was_expected() {
+    let _shared = beside_others();
     let dir = tmp("located");
     std::fs::create_dir_all(&dir).unwrap();
     let w = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
@@ -487,6 +509,7 @@ fn file_errors_say_file_line_column_and_what_was_expected() {
 
 #[test]
 fn a_session_shorter_than_one_tick_is_refused() {
+    let _shared = beside_others();
     assert_eq!(
         error_in(&root(), &["run", "wall", "--seconds", "0.0004"]),
         "error: session length 4e-4 s is shorter than one tick (1 ms at 1000 Hz): allowed \
@@ -505,6 +528,7 @@ fn a_session_shorter_than_one_tick_is_refused() {
 /// recording is finished (not truncated) and verifies, and the exit code is 130.
 #[test]
 fn ctrl_c_stops_a_session_cleanly_with_a_complete_recording() {
+    let _quiet = alone();
     let rec = tmp("interrupted.mcap");
     let child = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
         .args(["run", "wall", "--seconds", "3600", "--realtime", "--out"])
@@ -541,6 +565,7 @@ fn ctrl_c_stops_a_session_cleanly_with_a_complete_recording() {
 /// quietly with status 141, as any Unix filter, never with a panic message.
 #[test]
 fn a_closed_pipe_ends_the_program_quietly() {
+    let _shared = beside_others();
     for args in [&["scenes"][..], &["info", "recordings/wall.mcap"]] {
         let (reader, writer) = std::io::pipe().unwrap();
         drop(reader);
@@ -561,6 +586,7 @@ fn a_closed_pipe_ends_the_program_quietly() {
 /// the house score in the run summary.
 #[test]
 fn lesson_audio_and_score_work_from_any_directory() {
+    let _shared = beside_others();
     let dir = tmp("elsewhere");
     std::fs::create_dir_all(&dir).unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))

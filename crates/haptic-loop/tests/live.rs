@@ -113,6 +113,58 @@ fn a_foxglove_client_receives_the_scene_while_the_session_runs() {
     assert_eq!(live.dropped, 0);
 }
 
+/// The live view serves from the start of a bridged session, before the device's hello: a
+/// viewer that connects first is served (and told the channels), not refused.
+#[test]
+fn a_viewer_connects_before_the_device_says_hello() {
+    let free = || {
+        TcpListener::bind("127.0.0.1:0")
+            .unwrap()
+            .local_addr()
+            .unwrap()
+            .port()
+    };
+    let (ws_port, udp_port) = (free(), free());
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut o =
+        SessionOptions::new(SceneSource::from_path(&root.join("scenes/wall.toml")).unwrap());
+    let mut bridge =
+        haptic_devices::BridgeConfig::parse(&format!("udp:127.0.0.1:{udp_port}")).unwrap();
+    // No device will come: the session gives up after 3 s of waiting for the hello.
+    bridge.wait_s = 3.0;
+    o.bridge = Some(bridge);
+    o.live = Some(LiveConfig::parse(&format!("ws:127.0.0.1:{ws_port}")).unwrap());
+    let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}));
+    let t0 = Instant::now();
+    let mut ws = loop {
+        let mut req = format!("ws://127.0.0.1:{ws_port}")
+            .into_client_request()
+            .unwrap();
+        req.headers_mut()
+            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+        match connect(req) {
+            Ok((ws, _)) => break ws,
+            Err(_) if t0.elapsed() < Duration::from_secs(2) => {
+                std::thread::sleep(Duration::from_millis(20))
+            }
+            Err(e) => panic!("the live view refused a viewer before the hello: {e}"),
+        }
+    };
+    // The server greets the viewer (serverInfo) while the session still waits for the device.
+    let first = ws.read().unwrap();
+    let Message::Text(t) = first else {
+        panic!("expected the serverInfo text message")
+    };
+    let j: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
+    assert_eq!(j["op"], "serverInfo");
+    assert!(
+        !session.is_finished(),
+        "the session ended before the viewer was served"
+    );
+    let err = session.join().unwrap().unwrap_err().to_string();
+    assert!(err.contains("hello"), "{err}");
+}
+
 /// The shipped Foxglove layout names only topics and fields the live view publishes.
 #[test]
 fn the_shipped_foxglove_layout_uses_only_published_topics_and_fields() {

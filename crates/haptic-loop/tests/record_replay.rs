@@ -245,6 +245,32 @@ fn golden_recordings_replay_bit_exactly() {
     assert!(n >= 1, "no golden recordings in {}", dir.display());
 }
 
+/// A recording's timeline is its session's: every message, the description included, lies
+/// between the session's start and its last tick, so the file's statistics (what Foxglove's
+/// timeline shows) span the session and not the decades since 1970.
+#[test]
+fn the_timeline_of_a_recording_is_its_session() {
+    let out = tmp("timeline.mcap");
+    let mut o = wall_opts(Some(out.clone()));
+    let t0 = 1_795_577_000_000_000_000;
+    o.start_time_ns = Some(t0);
+    o.seconds = Some(0.25);
+    run_session(&o, &mut |_, _| {}).unwrap();
+    let buf = std::fs::read(&out).unwrap();
+    let stats = mcap::Summary::read(&buf).unwrap().unwrap().stats.unwrap();
+    // 250 ticks at 1 kHz: the last is tick 249, 249 ms after the start.
+    assert_eq!(stats.message_start_time, t0);
+    assert_eq!(stats.message_end_time, t0 + 249_000_000);
+    let rec = read_recording(&buf, false).unwrap();
+    let desc = rec
+        .messages
+        .iter()
+        .find(|m| m.channel == Channel::Description)
+        .unwrap();
+    assert_eq!(desc.log_time_ns, t0);
+    assert!(verify(&rec).unwrap().ok());
+}
+
 /// The schemas written today (from the channel declarations) are, byte for byte, the schemas
 /// stored in every golden recording, channel by channel, with the same ids and encodings.
 #[test]
@@ -260,6 +286,14 @@ fn golden_recordings_hold_the_schemas_the_declarations_write() {
         let rec = read_recording(&buf, false).unwrap();
         let summary = mcap::Summary::read(&buf).unwrap().unwrap();
         assert_eq!(summary.channels.len(), Channel::COUNT, "{}", p.display());
+        // The golden's timeline is its session's (the description at the start time).
+        let stats = summary.stats.as_ref().unwrap();
+        assert_eq!(
+            stats.message_start_time,
+            rec.description.start_time_ns,
+            "{}",
+            p.display()
+        );
         for (k, ch) in Channel::ALL.into_iter().enumerate() {
             let c = summary
                 .channels

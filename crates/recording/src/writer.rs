@@ -251,7 +251,9 @@ fn write_all(
         channel: Channel::Description,
         data: setup.description.encode(),
     };
-    sum.messages += write_msgs(&mut w, &ids, &mut seq, 0, &[desc], path, on_disk)?;
+    // The description is logged at the session's start, so the file's timeline is the session's.
+    let at = setup.description.start_time_ns;
+    sum.messages += write_msgs(&mut w, &ids, &mut seq, at, &[desc], path, on_disk)?;
     w.flush().map_err(|e| write_err(path, &e, on_disk))?;
     let mut next_flush = setup
         .description

@@ -202,6 +202,41 @@ fn build(file: SceneFile, specs: DeviceSpecs) -> Result<LoadedScene, SceneError>
     })
 }
 
+impl LoadedScene {
+    /// The recording's description of a session of this scene (built from `scene_toml`) in
+    /// `mode`, with the device connected by `link`, started at `start_time_ns` (ns since the
+    /// Unix epoch); no script (set `script_name`, `script_toml` and `operator` for a scripted
+    /// session).
+    pub fn description(
+        &self,
+        scene_toml: &str,
+        mode: &str,
+        link: &str,
+        start_time_ns: u64,
+    ) -> recording::DescriptionMsg {
+        let specs = &self.config.specs;
+        recording::DescriptionMsg {
+            format: recording::channels::FORMAT_VERSION.to_string(),
+            scene_name: self.file.scene.name.clone(),
+            scene_kind: self.scene.kind().to_string(),
+            scene_toml: scene_toml.to_string(),
+            device_model: specs.name.to_string(),
+            rate_hz: self.config.rate_hz,
+            mode: mode.to_string(),
+            script_name: String::new(),
+            script_toml: String::new(),
+            operator: link.to_string(),
+            state_fields: self.scene.state_fields(),
+            start_time_ns,
+            device_link: link.to_string(),
+            device_max_force_n: specs.limits.max_force_n,
+            device_max_stiffness_n_per_m: specs.limits.max_stiffness_n_per_m,
+            device_workspace_radius_m: specs.workspace_radius_m,
+            device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,40 +326,5 @@ stiffness_n_per_m = 2000.0
             err(&WALL.replace("[0.0, 0.0, 1.0]", "[0.0, 0.0, 0.0]")),
             "scene: `wall.normal` = [0, 0, 0] is out of range (allowed: a non-zero finite vector)"
         );
-    }
-}
-
-impl LoadedScene {
-    /// The recording's description of a session of this scene (built from `scene_toml`) in
-    /// `mode`, with the device connected by `link`, started at `start_time_ns` (ns since the
-    /// Unix epoch); no script (set `script_name`, `script_toml` and `operator` for a scripted
-    /// session).
-    pub fn description(
-        &self,
-        scene_toml: &str,
-        mode: &str,
-        link: &str,
-        start_time_ns: u64,
-    ) -> recording::DescriptionMsg {
-        let specs = &self.config.specs;
-        recording::DescriptionMsg {
-            format: recording::channels::FORMAT_VERSION.to_string(),
-            scene_name: self.file.scene.name.clone(),
-            scene_kind: self.scene.kind().to_string(),
-            scene_toml: scene_toml.to_string(),
-            device_model: specs.name.to_string(),
-            rate_hz: self.config.rate_hz,
-            mode: mode.to_string(),
-            script_name: String::new(),
-            script_toml: String::new(),
-            operator: link.to_string(),
-            state_fields: self.scene.state_fields(),
-            start_time_ns,
-            device_link: link.to_string(),
-            device_max_force_n: specs.limits.max_force_n,
-            device_max_stiffness_n_per_m: specs.limits.max_stiffness_n_per_m,
-            device_workspace_radius_m: specs.workspace_radius_m,
-            device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
-        }
     }
 }
