@@ -1,19 +1,12 @@
 //! `nanohaptics render`: PNG frames and an animated GIF of a recording (recomputed from its
 //! logged inputs, as `replay` does), or one picture of a scene's initial state; drawn by the
-//! `render` crate. Also the one-picture-per-recording step of `demo`.
+//! engine's media module. Also the one-picture-per-recording step of `demo`.
 
-use std::path::{Path, PathBuf};
-
-use haptic_devices::{DeviceError, HapticDevice, TickTime};
-use haptic_loop::replay_device::ReplayDevice;
-use haptic_loop::runner::{Pacing, Runner};
-use haptic_loop::scene::optical::RecordedPicture;
-use haptic_loop::scene::{SceneError, load_scene, load_scene_for};
-use haptic_loop::session::SessionError;
-use haptic_loop::sink::{Sink, SinkError, TickView};
-use haptic_loop::{HapticLoop, LoopConfig, Scene};
+use haptic_loop::media::{self, FramesOptions, MediaError};
+use haptic_loop::session::SceneSource;
 use recording::{RecordingError, read_recording_file};
-use render::{Camera, Frame, GifWriter, Image, Palette, Primitive, RenderError, Rgba, Style, View};
+use render::View;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `nanohaptics render`.
 #[derive(clap::Args, Debug)]
@@ -79,29 +72,12 @@ pub enum RenderCmdError {
         /// What the input can become.
         allowed: &'static str,
     },
-    /// Reading or writing a file.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong.
-        source: std::io::Error,
-    },
     /// The recording.
     #[error(transparent)]
     Recording(#[from] RecordingError),
-    /// The scene.
+    /// Drawing: the scene, the replay, the pictures.
     #[error(transparent)]
-    Scene(#[from] SceneError),
-    /// The device.
-    #[error(transparent)]
-    Device(#[from] DeviceError),
-    /// Drawing.
-    #[error(transparent)]
-    Render(#[from] RenderError),
-    /// Replaying the recording.
-    #[error("replay: {0}")]
-    Session(String),
+    Media(MediaError),
     /// The scene file, with where in it.
     #[error(transparent)]
     Input(#[from] haptic_loop::session::SessionError),
@@ -113,102 +89,29 @@ pub enum RenderCmdError {
     NoOutput,
 }
 
-/// Text and scale bar colour, light on the dark background the scenes' colours are chosen for
-/// (they are shared with the Foxglove channels).
-const INK: Rgba = Rgba([0.9, 0.9, 0.9, 1.0]);
-
-fn style() -> Style {
-    Style {
-        background: Rgba([0.12, 0.13, 0.15, 1.0]),
-        ..Style::default()
-    }
-}
-
-/// A camera that frames the action: the scene's bodies (not its backdrops — the ground, a wall
-/// plate, a substrate: `render::is_backdrop`) and every `extra` point (the cursor's world
-/// positions over a recording, so the cursor never leaves the image); the whole picture when
-/// only backdrops are drawn. Top view for a flat world unless `view` says otherwise.
-fn camera_for(
-    prims: &[Primitive],
-    extra: &[[f64; 3]],
-    view: Option<View>,
-    width: u32,
-) -> Result<Camera, RenderError> {
-    let (mut lo, mut hi) = render::action_bounds(prims)
-        .or_else(|| (!extra.is_empty()).then(|| (extra[0], extra[0])))
-        .or_else(|| render::bounds(prims))
-        .unwrap_or(([0.0; 3], [0.0; 3]));
-    for p in extra {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
+impl From<MediaError> for RenderCmdError {
+    /// A media option out of range is the flag's error (`--width`, `--every`).
+    fn from(e: MediaError) -> Self {
+        match e {
+            MediaError::Range {
+                option,
+                value,
+                allowed,
+            } => RenderCmdError::Arg {
+                flag: option,
+                value,
+                allowed,
+            },
+            e => RenderCmdError::Media(e),
         }
     }
-    // room around the cursor path for what the cursor carries (a particle, a brick)
-    if !extra.is_empty() {
-        let pad = 0.08 * (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
-        for i in 0..3 {
-            lo[i] -= pad;
-            hi[i] += pad;
-        }
-    }
-    let flat = (hi[2] - lo[2]) < 0.05 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    let view = view.unwrap_or(if flat {
-        View::Top
-    } else {
-        View::oblique_default()
-    });
-    Camera::fit(view, lo, hi, width, width * 3 / 4, 0.04)
 }
 
-/// World positions of the cursor over a recording, read from its device inputs (no physics).
-fn cursor_path(
-    rec: &recording::Recording,
-    config: &LoopConfig,
-) -> Result<Vec<[f64; 3]>, RenderCmdError> {
-    let mut dev = ReplayDevice::from_recording(rec, config.specs.clone(), config.period_ns())?;
-    let mut out = Vec::with_capacity(dev.ticks() as usize);
-    for n in 0..dev.ticks() {
-        let s = dev.sample(TickTime::new(n, config.rate_hz))?;
-        out.push(config.mapping.to_world(s.position_m));
-    }
-    Ok(out)
-}
-
-fn draw(
-    frame: &mut Frame,
-    scene: &dyn Scene,
-    prims: &mut Vec<Primitive>,
-    title: &str,
-) -> Result<(), RenderError> {
-    prims.clear();
-    scene.draw(prims);
-    draw_prims(frame, prims, title)
-}
-
-/// Draws `prims`, the scale bar and `title` into a cleared `frame`.
-fn draw_prims(frame: &mut Frame, prims: &[Primitive], title: &str) -> Result<(), RenderError> {
-    frame.clear();
-    for p in prims {
-        frame.push(p.clone())?;
-    }
-    frame.scale_bar(None, INK)?;
-    frame.title(title, INK)
-}
-
-fn parse_view(v: &Option<String>) -> Result<Option<View>, RenderError> {
-    v.as_deref().map(str::parse).transpose()
-}
-
-fn check_width(width: u32) -> Result<(), RenderCmdError> {
-    if !(64..=4096).contains(&width) {
-        return Err(RenderCmdError::Arg {
-            flag: "width",
-            value: width.to_string(),
-            allowed: "64–4096 px".into(),
-        });
-    }
-    Ok(())
+fn parse_view(v: &Option<String>) -> Result<Option<View>, RenderCmdError> {
+    v.as_deref()
+        .map(str::parse)
+        .transpose()
+        .map_err(|e: render::RenderError| RenderCmdError::Media(e.into()))
 }
 
 /// What `render` wrote.
@@ -271,7 +174,7 @@ pub fn output_for(recording: bool, out: &Path) -> Result<Output, RenderCmdError>
 
 /// Runs `nanohaptics render`.
 pub fn run(args: &RenderArgs) -> Result<RenderSummary, RenderCmdError> {
-    check_width(args.width)?;
+    media::check_width(args.width)?;
     if args.proximity && args.audio.is_none() {
         return Err(RenderCmdError::Arg {
             flag: "proximity",
@@ -320,7 +223,8 @@ fn write_audio(args: &RenderArgs, wav: &Path) -> Result<String, RenderCmdError> 
         args.proximity,
         args.sample_rate,
     )?;
-    render::audio::write_wav(wav, &s.samples, s.sample_rate_hz)?;
+    render::audio::write_wav(wav, &s.samples, s.sample_rate_hz)
+        .map_err(|e| RenderCmdError::Media(e.into()))?;
     let secs = s.samples.len() as f64 / f64::from(s.sample_rate_hz);
     Ok(format!(
         "{} ({secs:.3} s, {} sounds{})",
@@ -387,321 +291,42 @@ fn written_file(what: &str, path: &Path) -> String {
 }
 
 /// Draws a scene file's initial state into a PNG.
-pub fn scene_picture(
+fn scene_picture(
     scene_path: &Path,
     out: &Path,
     view: Option<View>,
     width: u32,
 ) -> Result<(), RenderCmdError> {
-    let source = haptic_loop::session::SceneSource::from_path(scene_path)?;
-    let loaded = load_scene(&source.text, None).map_err(|e| source.locate(e))?;
-    let mut prims = Vec::new();
-    loaded.scene.draw(&mut prims);
-    let rp: Vec<Primitive> = prims.clone();
-    let cam = camera_for(&rp, &[], view, width)?;
-    let mut frame = Frame::new(cam, style())?;
-    draw(
-        &mut frame,
-        loaded.scene.as_ref(),
-        &mut prims,
-        &format!("{} (initial state)", loaded.scene.kind()),
-    )?;
-    frame.finish()?.save_png(out)?;
-    Ok(())
+    let source = SceneSource::from_path(scene_path)?;
+    Ok(media::scene_picture(&source, out, view, width)?)
 }
 
-/// The frame renderer as a sink of the runner: draws every `every`-th tick into
-/// `out/frame_NNNNN.png` and, when asked, an animated GIF.
-struct FramesSink<'a> {
-    args: &'a RenderArgs,
-    frames_dir: Option<PathBuf>,
-    gif_path: Option<PathBuf>,
-    view: Option<View>,
-    every: u64,
-    rate: u64,
-    kind: &'static str,
-    path: Vec<[f64; 3]>,
-    prims: Vec<Primitive>,
-    frame: Option<Frame>,
-    img: Option<Image>,
-    gif: Option<GifWriter<std::io::BufWriter<std::fs::File>>>,
-    frames: u64,
-}
-
-impl FramesSink<'_> {
-    fn draw_tick(&mut self, n: u64, scene: &dyn Scene) -> Result<(), RenderCmdError> {
-        self.draw_tick_with(n, |prims| {
-            scene.draw(prims);
-            Ok(())
-        })
-    }
-
-    /// Draws tick `n` from the primitives `fill` appends.
-    fn draw_tick_with(
-        &mut self,
-        n: u64,
-        fill: impl FnOnce(&mut Vec<Primitive>) -> Result<(), RenderCmdError>,
-    ) -> Result<(), RenderCmdError> {
-        let title = format!("{}  t = {:.3} s", self.kind, n as f64 / self.rate as f64);
-        self.prims.clear();
-        fill(&mut self.prims)?;
-        if self.frame.is_none() {
-            let cam = camera_for(&self.prims, &self.path, self.view, self.args.width)?;
-            self.frame = Some(Frame::new(cam, style())?);
-            self.img = Some(Image::new(cam.width_px(), cam.height_px())?);
-        }
-        let (Some(f), Some(im)) = (self.frame.as_mut(), self.img.as_mut()) else {
-            return Ok(());
-        };
-        draw_prims(f, &self.prims, &title)?;
-        f.draw_into(im)?;
-        if let Some(dir) = &self.frames_dir {
-            im.save_png(dir.join(format!("frame_{:05}.png", self.frames)))?;
-        }
-        if let Some(path) = &self.gif_path {
-            if self.gif.is_none() {
-                let file = std::fs::File::create(path).map_err(|source| RenderCmdError::Io {
-                    path: path.clone(),
-                    source,
-                })?;
-                // palette from the first frame; the writer switches when new colours appear
-                let pal = Palette::from_images(&[im], 255)?;
-                let fps = self.rate as f64 / self.every as f64;
-                self.gif = Some(GifWriter::new(
-                    std::io::BufWriter::new(file),
-                    im.width(),
-                    im.height(),
-                    fps,
-                    pal,
-                )?);
-            }
-            if let Some(g) = self.gif.as_mut() {
-                g.add_frame(im)?;
-            }
-        }
-        self.frames += 1;
-        Ok(())
-    }
-}
-
-impl Sink for FramesSink<'_> {
-    fn name(&self) -> &'static str {
-        "frames"
-    }
-
-    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
-        let n = t.result.tick;
-        if n % self.every != 0 {
-            return Ok(());
-        }
-        self.draw_tick(n, t.lp.scene())
-            .map_err(|e| SinkError::new(SessionError::Option(e.to_string())))
-    }
-}
-
-/// Replays a recording through the runner with `sinks` and returns the loop at its end.
-fn replay_into(
-    rec: &recording::Recording,
-    sinks: Vec<&mut dyn Sink>,
-) -> Result<(HapticLoop, u64), RenderCmdError> {
-    let d = &rec.description;
-    let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
-    let config = loaded.config.clone();
-    let mut dev = ReplayDevice::from_recording(rec, config.specs.clone(), config.period_ns())?;
-    let ticks = dev.ticks();
-    let flags = dev.deadline_flags();
-    let switches = recording::switch_schedule(rec, config.period_ns())?;
-    let mut lp = HapticLoop::new(config, loaded.scene);
-    Runner::new(sinks)
-        .with_switches(switches)
-        .run(
-            &mut lp,
-            &mut dev,
-            d,
-            Some(ticks),
-            Pacing::Recorded(flags),
-            &mut |_, _| {},
-        )
-        .map_err(|e| RenderCmdError::Session(e.to_string()))?;
-    Ok((lp, ticks))
-}
-
-/// Recomputes a recording from its inputs and draws every `every`-th tick into
-/// `frames_dir/frame_NNNNN.png` and/or the GIF `gif_path`.
-///
-/// An optical-tweezers recording is drawn from its recorded state instead (no physics) when
-/// `every` is a multiple of the display cadence (the default is) and `resimulate` is false.
+/// Recomputes (or, for the optical tweezers, draws from the recorded state) the frames of the
+/// recording `args.input`.
 fn recording_frames(
     args: &RenderArgs,
     view: Option<View>,
     frames_dir: Option<PathBuf>,
-    gif_path: Option<PathBuf>,
+    gif: Option<PathBuf>,
     resimulate: bool,
 ) -> Result<RenderSummary, RenderCmdError> {
     let rec = read_recording_file(&args.input, false)?;
-    let d = &rec.description;
-    let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
-    let config = loaded.config.clone();
-    let rate = u64::from(config.rate_hz);
-    let display_every = u64::from(config.display_every).max(1);
-    let picture = recorded_picture(&loaded, d);
-    let every = args.every.unwrap_or(match picture {
-        // the display tick nearest 30 frames per second of session
-        Some(_) => {
-            display_every * ((rate / 30) as f64 / display_every as f64).round().max(1.0) as u64
-        }
-        None => (rate / 30).max(1),
-    });
-    let min_every = rate.div_ceil(50).max(1);
-    if every == 0 || (gif_path.is_some() && every < min_every) {
-        return Err(RenderCmdError::Arg {
-            flag: "every",
-            value: every.to_string(),
-            allowed: if gif_path.is_some() {
-                format!("{min_every} or more ticks (a GIF plays at most 50 frames/s)")
-            } else {
-                "1 or more ticks".into()
-            },
-        });
-    }
-    if let Some(dir) = &frames_dir {
-        std::fs::create_dir_all(dir).map_err(|source| RenderCmdError::Io {
-            path: dir.clone(),
-            source,
-        })?;
-    }
-    let mut sink = FramesSink {
-        args,
-        frames_dir: frames_dir.clone(),
-        gif_path: gif_path.clone(),
+    let opts = FramesOptions {
+        every: args.every,
         view,
-        every,
-        rate,
-        kind: loaded.scene.kind(),
-        path: cursor_path(&rec, &config)?,
-        prims: Vec::new(),
-        frame: None,
-        img: None,
-        gif: None,
-        frames: 0,
+        width: args.width,
+        frames_dir,
+        gif,
+        resimulate,
     };
-    let from_recorded_state = picture.is_some() && every % display_every == 0 && !resimulate;
-    let ticks = match picture {
-        Some(pic) if from_recorded_state => {
-            draw_recorded(&rec, &pic, every, config.display_scale, &mut sink)?
-        }
-        _ => replay_into(&rec, vec![&mut sink])?.1,
-    };
-    let frames = sink.frames;
-    let mut gif_bytes = 0;
-    let mut written = Vec::new();
-    if let Some(dir) = &frames_dir {
-        written.push(format!("{frames} PNG frames in {}", dir.display()));
-    }
-    if let (Some(g), Some(path)) = (sink.gif.take(), &gif_path) {
-        let mut w = g.finish()?;
-        std::io::Write::flush(&mut w).map_err(|source| RenderCmdError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        drop(w);
-        gif_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-        written.push(format!(
-            "GIF animation {} ({frames} frames, {gif_bytes} bytes)",
-            path.display()
-        ));
-    }
+    let s = media::recording_frames(&rec, &opts)?;
     Ok(RenderSummary {
-        frames,
-        ticks,
-        from_recorded_state,
-        gif_bytes,
-        written,
+        frames: s.frames,
+        ticks: s.ticks,
+        from_recorded_state: s.from_recorded_state,
+        gif_bytes: s.gif_bytes,
+        written: s.written,
     })
-}
-
-/// The recorded-state drawer of an optical-tweezers recording whose state fields this build
-/// reads; `None` for other scenes (they are recomputed).
-fn recorded_picture(
-    loaded: &haptic_loop::scene::file::LoadedScene,
-    d: &recording::channels::messages::DescriptionMsg,
-) -> Option<RecordedPicture> {
-    if d.scene_kind != "optical_tweezers" {
-        return None;
-    }
-    let pic = RecordedPicture::new(&loaded.file.world().ok()??);
-    pic.reads(&d.state_fields).then_some(pic)
-}
-
-/// Draws every `every`-th tick of an optical-tweezers recording from its recorded state (no
-/// physics): `/world/state`, the scene force of `/haptic/force` and the envelope polyline of
-/// `/foxglove/scene` (written at display rate; `every` is a multiple of the display cadence).
-/// Returns the number of ticks in the recording.
-fn draw_recorded(
-    rec: &recording::Recording,
-    pic: &RecordedPicture,
-    every: u64,
-    display_scale: f64,
-    sink: &mut FramesSink<'_>,
-) -> Result<u64, RenderCmdError> {
-    use foxglove::Decode;
-    use recording::Channel;
-    use recording::channels::messages::{ForceMsg, StateMsg};
-    let bad = |m: &recording::reader::RecordedMessage, detail: String| {
-        RenderCmdError::Recording(RecordingError::BadMessage {
-            topic: m.channel.topic().to_string(),
-            log_time_ns: m.log_time_ns,
-            detail,
-        })
-    };
-    let n_fields = rec.description.state_fields.len();
-    let mut state: Option<StateMsg> = None;
-    let mut force: Option<ForceMsg> = None;
-    let mut ticks = 0;
-    for m in &rec.messages {
-        match m.channel {
-            Channel::State => {
-                let s = StateMsg::decode(&m.data, n_fields).map_err(|e| bad(m, e.to_string()))?;
-                ticks = s.tick + 1;
-                state = Some(s);
-                force = None;
-            }
-            Channel::Force => {
-                force = Some(ForceMsg::decode(&m.data).map_err(|e| bad(m, e.to_string()))?);
-            }
-            Channel::FoxgloveScene => {
-                let (Some(s), Some(f)) = (&state, &force) else {
-                    continue;
-                };
-                if s.tick % every != 0 {
-                    continue;
-                }
-                let u = foxglove::schemas::SceneUpdate::decode(m.data.as_slice())
-                    .map_err(|e| bad(m, e.to_string()))?;
-                // the scene draws one polyline: the envelope around the particle
-                let envelope: Vec<[f64; 3]> = u
-                    .entities
-                    .iter()
-                    .filter(|e| e.id == "polyline_0")
-                    .flat_map(|e| e.lines.iter())
-                    .flat_map(|l| l.points.iter())
-                    .map(|q| {
-                        [
-                            q.x / display_scale,
-                            q.y / display_scale,
-                            q.z / display_scale,
-                        ]
-                    })
-                    .collect();
-                sink.draw_tick_with(s.tick, |prims| {
-                    pic.draw(&s.values, s.cursor_m, f.world_force_n, envelope, prims)
-                        .map_err(RenderCmdError::Session)
-                })?;
-            }
-            _ => {}
-        }
-    }
-    Ok(ticks)
 }
 
 /// Recomputes a recording and draws its last tick into a PNG (the `demo` picture of a scene).
@@ -716,90 +341,13 @@ fn final_picture_view(
     view: Option<View>,
     width: u32,
 ) -> Result<u64, RenderCmdError> {
-    let f = final_frame(rec_path, view, width)?;
-    f.frame.finish()?.save_png(out)?;
-    Ok(f.ticks)
-}
-
-/// The last picture of a recording, ready to draw.
-pub struct FinalPicture {
-    /// The picture.
-    pub frame: Frame,
-    /// Ticks recomputed.
-    pub ticks: u64,
-    /// The box the camera frames (m): the end state's bodies, not its backdrops (the framing
-    /// test checks it).
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub action_m: ([f64; 3], [f64; 3]),
-}
-
-/// Share of the picture's shorter side left around the end state's bodies (for their labels).
-const FINAL_MARGIN: f64 = 0.25;
-
-/// The last picture of a recording: the recomputed end state framed on its bodies (not the
-/// backdrops: `render::action_bounds`; the whole scene when the cursor is its only body), with
-/// the cursor's path as a faint trail; with the ticks recomputed.
-pub fn final_frame(
-    rec_path: &Path,
-    view: Option<View>,
-    width: u32,
-) -> Result<FinalPicture, RenderCmdError> {
-    check_width(width)?;
     let rec = read_recording_file(rec_path, false)?;
-    let d = &rec.description;
-    let loaded = load_scene_for(&d.scene_toml, d.device_specs())?;
-    let config = loaded.config.clone();
-    let kind = loaded.scene.kind();
-    let (lp, ticks) = replay_into(&rec, Vec::new())?;
-    let path = cursor_path(&rec, &config)?;
-    let mut prims = Vec::new();
-    lp.scene().draw(&mut prims);
-    // Framed on the end state's bodies (the cursor among them), with room for their labels;
-    // a scene whose only body is the cursor (the wall) shows its backdrop whole.
-    let bodies = prims
-        .iter()
-        .filter(|p| {
-            !render::is_backdrop(p) && matches!(p, Primitive::Sphere { .. } | Primitive::Box { .. })
-        })
-        .count();
-    let (lo, hi) = (if bodies >= 2 {
-        render::action_bounds(&prims)
-    } else {
-        None
-    })
-    .or_else(|| render::bounds(&prims))
-    .unwrap_or(([0.0; 3], [0.0; 3]));
-    let flat = (hi[2] - lo[2]) < 0.05 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    let view = view.unwrap_or(if flat {
-        View::Top
-    } else {
-        View::oblique_default()
-    });
-    let cam = Camera::fit(view, lo, hi, width, width * 3 / 4, FINAL_MARGIN)?;
-    let mut frame = Frame::new(cam, style())?;
-    // The trail: one point per 10 ms is finer than a pixel at any speed a hand moves.
-    if path.len() > 1 {
-        let step = (path.len() / 2000).max(1);
-        prims.insert(
-            0,
-            Primitive::Polyline {
-                points_m: path.iter().step_by(step).copied().collect(),
-                closed: false,
-                color: Rgba([0.55, 0.75, 1.0, 0.35]),
-            },
-        );
-    }
-    let t = ticks as f64 / f64::from(config.rate_hz);
-    draw_prims(
-        &mut frame,
-        &prims,
-        &format!("{kind}  t = {t:.3} s (end of recording)"),
-    )?;
-    Ok(FinalPicture {
-        frame,
-        ticks,
-        action_m: (lo, hi),
-    })
+    let f = media::final_frame(&rec, view, width)?;
+    f.frame
+        .finish()
+        .and_then(|img| img.save_png(out))
+        .map_err(|e| RenderCmdError::Media(e.into()))?;
+    Ok(f.ticks)
 }
 
 /// `nanohaptics render` as the program runs it: prints what was written.
@@ -846,7 +394,8 @@ mod tests {
             o.out = Some(rec.clone());
             o.arrays = false;
             run_session(&o, &mut |_, _| {}).expect("demo session");
-            let pic = final_frame(&rec, None, 800).expect("end picture");
+            let rec = read_recording_file(&rec, false).expect("recording");
+            let pic = media::final_frame(&rec, None, 800).expect("end picture");
             let frame = &pic.frame;
             let (w, h) = (800.0_f64, 600.0_f64);
             let bodies = frame.body_rects();

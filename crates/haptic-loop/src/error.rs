@@ -93,6 +93,14 @@ pub enum SessionError {
     /// A scene reported a state field name that cannot be a message field.
     #[error("scene state field `{0}` is not a lower-snake-case field name")]
     StateField(String),
+    /// A recording's state fields are not the ones its scene has now (another version of it).
+    #[error("recorded state fields {}, the scene now has {}", recorded.join(", "), now.join(", "))]
+    StateFieldsChanged {
+        /// The recording's state fields.
+        recorded: Vec<String>,
+        /// The rebuilt scene's.
+        now: Vec<String>,
+    },
     /// The live view could not start or publish.
     #[error("live view: {0}")]
     Live(String),

@@ -36,6 +36,7 @@ pub mod encode;
 pub mod error;
 pub mod haptic;
 pub mod live;
+pub mod media;
 pub mod record_sink;
 pub mod replay;
 pub mod replay_device;

@@ -172,40 +172,116 @@ impl Sink for VerifySink<'_> {
     }
 }
 
+/// A recording made ready to run again: its scene rebuilt from the description for the
+/// recorded device, its inputs (positions, buttons, sample ages, deadline flags) as a
+/// [`ReplayDevice`], its switches as the runner's schedule. The one re-simulation path of
+/// `replay`, `render` and `demo`.
+pub struct Resimulation<'r> {
+    rec: &'r Recording,
+    file: crate::scene::SceneFile,
+    lp: HapticLoop,
+    dev: ReplayDevice,
+    switches: Vec<(u64, haptic_types::Switch)>,
+}
+
+impl<'r> Resimulation<'r> {
+    /// Rebuilds `rec`'s session. Errors: the scene no longer loads, its rate is not the
+    /// recorded one, its state fields changed ([`SessionError::StateFieldsChanged`]), or the
+    /// recorded inputs or switches are malformed.
+    pub fn prepare(rec: &'r Recording) -> Result<Self, SessionError> {
+        let d = &rec.description;
+        let specs = d.device_specs();
+        let loaded = load_scene_for(&d.scene_toml, specs.clone())?;
+        let period = loaded.config.period_ns();
+        if loaded.config.rate_hz != d.rate_hz {
+            return Err(SessionError::Recording(RecordingError::BadMessage {
+                topic: Channel::Description.topic().into(),
+                log_time_ns: 0,
+                detail: format!(
+                    "rate_hz {} does not match the scene's {}",
+                    d.rate_hz, loaded.config.rate_hz
+                ),
+            }));
+        }
+        let now = loaded.scene.state_fields();
+        if now != d.state_fields {
+            return Err(SessionError::StateFieldsChanged {
+                recorded: d.state_fields.clone(),
+                now,
+            });
+        }
+        let dev = ReplayDevice::from_recording(rec, specs, period)?;
+        let switches = recording::switch_schedule(rec, period)?;
+        Ok(Resimulation {
+            rec,
+            file: loaded.file,
+            lp: HapticLoop::new(loaded.config, loaded.scene),
+            dev,
+            switches,
+        })
+    }
+
+    /// The scene file recorded in the description, parsed.
+    pub fn scene_file(&self) -> &crate::scene::SceneFile {
+        &self.file
+    }
+
+    /// Ticks the recording holds.
+    pub fn ticks(&self) -> u64 {
+        self.dev.ticks()
+    }
+
+    /// The rebuilt loop (its configuration and scene before the run).
+    pub fn haptic_loop(&self) -> &HapticLoop {
+        &self.lp
+    }
+
+    /// World positions of the cursor at every tick, read from the recorded inputs (no physics).
+    pub fn cursor_path(&self) -> Vec<haptic_types::Vec3> {
+        let c = self.lp.config();
+        self.dev
+            .positions_m()
+            .map(|p| c.mapping.to_world(p))
+            .collect()
+    }
+
+    /// Runs every recorded tick through the runner into `sinks` (recorded pacing: the
+    /// recorded deadline flags) and returns the loop at the end of the recording.
+    pub fn run(mut self, sinks: Vec<&mut dyn Sink>) -> Result<HapticLoop, SessionError> {
+        let ticks = self.dev.ticks();
+        let flags = self.dev.deadline_flags();
+        Runner::new(sinks).with_switches(self.switches).run(
+            &mut self.lp,
+            &mut self.dev,
+            &self.rec.description,
+            Some(ticks),
+            Pacing::Recorded(flags),
+            &mut |_, _| {},
+        )?;
+        Ok(self.lp)
+    }
+}
+
 /// Replays `rec` from its inputs and compares every verified output bit for bit.
 pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
+    let sim = match Resimulation::prepare(rec) {
+        Ok(sim) => sim,
+        Err(e @ SessionError::StateFieldsChanged { .. }) => {
+            return Ok(VerifyReport {
+                ticks: 0,
+                messages_compared: 0,
+                divergence: Some(Divergence {
+                    tick: 0,
+                    channel: Channel::State.topic().into(),
+                    detail: e.to_string(),
+                }),
+            });
+        }
+        Err(e) => return Err(e),
+    };
     let d = &rec.description;
-    let specs = d.device_specs();
-    let loaded = load_scene_for(&d.scene_toml, specs.clone())?;
-    let period = loaded.config.period_ns();
-    if loaded.config.rate_hz != d.rate_hz {
-        return Err(SessionError::Recording(RecordingError::BadMessage {
-            topic: Channel::Description.topic().into(),
-            log_time_ns: 0,
-            detail: format!(
-                "rate_hz {} does not match the scene's {}",
-                d.rate_hz, loaded.config.rate_hz
-            ),
-        }));
-    }
-    let n_fields = d.state_fields.len();
-    if loaded.scene.state_fields() != d.state_fields {
-        return Ok(VerifyReport {
-            ticks: 0,
-            messages_compared: 0,
-            divergence: Some(Divergence {
-                tick: 0,
-                channel: Channel::State.topic().into(),
-                detail: format!(
-                    "recorded state fields {}, the scene now has {}",
-                    d.state_fields.join(", "),
-                    loaded.scene.state_fields().join(", ")
-                ),
-            }),
-        });
-    }
-    let mut dev = ReplayDevice::from_recording(rec, specs, period)?;
-    let ticks = dev.ticks();
+    let period = sim.haptic_loop().config().period_ns();
+    let ticks = sim.ticks();
     // Expected outputs, grouped by tick, in file order.
     let mut expected: Vec<Vec<(Channel, &[u8])>> = vec![Vec::new(); ticks as usize];
     for m in rec.messages.iter().filter(|m| m.channel.verified()) {
@@ -220,25 +296,15 @@ pub fn verify(rec: &Recording) -> Result<VerifyReport, SessionError> {
         }
         expected[t as usize].push((m.channel, m.data.as_slice()));
     }
-    let flags = dev.deadline_flags();
-    let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let mut sink = VerifySink {
         expected,
-        n_fields,
+        n_fields: d.state_fields.len(),
         enc: None,
         msgs: Vec::with_capacity(8),
         compared: 0,
         divergence: None,
     };
-    let switches = recording::switch_schedule(rec, period)?;
-    Runner::new(vec![&mut sink]).with_switches(switches).run(
-        &mut lp,
-        &mut dev,
-        d,
-        Some(ticks),
-        Pacing::Recorded(flags),
-        &mut |_, _| {},
-    )?;
+    sim.run(vec![&mut sink])?;
     Ok(VerifyReport {
         ticks,
         messages_compared: sink.compared,

@@ -77,6 +77,11 @@ impl ReplayDevice {
         self.missed.clone()
     }
 
+    /// The recorded device positions, m, device frame, one per tick.
+    pub fn positions_m(&self) -> impl Iterator<Item = Vec3> + '_ {
+        self.samples.iter().map(|s| s.position_m)
+    }
+
     /// The forces commanded during the replay, N, one per tick.
     pub fn forces_n(&self) -> &[Vec3] {
         &self.forces_n

@@ -431,6 +431,7 @@ fn run_with_device(
 ) -> Result<SessionReport, SessionError> {
     // The live view serves from the start: a viewer may connect before a bridged device's
     // hello arrives.
+    #[cfg_attr(not(feature = "live"), allow(unused_mut))]
     let mut live = start_live(opts)?;
     dev.open()?;
     let specs = dev.specs().clone();

@@ -297,6 +297,20 @@ pub fn schema<T: Encode>() -> (String, String, Vec<u8>) {
     }
 }
 
+/// The points of the polylines of entity `id` in an encoded `foxglove.SceneUpdate` (display
+/// units, as written), in order; empty when the update has no such entity.
+pub fn polyline_points(data: &[u8], id: &str) -> Result<Vec<[f64; 3]>, String> {
+    use foxglove::Decode;
+    let u = SceneUpdate::decode(data).map_err(|e| e.to_string())?;
+    Ok(u.entities
+        .iter()
+        .filter(|e| e.id == id)
+        .flat_map(|e| e.lines.iter())
+        .flat_map(|l| l.points.iter())
+        .map(|q| [q.x, q.y, q.z])
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
