@@ -42,7 +42,7 @@ ALLOWED = {
     "nanohaptics-cli": LIBS | {"nanohaptics-lesson", "nanohaptics-play"},
     "ot-py": LIBS | {"nanohaptics-lesson"},
     "nanohaptics-fuzz": LIBS,
-    "bench-harness": {"render"},
+    "bench-harness": {"render", "world-form"},
 }
 
 # Top-level modules of a crate from the bottom up (one list entry may hold several modules of

@@ -1,4 +1,5 @@
-//! The one percentile definition (nearest rank on sorted samples) and a summary of samples.
+//! The project's one percentile (`world_form::numbers`, nearest rank on sorted samples) and a
+//! summary of samples.
 //!
 //! The q-quantile of n samples sorted ascending is the sample of 1-based rank ⌈q·n⌉, clamped
 //! to 1…n (see the crate documentation). Samples are sorted with `f64::total_cmp`, so a NaN
@@ -8,12 +9,7 @@
 /// rank ⌈q·n⌉, clamped to 1…n. `None` when `sorted` is empty or q is outside 0…1 or NaN.
 /// The samples keep their unit (µs in, µs out).
 pub fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
-    if sorted.is_empty() || !(0.0..=1.0).contains(&q) {
-        return None;
-    }
-    let n = sorted.len();
-    let rank = ((q * n as f64).ceil() as usize).clamp(1, n);
-    Some(sorted[rank - 1])
+    world_form::numbers::percentile(sorted, q)
 }
 
 /// Samples sorted once, with their nearest-rank percentiles; every figure keeps the unit of

@@ -56,15 +56,7 @@ impl WorldError {
     }
 }
 
-/// A number as people read it: plain between 1e-3 and 1e6, in exponent form beyond (never
-/// 300 digits of `1e308`).
-fn num(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-3..1e6).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
+use world_form::fmt_num as num;
 
 /// A cursor sample from a device or script cannot be used.
 #[derive(Debug, Clone, PartialEq, Error)]

@@ -84,10 +84,10 @@ fn rss_kib(pid: u32) -> Option<u64> {
     line.split_whitespace().nth(1)?.parse().ok()
 }
 
-/// The `q` quantile (0–1, nearest rank below) of `v`.
+/// The `q` quantile (0–1) of `v` by the project's one percentile (nearest rank).
 fn quantile(v: &mut [u64], q: f64) -> u64 {
     v.sort_unstable();
-    v[((v.len() - 1) as f64 * q) as usize]
+    world_form::numbers::percentile(v, q).unwrap_or(0)
 }
 
 #[test]

@@ -162,7 +162,7 @@ impl DurationHistogram {
             return Percentiles::default();
         }
         let rank = |q: f64| {
-            let want = ((q * self.n as f64).ceil() as u64).clamp(1, self.n);
+            let want = world_form::numbers::nearest_rank(self.n, q).unwrap_or(self.n);
             let mut seen = 0;
             for (b, c) in self.counts.iter().enumerate() {
                 seen += c;

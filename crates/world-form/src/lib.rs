@@ -5,7 +5,7 @@
 //! `step(&Input) -> StepReport` (force N, stiffness felt N/m, typed events). This crate holds the
 //! one piece of that form they all need: the device limits, defined once.
 //!
-//! What it is for: one [`Limits`] type (largest force, N; largest stable stiffness, N/m) with the
+//! What it is for: the one number formatter and percentile ([`numbers`]); one [`Limits`] type (largest force, N; largest stable stiffness, N/m) with the
 //! shipped device models' figures and one range check, used by `brickworld`, `nanoworld`,
 //! `ot-envelope`'s optical-tweezers world and `haptic-loop`'s device specifications.
 //!
@@ -23,6 +23,9 @@
 //! ```
 
 pub mod exact;
+pub mod numbers;
+
+pub use numbers::fmt_num;
 
 use serde::{Deserialize, Serialize};
 

@@ -78,14 +78,8 @@ pub fn out_of_range(field: &str, value: impl ToString, allowed: impl Into<String
     }
 }
 
-/// Formats a bound for an error message: plain in 1e-3..1e6, scientific outside (`1e-6`).
-pub fn fmt_num(x: f64) -> String {
-    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
+/// Formats a bound for an error message (the project's one number form).
+pub use world_form::fmt_num;
 
 /// Checks `lo ≤ value ≤ hi` (and finite).
 pub fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<(), SceneError> {
