@@ -54,7 +54,7 @@ RANKS = {
         "encode sink totals arrays",
         "record_sink replay_device live",
         "runner error",
-        "replay closed_loop",
+        "replay closed_loop sinks",
         "session builtin",
         "stepper sound media",
     ],

@@ -44,6 +44,7 @@ pub mod runner;
 pub mod scene;
 pub mod session;
 pub mod sink;
+pub mod sinks;
 pub mod sound;
 pub mod stepper;
 pub mod totals;

@@ -12,11 +12,10 @@
 //! ```
 
 use crate::haptic::HapticLoop;
-use crate::live::{LiveConfig, LiveSummary};
-use crate::record_sink::RecorderSink;
+use crate::live::LiveConfig;
 use crate::runner::{EndReason, Pacing, Runner};
 use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
-use crate::sink::Sink;
+use crate::sinks::{SessionSinks, live_summary, start_live};
 use crate::totals::Totals;
 use haptic_devices::TickTime;
 use haptic_devices::bridge::BridgeConfig;
@@ -431,8 +430,7 @@ fn run_with_device(
 ) -> Result<SessionReport, SessionError> {
     // The live view serves from the start: a viewer may connect before a bridged device's
     // hello arrives.
-    #[cfg_attr(not(feature = "live"), allow(unused_mut))]
-    let mut live = start_live(opts)?;
+    let live = start_live(opts.live.as_ref())?;
     dev.open()?;
     let specs = dev.specs().clone();
     let loaded =
@@ -471,20 +469,12 @@ fn run_with_device(
         None => Vec::new(),
     };
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
-    let mut arrays = SessionArrays::new(rate, fields);
-    let mut totals = Totals::default();
-    let mut recorder = opts.out.clone().map(RecorderSink::new);
-    let mut sinks: Vec<&mut dyn Sink> = vec![&mut totals];
-    if opts.arrays {
-        sinks.push(&mut arrays);
-    }
-    if let Some(r) = recorder.as_mut() {
-        sinks.push(r);
-    }
-    #[cfg(feature = "live")]
-    if let Some(l) = live.as_mut() {
-        sinks.push(l);
-    }
+    let mut sinks = SessionSinks::new(
+        SessionArrays::new(rate, fields),
+        opts.arrays,
+        opts.out.clone(),
+    );
+    sinks.live = live;
     let pacing = if bridged {
         Pacing::DeviceClock
     } else if opts.realtime {
@@ -492,7 +482,7 @@ fn run_with_device(
     } else {
         Pacing::Batch
     };
-    let mut runner = Runner::new(sinks).with_switches(switches);
+    let mut runner = Runner::new(sinks.list()).with_switches(switches);
     if let Some(f) = stop {
         runner = runner.stop_on(f);
     }
@@ -504,19 +494,20 @@ fn run_with_device(
             "the session ended before its first tick (no device sample arrived)".into(),
         ));
     }
+    let written = sinks.written();
     Ok(SessionReport {
         description,
-        arrays,
-        totals,
+        arrays: sinks.arrays,
+        totals: sinks.totals,
         stats,
-        written: recorder.and_then(|r| r.summary().cloned()),
+        written,
         end: match end {
             EndReason::Completed => "completed",
             EndReason::DeviceEnded => "device_ended",
             EndReason::Stopped => "stopped",
         },
         link: dev.link_counters(),
-        live: live_summary(live),
+        live: live_summary(sinks.live),
         sinks: sink_times,
     })
 }
@@ -525,36 +516,4 @@ fn run_with_device(
 pub fn read_arrays(path: &Path, salvage: bool) -> Result<SessionArrays, SessionError> {
     let rec = recording::read_recording_file(path, salvage)?;
     Ok(SessionArrays::from_recording(&rec)?)
-}
-
-/// The live view's sink (this build serves the live view: the `live` feature).
-#[cfg(feature = "live")]
-type Live = crate::live::LiveSink;
-/// Without the `live` feature there is no live view to serve.
-#[cfg(not(feature = "live"))]
-type Live = std::convert::Infallible;
-
-/// Starts the live view the options ask for (before the device is opened).
-fn start_live(opts: &SessionOptions) -> Result<Option<Live>, SessionError> {
-    match &opts.live {
-        #[cfg(feature = "live")]
-        Some(c) => Ok(Some(crate::live::LiveSink::new(c.clone())?)),
-        #[cfg(not(feature = "live"))]
-        Some(c) => Err(SessionError::Live(format!(
-            "cannot serve ws:{}: this build has no live view (build haptic-loop with its \
-             `live` feature, as the `nanohaptics` program is)",
-            c.bind
-        ))),
-        None => Ok(None),
-    }
-}
-
-#[cfg(feature = "live")]
-fn live_summary(live: Option<Live>) -> Option<LiveSummary> {
-    live.map(|l| l.summary())
-}
-
-#[cfg(not(feature = "live"))]
-fn live_summary(live: Option<Live>) -> Option<LiveSummary> {
-    live.map(|never| match never {})
 }

@@ -20,10 +20,10 @@
 
 use crate::arrays::SessionArrays;
 use crate::haptic::{HapticLoop, TickResult};
-use crate::record_sink::RecorderSink;
 use crate::scene::load_scene;
 use crate::session::{SceneSource, SessionError, now_unix_ns};
-use crate::sink::{SessionInfo, Sink, TickView, deliver};
+use crate::sink::{SessionInfo, TickView, deliver};
+use crate::sinks::SessionSinks;
 use haptic_devices::pacing::{DurationHistogram, Percentiles, TickStats};
 use haptic_devices::{DeviceModel, DeviceSample, ForceCommand};
 use recording::WriteSummary;
@@ -79,8 +79,7 @@ pub struct StepperReport {
 pub struct Stepper {
     lp: HapticLoop,
     description: DescriptionMsg,
-    arrays: Option<SessionArrays>,
-    recorder: Option<RecorderSink>,
+    sinks: SessionSinks,
     compute: DurationHistogram,
     started: Instant,
 }
@@ -103,24 +102,23 @@ impl Stepper {
             opts.start_time_ns.unwrap_or_else(now_unix_ns),
         );
         let lp = HapticLoop::new(loaded.config, loaded.scene);
-        let mut arrays = opts.arrays.then(|| SessionArrays::new(rate, fields));
-        let mut recorder = opts.out.clone().map(RecorderSink::new);
+        let mut sinks = SessionSinks::new(
+            SessionArrays::new(rate, fields),
+            opts.arrays,
+            opts.out.clone(),
+        );
         let info = SessionInfo {
             description: &description,
             config: lp.config(),
             ticks: None,
         };
-        if let Some(a) = arrays.as_mut() {
-            a.start(&info, &lp)?;
-        }
-        if let Some(r) = recorder.as_mut() {
-            r.start(&info, &lp)?;
+        for s in sinks.list() {
+            s.start(&info, &lp)?;
         }
         Ok(Stepper {
             lp,
             description,
-            arrays,
-            recorder,
+            sinks,
             compute: DurationHistogram::new(),
             started: Instant::now(),
         })
@@ -139,14 +137,7 @@ impl Stepper {
             start_late_ns: 0,
             compute_ns,
         };
-        let mut sinks: Vec<&mut dyn Sink> = Vec::with_capacity(2);
-        if let Some(a) = self.arrays.as_mut() {
-            sinks.push(a);
-        }
-        if let Some(r) = self.recorder.as_mut() {
-            sinks.push(r);
-        }
-        deliver(&mut sinks, &view)?;
+        deliver(&mut self.sinks.list(), &view)?;
         self.compute.record(t0.elapsed().as_nanos() as u64);
         Ok(self.lp.last_result())
     }
@@ -177,7 +168,7 @@ impl Stepper {
 
     /// Per-tick arrays so far (`None` when turned off).
     pub fn arrays(&self) -> Option<&SessionArrays> {
-        self.arrays.as_ref()
+        self.sinks.keep_arrays.then_some(&self.sinks.arrays)
     }
 
     /// Ends the session: closes the recording and returns what it produced.
@@ -189,14 +180,19 @@ impl Stepper {
             missed: 0,
             wall_s: self.started.elapsed().as_secs_f64(),
         };
-        if let Some(r) = self.recorder.as_mut() {
-            r.finish(&stats, &[])?;
+        for s in self.sinks.list() {
+            s.finish(&stats, &[])?;
         }
+        let written = self.sinks.written();
         Ok(StepperReport {
             description: self.description,
-            arrays: self.arrays.unwrap_or_default(),
+            arrays: if self.sinks.keep_arrays {
+                self.sinks.arrays
+            } else {
+                SessionArrays::default()
+            },
             stats,
-            written: self.recorder.and_then(|r| r.summary().cloned()),
+            written,
         })
     }
 }
