@@ -256,9 +256,7 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
         if v.is_finite() && (lo..=hi).contains(&v) {
             Ok(v)
         } else {
-            Err(format!(
-                "--{flag} = {v} is out of range (allowed: {lo}–{hi})"
-            ))
+            Err(format!("--{flag} = {v} is out of range: allowed {lo}–{hi}"))
         }
     };
     let loss = check("loss", a.loss, 0.0, 1.0)?;
@@ -498,7 +496,7 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
             let mut b = BridgeConfig::parse(d).map_err(|e| e.to_string())?;
             if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
                 return Err(format!(
-                    "--wait-s = {wait_s} is out of range (allowed: 0–86400)"
+                    "--wait-s = {wait_s} is out of range: allowed 0–86400"
                 ));
             }
             b.wait_s = wait_s;
@@ -521,7 +519,7 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode, String> {
         let mut c = LiveConfig::parse(l).map_err(|e| e.to_string())?;
         if !(1..=1000).contains(&live_hz) {
             return Err(format!(
-                "--live-hz = {live_hz} is out of range (allowed: 1–1000)"
+                "--live-hz = {live_hz} is out of range: allowed 1–1000"
             ));
         }
         c.display_hz = live_hz;

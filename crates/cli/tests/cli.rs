@@ -164,15 +164,15 @@ fn bad_input_is_an_error_naming_the_field() {
     assert_eq!(
         String::from_utf8_lossy(&o.stderr).trim(),
         format!(
-            "error: {}:6:10: scene: `loop.engage_s` = -1 is out of range (allowed: 0 ≤ \
-             loop.engage_s ≤ 10)",
+            "error: {}:6:10: scene: `loop.engage_s` = -1 is out of range: allowed 0 ≤ \
+             loop.engage_s ≤ 10",
             scene.display()
         )
     );
     let o = nh(&["run", "scenes/wall.toml", "--operator", "hand:mass_kg=-2"]);
     assert_eq!(
         String::from_utf8_lossy(&o.stderr).trim(),
-        "error: script: `mass_kg` = -2 is out of range (allowed: 0.01 ≤ mass_kg ≤ 10)"
+        "error: script: `mass_kg` = -2 is out of range: allowed 0.01 ≤ mass_kg ≤ 10"
     );
     let o = nh(&["info", "Cargo.toml"]);
     assert_eq!(
@@ -323,7 +323,7 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
         ),
         (
             vec!["--grip", "k=0"],
-            "error: --grip: grip `k` = 0 is out of range (allowed: 0 < k ≤ 10000 N/m)",
+            "error: --grip: grip `k` = 0 is out of range: allowed 0 < k ≤ 10000 N/m",
         ),
         (
             vec!["--ideal"],
@@ -431,8 +431,8 @@ fn file_errors_say_file_line_column_and_what_was_expected() {
     assert_eq!(
         error_in(&dir, &["run", "w.toml"]),
         format!(
-            "error: w.toml:{line}:21: scene: `wall.stiffness_n_per_m` = -5000 is out of range \
-             (allowed: 0 < wall.stiffness_n_per_m ≤ 1e12)"
+            "error: w.toml:{line}:21: scene: `wall.stiffness_n_per_m` = -5000 is out of range: \
+             allowed 0 < wall.stiffness_n_per_m ≤ 1e12"
         )
     );
     // A world's own parameter check, located in the world's table.
@@ -469,8 +469,8 @@ fn file_errors_say_file_line_column_and_what_was_expected() {
     );
     assert_eq!(
         error_in(&dir, &["run", "wall", "--script", "s3.toml"]),
-        "error: s3.toml:7:5: script: `waypoint[1].t_s` = -0.8 is out of range (allowed: 0 ≤ \
-         t_s ≤ 3600)"
+        "error: s3.toml:7:5: script: `waypoint[1].t_s` = -0.8 is out of range: allowed 0 ≤ \
+         t_s ≤ 3600"
     );
     // A recording or binary file given as a scene.
     let wall_rec = root().join("recordings/wall.mcap");
@@ -517,7 +517,7 @@ fn a_session_shorter_than_one_tick_is_refused() {
     );
     assert_eq!(
         error_in(&root(), &["run", "wall", "--seconds", "1e308"]),
-        "error: session length 1e308 s is out of range (allowed: 0 < seconds ≤ 3600)"
+        "error: session length 1e308 s is out of range: allowed 0 < seconds ≤ 3600"
     );
     // Half a tick rounds to one tick.
     let run = json(&nh(&["run", "wall", "--seconds", "0.0005", "--json"]));

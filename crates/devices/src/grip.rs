@@ -22,7 +22,7 @@ pub struct Grip {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum GripError {
     /// A number out of range.
-    #[error("grip `{field}` = {value} is out of range (allowed: {allowed})")]
+    #[error("grip `{field}` = {value} is out of range: allowed {allowed}")]
     OutOfRange {
         /// `k`, `b` or `m`.
         field: &'static str,
@@ -83,7 +83,7 @@ impl Grip {
     /// assert_eq!((g.stiffness_n_per_m, g.damping_n_s_per_m), (500.0, 4.0));
     /// assert_eq!(
     ///     Grip::parse("k=0,b=4").unwrap_err().to_string(),
-    ///     "grip `k` = 0 is out of range (allowed: 0 < k ≤ 10000 N/m)"
+    ///     "grip `k` = 0 is out of range: allowed 0 < k ≤ 10000 N/m"
     /// );
     /// ```
     pub fn parse(text: &str) -> Result<Grip, GripError> {
@@ -141,11 +141,11 @@ mod tests {
         assert_eq!(Grip::parse(&g.label()).unwrap(), g);
         assert_eq!(
             Grip::parse("b=-1,k=300").unwrap_err().to_string(),
-            "grip `b` = -1 is out of range (allowed: 0 ≤ b ≤ 200 N·s/m)"
+            "grip `b` = -1 is out of range: allowed 0 ≤ b ≤ 200 N·s/m"
         );
         assert_eq!(
             Grip::parse("k=NaN").unwrap_err().to_string(),
-            "grip `k` = NaN is out of range (allowed: 0 < k ≤ 10000 N/m)"
+            "grip `k` = NaN is out of range: allowed 0 < k ≤ 10000 N/m"
         );
         assert!(matches!(Grip::parse("tight"), Err(GripError::Syntax(_))));
         assert!(matches!(Grip::parse("b=3"), Err(GripError::Syntax(_))));

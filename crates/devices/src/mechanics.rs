@@ -38,7 +38,7 @@ pub struct Mechanics {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MechanicsError {
     /// A field out of range.
-    #[error("device `{field}` = {value} is out of range (allowed: {allowed})")]
+    #[error("device `{field}` = {value} is out of range: allowed {allowed}")]
     OutOfRange {
         /// Field name.
         field: &'static str,
@@ -231,7 +231,7 @@ mod tests {
         };
         assert_eq!(
             bad.validate().unwrap_err().to_string(),
-            "device `moving_mass_kg` = 0 is out of range (allowed: 0 < moving_mass_kg ≤ 10 kg)"
+            "device `moving_mass_kg` = 0 is out of range: allowed 0 < moving_mass_kg ≤ 10 kg"
         );
     }
 }

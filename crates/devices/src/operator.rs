@@ -211,7 +211,7 @@ mod tests {
                 .with_overrides("mass_kg=0")
                 .unwrap_err()
                 .to_string(),
-            "script: `mass_kg` = 0 is out of range (allowed: 0.01 ≤ mass_kg ≤ 10)"
+            "script: `mass_kg` = 0 is out of range: allowed 0.01 ≤ mass_kg ≤ 10"
         );
     }
 

@@ -54,7 +54,7 @@ pub enum ScriptError {
     #[error("script: `waypoint` must list at least one waypoint")]
     NoWaypoints,
     /// A number outside its allowed range.
-    #[error("script: `{field}` = {value} is out of range (allowed: {allowed})")]
+    #[error("script: `{field}` = {value} is out of range: allowed {allowed}")]
     OutOfRange {
         /// Field path, e.g. `waypoint[2].t_s`.
         field: String,
@@ -603,13 +603,13 @@ down = false
         assert_eq!(
             Script::from_toml(&bad, &FALCON).unwrap_err().to_string(),
             "script: `waypoint[1].position_mm (distance from the device origin, mm)` = 50 is out \
-             of range (allowed: ≤ 40 mm, the falcon workspace radius)"
+             of range: allowed ≤ 40 mm, the falcon workspace radius"
         );
         let bad = S.replace("t_s = 2.0", "t_s = 0.0");
         assert_eq!(
             Script::from_toml(&bad, &FALCON).unwrap_err().to_string(),
-            "script: `waypoint[1].t_s` = 0 is out of range (allowed: greater than the previous \
-             waypoint's t_s = 0)"
+            "script: `waypoint[1].t_s` = 0 is out of range: allowed greater than the previous \
+             waypoint's t_s = 0"
         );
         let bad = S.replacen("name = \"centre\"", "name = \"trigger\"", 1);
         assert_eq!(
@@ -628,7 +628,7 @@ down = false
         );
         assert_eq!(
             Script::from_toml(&bad, &FALCON).unwrap_err().to_string(),
-            "script: `waypoint[0].position_mm[0]` = NaN is out of range (allowed: a finite number)"
+            "script: `waypoint[0].position_mm[0]` = NaN is out of range: allowed a finite number"
         );
     }
 }

@@ -72,7 +72,7 @@ pub enum SessionError {
     },
     /// Session length out of range.
     #[error(
-        "session length {} s is out of range (allowed: 0 < seconds ≤ 3600)",
+        "session length {} s is out of range: allowed 0 < seconds ≤ 3600",
         crate::scene::check::fmt_num(*.0)
     )]
     Seconds(f64),

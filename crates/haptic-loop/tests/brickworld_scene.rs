@@ -69,8 +69,8 @@ fn scene_errors_name_the_field() {
     };
     assert_eq!(
         err(text.replace("dt_s = 0.001", "dt_s = 0.002")),
-        "scene: `brickworld.params.dt_s` = 0.002 is out of range (allowed: 0.001 s, the loop's \
-         tick (1 / loop.rate_hz))"
+        "scene: `brickworld.params.dt_s` = 0.002 is out of range: allowed 0.001 s, the loop's \
+         tick (1 / loop.rate_hz)"
     );
     // 1 N → 1 N: the 1000 N/m proxy would be 20 000 N/m on the Falcon.
     let e = err(text.replace("force_scale = 0.125", "force_scale = 1.0"));

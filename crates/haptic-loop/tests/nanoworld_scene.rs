@@ -73,12 +73,12 @@ fn scene_errors_name_the_field() {
     assert_eq!(
         err(text.replace("force_scale = 1.0e9", "force_scale = 1.0e11")),
         "scene: `nanoworld.params.interaction.game.pairs.tip_substrate.stiffness_n_per_m` = 2 is \
-         out of range (allowed: ≤ 0.2 N/m, the device's stiffness limit mapped \
-         to the world (lower mapping.force_scale or mapping.workspace_scale))"
+         out of range: allowed ≤ 0.2 N/m, the device's stiffness limit mapped \
+         to the world (lower mapping.force_scale or mapping.workspace_scale)"
     );
     assert_eq!(
         err(text.replace("preset = \"game\"", "preset = \"lunar\"")),
-        "scene: `nanoworld.preset` = \"lunar\" is out of range (allowed: \"game\" or \"physical\")"
+        "scene: `nanoworld.preset` = \"lunar\" is out of range: allowed \"game\" or \"physical\""
     );
     assert!(
         err(text.replace("preset = \"game\"", "colour = 1")).contains("unknown field `colour`")

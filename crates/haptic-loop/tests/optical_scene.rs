@@ -71,13 +71,13 @@ fn scene_errors_name_the_field() {
     };
     assert_eq!(
         err(text.replace("waist_y_nm = 300.0", "waist_y_nm = -300.0")),
-        "scene: `optical_tweezers.waist_y_nm` = -300 is out of range (allowed: 0 < \
-         optical_tweezers.waist_y_nm ≤ 1e6)"
+        "scene: `optical_tweezers.waist_y_nm` = -300 is out of range: allowed 0 < \
+         optical_tweezers.waist_y_nm ≤ 1e6"
     );
     assert_eq!(
         err(text.replace("stiffness_n_per_m = 0.8", "stiffness_n_per_m = 5.0")),
-        "scene: `optical_tweezers.stiffness_n_per_m` = 5 is out of range (allowed: 0 < \
-         stiffness ≤ 3 N/m, the device's limit mapped to the world)"
+        "scene: `optical_tweezers.stiffness_n_per_m` = 5 is out of range: allowed 0 < \
+         stiffness ≤ 3 N/m, the device's limit mapped to the world"
     );
     assert!(
         err(text.replace("clip = \"radial\"", "clip = \"sideways\""))

@@ -153,8 +153,8 @@ fn a_script_switch_the_scene_lacks_is_refused_with_its_line() {
     let e = run_session(&o, &mut |_, _| {}).unwrap_err().to_string();
     assert!(
         e.ends_with(
-            "script: `switch[0].value`: switch `restitution` = 1.5 is out of range \
-             (allowed: 0 ≤ value ≤ 1)"
+            "script: `switch[0].value`: switch `restitution` = 1.5 is out of range: \
+             allowed 0 ≤ value ≤ 1"
         ),
         "{e}"
     );

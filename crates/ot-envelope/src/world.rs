@@ -215,7 +215,7 @@ impl Params {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WorldError {
     /// A parameter outside its allowed range (or not finite).
-    #[error("`{field}` = {value} is out of range (allowed: {allowed})")]
+    #[error("`{field}` = {value} is out of range: allowed {allowed}")]
     Param {
         /// The field, as named in [`Params`].
         field: &'static str,
@@ -641,8 +641,8 @@ mod tests {
         });
         assert_eq!(
             e,
-            "`dt_s` = 0.000005 is out of range (allowed: 0 < dt_s ≤ 1.885e-6 s, two periods of \
-             the particle's small oscillation)"
+            "`dt_s` = 0.000005 is out of range: allowed 0 < dt_s ≤ 1.885e-6 s, two periods of \
+             the particle's small oscillation"
         );
     }
 
@@ -654,7 +654,7 @@ mod tests {
         });
         assert_eq!(
             e,
-            "`stiffness_n_per_m` = 5 is out of range (allowed: 0 < stiffness_n_per_m ≤ 3)"
+            "`stiffness_n_per_m` = 5 is out of range: allowed 0 < stiffness_n_per_m ≤ 3"
         );
         let e = refused(Params {
             depth_j: f64::NAN,
@@ -662,7 +662,7 @@ mod tests {
         });
         assert_eq!(
             e,
-            "`depth_j` = NaN is out of range (allowed: 0 < depth_j ≤ 0.000001)"
+            "`depth_j` = NaN is out of range: allowed 0 < depth_j ≤ 0.000001"
         );
     }
 

@@ -293,7 +293,7 @@ pub enum DeviceError {
     #[error("the recording has no device input for tick {0}")]
     EndOfRecording(u64),
     /// Specifications announced by a device out of range.
-    #[error("device specs: `{field}` = {value} is out of range (allowed: {allowed})")]
+    #[error("device specs: `{field}` = {value} is out of range: allowed {allowed}")]
     BadSpec {
         /// Field name.
         field: &'static str,

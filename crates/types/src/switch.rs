@@ -107,7 +107,7 @@ pub enum SwitchError {
         allowed: String,
     },
     /// A value outside the switch's range.
-    #[error("switch `{name}` = {value} is out of range (allowed: {allowed})")]
+    #[error("switch `{name}` = {value} is out of range: allowed {allowed}")]
     OutOfRange {
         /// The switch.
         name: String,
@@ -190,13 +190,13 @@ mod tests {
             check("brickworld", &SPECS, "gravity_m_per_s2", 101.0)
                 .unwrap_err()
                 .to_string(),
-            "switch `gravity_m_per_s2` = 101 is out of range (allowed: 0 ≤ value ≤ 100)"
+            "switch `gravity_m_per_s2` = 101 is out of range: allowed 0 ≤ value ≤ 100"
         );
         assert_eq!(
             check("brickworld", &SPECS, "inertia", 0.5)
                 .unwrap_err()
                 .to_string(),
-            "switch `inertia` = 0.5 is out of range (allowed: true / false (1 / 0))"
+            "switch `inertia` = 0.5 is out of range: allowed true / false (1 / 0)"
         );
         assert!(check("brickworld", &SPECS, "gravity_m_per_s2", f64::NAN).is_err());
         assert!(check("brickworld", &SPECS, "gravity_m_per_s2", 0.0).is_ok());
@@ -208,7 +208,7 @@ mod tests {
             check("brickworld", &SPECS, "gravity_m_s2", 101.0)
                 .unwrap_err()
                 .to_string(),
-            "switch `gravity_m_s2` = 101 is out of range (allowed: 0 ≤ value ≤ 100)"
+            "switch `gravity_m_s2` = 101 is out of range: allowed 0 ≤ value ≤ 100"
         );
     }
 }

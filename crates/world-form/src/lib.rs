@@ -18,7 +18,7 @@
 //! let bad = Limits { max_force_n: f64::NAN, ..Limits::FALCON };
 //! assert_eq!(
 //!     bad.validate().unwrap_err().to_string(),
-//!     "`max_force_n` = NaN is out of range (allowed: 0 < max_force_n ≤ 100000 N)"
+//!     "`max_force_n` = NaN is out of range: allowed 0 < max_force_n ≤ 100000 N"
 //! );
 //! ```
 
@@ -52,7 +52,7 @@ pub const MAX_STIFFNESS_LIMIT_N_PER_M: f64 = 1e7;
 
 /// A limit that is not finite, not positive or beyond the largest allowed value.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("`{field}` = {value} is out of range (allowed: 0 < {field} ≤ {max} {unit})")]
+#[error("`{field}` = {value} is out of range: allowed 0 < {field} ≤ {max} {unit}")]
 pub struct LimitsError {
     /// The field's name (`max_force_n` or `max_stiffness_n_per_m`).
     pub field: &'static str,
@@ -134,8 +134,8 @@ mod tests {
         .unwrap_err();
         assert_eq!(
             e.to_string(),
-            "`max_stiffness_n_per_m` = 0 is out of range (allowed: 0 < max_stiffness_n_per_m ≤ \
-             10000000 N/m)"
+            "`max_stiffness_n_per_m` = 0 is out of range: allowed 0 < max_stiffness_n_per_m ≤ \
+             10000000 N/m"
         );
         let e = Limits {
             max_force_n: 2e5,

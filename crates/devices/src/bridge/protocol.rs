@@ -461,7 +461,7 @@ mod tests {
                 specs: bad.clone()
             }
             .encode()),
-            "device specs: `max_force_n` = inf is out of range (allowed: 0.001 ≤ max_force_n ≤ 1000)"
+            "device specs: `max_force_n` = inf is out of range: allowed 0.001 ≤ max_force_n ≤ 1000"
         );
         // A force limit of 4e-159 N (found by the libFuzzer bridge target: its squares are
         // subnormal, and clamping to it took 12 s for 20 ticks) is no haptic device.
@@ -472,8 +472,8 @@ mod tests {
                 specs: bad
             }
             .encode()),
-            "device specs: `max_force_n` = 3.7555737088373936e-159 is out of range (allowed: \
-             0.001 ≤ max_force_n ≤ 1000)"
+            "device specs: `max_force_n` = 3.7555737088373936e-159 is out of range: allowed \
+             0.001 ≤ max_force_n ≤ 1000"
         );
     }
 

@@ -25,7 +25,7 @@ pub enum SceneError {
         message: String,
     },
     /// A number out of its allowed range.
-    #[error("scene: `{field}` = {value} is out of range (allowed: {allowed})")]
+    #[error("scene: `{field}` = {value} is out of range: allowed {allowed}")]
     OutOfRange {
         /// Field path, e.g. `mapping.force_scale`.
         field: String,

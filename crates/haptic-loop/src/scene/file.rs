@@ -272,13 +272,13 @@ stiffness_n_per_m = 2000.0
     fn bad_fields_are_named() {
         assert_eq!(
             err(&format!("{WALL}[loop]\nrate_hz = 999\n")),
-            "scene: `loop.rate_hz` = 999 is out of range (allowed: 100 ≤ rate_hz ≤ 20000 with \
-             10^9 / rate_hz a whole number)"
+            "scene: `loop.rate_hz` = 999 is out of range: allowed 100 ≤ rate_hz ≤ 20000 with \
+             10^9 / rate_hz a whole number"
         );
         assert_eq!(
             err(&format!("{WALL}[loop]\nrate_hz = 25000\n")),
-            "scene: `loop.rate_hz` = 25000 is out of range (allowed: 100 ≤ rate_hz ≤ 20000 with \
-             10^9 / rate_hz a whole number)"
+            "scene: `loop.rate_hz` = 25000 is out of range: allowed 100 ≤ rate_hz ≤ 20000 with \
+             10^9 / rate_hz a whole number"
         );
         assert_eq!(
             load_scene(&format!("{WALL}[loop]\nrate_hz = 10000\n"), None)
@@ -289,13 +289,13 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&format!("{WALL}[mapping]\nforce_scale = -1.0\n")),
-            "scene: `mapping.force_scale` = -1 is out of range (allowed: 1e-6 ≤ \
-             mapping.force_scale ≤ 1e18)"
+            "scene: `mapping.force_scale` = -1 is out of range: allowed 1e-6 ≤ \
+             mapping.force_scale ≤ 1e18"
         );
         assert_eq!(
             err(&format!("{WALL}[loop]\nwatchdog_timeout_s = 0.001\n")),
-            "scene: `loop.watchdog_timeout_s` = 0.001 is out of range (allowed: 0.0035 ≤ \
-             loop.watchdog_timeout_s ≤ 1)"
+            "scene: `loop.watchdog_timeout_s` = 0.001 is out of range: allowed 0.0035 ≤ \
+             loop.watchdog_timeout_s ≤ 1"
         );
         let s = load_scene(&format!("{WALL}[loop]\nrate_hz = 10000\n"), None).unwrap();
         // At 10 kHz: full force through age 29 (2.95 ms), zero from age 99 (9.95 ms).
@@ -308,8 +308,8 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&format!("{WALL}[display]\nrate_hz = 30\n")),
-            "scene: `display.rate_hz` = 30 is out of range (allowed: a divisor of loop.rate_hz = \
-             1000)"
+            "scene: `display.rate_hz` = 30 is out of range: allowed a divisor of loop.rate_hz = \
+             1000"
         );
         assert_eq!(
             err(&WALL.replace("kind = \"wall\"", "kind = \"moon\"")),
@@ -324,7 +324,7 @@ stiffness_n_per_m = 2000.0
         );
         assert_eq!(
             err(&WALL.replace("[0.0, 0.0, 1.0]", "[0.0, 0.0, 0.0]")),
-            "scene: `wall.normal` = [0, 0, 0] is out of range (allowed: a non-zero finite vector)"
+            "scene: `wall.normal` = [0, 0, 0] is out of range: allowed a non-zero finite vector"
         );
     }
 }

@@ -711,8 +711,8 @@ mod tests {
         );
         assert_eq!(
             build_error("tick_map = \"rk4\"\ntick_map_substeps = 0"),
-            "scene: `optical_tweezers.tick_map_substeps` = 0 is out of range (allowed: 1 ≤ \
-             optical_tweezers.tick_map_substeps ≤ 1000)"
+            "scene: `optical_tweezers.tick_map_substeps` = 0 is out of range: allowed 1 ≤ \
+             optical_tweezers.tick_map_substeps ≤ 1000"
         );
     }
 
@@ -733,8 +733,8 @@ mod tests {
     fn the_spread_build_fields_are_checked_and_reach_the_world() {
         assert_eq!(
             build_error("envelope_build_evals_per_tick = 0"),
-            "scene: `optical_tweezers.envelope_build_evals_per_tick` = 0 is out of range \
-             (allowed: 1 ≤ optical_tweezers.envelope_build_evals_per_tick ≤ 1e6)"
+            "scene: `optical_tweezers.envelope_build_evals_per_tick` = 0 is out of range: \
+             allowed 1 ≤ optical_tweezers.envelope_build_evals_per_tick ≤ 1e6"
         );
         assert_eq!(
             build_error("spread_build = false\nenvelope_build_evals_per_tick = 64"),
@@ -765,18 +765,18 @@ mod tests {
         let err = build_error;
         assert_eq!(
             err("tick_map_tol_nm = 0.0"),
-            "scene: `optical_tweezers.tick_map_tol_nm` = 0 is out of range (allowed: 1e-4 ≤ \
-             optical_tweezers.tick_map_tol_nm ≤ 100)"
+            "scene: `optical_tweezers.tick_map_tol_nm` = 0 is out of range: allowed 1e-4 ≤ \
+             optical_tweezers.tick_map_tol_nm ≤ 100"
         );
         assert_eq!(
             err("tick_map_speed_m_per_s = -1.0"),
-            "scene: `optical_tweezers.tick_map_speed_m_per_s` = -1 is out of range (allowed: 0 ≤ \
-             optical_tweezers.tick_map_speed_m_per_s ≤ 1000)"
+            "scene: `optical_tweezers.tick_map_speed_m_per_s` = -1 is out of range: allowed 0 ≤ \
+             optical_tweezers.tick_map_speed_m_per_s ≤ 1000"
         );
         assert_eq!(
             err("rk4_substeps = 0"),
-            "scene: `optical_tweezers.rk4_substeps` = 0 is out of range (allowed: 1 ≤ \
-             optical_tweezers.rk4_substeps ≤ 1000)"
+            "scene: `optical_tweezers.rk4_substeps` = 0 is out of range: allowed 1 ≤ \
+             optical_tweezers.rk4_substeps ≤ 1000"
         );
     }
 
@@ -800,10 +800,10 @@ mod tests {
         assert_eq!(
             with("dt_us = 0.2", "dt_us = 5.0").as_deref(),
             Some(
-                "scene: `optical_tweezers.dt_us` = 5 is out of range (allowed: 0 < dt_us ≤ 1.88 \
+                "scene: `optical_tweezers.dt_us` = 5 is out of range: allowed 0 < dt_us ≤ 1.88 \
                  µs, two periods of the particle's small oscillation in this trap (period \
                  2π·√(mass·waist²/(4·depth)), narrower waist); a longer tick makes the envelope \
-                 too costly for a haptic loop)"
+                 too costly for a haptic loop"
             )
         );
         // The fuzz finding: a particle 1000× lighter at the default 0.2 µs tick.

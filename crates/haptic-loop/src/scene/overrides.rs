@@ -335,8 +335,8 @@ mod tests {
         let text = override_scene(OT, &ov(&[("loop.rate_hz", Value::Integer(999))])).unwrap();
         assert_eq!(
             load_scene(&text, None).err().unwrap().to_string(),
-            "scene: `loop.rate_hz` = 999 is out of range (allowed: 100 ≤ rate_hz ≤ 20000 with \
-             10^9 / rate_hz a whole number)"
+            "scene: `loop.rate_hz` = 999 is out of range: allowed 100 ≤ rate_hz ≤ 20000 with \
+             10^9 / rate_hz a whole number"
         );
     }
 
