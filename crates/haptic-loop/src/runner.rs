@@ -75,6 +75,7 @@ pub struct Runner<'s> {
     stop: Option<&'s AtomicBool>,
     sink_ns: Vec<DurationHistogram>,
     switches: Vec<(u64, Switch)>,
+    live: Option<&'s mut dyn FnMut(u64, &mut HapticLoop)>,
 }
 
 /// Time each sink took per tick (its `tick` call), ns.
@@ -95,6 +96,7 @@ impl<'s> Runner<'s> {
             stop: None,
             sink_ns: vec![DurationHistogram::new(); n],
             switches: Vec::new(),
+            live: None,
         }
     }
 
@@ -104,6 +106,15 @@ impl<'s> Runner<'s> {
     pub fn with_switches(mut self, mut switches: Vec<(u64, Switch)>) -> Self {
         switches.sort_by_key(|(t, _)| *t);
         self.switches = switches;
+        self
+    }
+
+    /// Calls `hook(tick, loop)` before each tick's step, after that tick's scheduled switches:
+    /// a live session applies there what arrived since the last tick (a menu's switches, through
+    /// [`HapticLoop::switch`], which records them as the tick's input on `/scene/switch`, so a
+    /// replay applies them, as scheduled switches, on the same tick).
+    pub fn with_live(mut self, hook: &'s mut dyn FnMut(u64, &mut HapticLoop)) -> Self {
+        self.live = Some(hook);
         self
     }
 
@@ -182,6 +193,9 @@ impl<'s> Runner<'s> {
             for (_, sw) in self.switches[due..].iter().take_while(|(t, _)| *t == n) {
                 lp.switch(&sw.name, sw.value)
                     .map_err(|error| RunError::Switch { tick: n, error })?;
+            }
+            if let Some(hook) = self.live.as_mut() {
+                hook(n, lp);
             }
             lp.tick(sample, recorded_missed);
             let missed = match &pacing {
