@@ -69,13 +69,17 @@ pub enum EndReason {
     Stopped,
 }
 
+/// What a live session does before each tick's step (see [`Runner::with_live`]): called with
+/// the tick's index and the loop.
+pub type LiveHook<'a> = dyn FnMut(u64, &mut HapticLoop) + 'a;
+
 /// Runs ticks of a loop against a device and hands each to the sinks.
 pub struct Runner<'s> {
     sinks: Vec<&'s mut dyn Sink>,
     stop: Option<&'s AtomicBool>,
     sink_ns: Vec<DurationHistogram>,
     switches: Vec<(u64, Switch)>,
-    live: Option<&'s mut dyn FnMut(u64, &mut HapticLoop)>,
+    live: Option<&'s mut LiveHook<'s>>,
 }
 
 /// Time each sink took per tick (its `tick` call), ns.
@@ -113,7 +117,7 @@ impl<'s> Runner<'s> {
     /// a live session applies there what arrived since the last tick (a menu's switches, through
     /// [`HapticLoop::switch`], which records them as the tick's input on `/scene/switch`, so a
     /// replay applies them, as scheduled switches, on the same tick).
-    pub fn with_live(mut self, hook: &'s mut dyn FnMut(u64, &mut HapticLoop)) -> Self {
+    pub fn with_live(mut self, hook: &'s mut LiveHook<'s>) -> Self {
         self.live = Some(hook);
         self
     }

@@ -1,1 +1,317 @@
-fn main() {}
+//! The play bench (docs/bench/play.md): real sessions served to headless Chromium pages on
+//! loopback, measured from both ends.
+//!
+//! `cargo run --release -p nanohaptics-play --example play-bench [SECONDS]` runs, each for
+//! SECONDS (default 10) of play:
+//! 1. brickworld, one page that plays (the pointer circles at 60 events/s);
+//! 2. nanoworld, one page that plays (the same);
+//! 3. brickworld, one page that plays and two more that watch.
+//!
+//! Figures: browser input → force (the page's event time to the tick whose force used it,
+//! from the server), frames drawn per second by each page (requestAnimationFrame draws with a
+//! frame in hand, over the session), sound latency (the wall time its first sample leaves the
+//! page's audio output, by `AudioContext.getOutputTimestamp()` and `outputLatency`, minus the
+//! wall time of its tick), and missed 1 ms deadlines.
+
+#[path = "../tests/common/cdp.rs"]
+mod cdp;
+
+use cdp::Browser;
+use haptic_loop::session::SceneSource;
+use play::{LatencyMs, PlayConfig, run};
+use serde_json::Value;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+struct Outcome {
+    scene: &'static str,
+    #[allow(dead_code)]
+    pages: usize,
+    input: Option<LatencyMs>,
+    fps: Vec<f64>,
+    sound: Option<LatencyMs>,
+    sound_parts: [Option<LatencyMs>; 3],
+    output_latency_s: Option<f64>,
+    underruns: u64,
+    ticks: u64,
+    missed: u64,
+    tick_p99_us: f64,
+    dropped: u64,
+}
+
+fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result<Outcome, String> {
+    let out = std::env::temp_dir().join(format!("nh-play-bench-{}.mcap", std::process::id()));
+    let mut c = PlayConfig::new(
+        SceneSource::resolve(scene.as_ref()).map_err(|e| e.to_string())?,
+        out.clone(),
+    );
+    c.port = 0;
+    c.keep_serving_s = Some(0.0);
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = std::sync::mpsc::channel();
+    let s2 = stop.clone();
+    let handle = std::thread::spawn(move || {
+        run(&c, &s2, &mut |u| {
+            let _ = tx.send(u.to_string());
+        })
+    });
+    let url = rx
+        .recv_timeout(Duration::from_secs(10))
+        .map_err(|_| "no server")?;
+    let mut browsers = Vec::new();
+    for _ in 0..pages {
+        let mut b = Browser::launch_nice(1280, 760, nice)?;
+        b.open(&url)?;
+        b.wait_for("window.__play.hello !== null", 10.0)?;
+        browsers.push(b);
+    }
+    // The first page plays; the others watch (their Start makes them watchers).
+    for b in browsers.iter_mut() {
+        b.eval("document.getElementById('go').click(); 0")?;
+    }
+    browsers[0].wait_for("window.__play.role === 'hand'", 10.0)?;
+    let r = browsers[0].eval("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.left + r.width / 2, r.top + r.height / 2, 0.46 * Math.min(r.width, r.height)]; })()")?;
+    let (cx, cy, k) = (
+        r[0].as_f64().unwrap_or(0.0),
+        r[1].as_f64().unwrap_or(0.0),
+        r[2].as_f64().unwrap_or(0.0),
+    );
+    let t0 = Instant::now();
+    let mut i = 0u64;
+    while t0.elapsed().as_secs_f64() < seconds {
+        let a = i as f64 * 0.05;
+        let rr = 0.4 * k;
+        browsers[0].mouse(
+            "mouseMoved",
+            cx + rr * a.cos(),
+            cy + rr * a.sin(),
+            false,
+            0.0,
+        )?;
+        i += 1;
+        let next = Duration::from_secs_f64(i as f64 / 60.0);
+        if let Some(w) = next.checked_sub(t0.elapsed()) {
+            std::thread::sleep(w);
+        }
+    }
+    let mut fps = Vec::new();
+    let mut audio = Vec::new();
+    let mut parts: [Vec<f64>; 3] = Default::default();
+    let mut out_lat = None;
+    let mut underruns = 0;
+    for b in browsers.iter_mut() {
+        let v = b.eval("(() => { const P = window.__play; return [P.draws, performance.now() - P.drawT0, P.audioLatencyMs, P.outputLatencyS, P.pcm.underruns, P.audioParts]; })()")?;
+        for p in v[5].as_array().into_iter().flatten() {
+            for (k, part) in parts.iter_mut().enumerate() {
+                if let Some(x) = p[k].as_f64() {
+                    part.push(x);
+                }
+            }
+        }
+        fps.push(v[0].as_f64().unwrap_or(0.0) / (v[1].as_f64().unwrap_or(1.0) * 1e-3));
+        if let Some(a) = v[2].as_array() {
+            audio.extend(a.iter().filter_map(Value::as_f64));
+        }
+        out_lat = v[3].as_f64().or(out_lat);
+        underruns += v[4].as_u64().unwrap_or(0);
+        b.check()?;
+    }
+    browsers[0].key("e", true, false)?;
+    browsers[0].key("e", false, false)?;
+    let s = handle
+        .join()
+        .map_err(|_| "the session panicked")?
+        .map_err(|e| e.to_string())?;
+    stop.store(true, Ordering::Relaxed);
+    let _ = std::fs::remove_file(&out);
+    Ok(Outcome {
+        scene,
+        pages,
+        input: s.input_latency_ms,
+        fps,
+        sound: LatencyMs::of(&audio),
+        sound_parts: [
+            LatencyMs::of(&parts[0]),
+            LatencyMs::of(&parts[1]),
+            LatencyMs::of(&parts[2]),
+        ],
+        output_latency_s: out_lat,
+        underruns,
+        ticks: s.stats.ticks,
+        missed: s.stats.missed,
+        tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
+        dropped: s.messages_dropped,
+    })
+}
+
+/// The same session with a Rust WebSocket client as the hand and no browser: what the loop
+/// and the server cost alone on this machine.
+fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
+    let out = std::env::temp_dir().join(format!("nh-play-bench0-{}.mcap", std::process::id()));
+    let mut c = PlayConfig::new(
+        SceneSource::resolve(scene.as_ref()).map_err(|e| e.to_string())?,
+        out.clone(),
+    );
+    c.port = 0;
+    c.keep_serving_s = Some(0.0);
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = std::sync::mpsc::channel();
+    let s2 = stop.clone();
+    let handle = std::thread::spawn(move || {
+        run(&c, &s2, &mut |u| {
+            let _ = tx.send(u.to_string());
+        })
+    });
+    let url = rx
+        .recv_timeout(Duration::from_secs(10))
+        .map_err(|_| "no server")?;
+    let ws_url = format!("{}ws", url.replace("http://", "ws://"));
+    let (mut ws, _) = tungstenite::connect(ws_url.as_str()).map_err(|e| e.to_string())?;
+    if let tungstenite::stream::MaybeTlsStream::Plain(s) = ws.get_ref() {
+        s.set_read_timeout(Some(Duration::from_millis(1)))
+            .map_err(|e| e.to_string())?;
+    }
+    let send = |ws: &mut tungstenite::WebSocket<_>, m: String| {
+        ws.send(tungstenite::Message::text(m))
+            .map_err(|e: tungstenite::Error| e.to_string())
+    };
+    // Wait for the hello, then start.
+    loop {
+        match ws.read() {
+            Ok(tungstenite::Message::Text(t)) if t.as_str().contains("\"hello\"") => break,
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(_)) => {}
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    send(&mut ws, r#"{"type":"start"}"#.into())?;
+    std::thread::sleep(Duration::from_millis(100));
+    let t0 = Instant::now();
+    let mut i = 0u64;
+    while t0.elapsed().as_secs_f64() < seconds {
+        let a = i as f64 * 0.05;
+        let now_ms = haptic_loop::session::now_unix_ns() as f64 * 1e-6;
+        let m = format!(
+            r#"{{"type":"input","seq":{i},"pos":[{},{},0],"buttons":0,"t_ms":{now_ms}}}"#,
+            0.4 * a.cos(),
+            0.4 * a.sin()
+        );
+        send(&mut ws, m)?;
+        // Drain what the server sent (frames, sound) as a page would.
+        while ws.read().is_ok() {}
+        i += 1;
+        let next = Duration::from_secs_f64(i as f64 / 60.0);
+        while t0.elapsed() < next {
+            let _ = ws.read();
+        }
+    }
+    send(&mut ws, r#"{"type":"end"}"#.into())?;
+    let s = loop {
+        let _ = ws.read();
+        if handle.is_finished() {
+            break handle
+                .join()
+                .map_err(|_| "the session panicked")?
+                .map_err(|e| e.to_string())?;
+        }
+    };
+    stop.store(true, Ordering::Relaxed);
+    let _ = std::fs::remove_file(&out);
+    Ok(Outcome {
+        scene,
+        pages: 0,
+        input: s.input_latency_ms,
+        fps: Vec::new(),
+        sound: None,
+        sound_parts: [None, None, None],
+        output_latency_s: None,
+        underruns: 0,
+        ticks: s.stats.ticks,
+        missed: s.stats.missed,
+        tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
+        dropped: s.messages_dropped,
+    })
+}
+
+fn fmt(l: Option<LatencyMs>) -> String {
+    l.map_or("–".into(), |l| {
+        format!("{:.1} / {:.1} / {:.1} (n = {})", l.p50, l.p99, l.max, l.n)
+    })
+}
+
+fn main() {
+    let seconds: f64 = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10.0);
+    // (scene, pages, nice of the browsers)
+    let runs = [
+        ("brickworld", 1, 0),
+        ("nanoworld", 1, 0),
+        ("brickworld", 3, 0),
+        ("brickworld", 3, 19),
+    ];
+    println!(
+        "| scene | pages | input → force p50 / p99 / max (ms) | frames/s drawn (per page) | sound tick → output p50 / p99 / max (ms) | outputLatency (ms) | underruns | ticks | missed deadlines | tick work p99 (µs) | frames dropped |"
+    );
+    println!("|---|---:|---|---|---|---:|---:|---:|---:|---:|---:|");
+    let mut parts = Vec::new();
+    for (scene, pages, nice) in [("brickworld", 0, 0)].into_iter().chain(runs) {
+        let o = if pages == 0 {
+            no_browser(scene, seconds)
+        } else {
+            session(scene, pages, nice, seconds)
+        };
+        let pages = if nice != 0 {
+            format!("{pages} (nice {nice})")
+        } else {
+            pages.to_string()
+        };
+        if let Ok(o) = &o
+            && o.sound.is_some()
+        {
+            parts.push((o.scene, pages.clone(), o.sound_parts));
+        }
+        match o {
+            Ok(o) => println!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {} |",
+                o.scene,
+                pages,
+                fmt(o.input),
+                o.fps
+                    .iter()
+                    .map(|f| format!("{f:.1}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                fmt(o.sound),
+                o.output_latency_s
+                    .map_or("–".into(), |s| format!("{:.1}", s * 1e3)),
+                o.underruns,
+                o.ticks,
+                o.missed,
+                o.tick_p99_us,
+                o.dropped
+            ),
+            Err(e) => {
+                println!("| {scene} | {pages} | failed: {e} |");
+            }
+        }
+    }
+    println!();
+    println!(
+        "| scene | pages | tick → block at the page p50 / p99 (ms) | scheduling lead p50 / p99 (ms) | browser output pipeline p50 / p99 (ms) |"
+    );
+    println!("|---|---:|---|---|---|");
+    for (scene, pages, p) in parts {
+        let f = |l: Option<LatencyMs>| {
+            l.map_or("–".into(), |l| format!("{:.1} / {:.1}", l.p50, l.p99))
+        };
+        println!(
+            "| {scene} | {pages} | {} | {} | {} |",
+            f(p[0]),
+            f(p[1]),
+            f(p[2])
+        );
+    }
+}

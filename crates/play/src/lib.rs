@@ -15,7 +15,7 @@
 //! - **A real device too**: with [`PlayConfig::device`] a device bridged over UDP is the hand
 //!   and the pages only watch and listen.
 //! - **Live sound** ([`publish`]): the same synthesis as `render --audio --proximity`
-//!   ([`render::audio::StreamSynth`]), streamed to the pages in 10 ms blocks.
+//!   ([`render::audio::StreamSynth`]), streamed to the pages in 5 ms blocks.
 //! - **The live menu**: the scene's switches, set from a page and applied before the next tick
 //!   (through [`haptic_loop::runner::Runner::with_live`]), recorded as switches.
 //!

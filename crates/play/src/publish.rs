@@ -5,7 +5,7 @@
 //! **Sound.** The publisher feeds each tick's sounds (the recording's `brick.impact`,
 //! `nano.snap`, `nano.pull_off` events through [`haptic_loop::sound::sound_events`], the mapping
 //! `render --audio` uses) and its `nearest_m` (the proximity tone) to a
-//! [`render::audio::StreamSynth`] and sends the samples as they complete, in blocks of 10 ms.
+//! [`render::audio::StreamSynth`] and sends the samples as they complete, in blocks of 5 ms.
 //! The samples a page receives are therefore those of `nanohaptics render REC --audio OUT.wav
 //! --proximity` for the session's recording, sample for sample, unless that track needed its
 //! anti-clipping scale (the summary's `sound_samples_limited` counts the live samples limited
@@ -26,8 +26,8 @@ use tungstenite::Message;
 
 /// Ticks between two frames (16 ticks: 62.5 frames/s at 1 kHz).
 pub const FRAME_EVERY_TICKS: u64 = 16;
-/// Ticks between two sound blocks (10 ms at 1 kHz).
-pub const SOUND_BLOCK_TICKS: u64 = 10;
+/// Ticks between two sound blocks (5 ms at 1 kHz).
+pub const SOUND_BLOCK_TICKS: u64 = 5;
 /// Sample rate of the live sound, Hz (the default of `render --audio`).
 pub const SAMPLE_RATE_HZ: u32 = render::audio::SAMPLE_RATE_HZ;
 

@@ -4,6 +4,8 @@
 //! tick and the sound samples of `render --audio --proximity`; page errors fail the tests;
 //! screenshots go to docs/figures/play/.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 
 use common::cdp::{Browser, fnv1a};
@@ -155,7 +157,7 @@ fn end_session(b: &mut Browser, s: Session, shot: &str) -> (PlaySummary, Value) 
 }
 
 /// Replays the recording bit for bit and checks the sounds the page got against it.
-fn check_recording(out: &PathBuf, summary: &PlaySummary, page: &Value) {
+fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
     let rec = read_recording_file(out, false).unwrap();
     let report = haptic_loop::replay::verify(&rec).unwrap();
     assert!(report.ok(), "replay diverged: {:?}", report.divergence);

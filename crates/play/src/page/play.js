@@ -8,8 +8,8 @@
   const P = (window.__play = {
     hello: null, role: null, frames: 0, draws: 0, drawT0: 0, lastFrame: null,
     events: [], sounds: [], switched: [], errors: [], ended: null,
-    pcm: { first: -1, samples: 0, hash: 0x811c9dc5, blocks: 0, underruns: 0 },
-    audioLatencyMs: [], outputLatencyS: null, inputsSent: 0,
+    pcm: { first: -1, samples: 0, hash: 0x811c9dc5, blocks: 0, underruns: 0, early: 0, rebased: 0 },
+    audioLatencyMs: [], audioParts: [], outputLatencyS: null, inputsSent: 0,
   });
   // Okabe–Ito: colours that colour-blind players tell apart.
   const OKABE = [[0, 0, 0], [230, 159, 0], [86, 180, 233], [0, 158, 115], [240, 228, 66],
@@ -154,7 +154,7 @@
       } else if (p.k === 'line') {
         const pts = p.p.map((q) => project(q.map((x) => x * s)));
         const z = pts.reduce((a, v) => a + v[2], 0) / Math.max(1, pts.length);
-        items.push({ z: z + 1e3, fn: () => {
+        items.push({ z: -1e9, fn: () => { // outlines on the ground: over the ground, drawn last
           g.beginPath(); pts.forEach((v, k) => (k ? g.lineTo(v[0], v[1]) : g.moveTo(v[0], v[1])));
           if (p.closed) g.closePath();
           g.lineWidth = 2.5; g.strokeStyle = css(p.col, 1, 1); g.setLineDash([10, 6]); g.stroke(); g.setLineDash([]);
@@ -321,7 +321,7 @@
 
   // ---- sound --------------------------------------------------------------------------
   let actx = null, gain = null, muted = false, base = null;
-  const LEAD_S = 0.03;
+  const LEAD_S = 0.02; // jitter buffer: the blocks' arrival jitter on loopback is ~10 ms
   function startAudio() {
     try {
       actx = new AudioContext({ sampleRate: P.hello.sample_rate_hz, latencyHint: 'interactive' });
@@ -349,16 +349,26 @@
       if (base !== null) pc.underruns++;
       base = actx.currentTime + LEAD_S - first / sr;
     }
-    const at = base + first / sr;
+    let at = base + first / sr;
+    // Blocks that keep arriving early (a late first block, clock drift): come back to the lead.
+    const slack = at - actx.currentTime;
+    if (slack > LEAD_S + 0.015) {
+      if (++pc.early > 20) { base -= slack - LEAD_S; at = base + first / sr; pc.early = 0; pc.rebased++; }
+    } else pc.early = 0;
     const src = actx.createBufferSource(); src.buffer = ab; src.connect(gain); src.start(at);
-    // Tick to speaker: when this block's first sample leaves the output, minus its tick's time.
+    // Tick to speaker: when this block's first sample leaves the output (the output timestamp
+    // maps the context's clock to the page's; it already counts the output device's latency),
+    // minus its tick's wall time. Parts: tick → block here, the scheduling lead, and the
+    // browser's output pipeline (the rest).
     if (actx.getOutputTimestamp && wallMs > 0) {
       const ts = actx.getOutputTimestamp();
-      const out = actx.outputLatency || 0;
-      P.outputLatencyS = out;
-      if (ts.performanceTime > 0) {
-        const playWall = performance.timeOrigin + ts.performanceTime + (at - ts.contextTime) * 1000 + out * 1000;
-        if (P.audioLatencyMs.length < 100000) P.audioLatencyMs.push(playWall - wallMs);
+      P.outputLatencyS = actx.outputLatency || 0;
+      if (ts.performanceTime > 0 && P.audioLatencyMs.length < 100000) {
+        const nowWall = performance.timeOrigin + performance.now();
+        const playWall = performance.timeOrigin + ts.performanceTime + (at - ts.contextTime) * 1000;
+        const total = playWall - wallMs, arrive = nowWall - wallMs, lead = (at - actx.currentTime) * 1000;
+        P.audioLatencyMs.push(total);
+        P.audioParts.push([arrive, lead, total - arrive - lead]);
       }
     }
   }

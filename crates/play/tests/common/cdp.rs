@@ -41,6 +41,12 @@ fn chromium() -> Result<PathBuf, String> {
 impl Browser {
     /// Starts a headless browser with a window of `w × h` CSS pixels and opens a blank page.
     pub fn launch(w: u32, h: u32) -> Result<Browser, String> {
+        Self::launch_nice(w, h, 0)
+    }
+
+    /// [`Browser::launch`] at scheduling priority `nice` (0: normal; 19: lowest, through
+    /// `nice -n`).
+    pub fn launch_nice(w: u32, h: u32, nice: i32) -> Result<Browser, String> {
         let exe = chromium()?;
         let dir = std::env::temp_dir().join(format!(
             "nh-chromium-{}-{}",
@@ -48,7 +54,14 @@ impl Browser {
             Instant::now().elapsed().as_nanos() ^ (std::ptr::addr_of!(w) as usize as u128)
         ));
         std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-        let mut child = Command::new(exe)
+        let mut cmd = if nice != 0 {
+            let mut c = Command::new("nice");
+            c.args(["-n", &nice.to_string()]).arg(&exe);
+            c
+        } else {
+            Command::new(&exe)
+        };
+        let mut child = cmd
             .args([
                 "--headless=new",
                 "--remote-debugging-port=0",
@@ -78,8 +91,8 @@ impl Browser {
             }
         });
         let url = rx
-            .recv_timeout(Duration::from_secs(20))
-            .map_err(|_| "chromium printed no DevTools URL within 20 s".to_string())?;
+            .recv_timeout(Duration::from_secs(60))
+            .map_err(|_| "chromium printed no DevTools URL within 60 s".to_string())?;
         let (ws, _) = tungstenite::connect(url.as_str()).map_err(|e| e.to_string())?;
         let mut b = Browser {
             child,
