@@ -1,11 +1,13 @@
 //! The play bench (docs/bench/play.md): real sessions served to headless Chromium pages on
 //! loopback, measured from both ends.
 //!
-//! `cargo run --release -p nanohaptics-play --example play-bench [SECONDS]` runs, each for
-//! SECONDS (default 10) of play:
+//! `cargo run --release -p nanohaptics-play --example play-bench -- [--seconds S] [--out FILE]`
+//! runs, each for S seconds (default 10) of play:
+//! 0. brickworld with a Rust WebSocket client as the hand and no browser (the baseline);
 //! 1. brickworld, one page that plays (the pointer circles at 60 events/s);
 //! 2. nanoworld, one page that plays (the same);
-//! 3. brickworld, one page that plays and two more that watch.
+//! 3. brickworld, one page that plays and two more that watch (and again with the browsers at
+//!    `nice 19`).
 //!
 //! Figures: browser input → force (the page's event time to the tick whose force used it,
 //! from the server), frames drawn per second by each page (requestAnimationFrame draws with a
@@ -240,78 +242,192 @@ fn fmt(l: Option<LatencyMs>) -> String {
     })
 }
 
+fn loadavg() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
 fn main() {
-    let seconds: f64 = std::env::args()
-        .nth(1)
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let opt = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1).cloned())
+    };
+    let seconds: f64 = opt("--seconds")
         .and_then(|s| s.parse().ok())
         .unwrap_or(10.0);
+    let load0 = loadavg();
+    let t0 = Instant::now();
     // (scene, pages, nice of the browsers)
     let runs = [
+        ("brickworld", 0, 0),
         ("brickworld", 1, 0),
         ("nanoworld", 1, 0),
         ("brickworld", 3, 0),
         ("brickworld", 3, 19),
     ];
-    println!(
-        "| scene | pages | input → force p50 / p99 / max (ms) | frames/s drawn (per page) | sound tick → output p50 / p99 / max (ms) | outputLatency (ms) | underruns | ticks | missed deadlines | tick work p99 (µs) | frames dropped |"
-    );
-    println!("|---|---:|---|---|---|---:|---:|---:|---:|---:|---:|");
+    let mut md = String::new();
+    let mut line = |s: String| {
+        println!("{s}");
+        md.push_str(&s);
+        md.push('\n');
+    };
+    let mut rows = Vec::new();
     let mut parts = Vec::new();
-    for (scene, pages, nice) in [("brickworld", 0, 0)].into_iter().chain(runs) {
+    let mut outcomes = Vec::new();
+    for (scene, pages, nice) in runs {
         let o = if pages == 0 {
             no_browser(scene, seconds)
         } else {
             session(scene, pages, nice, seconds)
         };
-        let pages = if nice != 0 {
+        let label = if nice != 0 {
             format!("{pages} (nice {nice})")
         } else {
             pages.to_string()
         };
-        if let Ok(o) = &o
-            && o.sound.is_some()
-        {
-            parts.push((o.scene, pages.clone(), o.sound_parts));
-        }
         match o {
-            Ok(o) => println!(
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {} |",
-                o.scene,
-                pages,
-                fmt(o.input),
-                o.fps
-                    .iter()
-                    .map(|f| format!("{f:.1}"))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                fmt(o.sound),
-                o.output_latency_s
-                    .map_or("–".into(), |s| format!("{:.1}", s * 1e3)),
-                o.underruns,
-                o.ticks,
-                o.missed,
-                o.tick_p99_us,
-                o.dropped
-            ),
-            Err(e) => {
-                println!("| {scene} | {pages} | failed: {e} |");
+            Ok(o) => {
+                if o.sound.is_some() {
+                    parts.push((o.scene, label.clone(), o.sound_parts));
+                }
+                rows.push(format!(
+                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {} |",
+                    o.scene,
+                    label,
+                    fmt(o.input),
+                    if o.fps.is_empty() {
+                        "–".into()
+                    } else {
+                        o.fps
+                            .iter()
+                            .map(|f| format!("{f:.1}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    },
+                    fmt(o.sound),
+                    o.output_latency_s
+                        .map_or("–".into(), |s| format!("{:.1}", s * 1e3)),
+                    o.underruns,
+                    o.ticks,
+                    o.missed,
+                    o.tick_p99_us,
+                    o.dropped
+                ));
+                outcomes.push((label, o));
             }
+            Err(e) => rows.push(format!("| {scene} | {label} | failed: {e} |")),
         }
     }
-    println!();
-    println!(
-        "| scene | pages | tick → block at the page p50 / p99 (ms) | scheduling lead p50 / p99 (ms) | browser output pipeline p50 / p99 (ms) |"
+    let load1 = loadavg();
+    line("## play — the game in a browser (loopback, headless Chromium)".into());
+    line(String::new());
+    line(format!(
+        "Machine: {} cores, shared. Load average (1, 5, 15 min) at start `{load0}`, at end `{load1}`; the report ran {:.0} s. \
+         Command: `cargo run --release -p nanohaptics-play --example play-bench -- --seconds {seconds} --out docs/bench/play.md`.",
+        std::thread::available_parallelism().map_or(0, |n| n.get()),
+        t0.elapsed().as_secs_f64()
+    ));
+    line(String::new());
+    line(format!(
+        "Each row is one real-time session of {seconds} s of the built-in scene at 1 kHz, served by `play::run` on 127.0.0.1 to \
+         Debian's `chromium --headless=new` pages driven through the DevTools Protocol. The first page plays: its pointer circles \
+         at 60 events/s (the page sends each move at once); the other pages watch and listen. Pages 0: a Rust WebSocket client \
+         sends the same moves instead of a browser (the loop and the server alone)."
+    ));
+    line(String::new());
+    line(
+        "- **input → force**: the page's event time (`performance.timeOrigin + event.timeStamp`) to the wall time the force of \
+         the first tick that used it was sent; the server measures it (same machine, same clock; nearest-rank percentiles).".into(),
     );
-    println!("|---|---:|---|---|---|");
+    line(
+        "- **frames/s drawn**: the page's `requestAnimationFrame` draws of a frame in hand over the session (the server sends \
+         62.5 frames/s).".into(),
+    );
+    line(
+        "- **sound tick → output**: for every 5 ms sound block, the wall time its first sample leaves the page's audio output \
+         (its scheduled context time mapped through `AudioContext.getOutputTimestamp()`, which includes the output \
+         device's latency) minus the wall time of that sample's tick. Headless Chromium plays into a fake output device \
+         whose `outputLatency` is reported in the next column.".into(),
+    );
+    line(
+        "- **missed deadlines**: ticks whose force was not ready before the next tick's start (zero force was sent; \
+         recorded, so replay reproduces them).".into(),
+    );
+    line(String::new());
+    line("| scene | pages | input → force p50 / p99 / max (ms) | frames/s drawn (per page) | sound tick → output p50 / p99 / max (ms) | outputLatency (ms) | underruns | ticks | missed deadlines | tick work p99 (µs) | frames dropped |".into());
+    line("|---|---|---|---|---|---:|---:|---:|---:|---:|---:|".into());
+    for r in rows {
+        line(r);
+    }
+    line(String::new());
+    line("Where the sound's latency goes (per block):".into());
+    line(String::new());
+    line("| scene | pages | tick → block at the page p50 / p99 (ms) | scheduling lead p50 / p99 (ms) | browser output pipeline p50 / p99 (ms) |".into());
+    line("|---|---|---|---|---|".into());
     for (scene, pages, p) in parts {
         let f = |l: Option<LatencyMs>| {
             l.map_or("–".into(), |l| format!("{:.1} / {:.1}", l.p50, l.p99))
         };
-        println!(
+        line(format!(
             "| {scene} | {pages} | {} | {} | {} |",
             f(p[0]),
             f(p[1]),
             f(p[2])
-        );
+        ));
+    }
+    line(String::new());
+    let find = |scene: &str, label: &str| {
+        outcomes
+            .iter()
+            .find(|(l, o)| o.scene == scene && l == label)
+            .map(|(_, o)| o)
+    };
+    let verdict = |ok: bool| if ok { "**met**" } else { "**not met**" };
+    if let Some(o) = find("brickworld", "1") {
+        let p99 = o.input.map_or(f64::INFINITY, |l| l.p99);
+        line(format!(
+            "- Browser input → applied force p99 ≤ 20 ms: {} ({p99:.1} ms with one page; {} without a browser).",
+            verdict(p99 <= 20.0),
+            find("brickworld", "0")
+                .and_then(|o| o.input)
+                .map_or("–".into(), |l| format!("{:.1} ms", l.p99))
+        ));
+        let s99 = o.sound.map_or(f64::INFINITY, |l| l.p99);
+        let s50 = o.sound.map_or(f64::INFINITY, |l| l.p50);
+        line(format!(
+            "- Sound within 50 ms of its tick: {} (p50 {s50:.1} ms, p99 {s99:.1} ms, of which the headless output pipeline is the last column above).",
+            verdict(s99 <= 50.0)
+        ));
+    }
+    let fps: Vec<f64> = ["brickworld", "nanoworld"]
+        .iter()
+        .filter_map(|s| find(s, "1"))
+        .flat_map(|o| o.fps.clone())
+        .collect();
+    if !fps.is_empty() {
+        let min = fps.iter().copied().fold(f64::INFINITY, f64::min);
+        line(format!(
+            "- 60 frames/s drawn for the brick and nano worlds: {} (lowest {min:.1} frames/s with one page; {:.1}, rounding 59.5 up).",
+            verdict(min >= 59.5),
+            min
+        ));
+    }
+    if let Some(o) = find("brickworld", "3") {
+        line(format!(
+            "- 0 missed 1 kHz deadlines with three browsers watching one session: {} ({} of {} ticks; {} with no browser on the same machine).",
+            verdict(o.missed == 0),
+            o.missed,
+            o.ticks,
+            find("brickworld", "0").map_or("–".into(), |b| b.missed.to_string())
+        ));
+    }
+    if let Some(path) = opt("--out") {
+        if let Err(e) = std::fs::write(&path, md) {
+            eprintln!("error: cannot write {path}: {e}");
+            std::process::exit(1);
+        }
     }
 }
