@@ -107,7 +107,10 @@
     const s = P.hello.display_scale;
     const items = [];
     const labels = [];
-    for (const p of f.prims) {
+    f.prims.forEach((p, idx) => {
+      // The scenes draw their ground (or substrate) first: it is the background, drawn before
+      // everything (a painter's sort by face centre would put it over what stands far on it).
+      const ground = idx === 0 && p.k === 'box';
       if (p.k === 'box' || p.k === 'slot') {
         const cs = boxGeometry(p, s);
         const pr = cs.map(project);
@@ -127,7 +130,7 @@
             g.beginPath(); for (const [a, b] of EDGES) { g.moveTo(pr[a][0], pr[a][1]); g.lineTo(pr[b][0], pr[b][1]); }
             g.stroke(); g.setLineDash([]);
           } });
-          continue;
+          return;
         }
         for (const fc of FACES) {
           const n = qrot(p.q, fc[4]);
@@ -135,7 +138,7 @@
           if ((c[0] - B.eye[0]) * n[0] + (c[1] - B.eye[1]) * n[1] + (c[2] - B.eye[2]) * n[2] >= 0) continue;
           const z = (pr[fc[0]][2] + pr[fc[1]][2] + pr[fc[2]][2] + pr[fc[3]][2]) / 4;
           const shade = 0.45 + 0.55 * Math.max(0, n[0] * LIGHT[0] + n[1] * LIGHT[1] + n[2] * LIGHT[2]);
-          items.push({ z, fn: () => {
+          items.push({ z: ground ? Infinity : z, fn: () => {
             g.beginPath(); for (let k = 0; k < 4; k++) { const v = pr[fc[k]]; k ? g.lineTo(v[0], v[1]) : g.moveTo(v[0], v[1]); }
             g.closePath(); g.fillStyle = css(p.col, shade); g.fill();
             g.strokeStyle = 'rgba(0,0,0,0.35)'; g.lineWidth = 1; g.stroke();
@@ -170,7 +173,7 @@
           g.fillStyle = css(p.col, 1, 1); g.fillText(p.text, v[0], v[1]);
         });
       }
-    }
+    });
     if (f.cursor_m) {
       // The hand's height: a line down to the ground and a ring where it meets it.
       const c = f.cursor_m.map((x) => x * s);
