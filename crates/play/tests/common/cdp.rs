@@ -48,11 +48,14 @@ impl Browser {
     /// `nice -n`).
     pub fn launch_nice(w: u32, h: u32, nice: i32) -> Result<Browser, String> {
         let exe = chromium()?;
+        // One profile directory per browser: two browsers on one profile would be one browser.
+        static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let dir = std::env::temp_dir().join(format!(
             "nh-chromium-{}-{}",
             std::process::id(),
-            Instant::now().elapsed().as_nanos() ^ (std::ptr::addr_of!(w) as usize as u128)
+            NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
         ));
+        let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
         let mut cmd = if nice != 0 {
             let mut c = Command::new("nice");
