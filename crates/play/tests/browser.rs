@@ -336,7 +336,6 @@ fn a_keyboard_only_session_fills_a_slot() {
     key_to(&mut b, 2, 0.0075);
     b.wait_for("window.__play.lastFrame.state.slots_filled >= 1", 3.0)
         .unwrap();
-    b.screenshot(&figures().join("keyboard.png")).unwrap();
     let out = s.out.clone();
     let (summary, page) = end_session(&mut b, s, "end-keyboard.png");
     assert!(summary.state("slots_filled").unwrap() >= 1.0);
@@ -363,6 +362,34 @@ fn a_keyboard_only_session_fills_a_slot() {
     let rec = read_recording_file(&out, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
     assert!(page["inputsSent"].as_u64().unwrap() > 10);
+}
+
+#[test]
+fn the_nano_world_plays_in_the_page() {
+    let _one = serial();
+    let s = start("nanoworld", "nano");
+    let mut b = browser();
+    open_and_start(&mut b, &s.url, false);
+    let (cx, cy, k) = canvas_geometry(&mut b);
+    // Down towards the substrate and across it.
+    b.mouse("mouseMoved", cx, cy, false, 0.0).unwrap();
+    wheel_to(&mut b, cx, cy, -0.012, 20, 1.0, false);
+    for i in 0..=30 {
+        let f = f64::from(i) / 30.0;
+        b.mouse("mouseMoved", cx + 0.3 * k * f, cy - 0.2 * k * f, false, 0.0)
+            .unwrap();
+        sleep(Duration::from_millis(30));
+    }
+    sleep(Duration::from_millis(300));
+    b.screenshot(&figures().join("nano.png")).unwrap();
+    let drawn = b.eval("window.__play.draws").unwrap().as_u64().unwrap();
+    assert!(drawn > 30, "{drawn} draws");
+    let out = s.out.clone();
+    let (summary, page) = end_session(&mut b, s, "end-nano.png");
+    assert!(summary.stats.ticks > 1500);
+    assert_eq!(page["hello"]["kind"], "nanoworld");
+    let rec = read_recording_file(&out, false).unwrap();
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }
 
 #[test]
