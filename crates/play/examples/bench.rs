@@ -424,6 +424,18 @@ fn main() {
             find("brickworld", "0").map_or("–".into(), |b| b.missed.to_string())
         ));
     }
+    line(String::new());
+    line(
+        "Notes. The sound's own path (tick → block at the page, then the page's 20 ms jitter buffer, re-based when \
+         blocks keep arriving early) is the first two columns of the second table; the rest is the browser's output \
+         pipeline, here headless Chromium's fake output device (its `outputLatency` of 32 ms is counted in it); a \
+         real sound card's latency takes its place. Missed deadlines: the real-time loop waits for each period by \
+         sleeping and then spinning on one core; on this shared 2-core machine the browsers (software rendering, no \
+         GPU), the DevTools driver of this bench and other jobs take the cores too, so the tick thread is preempted \
+         (the row with no browser is the loop and the server alone). A missed deadline sends zero force that tick and \
+         is recorded, so the session still replays bit for bit. The deadline target needs a core the browsers do not \
+         share.".into(),
+    );
     if let Some(path) = opt("--out") {
         if let Err(e) = std::fs::write(&path, md) {
             eprintln!("error: cannot write {path}: {e}");
