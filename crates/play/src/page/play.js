@@ -257,7 +257,11 @@
       hand.n[0] *= m; hand.n[1] *= m;
     }
   }
-  canvas.addEventListener('pointermove', (e) => {
+  // pointerrawupdate (where the browser has it) is not held back to the next animation frame
+  // as pointermove is: the hand reaches the server up to a frame sooner.
+  const MOVE_EVENT = 'onpointerrawupdate' in window ? 'pointerrawupdate' : 'pointermove';
+  P.moveEvent = MOVE_EVENT;
+  canvas.addEventListener(MOVE_EVENT, (e) => {
     if (dragOrbit) {
       cam.yaw -= (e.clientX - dragOrbit[0]) * 0.01;
       cam.pitch = Math.max(-0.1, Math.min(1.5, cam.pitch + (e.clientY - dragOrbit[1]) * 0.01));
