@@ -228,3 +228,27 @@ fn a_bridged_device_is_the_hand_and_the_page_watches() {
     let rec = read_recording_file(&out, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }
+
+#[test]
+fn a_busy_port_and_a_bad_length_are_named() {
+    let busy = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = busy.local_addr().unwrap().port();
+    let mut c = PlayConfig::new(
+        SceneSource::resolve("brickworld".as_ref()).unwrap(),
+        std::env::temp_dir().join("nh-play-busy.mcap"),
+    );
+    c.port = port;
+    let stop = AtomicBool::new(false);
+    let e = run(&c, &stop, &mut |_| {}).unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!("cannot serve the page on 127.0.0.1:{port}: ")),
+        "{e}"
+    );
+    assert!(e.ends_with("(choose another with --port, or --port 0 for any free port)"));
+    c.port = 0;
+    c.seconds = Some(-1.0);
+    assert_eq!(
+        run(&c, &stop, &mut |_| {}).unwrap_err().to_string(),
+        "session length -1 s is out of range (allowed: 0 < seconds ≤ 3600)"
+    );
+}
