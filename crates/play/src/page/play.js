@@ -359,7 +359,7 @@
     let at = base + first / sr;
     // Blocks that keep arriving early (a late first block, clock drift): come back to the lead.
     const slack = at - actx.currentTime;
-    if (slack > LEAD_S + 0.015) {
+    if (slack > LEAD_S + 0.008) {
       if (++pc.early > 20) { base -= slack - LEAD_S; at = base + first / sr; pc.early = 0; pc.rebased++; }
     } else pc.early = 0;
     const src = actx.createBufferSource(); src.buffer = ab; src.connect(gain); src.start(at);
