@@ -16,6 +16,12 @@ python3 scripts/layering.py
 step "cargo clippy (warnings are errors)"
 cargo clippy --workspace --all-targets --release -- -D warnings
 
+step "chromium for the browser tests (crates/play/tests/browser.rs)"
+if ! command -v chromium >/dev/null; then
+  sudo_=""; [ "$(id -u)" = 0 ] || sudo_="sudo"
+  $sudo_ apt-get update -q && $sudo_ apt-get install -y -q chromium
+fi
+
 step "cargo test (release profile)"
 cargo test --workspace --release
 

@@ -16,6 +16,7 @@
 //! Exit status: 0 success, 1 error (bad input, unreadable file), 2 replay diverged.
 
 mod lesson_cmd;
+mod play_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
@@ -92,6 +93,9 @@ enum Cmd {
     /// The macro-vs-nano lesson: run both house tasks and the lesson's experiments, write a
     /// Markdown report with figures (`--out DIR`).
     Lesson(lesson_cmd::LessonArgs),
+    /// Play the teaching game in a browser: serves one page on loopback (pointer, keyboard or
+    /// gamepad as the hand, live sound, the menu, the score) and records the session.
+    Play(play_cmd::PlayArgs),
     /// Run every scene with its default script, record, verify, and summarise.
     Demo {
         /// Folder of scene files (default: `./scenes` if it exists, else the built-in scenes,
@@ -865,6 +869,7 @@ fn main() -> ExitCode {
         } => cmd_replay(&rec, verify, salvage, json),
         Cmd::Info { rec, salvage, json } => cmd_info(&rec, salvage, json),
         Cmd::Lesson(a) => lesson_cmd::cmd(&a),
+        Cmd::Play(a) => play_cmd::cmd(&a),
         Cmd::Demo { scenes, out, json } => cmd_demo(scenes.as_deref(), &out, json),
         Cmd::Scenes { action, dir } => cmd_scenes(action.as_deref(), dir.as_deref()),
         Cmd::FakeDevice(a) => cmd_fake(a),

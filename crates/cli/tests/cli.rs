@@ -281,6 +281,110 @@ fn a_bridged_live_session_against_fake_device_replays_bit_for_bit() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("identical bit for bit"));
 }
 
+/// `nanohaptics play` with a bridged device as the hand: it prints the page's address before
+/// the device's hello, serves the page, records the session, keeps the end screen up until
+/// Ctrl-C, and the recording replays bit for bit.
+#[test]
+fn play_serves_the_page_and_records_a_bridged_session() {
+    let _quiet = alone();
+    use std::io::{BufRead, Read, Write};
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let rec = tmp("play.mcap");
+    let mut play = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args([
+            "play",
+            "brickworld",
+            "--port",
+            "0",
+            "--seconds",
+            "1",
+            "--out",
+        ])
+        .arg(&rec)
+        .args(["--device", &format!("udp:127.0.0.1:{port}")])
+        .current_dir(root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = std::io::BufReader::new(play.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    let url = line
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no address in {line:?}"));
+    // The page is served before any device is there.
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut tcp = std::net::TcpStream::connect(addr).unwrap();
+    write!(
+        tcp,
+        "GET / HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    // Read the head, then the body by its Content-Length (the server may keep the socket).
+    tcp.set_read_timeout(Some(std::time::Duration::from_secs(10)))
+        .unwrap();
+    let mut resp = std::io::BufReader::new(tcp);
+    let mut page = String::new();
+    let mut len = 0;
+    loop {
+        let mut h = String::new();
+        resp.read_line(&mut h).unwrap();
+        if let Some(v) = h.to_ascii_lowercase().strip_prefix("content-length:") {
+            len = v.trim().parse().unwrap();
+        }
+        page.push_str(&h);
+        if h == "\r\n" {
+            break;
+        }
+    }
+    let mut body = vec![0; len];
+    resp.read_exact(&mut body).unwrap();
+    page.push_str(&String::from_utf8_lossy(&body));
+    assert!(
+        page.starts_with("HTTP/1.1 200"),
+        "{}",
+        &page[..page.len().min(200)]
+    );
+    assert!(page.contains("<canvas"), "the page has no canvas");
+    let dev = nh(&[
+        "fake-device",
+        &format!("udp:127.0.0.1:{port}"),
+        "--seconds",
+        "3",
+    ]);
+    assert!(
+        dev.status.success(),
+        "{}",
+        String::from_utf8_lossy(&dev.stderr)
+    );
+    // The end screen stays up until Ctrl-C; then the program says how the session went.
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    assert!(
+        play.try_wait().unwrap().is_none(),
+        "play ended before Ctrl-C"
+    );
+    let pid = play.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert!(play.wait().unwrap().success());
+    line.clear();
+    out.read_line(&mut line).unwrap();
+    assert!(line.starts_with("completed: 1000 ticks"), "{line}");
+    let o = nh(&["replay", rec.to_str().unwrap(), "--verify"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+}
+
 /// Issue 22 over the bridge: a modelled Falcon held loosely carries the first brick of the
 /// brick script for real (4 s, real time) with no force change above 1 N between periods,
 /// the motors taking energy from the hand rather than giving it, and the session replays bit

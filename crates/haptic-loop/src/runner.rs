@@ -69,12 +69,17 @@ pub enum EndReason {
     Stopped,
 }
 
+/// What a live session does before each tick's step (see [`Runner::with_live`]): called with
+/// the tick's index and the loop.
+pub type LiveHook<'a> = dyn FnMut(u64, &mut HapticLoop) + 'a;
+
 /// Runs ticks of a loop against a device and hands each to the sinks.
 pub struct Runner<'s> {
     sinks: Vec<&'s mut dyn Sink>,
     stop: Option<&'s AtomicBool>,
     sink_ns: Vec<DurationHistogram>,
     switches: Vec<(u64, Switch)>,
+    live: Option<&'s mut LiveHook<'s>>,
 }
 
 /// Time each sink took per tick (its `tick` call), ns.
@@ -95,6 +100,7 @@ impl<'s> Runner<'s> {
             stop: None,
             sink_ns: vec![DurationHistogram::new(); n],
             switches: Vec::new(),
+            live: None,
         }
     }
 
@@ -104,6 +110,15 @@ impl<'s> Runner<'s> {
     pub fn with_switches(mut self, mut switches: Vec<(u64, Switch)>) -> Self {
         switches.sort_by_key(|(t, _)| *t);
         self.switches = switches;
+        self
+    }
+
+    /// Calls `hook(tick, loop)` before each tick's step, after that tick's scheduled switches:
+    /// a live session applies there what arrived since the last tick (a menu's switches, through
+    /// [`HapticLoop::switch`], which records them as the tick's input on `/scene/switch`, so a
+    /// replay applies them, as scheduled switches, on the same tick).
+    pub fn with_live(mut self, hook: &'s mut LiveHook<'s>) -> Self {
+        self.live = Some(hook);
         self
     }
 
@@ -182,6 +197,9 @@ impl<'s> Runner<'s> {
             for (_, sw) in self.switches[due..].iter().take_while(|(t, _)| *t == n) {
                 lp.switch(&sw.name, sw.value)
                     .map_err(|error| RunError::Switch { tick: n, error })?;
+            }
+            if let Some(hook) = self.live.as_mut() {
+                hook(n, lp);
             }
             lp.tick(sample, recorded_missed);
             let missed = match &pacing {

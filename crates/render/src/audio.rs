@@ -162,6 +162,33 @@ fn peak_of(sound: &Sound) -> f64 {
     }
 }
 
+/// The samples one sound adds to the track: its first sample index and `g · wave(k / sr)` for
+/// each sample `k` of its voice (`None` for a sound that adds nothing). `index` is the sound's
+/// place in the session's list of sounds (it seeds the noise of impacts).
+fn event_samples(e: &SoundEvent, index: usize, sr: f64) -> Option<(usize, Vec<f64>)> {
+    if !(e.t_s.is_finite() && e.t_s >= 0.0) {
+        return None;
+    }
+    let a = peak_of(&e.sound);
+    if a == 0.0 {
+        return None;
+    }
+    let start = (e.t_s * sr).round() as usize;
+    let (len_s, mut wave) = voice(&e.sound, index as u64 + 1);
+    let len = (len_s * sr).ceil() as usize;
+    // Normalise the waveform's peak to 1 (it depends on the timbre only).
+    let mut norm = 0.0f64;
+    let samples: Vec<f64> = (0..len)
+        .map(|k| {
+            let v = wave(k as f64 / sr);
+            norm = norm.max(v.abs());
+            v
+        })
+        .collect();
+    let g = if norm > 0.0 { a / norm } else { 0.0 };
+    Some((start, samples.iter().map(|v| g * v).collect()))
+}
+
 /// Synthesises `duration_s` of sound at `sample_rate_hz`: the events, and the proximity tone
 /// when given. Deterministic; |sample| ≤ [`CEILING`].
 pub fn synthesize(
@@ -188,29 +215,11 @@ pub fn synthesize(
     let n = (duration_s * sr).round() as usize;
     let mut out = vec![0.0f64; n];
     for (i, e) in events.iter().enumerate() {
-        if !(e.t_s.is_finite() && e.t_s >= 0.0) {
-            continue;
-        }
-        let a = peak_of(&e.sound);
-        if a == 0.0 {
-            continue;
-        }
-        let start = (e.t_s * sr).round() as usize;
-        let (len_s, mut wave) = voice(&e.sound, i as u64 + 1);
-        let len = (len_s * sr).ceil() as usize;
-        // Normalise the waveform's peak to 1 (it depends on the timbre only).
-        let mut norm = 0.0f64;
-        let samples: Vec<f64> = (0..len)
-            .map(|k| {
-                let v = wave(k as f64 / sr);
-                norm = norm.max(v.abs());
-                v
-            })
-            .collect();
-        let g = if norm > 0.0 { a / norm } else { 0.0 };
-        for (k, v) in samples.iter().enumerate() {
-            if let Some(o) = out.get_mut(start + k) {
-                *o += g * v;
+        if let Some((start, samples)) = event_samples(e, i, sr) {
+            for (k, v) in samples.iter().enumerate() {
+                if let Some(o) = out.get_mut(start + k) {
+                    *o += v;
+                }
             }
         }
     }
@@ -222,26 +231,24 @@ pub fn synthesize(
     Ok(out.iter().map(|v| (v * scale) as f32).collect())
 }
 
-/// Adds the proximity tone: pitch and amplitude interpolated linearly between tick centres,
-/// phase continuous.
-fn tone(out: &mut [f64], p: &Proximity, sr: f64) {
-    if p.distance_m.is_empty() || p.dt_s.is_nan() || p.dt_s <= 0.0 {
-        return;
-    }
-    let at = |i: usize| -> (f64, f64) {
-        match p
-            .distance_m
-            .get(i)
-            .and_then(|d| tone_hz(*d, p.on_distance_m))
-        {
-            Some(f) => (f, TONE_AMPLITUDE),
-            None => (0.0, 0.0),
+/// The proximity tone's running state: phase (rad) and the pitch last sounded (Hz).
+#[derive(Clone, Copy, Debug)]
+struct ToneState {
+    phase: f64,
+    last_f: f64,
+}
+
+impl ToneState {
+    fn new() -> Self {
+        ToneState {
+            phase: 0.0,
+            last_f: 220.0,
         }
-    };
-    let mut phase = 0.0f64;
-    let mut last_f = 220.0;
-    for (k, o) in out.iter_mut().enumerate() {
-        let t = k as f64 / sr / p.dt_s;
+    }
+
+    /// The tone's sample `k`; `at(i)` is (pitch Hz, amplitude) at tick `i` ((0, 0): silent).
+    fn sample(&mut self, k: usize, sr: f64, dt_s: f64, at: &dyn Fn(usize) -> (f64, f64)) -> f64 {
+        let t = k as f64 / sr / dt_s;
         let i = t.floor() as usize;
         let w = t - t.floor();
         let ((f0, a0), (f1, a1)) = (at(i), at(i + 1));
@@ -251,11 +258,183 @@ fn tone(out: &mut [f64], p: &Proximity, sr: f64) {
             (true, true) => f0 * (1.0 - w) + f1 * w,
             (true, false) => f0,
             (false, true) => f1,
-            (false, false) => last_f,
+            (false, false) => self.last_f,
         };
-        last_f = f;
-        phase = (phase + std::f64::consts::TAU * f / sr) % std::f64::consts::TAU;
-        *o += amp * phase.sin();
+        self.last_f = f;
+        self.phase = (self.phase + std::f64::consts::TAU * f / sr) % std::f64::consts::TAU;
+        amp * self.phase.sin()
+    }
+}
+
+/// Pitch and amplitude of the tone at distance `d` ((0, 0) when silent).
+fn tone_at(d: Option<f64>, on_distance_m: f64) -> (f64, f64) {
+    match d.and_then(|d| tone_hz(d, on_distance_m)) {
+        Some(f) => (f, TONE_AMPLITUDE),
+        None => (0.0, 0.0),
+    }
+}
+
+/// Adds the proximity tone: pitch and amplitude interpolated linearly between tick centres,
+/// phase continuous.
+fn tone(out: &mut [f64], p: &Proximity, sr: f64) {
+    if p.distance_m.is_empty() || p.dt_s.is_nan() || p.dt_s <= 0.0 {
+        return;
+    }
+    let at = |i: usize| tone_at(p.distance_m.get(i).copied(), p.on_distance_m);
+    let mut state = ToneState::new();
+    for (k, o) in out.iter_mut().enumerate() {
+        *o += state.sample(k, sr, p.dt_s, &at);
+    }
+}
+
+/// The same synthesis as [`synthesize`], fed tick by tick during a live session: the sounds
+/// and distances of each tick go in as the tick ends, and every sample whose inputs are all
+/// known comes out.
+///
+/// A streamed track equals [`synthesize`]'s over the same sounds, distances and duration
+/// sample for sample (the same `f64` sums in the same order, then the cast to `f32`), as long
+/// as the whole track needs no anti-clipping scale (its peak ≤ [`CEILING`]). When it does, the
+/// offline track is scaled as a whole, which a live stream cannot know in advance: the
+/// streamed samples beyond ±[`CEILING`] are limited to it instead, and
+/// [`StreamSynth::limited`] counts them.
+///
+/// Latency: sample `k` needs the distance of the tick after the one it falls in (the tone is
+/// interpolated between tick centres), so it comes out at most two ticks after its time.
+#[derive(Debug)]
+pub struct StreamSynth {
+    sr: f64,
+    dt_s: f64,
+    on_distance_m: Option<f64>,
+    /// Sounds placed so far (the next one's index).
+    placed: usize,
+    /// Index of the next sample to emit.
+    next_sample: usize,
+    /// Sums of the sounds from `next_sample` on (grown as sounds are placed).
+    pending: std::collections::VecDeque<f64>,
+    /// Distances of ticks `base_tick ..`, m (non-finite: nothing near).
+    distances: std::collections::VecDeque<f64>,
+    base_tick: usize,
+    ticks: usize,
+    tone: ToneState,
+    limited: u64,
+}
+
+impl StreamSynth {
+    /// A stream at `sample_rate_hz` (8000–192000) for ticks of `dt_s` s (> 0, finite); with
+    /// `proximity_on_distance_m`, the proximity tone sounds below that distance, m.
+    pub fn new(
+        sample_rate_hz: u32,
+        dt_s: f64,
+        proximity_on_distance_m: Option<f64>,
+    ) -> Result<Self, RenderError> {
+        if !(8_000..=192_000).contains(&sample_rate_hz) {
+            return Err(RenderError::OutOfRange {
+                field: "sample_rate_hz".into(),
+                value: f64::from(sample_rate_hz),
+                allowed: "8000–192000 Hz",
+            });
+        }
+        if !(dt_s.is_finite() && dt_s > 0.0 && dt_s <= 1.0) {
+            return Err(RenderError::OutOfRange {
+                field: "dt_s".into(),
+                value: dt_s,
+                allowed: "0 < dt_s ≤ 1 s",
+            });
+        }
+        Ok(StreamSynth {
+            sr: f64::from(sample_rate_hz),
+            dt_s,
+            on_distance_m: proximity_on_distance_m,
+            placed: 0,
+            next_sample: 0,
+            pending: std::collections::VecDeque::new(),
+            distances: std::collections::VecDeque::new(),
+            base_tick: 0,
+            ticks: 0,
+            tone: ToneState::new(),
+            limited: 0,
+        })
+    }
+
+    /// Places a sound (call for each sound of a tick, in order, before [`StreamSynth::tick`]
+    /// of that tick). A sound whose onset was already emitted loses its emitted part.
+    pub fn push(&mut self, e: &SoundEvent) {
+        let i = self.placed;
+        self.placed += 1;
+        let Some((start, samples)) = event_samples(e, i, self.sr) else {
+            return;
+        };
+        for (k, v) in samples.iter().enumerate() {
+            let Some(rel) = (start + k).checked_sub(self.next_sample) else {
+                continue;
+            };
+            if self.pending.len() <= rel {
+                self.pending.resize(rel + 1, 0.0);
+            }
+            self.pending[rel] += v;
+        }
+    }
+
+    /// Ends a tick with its distance to the nearest object, m (ignored without the tone), and
+    /// appends the samples now complete to `out`.
+    pub fn tick(&mut self, distance_m: f64, out: &mut Vec<f32>) {
+        self.distances.push_back(distance_m);
+        self.ticks += 1;
+        self.emit(None, out);
+    }
+
+    /// Ends the stream after `duration_s` s (the offline track's length: `ticks · dt_s`) and
+    /// appends the remaining samples to `out`.
+    pub fn finish(&mut self, duration_s: f64, out: &mut Vec<f32>) {
+        let n = (duration_s * self.sr).round() as usize;
+        self.emit(Some(n), out);
+    }
+
+    /// Samples emitted so far.
+    pub fn emitted(&self) -> usize {
+        self.next_sample
+    }
+
+    /// Samples limited to ±[`CEILING`] so far (0 when the stream equals the offline track).
+    pub fn limited(&self) -> u64 {
+        self.limited
+    }
+
+    fn emit(&mut self, end: Option<usize>, out: &mut Vec<f32>) {
+        let (sr, dt) = (self.sr, self.dt_s);
+        loop {
+            let k = self.next_sample;
+            if end.is_some_and(|n| k >= n) {
+                break;
+            }
+            let t = k as f64 / sr / dt;
+            let i = t.floor() as usize;
+            // The tone reads ticks i and i + 1: wait for both (unless the stream ended).
+            if end.is_none() && i + 1 >= self.ticks {
+                break;
+            }
+            let mut v = self.pending.pop_front().unwrap_or(0.0);
+            if let Some(on) = self.on_distance_m {
+                let base = self.base_tick;
+                let d = &self.distances;
+                let at = |j: usize| {
+                    let d = j.checked_sub(base).and_then(|r| d.get(r).copied());
+                    tone_at(d, on)
+                };
+                v += self.tone.sample(k, sr, dt, &at);
+            }
+            if v.abs() > CEILING {
+                self.limited += 1;
+                v = CEILING.copysign(v);
+            }
+            out.push(v as f32);
+            self.next_sample += 1;
+            // Drop distances no later sample reads.
+            while self.base_tick < i && !self.distances.is_empty() {
+                self.distances.pop_front();
+                self.base_tick += 1;
+            }
+        }
     }
 }
 
@@ -393,5 +572,124 @@ mod tests {
         let r = hound::WavReader::open(&p).unwrap();
         assert_eq!(r.spec().sample_rate, SAMPLE_RATE_HZ);
         assert_eq!(r.len() as usize, s.len());
+    }
+
+    #[test]
+    fn the_stream_equals_the_offline_track_sample_for_sample() {
+        // 3 s at 1 kHz ticks: overlapping sounds of every kind (one at tick 0, two on one
+        // tick, one near the end cut by the duration) and a cursor that nears and leaves.
+        let dt = 1e-3;
+        let ticks = 3000usize;
+        let d: Vec<f64> = (0..ticks)
+            .map(|i| match i {
+                0..=399 => f64::INFINITY,
+                400..=1999 => 0.15 - 0.1 * (i as f64 * 3e-3).sin().abs(),
+                _ => 0.5,
+            })
+            .collect();
+        let at = |tick: u64, sound: Sound| SoundEvent {
+            t_s: tick as f64 * dt,
+            sound,
+        };
+        let events = vec![
+            at(0, Sound::Snap { amplitude: 0.3 }),
+            at(
+                417,
+                Sound::Impact {
+                    kind: Impact::BrickGround,
+                    amplitude: 0.5,
+                },
+            ),
+            at(
+                417,
+                Sound::Impact {
+                    kind: Impact::Cursor,
+                    amplitude: 0.2,
+                },
+            ),
+            at(
+                430,
+                Sound::Impact {
+                    kind: Impact::BrickBrick,
+                    amplitude: 0.25,
+                },
+            ),
+            at(1201, Sound::PullOff { amplitude: 0.4 }),
+            at(
+                2990,
+                Sound::Impact {
+                    kind: Impact::BrickGround,
+                    amplitude: 0.6,
+                },
+            ),
+        ];
+        for sr in [SAMPLE_RATE_HZ, 48_000, 8_000] {
+            let p = Proximity {
+                dt_s: dt,
+                distance_m: d.clone(),
+                on_distance_m: 0.1,
+            };
+            let offline = synthesize(&events, Some(&p), ticks as f64 * dt, sr).unwrap();
+            let mut s = StreamSynth::new(sr, dt, Some(0.1)).unwrap();
+            let mut out = Vec::new();
+            for (i, di) in d.iter().enumerate() {
+                for e in events.iter().filter(|e| (e.t_s / dt).round() as usize == i) {
+                    s.push(e);
+                }
+                s.tick(*di, &mut out);
+                // Never more than two ticks behind.
+                assert!(out.len() as f64 >= (i as f64 - 1.0) * dt * f64::from(sr) - 1.0);
+            }
+            s.finish(ticks as f64 * dt, &mut out);
+            assert_eq!(s.limited(), 0);
+            assert_eq!(out.len(), offline.len());
+            let differ = out
+                .iter()
+                .zip(&offline)
+                .filter(|(a, b)| a.to_bits() != b.to_bits());
+            assert_eq!(differ.count(), 0, "at {sr} Hz");
+            assert!(out.iter().any(|v| *v != 0.0));
+        }
+        // Without the tone as well.
+        let offline = synthesize(&events, None, 1.0, SAMPLE_RATE_HZ).unwrap();
+        let mut s = StreamSynth::new(SAMPLE_RATE_HZ, dt, None).unwrap();
+        let mut out = Vec::new();
+        for i in 0..1000 {
+            for e in events.iter().filter(|e| (e.t_s / dt).round() as usize == i) {
+                s.push(e);
+            }
+            s.tick(0.0, &mut out);
+        }
+        s.finish(1.0, &mut out);
+        assert_eq!(out, offline);
+        assert_eq!(
+            StreamSynth::new(100, dt, None).unwrap_err().to_string(),
+            "sample_rate_hz = 100 is out of range: allowed 8000–192000 Hz"
+        );
+        assert_eq!(
+            StreamSynth::new(SAMPLE_RATE_HZ, 0.0, None)
+                .unwrap_err()
+                .to_string(),
+            "dt_s = 0 is out of range: allowed 0 < dt_s ≤ 1 s"
+        );
+    }
+
+    #[test]
+    fn a_stream_too_loud_is_limited_and_says_so() {
+        let loud: Vec<SoundEvent> = (0..20).map(|_| impact(0.01, 10.0)).collect();
+        let mut s = StreamSynth::new(SAMPLE_RATE_HZ, 1e-3, None).unwrap();
+        let mut out = Vec::new();
+        for i in 0..100 {
+            if i == 10 {
+                for e in &loud {
+                    s.push(e);
+                }
+            }
+            s.tick(0.0, &mut out);
+        }
+        s.finish(0.1, &mut out);
+        assert!(s.limited() > 0);
+        let peak = out.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        assert_eq!(f64::from(peak), CEILING as f32 as f64);
     }
 }

@@ -1,0 +1,57 @@
+//! `nanohaptics play`: the teaching game in a browser (the `play` crate serves the page).
+
+use haptic_devices::BridgeConfig;
+use haptic_loop::session::SceneSource;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `nanohaptics play`.
+#[derive(clap::Args, Debug)]
+pub struct PlayArgs {
+    /// Scene file or built-in scene name (brickworld, nanoworld, wall, optical_tweezers).
+    #[arg(default_value = "brickworld")]
+    pub scene: PathBuf,
+    /// Loopback port of the page and its WebSocket (0: any free port).
+    #[arg(long, default_value_t = play::DEFAULT_PORT)]
+    pub port: u16,
+    /// A real device over the UDP bridge (udp:HOST:PORT) as the hand; the page is then the
+    /// view and the sound.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// The session's recording (MCAP), also offered for download on the end screen.
+    #[arg(long, default_value = "play.mcap")]
+    pub out: PathBuf,
+    /// Session length, s (0 < s ≤ 3600); without it the session ends when the player ends it
+    /// on the page or presses Ctrl-C.
+    #[arg(long)]
+    pub seconds: Option<f64>,
+}
+
+/// Runs `nanohaptics play`: prints the page's address, runs the session, prints its figures.
+/// After the session the end screen and the download stay up until Ctrl-C.
+pub fn cmd(a: &PlayArgs) -> Result<ExitCode, String> {
+    let scene = SceneSource::resolve(&a.scene).map_err(|e| e.to_string())?;
+    let mut c = play::PlayConfig::new(scene, a.out.clone());
+    c.port = a.port;
+    c.seconds = a.seconds;
+    c.device = a
+        .device
+        .as_deref()
+        .map(BridgeConfig::parse)
+        .transpose()
+        .map_err(|e| e.to_string())?;
+    let stop = crate::interrupt_flag()?;
+    let s = play::run(&c, &stop, &mut |url| {
+        println!("open {url} in a browser (Ctrl-C ends the session)");
+    })
+    .map_err(|e| e.to_string())?;
+    println!(
+        "{}: {} ticks, {} missed deadlines, score {}, recording {}",
+        s.end,
+        s.stats.ticks,
+        s.stats.missed,
+        s.state("score").unwrap_or(0.0),
+        s.recording.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,616 @@
+//! One loopback port for the page (HTTP) and its live link (WebSocket on `/ws`), on plain
+//! threads: one accepting, one per connection. Nothing here runs on the tick thread: the tick
+//! hands its data to the publisher thread ([`crate::publish`]), which queues it for each page
+//! (bounded queues; a page that cannot keep up loses frames, never the tick's time).
+
+use crate::input::{SharedInput, page_to_device};
+use crate::protocol::{self, PageMsg, ProtocolError};
+use haptic_loop::scene::SwitchSpec;
+use std::io::{Read, Write};
+use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::Duration;
+use tungstenite::protocol::Role;
+use tungstenite::{Message, WebSocket};
+
+const INDEX_HTML: &str = include_str!("page/index.html");
+const PLAY_JS: &str = include_str!("page/play.js");
+const PLAY_CSS: &str = include_str!("page/play.css");
+
+/// Messages queued per page before frames are dropped.
+pub const PAGE_QUEUE: usize = 512;
+
+/// What the scene offers the page, known once the scene is built.
+#[derive(Clone, Debug)]
+pub struct SceneLink {
+    /// The switches of the menu.
+    pub switches: &'static [SwitchSpec],
+    /// The scene kind (for switch errors).
+    pub kind: &'static str,
+    /// Workspace radius of the device, m.
+    pub workspace_radius_m: f64,
+    /// Bits of the device's buttons.
+    pub button_mask: u32,
+    /// Whether the page is the hand (false: a bridged device is).
+    pub page_is_hand: bool,
+}
+
+/// A switch asked for by a page: (page id, name as the scene names it, value).
+pub type SwitchRequest = (u64, String, f64);
+
+/// State shared by the server's threads, the tick's live hook and the publisher.
+#[derive(Default)]
+pub struct Shared {
+    /// The `hello` message (JSON) for pages, once the scene is known.
+    pub hello: Mutex<Option<String>>,
+    /// The scene's link to the pages, once built.
+    pub scene: Mutex<Option<SceneLink>>,
+    /// The `end` message (JSON) once the session ended.
+    pub end: Mutex<Option<String>>,
+    /// The finished recording, served on `/recording.mcap`.
+    pub recording: Mutex<Option<PathBuf>>,
+    /// The page's hand.
+    pub input: Arc<SharedInput>,
+    /// Switches waiting for the next tick.
+    pub switches: Mutex<Vec<SwitchRequest>>,
+    /// The player asked to end the session.
+    pub end_requested: AtomicBool,
+    /// The page that is the hand, if any.
+    pub player: Mutex<Option<u64>>,
+    /// Pages connected now.
+    pub pages: Mutex<Vec<Page>>,
+    /// Pages ever connected.
+    pub pages_served: AtomicU64,
+    /// Messages dropped because a page's queue was full.
+    pub dropped: AtomicU64,
+    /// Page messages refused (protocol or switch errors).
+    pub refused: AtomicU64,
+    shutdown: AtomicBool,
+    next_id: AtomicU64,
+}
+
+/// A connected page's outgoing queue.
+pub struct Page {
+    /// Its id.
+    pub id: u64,
+    tx: SyncSender<Message>,
+}
+
+impl Shared {
+    /// Queues `m` for every page (dropped for a page whose queue is full).
+    pub fn broadcast(&self, m: &Message) {
+        if let Ok(pages) = self.pages.lock() {
+            for p in pages.iter() {
+                self.queue(p, m.clone());
+            }
+        }
+    }
+
+    /// Queues `m` for page `id`.
+    pub fn send_to(&self, id: u64, m: Message) {
+        if let Ok(pages) = self.pages.lock()
+            && let Some(p) = pages.iter().find(|p| p.id == id)
+        {
+            self.queue(p, m);
+        }
+    }
+
+    fn queue(&self, p: &Page, m: Message) {
+        if let Err(TrySendError::Full(_)) = p.tx.try_send(m) {
+            self.dropped.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    fn error_to(&self, id: u64, field: &str, message: &str) {
+        self.refused.fetch_add(1, Ordering::Relaxed);
+        let m = serde_json::json!({"type": "error", "field": field, "message": message});
+        self.send_to(id, Message::text(m.to_string()));
+    }
+}
+
+/// The running server.
+pub struct Server {
+    addr: SocketAddr,
+    shared: Arc<Shared>,
+    accept: Option<JoinHandle<()>>,
+}
+
+impl Server {
+    /// Binds `127.0.0.1:port` (0: any free port) and starts serving.
+    pub fn start(port: u16, shared: Arc<Shared>) -> std::io::Result<Server> {
+        let listener = TcpListener::bind(("127.0.0.1", port))?;
+        listener.set_nonblocking(true)?;
+        let addr = listener.local_addr()?;
+        let sh = shared.clone();
+        let accept = std::thread::Builder::new()
+            .name("play-accept".into())
+            .spawn(move || accept_loop(listener, sh))?;
+        Ok(Server {
+            addr,
+            shared,
+            accept: Some(accept),
+        })
+    }
+
+    /// The address served.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// The page's URL.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.addr)
+    }
+
+    /// Stops accepting, closes the pages and joins the threads.
+    pub fn stop(&mut self) {
+        self.shared.shutdown.store(true, Ordering::Relaxed);
+        if let Some(h) = self.accept.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
+
+fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
+    let mut conns: Vec<JoinHandle<()>> = Vec::new();
+    while !shared.shutdown.load(Ordering::Relaxed) {
+        match listener.accept() {
+            Ok((stream, _)) => {
+                let sh = shared.clone();
+                if let Ok(h) = std::thread::Builder::new()
+                    .name("play-conn".into())
+                    .spawn(move || connection(stream, sh))
+                {
+                    conns.push(h);
+                }
+                conns.retain(|h| !h.is_finished());
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            Err(_) => std::thread::sleep(Duration::from_millis(5)),
+        }
+    }
+    for h in conns {
+        let _ = h.join();
+    }
+}
+
+/// A request's head: method, path and headers (names lower-cased).
+struct Head {
+    method: String,
+    path: String,
+    headers: Vec<(String, String)>,
+}
+
+impl Head {
+    fn header(&self, name: &str) -> Option<&str> {
+        self.headers
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+fn read_head(stream: &mut TcpStream) -> Option<Head> {
+    stream.set_read_timeout(Some(Duration::from_secs(5))).ok()?;
+    let mut buf = Vec::with_capacity(1024);
+    let mut byte = [0u8; 1];
+    while !buf.ends_with(b"\r\n\r\n") {
+        if buf.len() > 16 * 1024 || stream.read(&mut byte).ok()? == 0 {
+            return None;
+        }
+        buf.push(byte[0]);
+    }
+    let text = String::from_utf8(buf).ok()?;
+    let mut lines = text.split("\r\n");
+    let mut first = lines.next()?.split(' ');
+    let method = first.next()?.to_string();
+    let path = first.next()?.to_string();
+    let headers = lines
+        .filter_map(|l| l.split_once(':'))
+        .map(|(n, v)| (n.trim().to_ascii_lowercase(), v.trim().to_string()))
+        .collect();
+    Some(Head {
+        method,
+        path,
+        headers,
+    })
+}
+
+fn respond(stream: &mut TcpStream, status: &str, ctype: &str, extra: &str, body: &[u8]) {
+    let head = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n{extra}Connection: close\r\n\r\n",
+        body.len()
+    );
+    let _ = stream.write_all(head.as_bytes());
+    let _ = stream.write_all(body);
+    let _ = stream.flush();
+}
+
+fn connection(mut stream: TcpStream, shared: Arc<Shared>) {
+    let _ = stream.set_nodelay(true);
+    let Some(head) = read_head(&mut stream) else {
+        return;
+    };
+    if head.method != "GET" {
+        respond(
+            &mut stream,
+            "405 Method Not Allowed",
+            "text/plain",
+            "",
+            b"GET only\n",
+        );
+        return;
+    }
+    let path = head.path.split('?').next().unwrap_or("/");
+    match path {
+        "/" | "/index.html" => respond(
+            &mut stream,
+            "200 OK",
+            "text/html; charset=utf-8",
+            "",
+            INDEX_HTML.as_bytes(),
+        ),
+        "/play.js" => respond(
+            &mut stream,
+            "200 OK",
+            "text/javascript; charset=utf-8",
+            "",
+            PLAY_JS.as_bytes(),
+        ),
+        "/play.css" => respond(
+            &mut stream,
+            "200 OK",
+            "text/css; charset=utf-8",
+            "",
+            PLAY_CSS.as_bytes(),
+        ),
+        "/favicon.ico" => respond(&mut stream, "204 No Content", "image/x-icon", "", b""),
+        "/recording.mcap" => {
+            let file = shared.recording.lock().ok().and_then(|r| r.clone());
+            match file.map(|p| (std::fs::read(&p), p)) {
+                Some((Ok(bytes), p)) => {
+                    let name = p
+                        .file_name()
+                        .map(|n| n.to_string_lossy().replace('"', ""))
+                        .unwrap_or_else(|| "recording.mcap".into());
+                    respond(
+                        &mut stream,
+                        "200 OK",
+                        "application/octet-stream",
+                        &format!("Content-Disposition: attachment; filename=\"{name}\"\r\n"),
+                        &bytes,
+                    );
+                }
+                Some((Err(e), _)) => respond(
+                    &mut stream,
+                    "500 Internal Server Error",
+                    "text/plain",
+                    "",
+                    format!("cannot read the recording: {e}\n").as_bytes(),
+                ),
+                None => respond(
+                    &mut stream,
+                    "404 Not Found",
+                    "text/plain",
+                    "",
+                    b"the recording is served once the session has ended\n",
+                ),
+            }
+        }
+        "/ws" => {
+            let key = head.header("sec-websocket-key").map(str::to_string);
+            let upgrade = head
+                .header("upgrade")
+                .is_some_and(|u| u.eq_ignore_ascii_case("websocket"));
+            match key {
+                Some(k) if upgrade => {
+                    let accept = tungstenite::handshake::derive_accept_key(k.as_bytes());
+                    let resp = format!(
+                        "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
+                    );
+                    if stream.write_all(resp.as_bytes()).is_ok() {
+                        page_link(stream, &shared);
+                    }
+                }
+                _ => respond(
+                    &mut stream,
+                    "400 Bad Request",
+                    "text/plain",
+                    "",
+                    b"a WebSocket upgrade is expected here\n",
+                ),
+            }
+        }
+        _ => respond(
+            &mut stream,
+            "404 Not Found",
+            "text/plain",
+            "",
+            b"not found\n",
+        ),
+    }
+}
+
+/// Handles one page message from page `id`.
+fn on_message(shared: &Shared, id: u64, text: &str) {
+    let link = shared.scene.lock().ok().and_then(|s| s.clone());
+    let mask = link.as_ref().map_or(0, |l| l.button_mask);
+    let msg = match protocol::parse(text, mask) {
+        Ok(m) => m,
+        Err(e) => return shared.error_to(id, e.field(), &e.to_string()),
+    };
+    let is_player = |sh: &Shared| sh.player.lock().map(|p| *p == Some(id)).unwrap_or(false);
+    match msg {
+        PageMsg::Start => {
+            if link.as_ref().is_some_and(|l| l.page_is_hand)
+                && let Ok(mut p) = shared.player.lock()
+                && p.is_none()
+            {
+                *p = Some(id);
+            }
+            let role = role_of(shared, id, link.as_ref());
+            shared.send_to(
+                id,
+                Message::text(serde_json::json!({"type": "role", "role": role}).to_string()),
+            );
+        }
+        PageMsg::Input(i) => {
+            let Some(l) = link else {
+                return shared.error_to(id, "type", "the session has not started yet");
+            };
+            if !l.page_is_hand {
+                return shared.error_to(
+                    id,
+                    "type",
+                    "a device is the hand in this session: the page only watches",
+                );
+            }
+            if !is_player(shared) {
+                return shared.error_to(id, "type", "another page is the hand: this page watches");
+            }
+            shared.input.set(
+                page_to_device(i.pos, l.workspace_radius_m),
+                i.buttons,
+                i.t_ms,
+            );
+        }
+        PageMsg::Switch { name, value } => {
+            let Some(l) = link else {
+                return shared.error_to(id, "switch.name", "the session has not started yet");
+            };
+            match haptic_types::switch::check(l.kind, l.switches, &name, value) {
+                Ok(spec) => {
+                    if let Ok(mut q) = shared.switches.lock() {
+                        q.push((id, spec.name.to_string(), value));
+                    }
+                }
+                Err(e) => {
+                    let field = match e {
+                        haptic_loop::scene::SwitchError::Unknown { .. } => "switch.name",
+                        _ => "switch.value",
+                    };
+                    shared.error_to(id, field, &e.to_string());
+                }
+            }
+        }
+        PageMsg::End => {
+            if is_player(shared) || link.as_ref().is_some_and(|l| !l.page_is_hand) {
+                shared.end_requested.store(true, Ordering::Relaxed);
+            } else {
+                shared.error_to(id, "type", "only the page that plays can end the session");
+            }
+        }
+    }
+}
+
+fn role_of(shared: &Shared, id: u64, link: Option<&SceneLink>) -> &'static str {
+    match link {
+        Some(l) if !l.page_is_hand => "view",
+        _ if shared
+            .player
+            .lock()
+            .map(|p| *p == Some(id))
+            .unwrap_or(false) =>
+        {
+            "hand"
+        }
+        _ => "view",
+    }
+}
+
+/// A page's WebSocket: reads its messages, writes its queue.
+fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
+    let id = shared.next_id.fetch_add(1, Ordering::Relaxed) + 1;
+    shared.pages_served.fetch_add(1, Ordering::Relaxed);
+    let (tx, rx): (SyncSender<Message>, Receiver<Message>) = sync_channel(PAGE_QUEUE);
+    // The greeting first: the hello (or that the session waits), and the end if it is over.
+    let hello = shared.hello.lock().ok().and_then(|h| h.clone());
+    let _ = tx.try_send(Message::text(hello.unwrap_or_else(|| {
+        serde_json::json!({"type": "waiting", "for": "the device's hello"}).to_string()
+    })));
+    if let Some(end) = shared.end.lock().ok().and_then(|e| e.clone()) {
+        let _ = tx.try_send(Message::text(end));
+    }
+    if let Ok(mut pages) = shared.pages.lock() {
+        pages.push(Page { id, tx });
+    }
+    let _ = stream.set_read_timeout(Some(Duration::from_millis(2)));
+    let mut ws = WebSocket::from_raw_socket(stream, Role::Server, None);
+    'link: while !shared.shutdown.load(Ordering::Relaxed) {
+        match ws.read() {
+            Ok(Message::Text(t)) => on_message(shared, id, t.as_str()),
+            Ok(Message::Binary(_)) => {
+                shared.error_to(id, "type", &ProtocolError::Binary.to_string());
+            }
+            Ok(Message::Close(_)) => break,
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e))
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(_) => break,
+        }
+        let mut wrote = false;
+        while let Ok(m) = rx.try_recv() {
+            match ws.write(m) {
+                Ok(()) => wrote = true,
+                Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                    wrote = true;
+                }
+                Err(_) => break 'link,
+            }
+        }
+        if wrote && ws.flush().is_err() {
+            let _ = ws.flush();
+        }
+    }
+    let _ = ws.close(None);
+    let _ = ws.flush();
+    if let Ok(mut pages) = shared.pages.lock() {
+        pages.retain(|p| p.id != id);
+    }
+    if let Ok(mut p) = shared.player.lock()
+        && *p == Some(id)
+    {
+        *p = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic_loop::scene::brick::BRICK_SWITCHES;
+
+    fn shared(page_is_hand: bool) -> (Arc<Shared>, Receiver<Message>, Receiver<Message>) {
+        let sh = Arc::new(Shared::default());
+        *sh.scene.lock().unwrap() = Some(SceneLink {
+            switches: &BRICK_SWITCHES,
+            kind: "brickworld",
+            workspace_radius_m: 0.04,
+            button_mask: 0b1111,
+            page_is_hand,
+        });
+        let (t1, r1) = sync_channel(16);
+        let (t2, r2) = sync_channel(16);
+        sh.pages.lock().unwrap().push(Page { id: 1, tx: t1 });
+        sh.pages.lock().unwrap().push(Page { id: 2, tx: t2 });
+        (sh, r1, r2)
+    }
+
+    fn last_error(rx: &Receiver<Message>) -> serde_json::Value {
+        let mut last = serde_json::Value::Null;
+        while let Ok(m) = rx.try_recv() {
+            if let Message::Text(t) = m {
+                last = serde_json::from_str(t.as_str()).unwrap();
+            }
+        }
+        last
+    }
+
+    #[test]
+    fn switches_are_checked_before_they_reach_the_tick() {
+        let (sh, r1, _) = shared(true);
+        on_message(&sh, 1, r#"{"type":"switch","name":"gravity","value":1}"#);
+        let e = last_error(&r1);
+        assert_eq!(e["field"], "switch.name");
+        assert_eq!(
+            e["message"],
+            "the brickworld scene has no switch `gravity` (its switches: gravity_m_per_s2, \
+             restitution, friction, inertia, brick_mass_kg)"
+        );
+        on_message(&sh, 1, r#"{"type":"switch","name":"friction","value":11}"#);
+        let e = last_error(&r1);
+        assert_eq!(e["field"], "switch.value");
+        assert_eq!(
+            e["message"],
+            "switch `friction` = 11 is out of range (allowed: 0 ≤ value ≤ 10)"
+        );
+        on_message(&sh, 1, r#"{"type":"switch","name":"inertia","value":0.5}"#);
+        assert_eq!(last_error(&r1)["field"], "switch.value");
+        assert!(sh.switches.lock().unwrap().is_empty());
+        // Good ones wait for the tick, the old name under the switch's own.
+        on_message(
+            &sh,
+            2,
+            r#"{"type":"switch","name":"gravity_m_s2","value":0}"#,
+        );
+        on_message(
+            &sh,
+            1,
+            r#"{"type":"switch","name":"friction","value":0.25}"#,
+        );
+        assert_eq!(
+            *sh.switches.lock().unwrap(),
+            vec![
+                (2, "gravity_m_per_s2".to_string(), 0.0),
+                (1, "friction".to_string(), 0.25)
+            ]
+        );
+        assert_eq!(sh.refused.load(Ordering::Relaxed), 3);
+    }
+
+    #[test]
+    fn the_first_page_to_start_is_the_hand_and_the_others_watch() {
+        let (sh, r1, r2) = shared(true);
+        on_message(&sh, 2, r#"{"type":"start"}"#);
+        on_message(&sh, 1, r#"{"type":"start"}"#);
+        assert_eq!(last_error(&r2)["role"], "hand");
+        assert_eq!(last_error(&r1)["role"], "view");
+        let input = r#"{"type":"input","seq":1,"pos":[0.5,0,-0.5],"buttons":1,"t_ms":1}"#;
+        on_message(&sh, 1, input);
+        assert_eq!(
+            last_error(&r1)["message"],
+            "another page is the hand: this page watches"
+        );
+        assert_eq!(sh.input.latest().0.count, 0);
+        on_message(&sh, 2, input);
+        let (l, at) = sh.input.latest();
+        assert!(at.is_some());
+        assert_eq!((l.count, l.buttons, l.t_ms), (1, 1, 1.0));
+        assert_eq!(l.position_m, page_to_device([0.5, 0.0, -0.5], 0.04));
+        // Only the hand ends the session.
+        on_message(&sh, 1, r#"{"type":"end"}"#);
+        assert!(!sh.end_requested.load(Ordering::Relaxed));
+        on_message(&sh, 2, r#"{"type":"end"}"#);
+        assert!(sh.end_requested.load(Ordering::Relaxed));
+        // Bad input is answered with its field and range, and changes nothing.
+        on_message(
+            &sh,
+            2,
+            r#"{"type":"input","seq":2,"pos":[0,0,2],"buttons":0,"t_ms":1}"#,
+        );
+        let e = last_error(&r2);
+        assert_eq!(e["field"], "input.pos[2]");
+        assert_eq!(sh.input.latest().0.count, 1);
+    }
+
+    #[test]
+    fn with_a_device_as_the_hand_the_pages_only_watch() {
+        let (sh, r1, _) = shared(false);
+        on_message(&sh, 1, r#"{"type":"start"}"#);
+        assert_eq!(last_error(&r1)["role"], "view");
+        on_message(
+            &sh,
+            1,
+            r#"{"type":"input","seq":1,"pos":[0,0,0],"buttons":0,"t_ms":1}"#,
+        );
+        assert_eq!(
+            last_error(&r1)["message"],
+            "a device is the hand in this session: the page only watches"
+        );
+        assert_eq!(sh.input.latest().0.count, 0);
+    }
+}

@@ -1,0 +1,2 @@
+//! Helpers shared by the browser tests and the play bench.
+pub mod cdp;

@@ -1,0 +1,254 @@
+//! The server without a browser: its HTTP paths, the watchdog when the page goes quiet, and a
+//! bridged device as the hand with a page that watches (served before the device's hello).
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::bridge::fake::{FakeConfig, run_fake};
+use haptic_devices::script::Script;
+use haptic_devices::{DeviceModel, FALCON};
+use haptic_loop::session::{SceneSource, read_arrays};
+use play::{PlayConfig, PlayError, PlaySummary, run};
+use recording::read_recording_file;
+use serde_json::Value;
+use std::io::{Read, Write};
+use std::net::{TcpStream, UdpSocket};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::{Message, WebSocket};
+
+type Ws = WebSocket<MaybeTlsStream<TcpStream>>;
+
+fn start(
+    scene: &str,
+    name: &str,
+    device: Option<BridgeConfig>,
+) -> (
+    String,
+    Arc<AtomicBool>,
+    JoinHandle<Result<PlaySummary, PlayError>>,
+    PathBuf,
+) {
+    let out = std::env::temp_dir().join(format!("nh-play-srv-{}-{name}.mcap", std::process::id()));
+    let mut c = PlayConfig::new(SceneSource::resolve(scene.as_ref()).unwrap(), out.clone());
+    c.port = 0;
+    c.device = device;
+    c.keep_serving_s = Some(0.0);
+    let stop = Arc::new(AtomicBool::new(false));
+    let s2 = stop.clone();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let h = std::thread::spawn(move || {
+        run(&c, &s2, &mut |u| {
+            let _ = tx.send(u.to_string());
+        })
+    });
+    let url = rx.recv_timeout(Duration::from_secs(10)).unwrap();
+    (url, stop, h, out)
+}
+
+fn http(url: &str, request: &str) -> String {
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.write_all(request.as_bytes()).unwrap();
+    let mut out = String::new();
+    s.read_to_string(&mut out).unwrap();
+    out
+}
+
+fn page(url: &str) -> Ws {
+    let ws_url = format!("{}ws", url.replace("http://", "ws://"));
+    let (ws, _) = tungstenite::connect(ws_url.as_str()).unwrap();
+    if let MaybeTlsStream::Plain(s) = ws.get_ref() {
+        s.set_read_timeout(Some(Duration::from_millis(5))).unwrap();
+    }
+    ws
+}
+
+/// The text messages that arrive within `secs`.
+fn read_for(ws: &mut Ws, secs: f64) -> Vec<Value> {
+    let t0 = Instant::now();
+    let mut out = Vec::new();
+    while t0.elapsed().as_secs_f64() < secs {
+        if let Ok(Message::Text(t)) = ws.read() {
+            out.push(serde_json::from_str(t.as_str()).unwrap());
+        }
+    }
+    out
+}
+
+fn send(ws: &mut Ws, v: Value) {
+    ws.send(Message::text(v.to_string())).unwrap();
+}
+
+#[test]
+fn the_page_is_served_on_its_paths_only() {
+    let (url, stop, h, _) = start("brickworld", "http", None);
+    let get = |path: &str| http(&url, &format!("GET {path} HTTP/1.1\r\nHost: x\r\n\r\n"));
+    let index = get("/");
+    assert!(
+        index.starts_with("HTTP/1.1 200 OK\r\nContent-Type: text/html"),
+        "{index}"
+    );
+    assert!(index.contains("<canvas id=\"view\""));
+    assert!(get("/play.js").starts_with("HTTP/1.1 200 OK\r\nContent-Type: text/javascript"));
+    assert!(get("/play.css").starts_with("HTTP/1.1 200 OK\r\nContent-Type: text/css"));
+    assert!(get("/favicon.ico").starts_with("HTTP/1.1 204"));
+    let rec = get("/recording.mcap");
+    assert!(rec.starts_with("HTTP/1.1 404"));
+    assert!(rec.ends_with("the recording is served once the session has ended\n"));
+    assert!(get("/etc/passwd").starts_with("HTTP/1.1 404"));
+    assert!(get("/ws").starts_with("HTTP/1.1 400"));
+    let post = http(
+        &url,
+        "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\n\r\n",
+    );
+    assert!(post.starts_with("HTTP/1.1 405"));
+    // Loopback only.
+    assert!(url.starts_with("http://127.0.0.1:"));
+    stop.store(true, Ordering::Relaxed);
+    assert!(matches!(h.join().unwrap(), Err(PlayError::NotStarted)));
+}
+
+#[test]
+fn the_watchdog_takes_the_force_down_when_the_page_goes_quiet() {
+    let (url, _stop, h, out) = start("wall", "watchdog", None);
+    let mut ws = page(&url);
+    let hello = read_for(&mut ws, 0.3);
+    assert_eq!(hello[0]["type"], "hello");
+    assert_eq!(hello[0]["page_is_hand"], true);
+    send(&mut ws, serde_json::json!({"type": "start"}));
+    let press = |ws: &mut Ws, seq: u64| {
+        let t_ms = haptic_loop::session::now_unix_ns() as f64 * 1e-6;
+        send(
+            ws,
+            serde_json::json!({"type": "input", "seq": seq, "pos": [0.0, 0.0, -0.25], "buttons": 0, "t_ms": t_ms}),
+        );
+    };
+    let mut seq = 0;
+    // Pressing into the wall for 0.8 s, silent for 0.6 s, pressing again for 0.6 s.
+    for (secs, talk) in [(0.8, true), (0.6, false), (0.6, true)] {
+        let t0 = Instant::now();
+        while t0.elapsed().as_secs_f64() < secs {
+            if talk {
+                seq += 1;
+                press(&mut ws, seq);
+            }
+            let _ = read_for(&mut ws, 0.02);
+        }
+    }
+    send(&mut ws, serde_json::json!({"type": "end"}));
+    let msgs = read_for(&mut ws, 0.5);
+    assert!(msgs.iter().any(|m| m["type"] == "end"));
+    let s = h.join().unwrap().unwrap();
+    assert_eq!(s.end, "ended");
+    let a = read_arrays(&out, false).unwrap();
+    let first = |name: &str| a.events.iter().find(|e| e.1 == name).map(|e| e.0);
+    let (late, lost, back) = (
+        first("device.sample_late").unwrap(),
+        first("device.lost").unwrap(),
+        first("device.resumed").unwrap(),
+    );
+    assert!(late < lost && lost < back, "{late} {lost} {back}");
+    // Zero force from the loss to the return; the watchdog's ramp takes at most 10 ticks.
+    assert!(lost - late <= 10, "{late} {lost}");
+    let fz = |t: u64| a.device_force_n[t as usize][2];
+    assert!(
+        fz(late - 1) > 1.0,
+        "pressed into the wall: {}",
+        fz(late - 1)
+    );
+    assert!((lost..back).all(|t| fz(t) == 0.0));
+    assert!(a.state.len() > 1500);
+    let rec = read_recording_file(&out, false).unwrap();
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
+}
+
+#[test]
+fn a_bridged_device_is_the_hand_and_the_page_watches() {
+    let port = UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let mut b = BridgeConfig::parse(&format!("udp:127.0.0.1:{port}")).unwrap();
+    b.wait_s = 30.0;
+    let (url, _stop, h, out) = start("wall", "bridged", Some(b));
+    // The page is served before the device's hello: it is told what the session waits for.
+    let mut ws = page(&url);
+    let first = read_for(&mut ws, 0.3);
+    assert_eq!(first[0]["type"], "waiting");
+    assert_eq!(first[0]["for"], "the device's hello");
+    let text = SceneSource::builtin("wall").unwrap().scripts[0].1.clone();
+    let fake = FakeConfig {
+        target: format!("127.0.0.1:{port}").parse().unwrap(),
+        model: DeviceModel::Falcon,
+        script: Script::from_toml(&text, &FALCON).unwrap(),
+        hand: None,
+        physical: None,
+        loss: 0.0,
+        jitter_s: 0.0,
+        latency_s: 0.0,
+        seed: 1,
+        seconds: Some(2.0),
+        outage: None,
+        wait_s: 20.0,
+        bye: true,
+    };
+    let dev = std::thread::spawn(move || run_fake(&fake, None));
+    let msgs = read_for(&mut ws, 0.6);
+    let hello = msgs.iter().find(|m| m["type"] == "hello").unwrap();
+    assert_eq!(hello["page_is_hand"], false);
+    send(&mut ws, serde_json::json!({"type": "start"}));
+    send(
+        &mut ws,
+        serde_json::json!({"type": "input", "seq": 1, "pos": [0, 0, 0], "buttons": 0, "t_ms": 1}),
+    );
+    let mut msgs = read_for(&mut ws, 2.5);
+    dev.join().unwrap().unwrap();
+    let s = h.join().unwrap().unwrap();
+    msgs.extend(read_for(&mut ws, 0.2));
+    assert_eq!(s.end, "device_ended");
+    assert!(
+        msgs.iter()
+            .any(|m| m["type"] == "role" && m["role"] == "view")
+    );
+    assert!(msgs.iter().any(|m| m["type"] == "error"
+        && m["message"] == "a device is the hand in this session: the page only watches"));
+    let frames = msgs.iter().filter(|m| m["type"] == "frame").count();
+    assert!(
+        frames as u64 * 16 >= s.stats.ticks / 2,
+        "{frames} frames for {} ticks",
+        s.stats.ticks
+    );
+    assert!(s.input_latency_ms.is_none());
+    let rec = read_recording_file(&out, false).unwrap();
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
+}
+
+#[test]
+fn a_busy_port_and_a_bad_length_are_named() {
+    let busy = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = busy.local_addr().unwrap().port();
+    let mut c = PlayConfig::new(
+        SceneSource::resolve("brickworld".as_ref()).unwrap(),
+        std::env::temp_dir().join("nh-play-busy.mcap"),
+    );
+    c.port = port;
+    let stop = AtomicBool::new(false);
+    let e = run(&c, &stop, &mut |_| {}).unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!("cannot serve the page on 127.0.0.1:{port}: ")),
+        "{e}"
+    );
+    assert!(e.ends_with("(choose another with --port, or --port 0 for any free port)"));
+    c.port = 0;
+    c.seconds = Some(-1.0);
+    assert_eq!(
+        run(&c, &stop, &mut |_| {}).unwrap_err().to_string(),
+        "session length -1 s is out of range (allowed: 0 < seconds ≤ 3600)"
+    );
+}
