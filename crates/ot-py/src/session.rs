@@ -432,3 +432,80 @@ pub fn render_audio<'py>(
     })?;
     Ok((PyArray1::from_vec(py, s.samples), rate))
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use haptic_devices::OperatorParams;
+    use haptic_loop::session::{OperatorChoice, SceneSource, resolve};
+    use toml::Value;
+
+    #[test]
+    fn operator_names_are_the_command_lines() {
+        assert_eq!(
+            OperatorChoice::parse("rigid").unwrap(),
+            OperatorChoice::Rigid
+        );
+        assert_eq!(
+            OperatorChoice::parse("hand").unwrap(),
+            OperatorChoice::ScriptHand
+        );
+        assert_eq!(
+            OperatorChoice::parse("hand:stiffness_n_per_m=100,yield_force_n=0.5").unwrap(),
+            OperatorChoice::Hand(OperatorParams {
+                stiffness_n_per_m: 100.0,
+                yield_force_n: 0.5,
+                ..OperatorParams::default()
+            })
+        );
+        let err = |s: &str| OperatorChoice::parse(s).unwrap_err().to_string();
+        assert_eq!(
+            err("script"),
+            "operator `script` is not one of: rigid, hand, hand:key=value,..."
+        );
+        assert_eq!(
+            err("hand:mass_kg=20"),
+            "script: `mass_kg` = 20 is out of range (allowed: 0.01 ≤ mass_kg ≤ 10)"
+        );
+    }
+
+    #[test]
+    fn overrides_go_to_the_scene_or_the_simulated_hand_by_name() {
+        let wall = SceneSource::builtin("wall").unwrap();
+        let ov = [
+            (
+                "operator.stiffness_n_per_m".to_string(),
+                Value::Float(150.0),
+            ),
+            ("loop.rate_hz".to_string(), Value::Integer(2000)),
+        ];
+        let r = resolve(wall.clone(), None, &ov, None).unwrap();
+        assert!(
+            r.source
+                .text
+                .starts_with("# scene with overrides: loop.rate_hz = 2000\n")
+        );
+        assert!(
+            r.script
+                .starts_with("# script with overrides: operator.stiffness_n_per_m = 150.0\n")
+        );
+        assert_eq!(r.file.loop_.rate_hz, 2000);
+        // No overrides: the files as written, the scene's device.
+        let r = resolve(wall.clone(), None, &[], None).unwrap();
+        assert_eq!(r.source.text, wall.text);
+        assert_eq!(r.model, haptic_loop::DeviceModel::Falcon);
+        // A range error: the scene's own, naming the field.
+        let e = resolve(
+            wall,
+            None,
+            &[ov[1].clone(), ("loop.rate_hz".into(), Value::Integer(999))],
+            None,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("scene: `loop.rate_hz` = 999 is out of range"),
+            "{e}"
+        );
+    }
+}
