@@ -57,7 +57,7 @@ def test_an_operator_name_runs_the_same_session_in_python_and_on_the_command_lin
     "name, message",
     [
         ("script", "operator `script` is not one of: rigid, hand, hand:key=value,..."),
-        ("hand:stiffness_n_per_m=0", "script: `stiffness_n_per_m` = 0 is out of range (allowed: 1 ≤ stiffness_n_per_m ≤ 10000)"),
+        ("hand:stiffness_n_per_m=0", "script: `stiffness_n_per_m` = 0 is out of range: allowed 1 ≤ stiffness_n_per_m ≤ 10000"),
     ],
 )
 def test_a_refused_operator_name_is_refused_alike(name, message):

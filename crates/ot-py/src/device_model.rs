@@ -94,7 +94,7 @@ impl DeviceModel {
     ) -> PyResult<()> {
         if !(dt_s.is_finite() && dt_s > 0.0 && dt_s <= 1.0) {
             return Err(value_err(format!(
-                "dt_s = {dt_s} is out of range (allowed: 0 < dt_s ≤ 1 s)"
+                "dt_s = {dt_s} is out of range: allowed 0 < dt_s ≤ 1 s"
             )));
         }
         let f = vec3_arg(force, "force")?;
@@ -223,7 +223,7 @@ pub fn check_closed_loop<'py>(
         && !(s.is_finite() && s > 0.0 && s <= 3600.0)
     {
         return Err(value_err(format!(
-            "seconds = {s} is out of range (allowed: 0 < seconds ≤ 3600)"
+            "seconds = {s} is out of range: allowed 0 < seconds ≤ 3600"
         )));
     }
     let r = crate::session::resolve(scene, script, None, None)?;

@@ -465,7 +465,7 @@ mod tests {
         );
         assert_eq!(
             err("hand:mass_kg=20"),
-            "script: `mass_kg` = 20 is out of range (allowed: 0.01 ≤ mass_kg ≤ 10)"
+            "script: `mass_kg` = 20 is out of range: allowed 0.01 ≤ mass_kg ≤ 10"
         );
     }
 
