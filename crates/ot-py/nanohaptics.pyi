@@ -212,8 +212,9 @@ def working_envelope_3d(
 # ---------------------------------------------------------------- nano world
 
 NanoParams = Union[Literal["game", "physical"], dict, None]
-Member = Tuple[Literal["tip", "atom"], Optional[int]]
-Target = Tuple[Literal["substrate_atom", "substrate_plane", "atom"], Optional[int]]
+# serde's form of nanoworld's Member and Target, as in a recording's event detail.
+Member = Union[Literal["tip"], Dict[Literal["atom"], int]]
+Target = Union[Literal["substrate_plane"], Dict[Literal["substrate_atom", "atom"], int]]
 
 class NanoWorld:
     """The nano world of the teaching game: AFM tip (the cursor) over fixed
@@ -233,7 +234,8 @@ class NanoWorld:
         """The device limits in world units: {"max_force_n", "max_stiffness_n_per_m"}."""
     def step(self, position: ArrayLike, dt_s: float = 1e-3) -> dict:
         """One tick: {"force": (3,) N, "unlimited_force": (3,) N,
-        "saturated": bool, "events": list[dict]}."""
+        "saturated": bool, "events": list[dict]} (events in serde's form of
+        nanoworld::Event, as a recording's event detail)."""
     def run(self, positions: ArrayLike, dt_s: float = 1e-3) -> dict:
         """One tick per row of (T, 3) cursor positions (m): {"force" (T, 3) N,
         "unlimited_force" (T, 3) N, "saturated" (T,) bool, "tip" (T, 3) m,
@@ -368,7 +370,9 @@ class BrickWorld:
     @property
     def held_brick(self) -> Optional[int]: ...
     @property
-    def touching(self) -> list[dict]: ...
+    def touching(self) -> list[Union[str, dict]]:
+        """What the cursor touches, as the events name it: "ground", {"brick": id},
+        {"obstacle": k}."""
     @property
     def slots(self) -> list[dict]: ...
     @property
@@ -403,7 +407,7 @@ def run_scene(
     *,
     script: Optional[PathLike] = None,
     seconds: Optional[float] = None,
-    operator: Union[Literal["script", "rigid", "hand"], dict, None] = None,
+    operator: Union[Literal["hand", "rigid"], str, dict, None] = None,
     device: Union[Literal["falcon", "touch"], str, None] = None,
     out: Optional[PathLike] = None,
     wait_s: float = 120.0,
@@ -581,7 +585,7 @@ def sweep(
     workers: Optional[int] = None,
     script: Optional[PathLike] = None,
     seconds: Optional[float] = None,
-    operator: Union[Literal["script", "rigid", "hand"], dict, None] = None,
+    operator: Union[Literal["hand", "rigid"], str, dict, None] = None,
     device: Optional[Literal["falcon", "touch"]] = None,
     metrics: Optional[Callable[[dict], Mapping[str, Any]]] = None,
     record_dir: Optional[PathLike] = None,

@@ -73,6 +73,21 @@ def test_every_embedded_file_is_in_the_sdist(sdist):
     assert not missing, "\n".join(missing)
 
 
+def test_the_python_sources_are_in_the_sdist_where_pyproject_says(sdist):
+    # Mixed layout: pyproject.toml's python-source holds the package's Python files, and the
+    # stub is there as __init__.pyi (the link resolved to the stub's text).
+    conf = (sdist / "pyproject.toml").read_text()
+    assert re.search(r'^module-name = "nanohaptics\.nanohaptics"$', conf, re.M), conf
+    (source,) = re.findall(r'^python-source = "([^"]+)"$', conf, re.M)
+    pkg = sdist / source / "nanohaptics"
+    src = ROOT / "crates" / "ot-py" / "python" / "nanohaptics"
+    names = ["__init__.py", "bridge.py", "sweeps.py", "closed_loop.py", "py.typed"]
+    for name in names:
+        assert (pkg / name).read_bytes() == (src / name).read_bytes(), name
+    stub = (ROOT / "crates" / "ot-py" / "nanohaptics.pyi").read_bytes()
+    assert (pkg / "__init__.pyi").read_bytes() == stub
+
+
 def test_cargo_reads_the_unpacked_workspace(sdist):
     if not shutil.which("cargo"):
         pytest.skip("cargo is not installed")

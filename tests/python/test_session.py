@@ -92,9 +92,17 @@ def test_session_errors(tmp_path):
         nh.run_scene(SCENES / "nope.toml")
     cases = [
         (lambda: nh.run_scene(SCENES / "wall.toml", seconds=0.0),
-         "session length 0 s is out of range (allowed: 0 < seconds ≤ 3600)"),
+         "session length 0 s is out of range: allowed 0 < seconds ≤ 3600"),
         (lambda: nh.run_scene(SCENES / "wall.toml", operator="robot"),
-         'operator = "robot": allowed "script", "rigid", "hand" or a dict of hand parameters'),
+         "operator `robot` is not one of: rigid, hand, hand:key=value,..."),
+        # "script" was Python's own name for what the command line calls "hand"
+        (lambda: nh.run_scene(SCENES / "wall.toml", operator="script"),
+         "operator `script` is not one of: rigid, hand, hand:key=value,..."),
+        (lambda: nh.run_scene(SCENES / "wall.toml", operator="hand:stiffness_n_per_m=-1"),
+         "script: `stiffness_n_per_m` = -1 is out of range: allowed 1 ≤ stiffness_n_per_m ≤ 10000"),
+        (lambda: nh.run_scene(SCENES / "wall.toml", operator="hand:stifness=1"),
+         "script: operator: unknown key `stifness` (allowed: mass_kg, stiffness_n_per_m, "
+         "damping_n_s_per_m, yield_force_n)"),
         (lambda: nh.run_scene(SCENES / "wall.toml", device="phantom"),
          'device = "phantom": allowed "falcon", "touch" or "udp:HOST:PORT"'),
         (lambda: nh.run_scene(42), "scene: expected a path (str or os.PathLike)"),

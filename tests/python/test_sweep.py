@@ -75,8 +75,8 @@ def test_wrong_types_and_ranges_are_the_scene_files_errors():
     with pytest.raises(ValueError) as e:
         nh.resolve_scene(OT, overrides={"loop.rate_hz": 999})
     assert str(e.value) == (
-        "scene: `loop.rate_hz` = 999 is out of range (allowed: 100 ≤ rate_hz ≤ 20000 with "
-        "10^9 / rate_hz a whole number)"
+        "scene: `loop.rate_hz` = 999 is out of range: allowed 100 ≤ rate_hz ≤ 20000 with "
+        "10^9 / rate_hz a whole number"
     )
     with pytest.raises(ValueError) as e:
         nh.resolve_scene(OT, overrides={"optical_tweezers.stiffness_n_per_m": float("nan")})

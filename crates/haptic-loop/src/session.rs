@@ -517,3 +517,98 @@ pub fn read_arrays(path: &Path, salvage: bool) -> Result<SessionArrays, SessionE
     let rec = recording::read_recording_file(path, salvage)?;
     Ok(SessionArrays::from_recording(&rec)?)
 }
+
+impl OperatorChoice {
+    /// The operator by the name the command line's `--operator` and Python's `operator=` both
+    /// take: `rigid` (the stylus follows the script exactly), `hand` (as the script says: the
+    /// simulated hand with the script's `[operator]` parameters or the defaults, or a rigid
+    /// stylus for a script with `operator = "rigid"`), or `hand:key=value,...` (a simulated hand
+    /// with the default parameters changed: `mass_kg`, `stiffness_n_per_m`,
+    /// `damping_n_s_per_m`, `yield_force_n`, each checked against its range).
+    pub fn parse(name: &str) -> Result<Self, SessionError> {
+        match (name, name.strip_prefix("hand:")) {
+            ("rigid", _) => Ok(OperatorChoice::Rigid),
+            ("hand", _) => Ok(OperatorChoice::ScriptHand),
+            (_, Some(kv)) => Ok(OperatorChoice::Hand(
+                OperatorParams::default().with_overrides(kv)?,
+            )),
+            (_, None) => Err(SessionError::Option(format!(
+                "operator `{name}` is not one of: rigid, hand, hand:key=value,..."
+            ))),
+        }
+    }
+}
+
+/// A scene and its script made ready to run anywhere (see [`resolve`]).
+#[derive(Clone, Debug)]
+pub struct Resolved {
+    /// The scene, its text with the scene overrides applied.
+    pub source: SceneSource,
+    /// The script's TOML text with the `operator.*` overrides applied.
+    pub script: String,
+    /// The scene file, parsed.
+    pub file: SceneFile,
+    /// The device model it runs with: the one asked for, or else the scene's.
+    pub model: DeviceModel,
+}
+
+/// The scene `source` and its script (`script`: its text and where it came from; `None`: the
+/// scene's default script) with `overrides` applied in order (dotted field name → value;
+/// names under `operator` change the script's simulated hand, the others the scene; see
+/// [`crate::scene::overrides`]), every field checked as a session would load it for `device`
+/// (`None`: the scene's): names, types and ranges. Without overrides an error names the file,
+/// line and column; with them, the overridden field by its dotted name.
+pub fn resolve(
+    mut source: SceneSource,
+    script: Option<(String, String)>,
+    overrides: &[(String, toml::Value)],
+    device: Option<DeviceModel>,
+) -> Result<Resolved, SessionError> {
+    use crate::scene::overrides::{
+        OverrideError, is_script_field, override_scene, override_script,
+    };
+    let from = |e: OverrideError| match e {
+        OverrideError::Scene(e) => SessionError::Scene(e),
+        OverrideError::Script(e) => SessionError::Script(e),
+        field => SessionError::Option(field.to_string()),
+    };
+    let (script_ov, scene_ov): (Vec<_>, Vec<_>) = overrides
+        .iter()
+        .cloned()
+        .partition(|(k, _)| is_script_field(k));
+    // The file as read: its errors name the file, line and column.
+    source.parse()?;
+    source.text = override_scene(&source.text, &scene_ov).map_err(from)?;
+    let located = scene_ov.is_empty();
+    let scene_err = |e: SceneError| {
+        if located {
+            source.locate(e)
+        } else {
+            SessionError::Scene(e)
+        }
+    };
+    let file = SceneFile::parse(&source.text).map_err(scene_err)?;
+    let model = device.unwrap_or(file.device.model);
+    // Ranges: the scene's own validation, as for a scene file.
+    crate::scene::load_scene(&source.text, Some(model)).map_err(scene_err)?;
+    let (base, origin) = match script {
+        Some(t) => t,
+        None => script_source(&SessionOptions::new(source.clone()), &file)?,
+    };
+    let specs = model.specs();
+    Script::from_toml(&base, specs).map_err(|error| SessionError::ScriptFile {
+        at: Location {
+            at: error.position(&base),
+            file: origin,
+        },
+        error: Box::new(error),
+    })?;
+    let script = override_script(&base, &script_ov, specs).map_err(from)?;
+    Script::from_toml(&script, specs)?;
+    Ok(Resolved {
+        source,
+        script,
+        file,
+        model,
+    })
+}

@@ -12,7 +12,7 @@ use pyo3::types::{PyDict, PyList, PyString};
 use world_form::Limits;
 
 use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, vector};
-use crate::json::{from_py, tagged_to_py, to_py};
+use crate::json::{from_py, to_py};
 
 /// The grip commands by their names in `brickworld::Grip`.
 const GRIP_KEYS: [&str; 4] = ["hold", "turn_x", "turn_y", "turn_z"];
@@ -171,7 +171,7 @@ fn ticks_to_py<'py>(
     let ev = PyList::empty(py);
     for (i, t) in ticks.iter().enumerate() {
         for e in &t.report.events {
-            ev.append((i, tagged_to_py(py, e)?))?;
+            ev.append((i, to_py(py, e)?))?;
         }
     }
     d.set_item("events", ev)?;
@@ -319,13 +319,7 @@ impl BrickWorld {
         let b = parse_buttons(buttons, "buttons")?;
         let input = self.world.input([p.x, p.y, p.z], b).map_err(err)?;
         let r = self.world.step(&input);
-        let d = to_py(py, &r)?;
-        let ev = PyList::empty(py);
-        for e in &r.events {
-            ev.append(tagged_to_py(py, e)?)?;
-        }
-        d.set_item("events", ev)?;
-        Ok(d)
+        to_py(py, &r)
     }
 
     /// Step once per row of ``positions_m`` (T, 3) (m) with ``buttons``: None,
@@ -511,15 +505,11 @@ impl BrickWorld {
         self.world.held_brick().map(|b| b.0)
     }
 
-    /// What the cursor (or carried brick) touches: list of dicts
-    /// ({"type": "ground"}, {"type": "brick", "value": id}, ...).
+    /// What the cursor (or carried brick) touches, as the events name it: a list of
+    /// "ground", {"brick": id} and {"obstacle": index}.
     #[getter]
-    fn touching<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let l = PyList::empty(py);
-        for t in self.world.touching() {
-            l.append(tagged_to_py(py, t)?)?;
-        }
-        Ok(l)
+    fn touching<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.world.touching())
     }
 
     /// Blueprint slots: list of {"position_m", "orientation_xyzw", "filled_by"}.

@@ -94,7 +94,7 @@ impl DeviceModel {
     ) -> PyResult<()> {
         if !(dt_s.is_finite() && dt_s > 0.0 && dt_s <= 1.0) {
             return Err(value_err(format!(
-                "dt_s = {dt_s} is out of range (allowed: 0 < dt_s ≤ 1 s)"
+                "dt_s = {dt_s} is out of range: allowed 0 < dt_s ≤ 1 s"
             )));
         }
         let f = vec3_arg(force, "force")?;
@@ -204,7 +204,8 @@ impl DeviceModel {
 ///     tick with no grab, release, impact, snap or pull-off within 50 ms), "max_jump_n",
 ///     "hf_fraction" (power of the felt force above 50 Hz), "min_observer_j" and
 ///     "reserve_j" (the passivity observer), "safety_ticks", "energy_to_hand_j",
-///     "peak_force_n", "max_stiffness_n_per_m".
+///     "peak_force_n", "max_stiffness_n_per_m", "house_complete_s" (s, None without a house
+///     task): serde's form of ``haptic_loop::closed_loop::Report`` with "stable" first.
 #[pyfunction]
 #[pyo3(signature = (scene, *, script = None, model = "falcon", grip = "loose", counts = true, seconds = None))]
 pub fn check_closed_loop<'py>(
@@ -222,7 +223,7 @@ pub fn check_closed_loop<'py>(
         && !(s.is_finite() && s > 0.0 && s <= 3600.0)
     {
         return Err(value_err(format!(
-            "seconds = {s} is out of range (allowed: 0 < seconds ≤ 3600)"
+            "seconds = {s} is out of range: allowed 0 < seconds ≤ 3600"
         )));
     }
     let r = crate::session::resolve(scene, script, None, None)?;
@@ -232,15 +233,6 @@ pub fn check_closed_loop<'py>(
         .map_err(value_err)?;
     let d = PyDict::new(py);
     d.set_item("stable", rep.stable())?;
-    d.set_item("ticks", rep.ticks)?;
-    d.set_item("undeclared_jumps", rep.undeclared_jumps)?;
-    d.set_item("max_jump_n", rep.max_jump_n)?;
-    d.set_item("hf_fraction", rep.hf_fraction)?;
-    d.set_item("min_observer_j", rep.min_observer_j)?;
-    d.set_item("reserve_j", rep.reserve_j)?;
-    d.set_item("safety_ticks", rep.safety_ticks)?;
-    d.set_item("energy_to_hand_j", rep.energy_to_hand_j)?;
-    d.set_item("peak_force_n", rep.peak_force_n)?;
-    d.set_item("max_stiffness_n_per_m", rep.max_stiffness_n_per_m)?;
+    d.update(crate::json::to_py(py, &rep)?.cast::<pyo3::types::PyMapping>()?)?;
     Ok(d)
 }

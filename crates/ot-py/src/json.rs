@@ -1,5 +1,8 @@
 //! serde values to and from Python objects, for crates whose types derive
-//! `Serialize`/`Deserialize` (parameters, views, events).
+//! `Serialize`/`Deserialize` (parameters, views, events): the one conversion of the wheel.
+//! A value reaches Python in serde's form (the form a recording's event detail and a scene
+//! file's table have: `{"type": "snap", "member": "tip", "target": {"substrate_atom": 0}}`),
+//! and a dict comes back through serde, so what a getter returns is accepted as it is.
 
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -110,67 +113,4 @@ pub(crate) fn from_py<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, name: &str) -
         let text = e.to_string().trim_end().replace('\n', " ");
         PyValueError::new_err(format!("{name}: {text}"))
     })
-}
-
-/// `CamelCase` to `snake_case`.
-fn snake(name: &str) -> String {
-    let mut out = String::with_capacity(name.len() + 4);
-    for (i, c) in name.chars().enumerate() {
-        if c.is_ascii_uppercase() {
-            if i > 0 {
-                out.push('_');
-            }
-            out.push(c.to_ascii_lowercase());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
-
-/// An externally tagged enum value (`"Name"` or `{"Name": {fields}}`) as a
-/// flat dict `{"type": "name", **fields}`.
-pub(crate) fn tagged_to_py<'py, T: Serialize>(
-    py: Python<'py>,
-    t: &T,
-) -> PyResult<Bound<'py, PyDict>> {
-    let v = serde_json::to_value(t)
-        .map_err(|e| PyValueError::new_err(format!("cannot convert to Python: {e}")))?;
-    let d = PyDict::new(py);
-    match &v {
-        // Internally tagged (`{"type": "grabbed", "brick": 0}`): the fields as they are.
-        Value::Object(m) if m.get("type").is_some_and(Value::is_string) => {
-            for (f, x) in m {
-                d.set_item(f, value_to_py(py, x)?)?;
-            }
-        }
-        Value::String(s) => d.set_item("type", snake(s))?,
-        Value::Object(m) if m.len() == 1 => {
-            for (k, inner) in m {
-                d.set_item("type", snake(k))?;
-                match inner {
-                    Value::Object(fields) => {
-                        for (f, x) in fields {
-                            d.set_item(f, value_to_py(py, x)?)?;
-                        }
-                    }
-                    other => d.set_item("value", value_to_py(py, other)?)?,
-                }
-            }
-        }
-        other => d.set_item("value", value_to_py(py, other)?)?,
-    }
-    Ok(d)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::snake;
-
-    #[test]
-    fn camel_case_becomes_snake_case() {
-        assert_eq!(snake("GrabMissed"), "grab_missed");
-        assert_eq!(snake("Spawned"), "spawned");
-        assert_eq!(snake("TouchBegan"), "touch_began");
-    }
 }

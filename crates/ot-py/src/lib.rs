@@ -17,6 +17,12 @@
 //! `ValueError` with their text (which names the field and the allowed
 //! range). The user guide is `docs/python.md`; the type stub is
 //! `crates/ot-py/nanohaptics.pyi`.
+//!
+//! Layout (maturin's mixed layout): this crate is the extension module
+//! `nanohaptics.nanohaptics`; the package `nanohaptics` is the Python source under
+//! `crates/ot-py/python/nanohaptics/` (`pyproject.toml`'s `python-source`), whose
+//! `__init__.py` re-exports the extension's names and adds the Python modules
+//! `bridge`, `sweeps` and `closed_loop`.
 
 pub mod brick;
 mod convert;
@@ -59,48 +65,6 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<live::Session>()?;
     m.add_class::<device_model::DeviceModel>()?;
     m.add_function(wrap_pyfunction!(device_model::check_closed_loop, m)?)?;
-    // The device bridge's client and the device adapters are Python (they import the devices'
-    // Python SDKs); the source ships inside the extension and becomes `nanohaptics.bridge`.
-    let py = m.py();
-    let bridge = PyModule::from_code(
-        py,
-        pyo3::ffi::c_str!(include_str!("../python/nanohaptics/bridge.py")),
-        c"nanohaptics/bridge.py",
-        c"nanohaptics.bridge",
-    )?;
-    m.add_submodule(&bridge)?;
-    py.import("sys")?
-        .getattr("modules")?
-        .set_item("nanohaptics.bridge", &bridge)?;
-    // Parameter studies (`nanohaptics.sweeps`): Python over run_scene, re-exported as
-    // nanohaptics.sweep / grid / run_seed. Its functions pickle by reference
-    // (`nanohaptics.sweeps._execute`): importing nanohaptics registers the module.
-    let sweeps = PyModule::from_code(
-        py,
-        pyo3::ffi::c_str!(include_str!("../python/nanohaptics/sweeps.py")),
-        c"nanohaptics/sweeps.py",
-        c"nanohaptics.sweeps",
-    )?;
-    m.add_submodule(&sweeps)?;
-    py.import("sys")?
-        .getattr("modules")?
-        .set_item("nanohaptics.sweeps", &sweeps)?;
-    for name in ["sweep", "grid", "run_seed"] {
-        m.add(name, sweeps.getattr(name)?)?;
-    }
-    // The loop closed around a Session through a DeviceModel (`nanohaptics.closed_loop`),
-    // re-exported as nanohaptics.closed_loop.
-    let closed = PyModule::from_code(
-        py,
-        pyo3::ffi::c_str!(include_str!("../python/nanohaptics/closed_loop.py")),
-        c"nanohaptics/closed_loop.py",
-        c"nanohaptics.closed_loop",
-    )?;
-    m.add_submodule(&closed)?;
-    py.import("sys")?
-        .getattr("modules")?
-        .set_item("nanohaptics.closed_loop", &closed)?;
-    m.add("closed_loop", closed.getattr("closed_loop")?)?;
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

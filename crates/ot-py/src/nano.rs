@@ -3,8 +3,8 @@
 
 use nalgebra::Vector3;
 use nanoworld::{
-    BrokenLink, CurveSpec, Event, Member, PairKind, Target, TipContact, TipInput, World,
-    force_distance_curve as curve, house_script as script,
+    CurveSpec, Event, PairKind, TipContact, TipInput, World, force_distance_curve as curve,
+    house_script as script,
 };
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -12,117 +12,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::convert::{SIGNAL_CHUNK_TICKS, array1, array2, int_in, rows, value_error, vector};
-use crate::params_dict::{limits_from_py, limits_to_py, params_from_py, params_to_py};
-
-fn pair_name(p: PairKind) -> &'static str {
-    match p {
-        PairKind::TipSubstrate => "tip_substrate",
-        PairKind::TipAtom => "tip_atom",
-        PairKind::AtomAtom => "atom_atom",
-        PairKind::AtomSubstrate => "atom_substrate",
-    }
-}
-
-/// A member of the tip assembly as `("tip", None)` or `("atom", i)`.
-fn member(m: Member) -> (&'static str, Option<usize>) {
-    match m {
-        Member::Tip => ("tip", None),
-        Member::Atom(i) => ("atom", Some(i)),
-    }
-}
-
-/// A contact target as `("substrate_atom", j)`, `("substrate_plane", None)` or `("atom", i)`.
-fn target(t: Target) -> (&'static str, Option<usize>) {
-    match t {
-        Target::SubstrateAtom(j) => ("substrate_atom", Some(j)),
-        Target::SubstratePlane => ("substrate_plane", None),
-        Target::Atom(i) => ("atom", Some(i)),
-    }
-}
-
-fn broken(b: BrokenLink) -> &'static str {
-    match b {
-        BrokenLink::TipContact => "tip_contact",
-        BrokenLink::TipCarried => "tip_carried",
-        BrokenLink::CarriedContact => "carried_contact",
-        BrokenLink::TargetSupport => "target_support",
-    }
-}
-
-/// An event as a dict with a "type" key and its fields (SI units).
-fn event<'py>(py: Python<'py>, e: &Event) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    match *e {
-        Event::AtomSpawned { atom } => {
-            d.set_item("type", "atom_spawned")?;
-            d.set_item("atom", atom)?;
-        }
-        Event::Snap {
-            member: m,
-            target: t,
-            pair,
-            gap_m,
-            snap_force_n,
-        } => {
-            d.set_item("type", "snap")?;
-            d.set_item("member", member(m))?;
-            d.set_item("target", target(t))?;
-            d.set_item("pair", pair_name(pair))?;
-            d.set_item("gap_m", gap_m)?;
-            d.set_item("snap_force_n", snap_force_n)?;
-        }
-        Event::AtomAttached { atom, gap_m } => {
-            d.set_item("type", "atom_attached")?;
-            d.set_item("atom", atom)?;
-            d.set_item("gap_m", gap_m)?;
-        }
-        Event::PullOff {
-            member: m,
-            target: t,
-            broken: b,
-            pull_n,
-            pull_off_n,
-        } => {
-            d.set_item("type", "pull_off")?;
-            d.set_item("member", member(m))?;
-            d.set_item("target", target(t))?;
-            d.set_item("broken", broken(b))?;
-            d.set_item("pull_n", pull_n)?;
-            d.set_item("pull_off_n", pull_off_n)?;
-        }
-        Event::AtomTransferred { atom, onto } => {
-            d.set_item("type", "atom_transferred")?;
-            d.set_item("atom", atom)?;
-            d.set_item("onto", target(onto))?;
-        }
-        Event::AtomPickedUp { atom } => {
-            d.set_item("type", "atom_picked_up")?;
-            d.set_item("atom", atom)?;
-        }
-        Event::SlotFilled { slot } => {
-            d.set_item("type", "slot_filled")?;
-            d.set_item("slot", slot)?;
-        }
-        Event::SlotEmptied { slot } => {
-            d.set_item("type", "slot_emptied")?;
-            d.set_item("slot", slot)?;
-        }
-        Event::HouseComplete => {
-            d.set_item("type", "house_complete")?;
-        }
-        Event::AtomsThrownOff {
-            atoms,
-            load_n,
-            pull_off_n,
-        } => {
-            d.set_item("type", "atoms_thrown_off")?;
-            d.set_item("atoms", atoms)?;
-            d.set_item("load_n", load_n)?;
-            d.set_item("pull_off_n", pull_off_n)?;
-        }
-    }
-    Ok(d)
-}
+use crate::json::to_py;
+use crate::params_dict::{limits_from_py, params_from_py};
 
 /// What one tick of a batch left behind.
 struct TickRecord {
@@ -182,7 +73,8 @@ impl NanoWorld {
     ///     dict with "force" (3,) N to send to the device (finite, within
     ///     device["max_force_n"]), "unlimited_force" (3,) N before the device limit,
     ///     "saturated" bool, and "events": a list of dicts with a "type" key
-    ///     ("snap", "pull_off", "atom_attached", "atom_transferred", ...).
+    ///     ("snap", "pull_off", "atom_attached", "atom_transferred", ...), serde's
+    ///     form of `nanoworld::Event` (a recording's event detail has the same form).
     #[pyo3(signature = (position, dt_s=1e-3))]
     fn step<'py>(
         &mut self,
@@ -201,7 +93,7 @@ impl NanoWorld {
         d.set_item("saturated", r.saturated)?;
         let ev = PyList::empty(py);
         for e in &r.events {
-            ev.append(event(py, e)?)?;
+            ev.append(to_py(py, e)?)?;
         }
         d.set_item("events", ev)?;
         Ok(d)
@@ -279,7 +171,7 @@ impl NanoWorld {
         let ev = PyList::empty(py);
         for (k, r) in records.iter().enumerate() {
             for e in &r.events {
-                ev.append((k, event(py, e)?))?;
+                ev.append((k, to_py(py, e)?))?;
             }
         }
         d.set_item("events", ev)?;
@@ -311,17 +203,18 @@ impl NanoWorld {
         self.world.set_params(p).map_err(value_error)
     }
 
-    /// The parameters in force, as a dict with the scene-table layout.
+    /// The parameters in force, as a dict with the scene-table layout (serde's form of
+    /// `nanoworld::Params`).
     #[getter]
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        params_to_py(py, self.world.params())
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, self.world.params())
     }
 
     /// The device limits this world renders to, world units:
     /// {"max_force_n": N, "max_stiffness_n_per_m": N/m}.
     #[getter]
-    fn device<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        limits_to_py(py, self.world.limits())
+    fn device<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, self.world.limits())
     }
 
     /// Tip (apex) centre (3,) (m).
@@ -337,8 +230,8 @@ impl NanoWorld {
     }
 
     /// The tip's contact state: None when free, else a dict with "member"
-    /// (("tip", None) or ("atom", i)), "target" (("substrate_atom", j),
-    /// ("substrate_plane", None) or ("atom", i)), "pair", "tip_position"
+    /// ("tip" or {"atom": i}), "target" ({"substrate_atom": j},
+    /// "substrate_plane" or {"atom": i}), "pair" (as in the events), "tip_position"
     /// (3,) m where the tip is held, and "normal" (3,) unit contact normal.
     #[getter]
     fn contact<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
@@ -346,9 +239,9 @@ impl NanoWorld {
             TipContact::Free => Ok(None),
             TipContact::Anchored(a) => {
                 let d = PyDict::new(py);
-                d.set_item("member", member(a.member))?;
-                d.set_item("target", target(a.target))?;
-                d.set_item("pair", pair_name(a.pair))?;
+                d.set_item("member", to_py(py, &a.member)?)?;
+                d.set_item("target", to_py(py, &a.target)?)?;
+                d.set_item("pair", to_py(py, &a.pair)?)?;
                 d.set_item("tip_position", array1(py, &a.tip_position_m))?;
                 d.set_item("normal", array1(py, &a.normal))?;
                 Ok(Some(d))
@@ -425,7 +318,7 @@ impl NanoWorld {
             e.set_item("stiffness_n_per_m", l.stiffness_n_per_m)?;
             e.set_item("snap_force_n", l.snap_force_n)?;
             e.set_item("pull_off_n", l.pull_off_n)?;
-            d.set_item(pair_name(k), e)?;
+            d.set_item(to_py(py, &k)?, e)?;
         }
         Ok(d)
     }
@@ -494,10 +387,10 @@ impl NanoWorld {
 pub fn nano_params<'py>(
     py: Python<'py>,
     #[pyo3(from_py_with = crate::convert::mode_arg)] mode: String,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<Bound<'py, PyAny>> {
     match mode.as_str() {
-        "game" => params_to_py(py, &nanoworld::Params::game_default()),
-        "physical" => params_to_py(py, &nanoworld::Params::physical_default()),
+        "game" => to_py(py, &nanoworld::Params::game_default()),
+        "physical" => to_py(py, &nanoworld::Params::physical_default()),
         other => Err(PyValueError::new_err(format!(
             "mode = {other:?}: allowed \"game\", \"physical\""
         ))),

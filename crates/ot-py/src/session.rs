@@ -1,15 +1,12 @@
 //! Sessions of the haptic loop (`haptic-loop`): run a scene with a script and
 //! get per-tick arrays back; read an MCAP recording into the same arrays.
 
-use haptic_devices::OperatorParams;
-use haptic_devices::Script;
 use haptic_devices::bridge::BridgeConfig;
 use haptic_loop::DeviceModel;
-use haptic_loop::scene::overrides::{override_scene, override_script};
-use haptic_loop::scene::{SceneFile, load_scene};
+use haptic_loop::scene::overrides::{is_script_field, override_scene};
 use haptic_loop::session::{
-    Location, OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions,
-    read_arrays, read_toml_text, run_session_until, script_source,
+    OperatorChoice, Resolved, SceneSource, SessionArrays, SessionError, SessionOptions,
+    read_arrays, read_toml_text, run_session_until,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -91,19 +88,15 @@ pub(crate) fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<B
     Ok(d)
 }
 
+/// The `operator` argument: None (`hand`, the default), a name as the command line's
+/// `--operator` takes it (`rigid`, `hand`, `hand:key=value,...`: one parser,
+/// [`OperatorChoice::parse`]), or a dict of hand parameters (`hand:` with those values).
 fn operator_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OperatorChoice> {
     let Some(obj) = obj else {
         return Ok(OperatorChoice::ScriptHand);
     };
     if let Ok(s) = obj.cast::<PyString>() {
-        return match s.to_cow()?.as_ref() {
-            "script" => Ok(OperatorChoice::ScriptHand),
-            "rigid" => Ok(OperatorChoice::Rigid),
-            "hand" => Ok(OperatorChoice::Hand(OperatorParams::default())),
-            other => Err(PyValueError::new_err(format!(
-                "operator = {other:?}: allowed \"script\", \"rigid\", \"hand\" or a dict of hand parameters"
-            ))),
-        };
+        return OperatorChoice::parse(&s.to_cow()?).map_err(session_error);
     }
     Ok(OperatorChoice::Hand(from_py(obj, "operator")?))
 }
@@ -138,17 +131,12 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceArg> {
 
 type Overrides = Vec<(String, toml::Value)>;
 
-/// The `overrides` argument: a dict of dotted field name → value, split into the scene's
-/// fields and the simulated hand's (`operator.*`, the script's `[operator]` table), in the
-/// dict's order.
-fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<(Overrides, Overrides)> {
-    let (mut scene, mut script) = (Vec::new(), Vec::new());
-    let Some(obj) = obj else {
-        return Ok((scene, script));
+/// The `overrides` argument: a dict of dotted field name → value, in the dict's order.
+fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Overrides> {
+    let mut out = Vec::new();
+    let Some(obj) = obj.filter(|o| !o.is_none()) else {
+        return Ok(out);
     };
-    if obj.is_none() {
-        return Ok((scene, script));
-    }
     let d = obj.cast::<PyDict>().map_err(|_| {
         PyValueError::new_err(
             "overrides: expected a dict of dotted field names to values, e.g. \
@@ -162,22 +150,9 @@ fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<(Overrides, Ove
             ))
         })?;
         let value = py_to_toml(&v, &format!("overrides[{key:?}]"))?;
-        if key == "operator" || key.starts_with("operator.") || key.starts_with("operator[") {
-            script.push((key, value));
-        } else {
-            scene.push((key, value));
-        }
+        out.push((key, value));
     }
-    Ok((scene, script))
-}
-
-/// A scene resolved on this side (files read, overrides applied and validated): its TOML
-/// text, its script's TOML text and the device model it runs with.
-pub(crate) struct Resolved {
-    pub(crate) source: SceneSource,
-    pub(crate) script: String,
-    file: SceneFile,
-    model: DeviceModel,
+    Ok(out)
 }
 
 fn value_err(e: impl std::fmt::Display) -> PyErr {
@@ -209,62 +184,25 @@ fn scene_source(scene: &Bound<'_, PyAny>) -> PyResult<(SceneSource, Option<Strin
 }
 
 /// `scene` (a path, a built-in name, or a dict of `resolve_scene`) and `script`, with
-/// `overrides` applied; every field checked as a scene file's is (names, types, ranges).
+/// `overrides` applied and every field checked by the engine's resolution
+/// ([`haptic_loop::session::resolve`]).
 pub(crate) fn resolve(
     scene: &Bound<'_, PyAny>,
     script: Option<&Bound<'_, PyAny>>,
     overrides: Option<&Bound<'_, PyAny>>,
     device: Option<DeviceModel>,
 ) -> PyResult<Resolved> {
-    let (mut source, script_toml) = scene_source(scene)?;
-    let mut script_toml = script_toml.map(|t| (t, "script_toml".to_string()));
-    if let Some(s) = script {
-        let p = path_arg(s, "script")?;
-        let text = read_toml_text(&p).map_err(session_error)?;
-        script_toml = Some((text, p.display().to_string()));
-    }
-    let (scene_ov, script_ov) = overrides_from_py(overrides)?;
-    // The file as read: its errors name the file, line and column.
-    source.parse().map_err(session_error)?;
-    // With overrides, errors name the overridden field by its dotted name instead (a line of
-    // the rewritten text would point nowhere the user wrote).
-    source.text = override_scene(&source.text, &scene_ov).map_err(value_err)?;
-    let located = scene_ov.is_empty();
-    let scene_err = |e: haptic_loop::scene::SceneError| {
-        if located {
-            session_error(source.locate(e))
-        } else {
-            value_err(e)
+    let (source, script_toml) = scene_source(scene)?;
+    let script = match script {
+        Some(s) => {
+            let p = path_arg(s, "script")?;
+            let text = read_toml_text(&p).map_err(session_error)?;
+            Some((text, p.display().to_string()))
         }
+        None => script_toml.map(|t| (t, "script_toml".to_string())),
     };
-    let file = SceneFile::parse(&source.text).map_err(scene_err)?;
-    let model = device.unwrap_or(file.device.model);
-    // Ranges: the scene's own validation, as for a scene file.
-    load_scene(&source.text, Some(model)).map_err(scene_err)?;
-    let (base, origin) = match script_toml {
-        Some(t) => t,
-        None => {
-            script_source(&SessionOptions::new(source.clone()), &file).map_err(session_error)?
-        }
-    };
-    let specs = model.specs();
-    Script::from_toml(&base, specs).map_err(|error| {
-        session_error(SessionError::ScriptFile {
-            at: Location {
-                at: error.position(&base),
-                file: origin,
-            },
-            error: Box::new(error),
-        })
-    })?;
-    let script = override_script(&base, &script_ov, specs).map_err(value_err)?;
-    Script::from_toml(&script, specs).map_err(value_err)?;
-    Ok(Resolved {
-        source,
-        script,
-        file,
-        model,
-    })
+    let overrides = overrides_from_py(overrides)?;
+    haptic_loop::session::resolve(source, script, &overrides, device).map_err(session_error)
 }
 
 /// A scene ready to run anywhere: its files read and `overrides` applied and validated
@@ -328,11 +266,14 @@ pub fn resolve_scene<'py>(
 ///         ``default_script``.
 ///     seconds: session length (s), 0 < seconds <= 3600; default: the
 ///         script's duration.
-///     operator: "script" (as the script says, default), "rigid" (the stylus
-///         follows the script exactly), "hand" (a simulated hand with default
-///         parameters, pushed by the rendered force) or a dict of hand
-///         parameters (mass_kg, stiffness_n_per_m, damping_n_s_per_m,
-///         yield_force_n).
+///     operator: as the command line's ``--operator``: "hand" (default: as
+///         the script says, a simulated hand pushed by the rendered force with
+///         the script's ``[operator]`` parameters or the defaults, or a rigid
+///         stylus for a script with ``operator = "rigid"``), "rigid" (the
+///         stylus follows the script exactly), "hand:key=value,..." (a
+///         simulated hand with those of mass_kg, stiffness_n_per_m,
+///         damping_n_s_per_m, yield_force_n changed from the defaults), or a
+///         dict of those hand parameters (the same as "hand:...").
 ///     device: None (the scene's), "falcon", "touch", or "udp:HOST:PORT":
 ///         wait there for a device in another process (see
 ///         ``nanohaptics.bridge``) and run in real time against it until it
@@ -381,14 +322,14 @@ pub fn run_scene<'py>(
         }
         DeviceArg::Bridge(mut b) => {
             // A device in another process: no script, so only the scene's fields change.
-            let (scene_ov, script_ov) = overrides_from_py(overrides)?;
-            if let Some((k, _)) = script_ov.first() {
+            let ov = overrides_from_py(overrides)?;
+            if let Some((k, _)) = ov.iter().find(|(k, _)| is_script_field(k)) {
                 return Err(PyValueError::new_err(format!(
                     "override `{k}`: the simulated hand is not used with a bridged device"
                 )));
             }
             let (mut source, _) = scene_source(scene)?;
-            source.text = override_scene(&source.text, &scene_ov).map_err(value_err)?;
+            source.text = override_scene(&source.text, &ov).map_err(value_err)?;
             b.wait_s = wait_s;
             let mut opts = SessionOptions::new(source);
             opts.bridge = Some(b);
@@ -490,4 +431,81 @@ pub fn render_audio<'py>(
         Ok(s)
     })?;
     Ok((PyArray1::from_vec(py, s.samples), rate))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use haptic_devices::OperatorParams;
+    use haptic_loop::session::{OperatorChoice, SceneSource, resolve};
+    use toml::Value;
+
+    #[test]
+    fn operator_names_are_the_command_lines() {
+        assert_eq!(
+            OperatorChoice::parse("rigid").unwrap(),
+            OperatorChoice::Rigid
+        );
+        assert_eq!(
+            OperatorChoice::parse("hand").unwrap(),
+            OperatorChoice::ScriptHand
+        );
+        assert_eq!(
+            OperatorChoice::parse("hand:stiffness_n_per_m=100,yield_force_n=0.5").unwrap(),
+            OperatorChoice::Hand(OperatorParams {
+                stiffness_n_per_m: 100.0,
+                yield_force_n: 0.5,
+                ..OperatorParams::default()
+            })
+        );
+        let err = |s: &str| OperatorChoice::parse(s).unwrap_err().to_string();
+        assert_eq!(
+            err("script"),
+            "operator `script` is not one of: rigid, hand, hand:key=value,..."
+        );
+        assert_eq!(
+            err("hand:mass_kg=20"),
+            "script: `mass_kg` = 20 is out of range: allowed 0.01 ≤ mass_kg ≤ 10"
+        );
+    }
+
+    #[test]
+    fn overrides_go_to_the_scene_or_the_simulated_hand_by_name() {
+        let wall = SceneSource::builtin("wall").unwrap();
+        let ov = [
+            (
+                "operator.stiffness_n_per_m".to_string(),
+                Value::Float(150.0),
+            ),
+            ("loop.rate_hz".to_string(), Value::Integer(2000)),
+        ];
+        let r = resolve(wall.clone(), None, &ov, None).unwrap();
+        assert!(
+            r.source
+                .text
+                .starts_with("# scene with overrides: loop.rate_hz = 2000\n")
+        );
+        assert!(
+            r.script
+                .starts_with("# script with overrides: operator.stiffness_n_per_m = 150.0\n")
+        );
+        assert_eq!(r.file.loop_.rate_hz, 2000);
+        // No overrides: the files as written, the scene's device.
+        let r = resolve(wall.clone(), None, &[], None).unwrap();
+        assert_eq!(r.source.text, wall.text);
+        assert_eq!(r.model, haptic_loop::DeviceModel::Falcon);
+        // A range error: the scene's own, naming the field.
+        let e = resolve(
+            wall,
+            None,
+            &[ov[1].clone(), ("loop.rate_hz".into(), Value::Integer(999))],
+            None,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("scene: `loop.rate_hz` = 999 is out of range"),
+            "{e}"
+        );
+    }
 }

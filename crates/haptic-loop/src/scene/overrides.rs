@@ -166,6 +166,12 @@ fn apply(
     )))
 }
 
+/// Whether the override `name` changes the script's simulated hand (`operator`,
+/// `operator.stiffness_n_per_m`, ...: the script's `[operator]` table) rather than the scene.
+pub fn is_script_field(name: &str) -> bool {
+    name == "operator" || name.starts_with("operator.") || name.starts_with("operator[")
+}
+
 /// The scene file `text` with `overrides` (dotted field name → value) applied: unknown names,
 /// wrong types and misplaced values are [`OverrideError::Field`] errors naming the dotted
 /// field. Ranges are checked when the scene is built ([`crate::scene::load_scene`]).

@@ -40,7 +40,7 @@ def closed_loop(session, device, path: Callable[[float], Tuple[Vec3, Vec3]], sec
         the force answered; and "energy_to_hand_j", the work the motors did on the hand.
     """
     if not (isinstance(seconds, (int, float)) and np.isfinite(seconds) and 0 < seconds <= 3600):
-        raise ValueError(f"seconds = {seconds!r} is out of range (allowed: 0 < seconds ≤ 3600)")
+        raise ValueError(f"seconds = {seconds!r} is out of range: allowed 0 < seconds ≤ 3600")
     dt = 1.0 / session.rate_hz
     n = int(round(seconds * session.rate_hz))
     reading = np.zeros((n, 3))
