@@ -20,8 +20,8 @@ mod play_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
+use haptic_devices::DeviceModel;
 use haptic_devices::bridge::BridgeConfig;
-use haptic_devices::{DeviceModel, OperatorParams};
 use haptic_loop::live::LiveConfig;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{
@@ -337,20 +337,9 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// `--operator`: the one operator parser, shared with the wheel.
 fn parse_operator(s: &str) -> Result<OperatorChoice, String> {
-    match s {
-        "rigid" => Ok(OperatorChoice::Rigid),
-        "hand" => Ok(OperatorChoice::ScriptHand),
-        _ => match s.strip_prefix("hand:") {
-            Some(kv) => OperatorParams::default()
-                .with_overrides(kv)
-                .map(OperatorChoice::Hand)
-                .map_err(|e| e.to_string()),
-            None => Err(format!(
-                "--operator `{s}` is not one of: rigid, hand, hand:key=value,..."
-            )),
-        },
-    }
+    OperatorChoice::parse(s).map_err(|e| format!("--{e}"))
 }
 
 /// The house task's score at the end of a session (brick and nano worlds), from the last

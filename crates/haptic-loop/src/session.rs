@@ -482,7 +482,26 @@ fn run_with_device(
     } else {
         Pacing::Batch
     };
+    // The live view's menu (Foxglove's Parameters): switches set there are applied before
+    // the next tick's step and recorded as that tick's switches.
+    let menu = sinks.menu();
+    let mut apply_menu = |_tick: u64, lp: &mut HapticLoop| {
+        let Some(Ok(mut m)) = menu.as_ref().map(|m| m.try_lock()) else {
+            return;
+        };
+        for (name, value) in m.take() {
+            if lp.switch(&name, value).is_err() {
+                // The world refused it: the menu shows what is in force.
+                if let Some(v) = lp.scene().switch_value(&name) {
+                    m.set_value(&name, v);
+                }
+            }
+        }
+    };
     let mut runner = Runner::new(sinks.list()).with_switches(switches);
+    if menu.is_some() {
+        runner = runner.with_live(&mut apply_menu);
+    }
     if let Some(f) = stop {
         runner = runner.stop_on(f);
     }

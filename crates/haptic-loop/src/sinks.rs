@@ -20,6 +20,23 @@ pub type Live = crate::live::LiveSink;
 #[cfg(not(feature = "live"))]
 pub type Live = std::convert::Infallible;
 
+/// Without the `live` feature there is no menu to read (no live view serves one).
+#[cfg(not(feature = "live"))]
+pub enum Menu {}
+
+#[cfg(not(feature = "live"))]
+impl Menu {
+    /// Never called: no menu exists without the live view.
+    pub fn take(&mut self) -> Vec<(String, f64)> {
+        match *self {}
+    }
+
+    /// Never called: no menu exists without the live view.
+    pub fn set_value(&mut self, _name: &str, _value: f64) {
+        match *self {}
+    }
+}
+
 /// The sinks of one session.
 pub struct SessionSinks {
     /// Running totals (the summary); always delivered.
@@ -61,6 +78,18 @@ impl SessionSinks {
             v.push(l);
         }
         v
+    }
+
+    /// The live view's menu, when serving one.
+    #[cfg(feature = "live")]
+    pub fn menu(&self) -> Option<std::sync::Arc<std::sync::Mutex<crate::live::menu::Menu>>> {
+        self.live.as_ref().map(|l| l.menu())
+    }
+
+    /// The live view's menu (none without the `live` feature).
+    #[cfg(not(feature = "live"))]
+    pub fn menu(&self) -> Option<std::sync::Arc<std::sync::Mutex<Menu>>> {
+        None
     }
 
     /// What the recorder wrote (after the session's end).

@@ -165,6 +165,100 @@ fn a_viewer_connects_before_the_device_says_hello() {
     assert!(err.contains("hello"), "{err}");
 }
 
+/// The teaching game's menu in Foxglove's Parameters panel: the brick scene's switches are
+/// offered at their values, a set is applied before a tick's step and recorded as that tick's
+/// switch (so the recording replays bit for bit), and a value out of range is refused.
+#[test]
+fn foxglove_parameters_set_a_switch_that_is_recorded() {
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let out = std::env::temp_dir().join(format!("nh-live-menu-{}.mcap", std::process::id()));
+    let mut o = SessionOptions::new(SceneSource::resolve(Path::new("brickworld")).unwrap());
+    o.realtime = true;
+    o.seconds = Some(2.0);
+    o.out = Some(out.clone());
+    o.live = Some(LiveConfig::parse(&format!("ws:127.0.0.1:{port}")).unwrap());
+    let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}).unwrap());
+    let t0 = Instant::now();
+    let mut ws = loop {
+        let mut req = format!("ws://127.0.0.1:{port}")
+            .into_client_request()
+            .unwrap();
+        req.headers_mut()
+            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+        match connect(req) {
+            Ok((ws, _)) => break ws,
+            Err(_) if t0.elapsed() < Duration::from_secs(10) => {
+                std::thread::sleep(Duration::from_millis(20))
+            }
+            Err(e) => panic!("cannot connect: {e}"),
+        }
+    };
+    let mut reply = |ws: &mut tungstenite::WebSocket<_>, id: &str| loop {
+        if let Message::Text(t) = ws.read().unwrap() {
+            let j: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
+            if j["op"] == "serverInfo" {
+                let caps = j["capabilities"].as_array().unwrap();
+                assert!(caps.iter().any(|c| c == "parameters"), "{j}");
+            }
+            if j["op"] == "parameterValues" && j["id"] == id {
+                return j["parameters"].as_array().unwrap().clone();
+            }
+        }
+    };
+    // The menu is offered once the session has started (its scene is known).
+    let params = loop {
+        ws.send(Message::text(
+            serde_json::json!({"op": "getParameters", "parameterNames": [], "id": "get"})
+                .to_string(),
+        ))
+        .unwrap();
+        let p = reply(&mut ws, "get");
+        if !p.is_empty() {
+            break p;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let value = |ps: &[serde_json::Value], name: &str| {
+        ps.iter()
+            .find(|p| p["name"] == name)
+            .map(|p| p["value"].clone())
+    };
+    assert_eq!(
+        value(&params, "gravity_m_per_s2"),
+        Some(serde_json::json!(9.81))
+    );
+    assert_eq!(value(&params, "inertia"), Some(serde_json::json!(true)));
+    ws.send(Message::text(
+        serde_json::json!({"op": "setParameters", "id": "set", "parameters": [
+            {"name": "gravity_m_per_s2", "value": 2.5},
+            {"name": "restitution", "value": 7.0}]})
+        .to_string(),
+    ))
+    .unwrap();
+    let set = reply(&mut ws, "set");
+    assert_eq!(
+        value(&set, "gravity_m_per_s2"),
+        Some(serde_json::json!(2.5))
+    );
+    // Out of range (0–1): refused, the value in force kept.
+    assert_ne!(value(&set, "restitution"), Some(serde_json::json!(7.0)));
+    drop(ws);
+    session.join().unwrap();
+    let rec = recording::read_recording_file(&out, false).unwrap();
+    let sched = recording::switch_schedule(&rec, 1_000_000).unwrap();
+    assert_eq!(sched.len(), 1, "{sched:?}");
+    assert_eq!(
+        (sched[0].1.name.as_str(), sched[0].1.value),
+        ("gravity_m_per_s2", 2.5)
+    );
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
+    std::fs::remove_file(&out).ok();
+}
+
 /// The shipped Foxglove layout names only topics and fields the live view publishes.
 #[test]
 fn the_shipped_foxglove_layout_uses_only_published_topics_and_fields() {

@@ -19,6 +19,8 @@
 //! dropped and counted (`dropped` in `/live/state` and in the summary).
 
 #[cfg(feature = "live")]
+pub mod menu;
+#[cfg(feature = "live")]
 mod server;
 #[cfg(feature = "live")]
 pub use server::LiveSink;

@@ -44,6 +44,7 @@ const CAP: usize = 2048;
 /// The live Foxglove view of a session.
 pub struct LiveSink {
     config: LiveConfig,
+    menu: Arc<Mutex<super::menu::Menu>>,
     server: Option<WebSocketServerHandle>,
     ctx: Arc<Context>,
     shared: Arc<Shared>,
@@ -57,14 +58,18 @@ impl LiveSink {
     /// Starts the WebSocket server (clients may connect before the first tick).
     pub fn new(config: LiveConfig) -> Result<Self, LiveError> {
         let ctx = Context::new();
+        let menu = Arc::new(Mutex::new(super::menu::Menu::default()));
         let server = ctx
             .websocket_server()
             .name("nanohaptics")
+            .capabilities([foxglove::websocket::Capability::Parameters])
+            .listener(Arc::new(super::menu::MenuListener(menu.clone())))
             .bind(config.bind.ip().to_string(), config.bind.port())
             .start_blocking()
             .map_err(|e| LiveError::Serve(format!("cannot serve on ws:{}: {e}", config.bind)))?;
         Ok(LiveSink {
             config,
+            menu,
             server: Some(server),
             ctx,
             shared: Arc::new(Shared {
@@ -80,6 +85,12 @@ impl LiveSink {
             display_every: 1,
             plot_every: 1,
         })
+    }
+
+    /// The menu's queue of switches set in Foxglove (see [`menu`](super::menu)): the session
+    /// applies them before the next tick.
+    pub fn menu(&self) -> Arc<Mutex<super::menu::Menu>> {
+        self.menu.clone()
     }
 
     /// The port the server listens on (useful with port 0).
@@ -225,7 +236,15 @@ impl Sink for LiveSink {
         let shared = self.shared.clone();
         let start_ns = info.description.start_time_ns;
         let (period, rate, scale) = (c.period_ns(), c.rate_hz, c.display_scale);
-        let _ = lp;
+        let scene = lp.scene();
+        let values = scene
+            .switches()
+            .iter()
+            .filter_map(|s| Some((s.name.to_string(), scene.switch_value(s.name)?)))
+            .collect();
+        if let Ok(mut m) = self.menu.lock() {
+            m.offer(scene.kind(), scene.switches(), values);
+        }
         self.thread = Some(
             std::thread::Builder::new()
                 .name("live-view".into())
@@ -237,6 +256,14 @@ impl Sink for LiveSink {
 
     fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
         let r = t.result;
+        if !r.switches.is_empty() {
+            // What the loop applied is what the menu shows (rare: a switch set this tick).
+            if let Ok(mut m) = self.menu.try_lock() {
+                for s in &r.switches {
+                    m.set_value(&s.name, s.value);
+                }
+            }
+        }
         let display = r.tick % self.display_every == 0;
         if r.tick % self.plot_every != 0 && !display && r.events.is_empty() {
             return Ok(());

@@ -249,6 +249,18 @@ impl Scene for BrickScene {
         .map_err(|e| e.to_string())
     }
 
+    fn switch_value(&self, name: &str) -> Option<f64> {
+        let p = self.world.params();
+        Some(match name {
+            "gravity_m_per_s2" => p.gravity_m_per_s2,
+            "restitution" => p.restitution,
+            "friction" => p.friction,
+            "inertia" => f64::from(u8::from(p.inertia != brickworld::Inertia::Off)),
+            "brick_mass_kg" => p.brick_mass_kg,
+            _ => return None,
+        })
+    }
+
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         let pressed = |bit: Option<u32>| bit.is_some_and(|b| input.buttons.pressed(b));
         let grip = Grip {

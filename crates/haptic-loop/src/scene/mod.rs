@@ -98,6 +98,12 @@ pub trait Scene {
     fn set_switch(&mut self, name: &str, _value: f64) -> Result<(), String> {
         Err(format!("the {} scene has no switch `{name}`", self.kind()))
     }
+
+    /// The value switch `name` has now (a boolean switch: 0 or 1); `None` when the scene has
+    /// no such switch. Menus show it (the live view's Parameters).
+    fn switch_value(&self, _name: &str) -> Option<f64> {
+        None
+    }
 }
 
 /// A world constructor: a scene file's text and the checked loop configuration → the world.

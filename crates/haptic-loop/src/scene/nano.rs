@@ -273,6 +273,20 @@ impl Scene for NanoScene {
         Ok(())
     }
 
+    fn switch_value(&self, name: &str) -> Option<f64> {
+        Some(match name {
+            "adhesion_scale" => self.scales[0],
+            "tip_substrate_scale" => self.scales[1],
+            "tip_atom_scale" => self.scales[2],
+            "atom_atom_scale" => self.scales[3],
+            "atom_substrate_scale" => self.scales[4],
+            "atom_mass_kg" => self.base.atoms.mass_kg,
+            "gravity_m_per_s2" => self.base.gravity_m_per_s2,
+            "inertia" => f64::from(u8::from(self.base.inertia)),
+            _ => return None,
+        })
+    }
+
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         let cursor = Vector3::new(input.cursor_m[0], input.cursor_m[1], input.cursor_m[2]);
         if self.world.is_none() {
