@@ -197,7 +197,7 @@ fn foxglove_parameters_set_a_switch_that_is_recorded() {
             Err(e) => panic!("cannot connect: {e}"),
         }
     };
-    let mut reply = |ws: &mut tungstenite::WebSocket<_>, id: &str| loop {
+    let reply = |ws: &mut tungstenite::WebSocket<_>, id: &str| loop {
         if let Message::Text(t) = ws.read().unwrap() {
             let j: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
             if j["op"] == "serverInfo" {
