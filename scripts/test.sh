@@ -19,7 +19,8 @@ cargo clippy --workspace --all-targets --release -- -D warnings
 step "chromium for the browser tests (crates/play/tests/browser.rs)"
 if ! command -v chromium >/dev/null; then
   sudo_=""; [ "$(id -u)" = 0 ] || sudo_="sudo"
-  $sudo_ apt-get update -q && $sudo_ apt-get install -y -q chromium
+  $sudo_ env DEBIAN_FRONTEND=noninteractive apt-get update -q &&
+    $sudo_ env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium
 fi
 
 step "cargo test (release profile)"

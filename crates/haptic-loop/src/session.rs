@@ -55,7 +55,7 @@ pub fn read_toml_text(path: &Path) -> Result<String, SessionError> {
         message,
     };
     let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
-    if bytes.starts_with(mcap::MAGIC) {
+    if bytes.starts_with(recording::MAGIC) {
         return Err(io(
             "this is an MCAP recording, not a TOML file (recordings are for \
              `nanohaptics replay`, `info` and `render`)"

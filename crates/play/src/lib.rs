@@ -259,6 +259,7 @@ pub fn run(
         },
         "switches": switches.iter().map(|s| json!({
             "name": s.name, "min": s.min, "max": s.max, "boolean": s.boolean, "doc": s.doc,
+            "value": loaded.scene.switch_value(s.name),
         })).collect::<Vec<_>>(),
         "state_fields": fields,
         "sample_rate_hz": publish::SAMPLE_RATE_HZ,

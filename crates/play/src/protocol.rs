@@ -47,7 +47,7 @@ pub enum ProtocolError {
         expected: &'static str,
     },
     /// A number out of its range.
-    #[error("page message field `{field}` = {value} is out of range (allowed: {allowed})")]
+    #[error("page message field `{field}` = {value} is out of range: allowed {allowed}")]
     OutOfRange {
         /// The field.
         field: String,
@@ -312,12 +312,12 @@ mod tests {
         let input = |rest: &str| format!(r#"{{"type":"input","seq":1,{rest}}}"#);
         assert_eq!(
             err(&input(r#""pos":[0,0,1.5],"buttons":0,"t_ms":0"#)),
-            "page message field `input.pos[2]` = 1.5 is out of range (allowed: -1 ≤ value ≤ 1)"
+            "page message field `input.pos[2]` = 1.5 is out of range: allowed -1 ≤ value ≤ 1"
         );
         assert_eq!(
             err(&input(r#""pos":[0.8,0.8,0],"buttons":0,"t_ms":0"#)),
             "page message field `input.pos` = [0.8, 0.8, 0] (norm 1.1313708498984762) is out of \
-             range (allowed: a point of the unit ball, norm ≤ 1)"
+             range: allowed a point of the unit ball, norm ≤ 1"
         );
         assert_eq!(
             err(&input(r#""pos":[0,"a",0],"buttons":0,"t_ms":0"#)),
@@ -329,13 +329,13 @@ mod tests {
         );
         assert_eq!(
             err(&input(r#""pos":[0,0,0],"buttons":16,"t_ms":0"#)),
-            "page message field `input.buttons` = 16 is out of range (allowed: an integer whose \
-             bits are the device's buttons, 0–15)"
+            "page message field `input.buttons` = 16 is out of range: allowed an integer whose \
+             bits are the device's buttons, 0–15"
         );
         assert_eq!(
             err(&input(r#""pos":[0,0,0],"buttons":-1,"t_ms":0"#)),
-            "page message field `input.buttons` = -1 is out of range (allowed: an integer whose \
-             bits are the device's buttons, 0–15)"
+            "page message field `input.buttons` = -1 is out of range: allowed an integer whose \
+             bits are the device's buttons, 0–15"
         );
         assert_eq!(
             err(&input(r#""pos":[0,0,0],"buttons":0"#)),
@@ -343,8 +343,8 @@ mod tests {
         );
         assert_eq!(
             err(r#"{"type":"input","seq":-3,"pos":[0,0,0],"buttons":0,"t_ms":0}"#),
-            "page message field `input.seq` = -3 is out of range (allowed: an integer 0 ≤ seq ≤ \
-             9007199254740991)"
+            "page message field `input.seq` = -3 is out of range: allowed an integer 0 ≤ seq ≤ \
+             9007199254740991"
         );
         assert_eq!(
             err(r#"{"type":"switch","name":"friction","value":"lots"}"#),

@@ -536,7 +536,7 @@ mod tests {
         assert_eq!(e["field"], "switch.value");
         assert_eq!(
             e["message"],
-            "switch `friction` = 11 is out of range (allowed: 0 ≤ value ≤ 10)"
+            "switch `friction` = 11 is out of range: allowed 0 ≤ value ≤ 10"
         );
         on_message(&sh, 1, r#"{"type":"switch","name":"inertia","value":0.5}"#);
         assert_eq!(last_error(&r1)["field"], "switch.value");

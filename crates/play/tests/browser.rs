@@ -254,7 +254,7 @@ fn a_pointer_grabs_a_brick_and_places_it_in_a_slot() {
     let err = b.eval("window.__play.errors[0].message").unwrap();
     assert_eq!(
         err,
-        "switch `gravity_m_per_s2` = 1000 is out of range (allowed: 0 ≤ value ≤ 100)"
+        "switch `gravity_m_per_s2` = 1000 is out of range: allowed 0 ≤ value ≤ 100"
     );
     sleep(Duration::from_millis(300));
     b.screenshot(&figures().join("placed.png")).unwrap();

@@ -29,5 +29,7 @@ pub mod writer;
 pub use channels::messages::{Channel, DescriptionMsg};
 pub use edit::{rewrite, switch_schedule};
 pub use encode::{OutMsg, TickEncoder, TickMessages};
+/// The bytes every MCAP file starts with (to tell a recording from a scene file).
+pub use mcap::MAGIC;
 pub use reader::{Integrity, Recording, RecordingError, read_recording, read_recording_file};
 pub use writer::{Recorder, RecorderSetup, WriteSummary};

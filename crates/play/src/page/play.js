@@ -443,8 +443,11 @@
       const lab = document.createElement('label');
       const span = document.createElement('span'); span.textContent = s.name; span.title = s.doc; lab.appendChild(span);
       const inp = document.createElement('input');
-      if (s.boolean) { inp.type = 'checkbox'; inp.checked = true; }
-      else { inp.type = 'number'; inp.min = s.min; inp.max = s.max; inp.step = 'any'; inp.placeholder = `${s.min}–${s.max}`; }
+      if (s.boolean) { inp.type = 'checkbox'; inp.checked = s.value == null ? true : s.value !== 0; }
+      else {
+        inp.type = 'number'; inp.min = s.min; inp.max = s.max; inp.step = 'any'; inp.placeholder = `${s.min}–${s.max}`;
+        if (s.value != null) inp.value = String(s.value);
+      }
       inp.setAttribute('aria-label', `${s.name}: ${s.doc}`); inp.id = 'sw-' + s.name;
       const b = document.createElement('button'); b.type = 'button'; b.textContent = 'set';
       b.setAttribute('aria-label', `set ${s.name}`);
