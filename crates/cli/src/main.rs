@@ -339,7 +339,11 @@ fn cmd_fake(a: FakeArgs) -> Result<ExitCode, String> {
 
 /// `--operator`: the one operator parser, shared with the wheel.
 fn parse_operator(s: &str) -> Result<OperatorChoice, String> {
-    OperatorChoice::parse(s).map_err(|e| format!("--{e}"))
+    OperatorChoice::parse(s).map_err(|e| match e {
+        // An unknown name is the flag's error; a bad `hand:k=v` names its key.
+        SessionError::Option(m) => format!("--{m}"),
+        e => e.to_string(),
+    })
 }
 
 /// The house task's score at the end of a session (brick and nano worlds), from the last
