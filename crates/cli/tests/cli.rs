@@ -398,23 +398,36 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
         .unwrap()
         .port();
     let rec = tmp("modelled.mcap");
-    let sim = bridged_run("scenes/brickworld.toml", port, &rec, &[]);
-    let dev = nh(&[
-        "fake-device",
-        &format!("udp:127.0.0.1:{port}"),
-        "--script",
-        "scenes/brickworld.script.toml",
-        "--model",
-        "falcon",
-        "--grip",
-        "loose",
-        "--seconds",
-        "4",
-        "--json",
-    ]);
-    let d = json(&dev);
-    let s = json(&sim.wait_with_output().unwrap());
-    assert_eq!(s["end"], "device_ended");
+    // Real time over UDP on a shared 2-core machine: a reply later than the watchdog's grace
+    // (2.5 ms) makes the watchdog ramp the force, which is a jump the hand feels but not the
+    // rendering's buzz. Such a run is tried again (at most three runs); a jump over 1 N with
+    // every reply on time is the buzz, and fails at once.
+    let mut attempt = 0;
+    let d = loop {
+        attempt += 1;
+        let sim = bridged_run("scenes/brickworld.toml", port, &rec, &[]);
+        let dev = nh(&[
+            "fake-device",
+            &format!("udp:127.0.0.1:{port}"),
+            "--script",
+            "scenes/brickworld.script.toml",
+            "--model",
+            "falcon",
+            "--grip",
+            "loose",
+            "--seconds",
+            "4",
+            "--json",
+        ]);
+        let d = json(&dev);
+        let s = json(&sim.wait_with_output().unwrap());
+        assert_eq!(s["end"], "device_ended");
+        let late = d["round_trip"]["max_ns"].as_u64().unwrap() > 2_500_000;
+        if d["jumps_over_1n"] == 0 || !late || attempt == 3 {
+            break d;
+        }
+        eprintln!("run {attempt}: a reply later than the watchdog's grace, tried again: {d}");
+    };
     assert_eq!(d["jumps_over_1n"], 0, "{d}");
     assert!(d["max_jump_n"].as_f64().unwrap() < 1.0);
     assert!(d["energy_to_hand_j"].as_f64().unwrap() < 0.0, "{d}");
