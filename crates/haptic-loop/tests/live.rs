@@ -14,6 +14,26 @@ use std::time::{Duration, Instant};
 use tungstenite::client::IntoClientRequest;
 use tungstenite::{Message, connect};
 
+type Client = tungstenite::WebSocket<tungstenite::stream::MaybeTlsStream<std::net::TcpStream>>;
+
+/// A Foxglove client (`foxglove.sdk.v1`) connected to the live view on loopback `port`, trying
+/// every 20 ms for at most `within`; panics when the server refused it that long.
+fn foxglove_client(port: u16, within: Duration) -> Client {
+    let t0 = Instant::now();
+    loop {
+        let mut req = format!("ws://127.0.0.1:{port}")
+            .into_client_request()
+            .unwrap();
+        req.headers_mut()
+            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+        match connect(req) {
+            Ok((ws, _)) => return ws,
+            Err(_) if t0.elapsed() < within => std::thread::sleep(Duration::from_millis(20)),
+            Err(e) => panic!("the live view refused a viewer for {within:?}: {e}"),
+        }
+    }
+}
+
 #[test]
 fn a_foxglove_client_receives_the_scene_while_the_session_runs() {
     let port = TcpListener::bind("127.0.0.1:0")
@@ -30,21 +50,7 @@ fn a_foxglove_client_receives_the_scene_while_the_session_runs() {
     let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}).unwrap());
 
     // Connect (the server starts before the first tick).
-    let t0 = Instant::now();
-    let mut ws = loop {
-        let mut req = format!("ws://127.0.0.1:{port}")
-            .into_client_request()
-            .unwrap();
-        req.headers_mut()
-            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
-        match connect(req) {
-            Ok((ws, _)) => break ws,
-            Err(_) if t0.elapsed() < Duration::from_secs(10) => {
-                std::thread::sleep(Duration::from_millis(20))
-            }
-            Err(e) => panic!("cannot connect: {e}"),
-        }
-    };
+    let mut ws = foxglove_client(port, Duration::from_secs(10));
     // Channel advertisements (JSON text), then subscribe by topic.
     let mut channels: BTreeMap<String, u64> = BTreeMap::new();
     while channels.len() < 4 {
@@ -135,21 +141,7 @@ fn a_viewer_connects_before_the_device_says_hello() {
     o.bridge = Some(bridge);
     o.live = Some(LiveConfig::parse(&format!("ws:127.0.0.1:{ws_port}")).unwrap());
     let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}));
-    let t0 = Instant::now();
-    let mut ws = loop {
-        let mut req = format!("ws://127.0.0.1:{ws_port}")
-            .into_client_request()
-            .unwrap();
-        req.headers_mut()
-            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
-        match connect(req) {
-            Ok((ws, _)) => break ws,
-            Err(_) if t0.elapsed() < Duration::from_secs(2) => {
-                std::thread::sleep(Duration::from_millis(20))
-            }
-            Err(e) => panic!("the live view refused a viewer before the hello: {e}"),
-        }
-    };
+    let mut ws = foxglove_client(ws_port, Duration::from_secs(2));
     // The server greets the viewer (serverInfo) while the session still waits for the device.
     let first = ws.read().unwrap();
     let Message::Text(t) = first else {
@@ -182,21 +174,7 @@ fn foxglove_parameters_set_a_switch_that_is_recorded() {
     o.out = Some(out.clone());
     o.live = Some(LiveConfig::parse(&format!("ws:127.0.0.1:{port}")).unwrap());
     let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}).unwrap());
-    let t0 = Instant::now();
-    let mut ws = loop {
-        let mut req = format!("ws://127.0.0.1:{port}")
-            .into_client_request()
-            .unwrap();
-        req.headers_mut()
-            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
-        match connect(req) {
-            Ok((ws, _)) => break ws,
-            Err(_) if t0.elapsed() < Duration::from_secs(10) => {
-                std::thread::sleep(Duration::from_millis(20))
-            }
-            Err(e) => panic!("cannot connect: {e}"),
-        }
-    };
+    let mut ws = foxglove_client(port, Duration::from_secs(10));
     let reply = |ws: &mut tungstenite::WebSocket<_>, id: &str| loop {
         if let Message::Text(t) = ws.read().unwrap() {
             let j: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
