@@ -55,7 +55,9 @@ RANKS = {
         "record_sink replay_device live",
         "runner error",
         "replay closed_loop sinks",
-        "session builtin",
+        "builtin",
+        "setup",
+        "session",
         "stepper sound media",
     ],
     "nanohaptics-recording": [

@@ -43,6 +43,7 @@ pub mod replay_device;
 pub mod runner;
 pub mod scene;
 pub mod session;
+pub mod setup;
 pub mod sink;
 pub mod sinks;
 pub mod sound;

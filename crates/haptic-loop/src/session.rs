@@ -14,8 +14,9 @@
 use crate::haptic::HapticLoop;
 use crate::live::LiveConfig;
 use crate::runner::{EndReason, Pacing, Runner};
-use crate::scene::{SceneError, SceneFile, Switch, load_scene_for};
-use crate::sinks::{SessionSinks, live_summary, start_live};
+use crate::scene::{SceneError, SceneFile, Switch};
+use crate::setup::{Setup, SetupOptions};
+use crate::sinks::{live_summary, start_live};
 use crate::totals::Totals;
 use haptic_devices::TickTime;
 use haptic_devices::bridge::BridgeConfig;
@@ -26,126 +27,14 @@ use haptic_devices::{DeviceModel, OperatorParams, ScriptError};
 pub use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
 use recording::WriteSummary;
-use recording::channels::messages::{self, DescriptionMsg};
+use recording::channels::messages::DescriptionMsg;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 pub use crate::arrays::SessionArrays;
 pub use crate::error::SessionError;
 pub use crate::record_sink::stats_metadata;
-
-/// A scene file's text and the folder it came from (to find its default script).
-#[derive(Clone, Debug)]
-pub struct SceneSource {
-    /// TOML text.
-    pub text: String,
-    /// Where the text came from, as errors name it: the path, or `built-in NAME`.
-    pub origin: String,
-    /// Folder for relative paths in the file.
-    pub dir: Option<PathBuf>,
-    /// Scripts that come with the scene (a built-in scene's default script), file name → text;
-    /// consulted before the disk.
-    pub scripts: Vec<(String, String)>,
-}
-
-/// Reads a TOML text file; a recording or other binary file is named as such.
-pub fn read_toml_text(path: &Path) -> Result<String, SessionError> {
-    let io = |message: String| SessionError::Io {
-        path: path.display().to_string(),
-        message,
-    };
-    let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
-    if bytes.starts_with(recording::MAGIC) {
-        return Err(io(
-            "this is an MCAP recording, not a TOML file (recordings are for \
-             `nanohaptics replay`, `info` and `render`)"
-                .into(),
-        ));
-    }
-    String::from_utf8(bytes).map_err(|e| {
-        let ok = e.utf8_error().valid_up_to();
-        let text = String::from_utf8_lossy(&e.as_bytes()[..ok]).into_owned();
-        let at = haptic_types::textpos::position(&text, ok);
-        io(format!(
-            "not UTF-8 text: byte {ok} (line {}, column {}) is not valid UTF-8 (a TOML file is text)",
-            at.line, at.column
-        ))
-    })
-}
-
-impl SceneSource {
-    /// A scene from its TOML text; `origin` names it in errors (a path, `built-in wall`).
-    pub fn from_text(text: impl Into<String>, origin: impl Into<String>) -> Self {
-        SceneSource {
-            text: text.into(),
-            origin: origin.into(),
-            dir: None,
-            scripts: Vec::new(),
-        }
-    }
-
-    /// Reads a scene file.
-    pub fn from_path(path: &Path) -> Result<Self, SessionError> {
-        Ok(SceneSource {
-            text: read_toml_text(path)?,
-            origin: path.display().to_string(),
-            dir: path.parent().map(Path::to_path_buf),
-            scripts: Vec::new(),
-        })
-    }
-
-    /// `error`, located in this scene's text: `file:line:column: message`.
-    pub fn locate(&self, error: SceneError) -> SessionError {
-        SessionError::SceneFile {
-            at: Location {
-                file: self.origin.clone(),
-                at: error.position(&self.text),
-            },
-            error: Box::new(error),
-        }
-    }
-
-    /// Parses the scene's text, errors located.
-    pub fn parse(&self) -> Result<SceneFile, SessionError> {
-        SceneFile::parse(&self.text).map_err(|e| self.locate(e))
-    }
-
-    /// The built-in scene `name` (`wall` or `wall.toml`) with its default script.
-    pub fn builtin(name: &str) -> Option<Self> {
-        crate::builtin::find(name).map(|b| SceneSource {
-            text: b.scene.to_string(),
-            origin: format!("built-in {}", b.name),
-            dir: None,
-            scripts: vec![(b.script_file.to_string(), b.script.to_string())],
-        })
-    }
-
-    /// A scene file on disk, or else a built-in scene by name (`wall`, `wall.toml`): files on
-    /// disk override the built-ins, so this works from any directory.
-    pub fn resolve(arg: &Path) -> Result<Self, SessionError> {
-        if arg.exists() {
-            return Self::from_path(arg);
-        }
-        // `wall`, `wall.toml` or `scenes/wall.toml` (the repository's path, from anywhere).
-        let parent_ok = arg
-            .parent()
-            .is_none_or(|p| p.as_os_str().is_empty() || p == Path::new("scenes"));
-        let name = arg
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_default();
-        match Self::builtin(&name) {
-            Some(s) if parent_ok => Ok(s),
-            _ => Err(SessionError::Io {
-                path: arg.display().to_string(),
-                message: format!(
-                    "no such file, and not a built-in scene (built-in: {}; `nanohaptics scenes export DIR` writes editable copies)",
-                    crate::builtin::names()
-                ),
-            }),
-        }
-    }
-}
+pub use crate::setup::{SceneSource, now_unix_ns, read_toml_text};
 
 /// How the script drives the device.
 #[derive(Clone, Debug, PartialEq)]
@@ -354,15 +243,6 @@ fn script_switches(
     Ok(out)
 }
 
-/// Wall-clock time now, ns since the Unix epoch (information only: it never reaches the
-/// physics).
-pub fn now_unix_ns() -> u64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_nanos() as u64)
-        .unwrap_or(0)
-}
-
 /// Validates a session length and turns it into ticks.
 pub fn ticks_for(seconds: f64, rate_hz: u32) -> Result<u64, SessionError> {
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
@@ -432,48 +312,35 @@ fn run_with_device(
     // hello arrives.
     let live = start_live(opts.live.as_ref())?;
     dev.open()?;
-    let specs = dev.specs().clone();
-    let loaded =
-        load_scene_for(&opts.scene.text, specs.clone()).map_err(|e| opts.scene.locate(e))?;
-    let rate = loaded.config.rate_hz;
-    let ticks = match (opts.seconds, &script) {
-        (Some(s), _) => Some(ticks_for(s, rate)?),
-        (None, Some((s, _, _))) => Some(ticks_for(s.duration_s, rate)?),
-        (None, None) => None,
-    };
-    let fields = loaded.scene.state_fields();
-    if let Some(bad) = fields.iter().find(|f| !messages::valid_field_name(f)) {
-        return Err(SessionError::StateField(bad.clone()));
-    }
     let bridged = opts.bridge.is_some();
     let mode = if bridged || opts.realtime {
         "realtime"
     } else {
         "batch"
     };
-    let (script_name, script_toml) = match &script {
-        Some((s, t, _)) => (s.name.clone(), t.clone()),
-        None => (String::new(), String::new()),
+    let setup = Setup::new(&SetupOptions {
+        operator: Some(source.describe()),
+        script: script.as_ref().map(|(s, t, _)| (s.name.clone(), t.clone())),
+        start_time_ns: opts.start_time_ns,
+        keep_arrays: opts.arrays,
+        out: opts.out.clone(),
+        ..SetupOptions::new(&opts.scene, dev.specs().clone(), mode, &source.link_name())
+    })?;
+    let rate = setup.rate_hz();
+    let ticks = match (opts.seconds, &script) {
+        (Some(s), _) => Some(ticks_for(s, rate)?),
+        (None, Some((s, _, _))) => Some(ticks_for(s.duration_s, rate)?),
+        (None, None) => None,
     };
-    let mut description = loaded.description(
-        &opts.scene.text,
-        mode,
-        &source.link_name(),
-        opts.start_time_ns.unwrap_or_else(now_unix_ns),
-    );
-    description.script_name = script_name;
-    description.script_toml = script_toml;
-    description.operator = source.describe();
     let switches = match &script {
-        Some((s, text, origin)) => script_switches(s, text, origin, loaded.scene.as_ref(), rate)?,
+        Some((s, text, origin)) => script_switches(s, text, origin, setup.lp.scene(), rate)?,
         None => Vec::new(),
     };
-    let mut lp = HapticLoop::new(loaded.config, loaded.scene);
-    let mut sinks = SessionSinks::new(
-        SessionArrays::new(rate, fields),
-        opts.arrays,
-        opts.out.clone(),
-    );
+    let Setup {
+        mut lp,
+        description,
+        mut sinks,
+    } = setup;
     sinks.live = live;
     let pacing = if bridged {
         Pacing::DeviceClock

@@ -20,14 +20,14 @@
 
 use crate::arrays::SessionArrays;
 use crate::haptic::{HapticLoop, TickResult};
-use crate::scene::load_scene;
-use crate::session::{SceneSource, SessionError, now_unix_ns};
+use crate::session::{SceneSource, SessionError};
+use crate::setup::{Setup, SetupOptions};
 use crate::sink::{SessionInfo, TickView, deliver};
 use crate::sinks::SessionSinks;
 use haptic_devices::pacing::{DurationHistogram, Percentiles, TickStats};
 use haptic_devices::{DeviceModel, DeviceSample, ForceCommand};
 use recording::WriteSummary;
-use recording::channels::messages::{self, DescriptionMsg};
+use recording::channels::messages::DescriptionMsg;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -89,24 +89,16 @@ impl Stepper {
     pub fn new(opts: StepperOptions) -> Result<Self, SessionError> {
         let file = opts.scene.parse()?;
         let model = opts.device.unwrap_or(file.device.model);
-        let loaded = load_scene(&opts.scene.text, Some(model)).map_err(|e| opts.scene.locate(e))?;
-        let fields = loaded.scene.state_fields();
-        if let Some(bad) = fields.iter().find(|f| !messages::valid_field_name(f)) {
-            return Err(SessionError::StateField(bad.clone()));
-        }
-        let rate = loaded.config.rate_hz;
-        let description = loaded.description(
-            &opts.scene.text,
-            "stepped",
-            &opts.link,
-            opts.start_time_ns.unwrap_or_else(now_unix_ns),
-        );
-        let lp = HapticLoop::new(loaded.config, loaded.scene);
-        let mut sinks = SessionSinks::new(
-            SessionArrays::new(rate, fields),
-            opts.arrays,
-            opts.out.clone(),
-        );
+        let Setup {
+            lp,
+            description,
+            mut sinks,
+        } = Setup::new(&SetupOptions {
+            start_time_ns: opts.start_time_ns,
+            keep_arrays: opts.arrays,
+            out: opts.out.clone(),
+            ..SetupOptions::new(&opts.scene, model.specs().clone(), "stepped", &opts.link)
+        })?;
         let info = SessionInfo {
             description: &description,
             config: lp.config(),

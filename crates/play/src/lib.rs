@@ -31,23 +31,21 @@ pub mod server;
 
 use haptic_devices::bridge::{BridgeConfig, UdpDevice};
 use haptic_devices::pacing::{Percentiles, TickStats};
-use haptic_loop::record_sink::RecorderSink;
 use haptic_loop::runner::{EndReason, Pacing, Runner};
-use haptic_loop::scene::load_scene_for;
 use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
-use haptic_loop::sink::Sink;
+use haptic_loop::setup::{Setup, SetupOptions};
 use haptic_loop::totals::Totals;
-use haptic_loop::{HapticDevice, HapticLoop};
+use haptic_loop::{DeviceSpecs, HapticDevice, HapticLoop};
 use input::PageDevice;
 use publish::{PlaySink, PublishSummary, ToPublisher};
 use recording::WriteSummary;
-use recording::channels::messages;
 use serde_json::json;
 use server::{SceneLink, Server, Shared};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+use world_form::numbers::percentile;
 
 /// Default port of the page.
 pub const DEFAULT_PORT: u16 = 8080;
@@ -107,12 +105,11 @@ impl LatencyMs {
         }
         let mut s = v.to_vec();
         s.sort_by(f64::total_cmp);
-        let rank = |q: f64| s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1];
         Some(LatencyMs {
             n: s.len(),
-            p50: rank(0.5),
-            p99: rank(0.99),
-            max: s[s.len() - 1],
+            p50: percentile(&s, 0.5)?,
+            p99: percentile(&s, 0.99)?,
+            max: percentile(&s, 1.0)?,
         })
     }
 }
@@ -177,6 +174,149 @@ fn stats_ms(p: &Percentiles) -> serde_json::Value {
     json!({"p50_ms": p.p50_ns as f64 * 1e-6, "p99_ms": p.p99_ns as f64 * 1e-6, "max_ms": p.max_ns as f64 * 1e-6})
 }
 
+/// The hand of a play session: the page, or a device bridged over UDP.
+enum Hand {
+    Page(PageDevice),
+    Bridged(Box<UdpDevice>),
+}
+
+impl Hand {
+    /// Opens the hand `config` asks for: a bridged device (its hello is awaited here, with the
+    /// scene's name and `rate_hz`), or the page with the scene's device `specs`.
+    fn open(
+        config: &PlayConfig,
+        scene: &str,
+        rate_hz: u32,
+        specs: &DeviceSpecs,
+        shared: &Shared,
+    ) -> Result<Hand, PlayError> {
+        Ok(match &config.device {
+            Some(b) => {
+                let mut b = b.clone();
+                b.rate_hz = rate_hz;
+                b.scene = scene.to_string();
+                b.start_time_ns = now_unix_ns();
+                let mut dev = UdpDevice::new(b);
+                dev.open().map_err(SessionError::Device)?;
+                Hand::Bridged(Box::new(dev))
+            }
+            None => Hand::Page(PageDevice::new(specs.clone(), shared.input.clone())),
+        })
+    }
+
+    fn device(&mut self) -> &mut dyn HapticDevice {
+        match self {
+            Hand::Page(d) => d,
+            Hand::Bridged(d) => d.as_mut(),
+        }
+    }
+
+    fn is_page(&self) -> bool {
+        matches!(self, Hand::Page(_))
+    }
+
+    /// The link and the operator as the recording names them.
+    fn describe(&self, config: &PlayConfig) -> (String, &'static str) {
+        match &config.device {
+            Some(b) => (format!("udp:{}", b.bind), "person (bridged device)"),
+            None => ("page".to_string(), "person (browser page)"),
+        }
+    }
+}
+
+/// The page's `hello`: the scene, the device, the view's mapping, the menu of switches with
+/// their values now, the state fields and the sound's sample rate.
+fn hello_message(
+    scene_name: &str,
+    lp: &HapticLoop,
+    specs: &DeviceSpecs,
+    page_is_hand: bool,
+    seconds: Option<f64>,
+) -> serde_json::Value {
+    let scene = lp.scene();
+    let config = lp.config();
+    json!({
+        "type": "hello",
+        "scene": scene_name,
+        "kind": scene.kind(),
+        "rate_hz": config.rate_hz,
+        "device": specs.name,
+        "workspace_radius_m": specs.workspace_radius_m,
+        "max_force_n": specs.limits.max_force_n,
+        "buttons": specs.button_strs(),
+        "page_is_hand": page_is_hand,
+        "display_scale": config.display_scale,
+        "mapping": {
+            "origin_m": config.mapping.origin_m,
+            "workspace_scale": config.mapping.workspace_scale,
+        },
+        "switches": scene.switches().iter().map(|s| json!({
+            "name": s.name, "min": s.min, "max": s.max, "boolean": s.boolean, "doc": s.doc,
+            "value": scene.switch_value(s.name),
+        })).collect::<Vec<_>>(),
+        "state_fields": scene.state_fields(),
+        "sample_rate_hz": publish::SAMPLE_RATE_HZ,
+        "seconds": seconds,
+    })
+}
+
+/// The page's `end`: the session's figures and where to download its recording.
+fn end_message(
+    config: &PlayConfig,
+    end: &str,
+    stats: &TickStats,
+    rate_hz: u32,
+    totals: &Totals,
+    input_latency_ms: Option<LatencyMs>,
+    written: Option<&WriteSummary>,
+) -> serde_json::Value {
+    json!({
+        "type": "end",
+        "end": end,
+        "ticks": stats.ticks,
+        "seconds": stats.ticks as f64 / f64::from(rate_hz),
+        "missed_deadlines": stats.missed,
+        "tick_work": stats_ms(&stats.compute),
+        "state": totals.state_fields.iter().zip(&totals.last_state)
+            .map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        "peak_device_force_n": totals.peak_device_force_n,
+        "events": totals.events,
+        "input_latency_ms": input_latency_ms,
+        "recording": "/recording.mcap",
+        "recording_file": config.out.file_name().map(|n| n.to_string_lossy().to_string()),
+        "recording_bytes": written.map(|w| w.bytes),
+    })
+}
+
+/// The hook run before each tick's step: raises the end on `stop`, and applies the switches
+/// pages asked for (told to the publisher as applied on `tick`, or refused with the reason).
+fn switch_hook<'a>(
+    stop: &'a AtomicBool,
+    shared: Arc<Shared>,
+    tx: std::sync::mpsc::Sender<ToPublisher>,
+) -> impl FnMut(u64, &mut HapticLoop) + 'a {
+    move |tick: u64, lp: &mut HapticLoop| {
+        if stop.load(Ordering::Relaxed) {
+            shared.end_requested.store(true, Ordering::Relaxed);
+        }
+        // Never wait for a page's thread: a busy queue waits for the next tick.
+        let reqs = match shared.switches.try_lock() {
+            Ok(mut q) if !q.is_empty() => std::mem::take(&mut *q),
+            _ => return,
+        };
+        for (page, name, value) in reqs {
+            let m = match lp.switch(&name, value) {
+                Ok(()) => ToPublisher::Switched { tick, name, value },
+                Err(e) => ToPublisher::Refused {
+                    page,
+                    message: e.to_string(),
+                },
+            };
+            let _ = tx.send(m);
+        }
+    }
+}
+
 /// Runs a play session: serves the page (its URL is given to `on_ready` as soon as the port
 /// is bound, before any device or page), waits for the hand (a page's Start, or the bridged
 /// device's hello), runs the scene in real time at its tick rate while recording to
@@ -192,9 +332,7 @@ pub fn run(
     let file = scene_src.parse()?;
     // The scene with the file's device model: its rate and, for the page, the device.
     let model_specs = file.device.model.specs().clone();
-    let preload =
-        load_scene_for(&scene_src.text, model_specs.clone()).map_err(|e| scene_src.locate(e))?;
-    let rate = preload.config.rate_hz;
+    let rate = Setup::new(&SetupOptions::new(scene_src, model_specs.clone(), "", ""))?.rate_hz();
     let ticks = config.seconds.map(|s| ticks_for(s, rate)).transpose()?;
     let shared = Arc::new(Shared::default());
     let mut server = Server::start(config.port, shared.clone()).map_err(|e| PlayError::Serve {
@@ -204,70 +342,33 @@ pub fn run(
     let url = server.url();
     on_ready(&url);
 
-    // The hand.
-    let mut page_dev;
-    let mut udp_dev;
-    let dev: &mut dyn HapticDevice = match &config.device {
-        Some(b) => {
-            let mut b = b.clone();
-            b.rate_hz = rate;
-            b.scene = file.scene.name.clone();
-            b.start_time_ns = now_unix_ns();
-            udp_dev = UdpDevice::new(b);
-            udp_dev.open().map_err(SessionError::Device)?;
-            &mut udp_dev
-        }
-        None => {
-            page_dev = PageDevice::new(model_specs.clone(), shared.input.clone());
-            &mut page_dev
-        }
-    };
-    let specs = dev.specs().clone();
-    let loaded = if config.device.is_some() {
-        load_scene_for(&scene_src.text, specs.clone()).map_err(|e| scene_src.locate(e))?
-    } else {
-        preload
-    };
-    let fields = loaded.scene.state_fields();
-    if let Some(bad) = fields.iter().find(|f| !messages::valid_field_name(f)) {
-        return Err(SessionError::StateField(bad.clone()).into());
-    }
-    let kind = loaded.scene.kind();
-    let switches = loaded.scene.switches();
-    let page_is_hand = config.device.is_none();
-    let link = SceneLink {
-        switches,
-        kind,
-        workspace_radius_m: specs.workspace_radius_m,
-        button_mask: specs.button_mask(),
-        page_is_hand,
-    };
-    let hello = json!({
-        "type": "hello",
-        "scene": file.scene.name,
-        "kind": kind,
-        "rate_hz": rate,
-        "device": specs.name,
-        "workspace_radius_m": specs.workspace_radius_m,
-        "max_force_n": specs.limits.max_force_n,
-        "buttons": specs.button_strs(),
-        "page_is_hand": page_is_hand,
-        "display_scale": loaded.config.display_scale,
-        "mapping": {
-            "origin_m": loaded.config.mapping.origin_m,
-            "workspace_scale": loaded.config.mapping.workspace_scale,
-        },
-        "switches": switches.iter().map(|s| json!({
-            "name": s.name, "min": s.min, "max": s.max, "boolean": s.boolean, "doc": s.doc,
-            "value": loaded.scene.switch_value(s.name),
-        })).collect::<Vec<_>>(),
-        "state_fields": fields,
-        "sample_rate_hz": publish::SAMPLE_RATE_HZ,
-        "seconds": config.seconds,
-    });
+    let mut hand = Hand::open(config, &file.scene.name, rate, &model_specs, &shared)?;
+    let page_is_hand = hand.is_page();
+    let specs = hand.device().specs().clone();
+    let (link, operator) = hand.describe(config);
+    let Setup {
+        mut lp,
+        description,
+        mut sinks,
+    } = Setup::new(&SetupOptions {
+        operator: Some(operator.to_string()),
+        keep_arrays: false,
+        out: Some(config.out.clone()),
+        ..SetupOptions::new(scene_src, specs.clone(), "realtime", &link)
+    })?;
+    let scene = lp.scene();
+    let fields = scene.state_fields();
+    let kind = scene.kind();
     if let Ok(mut s) = shared.scene.lock() {
-        *s = Some(link);
+        *s = Some(SceneLink {
+            switches: scene.switches(),
+            kind,
+            workspace_radius_m: specs.workspace_radius_m,
+            button_mask: specs.button_mask(),
+            page_is_hand,
+        });
     }
+    let hello = hello_message(&file.scene.name, &lp, &specs, page_is_hand, config.seconds);
     if let Ok(mut h) = shared.hello.lock() {
         *h = Some(hello.to_string());
     }
@@ -278,76 +379,45 @@ pub fn run(
     }
 
     // The session.
-    let mut description = loaded.description(
-        &scene_src.text,
-        "realtime",
-        &match &config.device {
-            Some(b) => format!("udp:{}", b.bind),
-            None => "page".to_string(),
-        },
-        now_unix_ns(),
-    );
-    description.operator = if page_is_hand {
-        "person (browser page)".into()
-    } else {
-        "person (bridged device)".into()
-    };
     let prox = haptic_loop::sound::proximity_on_distance_m(kind)
         .filter(|_| fields.iter().any(|f| f == "nearest_m"));
-    let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let (tx, rx) = std::sync::mpsc::channel::<ToPublisher>();
     let publisher = {
         let sh = shared.clone();
-        let f = fields.clone();
         std::thread::Builder::new()
             .name("play-publish".into())
-            .spawn(move || publish::run_publisher(rx, sh, rate, f, prox))
+            .spawn(move || publish::run_publisher(rx, sh, rate, fields, prox))
             .map_err(|e| PlayError::Serve {
                 port: config.port,
                 message: e.to_string(),
             })?
     };
-    let mut totals = Totals::default();
-    let mut recorder = RecorderSink::new(config.out.clone());
     let mut play_sink = PlaySink::new(tx.clone(), shared.clone());
-    let hook_tx = tx;
-    let hook_shared = shared.clone();
-    let mut hook = move |tick: u64, lp: &mut HapticLoop| {
-        if stop.load(Ordering::Relaxed) {
-            hook_shared.end_requested.store(true, Ordering::Relaxed);
-        }
-        // Never wait for a page's thread: a busy queue waits for the next tick.
-        let reqs = match hook_shared.switches.try_lock() {
-            Ok(mut q) if !q.is_empty() => std::mem::take(&mut *q),
-            _ => return,
-        };
-        for (page, name, value) in reqs {
-            let m = match lp.switch(&name, value) {
-                Ok(()) => ToPublisher::Switched { tick, name, value },
-                Err(e) => ToPublisher::Refused {
-                    page,
-                    message: e.to_string(),
-                },
-            };
-            let _ = hook_tx.send(m);
-        }
-    };
+    let mut hook = switch_hook(stop, shared.clone(), tx);
     let pacing = if page_is_hand {
         Pacing::Realtime
     } else {
         Pacing::DeviceClock
     };
     let result = {
-        let sinks: Vec<&mut dyn Sink> = vec![&mut totals, &mut recorder, &mut play_sink];
-        let mut runner = Runner::new(sinks)
+        let mut list = sinks.list();
+        list.push(&mut play_sink);
+        let mut runner = Runner::new(list)
             .with_live(&mut hook)
             .stop_on(&shared.end_requested);
-        runner.run(&mut lp, dev, &description, ticks, pacing, &mut |_, _| {})
+        runner.run(
+            &mut lp,
+            hand.device(),
+            &description,
+            ticks,
+            pacing,
+            &mut |_, _| {},
+        )
     };
     drop(hook);
     let latencies = std::mem::take(&mut play_sink.input_latency_ms);
     drop(play_sink);
-    let closed = dev.close();
+    let closed = hand.device().close();
     let published = publisher.join().unwrap_or_default();
     let (stats, end) = result.map_err(SessionError::from)?;
     closed.map_err(SessionError::Device)?;
@@ -356,6 +426,7 @@ pub fn run(
         EndReason::Stopped => "ended",
         EndReason::DeviceEnded => "device_ended",
     };
+    let totals = &sinks.totals;
     let state: Vec<(String, f64)> = totals
         .state_fields
         .iter()
@@ -366,35 +437,21 @@ pub fn run(
     if let Ok(mut r) = shared.recording.lock() {
         *r = Some(config.out.clone());
     }
-    let written = recorder.summary().cloned();
-    let end_msg = json!({
-        "type": "end",
-        "end": end,
-        "ticks": stats.ticks,
-        "seconds": stats.ticks as f64 / f64::from(rate),
-        "missed_deadlines": stats.missed,
-        "tick_work": stats_ms(&stats.compute),
-        "state": totals.state_fields.iter().zip(&totals.last_state)
-            .map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
-        "peak_device_force_n": totals.peak_device_force_n,
-        "events": totals.events,
-        "input_latency_ms": input_latency_ms,
-        "recording": "/recording.mcap",
-        "recording_file": config.out.file_name().map(|n| n.to_string_lossy().to_string()),
-        "recording_bytes": written.as_ref().map(|w| w.bytes),
-    });
+    let written = sinks.written();
+    let end_msg = end_message(
+        config,
+        end,
+        &stats,
+        rate,
+        totals,
+        input_latency_ms,
+        written.as_ref(),
+    );
     if let Ok(mut e) = shared.end.lock() {
         *e = Some(end_msg.to_string());
     }
     shared.broadcast(&tungstenite::Message::text(end_msg.to_string()));
-    // The end screen and the download.
-    let until = config
-        .keep_serving_s
-        .filter(|s| s.is_finite() && *s >= 0.0)
-        .map(|s| Instant::now() + Duration::from_secs_f64(s.min(86_400.0)));
-    while !stop.load(Ordering::Relaxed) && until.is_none_or(|u| Instant::now() < u) {
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    serve_end_screen(config, stop);
     server.stop();
     Ok(PlaySummary {
         url,
@@ -409,4 +466,16 @@ pub fn run(
         messages_dropped: shared.dropped.load(Ordering::Relaxed),
         page_messages_refused: shared.refused.load(Ordering::Relaxed),
     })
+}
+
+/// Keeps the server up (the end screen and the recording's download) for
+/// [`PlayConfig::keep_serving_s`] or until `stop`.
+fn serve_end_screen(config: &PlayConfig, stop: &AtomicBool) {
+    let until = config
+        .keep_serving_s
+        .filter(|s| s.is_finite() && *s >= 0.0)
+        .map(|s| Instant::now() + Duration::from_secs_f64(s.min(86_400.0)));
+    while !stop.load(Ordering::Relaxed) && until.is_none_or(|u| Instant::now() < u) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
