@@ -40,7 +40,7 @@ pub fn cmd(a: &PlayArgs) -> Result<ExitCode, String> {
         .map(BridgeConfig::parse)
         .transpose()
         .map_err(|e| e.to_string())?;
-    let stop = crate::interrupt_flag()?;
+    let stop = crate::run_cmd::interrupt_flag()?;
     let s = play::run(&c, &stop, &mut |url| {
         println!("open {url} in a browser (Ctrl-C ends the session)");
     })

@@ -1,0 +1,217 @@
+//! `nanohaptics fake-device`: a device in another process, over the UDP bridge, played by a
+//! script through a simulated hand or a modelled device, with loss, jitter and outages.
+
+use crate::run_cmd::parse_operator;
+use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
+use haptic_devices::{DeviceModel, Grip, Mechanics, Script};
+use haptic_loop::session::OperatorChoice;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(clap::Args)]
+pub(crate) struct FakeArgs {
+    /// The simulator's bridge address, `udp:HOST:PORT`.
+    target: String,
+    /// Script file (TOML) the stylus plays (default: the built-in wall-press script).
+    #[arg(long)]
+    script: Option<PathBuf>,
+    /// `hand` (default: a simulated hand pushed by the force), `rigid`, or
+    /// `hand:mass_kg=0.3,stiffness_n_per_m=300,...` (also spelled `--hand`).
+    #[arg(long, alias = "hand", default_value = "hand")]
+    operator: String,
+    /// Device model: falcon, touch, delta3 or inverse3 (delta3 and inverse3 are always
+    /// modelled devices; see --grip).
+    #[arg(long, default_value = "falcon")]
+    model: String,
+    /// Play a modelled device (moving mass, encoder counts, force held over each period) held
+    /// by a hand: `loose` (300 N/m, 2 N·s/m), `firm` (1000 N/m, 8 N·s/m) or
+    /// `k=N/m,b=N·s/m[,m=kg]` (docs/devices.md). Replaces --operator.
+    #[arg(long)]
+    grip: Option<String>,
+    /// With --grip: an ideal device (no encoder counts, no force resolution).
+    #[arg(long)]
+    ideal: bool,
+    /// Probability that a sample is lost, 0–1.
+    #[arg(long, default_value_t = 0.0)]
+    loss: f64,
+    /// Extra delay of each sample, uniform in 0–J ms (samples may overtake each other).
+    #[arg(long, default_value_t = 0.0)]
+    jitter_ms: f64,
+    /// Fixed delay of each sample, ms.
+    #[arg(long, default_value_t = 0.0)]
+    latency_ms: f64,
+    /// Seed of the loss and jitter draws.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// How long to play, s (default: the script's duration).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Go silent from START s for SECONDS s, then come back (`--outage 1.0:0.05`).
+    #[arg(long)]
+    outage: Option<String>,
+    /// How long to wait for the simulator's welcome, s.
+    #[arg(long, default_value_t = 30.0)]
+    wait_s: f64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The default script of `fake-device`: press the wall scene's surface, as its own script does.
+const FAKE_SCRIPT: &str = include_str!("../../../scenes/wall.script.toml");
+
+pub(crate) fn cmd(a: FakeArgs) -> Result<ExitCode, String> {
+    let (cfg, physical) = config(&a)?;
+    if !a.json {
+        eprintln!("fake-device: saying hello to {} ...", cfg.target);
+    }
+    let r = run_fake(&cfg, None).map_err(|e| e.to_string())?;
+    if a.json {
+        println!("{}", serde_json::json!(r));
+    } else {
+        print_report(&r, physical, a.ideal);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A flag's value checked against its range.
+fn check(flag: &str, v: f64, lo: f64, hi: f64) -> Result<f64, String> {
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("--{flag} = {v} is out of range: allowed {lo}–{hi}"))
+    }
+}
+
+/// `--outage START:SECONDS`, each part checked.
+fn outage(o: &str) -> Result<(f64, f64), String> {
+    let bad = || format!("--outage `{o}`: expected START:SECONDS, e.g. 1.0:0.05");
+    let (s, d) = o.split_once(':').ok_or_else(bad)?;
+    let s: f64 = s.parse().map_err(|_| bad())?;
+    let d: f64 = d.parse().map_err(|_| bad())?;
+    Ok((
+        check("outage start", s, 0.0, 86400.0)?,
+        check("outage seconds", d, 0.0, 86400.0)?,
+    ))
+}
+
+/// The modelled device and its grip (`--grip`, or a loose grip for a device that is only
+/// ever modelled), `None` for an ideal stylus.
+fn physical(a: &FakeArgs) -> Result<Option<(Mechanics, Grip)>, String> {
+    let mech = Mechanics::preset(&a.model).map_err(|e| format!("--model: {e}"))?;
+    let grip = match (&a.grip, DeviceModel::from_name(&a.model).is_ok()) {
+        (Some(g), _) => Some(Grip::parse(g).map_err(|e| format!("--grip: {e}"))?),
+        (None, false) => Some(Grip::LOOSE),
+        (None, true) => None,
+    };
+    if a.ideal && grip.is_none() {
+        return Err("--ideal needs --grip (it removes a modelled device's encoder counts)".into());
+    }
+    Ok(grip.map(|g| {
+        let m = if a.ideal {
+            mech.without_quantization()
+        } else {
+            mech
+        };
+        (m, g)
+    }))
+}
+
+/// The script the stylus plays (`--script`, or the built-in wall press), errors located.
+fn script(a: &FakeArgs, model: DeviceModel) -> Result<Script, String> {
+    let (text, origin) = match &a.script {
+        Some(p) => (
+            haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?,
+            p.display().to_string(),
+        ),
+        None => (
+            FAKE_SCRIPT.to_string(),
+            "built-in fake-device script".into(),
+        ),
+    };
+    Script::from_toml(&text, model.specs()).map_err(|e| {
+        let at = haptic_loop::session::Location {
+            file: origin,
+            at: e.position(&text),
+        };
+        format!("--script: {at}: {e}")
+    })
+}
+
+/// The fake device's configuration from its flags, every value checked.
+fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), String> {
+    let target = a
+        .target
+        .strip_prefix("udp:")
+        .and_then(|t| t.parse().ok())
+        .ok_or_else(|| {
+            format!(
+                "fake-device `{}`: expected udp:HOST:PORT, e.g. udp:127.0.0.1:9870",
+                a.target
+            )
+        })?;
+    let physical = physical(a)?;
+    // Scripts name the buttons of the device they were written for: a Falcon's, or a Touch's.
+    let model = DeviceModel::from_name(&a.model).unwrap_or(DeviceModel::Falcon);
+    let script = script(a, model)?;
+    let hand = match parse_operator(&a.operator)? {
+        OperatorChoice::Rigid => None,
+        OperatorChoice::Hand(p) => Some(p),
+        OperatorChoice::ScriptHand => Some(script.operator.unwrap_or_default()),
+    };
+    let loss = check("loss", a.loss, 0.0, 1.0)?;
+    let jitter = check("jitter-ms", a.jitter_ms, 0.0, 1000.0)?;
+    let latency = check("latency-ms", a.latency_ms, 0.0, 1000.0)?;
+    let outage = a.outage.as_deref().map(outage).transpose()?;
+    if let Some(s) = a.seconds {
+        // Up to a day: a soak plays for hours.
+        check("seconds", s, 1e-3, 86400.0)?;
+    }
+    let cfg = FakeConfig {
+        target,
+        model,
+        script,
+        hand,
+        physical,
+        loss,
+        jitter_s: jitter * 1e-3,
+        latency_s: latency * 1e-3,
+        seed: a.seed,
+        seconds: a.seconds,
+        outage,
+        wait_s: check("wait-s", a.wait_s, 0.0, 86400.0)?,
+        bye: true,
+    };
+    Ok((cfg, physical))
+}
+
+/// The report as text: periods, samples, round trips, forces and the work done on the hand.
+fn print_report(r: &FakeReport, physical: Option<(Mechanics, Grip)>, ideal: bool) {
+    println!(
+        "fake-device: {} periods, {} samples sent, {} dropped (loss), {} silent (outage), {} replies",
+        r.ticks, r.sent, r.dropped, r.silent, r.replies
+    );
+    println!(
+        "  round trip p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; peak force {:.3} N (within limits: {})",
+        r.round_trip.p50_ns as f64 / 1e3,
+        r.round_trip.p99_ns as f64 / 1e3,
+        r.round_trip.max_ns as f64 / 1e3,
+        r.max_force_n,
+        if r.forces_within_limits { "yes" } else { "NO" }
+    );
+    println!(
+        "  force changes above 1 N between periods: {} (largest {:.3} N)",
+        r.jumps_over_1n, r.max_jump_n
+    );
+    if let Some((m, g)) = physical {
+        println!(
+            "  modelled {} held {} ({} N/m, {} N·s/m){}: the motors did {:+.4} J of work on the hand",
+            m.name,
+            g.label(),
+            g.stiffness_n_per_m,
+            g.damping_n_s_per_m,
+            if ideal { ", ideal sensing" } else { "" },
+            r.energy_to_hand_j
+        );
+    }
+}

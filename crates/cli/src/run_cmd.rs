@@ -1,0 +1,306 @@
+//! `nanohaptics run`: a scene with a script or a device, batch or real time, recorded and
+//! served live, with its summary.
+
+use haptic_devices::DeviceModel;
+use haptic_devices::bridge::BridgeConfig;
+use haptic_loop::live::LiveConfig;
+use haptic_loop::session::{
+    OperatorChoice, SceneSource, SessionError, SessionOptions, SessionReport, run_session_until,
+};
+use haptic_loop::totals::Totals;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+#[derive(clap::Args)]
+pub(crate) struct RunArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Script file (TOML); default: the scene's default script.
+    #[arg(long)]
+    script: Option<PathBuf>,
+    /// `rigid` (stylus follows the script exactly), `hand` (simulated hand with the script's
+    /// parameters) or `hand:mass_kg=0.3,stiffness_n_per_m=300,damping_n_s_per_m=12`.
+    #[arg(long, default_value = "hand")]
+    operator: String,
+    /// Device: a model overriding the scene's (falcon, touch), or a device in another process
+    /// over the UDP bridge, `udp:HOST:PORT` (listen there; waits for its hello; always real
+    /// time; see docs/device-bridge.md).
+    #[arg(long)]
+    device: Option<String>,
+    /// Serve a live Foxglove view at `ws:HOST:PORT` while the session runs (open
+    /// ws://HOST:PORT in Foxglove; layout in docs/foxglove/).
+    #[arg(long)]
+    live: Option<String>,
+    /// Rate of the live 3D scene, Hz (default 50).
+    #[arg(long, default_value_t = 50)]
+    live_hz: u32,
+    /// How long to wait for a bridged device's hello, s.
+    #[arg(long, default_value_t = 120.0)]
+    wait_s: f64,
+    /// Session length, s (default: the script's duration).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Record to this MCAP file.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Pace ticks against the wall clock (zero force on a missed deadline).
+    #[arg(long)]
+    realtime: bool,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `--operator`: the one operator parser, shared with the wheel.
+pub(crate) fn parse_operator(s: &str) -> Result<OperatorChoice, String> {
+    OperatorChoice::parse(s).map_err(|e| match e {
+        // An unknown name is the flag's error; a bad `hand:k=v` names its key.
+        SessionError::Option(m) => format!("--{m}"),
+        e => e.to_string(),
+    })
+}
+
+/// The house task's score at the end of a session (brick and nano worlds), from the last
+/// tick's state: `score`, slots filled, `dropped`, `comfort_exceeded_s`, `complete_s`.
+fn house_score(t: &Totals) -> serde_json::Value {
+    let Some(score) = t.last("score") else {
+        return serde_json::Value::Null;
+    };
+    let filled = t.last("slots_filled").or_else(|| t.last("house_score"));
+    serde_json::json!({
+        "score": score,
+        "slots_filled": filled,
+        "dropped": t.last("dropped"),
+        "comfort_exceeded_s": t.last("comfort_exceeded_s"),
+        "complete_s": t.last("complete_s"),
+        "rule": "100 × filled / slots − 10 per dropped brick or atom − 5 per second above half \
+                 the device's largest force; never below 0",
+    })
+}
+
+/// The run summary, from the session's running totals (constant memory: the run keeps no
+/// per-tick arrays).
+pub(crate) fn summary_json(r: &SessionReport) -> serde_json::Value {
+    let t = &r.totals;
+    serde_json::json!({
+        "scene": r.description.scene_name,
+        "kind": r.description.scene_kind,
+        "device": r.description.device_model,
+        "script": r.description.script_name,
+        "operator": r.description.operator,
+        "mode": r.description.mode,
+        "ticks": r.stats.ticks,
+        "duration_s": r.stats.ticks as f64 / f64::from(r.description.rate_hz),
+        "peak_device_force_n": t.peak_device_force_n,
+        "clamped_ticks": t.clamped_ticks,
+        "events": t.events,
+        "tick_stats": r.stats,
+        "written": r.written,
+        "end": r.end,
+        "device_link": r.description.device_link,
+        "link": r.link.iter().map(|(k, v)| (k.to_string(), *v)).collect::<BTreeMap<String, u64>>(),
+        "watchdog_ticks": t.watchdog_ticks,
+        "live": r.live,
+        "sinks": r.sinks,
+        "house_score": house_score(t),
+    })
+}
+
+pub(crate) fn print_summary(r: &SessionReport) {
+    let j = summary_json(r);
+    let s = &r.stats;
+    println!(
+        "{} ({}, {} device, {} operator)",
+        r.description.scene_name,
+        r.description.mode,
+        r.description.device_model,
+        r.description.operator
+    );
+    println!(
+        "  {} ticks ({:.3} s), peak force {:.3} N, {} clamped ticks, {} events",
+        s.ticks,
+        j["duration_s"].as_f64().unwrap_or(0.0),
+        j["peak_device_force_n"].as_f64().unwrap_or(0.0),
+        j["clamped_ticks"],
+        j["events"]
+    );
+    println!(
+        "  tick work p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; jitter p99 {:.1} µs; {} missed deadlines",
+        s.compute.p50_ns as f64 / 1e3,
+        s.compute.p99_ns as f64 / 1e3,
+        s.compute.max_ns as f64 / 1e3,
+        s.jitter.p99_ns as f64 / 1e3,
+        s.missed
+    );
+    let h = &j["house_score"];
+    if let Some(score) = h["score"].as_f64() {
+        let complete = h["complete_s"].as_f64().unwrap_or(-1.0);
+        println!(
+            "  house score {score:.1}: {:.0} slots filled, {:.0} dropped, {:.2} s above the \
+             comfort force, {}",
+            h["slots_filled"].as_f64().unwrap_or(0.0),
+            h["dropped"].as_f64().unwrap_or(0.0),
+            h["comfort_exceeded_s"].as_f64().unwrap_or(0.0),
+            if complete >= 0.0 {
+                format!("complete at {complete:.2} s")
+            } else {
+                "not complete".to_string()
+            }
+        );
+    }
+    if !r.sinks.is_empty() {
+        let parts: Vec<String> = r
+            .sinks
+            .iter()
+            .map(|t| format!("{} {:.1} µs", t.sink, t.tick.p99_ns as f64 / 1e3))
+            .collect();
+        println!("  sink time per tick, p99: {}", parts.join(", "));
+    }
+    if !r.link.is_empty() {
+        let parts: Vec<String> = r.link.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        println!("  device link: {}", parts.join(", "));
+    }
+    if let Some(l) = &r.live {
+        println!(
+            "  live view: {} scenes, {} states, {} log lines published, {} dropped",
+            l.scenes, l.states, l.logs, l.dropped
+        );
+    }
+    if let Some(w) = &r.written {
+        println!(
+            "  recorded {} messages, {} bytes ({:.0} bytes per minute)",
+            w.messages,
+            w.bytes,
+            w.bytes as f64 * 60.0 / (s.ticks as f64 / f64::from(r.description.rate_hz))
+        );
+    }
+}
+
+pub(crate) fn progress_bar(len: u64, label: &str) -> ProgressBar {
+    let pb = ProgressBar::new(len);
+    let style = ProgressStyle::with_template("{prefix:>16} [{bar:40}] {pos}/{len} ticks {eta}")
+        .map(|s| s.progress_chars("=> "))
+        .unwrap_or_else(|_| ProgressStyle::default_bar());
+    pb.set_style(style);
+    pb.set_prefix(label.to_string());
+    pb
+}
+
+pub(crate) fn cmd(args: RunArgs) -> Result<ExitCode, String> {
+    let RunArgs {
+        scene,
+        script,
+        operator,
+        device,
+        live,
+        live_hz,
+        wait_s,
+        seconds,
+        out,
+        realtime,
+        json,
+    } = args;
+    let mut opts = SessionOptions::new(SceneSource::resolve(&scene).map_err(|e| e.to_string())?);
+    opts.operator = parse_operator(&operator)?;
+    match device.as_deref() {
+        Some(d) if d.starts_with("udp:") => {
+            let mut b = BridgeConfig::parse(d).map_err(|e| e.to_string())?;
+            if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
+                return Err(format!(
+                    "--wait-s = {wait_s} is out of range: allowed 0–86400"
+                ));
+            }
+            b.wait_s = wait_s;
+            if !json {
+                eprintln!(
+                    "waiting for a device on udp:{} (nanohaptics fake-device udp:{} in another terminal) ...",
+                    b.bind, b.bind
+                );
+            }
+            opts.bridge = Some(b);
+        }
+        Some(d) => {
+            opts.device = Some(DeviceModel::from_name(d).map_err(|e| {
+                format!("--device: {e}; or udp:HOST:PORT for a device in another process")
+            })?);
+        }
+        None => {}
+    }
+    if let Some(l) = live.as_deref() {
+        let mut c = LiveConfig::parse(l).map_err(|e| e.to_string())?;
+        if !(1..=1000).contains(&live_hz) {
+            return Err(format!(
+                "--live-hz = {live_hz} is out of range: allowed 1–1000"
+            ));
+        }
+        c.display_hz = live_hz;
+        if !json {
+            eprintln!(
+                "live view on ws://{} (Foxglove: Open connection → Foxglove WebSocket)",
+                c.bind
+            );
+        }
+        opts.live = Some(c);
+    }
+    if let Some(p) = script.as_deref() {
+        opts.script =
+            Some(haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?);
+        opts.script_origin = Some(p.display().to_string());
+    }
+    opts.seconds = seconds;
+    opts.realtime = realtime;
+    opts.out = out;
+    // The summary comes from the running totals: no per-tick arrays, so memory stays flat
+    // however long the session runs.
+    opts.arrays = false;
+    let pb = (!json).then(|| progress_bar(0, "run"));
+    let stop = interrupt_flag()?;
+    let report = run_session_until(
+        &opts,
+        &mut |done, total| {
+            if let Some(pb) = &pb {
+                pb.set_length(total);
+                pb.set_position(done);
+            }
+        },
+        Some(&stop),
+    )
+    .map_err(|e| e.to_string())?;
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    if json {
+        println!("{}", summary_json(&report));
+    } else {
+        print_summary(&report);
+    }
+    if report.end == "stopped" {
+        eprintln!(
+            "stopped by an interrupt after {} ticks{}",
+            report.stats.ticks,
+            match &opts.out {
+                Some(p) => format!("; {} holds them, complete and verifiable", p.display()),
+                None => String::new(),
+            }
+        );
+        return Ok(ExitCode::from(130));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A flag raised by the first Ctrl-C (SIGINT) or SIGTERM: the session stops cleanly after
+/// the current tick and the recording is finished. A second one ends the program at once.
+pub(crate) fn interrupt_flag() -> Result<Arc<AtomicBool>, String> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let stop = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&stop))
+            .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&stop)))
+            .map_err(|e| format!("cannot watch for Ctrl-C: {e}"))?;
+    }
+    Ok(stop)
+}
