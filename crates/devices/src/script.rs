@@ -228,6 +228,102 @@ fn check(field: String, value: f64, ok: bool, allowed: &str) -> Result<(), Scrip
     }
 }
 
+/// `field` = `t_s` checked: finite, within 0 … [`MAX_SCRIPT_S`].
+fn check_time(field: String, t_s: f64) -> Result<(), ScriptError> {
+    check(
+        field,
+        t_s,
+        t_s.is_finite() && (0.0..=MAX_SCRIPT_S).contains(&t_s),
+        &format!("0 ≤ t_s ≤ {MAX_SCRIPT_S}"),
+    )
+}
+
+/// The `[[waypoint]]`s: times increasing, positions finite and inside the workspace.
+fn waypoints(file: &[WaypointFile], specs: &DeviceSpecs) -> Result<Vec<Waypoint>, ScriptError> {
+    let r_mm = specs.workspace_radius_m * 1e3;
+    let mut waypoints = Vec::with_capacity(file.len());
+    let mut last_t = f64::NEG_INFINITY;
+    for (i, w) in file.iter().enumerate() {
+        let field = format!("waypoint[{i}].t_s");
+        check_time(field.clone(), w.t_s)?;
+        check(
+            field,
+            w.t_s,
+            w.t_s > last_t,
+            &format!("greater than the previous waypoint's t_s = {last_t}"),
+        )?;
+        last_t = w.t_s;
+        for (k, c) in w.position_mm.iter().enumerate() {
+            check(
+                format!("waypoint[{i}].position_mm[{k}]"),
+                *c,
+                c.is_finite(),
+                "a finite number",
+            )?;
+        }
+        let p = vec3::scale(w.position_mm, 1e-3);
+        let dist_mm = vec3::norm(w.position_mm);
+        check(
+            format!("waypoint[{i}].position_mm (distance from the device origin, mm)"),
+            dist_mm,
+            vec3::norm(p) <= specs.workspace_radius_m,
+            &format!("≤ {r_mm} mm, the {} workspace radius", specs.name),
+        )?;
+        waypoints.push(Waypoint {
+            t_s: w.t_s,
+            position_m: p,
+        });
+    }
+    Ok(waypoints)
+}
+
+/// The `[[button]]` events, by time: each a button the device has.
+fn buttons(file: &[ButtonFile], specs: &DeviceSpecs) -> Result<Vec<ButtonEvent>, ScriptError> {
+    let mut buttons = Vec::with_capacity(file.len());
+    for (i, b) in file.iter().enumerate() {
+        check_time(format!("button[{i}].t_s"), b.t_s)?;
+        let index = specs
+            .button_index(&b.name)
+            .map_err(|source| ScriptError::Button {
+                field: format!("button[{i}].name"),
+                source,
+            })?;
+        buttons.push(ButtonEvent {
+            t_s: b.t_s,
+            index,
+            down: b.down,
+        });
+    }
+    buttons.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+    Ok(buttons)
+}
+
+/// The `[[switch]]` events, by time, each value finite (the scene checks names and ranges).
+fn switches(file: &[SwitchFile]) -> Result<Vec<SwitchEvent>, ScriptError> {
+    let mut switches = Vec::with_capacity(file.len());
+    for (i, w) in file.iter().enumerate() {
+        check_time(format!("switch[{i}].t_s"), w.t_s)?;
+        let value = match w.value {
+            SwitchValue::Bool(b) => f64::from(u8::from(b)),
+            SwitchValue::Number(v) => v,
+        };
+        check(
+            format!("switch[{i}].value"),
+            value,
+            value.is_finite(),
+            "a finite number",
+        )?;
+        switches.push(SwitchEvent {
+            t_s: w.t_s,
+            name: w.name.clone(),
+            value,
+            index: i,
+        });
+    }
+    switches.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+    Ok(switches)
+}
+
 /// Longest script accepted, s (one hour).
 pub const MAX_SCRIPT_S: f64 = 3600.0;
 
@@ -242,98 +338,14 @@ impl Script {
         if file.waypoint.is_empty() {
             return Err(ScriptError::NoWaypoints);
         }
-        let r_mm = specs.workspace_radius_m * 1e3;
-        let range = format!("0 ≤ t_s ≤ {MAX_SCRIPT_S}");
-        let mut waypoints = Vec::with_capacity(file.waypoint.len());
-        let mut last_t = f64::NEG_INFINITY;
-        for (i, w) in file.waypoint.iter().enumerate() {
-            let field = format!("waypoint[{i}].t_s");
-            check(
-                field.clone(),
-                w.t_s,
-                w.t_s.is_finite() && (0.0..=MAX_SCRIPT_S).contains(&w.t_s),
-                &range,
-            )?;
-            check(
-                field,
-                w.t_s,
-                w.t_s > last_t,
-                &format!("greater than the previous waypoint's t_s = {last_t}"),
-            )?;
-            last_t = w.t_s;
-            for (k, c) in w.position_mm.iter().enumerate() {
-                check(
-                    format!("waypoint[{i}].position_mm[{k}]"),
-                    *c,
-                    c.is_finite(),
-                    "a finite number",
-                )?;
-            }
-            let p = vec3::scale(w.position_mm, 1e-3);
-            let dist_mm = vec3::norm(w.position_mm);
-            check(
-                format!("waypoint[{i}].position_mm (distance from the device origin, mm)"),
-                dist_mm,
-                vec3::norm(p) <= specs.workspace_radius_m,
-                &format!("≤ {r_mm} mm, the {} workspace radius", specs.name),
-            )?;
-            waypoints.push(Waypoint {
-                t_s: w.t_s,
-                position_m: p,
-            });
-        }
-        let mut buttons = Vec::with_capacity(file.button.len());
-        for (i, b) in file.button.iter().enumerate() {
-            check(
-                format!("button[{i}].t_s"),
-                b.t_s,
-                b.t_s.is_finite() && (0.0..=MAX_SCRIPT_S).contains(&b.t_s),
-                &range,
-            )?;
-            let index = specs
-                .button_index(&b.name)
-                .map_err(|source| ScriptError::Button {
-                    field: format!("button[{i}].name"),
-                    source,
-                })?;
-            buttons.push(ButtonEvent {
-                t_s: b.t_s,
-                index,
-                down: b.down,
-            });
-        }
-        buttons.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
-        let mut switches = Vec::with_capacity(file.switch.len());
-        for (i, w) in file.switch.iter().enumerate() {
-            check(
-                format!("switch[{i}].t_s"),
-                w.t_s,
-                w.t_s.is_finite() && (0.0..=MAX_SCRIPT_S).contains(&w.t_s),
-                &range,
-            )?;
-            let value = match w.value {
-                SwitchValue::Bool(b) => f64::from(u8::from(b)),
-                SwitchValue::Number(v) => v,
-            };
-            check(
-                format!("switch[{i}].value"),
-                value,
-                value.is_finite(),
-                "a finite number",
-            )?;
-            switches.push(SwitchEvent {
-                t_s: w.t_s,
-                name: w.name.clone(),
-                value,
-                index: i,
-            });
-        }
-        switches.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        let waypoints = waypoints(&file.waypoint, specs)?;
+        let buttons = buttons(&file.button, specs)?;
+        let switches = switches(&file.switch)?;
         let natural = buttons
             .iter()
             .map(|b| b.t_s)
             .chain(switches.iter().map(|s| s.t_s))
-            .fold(last_t, f64::max);
+            .fold(waypoints[waypoints.len() - 1].t_s, f64::max);
         let duration_s = match file.script.duration_s {
             Some(d) => {
                 check(

@@ -11,7 +11,9 @@ use super::protocol::{Packet, Sample};
 use crate::pacing::{Pacer, Percentiles};
 use crate::script::Script;
 use crate::{ModelledDevice, OperatorParams, ScriptedDevice, SimulatedOperator};
-use haptic_types::device::{DeviceError, DeviceModel, ForceCommand, HapticDevice, TickTime};
+use haptic_types::device::{
+    DeviceError, DeviceModel, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
+};
 use haptic_types::vec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -96,8 +98,93 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         Some((mech, _)) => crate::modelled::specs_of(mech, cfg.model.specs()),
         None => cfg.model.specs().clone(),
     };
-    let link = |what: &str, e: std::io::Error| DeviceError::Link(format!("{what}: {e}"));
-    let bind: SocketAddr = if cfg.target.is_ipv4() {
+    let socket = open_socket(cfg.target)?;
+    // 1. Hello until welcome.
+    let rate_hz = handshake(&socket, cfg, &specs, stop)?;
+    // 2. A receiver thread timestamps each reply.
+    let receiver = Receiver::spawn(&socket, cfg.target)?;
+    // 3. The servo loop.
+    let mut modelled = cfg
+        .physical
+        .map(|(mech, grip)| ModelledDevice::new(cfg.script.clone(), mech, grip, cfg.model.specs()));
+    let mut other: Box<dyn HapticDevice> = match cfg.hand {
+        Some(p) => Box::new(SimulatedOperator::new(cfg.script.clone(), specs.clone(), p)),
+        None => Box::new(ScriptedDevice::new(cfg.script.clone(), specs.clone())),
+    };
+    let seconds = cfg.seconds.unwrap_or(cfg.script.duration_s);
+    let ticks = (seconds * f64::from(rate_hz)).round().max(0.0) as u64;
+    let pacer = Pacer::new(1_000_000_000 / u64::from(rate_hz));
+    let mut servo = Servo {
+        cfg,
+        socket: &socket,
+        max_force_n: specs.limits.max_force_n,
+        rng: ChaCha8Rng::seed_from_u64(cfg.seed),
+        start: Instant::now(),
+        pending: BTreeMap::new(),
+        sent_at: BTreeMap::new(),
+        rtt: Vec::with_capacity(ticks as usize),
+        rep: FakeReport {
+            forces_within_limits: true,
+            ..Default::default()
+        },
+        last_sent: None,
+        outage_begun: false,
+        force: [0.0; 3],
+    };
+    for k in 0..ticks {
+        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) || receiver.done.load(Ordering::Relaxed)
+        {
+            break;
+        }
+        pacer.wait_for(k);
+        servo.rep.ticks += 1;
+        let t = TickTime::new(k, rate_hz);
+        let dev: &mut dyn HapticDevice = match modelled.as_mut() {
+            Some(m) => m,
+            None => other.as_mut(),
+        };
+        dev.set_force(&ForceCommand {
+            force_n: servo.force,
+            ..Default::default()
+        })?;
+        let s = dev.sample(t)?;
+        servo.queue(k, t.time_s, s.position_m, s.buttons.0);
+        servo.send_due();
+        // A modelled device renders an answer when it arrives, as a driver's servo thread
+        // does: wait for the answer to this period's sample for up to half a period, so the
+        // force of sample k is held over [k, k + 1] (plus the round trip), not a period late.
+        if modelled.is_some() && servo.sent_at.contains_key(&k) {
+            receiver.await_answer(k, Duration::from_nanos(500_000_000 / u64::from(rate_hz)));
+        }
+        // Replies that arrived since the last period.
+        for r in receiver.take() {
+            servo.reply(&r);
+        }
+        // Forget sends never answered (lost replies) after a second.
+        if servo.sent_at.len() > 4 * rate_hz as usize {
+            let keep = servo
+                .sent_at
+                .split_off(&k.saturating_sub(u64::from(rate_hz)));
+            servo.sent_at = keep;
+        }
+    }
+    if cfg.bye {
+        let _ = socket.send_to(&Packet::Bye { reason: 0 }.encode(), cfg.target);
+    }
+    receiver.finish();
+    let mut rep = servo.rep;
+    rep.round_trip = Percentiles::of(&servo.rtt);
+    rep.energy_to_hand_j = modelled.map_or(0.0, |m| m.plant().energy_to_hand_j());
+    Ok(rep)
+}
+
+fn link(what: &str, e: std::io::Error) -> DeviceError {
+    DeviceError::Link(format!("{what}: {e}"))
+}
+
+/// A socket on any local port of `target`'s family, reading with a 50 ms timeout.
+fn open_socket(target: SocketAddr) -> Result<UdpSocket, DeviceError> {
+    let bind: SocketAddr = if target.is_ipv4() {
         "0.0.0.0:0"
     } else {
         "[::]:0"
@@ -108,7 +195,17 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     socket
         .set_read_timeout(Some(Duration::from_millis(50)))
         .map_err(|e| link("cannot configure the socket", e))?;
-    // 1. Hello until welcome.
+    Ok(socket)
+}
+
+/// Says hello with `specs` until the simulator's welcome (within `cfg.wait_s`), and returns
+/// the tick rate it asked for, Hz (100–10000).
+fn handshake(
+    socket: &UdpSocket,
+    cfg: &FakeConfig,
+    specs: &DeviceSpecs,
+    stop: Option<&AtomicBool>,
+) -> Result<u32, DeviceError> {
     let hello = Packet::Hello {
         rate_hz: 1000,
         specs: specs.clone(),
@@ -138,174 +235,181 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
             "the simulator asked for {rate_hz} Hz (this fake device plays 100–10000 Hz)"
         )));
     }
-    // 2. A receiver thread timestamps each reply.
-    let replies: Arc<Mutex<Vec<Reply>>> = Arc::new(Mutex::new(Vec::with_capacity(1024)));
-    let done = Arc::new(AtomicBool::new(false));
-    let rx = socket
-        .try_clone()
-        .map_err(|e| link("cannot clone the socket", e))?;
-    let (r2, d2, target) = (replies.clone(), done.clone(), cfg.target);
-    let thread = std::thread::Builder::new()
-        .name("fake-rx".into())
-        .spawn(move || {
-            let mut buf = [0u8; 2048];
-            while !d2.load(Ordering::Relaxed) {
-                if let Ok((n, from)) = rx.recv_from(&mut buf) {
-                    let at = Instant::now();
-                    if from != target {
-                        continue;
-                    }
-                    match Packet::decode(&buf[..n]) {
-                        Ok(Packet::Force(f)) => {
-                            if let Ok(mut v) = r2.lock() {
-                                v.push(Reply {
-                                    seq: f.seq,
-                                    at,
-                                    force_n: f.force_n,
-                                });
+    Ok(rate_hz)
+}
+
+/// The receiver thread: every force packet from the simulator, timestamped on arrival; a
+/// goodbye raises `done`.
+struct Receiver {
+    replies: Arc<Mutex<Vec<Reply>>>,
+    done: Arc<AtomicBool>,
+    thread: std::thread::JoinHandle<()>,
+}
+
+impl Receiver {
+    fn spawn(socket: &UdpSocket, target: SocketAddr) -> Result<Receiver, DeviceError> {
+        let replies: Arc<Mutex<Vec<Reply>>> = Arc::new(Mutex::new(Vec::with_capacity(1024)));
+        let done = Arc::new(AtomicBool::new(false));
+        let rx = socket
+            .try_clone()
+            .map_err(|e| link("cannot clone the socket", e))?;
+        let (r2, d2) = (replies.clone(), done.clone());
+        let thread = std::thread::Builder::new()
+            .name("fake-rx".into())
+            .spawn(move || {
+                let mut buf = [0u8; 2048];
+                while !d2.load(Ordering::Relaxed) {
+                    if let Ok((n, from)) = rx.recv_from(&mut buf) {
+                        let at = Instant::now();
+                        if from != target {
+                            continue;
+                        }
+                        match Packet::decode(&buf[..n]) {
+                            Ok(Packet::Force(f)) => {
+                                if let Ok(mut v) = r2.lock() {
+                                    v.push(Reply {
+                                        seq: f.seq,
+                                        at,
+                                        force_n: f.force_n,
+                                    });
+                                }
                             }
+                            Ok(Packet::Bye { .. }) => {
+                                d2.store(true, Ordering::Relaxed);
+                            }
+                            _ => {}
                         }
-                        Ok(Packet::Bye { .. }) => {
-                            d2.store(true, Ordering::Relaxed);
-                        }
-                        _ => {}
                     }
                 }
-            }
+            })
+            .map_err(|e| link("cannot start the receiver", e))?;
+        Ok(Receiver {
+            replies,
+            done,
+            thread,
         })
-        .map_err(|e| link("cannot start the receiver", e))?;
-    // 3. The servo loop.
-    let mut modelled = cfg
-        .physical
-        .map(|(mech, grip)| ModelledDevice::new(cfg.script.clone(), mech, grip, cfg.model.specs()));
-    let mut other: Box<dyn HapticDevice> = match cfg.hand {
-        Some(p) => Box::new(SimulatedOperator::new(cfg.script.clone(), specs.clone(), p)),
-        None => Box::new(ScriptedDevice::new(cfg.script.clone(), specs.clone())),
-    };
-    let seconds = cfg.seconds.unwrap_or(cfg.script.duration_s);
-    let ticks = (seconds * f64::from(rate_hz)).round().max(0.0) as u64;
-    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let pacer = Pacer::new(1_000_000_000 / u64::from(rate_hz));
-    let start = Instant::now();
-    let mut pending: BTreeMap<(u64, u64), Vec<u8>> = BTreeMap::new();
-    let mut sent_at: BTreeMap<u64, Instant> = BTreeMap::new();
-    let mut rtt = Vec::with_capacity(ticks as usize);
-    let mut rep = FakeReport {
-        forces_within_limits: true,
-        ..Default::default()
-    };
-    let mut last_sent: Option<Instant> = None;
-    let mut outage_begun = false;
-    let mut force = [0.0; 3];
-    for k in 0..ticks {
-        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) || done.load(Ordering::Relaxed) {
-            break;
+    }
+
+    /// Spins until the answer to sample `seq` has arrived, at most `wait`.
+    fn await_answer(&self, seq: u64, wait: Duration) {
+        let until = Instant::now() + wait;
+        while Instant::now() < until
+            && !self
+                .replies
+                .lock()
+                .map(|v| v.iter().any(|r| r.seq == seq))
+                .unwrap_or(true)
+        {
+            std::hint::spin_loop();
         }
-        pacer.wait_for(k);
-        rep.ticks += 1;
-        let t = TickTime::new(k, rate_hz);
-        let dev: &mut dyn HapticDevice = match modelled.as_mut() {
-            Some(m) => m,
-            None => other.as_mut(),
-        };
-        dev.set_force(&ForceCommand {
-            force_n: force,
-            ..Default::default()
-        })?;
-        let s = dev.sample(t)?;
+    }
+
+    /// The replies that arrived since the last call.
+    fn take(&self) -> Vec<Reply> {
+        self.replies
+            .lock()
+            .map(|mut v| std::mem::take(&mut *v))
+            .unwrap_or_default()
+    }
+
+    /// Stops the thread.
+    fn finish(self) {
+        self.done.store(true, Ordering::Relaxed);
+        let _ = self.thread.join();
+    }
+}
+
+/// The servo loop's sending side and its measurements.
+struct Servo<'a> {
+    cfg: &'a FakeConfig,
+    socket: &'a UdpSocket,
+    max_force_n: f64,
+    rng: ChaCha8Rng,
+    start: Instant,
+    /// Samples waiting for their due time, by (due ns, seq).
+    pending: BTreeMap<(u64, u64), Vec<u8>>,
+    sent_at: BTreeMap<u64, Instant>,
+    rtt: Vec<u64>,
+    rep: FakeReport,
+    last_sent: Option<Instant>,
+    outage_begun: bool,
+    /// The force rendered now, N.
+    force: [f64; 3],
+}
+
+impl Servo<'_> {
+    /// Period `k`'s sample at `time_s`: silent in the outage, dropped with the loss's
+    /// probability, or else queued after the latency and a jitter draw.
+    fn queue(&mut self, k: u64, time_s: f64, position_m: [f64; 3], buttons: u32) {
+        let cfg = self.cfg;
         let silent = cfg
             .outage
-            .is_some_and(|(a, d)| t.time_s >= a && t.time_s < a + d);
+            .is_some_and(|(a, d)| time_s >= a && time_s < a + d);
         if silent {
-            rep.silent += 1;
-            outage_begun = true;
-        } else if cfg.loss > 0.0 && rng.random::<f64>() < cfg.loss {
-            rep.dropped += 1;
+            self.rep.silent += 1;
+            self.outage_begun = true;
+        } else if cfg.loss > 0.0 && self.rng.random::<f64>() < cfg.loss {
+            self.rep.dropped += 1;
         } else {
             let delay = cfg.latency_s
                 + if cfg.jitter_s > 0.0 {
-                    rng.random::<f64>() * cfg.jitter_s
+                    self.rng.random::<f64>() * cfg.jitter_s
                 } else {
                     0.0
                 };
             let pkt = Packet::Sample(Sample {
                 seq: k,
-                device_time_ns: start.elapsed().as_nanos() as u64,
-                position_m: s.position_m,
-                buttons: s.buttons.0,
+                device_time_ns: self.start.elapsed().as_nanos() as u64,
+                position_m,
+                buttons,
             })
             .encode();
-            let due = start.elapsed().as_nanos() as u64 + (delay * 1e9) as u64;
-            pending.insert((due, k), pkt);
+            let due = self.start.elapsed().as_nanos() as u64 + (delay * 1e9) as u64;
+            self.pending.insert((due, k), pkt);
         }
-        // Send what is due (in due order: jitter may reorder samples).
-        let now_ns = start.elapsed().as_nanos() as u64;
-        while let Some(entry) = pending.first_entry() {
+    }
+
+    /// Sends what is due (in due order: jitter may reorder samples).
+    fn send_due(&mut self) {
+        let now_ns = self.start.elapsed().as_nanos() as u64;
+        while let Some(entry) = self.pending.first_entry() {
             if entry.key().0 > now_ns {
                 break;
             }
             let ((_, seq), pkt) = entry.remove_entry();
             let at = Instant::now();
-            if socket.send_to(&pkt, cfg.target).is_ok() {
-                rep.sent += 1;
-                sent_at.insert(seq, at);
-                last_sent = Some(at);
+            if self.socket.send_to(&pkt, self.cfg.target).is_ok() {
+                self.rep.sent += 1;
+                self.sent_at.insert(seq, at);
+                self.last_sent = Some(at);
             }
-        }
-        // A modelled device renders an answer when it arrives, as a driver's servo thread
-        // does: wait for the answer to this period's sample for up to half a period, so the
-        // force of sample k is held over [k, k + 1] (plus the round trip), not a period late.
-        if modelled.is_some() && sent_at.contains_key(&k) {
-            let until = Instant::now() + Duration::from_nanos(500_000_000 / u64::from(rate_hz));
-            while Instant::now() < until
-                && !replies
-                    .lock()
-                    .map(|v| v.iter().any(|r| r.seq == k))
-                    .unwrap_or(true)
-            {
-                std::hint::spin_loop();
-            }
-        }
-        // Replies that arrived since the last period.
-        let got: Vec<Reply> = replies
-            .lock()
-            .map(|mut v| std::mem::take(&mut *v))
-            .unwrap_or_default();
-        for r in got {
-            rep.replies += 1;
-            let mag = vec3::norm(r.force_n);
-            if !vec3::is_finite(r.force_n) || mag > specs.limits.max_force_n {
-                rep.forces_within_limits = false;
-            }
-            rep.max_force_n = rep.max_force_n.max(mag);
-            if let Some(t0) = sent_at.remove(&r.seq) {
-                rtt.push(r.at.duration_since(t0).as_nanos() as u64);
-            }
-            if outage_begun && rep.outage_force.last().is_none_or(|l| l.1 > 0.0) {
-                if let Some(ls) = last_sent {
-                    let ms = r.at.saturating_duration_since(ls).as_secs_f64() * 1e3;
-                    rep.outage_force.push((ms, mag));
-                }
-            }
-            let jump = vec3::norm(vec3::sub(r.force_n, force));
-            rep.max_jump_n = rep.max_jump_n.max(jump);
-            if jump > 1.0 {
-                rep.jumps_over_1n += 1;
-            }
-            force = r.force_n;
-        }
-        // Forget sends never answered (lost replies) after a second.
-        if sent_at.len() > 4 * rate_hz as usize {
-            let keep = sent_at.split_off(&k.saturating_sub(u64::from(rate_hz)));
-            sent_at = keep;
         }
     }
-    if cfg.bye {
-        let _ = socket.send_to(&Packet::Bye { reason: 0 }.encode(), cfg.target);
+
+    /// A reply: its round trip, its force checked against the device's limit, the force jump,
+    /// and the force after an outage began; the force rendered from now on.
+    fn reply(&mut self, r: &Reply) {
+        let rep = &mut self.rep;
+        rep.replies += 1;
+        let mag = vec3::norm(r.force_n);
+        if !vec3::is_finite(r.force_n) || mag > self.max_force_n {
+            rep.forces_within_limits = false;
+        }
+        rep.max_force_n = rep.max_force_n.max(mag);
+        if let Some(t0) = self.sent_at.remove(&r.seq) {
+            self.rtt.push(r.at.duration_since(t0).as_nanos() as u64);
+        }
+        if self.outage_begun && rep.outage_force.last().is_none_or(|l| l.1 > 0.0) {
+            if let Some(ls) = self.last_sent {
+                let ms = r.at.saturating_duration_since(ls).as_secs_f64() * 1e3;
+                rep.outage_force.push((ms, mag));
+            }
+        }
+        let jump = vec3::norm(vec3::sub(r.force_n, self.force));
+        rep.max_jump_n = rep.max_jump_n.max(jump);
+        if jump > 1.0 {
+            rep.jumps_over_1n += 1;
+        }
+        self.force = r.force_n;
     }
-    done.store(true, Ordering::Relaxed);
-    let _ = thread.join();
-    rep.round_trip = Percentiles::of(&rtt);
-    rep.energy_to_hand_j = modelled.map_or(0.0, |m| m.plant().energy_to_hand_j());
-    Ok(rep)
 }
