@@ -206,154 +206,9 @@ pub fn run_lesson(
         progress(done, total, name);
         done += 1;
     };
-    let rec = |f: &str| Some(opts.out.join(f));
-
-    step("macro_house");
-    let macro_house = run("macro_house", "brickworld", None, rec("macro_house.mcap"))?;
-    step("nano_house");
-    let nano_house = run("nano_house", "nanoworld", None, rec("nano_house.mcap"))?;
-
-    let mut lifts = Vec::new();
-    for (name, sw) in [
-        ("lift", vec![]),
-        ("lift_gravity_off", vec![("gravity_m_per_s2", 0.0)]),
-        ("lift_inertia_off", vec![("inertia", 0.0)]),
-    ] {
-        step(name);
-        let (text, _) = scripts::brick_lift(&sw);
-        lifts.push(run(name, "brickworld", Some(text), None)?);
-    }
-    let mut cycles = Vec::new();
-    for (name, sw) in [
-        ("approach_retract", vec![]),
-        ("approach_retract_half", vec![("adhesion_scale", 0.5)]),
-    ] {
-        step(name);
-        cycles.push(run(
-            name,
-            "nanoworld",
-            Some(scripts::approach_retract(&sw)),
-            None,
-        )?);
-    }
-    step("brick_throw");
-    let (text, _) = scripts::brick_throw(0.3);
-    let brick_throw_run = run("brick_throw", "brickworld", Some(text), None)?;
-    step("atom_throw");
-    let atom_throw_run = run(
-        "atom_throw",
-        "nanoworld",
-        Some(scripts::atom_throw(0.3, &[])),
-        None,
-    )?;
-    let mut sweep_runs = Vec::new();
-    for swing in SWEEP_SWING_S {
-        step("heavy_atom_throw");
-        let text = scripts::atom_throw(
-            swing,
-            &[("gravity_m_per_s2", 0.0), ("atom_mass_kg", SWEEP_MASS_KG)],
-        );
-        sweep_runs.push((
-            swing,
-            run("heavy_atom_throw", "nanoworld", Some(text), None)?,
-        ));
-    }
+    let runs = run_all(opts, &mut step)?;
     step("report");
-
-    // ---- numbers ------------------------------------------------------------------------
-    let brick_params = brickworld::Params::default();
-    let nano_params = nanoworld::Params::game_default();
-    let m = brick_params.brick_mass_kg;
-    let g = brick_params.gravity_m_per_s2;
-    let (hold_w, carry_w) = ((1.5, 2.1), (2.1, 3.0));
-    let mut lift_weight_n = [0.0; 3];
-    let mut lift_inertia_n = [0.0; 3];
-    for (i, r) in lifts.iter().enumerate() {
-        let a = &r.arrays;
-        lift_weight_n[i] = measure::mean_force(a, measure::window(a, hold_w.0, hold_w.1), 2);
-        lift_inertia_n[i] = measure::peak_force(a, measure::window(a, carry_w.0, carry_w.1), 0);
-    }
-    let hyst = |r: &Run| {
-        measure::hysteresis(&r.arrays).ok_or_else(|| missing(r.name, "no snap and pull-off"))
-    };
-    let hysteresis = hyst(&cycles[0])?;
-    let hysteresis_half = hyst(&cycles[1])?;
-    let brick_throw = measure::brick_throw(&brick_throw_run.arrays)
-        .ok_or_else(|| missing("brick_throw", "no release followed by an impact"))?;
-    let throw_hand = measure::peak_hand_acceleration(&brick_throw_run.arrays);
-    let scale = 1.5e-7; // the nano scene's workspace_scale (m of world per m of stylus)
-    let hold = tip_atom_hold_n(&nano_params);
-    let atom_m = nano_params.atoms.mass_kg;
-    let atom_hand = measure::peak_hand_acceleration(&atom_throw_run.arrays);
-    let atom_load =
-        atom_m * ((atom_hand * scale).powi(2) + nano_params.gravity_m_per_s2.powi(2)).sqrt();
-    let carried_end = measure::last(&atom_throw_run.arrays, "carried_atoms").unwrap_or(0.0);
-    let mut runs = Vec::new();
-    for (swing, r) in &sweep_runs {
-        let thrown = measure::events(&r.arrays, "nano.atoms_thrown_off")
-            .next()
-            .is_some();
-        runs.push((*swing, measure::peak_hand_acceleration(&r.arrays), thrown));
-    }
-    let kept_below = runs
-        .iter()
-        .filter(|r| !r.2)
-        .map(|r| r.1)
-        .fold(0.0, f64::max);
-    let thrown_from = runs
-        .iter()
-        .filter(|r| r.2)
-        .map(|r| r.1)
-        .fold(f64::INFINITY, f64::min);
-    let sweep = ThrowSweep {
-        mass_kg: SWEEP_MASS_KG,
-        hold_n: hold,
-        predicted_hand_m_per_s2: hold / SWEEP_MASS_KG / scale,
-        runs,
-        kept_below_m_per_s2: kept_below,
-        thrown_from_m_per_s2: thrown_from,
-    };
-    let e = brick_params.brick_half_extents_m;
-    let mut summary = LessonSummary {
-        macro_house: measure::house_outcome(&macro_house.arrays, "slots_filled"),
-        nano_house: measure::house_outcome(&nano_house.arrays, "house_score"),
-        lift_weight_n,
-        lift_inertia_n,
-        brick_mass_kg: m,
-        gravity_m_per_s2: g,
-        lift_inertia_predicted_n: m * 5.773_502_691_896_258 * 0.45 / (0.9 * 0.9),
-        hysteresis,
-        hysteresis_half,
-        brick_throw,
-        throw_hand_m_per_s2: throw_hand,
-        atom_stayed: carried_end >= 1.0,
-        atom_load_n: atom_load,
-        atom_inertia_n: atom_m * atom_hand * scale,
-        atom_hold_n: hold,
-        atom_mass_kg: atom_m,
-        atom_threshold_hand_m_per_s2: hold / atom_m / scale,
-        sweep,
-        sizes_m: [
-            ("brick, longest edge".into(), 2.0 * e[0].max(e[1]).max(e[2])),
-            (
-                "cursor sphere, diameter".into(),
-                2.0 * brick_params.proxy_radius_m,
-            ),
-            ("AFM tip, diameter".into(), 2.0 * nano_params.tip.radius_m),
-            ("atom, diameter".into(), 2.0 * nano_params.atoms.radius_m),
-            ("substrate spacing".into(), nano_params.substrate.spacing_m),
-        ],
-        files: Vec::new(),
-    };
-    let runs = Runs {
-        macro_house,
-        nano_house,
-        lifts,
-        cycles,
-        brick_throw: brick_throw_run,
-        atom_throw: atom_throw_run,
-        sweep: sweep_runs,
-    };
+    let mut summary = summarize(&runs)?;
     summary.files = report::write(&opts.out, opts.width_px, &summary, &runs)?;
     let json = serde_json::to_string_pretty(&summary).map_err(|e| LessonError::Io {
         path: "lesson.json".into(),
@@ -379,6 +234,163 @@ pub fn run_lesson(
         summary.files.push(wav);
     }
     Ok(summary)
+}
+
+/// The lesson's sessions, in order (`step(name)` before each); the two house tasks are
+/// recorded into `opts.out`.
+fn run_all(opts: &LessonOptions, step: &mut dyn FnMut(&str)) -> Result<Runs, LessonError> {
+    let rec = |f: &str| Some(opts.out.join(f));
+    step("macro_house");
+    let macro_house = run("macro_house", "brickworld", None, rec("macro_house.mcap"))?;
+    step("nano_house");
+    let nano_house = run("nano_house", "nanoworld", None, rec("nano_house.mcap"))?;
+    let mut lifts = Vec::new();
+    for (name, sw) in [
+        ("lift", vec![]),
+        ("lift_gravity_off", vec![("gravity_m_per_s2", 0.0)]),
+        ("lift_inertia_off", vec![("inertia", 0.0)]),
+    ] {
+        step(name);
+        let (text, _) = scripts::brick_lift(&sw);
+        lifts.push(run(name, "brickworld", Some(text), None)?);
+    }
+    let mut cycles = Vec::new();
+    for (name, sw) in [
+        ("approach_retract", vec![]),
+        ("approach_retract_half", vec![("adhesion_scale", 0.5)]),
+    ] {
+        step(name);
+        cycles.push(run(
+            name,
+            "nanoworld",
+            Some(scripts::approach_retract(&sw)),
+            None,
+        )?);
+    }
+    step("brick_throw");
+    let (text, _) = scripts::brick_throw(0.3);
+    let brick_throw = run("brick_throw", "brickworld", Some(text), None)?;
+    step("atom_throw");
+    let atom_throw = run(
+        "atom_throw",
+        "nanoworld",
+        Some(scripts::atom_throw(0.3, &[])),
+        None,
+    )?;
+    let mut sweep = Vec::new();
+    for swing in SWEEP_SWING_S {
+        step("heavy_atom_throw");
+        let text = scripts::atom_throw(
+            swing,
+            &[("gravity_m_per_s2", 0.0), ("atom_mass_kg", SWEEP_MASS_KG)],
+        );
+        sweep.push((
+            swing,
+            run("heavy_atom_throw", "nanoworld", Some(text), None)?,
+        ));
+    }
+    Ok(Runs {
+        macro_house,
+        nano_house,
+        lifts,
+        cycles,
+        brick_throw,
+        atom_throw,
+        sweep,
+    })
+}
+
+/// The nano scene's workspace scale, m of world per m of stylus.
+const NANO_WORKSPACE_SCALE: f64 = 1.5e-7;
+
+/// The threshold demonstration: each heavy-atom throw's peak hand acceleration and whether the
+/// atom was thrown off, against the predicted threshold.
+fn throw_sweep(sweep: &[(f64, Run)], hold: f64) -> ThrowSweep {
+    let mut runs = Vec::new();
+    for (swing, r) in sweep {
+        let thrown = measure::events(&r.arrays, "nano.atoms_thrown_off")
+            .next()
+            .is_some();
+        runs.push((*swing, measure::peak_hand_acceleration(&r.arrays), thrown));
+    }
+    let kept_below = runs
+        .iter()
+        .filter(|r| !r.2)
+        .map(|r| r.1)
+        .fold(0.0, f64::max);
+    let thrown_from = runs
+        .iter()
+        .filter(|r| r.2)
+        .map(|r| r.1)
+        .fold(f64::INFINITY, f64::min);
+    ThrowSweep {
+        mass_kg: SWEEP_MASS_KG,
+        hold_n: hold,
+        predicted_hand_m_per_s2: hold / SWEEP_MASS_KG / NANO_WORKSPACE_SCALE,
+        runs,
+        kept_below_m_per_s2: kept_below,
+        thrown_from_m_per_s2: thrown_from,
+    }
+}
+
+/// The lesson's figures from its runs (no files written yet).
+fn summarize(runs: &Runs) -> Result<LessonSummary, LessonError> {
+    let brick_params = brickworld::Params::default();
+    let nano_params = nanoworld::Params::game_default();
+    let m = brick_params.brick_mass_kg;
+    let g = brick_params.gravity_m_per_s2;
+    let (hold_w, carry_w) = ((1.5, 2.1), (2.1, 3.0));
+    let mut lift_weight_n = [0.0; 3];
+    let mut lift_inertia_n = [0.0; 3];
+    for (i, r) in runs.lifts.iter().enumerate() {
+        let a = &r.arrays;
+        lift_weight_n[i] = measure::mean_force(a, measure::window(a, hold_w.0, hold_w.1), 2);
+        lift_inertia_n[i] = measure::peak_force(a, measure::window(a, carry_w.0, carry_w.1), 0);
+    }
+    let hyst = |r: &Run| {
+        measure::hysteresis(&r.arrays).ok_or_else(|| missing(r.name, "no snap and pull-off"))
+    };
+    let brick_throw = measure::brick_throw(&runs.brick_throw.arrays)
+        .ok_or_else(|| missing("brick_throw", "no release followed by an impact"))?;
+    let scale = NANO_WORKSPACE_SCALE;
+    let hold = tip_atom_hold_n(&nano_params);
+    let atom_m = nano_params.atoms.mass_kg;
+    let atom_hand = measure::peak_hand_acceleration(&runs.atom_throw.arrays);
+    let atom_load =
+        atom_m * ((atom_hand * scale).powi(2) + nano_params.gravity_m_per_s2.powi(2)).sqrt();
+    let carried_end = measure::last(&runs.atom_throw.arrays, "carried_atoms").unwrap_or(0.0);
+    let e = brick_params.brick_half_extents_m;
+    Ok(LessonSummary {
+        macro_house: measure::house_outcome(&runs.macro_house.arrays, "slots_filled"),
+        nano_house: measure::house_outcome(&runs.nano_house.arrays, "house_score"),
+        lift_weight_n,
+        lift_inertia_n,
+        brick_mass_kg: m,
+        gravity_m_per_s2: g,
+        lift_inertia_predicted_n: m * 5.773_502_691_896_258 * 0.45 / (0.9 * 0.9),
+        hysteresis: hyst(&runs.cycles[0])?,
+        hysteresis_half: hyst(&runs.cycles[1])?,
+        brick_throw,
+        throw_hand_m_per_s2: measure::peak_hand_acceleration(&runs.brick_throw.arrays),
+        atom_stayed: carried_end >= 1.0,
+        atom_load_n: atom_load,
+        atom_inertia_n: atom_m * atom_hand * scale,
+        atom_hold_n: hold,
+        atom_mass_kg: atom_m,
+        atom_threshold_hand_m_per_s2: hold / atom_m / scale,
+        sweep: throw_sweep(&runs.sweep, hold),
+        sizes_m: [
+            ("brick, longest edge".into(), 2.0 * e[0].max(e[1]).max(e[2])),
+            (
+                "cursor sphere, diameter".into(),
+                2.0 * brick_params.proxy_radius_m,
+            ),
+            ("AFM tip, diameter".into(), 2.0 * nano_params.tip.radius_m),
+            ("atom, diameter".into(), 2.0 * nano_params.atoms.radius_m),
+            ("substrate spacing".into(), nano_params.substrate.spacing_m),
+        ],
+        files: Vec::new(),
+    })
 }
 
 /// The lesson's runs, for the figures.

@@ -134,8 +134,24 @@ pub fn write(
     runs: &Runs,
 ) -> Result<Vec<String>, LessonError> {
     let mut files = Vec::new();
+    house_figures(dir, w, runs, &mut files)?;
+    lift_figures(dir, w, runs, &mut files)?;
+    hysteresis_figure(dir, w, s, runs, &mut files)?;
+    throw_figure(dir, w, s, &mut files)?;
+    scale_figures(dir, w, s, &mut files)?;
+    let md = markdown(s);
+    write_file(&dir.join("lesson.md"), md.as_bytes())?;
+    files.insert(0, "lesson.md".to_string());
+    Ok(files)
+}
 
-    // 1. The house tasks: force over time with events.
+/// The house tasks: force over time with their events.
+fn house_figures(
+    dir: &Path,
+    w: u32,
+    runs: &Runs,
+    files: &mut Vec<String>,
+) -> Result<(), LessonError> {
     let macro_chart = house_chart(
         "Macro world: building the wall (force on the hand, world frame)",
         "force (N)",
@@ -147,7 +163,7 @@ pub fn write(
             ("brick.slot_filled", "slot", PURPLE),
         ],
     );
-    save(dir, "macro_forces.png", w, &macro_chart, &mut files)?;
+    save(dir, "macro_forces.png", w, &macro_chart, files)?;
     let nano_chart = house_chart(
         "Nano world: building the house (force on the tip, world frame)",
         "force (nN)",
@@ -159,9 +175,17 @@ pub fn write(
             ("nano.slot_filled", "slot", PURPLE),
         ],
     );
-    save(dir, "nano_forces.png", w, &nano_chart, &mut files)?;
+    save(dir, "nano_forces.png", w, &nano_chart, files)?;
+    Ok(())
+}
 
-    // 2. Lifting a brick: weight, inertia, and the same motion with switches.
+/// Lifting a brick: weight and inertia, and the same motion with the switches.
+fn lift_figures(
+    dir: &Path,
+    w: u32,
+    runs: &Runs,
+    files: &mut Vec<String>,
+) -> Result<(), LessonError> {
     let labels = ["normal", "gravity off", "inertia off"];
     let colors = [BLUE, GREEN, ORANGE];
     let mut c = Chart::new(
@@ -176,7 +200,7 @@ pub fn write(
         .map(|(r, (l, col))| series(l, force_curve(r, 2, 1.0), col, Style::Line))
         .collect();
     c.markers = lift_markers();
-    save(dir, "lift_weight.png", w, &c, &mut files)?;
+    save(dir, "lift_weight.png", w, &c, files)?;
     let mut c = Chart::new(
         "Lift and carry a brick: sideways force (inertia −M a)",
         "time (s)",
@@ -189,9 +213,18 @@ pub fn write(
         .map(|(r, (l, col))| series(l, force_curve(r, 0, 1.0), col, Style::Line))
         .collect();
     c.markers = lift_markers();
-    save(dir, "lift_inertia.png", w, &c, &mut files)?;
+    save(dir, "lift_inertia.png", w, &c, files)?;
+    Ok(())
+}
 
-    // 3. Approach–retract hysteresis.
+/// Approach and retract over one atom: snap-in and pull-off, adhesion full and halved.
+fn hysteresis_figure(
+    dir: &Path,
+    w: u32,
+    s: &LessonSummary,
+    runs: &Runs,
+    files: &mut Vec<String>,
+) -> Result<(), LessonError> {
     let (a1, r1) = branches(&runs.cycles[0]);
     let (a2, r2) = branches(&runs.cycles[1]);
     let mut c = Chart::new(
@@ -217,9 +250,17 @@ pub fn write(
             color: RED,
         },
     ];
-    save(dir, "hysteresis.png", w, &c, &mut files)?;
+    save(dir, "hysteresis.png", w, &c, files)?;
+    Ok(())
+}
 
-    // 4. Throwing: the heavy-atom sweep against the predicted threshold.
+/// Throwing: the heavy-atom sweep against the predicted threshold.
+fn throw_figure(
+    dir: &Path,
+    w: u32,
+    s: &LessonSummary,
+    files: &mut Vec<String>,
+) -> Result<(), LessonError> {
     let sw = &s.sweep;
     let ratio = |a_hand: f64| sw.mass_kg * a_hand * 1.5e-7 / sw.hold_n;
     let kept: Vec<[f64; 2]> = sw
@@ -254,9 +295,17 @@ pub fn write(
         label: "load above the hold".into(),
         color: RED,
     }];
-    save(dir, "throw_threshold.png", w, &c, &mut files)?;
+    save(dir, "throw_threshold.png", w, &c, files)?;
+    Ok(())
+}
 
-    // 5. Scales (the paper's Fig. 2): forces and sizes.
+/// Scales (the paper's Fig. 2): forces and sizes of the two worlds.
+fn scale_figures(
+    dir: &Path,
+    w: u32,
+    s: &LessonSummary,
+    files: &mut Vec<String>,
+) -> Result<(), LessonError> {
     let bar = |group: &str, label: &str, value: f64, color: [u8; 3]| Bar {
         group: group.to_string(),
         label: label.to_string(),
@@ -283,7 +332,7 @@ pub fn write(
             bar("nano", "atom inertia (throw)", s.atom_inertia_n, ORANGE),
         ],
     };
-    save(dir, "scale_forces.png", w, &forces, &mut files)?;
+    save(dir, "scale_forces.png", w, &forces, files)?;
     let sizes = BarChart {
         title: "Sizes in the two worlds (log scale): metres against nanometres".into(),
         y_label: "size (m)".into(),
@@ -302,12 +351,8 @@ pub fn write(
             })
             .collect(),
     };
-    save(dir, "scale_sizes.png", w, &sizes, &mut files)?;
-
-    let md = markdown(s);
-    write_file(&dir.join("lesson.md"), md.as_bytes())?;
-    files.insert(0, "lesson.md".to_string());
-    Ok(files)
+    save(dir, "scale_sizes.png", w, &sizes, files)?;
+    Ok(())
 }
 
 /// Force over time of a house task (vertical and magnitude, × `unit`) with its events marked.
@@ -369,12 +414,18 @@ fn house_row(name: &str, h: &measure::HouseOutcome, slots: &str, unit: f64, u: &
 /// The report's text.
 pub fn markdown(s: &LessonSummary) -> String {
     let mut m = String::new();
-    let h = &s.hysteresis;
-    let hh = &s.hysteresis_half;
-    let t = &s.brick_throw;
-    let sw = &s.sweep;
+    md_house(&mut m, s);
+    md_lift(&mut m, s);
+    md_touch(&mut m, s);
+    md_throw(&mut m, s);
+    md_scale(&mut m);
+    m
+}
+
+/// The title and the house task in both worlds.
+fn md_house(m: &mut String, s: &LessonSummary) {
     let _ = writeln!(
-        m,
+        *m,
         "# Building a house twice: bricks and atoms\n\n\
          A lesson from the haptic teaching game. The same operator (a rigid stylus playing each \
          world's house script) builds a small wall of bricks in the macro world and a house of \
@@ -385,7 +436,7 @@ pub fn markdown(s: &LessonSummary) -> String {
          `nanohaptics replay --verify` recomputes bit for bit.\n"
     );
     let _ = writeln!(
-        m,
+        *m,
         "## The house task in both worlds\n\n\
          | world | slots filled | score | dropped | force above comfort | complete at | peak force |\n\
          |---|---|---|---|---|---|---|"
@@ -393,7 +444,7 @@ pub fn markdown(s: &LessonSummary) -> String {
     m.push_str(&house_row("bricks", &s.macro_house, "of 4", 1.0, "N"));
     m.push_str(&house_row("atoms", &s.nano_house, "of 7", 1e9, "nN"));
     let _ = writeln!(
-        m,
+        *m,
         "\nScore = 100 × filled / slots − 10 per dropped brick or atom − 5 per second the hand \
          felt more than half the device's largest force (4 N on a Falcon); never below 0.\n\n\
          Listen: [bricks](macro_house.wav), [atoms](nano_house.wav) — a thud or a clack per \
@@ -407,8 +458,12 @@ pub fn markdown(s: &LessonSummary) -> String {
          contact, the **snap** into contact, and the much larger **pull-off** when it leaves: \
          atoms stick, and the tip has to tear itself away.\n"
     );
+}
+
+/// Lifting a brick: weight and inertia.
+fn md_lift(m: &mut String, s: &LessonSummary) {
     let _ = writeln!(
-        m,
+        *m,
         "## Lifting a brick: weight and inertia\n\n\
          Holding the {} kg brick still, the hand feels {} downwards (M g = {}). Carrying it \
          0.45 m sideways in 0.9 s, it feels up to {} sideways: the brick's inertia −M a \
@@ -432,8 +487,14 @@ pub fn markdown(s: &LessonSummary) -> String {
         si(-s.lift_weight_n[2], "N"),
         si(s.lift_inertia_n[2], "N"),
     );
+}
+
+/// Touching an atom: snap-to-contact and the tenfold pull-off.
+fn md_touch(m: &mut String, s: &LessonSummary) {
+    let h = &s.hysteresis;
+    let hh = &s.hysteresis_half;
     let _ = writeln!(
-        m,
+        *m,
         "## Touching an atom: snap-to-contact and the tenfold pull-off\n\n\
          The tip comes down over one substrate atom and goes back up. It is pulled in before it \
          touches, **snaps** into contact at a cursor height of {} with a force of {}, and \
@@ -450,8 +511,14 @@ pub fn markdown(s: &LessonSummary) -> String {
         si(hh.snap_force_n, "N"),
         si(hh.pull_off_n, "N"),
     );
+}
+
+/// Throwing a brick and an atom, and the threshold.
+fn md_throw(m: &mut String, s: &LessonSummary) {
+    let t = &s.brick_throw;
+    let sw = &s.sweep;
     let _ = writeln!(
-        m,
+        *m,
         "## Throwing\n\n\
          **A brick flies.** Swinging the hand 30 mm in 0.3 s (a peak hand acceleration of {}) \
          and letting go at the fastest point, the brick leaves at {} and lands {} away after \
@@ -490,13 +557,16 @@ pub fn markdown(s: &LessonSummary) -> String {
         si(sw.kept_below_m_per_s2, "m/s²"),
         si(sw.thrown_from_m_per_s2, "m/s²"),
     );
+}
+
+/// The two worlds' scales.
+fn md_scale(m: &mut String) {
     let _ = writeln!(
-        m,
+        *m,
         "## Scale\n\nThe forces of the two worlds are nine to ten orders of magnitude apart, and \
          so are their sizes; the device maps both onto the same few newtons and centimetres of \
          the hand.\n\n![forces](scale_forces.png)\n\n![sizes](scale_sizes.png)\n"
     );
-    m
 }
 
 #[cfg(test)]
