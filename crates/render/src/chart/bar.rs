@@ -47,7 +47,8 @@ impl BarChart {
         let slots = self.bars.len() + groups.len().saturating_sub(1);
         let slot_w = (r - l) / slots.max(1) as f64;
         let (t, b) = (y.px_hi as f32, y.px_lo as f32);
-        cv.y_ticks(&y, (l as f32, r as f32), false)?;
+        cv.y_grid(&y, (l as f32, r as f32));
+        cv.y_labels(&y, l as f32, false)?;
         let base = match self.y_scale {
             Scale::Linear => y.px(0.0).unwrap_or(y.px_lo),
             Scale::Log10 => y.px_lo,

@@ -220,26 +220,38 @@ impl Canvas {
         );
     }
 
-    /// Horizontal grid lines with their tick labels left of `l`, from `l` to `r`.
-    pub(super) fn y_ticks(
-        &mut self,
-        y: &Axis,
-        (l, r): (f32, f32),
-        sci: bool,
-    ) -> Result<(), ChartError> {
+    /// Horizontal grid lines at the ticks of `y`, from `l` to `r`.
+    pub(super) fn y_grid(&mut self, y: &Axis, (l, r): (f32, f32)) {
+        for py in y.ticks().into_iter().filter_map(|v| y.px(v)) {
+            let py = py as f32;
+            self.line(&[(l, py), (r, py)], GRID, 1.0, false, 255);
+        }
+    }
+
+    /// The tick labels of `y`, left of `l`.
+    pub(super) fn y_labels(&mut self, y: &Axis, l: f32, sci: bool) -> Result<(), ChartError> {
         let f = self.font;
         for v in y.ticks() {
             if let Some(py) = y.px(v) {
-                let py = py as f32;
-                self.line(&[(l, py), (r, py)], GRID, 1.0, false, 255);
                 let s = if sci { sci_label(v) } else { tick_label(v) };
-                self.text(&s, (l - 0.4 * f, py + 0.35 * f), 0.9 * f, 1.0, 0.0, INK)?;
+                let at = (l - 0.4 * f, py as f32 + 0.35 * f);
+                self.text(&s, at, 0.9 * f, 1.0, 0.0, INK)?;
             }
         }
         Ok(())
     }
 
-    /// Grid, ticks, frame, title and axis labels of the plot area of `x` and `y`.
+    /// The grid lines of the plot area of `x` and `y`.
+    pub(super) fn grid(&mut self, x: &Axis, y: &Axis) {
+        let (l, t, r, b) = frame(x, y);
+        self.y_grid(y, (l, r));
+        for px in x.ticks().into_iter().filter_map(|v| x.px(v)) {
+            let px = px as f32;
+            self.line(&[(px, t), (px, b)], GRID, 1.0, false, 255);
+        }
+    }
+
+    /// Tick labels, frame, title and axis labels of the plot area of `x` and `y`.
     pub(super) fn axes(
         &mut self,
         (x, y): (&Axis, &Axis),
@@ -250,13 +262,11 @@ impl Canvas {
     ) -> Result<(), ChartError> {
         let f = self.font;
         let (l, t, r, b) = frame(x, y);
-        self.y_ticks(y, (l, r), sci[1])?;
+        self.y_labels(y, l, sci[1])?;
         for v in x.ticks() {
             if let Some(px) = x.px(v) {
-                let px = px as f32;
-                self.line(&[(px, t), (px, b)], GRID, 1.0, false, 255);
                 let s = if sci[0] { sci_label(v) } else { tick_label(v) };
-                self.text(&s, (px, b + 1.3 * f), 0.9 * f, 0.5, 0.0, INK)?;
+                self.text(&s, (px as f32, b + 1.3 * f), 0.9 * f, 0.5, 0.0, INK)?;
             }
         }
         self.frame_box((l, t, r, b), INK, 1.2);

@@ -86,13 +86,15 @@ impl Chart {
         ))
     }
 
-    /// Draws the chart.
+    /// Draws the chart, in this order: grid, raster, bands, frame and labels, markers,
+    /// series, levels, legend.
     pub fn render(&self, width_px: u32, height_px: u32) -> Result<Image, ChartError> {
         let mut cv = Canvas::new(width_px, height_px)?;
         let (x, y) = self.axes(width_px, height_px)?;
         let f = cv.font;
         let area = frame(&x, &y);
         let (l, t, r, b) = area;
+        cv.grid(&x, &y);
         if let Some(raster) = &self.raster {
             draw_raster(&mut cv, raster, (&x, &y))?;
         }
