@@ -4,13 +4,13 @@
 //! Run: `cargo run --release -p ot-envelope --example figures`
 //! Writes `docs/figures/ot-envelope-fig{2,3,4,7,8}.png`.
 
+use bench_harness::chart::{Chart, Legend, Raster, Series, Style, write_grid_png};
 use nalgebra::Vector2;
 use ot_envelope::geometry::first_crossing;
 use ot_envelope::inverse::TrapSolver;
 use ot_envelope::paper::paper_envelope;
 use ot_envelope::{OffsetRegion, working_envelope};
 use ot_physics::{Method, Propagator, TrapModel};
-use bench_harness::chart::{Chart, Legend, Raster, Series, Style, write_grid_png};
 use std::time::Instant;
 
 type V2 = Vector2<f64>;
@@ -112,13 +112,7 @@ fn fig2() -> Res<()> {
     ];
     let mut charts = Vec::new();
     for (title, p, k, col) in &runs {
-        let mut c = panel(
-            title,
-            (-800.0, 800.0),
-            (-800.0, 800.0),
-            "x (nm)",
-            "y (nm)",
-        );
+        let mut c = panel(title, (-800.0, 800.0), (-800.0, 800.0), "x (nm)", "y (nm)");
         let (mut paths, mut starts) = (Vec::new(), Vec::new());
         for i in -4i32..=4 {
             for j in -4i32..=4 {
@@ -303,7 +297,8 @@ fn fig4() -> Res<()> {
                 .filter_map(|k| radial(&we.polygon, f64::from(k) * 3.6f64.to_radians()))
                 .map(|q| nm(&q))
                 .collect();
-            c.series.push(Series::new("", poly, faded(col, 0.4), pen(1.0)));
+            c.series
+                .push(Series::new("", poly, faded(col, 0.4), pen(1.0)));
             c.series.push(Series::new(label, pts, col, dots(3.0)));
         }
         c.legend = Legend::UpperLeft;

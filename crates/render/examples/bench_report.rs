@@ -314,7 +314,12 @@ fn plot_speed(runs: &[Run], path: &Path) -> Result<(), BoxError> {
         let per_frame = |s: f64| s * 1e3 / r.frames as f64;
         bars.extend([
             bar(r.name, "render (wall)", per_frame(r.render), PALETTE[0]),
-            bar(r.name, "GIF (wall)", per_frame(r.encode + r.palette), PALETTE[1]),
+            bar(
+                r.name,
+                "GIF (wall)",
+                per_frame(r.encode + r.palette),
+                PALETTE[1],
+            ),
             bar(r.name, "CPU, all", per_frame(r.cpu_s), [60, 60, 60]),
         ]);
     }

@@ -270,7 +270,7 @@ fn a_grid_puts_each_chart_in_its_panel() {
     // the fourth cell of the 2 × 2 grid is empty
     assert_eq!(grid.pixel(600, 600), Some(WHITE));
     assert_eq!(
-        render_grid(&[a.clone()], 2, 800, 400)
+        render_grid(std::slice::from_ref(&a), 2, 800, 400)
             .unwrap_err()
             .to_string(),
         "a grid of 1 charts in 2 columns: allowed 1..=1 columns and at least one chart"
