@@ -12,8 +12,10 @@
 //!   (`docs/bench/<name>.md`) and its figures (`docs/figures/`) go, and the machine facts
 //!   stated at the top of every section (CPU model, core count, load average at the start and
 //!   at the end of the run);
-//! * [`plot`]: line and scatter charts over plotters with linear or log axes, a legend and
-//!   axis labels with units.
+//! * [`chart`]: the workspace's one chart engine, `render::chart` re-exported (line, dot and
+//!   bar charts on linear or log axes, reference lines, legends, rows and grids of charts),
+//!   drawn with tiny-skia and the embedded font: no system fonts, the same PNG bytes
+//!   everywhere.
 //!
 //! # The percentile definition
 //!
@@ -28,13 +30,12 @@
 //! `crates/*/benches/`), nor a place for any physics.
 
 pub mod machine;
-pub mod plot;
 pub mod report;
 pub mod stats;
 pub mod table;
 pub mod timer;
 
-pub use plotters;
+pub use render::chart;
 pub use report::Report;
 pub use stats::{Summary, percentile};
 pub use table::{Align, Table};

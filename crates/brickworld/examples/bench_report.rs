@@ -5,8 +5,7 @@
 
 use std::fmt::Write as _;
 
-use bench_harness::plot::{Axis, Chart, Series};
-use bench_harness::plotters::prelude::*;
+use bench_harness::chart::{Chart, Legend, PALETTE, Series, Style, write_grid_png};
 use bench_harness::{Align, Report, Summary, Table, Timings};
 use brickworld::{AccelEstimator, BrickId, BrickPlacement, Grip, MotionEstimator, Params, World};
 use world_form::Limits;
@@ -672,91 +671,101 @@ fn aabb(c: [f64; 3], q: [f64; 4], h: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     )
 }
 
+/// The rectangle `lo`..`hi` as a closed polygon in the plane of coordinates `a`, `b`.
+fn rect_pts(lo: [f64; 3], hi: [f64; 3], (a, b): (usize, usize)) -> Vec<[f64; 2]> {
+    vec![
+        [lo[a], lo[b]],
+        [hi[a], lo[b]],
+        [hi[a], hi[b]],
+        [lo[a], hi[b]],
+        [lo[a], lo[b]],
+    ]
+}
+
 fn plot_wall(r: &Report, w: &World, traj: &[[f64; 3]]) {
-    let path = r.figure("brickworld-wall.png");
-    let root = BitMapBackend::new(&path, (1000, 450)).into_drawing_area();
-    root.fill(&WHITE).unwrap();
-    let (left, right) = root.split_horizontally(500);
     let h = w.params().brick_half_extents_m;
-    for (area, axes, title) in [
-        (left, (0usize, 2usize), "side view (x, z)"),
-        (right, (0usize, 1usize), "top view (x, y)"),
-    ] {
-        let (a, b) = axes;
-        let yr = if b == 2 { -0.02..0.45 } else { -0.45..0.45 };
-        let mut ch = ChartBuilder::on(&area)
-            .caption(title, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(45)
-            .build_cartesian_2d(-0.7..0.6, yr)
-            .unwrap();
-        ch.configure_mesh().x_desc("m").y_desc("m").draw().unwrap();
-        if let Some(z) = &w.params().loading_zone {
-            if b == 1 {
-                ch.draw_series(std::iter::once(Rectangle::new(
-                    [(z.min_m[0], z.min_m[1]), (z.max_m[0], z.max_m[1])],
-                    YELLOW.mix(0.3).filled(),
-                )))
-                .unwrap();
-            }
+    let panel = |(a, b): (usize, usize), title: &str| {
+        let mut ch = Chart::new(title, "m", "m");
+        let yr = if b == 2 { [-0.02, 0.45] } else { [-0.45, 0.45] };
+        (ch.x_range, ch.y_range, ch.legend) = (Some([-0.7, 0.6]), Some(yr), Legend::None);
+        if let (Some(z), 1) = (&w.params().loading_zone, b) {
+            let (lo, hi) = (z.min_m, z.max_m);
+            let zone = rect_pts([lo[0], lo[1], 0.0], [hi[0], hi[1], 0.0], (0, 1));
+            ch.series
+                .push(Series::new("", zone, [255, 255, 180], Style::Fill));
         }
-        ch.draw_series(LineSeries::new(
-            traj.iter().map(|p| (p[a], p[b])),
-            BLUE.mix(0.4),
-        ))
-        .unwrap();
+        let path = traj.iter().map(|p| [p[a], p[b]]).collect();
+        ch.series
+            .push(Series::new("", path, [150, 150, 255], Style::Line));
+        let outline = Style::Pen {
+            line_px: 3.0,
+            dot_px: 0.0,
+        };
         for s in w.slots() {
             let (lo, hi) = aabb(s.position_m, s.orientation_xyzw, h);
-            ch.draw_series(std::iter::once(Rectangle::new(
-                [(lo[a], lo[b]), (hi[a], hi[b])],
-                BLACK.mix(0.3).stroke_width(3),
-            )))
-            .unwrap();
+            let pts = rect_pts(lo, hi, (a, b));
+            ch.series
+                .push(Series::new("", pts, [178, 178, 178], outline));
         }
         for br in w.bricks() {
             let (lo, hi) = aabb(br.position_m, br.orientation_xyzw, br.half_extents_m);
-            ch.draw_series(std::iter::once(Rectangle::new(
-                [(lo[a], lo[b]), (hi[a], hi[b])],
-                RGBColor(178, 60, 40).mix(0.8).filled(),
-            )))
-            .unwrap();
+            let pts = rect_pts(lo, hi, (a, b));
+            ch.series
+                .push(Series::new("", pts, [193, 99, 83], Style::Fill));
         }
-    }
-    root.present().unwrap();
+        ch
+    };
+    let charts = [
+        panel((0, 2), "side view (x, z)"),
+        panel((0, 1), "top view (x, y)"),
+    ];
+    write_grid_png(&r.figure("brickworld-wall.png"), &charts, 2, 1000, 450).unwrap();
 }
 
 fn plot_estimators(r: &Report, est: &[EstimatorRow]) {
-    let colors = [RED, BLUE, GREEN, BLACK];
     let mut c = Chart::new(
         "Cursor acceleration estimate (50 µm quantization)",
-        Axis::linear("time (s)", 1.0, 1.5),
-        Axis::linear("acceleration (m/s²)", -30.0, 30.0),
+        "time (s)",
+        "acceleration (m/s²)",
     );
+    (c.x_range, c.y_range) = (Some([1.0, 1.5]), Some([-30.0, 30.0]));
+    let thin = Style::Pen {
+        line_px: 1.0,
+        dot_px: 0.0,
+    };
     for (i, (name, _, _, _, tr)) in est.iter().enumerate() {
-        let pts = tr.iter().map(|&(t, a)| (t, a.clamp(-30.0, 30.0))).collect();
-        c = c.with(Series::line(name, pts, colors[i % 4]).width(1));
+        let pts = tr.iter().map(|&(t, a)| [t, a.clamp(-30.0, 30.0)]).collect();
+        c.series.push(Series::new(name, pts, COLORS[i % 4], thin));
     }
-    c.save(&r.figure("brickworld-accel-estimators.png"), (900, 500))
+    c.write_png(&r.figure("brickworld-accel-estimators.png"), 900, 500)
         .unwrap();
 }
+
+/// Series colours: red, blue, green, black.
+const COLORS: [[u8; 3]; 4] = [PALETTE[3], PALETTE[0], PALETTE[2], [0, 0, 0]];
 
 fn plot_speed_error(r: &Report, pts: &[(usize, f64, f64, f64)]) {
     let xmax = pts.iter().map(|p| p.2).fold(0.0, f64::max) * 1.2;
     let mut c = Chart::new(
         "Tick time vs 10-stack sink (100 bricks awake)",
-        Axis::linear("tick CPU p50 (µs)", 0.0, xmax),
-        Axis::log("stack sink (mm)", 0.01, 100.0),
+        "tick CPU p50 (µs)",
+        "stack sink (mm)",
     );
-    for (hz, color) in [(30.0, RED), (120.0, BLUE), (500.0, GREEN)] {
-        let s: Vec<(f64, f64)> = pts
+    c.y_scale = bench_harness::chart::Scale::Log10;
+    (c.x_range, c.y_range) = (Some([0.0, xmax]), Some([0.01, 100.0]));
+    for (hz, color) in [(30.0, COLORS[0]), (120.0, COLORS[1]), (500.0, COLORS[2])] {
+        let s = pts
             .iter()
             .filter(|p| p.1 == hz)
-            .map(|p| (p.2, p.3.max(0.011)))
+            .map(|p| [p.2, p.3.max(0.011)])
             .collect();
         let name = format!("contacts {hz} Hz (1, 2, 4, 8 iterations)");
-        c = c.with(Series::line(&name, s, color).width(1).markers(4));
+        let pen = Style::Pen {
+            line_px: 1.0,
+            dot_px: 4.0,
+        };
+        c.series.push(Series::new(&name, s, color, pen));
     }
-    c.save(&r.figure("brickworld-speed-error.png"), (800, 500))
+    c.write_png(&r.figure("brickworld-speed-error.png"), 800, 500)
         .unwrap();
 }

@@ -7,8 +7,7 @@
 //! 20 s real-time session).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bench_harness::plot::{Axis, Chart, Series};
-use bench_harness::plotters::prelude::{BLUE, GREEN, RED, RGBColor, SeriesLabelPosition};
+use bench_harness::chart::{Chart, Legend, PALETTE, Scale, Series, Style};
 use bench_harness::{Report, Summary, Table, span};
 use haptic_devices::OperatorParams;
 use haptic_loop::replay::verify;
@@ -493,7 +492,11 @@ fn main() {
     let _ = std::fs::remove_dir_all(&tmp);
 }
 
-fn plot_ticks(path: &Path, series: &[(&str, &Vec<u64>, RGBColor)]) {
+const BLUE: [u8; 3] = PALETTE[0];
+const GREEN: [u8; 3] = PALETTE[2];
+const RED: [u8; 3] = PALETTE[3];
+
+fn plot_ticks(path: &Path, series: &[(&str, &Vec<u64>, [u8; 3])]) {
     let max = series
         .iter()
         .flat_map(|s| s.1.iter())
@@ -503,9 +506,11 @@ fn plot_ticks(path: &Path, series: &[(&str, &Vec<u64>, RGBColor)]) {
         / 1e3;
     let mut c = Chart::new(
         "tick work (up to the writer hand-off): fraction of ticks above a time",
-        Axis::log("tick work (µs)", 0.1, max * 1.5),
-        Axis::log("fraction of ticks ≥ x", 1e-5, 1.0),
+        "tick work (µs)",
+        "fraction of ticks ≥ x",
     );
+    (c.x_scale, c.y_scale) = (Scale::Log10, Scale::Log10);
+    (c.x_range, c.y_range) = (Some([0.1, max * 1.5]), Some([1e-5, 1.0]));
     for (name, data, color) in series {
         let v = tick_us(data);
         let n = v.len() as f64;
@@ -513,14 +518,14 @@ fn plot_ticks(path: &Path, series: &[(&str, &Vec<u64>, RGBColor)]) {
             .sorted()
             .iter()
             .enumerate()
-            .map(|(i, &x)| (x.max(0.1), ((n - i as f64) / n).max(1e-5)))
+            .map(|(i, &x)| [x.max(0.1), ((n - i as f64) / n).max(1e-5)])
             .collect();
-        c = c.with(Series::line(name, pts, *color));
+        c.series.push(Series::new(name, pts, *color, Style::Line));
     }
-    c.save(path, (900, 500)).unwrap();
+    c.write_png(path, 900, 500).unwrap();
 }
 
-fn plot_lag(path: &Path, series: &[(&str, &Vec<f64>, RGBColor)]) {
+fn plot_lag(path: &Path, series: &[(&str, &Vec<f64>, [u8; 3])]) {
     let ymax = series
         .iter()
         .flat_map(|s| s.1.iter())
@@ -530,48 +535,49 @@ fn plot_lag(path: &Path, series: &[(&str, &Vec<f64>, RGBColor)]) {
         * 1.1;
     let mut c = Chart::new(
         "optical tweezers: cursor–particle distance while dragging too fast",
-        Axis::linear("time (s)", 0.0, 2.5),
-        Axis::linear("cursor–particle distance (µm)", 0.0, ymax.max(1.0)),
+        "time (s)",
+        "cursor–particle distance (µm)",
     );
+    (c.x_range, c.y_range) = (Some([0.0, 2.5]), Some([0.0, ymax.max(1.0)]));
     for (name, lag, color) in series {
         let pts = lag
             .iter()
             .enumerate()
-            .map(|(i, l)| (i as f64 / 1000.0, l * 1e6))
+            .map(|(i, l)| [i as f64 / 1000.0, l * 1e6])
             .collect();
-        c = c.with(Series::line(name, pts, *color));
+        c.series.push(Series::new(name, pts, *color, Style::Line));
     }
-    c.save(path, (900, 500)).unwrap();
+    c.write_png(path, 900, 500).unwrap();
 }
 
 fn plot_wall(path: &Path, pen: &[f64], a: &haptic_loop::SessionArrays) {
     let engaged = || (0..pen.len()).filter(|&i| a.engagement[i] == 1.0);
     let world = engaged()
-        .map(|i| (pen[i] * 1e3, a.world_force_n[i][2].min(12.0)))
+        .map(|i| [pen[i] * 1e3, a.world_force_n[i][2].min(12.0)])
         .collect();
     let sent = engaged()
-        .map(|i| (pen[i] * 1e3, a.device_force_n[i][2]))
+        .map(|i| [pen[i] * 1e3, a.device_force_n[i][2]])
         .collect();
-    Chart::new(
+    let pen = |line_px| Style::Pen {
+        line_px,
+        dot_px: 0.0,
+    };
+    let mut c = Chart::new(
         "stiff wall: force sent vs penetration (Falcon, rigid stylus)",
-        Axis::linear("penetration (mm)", 0.0, 21.0),
-        Axis::linear("force (N)", 0.0, 12.0),
-    )
-    .with(
-        Series::line(
+        "penetration (mm)",
+        "force (N)",
+    );
+    (c.x_range, c.y_range) = (Some([0.0, 21.0]), Some([0.0, 12.0]));
+    c.series = vec![
+        Series::new(
             "requested 5000 N/m",
-            vec![(0.0, 0.0), (2.4, 12.0)],
-            RGBColor(180, 180, 180),
-        )
-        .width(1),
-    )
-    .with(Series::line(
-        "scene force (capped at 3000 N/m)",
-        world,
-        BLUE,
-    ))
-    .with(Series::line("force sent (clamped at 8 N)", sent, RED).width(3))
-    .legend(Some(SeriesLabelPosition::LowerRight))
-    .save(path, (900, 500))
-    .unwrap();
+            vec![[0.0, 0.0], [2.4, 12.0]],
+            [180, 180, 180],
+            pen(1.0),
+        ),
+        Series::new("scene force (capped at 3000 N/m)", world, BLUE, pen(2.0)),
+        Series::new("force sent (clamped at 8 N)", sent, RED, pen(3.0)),
+    ];
+    c.legend = Legend::LowerRight;
+    c.write_png(path, 900, 500).unwrap();
 }

@@ -14,12 +14,16 @@
 //!    with counts: the largest `s` still stable is the world's stiffness margin on that device.
 #![allow(clippy::unwrap_used)]
 
-use bench_harness::plot::{Axis, Chart, Series};
-use bench_harness::plotters::prelude::RGBColor;
+use bench_harness::chart::{Chart, Marker, Scale, Series, Style};
 use bench_harness::report::out_arg;
 use bench_harness::{Report, Table};
 use haptic_devices::{Grip, Mechanics, PRESETS};
 use haptic_loop::closed_loop::{run, scale_impedance};
+
+/// Dot and line colours of the figures.
+const GREEN: [u8; 3] = [40, 150, 60];
+const RED: [u8; 3] = [210, 50, 40];
+const BLUE: [u8; 3] = [40, 80, 200];
 
 const SCRIPT: &str = r#"
 [script]
@@ -106,9 +110,9 @@ fn main() {
                     let ok = r.stable();
                     if grip == Grip::LOOSE {
                         if ok {
-                            charts_pts.0.push((k, *b));
+                            charts_pts.0.push([k, *b]);
                         } else {
-                            charts_pts.1.push((k, *b));
+                            charts_pts.1.push([k, *b]);
                         }
                     }
                     if ok {
@@ -121,7 +125,7 @@ fn main() {
                     .iter()
                     .zip(largest)
                     .filter(|(_, k)| *k > 0.0)
-                    .map(|(b, k)| (k, *b))
+                    .map(|(b, k)| [k, *b])
                     .collect();
             }
             let rated = mech.limits.max_stiffness_n_per_m;
@@ -142,33 +146,32 @@ fn main() {
                 "Z-width of the {} (wall K, B; hand loose; counts)",
                 mech.name
             ),
-            Axis::log("K, wall stiffness (N/m)", 70.0, 1.5e5),
-            Axis::linear("B, wall damping (N·s/m)", -1.0, 17.0),
-        )
-        .with(Series::dots(
-            "stable, loose grip",
-            stable,
-            RGBColor(40, 150, 60),
-            5,
-        ))
-        .with(Series::dots(
-            "unstable, loose grip",
-            unstable,
-            RGBColor(210, 50, 40),
-            5,
-        ))
-        .with(Series::line("stability edge, firm grip", firm, RGBColor(40, 80, 200)).width(2));
-        let rated = mech.limits.max_stiffness_n_per_m;
-        chart = chart.with(
-            Series::line(
-                &format!("rated k_max {rated:.0} N/m"),
-                vec![(rated, -1.0), (rated, 17.0)],
-                RGBColor(120, 120, 120),
-            )
-            .width(1),
+            "K, wall stiffness (N/m)",
+            "B, wall damping (N·s/m)",
         );
+        chart.x_scale = Scale::Log10;
+        (chart.x_range, chart.y_range) = (Some([70.0, 1.5e5]), Some([-1.0, 17.0]));
+        let dots = Style::Pen {
+            line_px: 0.0,
+            dot_px: 5.0,
+        };
+        let line = Style::Pen {
+            line_px: 2.0,
+            dot_px: 0.0,
+        };
+        chart.series = vec![
+            Series::new("stable, loose grip", stable, GREEN, dots),
+            Series::new("unstable, loose grip", unstable, RED, dots),
+            Series::new("stability edge, firm grip", firm, BLUE, line),
+        ];
+        let rated = mech.limits.max_stiffness_n_per_m;
+        chart.markers.push(Marker {
+            x: rated,
+            label: format!("rated k_max {rated:.0} N/m"),
+            color: [120, 120, 120],
+        });
         let file = format!("zwidth-{}.png", mech.name);
-        chart.save(&md.figure(&file), (900, 560)).unwrap();
+        chart.write_png(&md.figure(&file), 900, 560).unwrap();
         md.image(&format!("Z-width of the {}", mech.name), &file);
     }
     md.para(
@@ -235,10 +238,10 @@ fn main() {
                 }
                 let k = k0.unwrap_or(0.0) * s;
                 if !r.stable() {
-                    bad_pts.push((k, row));
+                    bad_pts.push([k, row]);
                     break;
                 }
-                ok_pts.push((k, row));
+                ok_pts.push([k, row]);
                 margin = Some(s);
             }
             let Some(k0) = k0 else {
@@ -268,15 +271,22 @@ fn main() {
             .unwrap();
         }
         let file = format!("zwidth-world-{}.png", world.replace(' ', "-"));
-        Chart::new(
+        let mut c = Chart::new(
             &format!("The {world} on each device: its stiffest spring × s (loose grip, counts)"),
-            Axis::log("stiffest spring at the hand, N/m", 100.0, 2e5),
-            Axis::linear("device: 1 falcon, 2 touch, 3 delta3, 4 inverse3", 0.5, 4.5),
-        )
-        .with(Series::dots("stable", ok_pts, RGBColor(40, 150, 60), 6))
-        .with(Series::dots("unstable", bad_pts, RGBColor(210, 50, 40), 6))
-        .save(&md.figure(&file), (900, 360))
-        .unwrap();
+            "stiffest spring at the hand, N/m",
+            "device: 1 falcon, 2 touch, 3 delta3, 4 inverse3",
+        );
+        c.x_scale = Scale::Log10;
+        (c.x_range, c.y_range) = (Some([100.0, 2e5]), Some([0.5, 4.5]));
+        let dots = Style::Pen {
+            line_px: 0.0,
+            dot_px: 6.0,
+        };
+        c.series = vec![
+            Series::new("stable", ok_pts, GREEN, dots),
+            Series::new("unstable", bad_pts, RED, dots),
+        ];
+        c.write_png(&md.figure(&file), 900, 360).unwrap();
         world_figs.push((world, file));
     }
     md.heading("Each world's stiffness margin (loose grip, counts, safety layer off)");

@@ -6,8 +6,7 @@
 use std::error::Error;
 use std::fmt::Write as _;
 
-use bench_harness::plot::{Axis, Chart, Series};
-use bench_harness::plotters::prelude::{BLACK, BLUE, GREEN, RED, SeriesLabelPosition};
+use bench_harness::chart::{Chart, Legend, Level, PALETTE, Scale, Series, Style};
 use bench_harness::{Align, Report, Summary, Table, Timings, span};
 use nalgebra::Vector3;
 use nanoworld::{
@@ -94,33 +93,15 @@ fn time_world(n: usize, ticks: usize) -> Res<Timing> {
 }
 
 fn curve_plot(r: &Report, file: &str, title: &str, c: &ForceCurve, gap_label: &str) -> Res<()> {
-    let nm = |(g, f): (&f64, &f64)| (g / 1e-9, f / 1e-9);
-    let approach: Vec<(f64, f64)> = c
-        .approach_gap_m
-        .iter()
-        .zip(&c.approach_force_n)
-        .map(nm)
-        .collect();
-    let retract: Vec<(f64, f64)> = c
-        .retract_gap_m
-        .iter()
-        .zip(&c.retract_force_n)
-        .map(nm)
-        .collect();
-    let all = approach.iter().chain(&retract);
-    let (x0, x1) = all
-        .clone()
-        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let (y0, y1) = all.fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    let pad = 0.05 * (y1 - y0);
-    Chart::new(
-        title,
-        Axis::linear(gap_label, x0, x1),
-        Axis::linear("force z (nN)", y0 - pad, y1 + pad),
-    )
-    .with(Series::line("approach", approach, BLUE))
-    .with(Series::line("retract", retract, RED))
-    .save(&r.figure(file), (900, 560))?;
+    let nm = |(g, f): (&f64, &f64)| [g / 1e-9, f / 1e-9];
+    let approach = c.approach_gap_m.iter().zip(&c.approach_force_n).map(nm);
+    let retract = c.retract_gap_m.iter().zip(&c.retract_force_n).map(nm);
+    let mut ch = Chart::new(title, gap_label, "force z (nN)");
+    ch.series = vec![
+        Series::new("approach", approach.collect(), PALETTE[0], Style::Line),
+        Series::new("retract", retract.collect(), PALETTE[3], Style::Line),
+    ];
+    ch.write_png(&r.figure(file), 900, 560)?;
     Ok(())
 }
 
@@ -130,20 +111,33 @@ fn cost_plot(r: &Report, rows: &[Timing]) -> Res<()> {
         .map(|r| r.tick.p99().max(r.brute_us))
         .fold(0.0, f64::max)
         * 2.0;
-    let pts = |f: &dyn Fn(&Timing) -> f64| -> Vec<(f64, f64)> {
-        rows.iter().map(|r| (r.atoms as f64, f(r))).collect()
+    let line = |label: &str, f: &dyn Fn(&Timing) -> f64, color| {
+        let pts = rows.iter().map(|r| [r.atoms as f64, f(r)]).collect();
+        let pen = Style::Pen {
+            line_px: 2.0,
+            dot_px: 4.0,
+        };
+        Series::new(label, pts, color, pen)
     };
-    Chart::new(
+    let mut c = Chart::new(
         "nanoworld: tick cost vs substrate size (game mode, tip hovering in range)",
-        Axis::log("substrate atoms", 5e2, 2e6),
-        Axis::log("time per tick (µs)", 0.1, ymax),
-    )
-    .with(Series::line("tick p50 (cell list)", pts(&|r| r.tick.median()), BLUE).markers(4))
-    .with(Series::line("tick p99 (cell list)", pts(&|r| r.tick.p99()), RED).markers(4))
-    .with(Series::line("exact all-atom sum, one force", pts(&|r| r.brute_us), BLACK).markers(4))
-    .hline(Some("target: p99 ≤ 250 µs at 10⁵"), 250.0, GREEN)
-    .legend(Some(SeriesLabelPosition::UpperLeft))
-    .save(&r.figure("nanoworld-tick-cost.png"), (900, 560))?;
+        "substrate atoms",
+        "time per tick (µs)",
+    );
+    (c.x_scale, c.y_scale) = (Scale::Log10, Scale::Log10);
+    (c.x_range, c.y_range) = (Some([5e2, 2e6]), Some([0.1, ymax]));
+    c.series = vec![
+        line("tick p50 (cell list)", &|r| r.tick.median(), PALETTE[0]),
+        line("tick p99 (cell list)", &|r| r.tick.p99(), PALETTE[3]),
+        line("exact all-atom sum, one force", &|r| r.brute_us, [0, 0, 0]),
+    ];
+    c.levels.push(Level {
+        y: 250.0,
+        label: "target: p99 ≤ 250 µs at 10⁵".into(),
+        color: PALETTE[2],
+    });
+    c.legend = Legend::UpperLeft;
+    c.write_png(&r.figure("nanoworld-tick-cost.png"), 900, 560)?;
     Ok(())
 }
 

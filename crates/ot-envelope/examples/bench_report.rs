@@ -5,8 +5,7 @@
 //! Run: `cargo run --release -p ot-envelope --example ot-envelope-report`
 //! (about two minutes; single thread).
 
-use bench_harness::plot::{Axis, Chart, Series};
-use bench_harness::plotters::prelude::{BLUE, RED};
+use bench_harness::chart::{Chart, PALETTE, Scale, Series, Style};
 use bench_harness::{Report, Summary, Table, Timings, span};
 use nalgebra::{Vector2, Vector3};
 use ot_envelope::envelope3::working_envelope_3d;
@@ -451,27 +450,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
 
     // plot: time vs error
-    Chart::new(
+    let mut c = Chart::new(
         "Working envelope: time vs Hausdorff error (paper constants, v0 = 0)",
-        Axis::log("Hausdorff error (nm)", 0.05, 50.0),
-        Axis::log("time (s)", 1e-4, 100.0),
-    )
-    .with(
-        Series::line(
+        "Hausdorff error (nm)",
+        "time (s)",
+    );
+    (c.x_scale, c.y_scale) = (Scale::Log10, Scale::Log10);
+    (c.x_range, c.y_range) = (Some([0.05, 50.0]), Some([1e-4, 100.0]));
+    c.series = vec![
+        Series::new(
             "paper method (grid of targets)",
-            base_pts.iter().map(|(t, e)| (e / NM, *t)).collect(),
-            RED,
-        )
-        .width(1)
-        .markers(4),
-    )
-    .with(Series::dots(
-        "ours (fold curves)",
-        vec![(e_ours / NM, tours)],
-        BLUE,
-        6,
-    ))
-    .save(&md.figure("ot-envelope-bench.png"), (800, 560))?;
+            base_pts.iter().map(|(t, e)| [e / NM, *t]).collect(),
+            PALETTE[3],
+            Style::Pen {
+                line_px: 1.0,
+                dot_px: 4.0,
+            },
+        ),
+        Series::new(
+            "ours (fold curves)",
+            vec![[e_ours / NM, tours]],
+            PALETTE[0],
+            Style::Pen {
+                line_px: 0.0,
+                dot_px: 6.0,
+            },
+        ),
+    ];
+    c.write_png(&md.figure("ot-envelope-bench.png"), 800, 560)?;
     writeln!(md)?;
     md.image("time vs error", "ot-envelope-bench.png");
     md.finish()?;

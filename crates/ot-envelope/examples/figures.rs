@@ -4,21 +4,24 @@
 //! Run: `cargo run --release -p ot-envelope --example figures`
 //! Writes `docs/figures/ot-envelope-fig{2,3,4,7,8}.png`.
 
+use bench_harness::chart::{Chart, Legend, Raster, Series, Style, write_grid_png};
 use nalgebra::Vector2;
 use ot_envelope::geometry::first_crossing;
 use ot_envelope::inverse::TrapSolver;
 use ot_envelope::paper::paper_envelope;
 use ot_envelope::{OffsetRegion, working_envelope};
 use ot_physics::{Method, Propagator, TrapModel};
-use plotters::coord::Shift;
-use plotters::prelude::*;
 use std::time::Instant;
 
 type V2 = Vector2<f64>;
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 const NM: f64 = 1e-9;
-const ONE: RGBColor = RGBColor(200, 40, 40);
-const CONV: RGBColor = RGBColor(30, 80, 200);
+/// The paper's one-step model.
+const ONE: [u8; 3] = [200, 40, 40];
+/// The converged dynamics.
+const CONV: [u8; 3] = [30, 80, 200];
+const BLACK: [u8; 3] = [0, 0, 0];
+const WHITE: [u8; 3] = [255, 255, 255];
 
 fn model() -> TrapModel<2> {
     TrapModel::builder(1e-15, [600e-9, 300e-9])
@@ -45,40 +48,49 @@ fn trajectory(p: &Propagator<2>, r0: V2, k: usize) -> Res<Vec<V2>> {
     Ok(out)
 }
 
-type Chart<'a, 'b> = ChartContext<
-    'a,
-    BitMapBackend<'b>,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
+/// An empty panel over `x` × `y` (nm) without a legend.
+fn panel(title: &str, x: (f64, f64), y: (f64, f64), xl: &str, yl: &str) -> Chart {
+    let mut c = Chart::new(title, xl, yl);
+    (c.x_range, c.y_range) = (Some([x.0, x.1]), Some([y.0, y.1]));
+    c.legend = Legend::None;
+    c
+}
 
-fn panel<'a, 'b>(
-    area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
-    title: &str,
-    x: (f64, f64),
-    y: (f64, f64),
-    xl: &str,
-    yl: &str,
-) -> Res<Chart<'a, 'b>> {
-    let mut c = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 16))
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(50)
-        .build_cartesian_2d(x.0..x.1, y.0..y.1)?;
-    c.configure_mesh()
-        .x_desc(xl)
-        .y_desc(yl)
-        .light_line_style(WHITE)
-        .draw()?;
-    Ok(c)
+/// A line `px` wide.
+fn pen(px: f32) -> Style {
+    Style::Pen {
+        line_px: px,
+        dot_px: 0.0,
+    }
+}
+
+/// Dots of radius `px`.
+fn dots(px: f32) -> Style {
+    Style::Pen {
+        line_px: 0.0,
+        dot_px: px,
+    }
+}
+
+/// Points in nm.
+fn nm(q: &V2) -> [f64; 2] {
+    [q.x / NM, q.y / NM]
+}
+
+/// Line segments as one polyline with a gap (a NaN point) after each.
+fn segments(segs: &[(V2, V2)]) -> Vec<[f64; 2]> {
+    segs.iter()
+        .flat_map(|(a, b)| [nm(a), nm(b), [f64::NAN; 2]])
+        .collect()
+}
+
+/// `c` at `alpha` over white.
+fn faded(c: [u8; 3], alpha: f64) -> [u8; 3] {
+    c.map(|v| (alpha * f64::from(v) + (1.0 - alpha) * 255.0).round() as u8)
 }
 
 fn fig2() -> Res<()> {
-    let root =
-        BitMapBackend::new("docs/figures/ot-envelope-fig2.png", (1500, 520)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((1, 3));
-    let runs: [(&str, Propagator<2>, usize, RGBColor); 3] = [
+    let runs: [(&str, Propagator<2>, usize, [u8; 3]); 3] = [
         (
             "(a) paper: ONE RK4 step of 1 µs",
             prop(Method::PaperRk4, 1e-6)?,
@@ -98,41 +110,40 @@ fn fig2() -> Res<()> {
             CONV,
         ),
     ];
-    for (area, (title, p, k, col)) in areas.iter().zip(runs.iter()) {
-        let mut c = panel(
-            area,
-            title,
-            (-800.0, 800.0),
-            (-800.0, 800.0),
-            "x (nm)",
-            "y (nm)",
-        )?;
+    let mut charts = Vec::new();
+    for (title, p, k, col) in &runs {
+        let mut c = panel(title, (-800.0, 800.0), (-800.0, 800.0), "x (nm)", "y (nm)");
+        let (mut paths, mut starts) = (Vec::new(), Vec::new());
         for i in -4i32..=4 {
             for j in -4i32..=4 {
                 let r0 = V2::new(160e-9 * f64::from(i), 160e-9 * f64::from(j));
-                let tr = trajectory(p, r0, *k)?;
-                c.draw_series(LineSeries::new(
-                    tr.iter().map(|q| (q.x / NM, q.y / NM)),
-                    col,
-                ))?;
-                c.draw_series(std::iter::once(Circle::new(
-                    (r0.x / NM, r0.y / NM),
-                    2,
-                    BLACK.filled(),
-                )))?;
+                paths.extend(trajectory(p, r0, *k)?.iter().map(nm));
+                paths.push([f64::NAN; 2]);
+                starts.push(nm(&r0));
             }
         }
+        c.series = vec![
+            Series::new("", paths, *col, pen(1.0)),
+            Series::new("", starts, BLACK, dots(2.5)),
+        ];
+        charts.push(c);
     }
-    root.present()?;
+    write_grid_png(
+        "docs/figures/ot-envelope-fig2.png".as_ref(),
+        &charts,
+        3,
+        1500,
+        520,
+    )?;
     Ok(())
 }
 
-fn colour(t: f64) -> RGBColor {
+fn colour(t: f64) -> [u8; 3] {
     let t = t.clamp(0.0, 1.0);
     let r = (255.0 * (1.5 * t).min(1.0)) as u8;
     let g = (255.0 * (1.5 * t - 0.5).clamp(0.0, 1.0)) as u8;
     let b = (255.0 * (0.6 - t).clamp(0.0, 0.6)) as u8;
-    RGBColor(r, g, b)
+    [r, g, b]
 }
 
 /// Marching-squares contour segments of `f` (n × n grid over [lo, hi]) at `level`.
@@ -165,13 +176,10 @@ fn contour(f: &[f64], n: usize, lo: V2, hi: V2, level: f64) -> Vec<(V2, V2)> {
 }
 
 fn fig3() -> Res<()> {
-    let root =
-        BitMapBackend::new("docs/figures/ot-envelope-fig3.png", (1300, 620)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((1, 2));
     let n = 161;
     let (lo, hi) = (V2::new(-1500e-9, -1000e-9), V2::new(1500e-9, 1000e-9));
-    for (area, (title, p)) in areas.iter().zip([
+    let mut charts = Vec::new();
+    for (title, p) in [
         (
             "(a) paper one-step model: |Δ| vs particle position, iso-contours every 100 nm",
             prop(Method::PaperRk4, 1e-6)?,
@@ -180,7 +188,7 @@ fn fig3() -> Res<()> {
             "(b) converged: |Δ| vs particle position, iso-contours every 100 nm",
             prop(Method::Rk4 { substeps: 16 }, 1e-6)?,
         ),
-    ]) {
+    ] {
         let mut f = vec![0.0; n * n];
         let mut fmax: f64 = 0.0;
         let mut arg = V2::zeros();
@@ -196,55 +204,54 @@ fn fig3() -> Res<()> {
             }
         }
         let mut c = panel(
-            area,
             title,
             (lo.x / NM, hi.x / NM),
             (lo.y / NM, hi.y / NM),
             "particle x − trap x (nm)",
             "particle y − trap y (nm)",
-        )?;
-        let h = (hi - lo) / (n - 1) as f64 / NM;
+        );
+        // cells centred on the grid points, colour = |Δ| / 1200 nm
+        let h = (hi - lo) / (n - 1) as f64 / 2.0;
         let scale = 1200e-9;
-        c.draw_series(
-            (0..n)
-                .flat_map(|i| (0..n).map(move |j| (i, j)))
-                .map(|(i, j)| {
-                    let x = lo.x / NM + h.x * i as f64;
-                    let y = lo.y / NM + h.y * j as f64;
-                    Rectangle::new(
-                        [
-                            (x - h.x / 2.0, y - h.y / 2.0),
-                            (x + h.x / 2.0, y + h.y / 2.0),
-                        ],
-                        colour(f[i * n + j] / scale).filled(),
-                    )
-                }),
-        )?;
+        c.raster = Some(Raster {
+            x_range: [(lo.x - h.x) / NM, (hi.x + h.x) / NM],
+            y_range: [(lo.y - h.y) / NM, (hi.y + h.y) / NM],
+            columns: n,
+            cells: (0..n)
+                .flat_map(|j| (0..n).map(move |i| (i, j)))
+                .map(|(i, j)| colour(f[i * n + j] / scale))
+                .collect(),
+        });
+        let mut iso = Vec::new();
         for level in (1..12).map(|k| k as f64 * 100e-9) {
-            for (a, b) in contour(&f, n, lo, hi, level) {
-                c.draw_series(LineSeries::new(
-                    [(a.x / NM, a.y / NM), (b.x / NM, b.y / NM)],
-                    BLACK,
-                ))?;
-            }
+            iso.extend(contour(&f, n, lo, hi, level));
         }
-        c.draw_series(
-            [arg, -arg]
-                .iter()
-                .map(|q| Cross::new((q.x / NM, q.y / NM), 8, WHITE.stroke_width(3))),
-        )?;
-        c.draw_series(std::iter::once(Text::new(
-            format!(
-                "max |Δ| = {:.0} nm at ({:.0}, {:.0}) nm",
-                fmax / NM,
-                arg.x / NM,
-                arg.y / NM
+        let max = format!(
+            "max |Δ| = {:.0} nm at ({:.0}, {:.0}) nm",
+            fmax / NM,
+            arg.x / NM,
+            arg.y / NM
+        );
+        c.series = vec![
+            Series::new("", segments(&iso), BLACK, pen(1.0)),
+            Series::new("", vec![nm(&arg), nm(&-arg)], WHITE, dots(6.0)),
+            Series::new(
+                &max,
+                vec![nm(&arg), nm(&-arg)],
+                BLACK,
+                Style::Rings { radius_px: 8.0 },
             ),
-            (lo.x / NM + 40.0, hi.y / NM - 80.0),
-            ("sans-serif", 15).into_font().color(&WHITE),
-        )))?;
+        ];
+        c.legend = Legend::UpperRight;
+        charts.push(c);
     }
-    root.present()?;
+    write_grid_png(
+        "docs/figures/ot-envelope-fig3.png".as_ref(),
+        &charts,
+        2,
+        1300,
+        620,
+    )?;
     Ok(())
 }
 
@@ -263,64 +270,57 @@ fn radial(poly: &[V2], theta: f64) -> Option<V2> {
 }
 
 fn fig4() -> Res<()> {
-    let root =
-        BitMapBackend::new("docs/figures/ot-envelope-fig4.png", (1300, 640)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((1, 2));
     let one = prop(Method::PaperRk4, 1e-6)?;
     let conv = prop(Method::Rk4 { substeps: 8 }, 1e-6)?;
-    for (area, v0) in areas.iter().zip([V2::zeros(), V2::new(0.1, 0.1)]) {
+    let mut charts = Vec::new();
+    for v0 in [V2::zeros(), V2::new(0.1, 0.1)] {
         let title = format!(
             "locus of maximal displacement, 3.6° steps, v0 = ({:.0}, {:.0}) nm/µs",
             v0.x * 1e3,
             v0.y * 1e3
         );
         let mut c = panel(
-            area,
             &title,
             (-1500.0, 1500.0),
             (-1500.0, 1500.0),
             "Δx (nm)",
             "Δy (nm)",
-        )?;
+        );
         for (p, col, label) in [
             (&one, ONE, "paper one-step model"),
             (&conv, CONV, "converged (RK4 × 8)"),
         ] {
             let we = working_envelope(p, &v0, None)?;
-            let mut poly: Vec<(f64, f64)> =
-                we.polygon.iter().map(|q| (q.x / NM, q.y / NM)).collect();
+            let mut poly: Vec<[f64; 2]> = we.polygon.iter().map(nm).collect();
             poly.push(poly[0]);
-            c.draw_series(LineSeries::new(poly, col.mix(0.4)))?;
-            let pts: Vec<V2> = (0..100)
+            let pts: Vec<[f64; 2]> = (0..100)
                 .filter_map(|k| radial(&we.polygon, f64::from(k) * 3.6f64.to_radians()))
+                .map(|q| nm(&q))
                 .collect();
-            c.draw_series(
-                pts.iter()
-                    .map(|q| Circle::new((q.x / NM, q.y / NM), 3, col.filled())),
-            )?
-            .label(label)
-            .legend(move |(x, y)| Circle::new((x + 8, y), 4, col.filled()));
+            c.series
+                .push(Series::new("", poly, faded(col, 0.4), pen(1.0)));
+            c.series.push(Series::new(label, pts, col, dots(3.0)));
         }
-        c.configure_series_labels()
-            .border_style(BLACK)
-            .background_style(WHITE)
-            .draw()?;
+        c.legend = Legend::UpperLeft;
+        charts.push(c);
     }
-    root.present()?;
+    write_grid_png(
+        "docs/figures/ot-envelope-fig4.png".as_ref(),
+        &charts,
+        2,
+        1300,
+        640,
+    )?;
     Ok(())
 }
 
 fn fig7() -> Res<()> {
-    let root =
-        BitMapBackend::new("docs/figures/ot-envelope-fig7.png", (1300, 640)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((1, 2));
     let v0 = V2::new(0.1, 0.1);
     let target = V2::new(-160e-9, -800e-9);
     let n = 241;
     let (lo, hi) = (V2::new(-1200e-9, -900e-9), V2::new(1200e-9, 900e-9));
-    for (area, (title, p)) in areas.iter().zip([
+    let mut charts = Vec::new();
+    for (title, p) in [
         (
             "(a) paper one-step model, Δt = 1.3 µs",
             prop(Method::PaperRk4, 1.3e-6)?,
@@ -329,7 +329,7 @@ fn fig7() -> Res<()> {
             "(b) converged (RK4 × 12), Δt = 1.3 µs",
             prop(Method::Rk4 { substeps: 12 }, 1.3e-6)?,
         ),
-    ]) {
+    ] {
         let mut fx = vec![0.0; n * n];
         let mut fy = vec![0.0; n * n];
         for i in 0..n {
@@ -343,45 +343,40 @@ fn fig7() -> Res<()> {
         let region = OffsetRegion::new(lo, hi)?;
         let solver = TrapSolver::new(&p, &v0, Some(region), Some(0.1))?;
         let sols = solver.solve(&target)?.0;
-        let full = format!(
-            "{title}: Δx = −160 nm (red), Δy = −800 nm (blue); {} solutions",
-            sols.offsets().len()
-        );
+        let full = format!("{title}: {} solutions", sols.offsets().len());
         let mut c = panel(
-            area,
             &full,
             (lo.x / NM, hi.x / NM),
             (lo.y / NM, hi.y / NM),
             "trap offset x (nm)",
             "trap offset y (nm)",
-        )?;
-        for (a, b) in contour(&fx, n, lo, hi, target.x) {
-            c.draw_series(LineSeries::new(
-                [(a.x / NM, a.y / NM), (b.x / NM, b.y / NM)],
-                ONE.stroke_width(2),
-            ))?;
-        }
-        for (a, b) in contour(&fy, n, lo, hi, target.y) {
-            c.draw_series(LineSeries::new(
-                [(a.x / NM, a.y / NM), (b.x / NM, b.y / NM)],
-                CONV.stroke_width(2),
-            ))?;
-        }
-        c.draw_series(
-            sols.offsets()
-                .iter()
-                .map(|o| Circle::new((o.x / NM, o.y / NM), 7, BLACK.stroke_width(2))),
-        )?;
+        );
+        let x_iso = contour(&fx, n, lo, hi, target.x);
+        let y_iso = contour(&fy, n, lo, hi, target.y);
+        c.series = vec![
+            Series::new("Δx = −160 nm", segments(&x_iso), ONE, pen(2.0)),
+            Series::new("Δy = −800 nm", segments(&y_iso), CONV, pen(2.0)),
+            Series::new(
+                "solutions (both at once)",
+                sols.offsets().iter().map(nm).collect(),
+                BLACK,
+                Style::Rings { radius_px: 7.0 },
+            ),
+        ];
+        c.legend = Legend::LowerLeft;
+        charts.push(c);
     }
-    root.present()?;
+    write_grid_png(
+        "docs/figures/ot-envelope-fig7.png".as_ref(),
+        &charts,
+        2,
+        1300,
+        640,
+    )?;
     Ok(())
 }
 
 fn fig8() -> Res<()> {
-    let root =
-        BitMapBackend::new("docs/figures/ot-envelope-fig8.png", (1600, 1100)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 2));
     let v0 = V2::new(0.1, 0.1);
     let conv = prop(Method::Rk4 { substeps: 8 }, 1e-6)?;
     let one = prop(Method::PaperRk4, 1e-6)?;
@@ -392,13 +387,13 @@ fn fig8() -> Res<()> {
     let ours1 = working_envelope(&one, &v0, None)?;
     let t_ours1 = s.elapsed().as_secs_f64();
     let (t_lo, t_hi) = (V2::new(-520e-9, -740e-9), V2::new(700e-9, 840e-9));
-    let draw_poly = |c: &mut Chart<'_, '_>, poly: &[V2], col: RGBColor| -> Res<()> {
-        let mut pts: Vec<(f64, f64)> = poly.iter().map(|q| (q.x / NM, q.y / NM)).collect();
+    let closed = |label: &str, poly: &[V2], col: [u8; 3]| {
+        let mut pts: Vec<[f64; 2]> = poly.iter().map(nm).collect();
         pts.push(pts[0]);
-        c.draw_series(LineSeries::new(pts, col.stroke_width(2)))?;
-        Ok(())
+        Series::new(label, pts, col, pen(2.0))
     };
-    for (k, spacing) in [80e-9, 40e-9, 20e-9].into_iter().enumerate() {
+    let mut charts = Vec::new();
+    for spacing in [80e-9, 40e-9, 20e-9] {
         let s = Instant::now();
         let b = paper_envelope(&conv, &v0, &ours.region, 0.3, t_lo, t_hi, spacing)?;
         let t = s.elapsed().as_secs_f64();
@@ -407,30 +402,34 @@ fn fig8() -> Res<()> {
             spacing / NM,
             t * 1e3
         );
+        // room on top for the legend, clear of the targets
         let mut c = panel(
-            &areas[k],
             &title,
             (-650.0, 800.0),
-            (-850.0, 950.0),
+            (-850.0, 1250.0),
             "Δx (nm)",
             "Δy (nm)",
-        )?;
+        );
         let [nx, ny] = b.shape;
-        let pts: Vec<(V2, bool)> = (0..nx)
-            .flat_map(|a| (0..ny).map(move |bb| (a, bb)))
-            .map(|(a, bb)| {
-                (
-                    t_lo + V2::new(a as f64, bb as f64) * spacing,
-                    b.solved[a * ny + bb],
-                )
-            })
-            .collect();
-        c.draw_series(pts.iter().map(|(q, ok)| {
-            let r = if *ok { 3 } else { 1 };
-            Circle::new((q.x / NM, q.y / NM), r, BLACK.filled())
-        }))?;
-        draw_poly(&mut c, &b.polygon, ONE)?;
-        draw_poly(&mut c, &ours.polygon, CONV)?;
+        let (mut solved, mut unsolved) = (Vec::new(), Vec::new());
+        for a in 0..nx {
+            for bb in 0..ny {
+                let q = nm(&(t_lo + V2::new(a as f64, bb as f64) * spacing));
+                if b.solved[a * ny + bb] {
+                    solved.push(q);
+                } else {
+                    unsolved.push(q);
+                }
+            }
+        }
+        c.series = vec![
+            Series::new("target solved", solved, BLACK, dots(3.0)),
+            Series::new("target not solved", unsolved, BLACK, dots(1.0)),
+            closed("paper method's envelope", &b.polygon, ONE),
+            closed("ours", &ours.polygon, CONV),
+        ];
+        c.legend = Legend::UpperLeft;
+        charts.push(c);
     }
     let title = format!(
         "ours: converged {:.2} ms (blue), one-step model {:.2} ms (red)",
@@ -438,16 +437,25 @@ fn fig8() -> Res<()> {
         t_ours1 * 1e3
     );
     let mut c = panel(
-        &areas[3],
         &title,
         (-650.0, 800.0),
         (-850.0, 950.0),
         "Δx (nm)",
         "Δy (nm)",
+    );
+    c.series = vec![
+        closed("converged (RK4 × 8)", &ours.polygon, CONV),
+        closed("paper one-step model", &ours1.polygon, ONE),
+    ];
+    c.legend = Legend::UpperLeft;
+    charts.push(c);
+    write_grid_png(
+        "docs/figures/ot-envelope-fig8.png".as_ref(),
+        &charts,
+        2,
+        1600,
+        1100,
     )?;
-    draw_poly(&mut c, &ours.polygon, CONV)?;
-    draw_poly(&mut c, &ours1.polygon, ONE)?;
-    root.present()?;
     Ok(())
 }
 

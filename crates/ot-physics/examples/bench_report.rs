@@ -12,8 +12,7 @@
 
 mod common;
 
-use bench_harness::plot::{Axis, Chart, Series, save_row};
-use bench_harness::plotters::prelude::{BLACK, Color, Palette, Palette99, RGBAColor, RGBColor};
+use bench_harness::chart::{Chart, Level, PALETTE, Scale, Series, Style, write_grid_png};
 use bench_harness::{Report, Table, span};
 use common::{Problem, Row, cheapest_within, errors, measure, our_settings, peer, time_at_error};
 use nalgebra::Vector2;
@@ -462,22 +461,21 @@ fn thermal_validation() -> Result<String, BoxError> {
 }
 
 /// A fixed, distinguishable colour per method family (peers in black/grey).
-fn family_color(family: &str, i: usize) -> RGBAColor {
-    let rgb = match family {
-        "paper-rk4" => RGBColor(220, 20, 60),
-        "rk4" => RGBColor(46, 139, 87),
-        "rk8" => RGBColor(30, 90, 220),
-        "rk8 batch" => RGBColor(0, 40, 120),
-        "dopri5" => RGBColor(0, 170, 200),
-        "adaptive" => RGBColor(255, 140, 0),
-        "symplectic" => RGBColor(138, 43, 226),
-        "yoshida4" => RGBColor(230, 60, 200),
-        "yoshida6" => RGBColor(150, 90, 40),
-        "ode_solvers Dop853" => RGBColor(0, 0, 0),
-        "scipy DOP853" => RGBColor(140, 140, 140),
-        _ => return Palette99::pick(i).to_rgba(),
-    };
-    rgb.to_rgba()
+fn family_color(family: &str, i: usize) -> [u8; 3] {
+    match family {
+        "paper-rk4" => [220, 20, 60],
+        "rk4" => [46, 139, 87],
+        "rk8" => [30, 90, 220],
+        "rk8 batch" => [0, 40, 120],
+        "dopri5" => [0, 170, 200],
+        "adaptive" => [255, 140, 0],
+        "symplectic" => [138, 43, 226],
+        "yoshida4" => [230, 60, 200],
+        "yoshida6" => [150, 90, 40],
+        "ode_solvers Dop853" => [0, 0, 0],
+        "scipy DOP853" => [140, 140, 140],
+        _ => PALETTE[i % PALETTE.len()],
+    }
 }
 
 fn plot(ours: &[Row], peer: &[Row], scipy: Option<&Scipy>, path: &Path) -> Result<(), BoxError> {
@@ -503,31 +501,39 @@ fn plot(ours: &[Row], peer: &[Row], scipy: Option<&Scipy>, path: &Path) -> Resul
         let xmax = all.iter().map(|r| x(r)).fold(0.0, f64::max) * 1.5;
         let mut c = Chart::new(
             &format!("paper problem: max error vs {what}"),
-            Axis::log(xlabel, xmin, xmax),
-            Axis::log("max displacement error (nm)", err_min * 0.5, err_max).sci(),
-        )
-        .hline(None, TARGET_NM, BLACK.mix(0.4));
+            xlabel,
+            "max displacement error (nm)",
+        );
+        (c.x_scale, c.y_scale, c.y_sci) = (Scale::Log10, Scale::Log10, true);
+        (c.x_range, c.y_range) = (Some([xmin, xmax]), Some([err_min * 0.5, err_max]));
+        c.levels.push(Level {
+            y: TARGET_NM,
+            label: format!("target {TARGET_NM} nm"),
+            color: [150, 150, 150],
+        });
         for (i, fam) in families.iter().enumerate() {
             let pts = all
                 .iter()
                 .filter(|r| r.method == *fam && r.max_err_nm > 0.0)
-                .map(|r| (x(r), r.max_err_nm.max(err_min * 0.5)))
+                .map(|r| [x(r), r.max_err_nm.max(err_min * 0.5)])
                 .collect();
-            c = c.with(Series::line(fam, pts, family_color(fam, i)).markers(3));
+            let pen = Style::Pen {
+                line_px: 2.0,
+                dot_px: 3.0,
+            };
+            c.series
+                .push(Series::new(fam, pts, family_color(fam, i), pen));
         }
         c
     };
-    save_row(
-        path,
-        (1400, 600),
-        &[
-            panel("CPU time", "CPU time per trajectory (ns)", |r| {
-                r.ns_per_traj
-            }),
-            panel("work", "force evaluations per trajectory", |r| {
-                r.evals_per_traj
-            }),
-        ],
-    )?;
+    let charts = [
+        panel("CPU time", "CPU time per trajectory (ns)", |r| {
+            r.ns_per_traj
+        }),
+        panel("work", "force evaluations per trajectory", |r| {
+            r.evals_per_traj
+        }),
+    ];
+    write_grid_png(path, &charts, 2, 1400, 600)?;
     Ok(())
 }

@@ -9,7 +9,7 @@
 
 mod scenes;
 
-use bench_harness::plotters::prelude::*;
+use bench_harness::chart::{Bar, BarChart, PALETTE, Scale};
 use bench_harness::{Align, Report, Span, Table, span};
 use render::{Camera, Frame, GifWriter, Image, Palette, Rgba, Style, View};
 use scenes::*;
@@ -300,90 +300,37 @@ fn main() -> Result<(), BoxError> {
     Ok(())
 }
 
+/// Time per frame of each run (render, GIF, CPU) next to the 30 s / 1800 frames target.
 fn plot_speed(runs: &[Run], path: &Path) -> Result<(), BoxError> {
-    let area = BitMapBackend::new(path, (900, 420)).into_drawing_area();
-    area.fill(&WHITE)?;
-    let max_ms = runs
-        .iter()
-        .map(|r| r.total() * 1e3 / r.frames as f64)
-        .fold(TARGET_S * 1e3 / (SECONDS * FPS), f64::max)
-        * 1.45;
-    let mut chart = ChartBuilder::on(&area)
-        .caption("Time per frame, 640×480, one thread", ("sans-serif", 22))
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..(runs.len() as f64), 0.0..max_ms)?;
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .x_labels(0)
-        .y_desc("ms per frame")
-        .draw()?;
-    for (i, r) in runs.iter().enumerate() {
-        let x = i as f64;
-        let rm = r.render * 1e3 / r.frames as f64;
-        let em = (r.encode + r.palette) * 1e3 / r.frames as f64;
-        let render_bar = chart.draw_series(std::iter::once(Rectangle::new(
-            [(x + 0.2, 0.0), (x + 0.8, rm)],
-            RGBColor(70, 110, 190).filled(),
-        )))?;
-        if i == 0 {
-            render_bar.label("render (wall)").legend(|(x, y)| {
-                Rectangle::new(
-                    [(x, y - 5), (x + 12, y + 5)],
-                    RGBColor(70, 110, 190).filled(),
-                )
-            });
-        }
-        let gif_bar = chart.draw_series(std::iter::once(Rectangle::new(
-            [(x + 0.2, rm), (x + 0.8, rm + em)],
-            RGBColor(230, 150, 60).filled(),
-        )))?;
-        if i == 0 {
-            gif_bar
-                .label("GIF palette + encode (wall)")
-                .legend(|(x, y)| {
-                    Rectangle::new(
-                        [(x, y - 5), (x + 12, y + 5)],
-                        RGBColor(230, 150, 60).filled(),
-                    )
-                });
-        }
-        let c = r.cpu_s * 1e3 / r.frames as f64;
-        let cpu_line = chart.draw_series(LineSeries::new(
-            [(x + 0.15, c), (x + 0.85, c)],
-            BLACK.stroke_width(3),
-        ))?;
-        if i == 0 {
-            cpu_line
-                .label("CPU time, whole session")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 12, y)], BLACK.stroke_width(3)));
-        }
-        chart.draw_series(std::iter::once(Text::new(
-            r.name.to_string(),
-            (x + 0.22, rm + em + max_ms * 0.05),
-            ("sans-serif", 15),
-        )))?;
-    }
-    // the 30 s / 1800 frames target
     let target_ms = TARGET_S * 1e3 / (SECONDS * FPS);
-    chart.draw_series(LineSeries::new(
-        [(0.0, target_ms), (runs.len() as f64, target_ms)],
-        RED.stroke_width(2),
-    ))?;
-    chart.draw_series(std::iter::once(Text::new(
-        "target: 1800 frames in 30 s",
-        (0.02, target_ms - max_ms * 0.03),
-        ("sans-serif", 15).into_font().color(&RED),
-    )))?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .draw()?;
-    area.present()?;
+    let bar = |group: &str, label: &str, value: f64, color: [u8; 3]| Bar {
+        group: group.to_string(),
+        label: label.to_string(),
+        value,
+        color,
+    };
+    let mut bars = Vec::new();
+    for r in runs {
+        let per_frame = |s: f64| s * 1e3 / r.frames as f64;
+        bars.extend([
+            bar(r.name, "render (wall)", per_frame(r.render), PALETTE[0]),
+            bar(
+                r.name,
+                "GIF (wall)",
+                per_frame(r.encode + r.palette),
+                PALETTE[1],
+            ),
+            bar(r.name, "CPU, all", per_frame(r.cpu_s), [60, 60, 60]),
+        ]);
+    }
+    bars.push(bar("target", "1800 in 30 s", target_ms, PALETTE[3]));
+    let chart = BarChart {
+        title: "Time per frame, 640×480, one thread".into(),
+        y_label: "ms per frame".into(),
+        y_scale: Scale::Linear,
+        bars,
+    };
+    chart.write_png(path, 900, 420)?;
     Ok(())
 }
 
