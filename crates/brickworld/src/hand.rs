@@ -13,7 +13,7 @@ use crate::event::{Axis, Body, BrickId, Event, Touch};
 use crate::impact::IMPACT_MIN_SPEED_M_PER_S;
 use crate::input::{CursorInput, Grip};
 use crate::params::{AccelEstimator, Inertia, Params};
-use crate::proxy::{self, HeldShape};
+use crate::proxy::{self, HeldShape, ProxyUpdate};
 
 /// Range of [`crate::World::nearest_m`], m: farther solids count as none.
 pub const NEAREST_MAX_M: f64 = 1.0;
@@ -145,11 +145,29 @@ impl Hand {
             self.proxy = Vector::new(c.x, c.y, params.workspace_half_extent_m);
             self.started = true;
         }
-        let grip = input.grip();
+        // 1. Grip: release before grab so one tick can't do both on one brick.
+        self.grip_edges(input.grip(), params, bricks, events);
+        // 2. God-object update (a coupled brick is a body of its own, not part of the proxy).
+        let (upd, approach_speed) = self.move_proxy(c, tick, params, bricks);
+        // 3. The force the device renders this tick.
+        let (felt, felt_spring) =
+            self.device_force(c, params, limits, bricks, upd.penetration_before_m);
+        // 4. Touch bookkeeping and the hand's push on dynamic bricks.
+        self.touches(&upd, tick, approach_speed, params, bricks, events);
+        push_bricks(&upd, felt_spring, params, bricks);
+        felt
+    }
+
+    /// The grip's edges since the last tick: a release, then a grab, then the turns.
+    fn grip_edges(
+        &mut self,
+        grip: Grip,
+        params: &Params,
+        bricks: &mut BrickSet,
+        events: &mut Vec<Event>,
+    ) {
         let prev = self.grip;
         self.grip = grip;
-
-        // 1. Grip: release before grab so one tick can't do both on one brick.
         if prev.hold && !grip.hold {
             self.release(params, bricks, events);
         }
@@ -165,8 +183,17 @@ impl Hand {
                 self.turn(axis, params, bricks, events);
             }
         }
+    }
 
-        // 2. God-object update (a coupled brick is a body of its own, not part of the proxy).
+    /// Moves the god-object towards the cursor `c` (a rigidly carried brick with it, as a
+    /// kinematic body); returns the update and the approach speed for impacts, m/s.
+    fn move_proxy(
+        &mut self,
+        c: Vector,
+        tick: u64,
+        params: &Params,
+        bricks: &mut BrickSet,
+    ) -> (ProxyUpdate, f64) {
         let ball = Ball::new(params.proxy_radius_m);
         let held_shape = self
             .held
@@ -196,11 +223,23 @@ impl Hand {
                 rb.set_next_kinematic_position(Pose::from_parts(self.proxy + h.offset, h.rotation));
             }
         }
+        (upd, approach_speed)
+    }
 
-        // 3. The force the device renders this tick: spring + weight + inertia, scaled down
-        //    to the device limit. The hand pushes the world with exactly the reaction of the
-        //    spring part of it (action = reaction at the coupling): a proxy pressed deep into a
-        //    brick pushes with at most the device's force, not with the stretched spring's.
+    /// The force the device renders this tick: spring + weight + inertia (or the coupling's
+    /// pull), scaled down to the device limit; and the spring's part of it as felt (scaled
+    /// alike). The hand pushes the world with exactly the reaction of that part (action =
+    /// reaction at the coupling): a proxy pressed deep into a brick pushes with at most the
+    /// device's force, not with the stretched spring's. A coupled brick gets the reaction of
+    /// the coupling's felt pull.
+    fn device_force(
+        &mut self,
+        c: Vector,
+        params: &Params,
+        limits: &Limits,
+        bricks: &mut BrickSet,
+        penetration_m: f64,
+    ) -> (Felt, Vector) {
         let spring = (self.proxy - c) * params.proxy_stiffness_n_per_m;
         let m = params.brick_mass_kg;
         let accel = Vector::from_array(self.motion.acceleration());
@@ -229,7 +268,6 @@ impl Hand {
             1.0
         };
         let (force, saturated) = (total * scale, scale < 1.0);
-        let felt_spring = spring * scale;
         if let Some(h) = self.held.filter(|h| h.coupled) {
             // The brick gets exactly the reaction of what the hand feels of the coupling: the
             // same force both ways, the scale-down included.
@@ -237,8 +275,30 @@ impl Hand {
                 rb.apply_impulse(-coupling * (scale * params.dt_s), true);
             }
         }
+        let felt = Felt {
+            force,
+            saturated,
+            spring,
+            weight,
+            inertia,
+            coupling,
+            acceleration: accel,
+            penetration_m,
+        };
+        (felt, spring * scale)
+    }
 
-        // 4. Touch bookkeeping and the hand's push on dynamic bricks.
+    /// What the cursor (or carried brick) touches after the update: `TouchEnded` and
+    /// `TouchBegan` events, and an `Impact` for a touch begun at speed.
+    fn touches(
+        &mut self,
+        upd: &ProxyUpdate,
+        tick: u64,
+        approach_speed: f64,
+        params: &Params,
+        bricks: &BrickSet,
+        events: &mut Vec<Event>,
+    ) {
         let mut touching: Vec<Touch> = upd
             .contacts
             .iter()
@@ -266,39 +326,6 @@ impl Hand {
             }
         }
         self.touching = touching;
-        let pushes: Vec<(RigidBodyHandle, Vector)> = upd
-            .contacts
-            .iter()
-            .filter_map(|ct| {
-                let co = bricks.phys.colliders.get(ct.collider)?;
-                let body = co.parent()?;
-                let rb = bricks.phys.bodies.get(body)?;
-                (rb.body_type() == RigidBodyType::Dynamic).then_some((body, ct.point))
-            })
-            .collect();
-        if !pushes.is_empty() && felt_spring.length_squared() > 0.0 {
-            // The hand pushes with the reaction of the spring it feels, shared by the contacts,
-            // at the contact points, as the impulse of that force over this tick. (A user force
-            // at a point would be the natural call, but rapier 0.36 does not resist the torque
-            // of user forces with contacts: 10 N pressed 5 cm off-centre launched a resting
-            // 0.5 kg brick 0.45 m up. Velocity impulses are resisted correctly.)
-            let share = -felt_spring * (params.dt_s / pushes.len() as f64);
-            for (body, point) in pushes {
-                if let Some(rb) = bricks.phys.bodies.get_mut(body) {
-                    rb.apply_impulse_at_point(share, point, true);
-                }
-            }
-        }
-        Felt {
-            force,
-            saturated,
-            spring,
-            weight,
-            inertia,
-            coupling,
-            acceleration: accel,
-            penetration_m: upd.penetration_before_m,
-        }
     }
 
     /// Distance from the cursor sphere's surface to the nearest solid other than the carried
@@ -558,5 +585,32 @@ impl Hand {
             brick: h.brick,
             axis,
         });
+    }
+}
+
+/// The hand's push on the dynamic bricks it touches: the reaction of the spring it feels
+/// (`felt_spring`, N), shared by the contacts, at the contact points, as the impulse of that
+/// force over this tick.
+fn push_bricks(upd: &ProxyUpdate, felt_spring: Vector, params: &Params, bricks: &mut BrickSet) {
+    let pushes: Vec<(RigidBodyHandle, Vector)> = upd
+        .contacts
+        .iter()
+        .filter_map(|ct| {
+            let co = bricks.phys.colliders.get(ct.collider)?;
+            let body = co.parent()?;
+            let rb = bricks.phys.bodies.get(body)?;
+            (rb.body_type() == RigidBodyType::Dynamic).then_some((body, ct.point))
+        })
+        .collect();
+    if !pushes.is_empty() && felt_spring.length_squared() > 0.0 {
+        // (A user force at a point would be the natural call, but rapier 0.36 does not resist
+        // the torque of user forces with contacts: 10 N pressed 5 cm off-centre launched a
+        // resting 0.5 kg brick 0.45 m up. Velocity impulses are resisted correctly.)
+        let share = -felt_spring * (params.dt_s / pushes.len() as f64);
+        for (body, point) in pushes {
+            if let Some(rb) = bricks.phys.bodies.get_mut(body) {
+                rb.apply_impulse_at_point(share, point, true);
+            }
+        }
     }
 }
