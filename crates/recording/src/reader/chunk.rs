@@ -173,14 +173,14 @@ fn chunk_error(f: &Rec<'_>, c: &ChunkRec<'_>, p: usize, e: &McapError) -> Record
         McapError::UnsupportedCompression(name) => {
             format!("compression `{name}` is not supported (allowed: zstd, lz4, none)")
         }
-        McapError::DecompressionError(d) => format!(
-            "the {} data does not decompress to the {size} bytes the chunk announces ({d})",
-            c.compression
-        ),
-        McapError::Io(d) => format!(
-            "the {} data does not decompress to the {size} bytes the chunk announces ({d})",
-            c.compression
-        ),
+        // The MCAP reader's words for compressed data that ends before the announced size.
+        McapError::DecompressionError(d) if d == "decompressor made no progress" => {
+            format!("the records decompress to fewer bytes than the {size} the chunk announces")
+        }
+        McapError::DecompressionError(d) => {
+            format!("the {} data does not decompress ({d})", c.compression)
+        }
+        McapError::Io(d) => format!("the {} data does not decompress ({d})", c.compression),
         McapError::RecordTooLarge { opcode, len } => inside(format!(
             "a {} record announcing {len} bytes, {} are left",
             op_name(*opcode),
