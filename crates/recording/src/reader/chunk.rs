@@ -15,6 +15,12 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 /// Largest uncompressed chunk accepted, bytes (the writer makes 8 MiB chunks).
 const MAX_CHUNK: u64 = 1 << 30;
 
+/// The record length limit of the chunk reader, bytes, unless a chunk needs more (its size):
+/// a record inside a chunk announcing more is refused before it is buffered; one announcing
+/// less but more than is left in its chunk is refused at the end of the chunk's records, after
+/// a buffer of at most this size (the writer makes 8 MiB chunks).
+const REUSE_LIMIT: usize = 16 << 20;
+
 /// The bound of a chunk's uncompressed size for `compressed` bytes of records: 1000 times
 /// them plus 1 MiB, at most [`MAX_CHUNK`].
 fn bound(compressed: u64) -> u64 {
@@ -92,16 +98,22 @@ impl Walk {
         c: &ChunkRec<'_>,
         info: &mut ChunkInfo,
     ) -> Result<Option<(u64, u64)>, RecordingError> {
-        let limit = usize::try_from(c.uncompressed_size)
-            .unwrap_or(usize::MAX)
-            .max(f.body.len());
-        let mut reader = LinearReader::new_with_options(
-            LinearReaderOptions::default()
-                .with_skip_start_magic(true)
-                .with_skip_end_magic(true)
-                .with_prevalidate_chunk_crcs(true)
-                .with_record_length_limit(limit),
-        );
+        let size = usize::try_from(c.uncompressed_size).unwrap_or(usize::MAX);
+        let need = size.max(f.body.len());
+        // One reader for the chunks of a file (its buffers and decoders are reused), while its
+        // length limit covers the chunk.
+        let (limit, mut reader) = match self.chunk_reader.take() {
+            Some((limit, r)) if limit >= need => (limit, r),
+            _ => {
+                let limit = need.max(REUSE_LIMIT);
+                let options = LinearReaderOptions::default()
+                    .with_skip_start_magic(true)
+                    .with_skip_end_magic(true)
+                    .with_prevalidate_chunk_crcs(true)
+                    .with_record_length_limit(limit);
+                (limit, LinearReader::new_with_options(options))
+            }
+        };
         let mut given = false;
         let mut times: Option<(u64, u64)> = None;
         // Offset of the next record in the decompressed records.
@@ -109,6 +121,10 @@ impl Walk {
         while let Some(event) = reader.next_event() {
             let (opcode, body) = match event {
                 Err(e) => return Err(chunk_error(f, c, p, &e)),
+                // Every record read: the reader asks for the next chunk, and is kept for it.
+                Ok(LinearReadEvent::ReadRequest(_)) if given && p == size => break,
+                // A record runs past the chunk's records: the reader fails at the end of its
+                // input (it is not kept).
                 Ok(LinearReadEvent::ReadRequest(_)) if given => {
                     reader.notify_read(0);
                     continue;
@@ -151,6 +167,7 @@ impl Walk {
             }
             p += HEAD + body.len();
         }
+        self.chunk_reader = Some((limit, reader));
         Ok(times)
     }
 }

@@ -44,6 +44,8 @@ pub(super) struct Walk {
     pub per_channel: BTreeMap<u16, u64>,
     pub time_range: Option<(u64, u64)>,
     pub integrity: Integrity,
+    /// The MCAP reader of the chunks and its record length limit, bytes ([`super::chunk`]).
+    pub chunk_reader: Option<(usize, mcap::sans_io::LinearReader)>,
 }
 
 /// The data-end record: its offset, the data-section CRC it holds, and its end.
