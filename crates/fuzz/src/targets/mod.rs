@@ -1,6 +1,6 @@
 //! The fuzz targets: their seed corpora, how an input is made from a seed, and what counts as a
 //! finding (besides a panic, an abort or a hang, which the driver catches). One module per
-//! family of targets: [`recordings`] (`recording`, `verify`), [`cli`], [`physics`] (`scene`,
+//! family of targets: `recordings` (`recording`, `verify`), `cli`, `physics` (`scene`,
 //! `script`, `bridge`); `params` lives in [`crate::params`].
 
 mod cli;

@@ -1,9 +1,10 @@
 //! A chunk: its header read by our field parser (to bound its uncompressed size before
 //! anything is allocated, and to refuse a CRC that was not written), then opened by the `mcap`
-//! crate's sans-io [`LinearReader`], one per chunk: it decompresses the records (zstd, lz4),
-//! checks their CRC-32 before giving any of them, and frames them (a record length over the
-//! chunk's size is refused before it is buffered). Each record is placed at its offset in the
-//! decompressed bytes, and walked like a record of the data section.
+//! crate's sans-io [`LinearReader`] (one for the chunks of a file): it decompresses the
+//! records (zstd, lz4), checks their CRC-32 before giving any of them, and frames them (a
+//! record length over its limit, see [`REUSE_LIMIT`], is refused before it is buffered). Each
+//! record is placed at its offset in the decompressed bytes, and walked like a record of the
+//! data section.
 
 use super::framing::{HEAD, Rec, mcap_detail};
 use super::walk::{ChunkInfo, Walk};

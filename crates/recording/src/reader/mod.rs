@@ -1,21 +1,21 @@
 //! Reading recordings: every record in file order, with every integrity check a recording
 //! carries. The jobs, one module each:
 //!
-//! - [`framing`] (the `mcap` crate's sans-io `LinearReader`): magic bytes, record framing, the
+//! - `framing` (the `mcap` crate's sans-io `LinearReader`): magic bytes, record framing, the
 //!   data-section CRC and the summary-section CRC, each record placed at its byte offset;
-//! - [`chunk`] (the same reader, one per chunk): decompression (zstd, lz4) and the chunk's
-//!   CRC-32, checked before any of its records is used, then its records at their offsets in
-//!   the decompressed bytes;
-//! - [`walk`]: the data section's records (schemas, channels, messages, message indexes,
+//! - `chunk` (a second such reader, kept for the chunks of a file): decompression (zstd,
+//!   lz4) and the chunk's CRC-32, checked before any of its records is used, then its records
+//!   at their offsets in the decompressed bytes;
+//! - `walk`: the data section's records (schemas, channels, messages, message indexes,
 //!   metadata) through the bounded field parser [`crate::parse`];
-//! - [`ticks`]: `/device/input` carries ticks 0, 1, 2, … in file order (no gap, no repeat),
+//! - `ticks`: `/device/input` carries ticks 0, 1, 2, … in file order (no gap, no repeat),
 //!   each tick ends with its `/loop/timing` message, and the count matches the `session`
 //!   metadata record;
-//! - [`summary`] and [`check`]: the summary section read, then checked against the records:
+//! - `summary` and `check`: the summary section read, then checked against the records:
 //!   statistics (message, channel, chunk and metadata counts, time range, messages per
 //!   channel), chunk indexes (offset, length, times, sizes, message index offsets), the message
 //!   indexes after each chunk, metadata indexes, summary offsets;
-//! - [`salvage`]: a truncated file keeps its complete ticks (with `salvage`), or is an error
+//! - `salvage`: a truncated file keeps its complete ticks (with `salvage`), or is an error
 //!   that says how many are readable.
 //!
 //! Errors say what is wrong and where (not an MCAP file; the record and byte offset of a damaged
