@@ -429,3 +429,42 @@ fn a_full_disk_keeps_the_os_error_the_path_and_the_ticks_on_disk() {
         format!("error: {want}")
     );
 }
+
+#[test]
+fn a_summary_record_removed_fails_the_summary_crc_first_then_the_footer_offsets() {
+    // The mcap crate's reader compares the summary CRC as the footer is read, so a summary
+    // record removed is refused for the CRC before the footer's offsets are compared (the
+    // reader of issue 11 compared `summary_offset_start` first). With the CRC rewritten, the
+    // footer's offset is the error, at the footer's byte offset.
+    let b = wall_bytes();
+    let (st, st_end) = of(b, 0x0B)[0];
+    let mut m = b[..st].to_vec();
+    m.extend_from_slice(&b[st_end..]);
+    let (_, de_end) = of(&m, 0x0F)[0];
+    let (f, _) = of(&m, 0x02)[0];
+    let calc = crc32fast::hash(&m[de_end..f + 25]);
+    let saved = u32::from_le_bytes(m[f + 25..f + 29].try_into().unwrap());
+    assert_eq!(
+        err(&m),
+        format!(
+            "corrupt recording: footer at byte {f}: the CRC-32 of the summary section (bytes \
+             {de_end}–{}) is 0x{calc:08x}, the footer says 0x{saved:08x} (the summary was \
+             changed)",
+            f + 24
+        )
+    );
+    fix_summary_crc(&mut m);
+    let first = u64::from_le_bytes(
+        b[f + (st_end - st) + 17..f + (st_end - st) + 25]
+            .try_into()
+            .unwrap(),
+    );
+    let moved = of(&m, 0x0E)[0].0;
+    assert_eq!(
+        err(&m),
+        format!(
+            "corrupt recording: footer at byte {f}: summary_offset_start = {first}, the first \
+             summary offset record is at byte {moved}"
+        )
+    );
+}

@@ -53,7 +53,7 @@ fn panics_aborts_hangs_and_non_finite_results_are_named_by_input() {
         panic["detail"]
             .as_str()
             .unwrap()
-            .starts_with("selftest panic at input 3 at crates/fuzz/src/targets.rs:"),
+            .starts_with("selftest panic at input 3 at crates/fuzz/src/targets/mod.rs:"),
         "{panic}"
     );
 }

@@ -9,9 +9,10 @@
 //!   for replay so that replay compares exactly what was written;
 //! - [`edit`]: a recording's switch schedule and its rewrite as a new complete file;
 //! - [`writer`]: a writer thread that never stalls a tick ([`Recorder`]);
-//! - [`reader`]: the strict reader ([`read_recording`]): CRCs, the summary against the records,
-//!   tick order and count, and salvage of a truncated file, with byte offsets in its errors;
-//!   [`parse`] is its bounded record parser;
+//! - [`reader`]: the strict reader ([`read_recording`]): framing, decompression and CRCs by the
+//!   `mcap` crate's sans-io reader; on top, the summary against the records, tick order and
+//!   count, and salvage of a truncated file, with byte offsets in its errors; [`parse`] is its
+//!   bounded field parser;
 //! - [`foxglove_out`]: the Foxglove scene, transform and log messages of a tick.
 //!
 //! What it is not: no haptic loop, no scenes, no devices. It knows the shared types of

@@ -1,48 +1,17 @@
-//! A bounded MCAP record parser: every length read from a file is checked against the bytes
-//! that hold it before anything is allocated, and a chunk is decompressed into a buffer that
-//! grows with the bytes the decoder actually produces (never with a size the file announces).
+//! The field parser of the reader: the body of each record (framed, decompressed and
+//! CRC-checked by the `mcap` crate's sans-io reader, see [`super::reader`]) read field by
+//! field, every length checked against the bytes that hold it before anything is allocated.
 //!
-//! The MCAP crate's readers trust record lengths found inside a decompressed chunk and reserve
-//! them up front, so a damaged chunk could abort the process (`memory allocation of … bytes
-//! failed`) or panic (`capacity overflow`). This module reads our own files instead: its errors
-//! are plain text that [`super::reader`] places at a byte offset and a record.
+//! Why not `mcap::parse_record`: its string and byte fields reserve the length they announce
+//! before reading (a damaged `u32` length reserves up to 4 GiB), a repeated map key silently
+//! replaces the first, and its errors (`Record parse failed`) name no field. These parsers name
+//! the field (`` `name` needs N bytes at byte K of the record ``) and refuse repeated keys;
+//! [`super::reader`] places their errors at a byte offset and a record.
 
 use std::collections::BTreeMap;
-use std::io::Read;
 
-/// Record opcodes (MCAP specification).
-pub mod op {
-    /// Header.
-    pub const HEADER: u8 = 0x01;
-    /// Footer.
-    pub const FOOTER: u8 = 0x02;
-    /// Schema.
-    pub const SCHEMA: u8 = 0x03;
-    /// Channel.
-    pub const CHANNEL: u8 = 0x04;
-    /// Message.
-    pub const MESSAGE: u8 = 0x05;
-    /// Chunk.
-    pub const CHUNK: u8 = 0x06;
-    /// Message index.
-    pub const MESSAGE_INDEX: u8 = 0x07;
-    /// Chunk index.
-    pub const CHUNK_INDEX: u8 = 0x08;
-    /// Attachment.
-    pub const ATTACHMENT: u8 = 0x09;
-    /// Attachment index.
-    pub const ATTACHMENT_INDEX: u8 = 0x0A;
-    /// Statistics.
-    pub const STATISTICS: u8 = 0x0B;
-    /// Metadata.
-    pub const METADATA: u8 = 0x0C;
-    /// Metadata index.
-    pub const METADATA_INDEX: u8 = 0x0D;
-    /// Summary offset.
-    pub const SUMMARY_OFFSET: u8 = 0x0E;
-    /// Data end.
-    pub const DATA_END: u8 = 0x0F;
-}
+/// Record opcodes (MCAP specification), from the `mcap` crate.
+pub use mcap::records::op;
 
 /// The name of a record type, for messages.
 pub fn op_name(opcode: u8) -> String {
@@ -63,70 +32,6 @@ pub fn op_name(opcode: u8) -> String {
         op::SUMMARY_OFFSET => "summary offset".into(),
         op::DATA_END => "data end".into(),
         other => format!("record of unknown opcode 0x{other:02x}"),
-    }
-}
-
-/// One record framed by its opcode and length.
-#[derive(Clone, Copy, Debug)]
-pub struct Framed<'a> {
-    /// Opcode.
-    pub opcode: u8,
-    /// Offset of the opcode byte in the buffer that holds the record.
-    pub at: usize,
-    /// The body (after the 9-byte opcode and length).
-    pub body: &'a [u8],
-}
-
-impl Framed<'_> {
-    /// Offset just past the record.
-    pub fn end(&self) -> usize {
-        self.at + 9 + self.body.len()
-    }
-}
-
-/// Why a record could not be framed.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FrameError {
-    /// Fewer than 9 bytes left for the opcode and length.
-    ShortHeader {
-        /// Bytes left.
-        left: usize,
-    },
-    /// The announced length runs past the end of the buffer.
-    PastEnd {
-        /// Opcode.
-        opcode: u8,
-        /// Announced body length, bytes.
-        len: u64,
-        /// Bytes left after the opcode and length.
-        left: usize,
-    },
-}
-
-/// Frames the record at `at` of `buf` (none when `at` is the end of `buf`).
-pub fn frame(buf: &[u8], at: usize) -> Option<Result<Framed<'_>, FrameError>> {
-    let rest = buf.get(at..)?;
-    if rest.is_empty() {
-        return None;
-    }
-    let Some((head, tail)) = rest.split_first_chunk::<9>() else {
-        return Some(Err(FrameError::ShortHeader { left: rest.len() }));
-    };
-    let opcode = head[0];
-    let mut l = [0u8; 8];
-    l.copy_from_slice(&head[1..]);
-    let len = u64::from_le_bytes(l);
-    match usize::try_from(len).ok().filter(|&n| n <= tail.len()) {
-        Some(n) => Some(Ok(Framed {
-            opcode,
-            at,
-            body: &tail[..n],
-        })),
-        None => Some(Err(FrameError::PastEnd {
-            opcode,
-            len,
-            left: tail.len(),
-        })),
     }
 }
 
@@ -367,48 +272,6 @@ pub fn chunk(b: &[u8]) -> Result<ChunkRec<'_>, String> {
     Ok(r)
 }
 
-/// Decompresses a chunk's records into a buffer that grows with the decoder's output, up to
-/// `size` bytes (the announced uncompressed size, already checked against a bound). Fails when
-/// the data does not decode or decodes to another size.
-pub fn decompress(compression: &str, src: &[u8], size: u64) -> Result<Vec<u8>, String> {
-    let mut out = Vec::with_capacity(usize::try_from(size.min(1 << 22)).unwrap_or(0));
-    let read = |r: &mut dyn Read, out: &mut Vec<u8>| {
-        r.take(size.saturating_add(1))
-            .read_to_end(out)
-            .map_err(|e| format!("the {compression} data does not decompress ({e})"))
-    };
-    match compression {
-        "" => out.extend_from_slice(src),
-        "zstd" => {
-            let mut d = zstd::stream::read::Decoder::with_buffer(src)
-                .map_err(|e| format!("the zstd decoder cannot start ({e})"))?;
-            read(&mut d, &mut out)?;
-        }
-        "lz4" => {
-            let mut d = lz4::Decoder::new(src)
-                .map_err(|e| format!("the lz4 decoder cannot start ({e})"))?;
-            read(&mut d, &mut out)?;
-        }
-        other => {
-            return Err(format!(
-                "compression `{other}` is not supported (allowed: zstd, lz4, none)"
-            ));
-        }
-    }
-    if out.len() as u64 != size {
-        return Err(format!(
-            "the records decompress to {}{} bytes, the chunk announces {size}",
-            if out.len() as u64 > size {
-                "more than "
-            } else {
-                ""
-            },
-            out.len().min(usize::try_from(size).unwrap_or(usize::MAX))
-        ));
-    }
-    Ok(out)
-}
-
 /// A message index record.
 pub fn message_index(b: &[u8]) -> Result<(u16, Vec<(u64, u64)>), String> {
     let mut c = Cur::new(b);
@@ -550,41 +413,41 @@ mod tests {
             schema(&b).unwrap_err(),
             "`name` needs 4294967295 bytes at byte 6 of the record, only 6 are left"
         );
-        // A record announcing u64::MAX bytes.
-        let mut f = vec![0x05];
-        f.extend_from_slice(&u64::MAX.to_le_bytes());
-        f.extend_from_slice(&[0; 4]);
+        // A records field announcing u64::MAX bytes inside a chunk record.
+        let mut c = vec![0u8; 8 + 8 + 8 + 4];
+        c.extend_from_slice(&4u32.to_le_bytes());
+        c.extend_from_slice(b"zstd");
+        c.extend_from_slice(&u64::MAX.to_le_bytes());
+        c.extend_from_slice(&[0; 4]);
         assert_eq!(
-            frame(&f, 0).unwrap().unwrap_err(),
-            FrameError::PastEnd {
-                opcode: 5,
-                len: u64::MAX,
-                left: 4
-            }
+            chunk(&c).unwrap_err(),
+            "`records` needs 18446744073709551615 bytes at byte 44 of the record, only 4 are left"
         );
-        assert_eq!(
-            frame(&f[..5], 0).unwrap().unwrap_err(),
-            FrameError::ShortHeader { left: 5 }
-        );
-        assert!(frame(&f, f.len()).is_none());
     }
 
     #[test]
-    fn decompression_stops_at_the_announced_size() {
-        let data = vec![7u8; 100_000];
-        let z = zstd::bulk::compress(&data, 3).unwrap();
-        assert_eq!(decompress("zstd", &z, 100_000).unwrap(), data);
+    fn repeated_keys_and_short_footers_are_named() {
+        let mut m = Vec::new();
+        for _ in 0..2 {
+            m.extend_from_slice(&1u32.to_le_bytes());
+            m.extend_from_slice(b"k");
+            m.extend_from_slice(&1u32.to_le_bytes());
+            m.extend_from_slice(b"v");
+        }
+        let mut b = 4u32.to_le_bytes().to_vec();
+        b.extend_from_slice(b"name");
+        b.extend_from_slice(&(m.len() as u32).to_le_bytes());
+        b.extend_from_slice(&m);
+        assert_eq!(metadata(&b).unwrap_err(), "`metadata` repeats the key `k`");
         assert_eq!(
-            decompress("zstd", &z, 1000).unwrap_err(),
-            "the records decompress to more than 1000 bytes, the chunk announces 1000"
+            footer(&[0; 18]).unwrap_err(),
+            "`summary_crc` needs 4 bytes at byte 16 of the record, only 2 are left"
         );
         assert_eq!(
-            decompress("zstd", &z, 200_000).unwrap_err(),
-            "the records decompress to 100000 bytes, the chunk announces 200000"
+            footer(&[0; 21]).unwrap_err(),
+            "the footer is 21 bytes, not 20"
         );
-        assert_eq!(
-            decompress("brotli", &z, 1).unwrap_err(),
-            "compression `brotli` is not supported (allowed: zstd, lz4, none)"
-        );
+        assert_eq!(op_name(0x42), "record of unknown opcode 0x42");
+        assert_eq!(op_name(op::DATA_END), "data end");
     }
 }

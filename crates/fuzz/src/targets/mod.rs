@@ -1,0 +1,213 @@
+//! The fuzz targets: their seed corpora, how an input is made from a seed, and what counts as a
+//! finding (besides a panic, an abort or a hang, which the driver catches). One module per
+//! family of targets: `recordings` (`recording`, `verify`), `cli`, `physics` (`scene`,
+//! `script`, `bridge`); `params` lives in [`crate::params`].
+
+mod cli;
+mod physics;
+mod recordings;
+
+use crate::mutate::{self, Rng};
+use ::recording::{Recording, read_recording};
+use cli::{CLI_SEEDS, argv, mutate_argv};
+use haptic_devices::bridge::protocol::{Packet, Sample};
+use haptic_loop::DeviceModel;
+use haptic_loop::DeviceSpecs;
+use recordings::mutate_recording;
+use std::path::PathBuf;
+use std::time::Duration;
+
+pub use physics::{run_bridge, run_scene, run_script};
+pub use recordings::{OutputChange, seed_recording, verified_outputs, verify_changed};
+
+/// The targets, by name.
+pub const TARGETS: &[&str] = &[
+    "scene",
+    "script",
+    "recording",
+    "verify",
+    "bridge",
+    "params",
+    "cli",
+];
+
+pub use crate::outcome::Outcome;
+
+/// A target with its seeds, ready to make and run inputs.
+pub struct Target {
+    /// Name.
+    pub name: &'static str,
+    seeds: Vec<Vec<u8>>,
+    /// For `verify`: the seed recording, read.
+    seed_rec: Option<Recording>,
+    /// For `cli`: the program and the folder it runs in.
+    cli: Option<(PathBuf, PathBuf)>,
+    /// Per-input time limit (the CLI target kills its child process at it).
+    pub timeout: Duration,
+}
+
+fn falcon() -> &'static DeviceSpecs {
+    DeviceModel::Falcon.specs()
+}
+
+/// The folder the fuzzer works in (seed files, the CLI's working folder).
+pub fn work_dir() -> PathBuf {
+    std::env::temp_dir().join(format!("nanohaptics-fuzz-{}", std::process::id()))
+}
+
+impl Target {
+    /// The target `name`, its seeds built (the CLI target needs the `nanohaptics` program next
+    /// to this one).
+    pub fn new(name: &str, timeout: Duration) -> Result<Target, String> {
+        let name = *TARGETS
+            .iter()
+            .chain(&["selftest"])
+            .find(|t| **t == name)
+            .ok_or_else(|| format!("unknown target `{name}` (targets: {})", TARGETS.join(", ")))?;
+        let dir = work_dir();
+        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let builtins = haptic_loop::builtin::SCENES;
+        let mut t = Target {
+            name,
+            seeds: Vec::new(),
+            seed_rec: None,
+            cli: None,
+            timeout,
+        };
+        match name {
+            "selftest" => t.seeds = vec![b"selftest".to_vec()],
+            "scene" => {
+                t.seeds = builtins
+                    .iter()
+                    .map(|b| b.scene.as_bytes().to_vec())
+                    .collect()
+            }
+            "script" => {
+                t.seeds = builtins
+                    .iter()
+                    .map(|b| b.script.as_bytes().to_vec())
+                    .collect()
+            }
+            "recording" | "verify" => {
+                let b = seed_recording(&dir)?;
+                t.seed_rec = Some(read_recording(&b, false).map_err(|e| e.to_string())?);
+                t.seeds = vec![b];
+            }
+            "params" => t.seeds = crate::params::seeds(),
+            "bridge" => {
+                let sample = Sample {
+                    seq: 7,
+                    device_time_ns: 1_000_000,
+                    position_m: [0.001, -0.002, -0.006],
+                    buttons: 1,
+                };
+                t.seeds = vec![
+                    Packet::Hello {
+                        rate_hz: 1000,
+                        specs: falcon().clone(),
+                    }
+                    .encode(),
+                    Packet::Hello {
+                        rate_hz: 1000,
+                        specs: DeviceModel::Touch.specs().clone(),
+                    }
+                    .encode(),
+                    Packet::Welcome {
+                        rate_hz: 1000,
+                        start_time_ns: 1_795_000_000_000_000_000,
+                        scene: "wall".into(),
+                    }
+                    .encode(),
+                    Packet::Sample(sample).encode(),
+                    Packet::Bye { reason: 0 }.encode(),
+                ];
+            }
+            _ => {
+                let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+                let prog =
+                    exe.with_file_name(format!("nanohaptics{}", std::env::consts::EXE_SUFFIX));
+                if !prog.exists() {
+                    return Err(format!(
+                        "the cli target runs {}, which is not built (cargo build --release -p \
+                         haptic-loop --bin nanohaptics)",
+                        prog.display()
+                    ));
+                }
+                std::fs::write(dir.join("seed.mcap"), seed_recording(&dir)?)
+                    .map_err(|e| e.to_string())?;
+                t.seeds = CLI_SEEDS
+                    .iter()
+                    .map(|args| args.join("\u{1f}").into_bytes())
+                    .collect();
+                t.cli = Some((prog, dir));
+            }
+        }
+        Ok(t)
+    }
+
+    /// The seed inputs, unmutated.
+    pub fn seeds(&self) -> &[Vec<u8>] {
+        &self.seeds
+    }
+
+    /// Input `index` of a campaign with `seed`: a seed with 1–4 mutations.
+    pub fn input(&self, seed: u64, index: u64) -> Vec<u8> {
+        let mut r = Rng::for_input(seed, index);
+        let mut b = r.pick(&self.seeds).clone();
+        let n = 1 + r.below(if self.name == "cli" { 2 } else { 4 });
+        for _ in 0..n {
+            match self.name {
+                "scene" | "script" | "params" => mutate::mutate_text(&mut r, &mut b, &self.seeds),
+                "recording" | "verify" => mutate_recording(&mut r, &mut b),
+                "cli" => mutate_argv(&mut r, &mut b),
+                _ => mutate::mutate_bytes(&mut r, &mut b, &self.seeds),
+            }
+        }
+        b
+    }
+
+    /// Runs one input.
+    pub fn run(&self, input: &[u8], index: u64) -> Outcome {
+        match self.name {
+            "scene" => run_scene(input),
+            "script" => run_script(input),
+            "recording" => self.run_recording(input),
+            "verify" => self.run_verify(input, index),
+            "bridge" => run_bridge(input),
+            "params" => crate::params::run_params(input),
+            "selftest" => selftest(index, self.timeout),
+            _ => self.run_cli(input),
+        }
+    }
+
+    /// A human-readable form of an input (for reports): the text, the argument list, or the
+    /// byte count.
+    pub fn show(&self, input: &[u8]) -> String {
+        match self.name {
+            "scene" | "script" | "params" => String::from_utf8_lossy(input).into_owned(),
+            "cli" => {
+                let a: Vec<String> = argv(input)
+                    .iter()
+                    .map(|a| format!("'{}'", String::from_utf8_lossy(a)))
+                    .collect();
+                format!("nanohaptics {}", a.join(" "))
+            }
+            _ => format!("{} bytes", input.len()),
+        }
+    }
+}
+
+/// The harness's own check (`--target selftest`, not part of `--all`): input 3 of every 100
+/// panics, input 5 aborts, input 7 hangs, input 9 gives a non-finite force; the rest pass.
+fn selftest(index: u64, timeout: Duration) -> Outcome {
+    match index % 100 {
+        3 => panic!("selftest panic at input {index}"),
+        5 => std::process::abort(),
+        7 => {
+            std::thread::sleep(timeout * 3);
+            Outcome::Accepted
+        }
+        9 => Outcome::Finding("non-finite", "selftest force NaN".into()),
+        _ => Outcome::Accepted,
+    }
+}
