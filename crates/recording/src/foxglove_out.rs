@@ -113,129 +113,140 @@ pub fn scene_update(prims: &[Primitive], scale: f64, time_ns: u64) -> SceneUpdat
             id: entity_id(p, &mut counts),
             ..Default::default()
         };
-        match p {
-            // Foxglove has no cursor or dashed-slot primitive: a cursor is
-            // drawn as its sphere, a blueprint slot as its box.
-            Primitive::Sphere {
-                center_m,
-                radius_m,
-                color: c,
-            }
-            | Primitive::Cursor {
-                center_m,
-                radius_m,
-                color: c,
-            } => e.spheres.push(SpherePrimitive {
-                pose: pose(*center_m, scale, identity()),
-                size: Some(v3([2.0 * radius_m; 3], scale)),
-                color: Some(color(*c)),
-            }),
-            Primitive::Box {
-                center_m,
-                half_extents_m,
-                rotation,
-                color: c,
-            }
-            | Primitive::Slot {
-                center_m,
-                half_extents_m,
-                rotation,
-                color: c,
-            } => e.cubes.push(CubePrimitive {
-                pose: pose(
-                    *center_m,
-                    scale,
-                    Quaternion {
-                        x: rotation[0],
-                        y: rotation[1],
-                        z: rotation[2],
-                        w: rotation[3],
-                    },
-                ),
-                size: Some(v3(vec3::scale(*half_extents_m, 2.0), scale)),
-                color: Some(color(*c)),
-            }),
-            Primitive::Ellipse {
-                center_m,
-                semi_axes_m,
-                color: c,
-            } => e.cylinders.push(CylinderPrimitive {
-                // A flat elliptic disc: a cylinder of height 1 % of the larger axis.
-                pose: pose(*center_m, scale, identity()),
-                size: Some(v3(
-                    [
-                        2.0 * semi_axes_m[0],
-                        2.0 * semi_axes_m[1],
-                        0.01 * semi_axes_m[0].max(semi_axes_m[1]),
-                    ],
-                    scale,
-                )),
-                bottom_scale: 1.0,
-                top_scale: 1.0,
-                color: Some(color(*c)),
-            }),
-            Primitive::Polyline {
-                points_m,
-                closed,
-                color: c,
-            } => e.lines.push(LinePrimitive {
-                r#type: if *closed {
-                    line_primitive::Type::LineLoop as i32
-                } else {
-                    line_primitive::Type::LineStrip as i32
-                },
-                pose: pose([0.0; 3], scale, identity()),
-                thickness: 2.0,
-                scale_invariant: true,
-                points: points_m
-                    .iter()
-                    .map(|q| Point3 {
-                        x: q[0] * scale,
-                        y: q[1] * scale,
-                        z: q[2] * scale,
-                    })
-                    .collect(),
-                color: Some(color(*c)),
-                colors: Vec::new(),
-                indices: Vec::new(),
-            }),
-            Primitive::Arrow {
-                from_m,
-                to_m,
-                color: c,
-            } => {
-                let d = vec3::sub(*to_m, *from_m);
-                let len = vec3::norm(d) * scale;
-                if len > 0.0 && len.is_finite() {
-                    e.arrows.push(ArrowPrimitive {
-                        pose: pose(*from_m, scale, quat_x_to(vec3::scale(d, scale / len))),
-                        shaft_length: 0.75 * len,
-                        shaft_diameter: 0.05 * len,
-                        head_length: 0.25 * len,
-                        head_diameter: 0.12 * len,
-                        color: Some(color(*c)),
-                    });
-                }
-            }
-            Primitive::Label {
-                position_m,
-                text,
-                color: c,
-            } => e.texts.push(TextPrimitive {
-                pose: pose(*position_m, scale, identity()),
-                billboard: true,
-                font_size: 14.0,
-                scale_invariant: true,
-                color: Some(color(*c)),
-                text: text.clone(),
-            }),
-        }
+        add_primitive(&mut e, p, scale);
         entities.push(e);
     }
     SceneUpdate {
         deletions: Vec::new(),
         entities,
     }
+}
+
+/// Adds `p` to entity `e` as Foxglove's primitive of its kind (positions × `scale`).
+fn add_primitive(e: &mut SceneEntity, p: &Primitive, scale: f64) {
+    match p {
+        // Foxglove has no cursor or dashed-slot primitive: a cursor is
+        // drawn as its sphere, a blueprint slot as its box.
+        Primitive::Sphere {
+            center_m,
+            radius_m,
+            color: c,
+        }
+        | Primitive::Cursor {
+            center_m,
+            radius_m,
+            color: c,
+        } => e.spheres.push(SpherePrimitive {
+            pose: pose(*center_m, scale, identity()),
+            size: Some(v3([2.0 * radius_m; 3], scale)),
+            color: Some(color(*c)),
+        }),
+        Primitive::Box {
+            center_m,
+            half_extents_m,
+            rotation,
+            color: c,
+        }
+        | Primitive::Slot {
+            center_m,
+            half_extents_m,
+            rotation,
+            color: c,
+        } => e.cubes.push(CubePrimitive {
+            pose: pose(
+                *center_m,
+                scale,
+                Quaternion {
+                    x: rotation[0],
+                    y: rotation[1],
+                    z: rotation[2],
+                    w: rotation[3],
+                },
+            ),
+            size: Some(v3(vec3::scale(*half_extents_m, 2.0), scale)),
+            color: Some(color(*c)),
+        }),
+        Primitive::Ellipse {
+            center_m,
+            semi_axes_m,
+            color: c,
+        } => e.cylinders.push(CylinderPrimitive {
+            // A flat elliptic disc: a cylinder of height 1 % of the larger axis.
+            pose: pose(*center_m, scale, identity()),
+            size: Some(v3(
+                [
+                    2.0 * semi_axes_m[0],
+                    2.0 * semi_axes_m[1],
+                    0.01 * semi_axes_m[0].max(semi_axes_m[1]),
+                ],
+                scale,
+            )),
+            bottom_scale: 1.0,
+            top_scale: 1.0,
+            color: Some(color(*c)),
+        }),
+        Primitive::Polyline {
+            points_m,
+            closed,
+            color: c,
+        } => e.lines.push(line(points_m, *closed, *c, scale)),
+        Primitive::Arrow {
+            from_m,
+            to_m,
+            color: c,
+        } => e.arrows.extend(arrow(*from_m, *to_m, *c, scale)),
+        Primitive::Label {
+            position_m,
+            text,
+            color: c,
+        } => e.texts.push(TextPrimitive {
+            pose: pose(*position_m, scale, identity()),
+            billboard: true,
+            font_size: 14.0,
+            scale_invariant: true,
+            color: Some(color(*c)),
+            text: text.clone(),
+        }),
+    }
+}
+
+/// A polyline (a loop when `closed`) of width 2 px on screen.
+fn line(points_m: &[Vec3], closed: bool, c: Rgba, scale: f64) -> LinePrimitive {
+    LinePrimitive {
+        r#type: if closed {
+            line_primitive::Type::LineLoop as i32
+        } else {
+            line_primitive::Type::LineStrip as i32
+        },
+        pose: pose([0.0; 3], scale, identity()),
+        thickness: 2.0,
+        scale_invariant: true,
+        points: points_m
+            .iter()
+            .map(|q| Point3 {
+                x: q[0] * scale,
+                y: q[1] * scale,
+                z: q[2] * scale,
+            })
+            .collect(),
+        color: Some(color(c)),
+        colors: Vec::new(),
+        indices: Vec::new(),
+    }
+}
+
+/// An arrow from `from_m` to `to_m` (none when of zero or non-finite length).
+fn arrow(from_m: Vec3, to_m: Vec3, c: Rgba, scale: f64) -> Option<ArrowPrimitive> {
+    let d = vec3::sub(to_m, from_m);
+    let len = vec3::norm(d) * scale;
+    (len > 0.0 && len.is_finite()).then(|| ArrowPrimitive {
+        pose: pose(from_m, scale, quat_x_to(vec3::scale(d, scale / len))),
+        shaft_length: 0.75 * len,
+        shaft_diameter: 0.05 * len,
+        head_length: 0.25 * len,
+        head_diameter: 0.12 * len,
+        color: Some(color(c)),
+    })
 }
 
 /// The cursor frame relative to the world frame.
