@@ -112,8 +112,7 @@ fn golden_recording_becomes_frames_and_a_gif() {
 
 #[test]
 fn optical_tweezers_frames_from_the_recorded_state_equal_the_recomputed_ones() {
-    let dir =
-        std::env::temp_dir().join(format!("nanohaptics-render-ot-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("nanohaptics-render-ot-{}", std::process::id()));
     let args = |out: &str| RenderArgs {
         input: root().join("recordings/optical_tweezers.mcap"),
         out: Some(dir.join(out)),
@@ -126,8 +125,7 @@ fn optical_tweezers_frames_from_the_recorded_state_equal_the_recomputed_ones() {
         sample_rate: 44_100,
     };
     let (a, b) = (args("recorded"), args("recomputed"));
-    let recorded =
-        recording_frames(&a, None, a.out.clone(), None, false).expect("recorded state");
+    let recorded = recording_frames(&a, None, a.out.clone(), None, false).expect("recorded state");
     let recomputed = recording_frames(&b, None, b.out.clone(), None, true).expect("recomputed");
     assert!(recorded.from_recorded_state && !recomputed.from_recorded_state);
     assert_eq!(recorded.ticks, recomputed.ticks);
@@ -221,8 +219,8 @@ fn the_wav_has_a_sound_on_each_recorded_impact() {
     assert!(s.written[0].starts_with("WAV sound"), "{}", s.written[0]);
     let (x, sr) = read_wav(&wav);
     let hits = impacts(&root().join("recordings/brickworld.mcap"));
-    let rec = read_recording_file(&root().join("recordings/brickworld.mcap"), false)
-        .expect("recording");
+    let rec =
+        read_recording_file(&root().join("recordings/brickworld.mcap"), false).expect("recording");
     let ticks = haptic_loop::session::SessionArrays::from_recording(&rec)
         .expect("arrays")
         .tick
