@@ -32,7 +32,7 @@ for crate in "${order[@]}"; do
 done
 if [ "$assemble_only" = 0 ]; then
   echo "==> haptic-loop-live-report (4 real-time sessions, about 3.5 minutes)"
-  cargo run --release -q -p haptic-loop --example haptic-loop-live-report -- --out docs/bench/haptic-loop-live.md > /dev/null
+  cargo run --release -q -p haptic-loop --features live --example haptic-loop-live-report -- --out docs/bench/haptic-loop-live.md > /dev/null
   echo "==> haptic-loop-zwidth-report (Z-width and margins in closed loop, about 10 s)"
   cargo run --release -q -p haptic-loop --example haptic-loop-zwidth-report -- --out docs/bench/zwidth.md > /dev/null
   echo "==> haptic-loop-teaching-report (the lesson and the sound, three runs each)"
