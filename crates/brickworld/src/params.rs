@@ -382,6 +382,15 @@ impl Params {
 
     /// Checks every field against its documented range (device-independent part).
     pub fn validate(&self) -> Result<(), ParamError> {
+        self.validate_dynamics()?;
+        if let Some(z) = &self.loading_zone {
+            validate_loading_zone(z)?;
+        }
+        self.validate_layout()
+    }
+
+    /// The tick, gravity, contacts, coupling, estimators, brick and proxy, solver.
+    fn validate_dynamics(&self) -> Result<(), ParamError> {
         range("dt_s", self.dt_s, Lo::Closed(1e-4), 1e-2)?;
         range(
             "gravity_m_per_s2",
@@ -467,35 +476,11 @@ impl Params {
             Lo::Closed(1.0),
             1000.0,
         )?;
-        if let Some(z) = &self.loading_zone {
-            for i in 0..2 {
-                range(
-                    &format!("loading_zone.min_m[{i}]"),
-                    z.min_m[i],
-                    Lo::Closed(-100.0),
-                    100.0,
-                )?;
-                range(
-                    &format!("loading_zone.max_m[{i}]"),
-                    z.max_m[i],
-                    Lo::Closed(-100.0),
-                    100.0,
-                )?;
-                if z.min_m[i] >= z.max_m[i] {
-                    return Err(ParamError::Inconsistent {
-                        field: format!("loading_zone.max_m[{i}]"),
-                        reason: format!("must exceed loading_zone.min_m[{i}] = {}", z.min_m[i]),
-                    });
-                }
-                range(
-                    &format!("loading_zone.spawn_m[{i}]"),
-                    z.spawn_m[i],
-                    Lo::Closed(-100.0),
-                    100.0,
-                )?;
-            }
-            range("loading_zone.height_m", z.height_m, Lo::Open(0.0), 10.0)?;
-        }
+        Ok(())
+    }
+
+    /// The blueprint, the bricks placed at the start and the obstacles.
+    fn validate_layout(&self) -> Result<(), ParamError> {
         for (i, s) in self.blueprint.slots.iter().enumerate() {
             placement(&format!("blueprint.slots[{i}]"), s)?;
         }
@@ -550,6 +535,38 @@ impl Params {
             limits.max_stiffness_n_per_m,
         )
     }
+}
+
+/// The loading zone: its corners ordered and within ±100 m, its spawn point, its height.
+fn validate_loading_zone(z: &LoadingZone) -> Result<(), ParamError> {
+    for i in 0..2 {
+        range(
+            &format!("loading_zone.min_m[{i}]"),
+            z.min_m[i],
+            Lo::Closed(-100.0),
+            100.0,
+        )?;
+        range(
+            &format!("loading_zone.max_m[{i}]"),
+            z.max_m[i],
+            Lo::Closed(-100.0),
+            100.0,
+        )?;
+        if z.min_m[i] >= z.max_m[i] {
+            return Err(ParamError::Inconsistent {
+                field: format!("loading_zone.max_m[{i}]"),
+                reason: format!("must exceed loading_zone.min_m[{i}] = {}", z.min_m[i]),
+            });
+        }
+        range(
+            &format!("loading_zone.spawn_m[{i}]"),
+            z.spawn_m[i],
+            Lo::Closed(-100.0),
+            100.0,
+        )?;
+    }
+    range("loading_zone.height_m", z.height_m, Lo::Open(0.0), 10.0)?;
+    Ok(())
 }
 
 /// Failure to read parameters from TOML text.

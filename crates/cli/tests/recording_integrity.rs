@@ -97,6 +97,21 @@ fn err(b: &[u8]) -> String {
     read_recording(b, false).unwrap_err().to_string()
 }
 
+/// The reader's error for file `m` whose summary section no longer matches the footer's
+/// CRC: it names the footer's byte, the summary's bytes and both CRCs.
+fn summary_crc_error(m: &[u8]) -> String {
+    let (_, de_end) = of(m, 0x0F)[0];
+    let (f, _) = of(m, 0x02)[0];
+    let calc = crc32fast::hash(&m[de_end..f + 25]);
+    let saved = u32::from_le_bytes(m[f + 25..f + 29].try_into().unwrap());
+    format!(
+        "corrupt recording: footer at byte {f}: the CRC-32 of the summary section (bytes \
+         {de_end}–{}) is 0x{calc:08x}, the footer says 0x{saved:08x} (the summary was \
+         changed)",
+        f + 24
+    )
+}
+
 #[test]
 fn byte_flips_and_cuts_of_golden_recordings_are_errors_never_aborts() {
     // Every golden recording, 200 single-bit flips each (spread over the whole file, so inside
@@ -323,20 +338,7 @@ fn a_change_in_any_crc_covered_byte_does_not_verify() {
     let (st, _) = of(b, 0x0B)[0];
     let mut m = b.to_vec();
     m[st + 9] ^= 1; // message_count
-    let (de, de_end) = of(b, 0x0F)[0];
-    let _ = de;
-    let (f, _) = of(b, 0x02)[0];
-    let calc = crc32fast::hash(&m[de_end..f + 25]);
-    let saved = u32::from_le_bytes(m[f + 25..f + 29].try_into().unwrap());
-    assert_eq!(
-        err(&m),
-        format!(
-            "corrupt recording: footer at byte {f}: the CRC-32 of the summary section (bytes \
-             {de_end}–{}) is 0x{calc:08x}, the footer says 0x{saved:08x} (the summary was \
-             changed)",
-            f + 24
-        )
-    );
+    assert_eq!(err(&m), summary_crc_error(&m));
     fix_summary_crc(&mut m);
     let n = u64::from_le_bytes(b[st + 9..st + 17].try_into().unwrap());
     assert_eq!(
@@ -362,6 +364,8 @@ fn a_change_in_any_crc_covered_byte_does_not_verify() {
         )
     );
     // The data end's own CRC field, and the footer's.
+    let (de, _) = of(b, 0x0F)[0];
+    let (f, _) = of(b, 0x02)[0];
     let mut m = b.to_vec();
     m[de + 9] ^= 0x80;
     assert!(err(&m).contains("(the data section was changed)"));
@@ -440,19 +444,8 @@ fn a_summary_record_removed_fails_the_summary_crc_first_then_the_footer_offsets(
     let (st, st_end) = of(b, 0x0B)[0];
     let mut m = b[..st].to_vec();
     m.extend_from_slice(&b[st_end..]);
-    let (_, de_end) = of(&m, 0x0F)[0];
+    assert_eq!(err(&m), summary_crc_error(&m));
     let (f, _) = of(&m, 0x02)[0];
-    let calc = crc32fast::hash(&m[de_end..f + 25]);
-    let saved = u32::from_le_bytes(m[f + 25..f + 29].try_into().unwrap());
-    assert_eq!(
-        err(&m),
-        format!(
-            "corrupt recording: footer at byte {f}: the CRC-32 of the summary section (bytes \
-             {de_end}–{}) is 0x{calc:08x}, the footer says 0x{saved:08x} (the summary was \
-             changed)",
-            f + 24
-        )
-    );
     fix_summary_crc(&mut m);
     let first = u64::from_le_bytes(
         b[f + (st_end - st) + 17..f + (st_end - st) + 25]

@@ -290,14 +290,11 @@ fn nonneg_up_to(field: &str, value: f64, max: f64) -> Result<(), ParamError> {
 }
 
 /// `v` in `e` notation with at most 6 significant digits and no trailing zeros (`2e1`).
+/// `v` rounded to six significant digits, in the one number form of errors
+/// ([`world_form::numbers::fmt_num`]): a derived bound reads `20`, not `19.999999999999996`.
 fn short(v: f64) -> String {
-    let t = format!("{v:.5e}");
-    match t.split_once('e') {
-        Some((m, e)) if m.contains('.') => {
-            format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
-        }
-        _ => t,
-    }
+    let rounded: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+    world_form::numbers::fmt_num(rounded)
 }
 
 fn finite(field: &str, value: f64) -> Result<(), ParamError> {

@@ -106,7 +106,7 @@ fn stiffness_above_pull_off_over_snap_gap_is_refused() {
     assert_eq!(
         e.to_string(),
         "interaction.game.pairs.tip_substrate.stiffness_n_per_m = 2.5e1 is out of range: \
-         allowed 0 < value < pull_off_ratio * snap force / snap_gap_m = 2e1 N/m \
+         allowed 0 < value < pull_off_ratio * snap force / snap_gap_m = 20 N/m \
          (stiffer contacts release on the tick after they snap)"
     );
     // Just below the bound the hysteresis survives: the contact holds on the next tick.

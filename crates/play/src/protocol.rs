@@ -147,117 +147,127 @@ pub fn parse(text: &str, button_mask: u32) -> Result<PageMsg, ProtocolError> {
     match t {
         "start" => Ok(PageMsg::Start),
         "end" => Ok(PageMsg::End),
-        "switch" => {
-            let name = match v.get("name") {
-                Some(Value::String(s)) if (1..=64).contains(&s.len()) => s.clone(),
-                other => {
-                    return Err(ProtocolError::Field {
-                        field: "switch.name".into(),
-                        got: kind(other),
-                        expected: "a switch name of 1–64 characters",
-                    });
-                }
-            };
-            let value = number(&v, "value", "switch.value")?;
-            Ok(PageMsg::Switch { name, value })
-        }
-        "input" => {
-            let seq = match v.get("seq") {
-                Some(Value::Number(n)) if n.as_u64().is_some_and(|s| s <= MAX_SAFE_INTEGER) => {
-                    n.as_u64().unwrap_or(0)
-                }
-                Some(Value::Number(n)) => {
-                    return Err(ProtocolError::OutOfRange {
-                        field: "input.seq".into(),
-                        value: n.to_string(),
-                        allowed: format!("an integer 0 ≤ seq ≤ {MAX_SAFE_INTEGER}"),
-                    });
-                }
-                other => {
-                    return Err(ProtocolError::Field {
-                        field: "input.seq".into(),
-                        got: kind(other),
-                        expected: "an integer",
-                    });
-                }
-            };
-            let arr = match v.get("pos") {
-                Some(Value::Array(a)) if a.len() == 3 => a,
-                other => {
-                    return Err(ProtocolError::Field {
-                        field: "input.pos".into(),
-                        got: kind(other),
-                        expected: "a list of 3 numbers",
-                    });
-                }
-            };
-            let mut pos = [0.0; 3];
-            for (i, x) in arr.iter().enumerate() {
-                let field = format!("input.pos[{i}]");
-                let n = x.as_f64().ok_or_else(|| ProtocolError::Field {
-                    field: field.clone(),
-                    got: kind(Some(x)),
-                    expected: "a number",
-                })?;
-                if !(-1.0..=1.0).contains(&n) {
-                    return Err(ProtocolError::OutOfRange {
-                        field,
-                        value: n.to_string(),
-                        allowed: "-1 ≤ value ≤ 1".into(),
-                    });
-                }
-                pos[i] = n;
-            }
-            let r2 = pos[0] * pos[0] + pos[1] * pos[1] + pos[2] * pos[2];
-            if r2 > 1.0 {
-                return Err(ProtocolError::OutOfRange {
-                    field: "input.pos".into(),
-                    value: format!("[{}, {}, {}] (norm {})", pos[0], pos[1], pos[2], r2.sqrt()),
-                    allowed: "a point of the unit ball, norm ≤ 1".into(),
-                });
-            }
-            let buttons = match v.get("buttons") {
-                Some(Value::Number(n))
-                    if n.as_u64().is_some_and(|b| b & !u64::from(button_mask) == 0) =>
-                {
-                    n.as_u64().unwrap_or(0) as u32
-                }
-                Some(Value::Number(n)) => {
-                    return Err(ProtocolError::OutOfRange {
-                        field: "input.buttons".into(),
-                        value: n.to_string(),
-                        allowed: format!(
-                            "an integer whose bits are the device's buttons, 0–{button_mask}"
-                        ),
-                    });
-                }
-                other => {
-                    return Err(ProtocolError::Field {
-                        field: "input.buttons".into(),
-                        got: kind(other),
-                        expected: "an integer",
-                    });
-                }
-            };
-            let t_ms = number(&v, "t_ms", "input.t_ms")?;
-            if !(0.0..1e14).contains(&t_ms) {
-                return Err(ProtocolError::OutOfRange {
-                    field: "input.t_ms".into(),
-                    value: t_ms.to_string(),
-                    allowed: "0 ≤ t_ms < 1e14 (ms since the Unix epoch)".into(),
-                });
-            }
-            Ok(PageMsg::Input(PageInput {
-                seq,
-                pos,
-                buttons,
-                t_ms,
-            }))
-        }
+        "switch" => parse_switch(&v),
+        "input" => parse_input(&v, button_mask),
         other => Err(ProtocolError::UnknownType(format!(
             "\"{}\"",
             other.escape_default()
         ))),
+    }
+}
+
+/// A `switch` message: a name of 1–64 characters and a number.
+fn parse_switch(v: &Value) -> Result<PageMsg, ProtocolError> {
+    let name = match v.get("name") {
+        Some(Value::String(s)) if (1..=64).contains(&s.len()) => s.clone(),
+        other => {
+            return Err(ProtocolError::Field {
+                field: "switch.name".into(),
+                got: kind(other),
+                expected: "a switch name of 1–64 characters",
+            });
+        }
+    };
+    let value = number(v, "value", "switch.value")?;
+    Ok(PageMsg::Switch { name, value })
+}
+
+/// An `input` message: its sequence number, position, buttons and page time.
+fn parse_input(v: &Value, button_mask: u32) -> Result<PageMsg, ProtocolError> {
+    let seq = input_seq(v)?;
+    let pos = input_pos(v)?;
+    let buttons = input_buttons(v, button_mask)?;
+    let t_ms = number(v, "t_ms", "input.t_ms")?;
+    if !(0.0..1e14).contains(&t_ms) {
+        return Err(ProtocolError::OutOfRange {
+            field: "input.t_ms".into(),
+            value: t_ms.to_string(),
+            allowed: "0 ≤ t_ms < 1e14 (ms since the Unix epoch)".into(),
+        });
+    }
+    Ok(PageMsg::Input(PageInput {
+        seq,
+        pos,
+        buttons,
+        t_ms,
+    }))
+}
+
+/// `input.seq`: an integer a page's JavaScript number holds exactly.
+fn input_seq(v: &Value) -> Result<u64, ProtocolError> {
+    match v.get("seq") {
+        Some(Value::Number(n)) if n.as_u64().is_some_and(|s| s <= MAX_SAFE_INTEGER) => {
+            Ok(n.as_u64().unwrap_or(0))
+        }
+        Some(Value::Number(n)) => Err(ProtocolError::OutOfRange {
+            field: "input.seq".into(),
+            value: n.to_string(),
+            allowed: format!("an integer 0 ≤ seq ≤ {MAX_SAFE_INTEGER}"),
+        }),
+        other => Err(ProtocolError::Field {
+            field: "input.seq".into(),
+            got: kind(other),
+            expected: "an integer",
+        }),
+    }
+}
+
+/// `input.pos`: a point of the unit ball (the device workspace, normalised).
+fn input_pos(v: &Value) -> Result<[f64; 3], ProtocolError> {
+    let arr = match v.get("pos") {
+        Some(Value::Array(a)) if a.len() == 3 => a,
+        other => {
+            return Err(ProtocolError::Field {
+                field: "input.pos".into(),
+                got: kind(other),
+                expected: "a list of 3 numbers",
+            });
+        }
+    };
+    let mut pos = [0.0; 3];
+    for (i, x) in arr.iter().enumerate() {
+        let field = format!("input.pos[{i}]");
+        let n = x.as_f64().ok_or_else(|| ProtocolError::Field {
+            field: field.clone(),
+            got: kind(Some(x)),
+            expected: "a number",
+        })?;
+        if !(-1.0..=1.0).contains(&n) {
+            return Err(ProtocolError::OutOfRange {
+                field,
+                value: n.to_string(),
+                allowed: "-1 ≤ value ≤ 1".into(),
+            });
+        }
+        pos[i] = n;
+    }
+    let r2 = pos[0] * pos[0] + pos[1] * pos[1] + pos[2] * pos[2];
+    if r2 > 1.0 {
+        return Err(ProtocolError::OutOfRange {
+            field: "input.pos".into(),
+            value: format!("[{}, {}, {}] (norm {})", pos[0], pos[1], pos[2], r2.sqrt()),
+            allowed: "a point of the unit ball, norm ≤ 1".into(),
+        });
+    }
+    Ok(pos)
+}
+
+/// `input.buttons`: an integer whose bits are among the device's buttons (`button_mask`).
+fn input_buttons(v: &Value, button_mask: u32) -> Result<u32, ProtocolError> {
+    match v.get("buttons") {
+        Some(Value::Number(n)) if n.as_u64().is_some_and(|b| b & !u64::from(button_mask) == 0) => {
+            Ok(n.as_u64().unwrap_or(0) as u32)
+        }
+        Some(Value::Number(n)) => Err(ProtocolError::OutOfRange {
+            field: "input.buttons".into(),
+            value: n.to_string(),
+            allowed: format!("an integer whose bits are the device's buttons, 0–{button_mask}"),
+        }),
+        other => Err(ProtocolError::Field {
+            field: "input.buttons".into(),
+            got: kind(other),
+            expected: "an integer",
+        }),
     }
 }
 

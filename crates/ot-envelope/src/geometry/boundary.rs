@@ -2,7 +2,7 @@
 //! crossings found through a bucket grid, segments split at them) walked with the right-hand
 //! rule around its unbounded face.
 
-use super::{V2, cross, signed_area};
+use super::{V2, bbox, cross, signed_area};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Union–find over vertex ids.
@@ -128,11 +128,7 @@ struct Grid {
 impl Grid {
     /// Cells of about twice the mean segment length (at most 1024 × 1024).
     fn new(pts: &[V2], segs: &[(usize, usize)]) -> Grid {
-        let (mut lo, mut hi) = (pts[0], pts[0]);
-        for p in pts {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
+        let (lo, hi) = bbox(pts);
         let mean_len = segs
             .iter()
             .map(|&(a, b)| (pts[b] - pts[a]).norm())
