@@ -31,6 +31,15 @@ impl Totals {
         let k = self.state_fields.iter().position(|f| f == name)?;
         self.last_state.get(k).copied()
     }
+
+    /// The scene's state after the last tick, (field name, value) in the scene's order.
+    pub fn state(&self) -> Vec<(String, f64)> {
+        self.state_fields
+            .iter()
+            .cloned()
+            .zip(self.last_state.iter().copied())
+            .collect()
+    }
 }
 
 impl Sink for Totals {

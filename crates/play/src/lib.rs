@@ -260,6 +260,33 @@ fn hello_message(
     })
 }
 
+/// Tells the server and every page what is played: the scene's switches and the device (for
+/// checking page messages), and the `hello` (kept for pages that connect later).
+fn announce(
+    shared: &Shared,
+    scene_name: &str,
+    lp: &HapticLoop,
+    specs: &DeviceSpecs,
+    page_is_hand: bool,
+    seconds: Option<f64>,
+) {
+    let scene = lp.scene();
+    if let Ok(mut s) = shared.scene.lock() {
+        *s = Some(SceneLink {
+            switches: scene.switches(),
+            kind: scene.kind(),
+            workspace_radius_m: specs.workspace_radius_m,
+            button_mask: specs.button_mask(),
+            page_is_hand,
+        });
+    }
+    let hello = hello_message(scene_name, lp, specs, page_is_hand, seconds);
+    if let Ok(mut h) = shared.hello.lock() {
+        *h = Some(hello.to_string());
+    }
+    shared.broadcast(&tungstenite::Message::text(hello.to_string()));
+}
+
 /// The page's `end`: the session's figures and where to download its recording.
 fn end_message(
     config: &PlayConfig,
@@ -286,6 +313,17 @@ fn end_message(
         "recording_file": config.out.file_name().map(|n| n.to_string_lossy().to_string()),
         "recording_bytes": written.map(|w| w.bytes),
     })
+}
+
+/// Offers the recording for download and tells every page (and later ones) the end.
+fn offer_end(shared: &Shared, config: &PlayConfig, end_msg: &serde_json::Value) {
+    if let Ok(mut r) = shared.recording.lock() {
+        *r = Some(config.out.clone());
+    }
+    if let Ok(mut e) = shared.end.lock() {
+        *e = Some(end_msg.to_string());
+    }
+    shared.broadcast(&tungstenite::Message::text(end_msg.to_string()));
 }
 
 /// The hook run before each tick's step: raises the end on `stop`, and applies the switches
@@ -356,23 +394,16 @@ pub fn run(
         out: Some(config.out.clone()),
         ..SetupOptions::new(scene_src, specs.clone(), "realtime", &link)
     })?;
-    let scene = lp.scene();
-    let fields = scene.state_fields();
-    let kind = scene.kind();
-    if let Ok(mut s) = shared.scene.lock() {
-        *s = Some(SceneLink {
-            switches: scene.switches(),
-            kind,
-            workspace_radius_m: specs.workspace_radius_m,
-            button_mask: specs.button_mask(),
-            page_is_hand,
-        });
-    }
-    let hello = hello_message(&file.scene.name, &lp, &specs, page_is_hand, config.seconds);
-    if let Ok(mut h) = shared.hello.lock() {
-        *h = Some(hello.to_string());
-    }
-    shared.broadcast(&tungstenite::Message::text(hello.to_string()));
+    let fields = lp.scene().state_fields();
+    let kind = lp.scene().kind();
+    announce(
+        &shared,
+        &file.scene.name,
+        &lp,
+        &specs,
+        page_is_hand,
+        config.seconds,
+    );
     if page_is_hand && !shared.input.wait_first(stop) {
         server.stop();
         return Err(PlayError::NotStarted);
@@ -382,16 +413,14 @@ pub fn run(
     let prox = haptic_loop::sound::proximity_on_distance_m(kind)
         .filter(|_| fields.iter().any(|f| f == "nearest_m"));
     let (tx, rx) = std::sync::mpsc::channel::<ToPublisher>();
-    let publisher = {
-        let sh = shared.clone();
-        std::thread::Builder::new()
-            .name("play-publish".into())
-            .spawn(move || publish::run_publisher(rx, sh, rate, fields, prox))
-            .map_err(|e| PlayError::Serve {
-                port: config.port,
-                message: e.to_string(),
-            })?
-    };
+    let sh = shared.clone();
+    let publisher = std::thread::Builder::new()
+        .name("play-publish".into())
+        .spawn(move || publish::run_publisher(rx, sh, rate, fields, prox))
+        .map_err(|e| PlayError::Serve {
+            port: config.port,
+            message: e.to_string(),
+        })?;
     let mut play_sink = PlaySink::new(tx.clone(), shared.clone());
     let mut hook = switch_hook(stop, shared.clone(), tx);
     let pacing = if page_is_hand {
@@ -427,16 +456,8 @@ pub fn run(
         EndReason::DeviceEnded => "device_ended",
     };
     let totals = &sinks.totals;
-    let state: Vec<(String, f64)> = totals
-        .state_fields
-        .iter()
-        .cloned()
-        .zip(totals.last_state.iter().copied())
-        .collect();
+    let state = totals.state();
     let input_latency_ms = LatencyMs::of(&latencies);
-    if let Ok(mut r) = shared.recording.lock() {
-        *r = Some(config.out.clone());
-    }
     let written = sinks.written();
     let end_msg = end_message(
         config,
@@ -447,10 +468,7 @@ pub fn run(
         input_latency_ms,
         written.as_ref(),
     );
-    if let Ok(mut e) = shared.end.lock() {
-        *e = Some(end_msg.to_string());
-    }
-    shared.broadcast(&tungstenite::Message::text(end_msg.to_string()));
+    offer_end(&shared, config, &end_msg);
     serve_end_screen(config, stop);
     server.stop();
     Ok(PlaySummary {
