@@ -28,7 +28,7 @@ WORLDS = {"world-form", "ot-physics", "ot-envelope", "brickworld", "nanoworld"}
 LIBS = WORLDS | {"haptic-types", "nanohaptics-recording", "haptic-devices", "render", "haptic-loop"}
 ALLOWED = {
     "world-form": set(),
-    "ot-physics": set(),
+    "ot-physics": {"world-form"},
     "ot-envelope": {"ot-physics", "world-form"},
     "brickworld": {"world-form"},
     "nanoworld": {"world-form"},

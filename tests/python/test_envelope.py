@@ -129,7 +129,7 @@ def test_envelope_errors_name_the_argument(paper):
         (lambda: nh.solve_trap(t3, (0, 0, 0), DT, (1e-7, 0)),
          "trap: solve_trap needs a 2D trap (axial_waist=None); use working_envelope_3d for 3D"),
         (lambda: nh.working_envelope(paper, (0, 0), DT, tol=-1.0),
-         "tol [m] = -1e0 is out of range: allowed finite and > 0"),
+         "tol [m] = -1 is out of range: allowed finite and > 0"),
         (lambda: nh.clip_command(paper, (0, 0), DT, (1e-7, 0), mode="sideways"),
          'mode = "sideways": allowed "radial", "nearest"'),
         (lambda: nh.solve_trap(paper, (0, 0), DT, (1e-7, 0, 0)), "target: expected shape (2,), got (3,)"),

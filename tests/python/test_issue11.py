@@ -140,7 +140,7 @@ def test_a_refused_row_of_a_batch_is_named():
     rows[3, 2] = 2.0
     with pytest.raises(ValueError) as e:
         w.run(rows)
-    assert str(e.value) == "positions[3]: tip position z = 2e0 is out of range: allowed |z| <= 1 m"
+    assert str(e.value) == "positions[3]: tip position z = 2 is out of range: allowed |z| <= 1 m"
     assert w.tick == 0, "a refused batch changes nothing"
 
 

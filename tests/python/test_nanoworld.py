@@ -214,7 +214,7 @@ def test_step_and_curve_errors_name_the_argument():
     cases = [
         (lambda: nh.NanoWorld((0, 0)), "start: expected shape (3,), got (2,)"),
         (lambda: world.step((0, 0, float("nan"))), "position[2] = NaN is out of range: allowed finite (m)"),
-        (lambda: world.step((0, 0, 5e-9), dt_s=0.0), "dt_s = 0e0 is out of range: allowed 1e-9 <= dt_s <= 1 s"),
+        (lambda: world.step((0, 0, 5e-9), dt_s=0.0), "dt_s = 0 is out of range: allowed 1e-9 <= dt_s <= 1 s"),
         (lambda: world.run(np.zeros((4, 2))), "positions: expected shape (N, 3), got (4, 2)"),
         (
             lambda: nh.force_distance_curve(far_gap_m=2e-6),
@@ -225,7 +225,7 @@ def test_step_and_curve_errors_name_the_argument():
             "near_gap_m = 3e-9 is out of range: allowed finite and < far_gap_m = 2e-9 m",
         ),
         (lambda: nh.force_distance_curve(steps=1), "steps = 1 is out of range: allowed 2 ..= 10000000"),
-        (lambda: world.house_script(step_m=0.0), "step_m = 0e0 is out of range: allowed 0 < step_m <= 1e-6 m"),
+        (lambda: world.house_script(step_m=0.0), "step_m = 0 is out of range: allowed 0 < step_m <= 1e-6 m"),
         (lambda: nh.nano_params("quantum"), 'mode = "quantum": allowed "game", "physical"'),
     ]
     for fn, msg in cases:
@@ -263,7 +263,7 @@ def test_issue12_limits_come_from_the_device():
     # A stiffest spring beyond the device's stiffness is refused by name.
     with pytest.raises(ValueError) as e:
         nh.NanoWorld(start, device={"max_force_n": 8e-9, "max_stiffness_n_per_m": 1.0})
-    assert str(e.value).startswith("interaction.game.pairs.tip_substrate.stiffness_n_per_m = 2e0 is out of range")
+    assert str(e.value).startswith("interaction.game.pairs.tip_substrate.stiffness_n_per_m = 2 is out of range")
     # The old unit spelling of gravity still loads.
     q = nh.nano_params()
     q["gravity_m_s2"] = q.pop("gravity_m_per_s2")

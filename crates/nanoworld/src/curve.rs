@@ -70,7 +70,10 @@ pub fn force_distance_curve(
         return Err(bad(
             "near_gap_m",
             spec.near_gap_m,
-            &format!("finite and < far_gap_m = {:e} m", spec.far_gap_m),
+            &format!(
+                "finite and < far_gap_m = {} m",
+                world_form::numbers::fmt_num(spec.far_gap_m)
+            ),
         ));
     }
     if !(2..=10_000_000).contains(&spec.steps) {

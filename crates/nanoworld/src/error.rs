@@ -6,7 +6,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ParamError {
     /// `field` holds `value`, which is outside `allowed`.
-    #[error("{field} = {value:e} is out of range: allowed {allowed}")]
+    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
     OutOfRange {
         /// Dotted path of the field, as in the scene table (e.g. `interaction.game.tip_atom.snap_gap_m`).
         field: String,
@@ -67,7 +67,7 @@ pub enum StepError {
     },
     /// A tip (cursor) position component is finite but farther than
     /// [`crate::MAX_POSITION_M`] from the origin along its axis.
-    #[error("tip position {axis} = {value:e} is out of range: allowed |{axis}| <= 1 m")]
+    #[error("tip position {axis} = {} is out of range: allowed |{axis}| <= 1 m", world_form::numbers::fmt_num(*value))]
     PositionOutOfRange {
         /// `x`, `y` or `z`.
         axis: char,
@@ -75,7 +75,7 @@ pub enum StepError {
         value: f64,
     },
     /// The tick length is not in [[`crate::MIN_DT_S`], 1] s.
-    #[error("dt_s = {0:e} is out of range: allowed 1e-9 <= dt_s <= 1 s")]
+    #[error("dt_s = {} is out of range: allowed 1e-9 <= dt_s <= 1 s", world_form::numbers::fmt_num(*_0))]
     BadDt(f64),
 }
 
@@ -86,7 +86,7 @@ pub enum CurveError {
     #[error(transparent)]
     Params(#[from] ParamError),
     /// A curve setting is out of range.
-    #[error("{field} = {value:e} is out of range: allowed {allowed}")]
+    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
     OutOfRange {
         /// Name of the setting in [`crate::CurveSpec`].
         field: &'static str,

@@ -468,8 +468,8 @@ impl Params {
                 let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
                 check(&format!("initial_atoms_xy_m[{i}]"), d, d >= min_sep, || {
                     format!(
-                        "distance to initial_atoms_xy_m[{j}] >= 2*atoms.radius_m = {:e} m",
-                        2.0 * self.atoms.radius_m
+                        "distance to initial_atoms_xy_m[{j}] >= 2*atoms.radius_m = {} m",
+                        world_form::numbers::fmt_num(2.0 * self.atoms.radius_m)
                     )
                 })?;
             }
@@ -522,7 +522,11 @@ impl Params {
             ParamError::range(
                 format!("device.{}", e.field),
                 e.value,
-                format!("0 < value <= {:e} {}", e.max, e.unit),
+                format!(
+                    "0 < value <= {} {}",
+                    world_form::numbers::fmt_num(e.max),
+                    e.unit
+                ),
             )
         })?;
         let (field, k) = self.max_render_stiffness();

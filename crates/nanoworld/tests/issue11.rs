@@ -105,7 +105,7 @@ fn stiffness_above_pull_off_over_snap_gap_is_refused() {
     let e = p.validate().expect_err("too stiff");
     assert_eq!(
         e.to_string(),
-        "interaction.game.pairs.tip_substrate.stiffness_n_per_m = 2.5e1 is out of range: \
+        "interaction.game.pairs.tip_substrate.stiffness_n_per_m = 25 is out of range: \
          allowed 0 < value < pull_off_ratio * snap force / snap_gap_m = 20 N/m \
          (stiffer contacts release on the tick after they snap)"
     );

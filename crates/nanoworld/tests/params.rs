@@ -52,13 +52,13 @@ fn nan_and_negative_values_are_rejected_not_clamped() {
         World::new(&p, &bad, start())
             .expect_err("negative")
             .to_string(),
-        "device.max_force_n = -1e0 is out of range: allowed 0 < value <= 1e5 N"
+        "device.max_force_n = -1 is out of range: allowed 0 < value <= 100000 N"
     );
     let mut p = Params::game_default();
     game(&mut p).pull_off_ratio = 0.5;
     assert_eq!(
         p.validate().expect_err("ratio").to_string(),
-        "interaction.game.pull_off_ratio = 5e-1 is out of range: allowed 1 <= value <= 1000"
+        "interaction.game.pull_off_ratio = 0.5 is out of range: allowed 1 <= value <= 1000"
     );
     let mut p = Params::game_default();
     p.initial_atoms_xy_m.push([5.0e-9, 6.15e-9]);
@@ -149,7 +149,7 @@ fn bad_tick_input_is_a_typed_error() {
         .expect_err("dt");
     assert_eq!(
         e.to_string(),
-        "dt_s = 0e0 is out of range: allowed 1e-9 <= dt_s <= 1 s"
+        "dt_s = 0 is out of range: allowed 1e-9 <= dt_s <= 1 s"
     );
     // A rejected tick leaves the world untouched.
     assert_eq!(w.tick(), 0);

@@ -7,7 +7,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum EnvelopeError {
     /// A number outside its allowed range (or NaN / infinite).
-    #[error("{field} = {value:e} is out of range: allowed {allowed}")]
+    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
     OutOfRange {
         /// Parameter name with its unit, e.g. `tol [m]`.
         field: &'static str,

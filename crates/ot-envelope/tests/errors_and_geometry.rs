@@ -14,7 +14,7 @@ fn bad_arguments_name_the_field_and_range() {
     let e = working_envelope(&p, &v(0.0, 0.0), Some(0.0)).expect_err("must be rejected");
     assert_eq!(
         e.to_string(),
-        "tol [m] = 0e0 is out of range: allowed finite and > 0"
+        "tol [m] = 0 is out of range: allowed finite and > 0"
     );
     let e = working_envelope(&p, &v(f64::INFINITY, 0.0), None).expect_err("must be rejected");
     assert_eq!(
@@ -29,7 +29,7 @@ fn bad_arguments_name_the_field_and_range() {
     let e = OffsetRegion::new(v(1.0, 0.0), v(0.0, 1.0)).expect_err("must be rejected");
     assert_eq!(
         e.to_string(),
-        "region.hi - region.lo [m] = -1e0 is out of range: allowed > 0 on each axis"
+        "region.hi - region.lo [m] = -1 is out of range: allowed > 0 on each axis"
     );
     let opts = EnvelopeOptions {
         cell_waists: Some(1e-6),
@@ -43,7 +43,7 @@ fn bad_arguments_name_the_field_and_range() {
     let e = SteeringRange::new(v(0.0, 0.0), -1.0).expect_err("must be rejected");
     assert_eq!(
         e.to_string(),
-        "steering.radius [m] = -1e0 is out of range: allowed finite and > 0"
+        "steering.radius [m] = -1 is out of range: allowed finite and > 0"
     );
 }
 

@@ -131,7 +131,7 @@ fn every_slice_spends_at_most_its_budget_plus_one_work_item() {
     let mut b = EnvelopeBuild::new(&prop, &v(0.0, 0.0), MARGIN, Some(CELL), TOL).unwrap();
     assert_eq!(
         b.advance(&prop, Some(0)).unwrap_err().to_string(),
-        "budget [force evaluations] = 0e0 is out of range: allowed ≥ 1"
+        "budget [force evaluations] = 0 is out of range: allowed ≥ 1"
     );
 }
 
@@ -284,12 +284,12 @@ fn bad_spread_settings_are_typed_errors() {
     let mut p = params(Some(0));
     assert_eq!(
         TickController::new(p).unwrap_err().to_string(),
-        "build_evals_per_tick = 0e0 is out of range: allowed ≥ 1 (or none: no spread build)"
+        "build_evals_per_tick = 0 is out of range: allowed ≥ 1 (or none: no spread build)"
     );
     p = params(Some(256));
     p.spread_dv = 0.05;
     assert_eq!(
         TickController::new(p).unwrap_err().to_string(),
-        "spread_dv [m/s] = 5e-2 is out of range: allowed ≤ warm_dv"
+        "spread_dv [m/s] = 0.05 is out of range: allowed ≤ warm_dv"
     );
 }

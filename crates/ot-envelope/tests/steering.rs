@@ -175,6 +175,6 @@ fn steer_params_from_toml_are_validated() {
     let e = Controller::new(bad).expect_err("must be rejected");
     assert_eq!(
         e.to_string(),
-        "stiffness [N/m] = -1e0 is out of range: allowed finite and > 0"
+        "stiffness [N/m] = -1 is out of range: allowed finite and > 0"
     );
 }

@@ -136,13 +136,13 @@ fn bad_tick_settings_are_typed_errors() {
     p.warm_dv = -1.0;
     assert_eq!(
         TickController::new(p).unwrap_err().to_string(),
-        "warm_dv [m/s] = -1e0 is out of range: allowed finite and > 0"
+        "warm_dv [m/s] = -1 is out of range: allowed finite and > 0"
     );
     let mut p = params(true);
     p.verify_points = 0;
     assert_eq!(
         TickController::new(p).unwrap_err().to_string(),
-        "verify_points = 0e0 is out of range: allowed 1 ..= 64"
+        "verify_points = 0 is out of range: allowed 1 ..= 64"
     );
 }
 

@@ -10,7 +10,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PhysicsError {
     /// A number lies outside its allowed range (or is NaN / infinite).
-    #[error("{field} = {value:e} is out of range: allowed {allowed}")]
+    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
     OutOfRange {
         /// Name of the parameter, with its unit (e.g. `waist_x [m]`).
         field: &'static str,

@@ -181,7 +181,7 @@ fn error_budget_chooses_the_cheapest_map_within_tolerance_and_it_holds_off_the_p
         choose_tick_map(paper_model(), 0.2e-6, -1.0, 0.1)
             .unwrap_err()
             .to_string(),
-        "tick map tolerance [m] = -1e0 is out of range: allowed finite and > 0"
+        "tick map tolerance [m] = -1 is out of range: allowed finite and > 0"
     );
 }
 

@@ -424,7 +424,7 @@ fn method_and_interval_errors_are_typed() {
     let e = Propagator::new(model, Method::default(), 0.0).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "dt [s] = 0e0 is out of range: allowed finite and > 0"
+        "dt [s] = 0 is out of range: allowed finite and > 0"
     );
     let e = Method::from_name("euler", None, None).unwrap_err();
     assert!(
@@ -434,7 +434,7 @@ fn method_and_interval_errors_are_typed() {
     let e = Method::from_name("rk4", None, Some(0)).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "substeps = 0e0 is out of range: allowed 1 ..= 10000000"
+        "substeps = 0 is out of range: allowed 1 ..= 10000000"
     );
     let e = Method::from_name("adaptive", Some(f64::NAN), None).unwrap_err();
     assert!(matches!(e, PhysicsError::OutOfRange { field: "rtol", .. }));

@@ -143,7 +143,7 @@ fn thermal_run_errors_are_typed() {
     let e = simulate(&model, start, &cfg).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "sample_rate [Hz] = 0e0 is out of range: allowed finite and > 0"
+        "sample_rate [Hz] = 0 is out of range: allowed finite and > 0"
     );
     cfg.sample_rate = FS;
     cfg.scheme = Scheme::Baoab;

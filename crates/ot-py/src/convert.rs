@@ -65,9 +65,9 @@ fn all_finite(n: &Numbers, name: &str, unit: &str) -> PyResult<()> {
         rest %= stride;
     }
     Err(PyValueError::new_err(format!(
-        "{name}[{}] = {:e} is out of range: allowed finite ({unit})",
+        "{name}[{}] = {} is out of range: allowed finite ({unit})",
         idx.join(", "),
-        n.data[k]
+        world_form::numbers::fmt_num(n.data[k])
     )))
 }
 

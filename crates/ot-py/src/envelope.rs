@@ -316,8 +316,8 @@ pub fn polygon_radius<'py>(
     }
     if let Some(k) = a.data.iter().position(|v| !v.is_finite()) {
         return Err(PyValueError::new_err(format!(
-            "angles[{k}] = {:e} is out of range: allowed finite (rad)",
-            a.data[k]
+            "angles[{k}] = {} is out of range: allowed finite (rad)",
+            world_form::numbers::fmt_num(a.data[k])
         )));
     }
     if poly.len().saturating_mul(a.data.len()) > MAX_RADIUS_PAIRS {

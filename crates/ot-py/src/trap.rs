@@ -147,7 +147,8 @@ fn positive(value: f64, name: &str, unit: &str) -> PyResult<f64> {
         Ok(value)
     } else {
         Err(PyValueError::new_err(format!(
-            "{name} = {value:e} is out of range: allowed finite and > 0 ({unit})"
+            "{name} = {} is out of range: allowed finite and > 0 ({unit})",
+            world_form::numbers::fmt_num(value)
         )))
     }
 }
@@ -408,9 +409,10 @@ impl GaussianTrap {
         for (i, ki) in k.iter().enumerate() {
             if !ki.is_finite() {
                 return Err(PyValueError::new_err(format!(
-                    "{} = {:e} is out of range: allowed a waist whose stiffness \
+                    "{} = {} is out of range: allowed a waist whose stiffness \
                      2*ln2*depth/waist**2 is finite (m)",
-                    names[i], waists[i]
+                    names[i],
+                    world_form::numbers::fmt_num(waists[i])
                 )));
             }
         }
