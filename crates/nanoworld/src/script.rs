@@ -24,12 +24,13 @@ pub enum ScriptError {
         slot: usize,
     },
     /// `step_m` is not a positive finite length.
-    #[error("step_m = {0:e} is out of range: allowed 0 < step_m <= 1e-6 m")]
+    #[error("step_m = {} is out of range: allowed 0 < step_m <= 1e-6 m", world_form::numbers::fmt_num(*_0))]
     BadStep(f64),
     /// `step_m` is so small that the script would exceed [`MAX_SCRIPT_SAMPLES`].
     #[error(
-        "step_m = {step_m:e} is out of range for this house: the path is {path_m:e} m long, \
+        "step_m = {} is out of range for this house: the path is {path_m:e} m long, \
          so allowed {min_step_m:e} <= step_m <= 1e-6 m (at most {max} samples)",
+        world_form::numbers::fmt_num(*step_m),
         max = MAX_SCRIPT_SAMPLES
     )]
     TooManySamples {
