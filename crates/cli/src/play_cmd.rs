@@ -45,13 +45,6 @@ pub fn cmd(a: &PlayArgs) -> Result<ExitCode, String> {
         println!("open {url} in a browser (Ctrl-C ends the session)");
     })
     .map_err(|e| e.to_string())?;
-    println!(
-        "{}: {} ticks, {} missed deadlines, score {}, recording {}",
-        s.end,
-        s.stats.ticks,
-        s.stats.missed,
-        s.state("score").unwrap_or(0.0),
-        s.recording.display()
-    );
+    println!("{}", s.line());
     Ok(ExitCode::SUCCESS)
 }

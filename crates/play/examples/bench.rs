@@ -20,7 +20,7 @@ mod cdp;
 
 use cdp::Browser;
 use haptic_loop::session::SceneSource;
-use play::{LatencyMs, PlayConfig, run};
+use play::{LatencyMs, PlayConfig, Running, start};
 use serde_json::Value;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -51,16 +51,7 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
     c.port = 0;
     c.keep_serving_s = Some(0.0);
     let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = std::sync::mpsc::channel();
-    let s2 = stop.clone();
-    let handle = std::thread::spawn(move || {
-        run(&c, &s2, &mut |u| {
-            let _ = tx.send(u.to_string());
-        })
-    });
-    let url = rx
-        .recv_timeout(Duration::from_secs(10))
-        .map_err(|_| "no server")?;
+    let Running { url, handle } = start(c, stop.clone()).map_err(|e| e.to_string())?;
     let mut browsers = Vec::new();
     for _ in 0..pages {
         let mut b = Browser::launch_nice(1280, 760, nice)?;
@@ -158,16 +149,7 @@ fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
     c.port = 0;
     c.keep_serving_s = Some(0.0);
     let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = std::sync::mpsc::channel();
-    let s2 = stop.clone();
-    let handle = std::thread::spawn(move || {
-        run(&c, &s2, &mut |u| {
-            let _ = tx.send(u.to_string());
-        })
-    });
-    let url = rx
-        .recv_timeout(Duration::from_secs(10))
-        .map_err(|_| "no server")?;
+    let Running { url, handle } = start(c, stop.clone()).map_err(|e| e.to_string())?;
     let ws_url = format!("{}ws", url.replace("http://", "ws://"));
     let (mut ws, _) = tungstenite::connect(ws_url.as_str()).map_err(|e| e.to_string())?;
     if let tungstenite::stream::MaybeTlsStream::Plain(s) = ws.get_ref() {

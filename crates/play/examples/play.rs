@@ -24,14 +24,7 @@ fn main() {
     c.keep_serving_s = Some(600.0);
     let stop = AtomicBool::new(false);
     match run(&c, &stop, &mut |url| println!("open {url} in a browser")) {
-        Ok(s) => println!(
-            "{}: {} ticks, {} missed deadlines, score {}, recording {}",
-            s.end,
-            s.stats.ticks,
-            s.stats.missed,
-            s.state("score").unwrap_or(0.0),
-            s.recording.display()
-        ),
+        Ok(s) => println!("{}", s.line()),
         Err(e) => {
             eprintln!("error: {e}");
             std::process::exit(1);

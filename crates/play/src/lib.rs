@@ -143,6 +143,18 @@ pub struct PlaySummary {
 }
 
 impl PlaySummary {
+    /// One line for a person: how it ended, ticks, missed deadlines, score and recording.
+    pub fn line(&self) -> String {
+        format!(
+            "{}: {} ticks, {} missed deadlines, score {}, recording {}",
+            self.end,
+            self.stats.ticks,
+            self.stats.missed,
+            self.state("score").unwrap_or(0.0),
+            self.recording.display()
+        )
+    }
+
     /// The value of state field `name` after the last tick.
     pub fn state(&self, name: &str) -> Option<f64> {
         self.state.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
@@ -352,6 +364,44 @@ fn switch_hook<'a>(
             };
             let _ = tx.send(m);
         }
+    }
+}
+
+/// A play session running on its own thread (see [`start`]).
+pub struct Running {
+    /// The page's URL.
+    pub url: String,
+    /// The session's thread; joins with what [`run`] returned.
+    pub handle: std::thread::JoinHandle<Result<PlaySummary, PlayError>>,
+}
+
+/// Runs [`run`] on its own thread and returns as soon as the page is served, with its URL;
+/// raise `stop` to end it. A session that fails before serving (a busy port, a bad scene)
+/// returns its error here.
+pub fn start(config: PlayConfig, stop: Arc<AtomicBool>) -> Result<Running, PlayError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let port = config.port;
+    let handle = std::thread::Builder::new()
+        .name("play".into())
+        .spawn(move || {
+            run(&config, &stop, &mut |u| {
+                let _ = tx.send(u.to_string());
+            })
+        })
+        .map_err(|e| PlayError::Serve {
+            port,
+            message: e.to_string(),
+        })?;
+    match rx.recv() {
+        Ok(url) => Ok(Running { url, handle }),
+        // The session ended before serving: its own error.
+        Err(_) => match handle.join() {
+            Ok(Err(e)) => Err(e),
+            Ok(Ok(_)) | Err(_) => Err(PlayError::Serve {
+                port,
+                message: "the session's thread ended before serving the page".into(),
+            }),
+        },
     }
 }
 

@@ -10,7 +10,7 @@ mod common;
 
 use common::cdp::{Browser, fnv1a};
 use haptic_loop::session::{SceneSource, read_arrays};
-use play::{PlayConfig, PlayError, PlaySummary, run};
+use play::{PlayConfig, PlayError, PlaySummary};
 use recording::read_recording_file;
 use serde_json::Value;
 use std::path::PathBuf;
@@ -44,16 +44,7 @@ fn start(scene: &str, name: &str) -> Session {
     c.port = 0;
     c.seconds = Some(60.0);
     let stop = Arc::new(AtomicBool::new(false));
-    let (tx, rx) = std::sync::mpsc::channel();
-    let s2 = stop.clone();
-    let handle = std::thread::spawn(move || {
-        run(&c, &s2, &mut |u| {
-            let _ = tx.send(u.to_string());
-        })
-    });
-    let url = rx
-        .recv_timeout(Duration::from_secs(10))
-        .expect("the server did not start");
+    let play::Running { url, handle } = play::start(c, stop.clone()).expect("the server started");
     Session {
         url,
         stop,

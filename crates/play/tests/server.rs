@@ -245,6 +245,12 @@ fn a_busy_port_and_a_bad_length_are_named() {
         "{e}"
     );
     assert!(e.ends_with("(choose another with --port, or --port 0 for any free port)"));
+    // On its own thread (`start`), the same error comes back instead of a URL.
+    let threaded = match play::start(c.clone(), std::sync::Arc::new(AtomicBool::new(false))) {
+        Err(e) => e.to_string(),
+        Ok(r) => panic!("served {} on a busy port", r.url),
+    };
+    assert_eq!(threaded, e);
     c.port = 0;
     c.seconds = Some(-1.0);
     assert_eq!(

@@ -2,7 +2,7 @@
 //! crossings found through a bucket grid, segments split at them) walked with the right-hand
 //! rule around its unbounded face.
 
-use super::{V2, bbox, cross, signed_area};
+use super::{V2, bbox, cross, grid_shape, signed_area};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Union–find over vertex ids.
@@ -134,10 +134,7 @@ impl Grid {
             .map(|&(a, b)| (pts[b] - pts[a]).norm())
             .sum::<f64>()
             / segs.len() as f64;
-        let span = (hi - lo).max().max(f64::MIN_POSITIVE);
-        let cell = (mean_len * 2.0).max(span / 512.0).max(f64::MIN_POSITIVE);
-        let nbx = (((hi.x - lo.x) / cell) as usize + 1).min(1024);
-        let nby = (((hi.y - lo.y) / cell) as usize + 1).min(1024);
+        let (cell, nbx, nby) = grid_shape(lo, hi, mean_len, 512.0, 1024);
         let mut grid = Grid {
             lo,
             cell,

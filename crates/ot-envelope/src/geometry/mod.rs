@@ -17,6 +17,23 @@ fn cross(a: &V2, b: &V2) -> f64 {
     a.x * b.y - a.y * b.x
 }
 
+/// A bucket grid over the box `(lo, hi)`: the cell side (about twice `mean_len`, at least the
+/// box's larger side / `min_div`, never 0) and the cell counts along x and y (at most
+/// `max_cells` each).
+fn grid_shape(
+    lo: V2,
+    hi: V2,
+    mean_len: f64,
+    min_div: f64,
+    max_cells: usize,
+) -> (f64, usize, usize) {
+    let span = (hi - lo).max().max(f64::MIN_POSITIVE);
+    let cell = (mean_len * 2.0).max(span / min_div).max(f64::MIN_POSITIVE);
+    let nx = (((hi.x - lo.x) / cell) as usize + 1).min(max_cells);
+    let ny = (((hi.y - lo.y) / cell) as usize + 1).min(max_cells);
+    (cell, nx, ny)
+}
+
 /// Bounding box `(lo, hi)` of a point set (m); `(+∞, −∞)` when empty.
 pub fn bbox(points: &[V2]) -> (V2, V2) {
     let mut lo = V2::repeat(f64::INFINITY);
@@ -197,10 +214,7 @@ impl<'a> EdgeGrid<'a> {
             .map(|i| (poly[(i + 1) % n] - poly[i]).norm())
             .sum::<f64>()
             / n.max(1) as f64;
-        let span = (hi - lo).max().max(f64::MIN_POSITIVE);
-        let cell = (2.0 * mean).max(span / 256.0).max(f64::MIN_POSITIVE);
-        let nx = (((hi.x - lo.x) / cell) as usize + 1).min(256);
-        let ny = (((hi.y - lo.y) / cell) as usize + 1).min(256);
+        let (cell, nx, ny) = grid_shape(lo, hi, mean, 256.0, 256);
         let mut g = EdgeGrid {
             poly,
             lo,
