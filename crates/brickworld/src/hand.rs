@@ -70,6 +70,8 @@ pub(crate) struct Hand {
     held: Option<Held>,
     /// What the cursor (or carried brick) touches, sorted.
     touching: Vec<Touch>,
+    /// Outward normals of the surfaces the god-object touched in the last update.
+    contact_normals: Vec<Vector>,
     /// The proxy's speed over the last tick, m/s (for cursor impacts).
     proxy_speed: f64,
     /// Whether a sample has arrived.
@@ -93,6 +95,7 @@ impl Hand {
             damper: Vector::ZERO,
             held: None,
             touching: Vec::new(),
+            contact_normals: Vec::new(),
             proxy_speed: 0.0,
             started: false,
         }
@@ -153,6 +156,9 @@ impl Hand {
         let (felt, felt_spring) =
             self.device_force(c, params, limits, bricks, upd.penetration_before_m);
         // 4. Touch bookkeeping and the hand's push on dynamic bricks.
+        self.contact_normals.clear();
+        self.contact_normals
+            .extend(upd.contacts.iter().map(|ct| ct.normal));
         self.touches(&upd, tick, approach_speed, params, bricks, events);
         push_bricks(&upd, felt_spring, params, bricks);
         felt
@@ -342,6 +348,125 @@ impl Hand {
             Some((_, proj)) => ((proj.point - self.proxy).length() - r).max(0.0),
             None => f64::INFINITY,
         }
+    }
+
+    /// Outward normals of the surfaces the god-object touched in the last update.
+    pub(crate) fn contact_normals(&self) -> &[Vector] {
+        &self.contact_normals
+    }
+
+    /// The nearest solid's surface point and outward normal from the proxy (the carried brick
+    /// excluded), when it is within `range_m` of the cursor sphere's surface.
+    pub(crate) fn nearest_surface(
+        &self,
+        params: &Params,
+        bricks: &BrickSet,
+        range_m: f64,
+    ) -> Option<(Vector, Vector)> {
+        let mut filter = QueryFilter::default();
+        if let Some(h) = self.held {
+            filter = filter.exclude_collider(bricks.collider(h.brick));
+        }
+        let r = params.proxy_radius_m;
+        let qp = bricks.phys.query_pipeline_with_filter(filter);
+        let (_, proj) = qp.project_point(self.proxy, range_m + r, true)?;
+        let d = self.proxy - proj.point;
+        let len = d.length();
+        (!proj.is_inside && len > 0.0).then(|| (proj.point, d / len))
+    }
+
+    /// The carried brick's coupling in the state the next tick starts from: the brick's
+    /// centre less the grip offset, its velocity, its mass, the coupling's springs and damper
+    /// (as [`Hand::coupling_pull`] uses them) and the dashpot's share; `None` unless a brick
+    /// is carried through the coupling.
+    pub(crate) fn carried_body(
+        &self,
+        params: &Params,
+        limits: &Limits,
+        bricks: &BrickSet,
+    ) -> Option<crate::local::CarriedBody> {
+        let h = self.held.filter(|h| h.coupled)?;
+        let rb = bricks.phys.bodies.get(bricks.body(h.brick))?;
+        let m = rb.mass();
+        if m.is_nan() || m <= 0.0 {
+            return None;
+        }
+        let cap = m / (params.dt_s * params.dt_s);
+        let c = &params.coupling;
+        let k = Self::coupling_stiffness(params, limits);
+        let k_series = (c.max_fraction - c.stiffness_fraction) * limits.max_stiffness_n_per_m;
+        Some(crate::local::CarriedBody {
+            position_m: (rb.translation() - h.offset).to_array(),
+            velocity_m_per_s: rb.linvel().to_array(),
+            mass_kg: m,
+            stiffness_n_per_m: k.min(cap),
+            series_stiffness_n_per_m: k_series.min(cap),
+            damping_n_s_per_m: 2.0 * c.damping_ratio * (k * m).sqrt(),
+            damper_m: self.damper.to_array(),
+            external_force_n: [0.0, 0.0, -m * params.gravity_m_per_s2],
+            substeps: u32::try_from(params.solver_iterations).unwrap_or(1),
+            restitution: params.restitution,
+        })
+    }
+
+    /// The surfaces the carried brick touches or nears within `margin_m`, as planes on its grip
+    /// point at `grip_m`: the direction in which the other body lets it move (the contact's
+    /// normal on that body) and how far it may go the other way (the gap); the nearest
+    /// surface of each collider, deduplicated by normal, at most [`crate::local::MAX_PLANES`]
+    /// (nearest first).
+    pub(crate) fn carried_contacts(
+        &self,
+        params: &Params,
+        bricks: &BrickSet,
+        grip_m: [f64; 3],
+        margin_m: f64,
+    ) -> Vec<crate::local::ContactPlane> {
+        let mut out: Vec<crate::local::ContactPlane> = Vec::new();
+        let Some(h) = self.held.filter(|h| h.coupled) else {
+            return out;
+        };
+        let me = bricks.collider(h.brick);
+        let Some(rb) = bricks.phys.bodies.get(bricks.body(h.brick)) else {
+            return out;
+        };
+        let pose = *rb.position();
+        let e = Vector::from_array(params.brick_half_extents_m);
+        let brick = Cuboid::new(e);
+        let grown = Cuboid::new(e + Vector::splat(margin_m));
+        let x = Vector::from_array(grip_m);
+        let qp = bricks
+            .phys
+            .query_pipeline_with_filter(QueryFilter::default().exclude_collider(me));
+        let mut found: Vec<(f64, Vector)> = qp
+            .intersect_shape(pose, &grown)
+            .filter_map(|(_, co)| {
+                let c = rapier3d_f64::parry::query::contact(
+                    &pose,
+                    &brick,
+                    co.position(),
+                    co.shape(),
+                    margin_m,
+                )
+                .ok()??;
+                let n = c.normal2;
+                (n.is_finite() && c.dist.is_finite()).then_some((c.dist, n))
+            })
+            .collect();
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (dist, n) in found {
+            let dup = out
+                .iter()
+                .any(|q| Vector::from_array(q.normal).dot(n) > 1.0 - 1e-9);
+            if dup || out.len() == crate::local::MAX_PLANES {
+                continue;
+            }
+            out.push(crate::local::ContactPlane {
+                normal: n.to_array(),
+                offset_m: n.dot(x) - dist.max(0.0),
+                stiffness_n_per_m: 0.0,
+            });
+        }
+        out
     }
 
     /// Stiffness of the coupling spring, N/m (world units): a fraction of the device's

@@ -45,6 +45,7 @@ pub mod hand;
 pub mod impact;
 pub mod impacts;
 pub mod input;
+pub mod local;
 pub mod params;
 pub mod proxy;
 pub mod script;
@@ -60,6 +61,7 @@ pub use estimator::{AdaptiveWindow, MotionEstimator};
 pub use event::{Axis, Body, BrickId, Event, Touch};
 pub use hand::NEAREST_MAX_M;
 pub use input::{CursorInput, Grip};
+pub use local::{CarriedBody, ContactPlane, LocalPrimitives};
 pub use params::{
     AccelEstimator, Blueprint, BrickPlacement, BrickProps, Coupling, Inertia, LoadingZone,
     Obstacle, Params, ParamsFromTomlError,

@@ -255,6 +255,34 @@ impl World {
         self.hand.nearest_m(&self.params, &self.bricks)
     }
 
+    /// Outward normals of the surfaces the god-object touched in the last step.
+    pub(crate) fn hand_contact_normals(&self) -> &[Vector] {
+        self.hand.contact_normals()
+    }
+
+    /// The nearest surface within `range_m` of the cursor sphere (the carried brick
+    /// excluded): its point and outward normal.
+    pub(crate) fn nearest_surface(&self, range_m: f64) -> Option<(Vector, Vector)> {
+        self.hand
+            .nearest_surface(&self.params, &self.bricks, range_m)
+    }
+
+    /// The brick carried through the coupling, in the state the next step starts from.
+    pub(crate) fn carried_body(&self) -> Option<crate::local::CarriedBody> {
+        self.hand
+            .carried_body(&self.params, &self.limits, &self.bricks)
+    }
+
+    /// The carried brick's contacts as planes on its grip point at `grip_m`.
+    pub(crate) fn carried_contacts(
+        &self,
+        grip_m: [f64; 3],
+        margin_m: f64,
+    ) -> Vec<crate::local::ContactPlane> {
+        self.hand
+            .carried_contacts(&self.params, &self.bricks, grip_m, margin_m)
+    }
+
     /// Number of bricks the physics engine currently simulates (awake), for cost accounting.
     pub fn awake_brick_count(&self) -> usize {
         self.bricks.awake_count()

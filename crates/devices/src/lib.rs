@@ -47,6 +47,9 @@
 
 pub mod bridge;
 mod grip;
+pub mod link;
+pub mod linked;
+pub mod local;
 mod mechanics;
 pub mod modelled;
 pub mod operator;

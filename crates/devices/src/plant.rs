@@ -55,6 +55,21 @@ pub struct Plant {
     last_force_n: Vec3,
 }
 
+/// `F0 − K (p − p0)` of a hold at `p`, N.
+fn hold_force(hold: &Hold, p: Vec3) -> Vec3 {
+    let d = [
+        p[0] - hold.p0_m[0],
+        p[1] - hold.p0_m[1],
+        p[2] - hold.p0_m[2],
+    ];
+    let k = &hold.stiffness_n_per_m;
+    let mut f = [0.0; 3];
+    for (i, fi) in f.iter_mut().enumerate() {
+        *fi = hold.force_n[i] - (k[3 * i] * d[0] + k[3 * i + 1] * d[1] + k[3 * i + 2] * d[2]);
+    }
+    f
+}
+
 fn quantize(x: f64, q: f64) -> f64 {
     if q > 0.0 { (x / q).round() * q } else { x }
 }
@@ -120,16 +135,12 @@ impl Plant {
     /// down to the largest force (direction kept), each component rounded to the force
     /// resolution.
     pub fn rendered_force(&self, hold: &Hold, p: Vec3) -> Vec3 {
-        let d = [
-            p[0] - hold.p0_m[0],
-            p[1] - hold.p0_m[1],
-            p[2] - hold.p0_m[2],
-        ];
-        let k = &hold.stiffness_n_per_m;
-        let mut f = [0.0; 3];
-        for (i, fi) in f.iter_mut().enumerate() {
-            *fi = hold.force_n[i] - (k[3 * i] * d[0] + k[3 * i + 1] * d[1] + k[3 * i + 2] * d[2]);
-        }
+        self.motors(hold_force(hold, p))
+    }
+
+    /// What the motors make of the force `f`: scaled down to the largest force (direction
+    /// kept), each component rounded to the force resolution; zero for a non-finite force.
+    pub fn motors(&self, mut f: Vec3) -> Vec3 {
         let n = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
         let max = self.mech.limits.max_force_n;
         if !n.is_finite() {
@@ -149,6 +160,19 @@ impl Plant {
     /// and renders the latest hold; a loop faster than the servo has its answers sampled, a
     /// slower one has each answer rendered over several servo periods.
     pub fn advance(&mut self, dt_s: f64, intent: impl Fn(f64) -> (Vec3, Vec3), hold: &Hold) {
+        let h = *hold;
+        self.advance_with(dt_s, intent, &mut |p, _| hold_force(&h, p));
+    }
+
+    /// Advances by `dt_s` as [`Plant::advance`] does, with the force at each servo instant
+    /// from `render(reading, servo_period_s)` (N, before the motors' clamp and resolution): a
+    /// device side with a model of its own ([`crate::local::DeviceSide`]).
+    pub fn advance_with(
+        &mut self,
+        dt_s: f64,
+        intent: impl Fn(f64) -> (Vec3, Vec3),
+        render: &mut dyn FnMut(Vec3, f64) -> Vec3,
+    ) {
         let dt_ns = (dt_s * 1e9).round().max(1.0) as u64;
         let servo_ns = (1e9 / self.mech.servo_rate_hz).round().max(1.0) as u64;
         let n = dt_ns.div_ceil(MAX_SUBSTEP_NS).max(1);
@@ -161,7 +185,8 @@ impl Plant {
             let t0 = start + s * dt_ns / n;
             let t1 = start + (s + 1) * dt_ns / n;
             if t0 >= self.next_servo_ns {
-                self.last_force_n = self.rendered_force(hold, self.reading_m());
+                let f = render(self.reading_m(), servo_ns as f64 * 1e-9);
+                self.last_force_n = self.motors(f);
                 while self.next_servo_ns <= t0 {
                     self.next_servo_ns += servo_ns;
                 }

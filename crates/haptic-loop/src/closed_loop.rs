@@ -15,8 +15,11 @@
 use crate::haptic::{HapticLoop, status};
 use crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
 use crate::scene::{SceneError, load_scene_for};
+use haptic_devices::link::{LinkError, LinkParams};
+use haptic_devices::linked::LinkedDevice;
+use haptic_devices::local::Protocol;
 use haptic_devices::modelled::specs_of;
-use haptic_devices::{DeviceModel, HapticDevice, ModelledDevice, Script, ScriptError, TickTime};
+use haptic_devices::{DeviceModel, DeviceSample, Script, ScriptError};
 use haptic_devices::{Grip, Mechanics};
 use rustfft::{FftPlanner, num_complex::Complex};
 
@@ -69,6 +72,9 @@ pub struct Report {
     /// When the scene's house task was completed, s (its `complete_s` state field: −1 while
     /// not complete; `None` for a scene without a house task).
     pub house_complete_s: Option<f64>,
+    /// Servo periods on which the device side's two-port passivity layer held the force back
+    /// (protocol 2; 0 otherwise).
+    pub device_interventions: u64,
 }
 
 impl Report {
@@ -89,10 +95,13 @@ pub enum ClosedLoopError {
     /// The script does not fit the device.
     #[error("script: {0}")]
     Script(#[from] ScriptError),
+    /// A link parameter out of range.
+    #[error("{0}")]
+    Link(#[from] LinkError),
 }
 
 /// Plays `scene_text` with `script_text` (its buttons named for a Falcon) through the device
-/// `mech` held with `grip`, for the script's duration (or `seconds`).
+/// `mech` held with `grip`, for the script's duration (or `seconds`), on an ideal link.
 pub fn run(
     scene_text: &str,
     script_text: &str,
@@ -100,6 +109,43 @@ pub fn run(
     grip: Grip,
     seconds: Option<f64>,
 ) -> Result<Report, ClosedLoopError> {
+    run_linked(scene_text, script_text, mech, grip, &Linked::IDEAL, seconds)
+}
+
+/// The link of a closed-loop run and the protocol the device side speaks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Linked {
+    /// Latency, jitter and loss, each way.
+    pub link: LinkParams,
+    /// What the device renders between answers.
+    pub protocol: Protocol,
+}
+
+impl Linked {
+    /// No delay, no loss; protocol 1.
+    pub const IDEAL: Linked = Linked {
+        link: LinkParams::IDEAL,
+        protocol: Protocol::V1,
+    };
+}
+
+/// As [`run`], with the device at the far end of `linked.link`: its samples reach the loop
+/// and the loop's answers reach it after the link's latency and jitter, or never (loss).
+///
+/// The loop's side follows the bridge's rule (`UdpDevice`): tick `k` waits for the device's
+/// sample `k`; without it, it runs `k − a + ½` periods after the last on-time sample (slot
+/// `a`) on the newest sample it has, with its age. The device renders each answer from its
+/// arrival with [`haptic_devices::local::DeviceSide`]. Time is simulated in whole
+/// nanoseconds and every draw is seeded: a run repeats to the bit.
+pub fn run_linked(
+    scene_text: &str,
+    script_text: &str,
+    mech: Mechanics,
+    grip: Grip,
+    linked: &Linked,
+    seconds: Option<f64>,
+) -> Result<Report, ClosedLoopError> {
+    linked.link.validate()?;
     let falcon = DeviceModel::Falcon.specs().clone();
     let specs = specs_of(&mech, &falcon);
     let loaded = load_scene_for(scene_text, specs.clone())?;
@@ -111,58 +157,34 @@ pub fn run(
         .safety
         .passivity_reserve_j
         .unwrap_or(DEFAULT_PASSIVITY_RESERVE_J);
-    let window = (EVENT_WINDOW_S * f64::from(rate)).round() as u64;
+    // A declared event's force reaches the hand a round trip after its tick.
+    let round_trip_s = 2.0 * (linked.link.latency_s + linked.link.jitter_s);
+    let window = ((EVENT_WINDOW_S + round_trip_s) * f64::from(rate)).round() as u64;
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
-    let mut dev = ModelledDevice::new(script, mech, grip, &falcon);
-    let mut forces: Vec<[f64; 3]> = Vec::with_capacity(ticks as usize);
-    let mut last_declared: Option<u64> = None;
-    let mut rep = Report {
-        ticks,
-        undeclared_jumps: 0,
-        max_jump_n: 0.0,
-        hf_fraction: 0.0,
-        min_observer_j: f64::INFINITY,
-        reserve_j,
-        safety_ticks: 0,
-        energy_to_hand_j: 0.0,
-        peak_force_n: 0.0,
-        max_stiffness_n_per_m: 0.0,
-        house_complete_s: None,
-    };
-    let mut prev = [0.0; 3];
-    for i in 0..ticks {
-        let sample = match dev.sample(TickTime::new(i, rate)) {
-            Ok(s) => s,
-            Err(_) => break,
-        };
+    let mut dev = LinkedDevice::new(
+        script,
+        mech,
+        grip,
+        &falcon,
+        &linked.link,
+        rate,
+        linked.protocol,
+    );
+    // The device's local model meets a contact up to a round trip before the world declares
+    // it (its body, frictionless on its contact planes, sooner still): a declared event
+    // explains the jumps within its window on either side.
+    let mut meter = Meter::new(ticks, reserve_j, window, window);
+    let mut sim = LoopSide::new(dev.period_ns());
+    for k in 0..ticks {
+        let sample = sim.wait(k, &mut dev);
         let r = lp.tick(sample, false);
-        if r.events
-            .iter()
-            .any(|e| DECLARED_EVENTS.contains(&e.name.as_str()))
-        {
-            last_declared = Some(i);
-        }
-        if r.status & (status::PASSIVITY | status::RATE_LIMITED) != 0 {
-            rep.safety_ticks += 1;
-        }
-        let k = &r.device_stiffness_n_per_m;
-        rep.max_stiffness_n_per_m = rep.max_stiffness_n_per_m.max(k[0]).max(k[4]).max(k[8]);
-        let f = r.device_force_n;
-        let jump = haptic_types::vec3::norm(haptic_types::vec3::sub(f, prev));
-        rep.max_jump_n = rep.max_jump_n.max(jump);
-        rep.peak_force_n = rep.peak_force_n.max(haptic_types::vec3::norm(f));
-        if jump > JUMP_N && last_declared.is_none_or(|t| i - t > window) {
-            rep.undeclared_jumps += 1;
-        }
-        prev = f;
-        forces.push(f);
-        rep.min_observer_j = rep.min_observer_j.min(lp.passivity_tank_j());
-        let cmd = lp.command(i);
-        if dev.set_force(&cmd).is_err() {
-            break;
-        }
+        meter.tick(k, r);
+        meter.observe(lp.passivity_tank_j());
+        let cmd = lp.command(sample.seq);
+        let local = (linked.protocol == Protocol::V2).then(|| lp.local_model());
+        dev.send_answer(sim.now_ns, cmd, local);
     }
-    rep.hf_fraction = hf_fraction(&forces, f64::from(rate), BUZZ_HZ);
+    let mut rep = meter.finish(dev.felt(), f64::from(rate));
     if let Some(i) = lp
         .scene()
         .state_fields()
@@ -174,7 +196,170 @@ pub fn run(
         rep.house_complete_s = state.get(i).copied();
     }
     rep.energy_to_hand_j = dev.plant().energy_to_hand_j();
+    rep.device_interventions = dev.device_side().interventions();
     Ok(rep)
+}
+
+/// The loop's side of a modelled link: which sample each tick uses and when it runs (the
+/// bridge's rule, in simulated time).
+struct LoopSide {
+    period_ns: u64,
+    /// The simulator's clock, ns.
+    now_ns: u64,
+    /// The device's next sample to send.
+    next_send: u64,
+    /// (arrival ns, slot) of the last on-time sample.
+    anchor: Option<(u64, u64)>,
+    /// Samples arrived and not yet used, by sequence number.
+    queue: std::collections::BTreeMap<u64, DeviceSample>,
+    last: Option<DeviceSample>,
+}
+
+impl LoopSide {
+    fn new(period_ns: u64) -> LoopSide {
+        LoopSide {
+            period_ns,
+            now_ns: 0,
+            next_send: 0,
+            anchor: None,
+            queue: std::collections::BTreeMap::new(),
+            last: None,
+        }
+    }
+
+    /// Moves the device to `t` (sending its samples on its own clock) and the clock with it.
+    fn device_until(&mut self, t: u64, dev: &mut LinkedDevice) {
+        while self.next_send * self.period_ns <= t {
+            dev.advance_to(self.next_send * self.period_ns);
+            dev.send_sample(self.next_send);
+            self.next_send += 1;
+        }
+        dev.advance_to(t);
+        self.now_ns = self.now_ns.max(t);
+        for (_, s) in dev.samples_arrived(self.now_ns) {
+            self.queue.insert(s.seq, s);
+        }
+    }
+
+    /// Waits for tick `k`'s sample (or its deadline) and returns what the tick reads.
+    fn wait(&mut self, k: u64, dev: &mut LinkedDevice) -> DeviceSample {
+        let deadline = self
+            .anchor
+            .map(|(t, a)| t + (k - a) * self.period_ns + self.period_ns / 2);
+        loop {
+            self.device_until(self.now_ns, dev);
+            if self.queue.last_key_value().is_some_and(|(&s, _)| s >= k) {
+                break;
+            }
+            let next_send = self.next_send * self.period_ns;
+            let mut t = dev.next_sample_arrival().unwrap_or(u64::MAX).min(next_send);
+            if let Some(d) = deadline {
+                if d <= t {
+                    self.device_until(d, dev);
+                    break;
+                }
+            }
+            t = t.max(self.now_ns);
+            self.device_until(t, dev);
+        }
+        // The newest sample for this slot or an earlier one.
+        let keep = self.queue.split_off(&(k + 1));
+        if let Some((_, s)) = self.queue.pop_last() {
+            self.last = Some(s);
+        }
+        self.queue = keep;
+        let s = self.last.unwrap_or(DeviceSample {
+            seq: k,
+            ..DeviceSample::new([0.0; 3], Default::default())
+        });
+        let age = u32::try_from(k.saturating_sub(s.seq)).unwrap_or(u32::MAX);
+        if age == 0 {
+            self.anchor = Some((self.now_ns, k));
+        }
+        DeviceSample {
+            age_ticks: age,
+            ..s
+        }
+    }
+}
+
+/// What a hand would feel, tick by tick: the declared events and the safety layer's ticks
+/// from the loop, the force from the device (what its motors rendered at each sample).
+struct Meter {
+    rep: Report,
+    window: u64,
+    /// Ticks by which a felt jump may precede the tick that declares its event.
+    lead: u64,
+    declared: Vec<u64>,
+}
+
+impl Meter {
+    fn new(ticks: u64, reserve_j: f64, window: u64, lead: u64) -> Meter {
+        Meter {
+            rep: Report {
+                ticks,
+                undeclared_jumps: 0,
+                max_jump_n: 0.0,
+                hf_fraction: 0.0,
+                min_observer_j: f64::INFINITY,
+                reserve_j,
+                safety_ticks: 0,
+                energy_to_hand_j: 0.0,
+                peak_force_n: 0.0,
+                max_stiffness_n_per_m: 0.0,
+                house_complete_s: None,
+                device_interventions: 0,
+            },
+            window,
+            lead,
+            declared: Vec::new(),
+        }
+    }
+
+    fn tick(&mut self, i: u64, r: &haptic_types::tick::TickResult) {
+        let rep = &mut self.rep;
+        if r.events
+            .iter()
+            .any(|e| DECLARED_EVENTS.contains(&e.name.as_str()))
+        {
+            self.declared.push(i);
+        }
+        if r.status & (status::PASSIVITY | status::RATE_LIMITED) != 0 {
+            rep.safety_ticks += 1;
+        }
+        let k = &r.device_stiffness_n_per_m;
+        rep.max_stiffness_n_per_m = rep.max_stiffness_n_per_m.max(k[0]).max(k[4]).max(k[8]);
+    }
+
+    fn observe(&mut self, tank_j: f64) {
+        self.rep.min_observer_j = self.rep.min_observer_j.min(tank_j);
+    }
+
+    /// The figures of the force the device rendered at each sample (`felt[i]`, N).
+    fn finish(mut self, felt: &[[f64; 3]], rate_hz: f64) -> Report {
+        let rep = &mut self.rep;
+        let mut prev = [0.0; 3];
+        let mut d = 0;
+        for (i, &f) in felt.iter().enumerate() {
+            let i = i as u64;
+            while d + 1 < self.declared.len() && self.declared[d + 1] <= i {
+                d += 1;
+            }
+            let last_declared = self.declared.get(d).filter(|&&t| t <= i);
+            let next_declared = self.declared.get(d + 1).or(self.declared.get(d));
+            let ahead = next_declared.is_some_and(|&t| t >= i && t - i <= self.lead);
+            let jump = haptic_types::vec3::norm(haptic_types::vec3::sub(f, prev));
+            rep.max_jump_n = rep.max_jump_n.max(jump);
+            rep.peak_force_n = rep.peak_force_n.max(haptic_types::vec3::norm(f));
+            if jump > JUMP_N && !ahead && last_declared.is_none_or(|t| i - t > self.window) {
+                rep.undeclared_jumps += 1;
+            }
+            prev = f;
+        }
+        rep.ticks = felt.len() as u64;
+        rep.hf_fraction = hf_fraction(felt, rate_hz, BUZZ_HZ);
+        self.rep
+    }
 }
 
 /// A scene and a device with the device-side impedance scaled by `s` (> 0): the mapping's

@@ -262,9 +262,19 @@ pub fn run_session_until(
     stop: Option<&AtomicBool>,
 ) -> Result<SessionReport, SessionError> {
     let file = opts.scene.parse()?;
-    // 1. The device source: a script (rigid or through a simulated hand) or a bridged device.
+    // One start time for the welcome and the description.
+    let start_time_ns = opts.start_time_ns.unwrap_or_else(now_unix_ns);
+    // 1. The device source: a script (rigid or through a simulated hand) or a bridged device,
+    //    welcomed with the scene's rate, name and start time.
     let (source, script) = match &opts.bridge {
-        Some(b) => (DeviceSource::Udp(b.clone()), None),
+        Some(b) => (
+            DeviceSource::Udp(b.clone().for_session(
+                file.loop_.rate_hz,
+                &file.scene.name,
+                start_time_ns,
+            )),
+            None,
+        ),
         None => {
             let model = opts.device.unwrap_or(file.device.model);
             let (script, text, origin) = load_script(opts, &file, model.specs())?;
@@ -285,7 +295,15 @@ pub fn run_session_until(
         }
     };
     let mut dev = open_device(&source, script.as_ref().map(|s| &s.0))?;
-    let result = run_with_device(opts, &source, script, dev.as_mut(), progress, stop);
+    let result = run_with_device(
+        opts,
+        &source,
+        script,
+        start_time_ns,
+        dev.as_mut(),
+        progress,
+        stop,
+    );
     let closed = dev.close();
     let report = result?;
     closed?;
@@ -304,6 +322,7 @@ fn run_with_device(
     opts: &SessionOptions,
     source: &DeviceSource,
     script: Option<(Script, String, String)>,
+    start_time_ns: u64,
     dev: &mut dyn haptic_devices::HapticDevice,
     progress: &mut dyn FnMut(u64, u64),
     stop: Option<&AtomicBool>,
@@ -321,7 +340,7 @@ fn run_with_device(
     let setup = Setup::new(&SetupOptions {
         operator: Some(source.describe()),
         script: script.as_ref().map(|(s, t, _)| (s.name.clone(), t.clone())),
-        start_time_ns: opts.start_time_ns,
+        start_time_ns: Some(start_time_ns),
         keep_arrays: opts.arrays,
         out: opts.out.clone(),
         ..SetupOptions::new(&opts.scene, dev.specs().clone(), mode, &source.link_name())

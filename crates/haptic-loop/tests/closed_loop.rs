@@ -12,7 +12,7 @@
 #![allow(clippy::unwrap_used)]
 
 use haptic_devices::{Grip, Mechanics, PRESETS};
-use haptic_loop::closed_loop::{ClosedLoopError, Report, run};
+use haptic_loop::closed_loop::{Report, run};
 
 fn root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -34,35 +34,19 @@ const SCENES: [(&str, &str); 5] = [
     ),
 ];
 
-/// Runs a scene; a device softer than the brick world was written for gets its proxy spring
-/// at 80 % of its own cap (the 1000 N/m proxy exceeds a Touch's 160 N/m in that world).
-/// `None` when the scene refuses the device (the optical tweezers' 0.8 N/m spring on a Touch).
+/// Runs a scene on a device: every built-in scene plays on every preset (a softer device than
+/// the scene's Falcon gets the mapping fitted to it, issue 31).
 fn play(
     scene: &str,
     script: &str,
     mech: Mechanics,
     grip: Grip,
     edit: &dyn Fn(String) -> String,
-) -> Option<Report> {
+) -> Report {
     let text = edit(read(scene));
-    let script = read(script);
-    match run(&text, &script, mech, grip, None) {
-        Ok(r) => Some(r),
-        Err(ClosedLoopError::Scene(_)) if scene == "brickworld.toml" => {
-            let cap = mech.limits.max_stiffness_n_per_m / (0.125 * 20.0);
-            let t = text.replace(
-                "[brickworld.params]\n",
-                &format!(
-                    "[brickworld.params]\nproxy_stiffness_n_per_m = {}\n",
-                    0.8 * cap
-                ),
-            );
-            Some(run(&t, &script, mech, grip, None).unwrap())
-        }
-        Err(e) => {
-            println!("{scene} refuses {}: {e}", mech.name);
-            None
-        }
+    match run(&text, &read(script), mech, grip, None) {
+        Ok(r) => r,
+        Err(e) => panic!("{scene} refuses {}: {e}", mech.name),
     }
 }
 
@@ -93,9 +77,7 @@ fn every_scene_is_stable_through_every_device_and_grip() {
                     } else {
                         mech.without_quantization()
                     };
-                    let Some(r) = play(scene, script, m, grip, &|t| t) else {
-                        continue;
-                    };
+                    let r = play(scene, script, m, grip, &|t| t);
                     runs += 1;
                     let label = format!(
                         "{scene} {} {} {}",
@@ -119,20 +101,12 @@ fn every_scene_is_stable_through_every_device_and_grip() {
             }
         }
     }
-    // 5 scenes × 4 devices × 2 grips × 2 sensings, less the optical tweezers on a Touch.
-    assert_eq!(runs, 72);
+    // 5 scenes × 4 devices × 2 grips × 2 sensings: no device is refused.
+    assert_eq!(runs, 80);
     assert!(failures.is_empty(), "unstable runs: {failures:#?}");
-    // The one exception: a Touch renders 400 N/m, so the brick world's coupling is 48 N/m in
-    // the world and the 0.5 kg brick hangs 10 cm under a hand whose script was written for a
-    // Falcon; held loosely, its set-downs miss the slots (held firmly, the house completes).
-    assert_eq!(
-        unbuilt,
-        [
-            "brickworld.toml touch loose counts",
-            "brickworld.toml touch loose ideal"
-        ],
-        "houses not completed"
-    );
+    // Both house tasks complete on every device and grip: a Touch plays the brick world with
+    // its mapping fitted (force_scale × 400/3000), so the world's coupling is the Falcon's.
+    assert!(unbuilt.is_empty(), "houses not completed: {unbuilt:?}");
 }
 
 /// Issue 22's case: a brick carried on a Falcon held loosely, with encoder counts. The paper's
@@ -166,8 +140,7 @@ fn the_papers_inertia_buzzes_where_the_coupling_does_not() {
             Mechanics::FALCON,
             Grip::LOOSE,
             edit,
-        )
-        .unwrap();
+        );
         println!("{}", line(label, &r));
         assert_eq!(r.stable(), smooth, "{label}: {r:?}");
         if !smooth {
@@ -177,4 +150,18 @@ fn the_papers_inertia_buzzes_where_the_coupling_does_not() {
             );
         }
     }
+}
+
+/// A scene may keep its mapping as written (`mapping.fit_device = false`): a device that cannot
+/// render one of its springs is then refused, with the value and the cap.
+#[test]
+fn a_scene_that_refuses_to_be_fitted_names_the_spring_and_the_cap() {
+    let text = read("brickworld.toml").replace("[mapping]\n", "[mapping]\nfit_device = false\n");
+    let script = read("brickworld.script.toml");
+    let e = run(&text, &script, Mechanics::TOUCH, Grip::LOOSE, Some(0.1)).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scene: brickworld.params: parameter `proxy_stiffness_n_per_m` = 1000 is out of range: \
+         allowed (0, 160]"
+    );
 }

@@ -416,11 +416,30 @@ fn touch_device_caps_at_its_own_limits() {
             .to_string(),
     );
     let a = run_session(&o, &mut |_, _| {}).unwrap().arrays;
+    // The scene is written for a Falcon (3000 N/m): on a Touch (400 N/m) its mapping is
+    // fitted (issue 31), so the wall keeps the stiffness it has on a Falcon in the world and
+    // reaches the device at the Touch's 400 N/m, said by a `device.fit` event at tick 0.
     assert!(
         a.state_column("stiffness_n_per_m")
             .unwrap()
             .iter()
-            .all(|&k| k == 400.0)
+            .all(|&k| k == 3000.0)
+    );
+    let kz = a
+        .device_stiffness_n_per_m
+        .iter()
+        .map(|k| k[8])
+        .fold(0.0, f64::max);
+    assert!((kz - 400.0).abs() < 1e-9, "{kz}");
+    let fit: Vec<_> = a.events.iter().filter(|e| e.1 == "device.fit").collect();
+    assert_eq!(fit.len(), 1);
+    assert_eq!(fit[0].0, 0);
+    assert_eq!(
+        fit[0].2,
+        "mapping.force_scale 1 → 0.13333333333333333 (×0.13333333333333333): touch renders up \
+         to 400 N/m, the scene is written for falcon (3000 N/m); every world stiffness, damping \
+         and force reaches the device ×0.13333333333333333 (set mapping.fit_device = false to \
+         refuse instead)"
     );
     let peak = a
         .device_force_n

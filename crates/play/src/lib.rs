@@ -204,10 +204,7 @@ impl Hand {
     ) -> Result<Hand, PlayError> {
         Ok(match &config.device {
             Some(b) => {
-                let mut b = b.clone();
-                b.rate_hz = rate_hz;
-                b.scene = scene.to_string();
-                b.start_time_ns = now_unix_ns();
+                let b = b.clone().for_session(rate_hz, scene, now_unix_ns());
                 let mut dev = UdpDevice::new(b);
                 dev.open().map_err(SessionError::Device)?;
                 Hand::Bridged(Box::new(dev))

@@ -27,6 +27,7 @@
 
 pub mod device;
 pub mod event;
+pub mod local;
 pub mod primitive;
 pub mod switch;
 pub mod textpos;

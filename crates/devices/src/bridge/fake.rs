@@ -55,9 +55,22 @@ pub struct FakeConfig {
     pub bye: bool,
 }
 
+/// What the simulator's welcome said.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct WelcomeInfo {
+    /// The session's tick rate, Hz: the device sends one sample per tick.
+    pub rate_hz: u32,
+    /// Session start, ns since the Unix epoch.
+    pub start_time_ns: u64,
+    /// The scene's name.
+    pub scene: String,
+}
+
 /// What the fake device measured.
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct FakeReport {
+    /// The simulator's welcome (the rate the device played at).
+    pub welcome: WelcomeInfo,
     /// Servo periods played.
     pub ticks: u64,
     /// Samples sent.
@@ -100,7 +113,8 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     };
     let socket = open_socket(cfg.target)?;
     // 1. Hello until welcome.
-    let rate_hz = handshake(&socket, cfg, &specs, stop)?;
+    let welcome = handshake(&socket, cfg, &specs, stop)?;
+    let rate_hz = welcome.rate_hz;
     // 2. A receiver thread timestamps each reply.
     let receiver = Receiver::spawn(&socket, cfg.target)?;
     // 3. The servo loop.
@@ -124,6 +138,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         sent_at: BTreeMap::new(),
         rtt: Vec::with_capacity(ticks as usize),
         rep: FakeReport {
+            welcome,
             forces_within_limits: true,
             ..Default::default()
         },
@@ -199,13 +214,13 @@ fn open_socket(target: SocketAddr) -> Result<UdpSocket, DeviceError> {
 }
 
 /// Says hello with `specs` until the simulator's welcome (within `cfg.wait_s`), and returns
-/// the tick rate it asked for, Hz (100–10000).
+/// the welcome (its tick rate checked: 100–10000 Hz).
 fn handshake(
     socket: &UdpSocket,
     cfg: &FakeConfig,
     specs: &DeviceSpecs,
     stop: Option<&AtomicBool>,
-) -> Result<u32, DeviceError> {
+) -> Result<WelcomeInfo, DeviceError> {
     let hello = Packet::Hello {
         rate_hz: 1000,
         specs: specs.clone(),
@@ -213,7 +228,7 @@ fn handshake(
     .encode();
     let deadline = Instant::now() + Duration::from_secs_f64(cfg.wait_s.max(0.0));
     let mut buf = [0u8; 2048];
-    let rate_hz = loop {
+    let welcome = loop {
         if Instant::now() > deadline || stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             return Err(DeviceError::Link(format!(
                 "no welcome from {} within {} s",
@@ -224,18 +239,28 @@ fn handshake(
         let _ = socket.send_to(&hello, cfg.target);
         if let Ok((n, from)) = socket.recv_from(&mut buf) {
             if from == cfg.target {
-                if let Ok(Packet::Welcome { rate_hz, .. }) = Packet::decode(&buf[..n]) {
-                    break rate_hz;
+                if let Ok(Packet::Welcome {
+                    rate_hz,
+                    start_time_ns,
+                    scene,
+                }) = Packet::decode(&buf[..n])
+                {
+                    break WelcomeInfo {
+                        rate_hz,
+                        start_time_ns,
+                        scene,
+                    };
                 }
             }
         }
     };
+    let rate_hz = welcome.rate_hz;
     if !(100..=10_000).contains(&rate_hz) {
         return Err(DeviceError::Link(format!(
             "the simulator asked for {rate_hz} Hz (this fake device plays 100–10000 Hz)"
         )));
     }
-    Ok(rate_hz)
+    Ok(welcome)
 }
 
 /// The receiver thread: every force packet from the simulator, timestamped on arrival; a

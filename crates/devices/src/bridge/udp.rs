@@ -49,6 +49,16 @@ impl BridgeConfig {
             start_time_ns: 0,
         })
     }
+
+    /// This configuration for a session of `scene` at `rate_hz` that starts at
+    /// `start_time_ns` (ns since the Unix epoch): what the welcome tells the device. Every
+    /// way of running a bridged session (`run`, `play`, the wheel) fills it from the scene.
+    pub fn for_session(mut self, rate_hz: u32, scene: &str, start_time_ns: u64) -> Self {
+        self.rate_hz = rate_hz;
+        self.scene = scene.to_string();
+        self.start_time_ns = start_time_ns;
+        self
+    }
 }
 
 /// Counters of the link, in the order they are reported.

@@ -75,6 +75,14 @@ impl HapticLoop {
         } else {
             0.0
         };
+        let max = self.config.specs.limits.max_force_n;
+        let mag = vec3::norm(f);
+        let clamp_ratio = if mag > max { max / mag } else { 1.0 };
+        self.local_gain = if force_ok && vec3::is_finite(f) {
+            gain * clamp_ratio
+        } else {
+            0.0
+        };
         let (f, k_gain) = self.clamp(f, k_gain);
         (f, k_gain, force_ok)
     }

@@ -47,6 +47,15 @@ impl HapticLoop {
                 .push(Event::new("switch.set", switch::event_detail(&sw)));
             r.switches.push(sw);
         }
+        if tick == 0 {
+            if let Some(fit) = &self.config.device_fit {
+                let specs = &self.config.specs;
+                r.events.push(Event::new(
+                    "device.fit",
+                    fit.describe(&specs.name, specs.limits.max_stiffness_n_per_m),
+                ));
+            }
+        }
     }
 
     /// Takes the sample: an invalid one (`problem` says why) holds the cursor and raises

@@ -44,6 +44,7 @@ pub use haptic_types::tick::{TickResult, status};
 
 mod force;
 mod input;
+mod local;
 mod safety;
 
 /// The haptic loop around one scene.
@@ -68,6 +69,12 @@ pub struct HapticLoop {
     last_position_m: Option<Vec3>,
     passivity_active: bool,
     rate_limiting: bool,
+    /// Device newtons per world newton of the last tick's force before the safety layer: the
+    /// mapping's scale times engagement, watchdog and clamp (0 when the force was zeroed). The
+    /// local model's primitives are felt through it.
+    local_gain: f64,
+    /// The scene's local primitives (reused).
+    primitives: std::cell::RefCell<crate::scene::WorldPrimitives>,
 }
 
 /// Largest damping the passivity controller adds, N·s/m (device side): the damping of a loose
@@ -127,6 +134,8 @@ impl HapticLoop {
             last_position_m: None,
             passivity_active: false,
             rate_limiting: false,
+            local_gain: 0.0,
+            primitives: Default::default(),
             config,
         }
     }
@@ -260,6 +269,14 @@ impl HapticLoop {
             r.device_force_n = [0.0; 3];
             r.device_stiffness_n_per_m = [0.0; 9];
         }
+    }
+
+    /// The observer's tank at the start, J: the scene's reserve (or the default).
+    fn initial_tank_j(&self) -> f64 {
+        self.config
+            .safety
+            .passivity_reserve_j
+            .unwrap_or(crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J)
     }
 
     /// The passivity observer's energy tank, J (device side): the reserve minus the energy the

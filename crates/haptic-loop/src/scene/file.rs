@@ -156,7 +156,13 @@ impl SceneFile {
     /// Builds the loop configuration for a device with `specs` (e.g. announced by a bridged
     /// device), checking every common field.
     pub fn loop_config_for(&self, specs: DeviceSpecs) -> Result<LoopConfig, SceneError> {
-        LoopConfig::new(&self.mapping, &self.loop_, &self.display, specs)
+        LoopConfig::new(
+            &self.mapping,
+            &self.loop_,
+            &self.display,
+            specs,
+            self.device.model.specs(),
+        )
     }
 }
 

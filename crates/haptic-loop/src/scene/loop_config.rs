@@ -18,6 +18,13 @@ pub struct MappingSection {
     /// World point under the device origin, m.
     #[serde(deserialize_with = "world_form::exact::array")]
     pub origin_m: [f64; 3],
+    /// Fit the mapping to a device softer than the one the scene is written for (`[device]
+    /// model`): `force_scale` times the ratio of the two devices' largest stiffnesses, so every
+    /// spring, damper and force of the world reaches the device in the same proportion of its
+    /// range (as CHAI3D scales materials to the connected device). The world's physics does
+    /// not change. `false`: the mapping is used as written, and a world spring the device
+    /// cannot render is refused.
+    pub fit_device: bool,
 }
 
 impl Default for MappingSection {
@@ -26,7 +33,52 @@ impl Default for MappingSection {
             workspace_scale: 1.0,
             force_scale: 1.0,
             origin_m: [0.0; 3],
+            fit_device: true,
         }
+    }
+}
+
+/// How the mapping was fitted to a softer device than the scene was written for.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct DeviceFit {
+    /// The device the scene is written for (`[device] model`).
+    pub written_for: String,
+    /// Its largest stiffness, N/m.
+    pub written_for_stiffness_n_per_m: f64,
+    /// The scene file's `force_scale`.
+    pub scene_force_scale: f64,
+    /// The factor applied (< 1): the connected device's largest stiffness over the other's.
+    pub factor: f64,
+}
+
+impl DeviceFit {
+    /// The fit for a device with `specs` running a scene written for `written_for` with
+    /// `force_scale`: `None` when the device is as stiff or stiffer.
+    pub fn of(specs: &DeviceSpecs, written_for: &DeviceSpecs, force_scale: f64) -> Option<Self> {
+        let k = specs.limits.max_stiffness_n_per_m;
+        let k0 = written_for.limits.max_stiffness_n_per_m;
+        (k < k0).then(|| DeviceFit {
+            written_for: written_for.name.to_string(),
+            written_for_stiffness_n_per_m: k0,
+            scene_force_scale: force_scale,
+            factor: k / k0,
+        })
+    }
+
+    /// What the recording's `device.fit` event says: the scene's `force_scale`, the fitted one
+    /// and why.
+    pub fn describe(&self, device: &str, device_stiffness_n_per_m: f64) -> String {
+        use world_form::numbers::fmt_num;
+        format!(
+            "mapping.force_scale {} → {} (×{}): {device} renders up to {} N/m, the scene is written for {} ({} N/m); every world stiffness, damping and force reaches the device ×{} (set mapping.fit_device = false to refuse instead)",
+            fmt_num(self.scene_force_scale),
+            fmt_num(self.scene_force_scale * self.factor),
+            fmt_num(self.factor),
+            fmt_num(device_stiffness_n_per_m),
+            self.written_for,
+            fmt_num(self.written_for_stiffness_n_per_m),
+            fmt_num(self.factor),
+        )
     }
 }
 
@@ -165,6 +217,8 @@ pub struct LoopConfig {
     pub watchdog_timeout_ticks: u32,
     /// The safety layer at the device port.
     pub safety: Safety,
+    /// How the mapping was fitted to a softer device (`None`: used as written).
+    pub device_fit: Option<DeviceFit>,
 }
 
 impl LoopConfig {
@@ -175,6 +229,7 @@ impl LoopConfig {
         l: &LoopSection,
         d: &DisplaySection,
         specs: DeviceSpecs,
+        written_for: &DeviceSpecs,
     ) -> Result<LoopConfig, SceneError> {
         check_range("mapping.workspace_scale", m.workspace_scale, 1e-12, 1e3)?;
         check_range("mapping.force_scale", m.force_scale, 1e-6, 1e18)?;
@@ -223,6 +278,13 @@ impl LoopConfig {
             passivity_reserve_j: l.passivity.then_some(l.passivity_reserve_j),
             max_force_rate_n_per_s: l.force_rate_limit.then_some(rate),
         };
+        let device_fit = m
+            .fit_device
+            .then(|| DeviceFit::of(&specs, written_for, m.force_scale))
+            .flatten();
+        let force_scale = device_fit
+            .as_ref()
+            .map_or(m.force_scale, |f| m.force_scale * f.factor);
         Ok(LoopConfig {
             rate_hz: l.rate_hz,
             engage_ticks: (l.engage_s * f64::from(l.rate_hz)).round() as u64,
@@ -230,13 +292,14 @@ impl LoopConfig {
             display_scale: d.scale,
             mapping: Mapping {
                 workspace_scale: m.workspace_scale,
-                force_scale: m.force_scale,
+                force_scale,
                 origin_m: m.origin_m,
             },
             specs,
             watchdog_grace_ticks: grace_ticks as u32,
             watchdog_timeout_ticks: timeout_ticks as u32,
             safety,
+            device_fit,
         })
     }
 

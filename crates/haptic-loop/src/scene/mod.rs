@@ -104,7 +104,15 @@ pub trait Scene {
     fn switch_value(&self, _name: &str) -> Option<f64> {
         None
     }
+
+    /// Writes what the device may render on its own until the next tick (after the last
+    /// step; world frame and units): the contact planes at and near the cursor and a carried
+    /// body (bridge protocol 2, `haptic_types::local`). None by default: the device then
+    /// renders the answered force with its local stiffness.
+    fn local_primitives(&self, _out: &mut WorldPrimitives) {}
 }
+
+pub use haptic_types::local::WorldPrimitives;
 
 /// A world constructor: a scene file's text and the checked loop configuration → the world.
 pub type BuildWorld = fn(&str, &LoopConfig) -> Result<Box<dyn Scene>, SceneError>;

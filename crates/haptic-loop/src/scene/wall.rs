@@ -187,6 +187,15 @@ impl Scene for WallScene {
             .collect()
     }
 
+    fn local_primitives(&self, out: &mut super::WorldPrimitives) {
+        // The wall's face as a plane (its damper stays with the simulator).
+        out.planes.push(haptic_types::local::Plane {
+            normal: self.normal,
+            offset_m: vec3::dot(self.point_m, self.normal),
+            stiffness_n_per_m: self.stiffness,
+        });
+    }
+
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         if !self.started {
             self.started = true;

@@ -1,0 +1,264 @@
+//! The device side of the bridge: what a device's servo thread renders between the
+//! simulator's answers, and the two-port passivity layer that bounds it (issue 31).
+//!
+//! Library code for every device side: `fake-device`, the modelled devices of the closed-loop
+//! tests and benchmarks ([`crate::linked`]), and (ported line by line, tested against this one)
+//! the Python adapters of `nanohaptics.bridge`.
+//!
+//! - **Protocol 1** renders the newest answer's `F0 − K (p − p0)`, with `p0` the reading that
+//!   answer was computed from (the device keeps its recent readings by sequence number), so
+//!   the answer's local stiffness is felt without delay however late the answer arrives.
+//! - **Protocol 2** renders the answer's [`LocalModel`]: its residual, its contact planes at
+//!   the position read now, and the carried body ([`Body`]), integrated here one step per
+//!   sample with the reading sent, as the simulator integrates it: each answer restarts the
+//!   body from the state the simulator reports for the answered sample and replays the
+//!   readings sent since, so in free carry the device's body and the simulator's are one
+//!   trajectory, the device's ahead by the link's delay, and the coupling's dynamics never
+//!   wait for the link.
+//!
+//! Both run behind the **two-port passivity layer** (after Ryu, Artigas and Preusche 2010):
+//! the device counts the work its motors did on the hand, `W_dev = Σ F·Δp` over its servo
+//! periods, and the simulator reports the work its answers did on the readings it received,
+//! `W_world`. Whatever the link's delay, loss or jitter, the device never lets `W_dev` exceed
+//! `W_world + reserve`: beyond that it scales its force down on the servo period where the
+//! force would do positive work, so the excess is never delivered (an intervention is counted,
+//! and reported with the status bit [`PASSIVITY_TWO_PORT`]).
+
+use haptic_types::device::ForceCommand;
+use haptic_types::local::{Body, LocalModel};
+use haptic_types::vec3::{self, Vec3};
+use std::collections::VecDeque;
+
+/// Which answers the device side renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Protocol {
+    /// `F0 − K (p − p0)` (protocol version 1).
+    V1,
+    /// The local model (protocol version 2), with the two-port passivity layer.
+    V2,
+}
+
+impl Protocol {
+    /// The version number on the wire.
+    pub fn version(self) -> u8 {
+        match self {
+            Protocol::V1 => 1,
+            Protocol::V2 => 2,
+        }
+    }
+}
+
+/// Status bit the device side reports when its two-port layer held the force back.
+pub const PASSIVITY_TWO_PORT: u8 = 64;
+
+/// Energy the device may give the hand beyond what the world delivered, J (the single-port
+/// layer's default reserve).
+pub const DEVICE_RESERVE_J: f64 = 0.02;
+
+/// Largest damping the two-port layer adds, N·s/m: the damping of a loose grip, as the
+/// single-port layer's.
+pub const DEVICE_MAX_DAMPING_N_S_PER_M: f64 = 2.0;
+
+/// Readings kept for answers that arrive late, periods (1 s at 1 kHz; older answers are
+/// rendered against the oldest kept reading).
+const KEEP_READINGS: usize = 1000;
+
+/// The answer being rendered.
+#[derive(Clone, Debug)]
+struct Answer {
+    cmd: ForceCommand,
+    p0: Vec3,
+    local: Option<LocalModel>,
+}
+
+/// What the device's servo thread renders, and its two-port passivity layer.
+#[derive(Clone, Debug)]
+pub struct DeviceSide {
+    protocol: Protocol,
+    max_force_n: f64,
+    /// The loop's period (one sample per period), s.
+    period_s: f64,
+    /// Recent readings sent, by sequence number (oldest first).
+    readings: VecDeque<(u64, Vec3)>,
+    answer: Option<Answer>,
+    /// The carried body as integrated here, and the sequence number of the reading it is to
+    /// be stepped with next (its state is the one that reading meets).
+    body: Option<(Body, u64)>,
+    /// Work the motors did on the hand, J.
+    work_j: f64,
+    /// The world's reported work, J.
+    world_j: f64,
+    reserve_j: f64,
+    last_p: Option<Vec3>,
+    last_f: Vec3,
+    interventions: u64,
+}
+
+impl DeviceSide {
+    /// A device side speaking `protocol` whose motors give at most `max_force_n`, sampled
+    /// once per loop period of `period_s`.
+    pub fn new(protocol: Protocol, max_force_n: f64, period_s: f64) -> DeviceSide {
+        DeviceSide {
+            protocol,
+            max_force_n,
+            period_s,
+            readings: VecDeque::with_capacity(KEEP_READINGS + 1),
+            answer: None,
+            body: None,
+            work_j: 0.0,
+            world_j: 0.0,
+            reserve_j: DEVICE_RESERVE_J,
+            last_p: None,
+            last_f: [0.0; 3],
+            interventions: 0,
+        }
+    }
+
+    /// The protocol spoken.
+    pub fn protocol(&self) -> Protocol {
+        self.protocol
+    }
+
+    /// The device sent reading `p` as sample `seq`.
+    pub fn record_reading(&mut self, seq: u64, p: Vec3) {
+        self.readings.push_back((seq, p));
+        if self.readings.len() > KEEP_READINGS {
+            self.readings.pop_front();
+        }
+        self.catch_up(seq);
+    }
+
+    /// Steps the body with every kept reading before `seq` it has not met yet.
+    fn catch_up(&mut self, seq: u64) {
+        if let Some((body, next)) = self.body.as_mut() {
+            while *next < seq {
+                let Some(p) = reading_of(&self.readings, *next) else {
+                    break;
+                };
+                let planes = self
+                    .answer
+                    .as_ref()
+                    .and_then(|a| a.local.as_ref())
+                    .map_or(&[][..], |m| &m.body_planes[..]);
+                body.step(p, self.period_s, planes);
+                *next += 1;
+            }
+        }
+    }
+
+    /// An answer arrived: rendered from now on if it is newer than the one rendered (answers
+    /// overtaken by a newer one are dropped). Protocol 2's body restarts from the state the
+    /// answer reports and replays the readings sent since.
+    pub fn receive(&mut self, cmd: &ForceCommand, local: Option<LocalModel>) {
+        if self.answer.as_ref().is_some_and(|a| a.cmd.seq > cmd.seq) {
+            return;
+        }
+        let p0 = reading_of(&self.readings, cmd.seq)
+            .or_else(|| self.readings.front().map(|r| r.1))
+            .unwrap_or([0.0; 3]);
+        let local = if self.protocol == Protocol::V2 {
+            local
+        } else {
+            None
+        };
+        if let Some(m) = &local {
+            self.world_j = m.world_energy_j;
+        }
+        self.body = local
+            .as_ref()
+            .and_then(|m| m.body)
+            .map(|b| (b, cmd.seq + 1));
+        self.answer = Some(Answer {
+            cmd: *cmd,
+            p0,
+            local,
+        });
+        if let Some(&(newest, _)) = self.readings.back() {
+            self.catch_up(newest);
+        }
+    }
+
+    /// The force to render at the reading `p` for the next servo period of `dt_s`, N (before
+    /// the motors' clamp and resolution): the answer's model, held back by the two-port layer.
+    pub fn render(&mut self, p: Vec3, servo_s: f64) -> Vec3 {
+        // The work the last period's force did on the hand, and the stylus's velocity.
+        let mut v = [0.0; 3];
+        if let Some(lp) = self.last_p {
+            let d = vec3::sub(p, lp);
+            self.work_j += vec3::dot(self.last_f, d);
+            v = vec3::scale(d, 1.0 / servo_s);
+        }
+        self.last_p = Some(p);
+        let Some(a) = &self.answer else {
+            self.last_f = [0.0; 3];
+            return [0.0; 3];
+        };
+        let mut f = match &a.local {
+            None => {
+                let d = vec3::sub(p, a.p0);
+                let k = &a.cmd.stiffness_n_per_m;
+                let mut f = a.cmd.force_n;
+                for (i, fi) in f.iter_mut().enumerate() {
+                    *fi -= k[3 * i] * d[0] + k[3 * i + 1] * d[1] + k[3 * i + 2] * d[2];
+                }
+                f
+            }
+            Some(m) => {
+                let mut f = m.static_force(p, a.p0);
+                if let Some((body, _)) = &self.body {
+                    f = vec3::sub(f, body.pull(p, self.period_s).0);
+                }
+                f
+            }
+        };
+        if !vec3::is_finite(f) {
+            f = [0.0; 3];
+        }
+        let n = vec3::norm(f);
+        if n > self.max_force_n {
+            f = vec3::scale(f, self.max_force_n / n);
+        }
+        if self.protocol == Protocol::V2 {
+            f = self.bound(f, v, servo_s);
+        }
+        self.last_f = f;
+        f
+    }
+
+    /// The two-port layer: while the hand has received more than the world delivered plus the
+    /// reserve, a damper on the stylus's motion (from the last servo period's readings) takes
+    /// the surplus back over the next period, at most [`DEVICE_MAX_DAMPING_N_S_PER_M`] (more,
+    /// and the damper rendered through a held force chatters itself).
+    fn bound(&mut self, f: Vec3, v: Vec3, servo_s: f64) -> Vec3 {
+        let surplus = self.work_j - self.world_j - self.reserve_j;
+        let v2 = vec3::dot(v, v);
+        if surplus <= 0.0 || v2 == 0.0 {
+            return f;
+        }
+        self.interventions += 1;
+        let alpha = (surplus / (servo_s * v2)).min(DEVICE_MAX_DAMPING_N_S_PER_M);
+        let g = vec3::sub(f, vec3::scale(v, alpha));
+        let n = vec3::norm(g);
+        if n > self.max_force_n {
+            vec3::scale(g, self.max_force_n / n)
+        } else {
+            g
+        }
+    }
+
+    /// Work the motors did on the hand so far, J.
+    pub fn work_j(&self) -> f64 {
+        self.work_j
+    }
+
+    /// Servo periods on which the two-port layer held the force back.
+    pub fn interventions(&self) -> u64 {
+        self.interventions
+    }
+}
+
+fn reading_of(readings: &VecDeque<(u64, Vec3)>, seq: u64) -> Option<Vec3> {
+    let first = readings.front()?.0;
+    let i = usize::try_from(seq.checked_sub(first)?).ok()?;
+    readings.get(i).filter(|r| r.0 == seq).map(|r| r.1)
+}

@@ -1,0 +1,94 @@
+//! The local model sent with each answer (bridge protocol 2): the scene's contact planes and
+//! carried body mapped to the device, and the residual that makes the model give exactly the
+//! answered force at the answered reading.
+
+use super::HapticLoop;
+use haptic_types::local::{Body, LocalModel, Plane};
+use haptic_types::tick::status;
+use haptic_types::vec3::{self, Vec3};
+
+impl HapticLoop {
+    /// The local model of the last tick (see `haptic_types::local`), device frame and units.
+    ///
+    /// The scene's primitives are mapped to the device (`p = (x − origin) / workspace_scale`;
+    /// stiffness, damping and mass times `force_scale · workspace_scale`; forces times
+    /// `force_scale`) and felt through the tick's gain (engagement, watchdog and clamp; zero
+    /// after a missed deadline). The residual is the answered force less the primitives' at
+    /// the answered reading, so at that reading the device renders exactly
+    /// [`HapticLoop::command`]'s force; a scene without primitives sends its force with its
+    /// local stiffness as the residual (what protocol 1 renders). `world_energy_j` is the work
+    /// the answered forces did on the readings received: the two-port layer's budget.
+    pub fn local_model(&self) -> LocalModel {
+        let r = &self.result;
+        let mut prims = self.primitives.borrow_mut();
+        prims.clear();
+        self.scene.local_primitives(&mut prims);
+        let m = &self.config.mapping;
+        let (ws, fs) = (m.workspace_scale, m.force_scale);
+        let kd = fs * ws;
+        let gain = if r.status & status::DEADLINE_MISSED != 0 {
+            0.0
+        } else {
+            self.local_gain / fs
+        };
+        let to_device = |x: Vec3| vec3::scale(vec3::sub(x, m.origin_m), 1.0 / ws);
+        let planes: Vec<Plane> = prims
+            .planes
+            .iter()
+            .map(|p| Plane {
+                normal: p.normal,
+                offset_m: (p.offset_m - vec3::dot(p.normal, m.origin_m)) / ws,
+                stiffness_n_per_m: p.stiffness_n_per_m * kd * gain,
+            })
+            .collect();
+        let body = prims.body.map(|b| Body {
+            position_m: to_device(b.position_m),
+            velocity_m_per_s: vec3::scale(b.velocity_m_per_s, 1.0 / ws),
+            mass_kg: b.mass_kg * kd,
+            stiffness_n_per_m: b.stiffness_n_per_m * kd * gain,
+            series_stiffness_n_per_m: b.series_stiffness_n_per_m * kd * gain,
+            damping_n_s_per_m: b.damping_n_s_per_m * kd * gain,
+            damper_m: vec3::scale(b.damper_m, 1.0 / ws),
+            external_force_n: vec3::scale(b.external_force_n, fs),
+            substeps: b.substeps,
+            restitution: b.restitution,
+        });
+        let body_planes: Vec<Plane> = prims
+            .body_planes
+            .iter()
+            .map(|p| Plane {
+                normal: p.normal,
+                offset_m: (p.offset_m - vec3::dot(p.normal, m.origin_m)) / ws,
+                stiffness_n_per_m: 0.0,
+            })
+            .collect();
+        let world_energy_j = self.initial_tank_j() - self.tank_j;
+        if planes.is_empty() && body.is_none() {
+            return LocalModel {
+                residual_force_n: r.device_force_n,
+                residual_stiffness_n_per_m: r.device_stiffness_n_per_m,
+                planes,
+                body,
+                body_planes,
+                world_energy_j,
+            };
+        }
+        let p0 = to_device(r.cursor_m);
+        let model = LocalModel {
+            residual_force_n: [0.0; 3],
+            residual_stiffness_n_per_m: [0.0; 9],
+            planes,
+            body,
+            body_planes,
+            world_energy_j,
+        };
+        let mut local = model.static_force(p0, p0);
+        if let Some(b) = &model.body {
+            local = vec3::sub(local, b.pull(p0, self.config.dt_s()).0);
+        }
+        LocalModel {
+            residual_force_n: vec3::sub(r.device_force_n, local),
+            ..model
+        }
+    }
+}
