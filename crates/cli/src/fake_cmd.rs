@@ -3,6 +3,7 @@
 
 use crate::run_cmd::parse_operator;
 use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
+use haptic_devices::local::Protocol;
 use haptic_devices::{DeviceModel, Grip, Mechanics, Script};
 use haptic_loop::session::OperatorChoice;
 use std::path::PathBuf;
@@ -31,6 +32,11 @@ pub(crate) struct FakeArgs {
     /// With --grip: an ideal device (no encoder counts, no force resolution).
     #[arg(long)]
     ideal: bool,
+    /// The bridge protocol a modelled device asks for: 2 (the default: it renders the
+    /// simulator's local model at its own servo rate, behind the two-port passivity layer) or
+    /// 1 (the answered force and stiffness only; docs/device-bridge.md).
+    #[arg(long, default_value_t = 2)]
+    protocol: u8,
     /// Probability that a sample is lost, 0–1.
     #[arg(long, default_value_t = 0.0)]
     loss: f64,
@@ -140,16 +146,17 @@ fn script(a: &FakeArgs, model: DeviceModel) -> Result<Script, String> {
 
 /// The fake device's configuration from its flags, every value checked.
 fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), String> {
-    let target = a
-        .target
-        .strip_prefix("udp:")
-        .and_then(|t| t.parse().ok())
-        .ok_or_else(|| {
-            format!(
-                "fake-device `{}`: expected udp:HOST:PORT, e.g. udp:127.0.0.1:9870",
-                a.target
-            )
-        })?;
+    let target = haptic_devices::bridge::parse_endpoint(
+        &a.target,
+        "udp",
+        "fake-device",
+        "udp:127.0.0.1:9870",
+    )?;
+    let protocol = match a.protocol {
+        1 => Protocol::V1,
+        2 => Protocol::V2,
+        p => return Err(format!("--protocol = {p} is out of range: allowed 1 or 2")),
+    };
     let physical = physical(a)?;
     // Scripts name the buttons of the device they were written for: a Falcon's, or a Touch's.
     let model = DeviceModel::from_name(&a.model).unwrap_or(DeviceModel::Falcon);
@@ -181,6 +188,7 @@ fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), Strin
         outage,
         wait_s: check("wait-s", a.wait_s, 0.0, 86400.0)?,
         bye: true,
+        protocol,
     };
     Ok((cfg, physical))
 }
@@ -212,6 +220,18 @@ fn print_report(r: &FakeReport, physical: Option<(Mechanics, Grip)>, ideal: bool
             g.damping_n_s_per_m,
             if ideal { ", ideal sensing" } else { "" },
             r.energy_to_hand_j
+        );
+        println!(
+            "  protocol {}{}",
+            r.protocol,
+            if r.protocol == 2 {
+                format!(
+                    ": the local model rendered at the device's servo rate; the two-port layer held the force back on {} servo periods",
+                    r.two_port_interventions
+                )
+            } else {
+                ": the answered force and stiffness".to_string()
+            }
         );
     }
 }

@@ -70,6 +70,7 @@ fn run_case(c: &Case) -> (SessionReport, FakeReport) {
         outage: c.outage,
         wait_s: 30.0,
         bye: true,
+        protocol: haptic_devices::local::Protocol::V2,
     };
     let h = std::thread::spawn(move || run_session(&o, &mut |_, _| {}).unwrap());
     let dev = run_fake(&f, None).unwrap();

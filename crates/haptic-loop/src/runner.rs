@@ -210,6 +210,9 @@ impl<'s> Runner<'s> {
             if missed && !recorded_missed {
                 lp.mark_deadline_missed();
             }
+            if dev.wants_local_model() {
+                dev.set_local_model(lp.local_model());
+            }
             dev.set_force(&lp.command(sample.seq))?;
             let compute_ns = t0.elapsed().as_nanos() as u64;
             missed_count += u64::from(missed);

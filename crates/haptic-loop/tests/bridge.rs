@@ -67,6 +67,7 @@ fn fake(addr: SocketAddr) -> FakeConfig {
         outage: None,
         wait_s: 20.0,
         bye: true,
+        protocol: haptic_devices::local::Protocol::V2,
     }
 }
 
@@ -207,6 +208,7 @@ fn duplicate_reordered_malformed_oversized_and_stranger_packets_are_counted_and_
         let s = UdpSocket::bind("127.0.0.1:0").unwrap();
         s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
         let hello = Packet::Hello {
+            version: 1,
             rate_hz: 1000,
             specs: FALCON,
         }
@@ -239,8 +241,9 @@ fn duplicate_reordered_malformed_oversized_and_stranger_packets_are_counted_and_
                 loop {
                     let (n, _) = s.recv_from(&mut buf).unwrap();
                     if let Ok(Packet::Force(f)) = Packet::decode(&buf[..n]) {
+                        let seq = f.seq;
                         replies.push(f);
-                        if f.seq
+                        if seq
                             == Packet::decode(b).map_or(0, |p| match p {
                                 Packet::Sample(x) => x.seq,
                                 _ => 0,
@@ -371,14 +374,24 @@ fn the_welcome_carries_the_scenes_rate_name_and_start_time() {
     assert!(dev.welcome.scene.starts_with("optical tweezers at 10 kHz"));
     assert_eq!(dev.welcome.start_time_ns, 1_700_000_000_123_456_789);
     assert_eq!(r.description.start_time_ns, 1_700_000_000_123_456_789);
-    // 0.5 s at 10 kHz: 5000 samples, and the session ran one tick per sample.
-    assert_eq!(dev.ticks, 5000);
-    assert_eq!(dev.sent, 5000);
-    assert_eq!(r.stats.ticks, 5000);
-    // On a quiet machine no tick is stale; on 2 shared cores a few may be (not timed here),
-    // but never the 99.98 % of a device paced at 1 kHz.
+    // 0.5 s at 10 kHz: the device sent 5000 samples and every one arrived (it was welcomed
+    // with 1000 Hz and sent 500).
+    assert_eq!((dev.ticks, dev.sent), (5000, 5000));
+    assert_eq!(counter(&r, "received"), 5000);
+    // On a quiet machine every sample has its tick and none is stale; on 2 shared cores with
+    // the device spinning beside the loop a few are late (not timed here), never the 99.98 %
+    // of a session paced at 1 kHz against a 10 kHz loop.
     let stale = counter(&r, "stale_ticks");
-    assert!(stale < 500, "{stale} stale ticks of 5000");
-    println!("10 kHz over the bridge: {stale} stale ticks of 5000");
+    println!(
+        "10 kHz over the bridge: {} ticks, {stale} stale, {} superseded",
+        r.stats.ticks,
+        counter(&r, "superseded")
+    );
+    assert!(r.stats.ticks >= 4000, "{} ticks", r.stats.ticks);
+    assert!(
+        stale * 5 < r.stats.ticks,
+        "{stale} stale ticks of {}",
+        r.stats.ticks
+    );
     assert_replays(&out);
 }

@@ -347,6 +347,15 @@ pub trait HapticDevice {
     fn link_counters(&self) -> Vec<(&'static str, u64)> {
         Vec::new()
     }
+    /// Whether the device renders the local model between answers (bridge protocol 2): the
+    /// runner then hands it each tick's model with [`HapticDevice::set_local_model`] before
+    /// [`HapticDevice::set_force`].
+    fn wants_local_model(&self) -> bool {
+        false
+    }
+    /// The local model that goes with the next [`HapticDevice::set_force`] (protocol-2 devices
+    /// only; others ignore it).
+    fn set_local_model(&mut self, _model: crate::local::LocalModel) {}
 }
 
 #[cfg(test)]

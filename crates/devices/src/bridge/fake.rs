@@ -3,14 +3,21 @@
 //! measures the round trip of every answered sample.
 //!
 //! The device runs its own servo clock at the session's tick rate (from the welcome). Each
-//! period it reads its (simulated) stylus, sends a sample, and renders the last force that came
-//! back. A receiver thread timestamps each reply on arrival, so the round trip is measured from
-//! the send of a sample to the arrival of its answer.
+//! period it reads its (simulated) stylus, sends a sample, and renders what came back. A
+//! receiver thread timestamps each reply on arrival, so the round trip is measured from the
+//! send of a sample to the arrival of its answer.
+//!
+//! A modelled device (`--model`) renders through the device-side library
+//! ([`crate::local::DeviceSide`]) as a real device's servo thread would: protocol 2's local
+//! model at its own servo rate, or protocol 1's `F0 − K (p − p0)`, behind the two-port
+//! passivity layer; the figures it reports (jumps, energy) are of the force its motors
+//! rendered, what the hand felt.
 
-use super::protocol::{Packet, Sample};
+use super::protocol::{ForceReply, Packet, Sample};
+use crate::local::{DeviceSide, Protocol};
 use crate::pacing::{Pacer, Percentiles};
 use crate::script::Script;
-use crate::{ModelledDevice, OperatorParams, ScriptedDevice, SimulatedOperator};
+use crate::{OperatorParams, Plant, ScriptedDevice, SimulatedOperator};
 use haptic_types::device::{
     DeviceError, DeviceModel, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
@@ -53,11 +60,15 @@ pub struct FakeConfig {
     pub wait_s: f64,
     /// Say goodbye at the end (the session then ends too).
     pub bye: bool,
+    /// The protocol a modelled device asks for in its hello (the session may answer with 1).
+    pub protocol: Protocol,
 }
 
 /// What the simulator's welcome said.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct WelcomeInfo {
+    /// The session's protocol version (1, or 2: the local model).
+    pub version: u8,
     /// The session's tick rate, Hz: the device sends one sample per tick.
     pub rate_hz: u32,
     /// Session start, ns since the Unix epoch.
@@ -85,13 +96,18 @@ pub struct FakeReport {
     pub round_trip: Percentiles,
     /// Largest force received, N.
     pub max_force_n: f64,
+    /// The protocol the session speaks (from the welcome).
+    pub protocol: u8,
     /// Periods whose force changed by more than 1 N from the period before (a buzz shows
-    /// here).
+    /// here): the force received, or for a modelled device the force its motors rendered.
     pub jumps_over_1n: u64,
     /// Largest change of force between two periods, N.
     pub max_jump_n: f64,
     /// Work the device's motors did on the hand, J (modelled device only; 0 otherwise).
     pub energy_to_hand_j: f64,
+    /// Servo periods on which the device side's two-port passivity layer held the force back
+    /// (modelled device, protocol 2).
+    pub two_port_interventions: u64,
     /// Force received after the outage began, as (ms after the last sample sent, N), one entry
     /// per reply until it reached zero.
     pub outage_force: Vec<(f64, f64)>,
@@ -100,9 +116,8 @@ pub struct FakeReport {
 }
 
 struct Reply {
-    seq: u64,
     at: Instant,
-    force_n: [f64; 3],
+    force: ForceReply,
 }
 
 /// Runs the fake device to the end; `stop` ends it early.
@@ -118,9 +133,15 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     // 2. A receiver thread timestamps each reply.
     let receiver = Receiver::spawn(&socket, cfg.target)?;
     // 3. The servo loop.
-    let mut modelled = cfg
-        .physical
-        .map(|(mech, grip)| ModelledDevice::new(cfg.script.clone(), mech, grip, cfg.model.specs()));
+    let protocol = if welcome.version == super::protocol::VERSION_2 {
+        Protocol::V2
+    } else {
+        Protocol::V1
+    };
+    let mut modelled = cfg.physical.map(|(mech, grip)| Modelled {
+        plant: Plant::new(mech, grip, cfg.script.position(0.0)),
+        side: DeviceSide::new(protocol, mech.limits.max_force_n, 1.0 / f64::from(rate_hz)),
+    });
     let mut other: Box<dyn HapticDevice> = match cfg.hand {
         Some(p) => Box::new(SimulatedOperator::new(cfg.script.clone(), specs.clone(), p)),
         None => Box::new(ScriptedDevice::new(cfg.script.clone(), specs.clone())),
@@ -138,6 +159,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         sent_at: BTreeMap::new(),
         rtt: Vec::with_capacity(ticks as usize),
         rep: FakeReport {
+            protocol: welcome.version,
             welcome,
             forces_within_limits: true,
             ..Default::default()
@@ -145,7 +167,9 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         last_sent: None,
         outage_begun: false,
         force: [0.0; 3],
+        felt: [0.0; 3],
     };
+    let dt = 1.0 / f64::from(rate_hz);
     for k in 0..ticks {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) || receiver.done.load(Ordering::Relaxed)
         {
@@ -154,16 +178,34 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         pacer.wait_for(k);
         servo.rep.ticks += 1;
         let t = TickTime::new(k, rate_hz);
-        let dev: &mut dyn HapticDevice = match modelled.as_mut() {
-            Some(m) => m,
-            None => other.as_mut(),
+        let (position_m, buttons) = match modelled.as_mut() {
+            Some(m) => {
+                // The device and hand over the last period, rendered by the device side.
+                if k > 0 {
+                    let t0 = t.time_s - dt;
+                    let script = &cfg.script;
+                    let side = &mut m.side;
+                    m.plant.advance_with(
+                        dt,
+                        |s| (script.position(t0 + s), script.velocity(t0 + s)),
+                        &mut |p, servo_s| side.render(p, servo_s),
+                    );
+                    servo.felt(m.plant.last_force_n());
+                }
+                let reading = m.plant.reading_m();
+                m.side.record_reading(k, reading);
+                (reading, cfg.script.buttons(t.time_s).0)
+            }
+            None => {
+                other.set_force(&ForceCommand {
+                    force_n: servo.force,
+                    ..Default::default()
+                })?;
+                let s = other.sample(t)?;
+                (s.position_m, s.buttons.0)
+            }
         };
-        dev.set_force(&ForceCommand {
-            force_n: servo.force,
-            ..Default::default()
-        })?;
-        let s = dev.sample(t)?;
-        servo.queue(k, t.time_s, s.position_m, s.buttons.0);
+        servo.queue(k, t.time_s, position_m, buttons);
         servo.send_due();
         // A modelled device renders an answer when it arrives, as a driver's servo thread
         // does: wait for the answer to this period's sample for up to half a period, so the
@@ -173,7 +215,20 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         }
         // Replies that arrived since the last period.
         for r in receiver.take() {
-            servo.reply(&r);
+            servo.reply(&r, modelled.is_none());
+            if let Some(m) = modelled.as_mut() {
+                let f = &r.force;
+                m.side.receive(
+                    &ForceCommand {
+                        tick: f.tick,
+                        seq: f.seq,
+                        force_n: f.force_n,
+                        stiffness_n_per_m: f.stiffness_n_per_m,
+                        status: f.status,
+                    },
+                    f.local.clone(),
+                );
+            }
         }
         // Forget sends never answered (lost replies) after a second.
         if servo.sent_at.len() > 4 * rate_hz as usize {
@@ -189,8 +244,17 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     receiver.finish();
     let mut rep = servo.rep;
     rep.round_trip = Percentiles::of(&servo.rtt);
-    rep.energy_to_hand_j = modelled.map_or(0.0, |m| m.plant().energy_to_hand_j());
+    if let Some(m) = &modelled {
+        rep.energy_to_hand_j = m.plant.energy_to_hand_j();
+        rep.two_port_interventions = m.side.interventions();
+    }
     Ok(rep)
+}
+
+/// A modelled device: the device and hand, and what its servo thread renders.
+struct Modelled {
+    plant: Plant,
+    side: DeviceSide,
 }
 
 fn link(what: &str, e: std::io::Error) -> DeviceError {
@@ -221,7 +285,13 @@ fn handshake(
     specs: &DeviceSpecs,
     stop: Option<&AtomicBool>,
 ) -> Result<WelcomeInfo, DeviceError> {
+    let version = if cfg.physical.is_some() {
+        cfg.protocol.version()
+    } else {
+        super::protocol::VERSION
+    };
     let hello = Packet::Hello {
+        version,
         rate_hz: 1000,
         specs: specs.clone(),
     }
@@ -240,12 +310,14 @@ fn handshake(
         if let Ok((n, from)) = socket.recv_from(&mut buf) {
             if from == cfg.target {
                 if let Ok(Packet::Welcome {
+                    version,
                     rate_hz,
                     start_time_ns,
                     scene,
                 }) = Packet::decode(&buf[..n])
                 {
                     break WelcomeInfo {
+                        version,
                         rate_hz,
                         start_time_ns,
                         scene,
@@ -292,11 +364,7 @@ impl Receiver {
                         match Packet::decode(&buf[..n]) {
                             Ok(Packet::Force(f)) => {
                                 if let Ok(mut v) = r2.lock() {
-                                    v.push(Reply {
-                                        seq: f.seq,
-                                        at,
-                                        force_n: f.force_n,
-                                    });
+                                    v.push(Reply { at, force: f });
                                 }
                             }
                             Ok(Packet::Bye { .. }) => {
@@ -322,7 +390,7 @@ impl Receiver {
             && !self
                 .replies
                 .lock()
-                .map(|v| v.iter().any(|r| r.seq == seq))
+                .map(|v| v.iter().any(|r| r.force.seq == seq))
                 .unwrap_or(true)
         {
             std::hint::spin_loop();
@@ -358,8 +426,10 @@ struct Servo<'a> {
     rep: FakeReport,
     last_sent: Option<Instant>,
     outage_begun: bool,
-    /// The force rendered now, N.
+    /// The force received last, N.
     force: [f64; 3],
+    /// The force a modelled device's motors rendered last period, N.
+    felt: [f64; 3],
 }
 
 impl Servo<'_> {
@@ -411,17 +481,19 @@ impl Servo<'_> {
         }
     }
 
-    /// A reply: its round trip, its force checked against the device's limit, the force jump,
-    /// and the force after an outage began; the force rendered from now on.
-    fn reply(&mut self, r: &Reply) {
+    /// A reply: its round trip, its force checked against the device's limit, the force after
+    /// an outage began; the force received from now on, and (`count_jumps`: a device that
+    /// renders what it receives) its jump.
+    fn reply(&mut self, r: &Reply, count_jumps: bool) {
         let rep = &mut self.rep;
+        let f = r.force.force_n;
         rep.replies += 1;
-        let mag = vec3::norm(r.force_n);
-        if !vec3::is_finite(r.force_n) || mag > self.max_force_n {
+        let mag = vec3::norm(f);
+        if !vec3::is_finite(f) || mag > self.max_force_n {
             rep.forces_within_limits = false;
         }
         rep.max_force_n = rep.max_force_n.max(mag);
-        if let Some(t0) = self.sent_at.remove(&r.seq) {
+        if let Some(t0) = self.sent_at.remove(&r.force.seq) {
             self.rtt.push(r.at.duration_since(t0).as_nanos() as u64);
         }
         if self.outage_begun && rep.outage_force.last().is_none_or(|l| l.1 > 0.0) {
@@ -430,11 +502,28 @@ impl Servo<'_> {
                 rep.outage_force.push((ms, mag));
             }
         }
-        let jump = vec3::norm(vec3::sub(r.force_n, self.force));
-        rep.max_jump_n = rep.max_jump_n.max(jump);
-        if jump > 1.0 {
-            rep.jumps_over_1n += 1;
+        if count_jumps {
+            self.jump(f);
         }
-        self.force = r.force_n;
+        self.force = f;
+    }
+
+    /// The force a modelled device's motors rendered over the last period, N.
+    fn felt(&mut self, f: [f64; 3]) {
+        self.jump(f);
+        self.felt = f;
+    }
+
+    fn jump(&mut self, f: [f64; 3]) {
+        let before = if self.cfg.physical.is_some() {
+            self.felt
+        } else {
+            self.force
+        };
+        let jump = vec3::norm(vec3::sub(f, before));
+        self.rep.max_jump_n = self.rep.max_jump_n.max(jump);
+        if jump > 1.0 {
+            self.rep.jumps_over_1n += 1;
+        }
     }
 }

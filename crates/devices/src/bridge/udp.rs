@@ -88,6 +88,8 @@ struct State {
     ended: bool,
     error: Option<String>,
     c: Counters,
+    /// The protocol version of the session: the device's hello's, at most version 2.
+    version: u8,
 }
 
 struct Shared {
@@ -111,6 +113,10 @@ pub struct UdpDevice {
     generation: u64,
     peer: Option<SocketAddr>,
     tx: Vec<u8>,
+    /// The session's protocol version as of the last sample.
+    version: u8,
+    /// The local model for the next force packet (protocol 2).
+    local: Option<haptic_types::local::LocalModel>,
 }
 
 /// Most samples waiting for a tick; older ones are dropped (counted as superseded) so latency
@@ -139,7 +145,9 @@ impl UdpDevice {
             anchor: None,
             generation: 0,
             peer: None,
-            tx: Vec::with_capacity(super::protocol::FORCE_LEN),
+            tx: Vec::with_capacity(super::protocol::MAX_PACKET),
+            version: super::protocol::VERSION,
+            local: None,
         }
     }
 
@@ -155,17 +163,21 @@ impl UdpDevice {
             .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))
     }
 
-    fn welcome(&self) -> Vec<u8> {
-        Packet::Welcome {
-            rate_hz: self.config.rate_hz,
-            start_time_ns: self.config.start_time_ns,
-            scene: self.config.scene.clone(),
-        }
-        .encode()
+    /// The welcome in each version, [version 1, version 2].
+    fn welcomes(&self) -> [Vec<u8>; 2] {
+        [super::protocol::VERSION, super::protocol::VERSION_2].map(|version| {
+            Packet::Welcome {
+                version,
+                rate_hz: self.config.rate_hz,
+                start_time_ns: self.config.start_time_ns,
+                scene: self.config.scene.clone(),
+            }
+            .encode()
+        })
     }
 }
 
-fn receive(socket: UdpSocket, shared: Arc<Shared>, welcome: Vec<u8>) {
+fn receive(socket: UdpSocket, shared: Arc<Shared>, welcomes: [Vec<u8>; 2]) {
     let mut buf = vec![0u8; 2048];
     while !shared.stop.load(Ordering::Relaxed) {
         let (n, from) = match socket.recv_from(&mut buf) {
@@ -197,7 +209,7 @@ fn receive(socket: UdpSocket, shared: Arc<Shared>, welcome: Vec<u8>) {
         match packet {
             Err(super::protocol::ProtocolError::Oversized(_)) => st.c.oversized += 1,
             Err(_) => st.c.malformed += 1,
-            Ok(Packet::Hello { specs, .. }) => {
+            Ok(Packet::Hello { specs, version, .. }) => {
                 // A first hello, a repeated one, or a device that restarted: welcome it and
                 // accept its new numbering. Its limits cannot change during a session.
                 if st.specs.as_ref().is_some_and(|s| *s != specs) {
@@ -212,7 +224,9 @@ fn receive(socket: UdpSocket, shared: Arc<Shared>, welcome: Vec<u8>) {
                     }
                     st.peer = Some(from);
                     st.last_seq = None;
-                    let _ = socket.send_to(&welcome, from);
+                    st.version = version.min(super::protocol::VERSION_2);
+                    let welcome = &welcomes[usize::from(st.version == super::protocol::VERSION_2)];
+                    let _ = socket.send_to(welcome, from);
                     drop(st);
                     shared.arrived.notify_all();
                     continue;
@@ -266,7 +280,7 @@ impl HapticDevice for UdpDevice {
             .map_err(|e| link("cannot configure", e))?;
         let rx = socket.try_clone().map_err(|e| link("cannot clone", e))?;
         let shared = self.shared.clone();
-        let welcome = self.welcome();
+        let welcome = self.welcomes();
         self.thread = Some(
             std::thread::Builder::new()
                 .name("bridge-rx".into())
@@ -344,6 +358,7 @@ impl HapticDevice for UdpDevice {
                 .0;
         }
         self.peer = st.peer;
+        self.version = st.version.max(super::protocol::VERSION);
         let Some(k) = self.slot.or_else(|| st.queue.front().map(|s| s.seq)) else {
             return Err(DeviceError::Link(format!(
                 "no sample from the device within {} s of its hello",
@@ -393,14 +408,24 @@ impl HapticDevice for UdpDevice {
         })
     }
 
+    fn wants_local_model(&self) -> bool {
+        self.version == super::protocol::VERSION_2
+    }
+
+    fn set_local_model(&mut self, model: haptic_types::local::LocalModel) {
+        self.local = Some(model);
+    }
+
     fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
         if let (Some(sock), Some(peer)) = (&self.socket, self.peer) {
+            let local = self.local.take().filter(|_| self.version == 2);
             let p = Packet::Force(ForceReply {
                 seq: cmd.seq,
                 tick: cmd.tick,
                 force_n: cmd.force_n,
                 stiffness_n_per_m: cmd.stiffness_n_per_m,
                 status: cmd.status,
+                local,
             });
             p.encode_into(&mut self.tx);
             if sock.send_to(&self.tx, peer).is_err() {
@@ -420,6 +445,7 @@ impl HapticDevice for UdpDevice {
                 force_n: [0.0; 3],
                 stiffness_n_per_m: [0.0; 9],
                 status: 0,
+                local: (self.version == 2).then(haptic_types::local::LocalModel::default),
             });
             let _ = sock.send_to(&zero.encode(), peer);
             let _ = sock.send_to(&Packet::Bye { reason: 0 }.encode(), peer);

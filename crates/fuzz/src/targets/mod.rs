@@ -10,6 +10,7 @@ mod recordings;
 use crate::mutate::{self, Rng};
 use ::recording::{Recording, read_recording};
 use cli::{CLI_SEEDS, argv, mutate_argv};
+use haptic_devices::bridge::protocol::ForceReply;
 use haptic_devices::bridge::protocol::{Packet, Sample};
 use haptic_loop::DeviceModel;
 use haptic_loop::DeviceSpecs;
@@ -103,16 +104,28 @@ impl Target {
                 };
                 t.seeds = vec![
                     Packet::Hello {
+                        version: 1,
                         rate_hz: 1000,
                         specs: falcon().clone(),
                     }
                     .encode(),
                     Packet::Hello {
+                        version: 2,
                         rate_hz: 1000,
                         specs: DeviceModel::Touch.specs().clone(),
                     }
                     .encode(),
+                    Packet::Force(ForceReply {
+                        seq: 7,
+                        tick: 7,
+                        force_n: [0.0, 0.0, 1.0],
+                        stiffness_n_per_m: [0.0; 9],
+                        status: 0,
+                        local: Some(seed_local_model()),
+                    })
+                    .encode(),
                     Packet::Welcome {
+                        version: 2,
                         rate_hz: 1000,
                         start_time_ns: 1_795_000_000_000_000_000,
                         scene: "wall".into(),
@@ -209,5 +222,35 @@ fn selftest(index: u64, timeout: Duration) -> Outcome {
         }
         9 => Outcome::Finding("non-finite", "selftest force NaN".into()),
         _ => Outcome::Accepted,
+    }
+}
+
+/// A protocol-2 local model for the bridge target's seeds: a floor plane, a carried body on its
+/// coupling, the floor under the body.
+fn seed_local_model() -> haptic_types::local::LocalModel {
+    use haptic_types::local::{Body, LocalModel, Plane};
+    let floor = |offset_m, stiffness_n_per_m| Plane {
+        normal: [0.0, 0.0, 1.0],
+        offset_m,
+        stiffness_n_per_m,
+    };
+    LocalModel {
+        residual_force_n: [0.0, 0.0, 0.1],
+        residual_stiffness_n_per_m: [0.0; 9],
+        planes: vec![floor(-0.01, 2500.0)],
+        body: Some(Body {
+            position_m: [0.0, 0.0, -0.001],
+            velocity_m_per_s: [0.0; 3],
+            mass_kg: 1.25,
+            stiffness_n_per_m: 900.0,
+            series_stiffness_n_per_m: 900.0,
+            damping_n_s_per_m: 60.0,
+            damper_m: [0.0; 3],
+            external_force_n: [0.0, 0.0, -0.6],
+            substeps: 4,
+            restitution: 0.2,
+        }),
+        body_planes: vec![floor(-0.02, 0.0)],
+        world_energy_j: 0.0,
     }
 }

@@ -2,8 +2,10 @@
 //! script is sampled), and every force must be finite and within the device's limit.
 
 use super::{Outcome, falcon};
+use haptic_devices::ForceCommand;
 use haptic_devices::Script;
 use haptic_devices::bridge::protocol::Packet;
+use haptic_devices::local::{DeviceSide, Protocol};
 use haptic_loop::scene::load_scene_for;
 use haptic_loop::{Buttons, DeviceSample, DeviceSpecs, HapticLoop};
 
@@ -154,6 +156,45 @@ pub fn run_bridge(input: &[u8]) -> Outcome {
                             t.device_force_n[2]
                         ),
                     );
+                }
+            }
+            Outcome::Accepted
+        }
+        Packet::Force(f) => {
+            // A force packet rendered by the device side (a Falcon's servo thread, both
+            // protocols): the force its motors are asked for stays finite and within the limit.
+            let max = falcon().limits.max_force_n;
+            for protocol in [Protocol::V1, Protocol::V2] {
+                let mut side = DeviceSide::new(protocol, max, 1e-3);
+                side.record_reading(f.seq, [0.0; 3]);
+                side.record_reading(f.seq.saturating_add(1), [0.001, 0.0, -0.002]);
+                side.receive(
+                    &ForceCommand {
+                        tick: f.tick,
+                        seq: f.seq,
+                        force_n: f.force_n,
+                        stiffness_n_per_m: f.stiffness_n_per_m,
+                        status: f.status,
+                    },
+                    f.local.clone(),
+                );
+                for p in [[0.0; 3], [0.001, 0.0, -0.002], [0.03, -0.03, 0.03]] {
+                    let g = side.render(p, 2.5e-4);
+                    if !finite3(g) || norm(g) > max {
+                        return Outcome::Finding(
+                            "non-finite",
+                            format!(
+                                "protocol {} device side renders ({}, {}, {}) N at ({}, {}, {}) m",
+                                protocol.version(),
+                                g[0],
+                                g[1],
+                                g[2],
+                                p[0],
+                                p[1],
+                                p[2]
+                            ),
+                        );
+                    }
                 }
             }
             Outcome::Accepted
