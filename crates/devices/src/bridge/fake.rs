@@ -226,7 +226,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
                         stiffness_n_per_m: f.stiffness_n_per_m,
                         status: f.status,
                     },
-                    f.local.clone(),
+                    f.local.as_deref().cloned(),
                 );
             }
         }

@@ -108,7 +108,7 @@ pub struct ForceReply {
     /// cap, 16 force invalid, 32 watchdog, 64 passivity controller, 128 force-rate limit).
     pub status: u8,
     /// The local model (version 2 only; `None`: a version-1 packet).
-    pub local: Option<LocalModel>,
+    pub local: Option<Box<LocalModel>>,
 }
 
 /// Why a datagram was refused.
@@ -403,7 +403,7 @@ impl Packet {
                 let local = if version == VERSION_2 {
                     let m = r.local()?;
                     r.end("force (version 2)")?;
-                    Some(m)
+                    Some(Box::new(m))
                 } else {
                     None
                 };
@@ -732,7 +732,7 @@ mod tests {
             force_n: [0.5, 0.0, -1.0],
             stiffness_n_per_m: [0.0; 9],
             status: 1,
-            local: Some(full_model()),
+            local: Some(Box::new(full_model())),
         });
         let b = f.encode();
         assert_eq!(b.len(), force_v2_len(2, true, 1));
@@ -752,7 +752,7 @@ mod tests {
             force_n: [0.0; 3],
             stiffness_n_per_m: [0.0; 9],
             status: 0,
-            local: Some(m),
+            local: Some(Box::new(m)),
         });
         assert_eq!(g.encode().len(), force_v2_len(2, false, 1));
         assert_eq!(Packet::decode(&g.encode()), Ok(g));
@@ -770,7 +770,7 @@ mod tests {
                     force_n: [0.0; 3],
                     stiffness_n_per_m: [0.0; 9],
                     status: 0,
-                    local: Some(m),
+                    local: Some(Box::new(m)),
                 })
                 .encode(),
             )
@@ -795,7 +795,7 @@ mod tests {
             force_n: [0.0; 3],
             stiffness_n_per_m: [0.0; 9],
             status: 0,
-            local: Some(full_model()),
+            local: Some(Box::new(full_model())),
         })
         .encode();
         // Five planes announced.

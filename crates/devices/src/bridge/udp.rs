@@ -418,7 +418,11 @@ impl HapticDevice for UdpDevice {
 
     fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
         if let (Some(sock), Some(peer)) = (&self.socket, self.peer) {
-            let local = self.local.take().filter(|_| self.version == 2);
+            let local = self
+                .local
+                .take()
+                .filter(|_| self.version == 2)
+                .map(Box::new);
             let p = Packet::Force(ForceReply {
                 seq: cmd.seq,
                 tick: cmd.tick,
@@ -445,7 +449,7 @@ impl HapticDevice for UdpDevice {
                 force_n: [0.0; 3],
                 stiffness_n_per_m: [0.0; 9],
                 status: 0,
-                local: (self.version == 2).then(haptic_types::local::LocalModel::default),
+                local: (self.version == 2).then(Box::default),
             });
             let _ = sock.send_to(&zero.encode(), peer);
             let _ = sock.send_to(&Packet::Bye { reason: 0 }.encode(), peer);

@@ -121,7 +121,7 @@ impl Target {
                         force_n: [0.0, 0.0, 1.0],
                         stiffness_n_per_m: [0.0; 9],
                         status: 0,
-                        local: Some(seed_local_model()),
+                        local: Some(Box::new(seed_local_model())),
                     })
                     .encode(),
                     Packet::Welcome {

@@ -176,7 +176,7 @@ pub fn run_bridge(input: &[u8]) -> Outcome {
                         stiffness_n_per_m: f.stiffness_n_per_m,
                         status: f.status,
                     },
-                    f.local.clone(),
+                    f.local.as_deref().cloned(),
                 );
                 for p in [[0.0; 3], [0.001, 0.0, -0.002], [0.03, -0.03, 0.03]] {
                     let g = side.render(p, 2.5e-4);
