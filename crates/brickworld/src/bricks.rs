@@ -461,6 +461,11 @@ impl BrickSet {
             if let Some(co) = self.phys.colliders.get_mut(b.collider) {
                 co.set_mass(kg);
             }
+            // The body's mass at once, not at the engine's next step: an impulse applied before
+            // that step (the coupling's pull on a carried brick) must move the new mass.
+            if let Some(rb) = self.phys.bodies.get_mut(b.body) {
+                rb.recompute_mass_properties_from_colliders(&self.phys.colliders);
+            }
         }
         self.phys.wake_up_all(true);
     }

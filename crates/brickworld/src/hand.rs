@@ -149,7 +149,7 @@ impl Hand {
             self.started = true;
         }
         // 1. Grip: release before grab so one tick can't do both on one brick.
-        self.grip_edges(input.grip(), params, bricks, events);
+        self.grip_edges(input.grip(), params, limits, bricks, events);
         // 2. God-object update (a coupled brick is a body of its own, not part of the proxy).
         let (upd, approach_speed) = self.move_proxy(c, tick, params, bricks);
         // 3. The force the device renders this tick.
@@ -169,6 +169,7 @@ impl Hand {
         &mut self,
         grip: Grip,
         params: &Params,
+        limits: &Limits,
         bricks: &mut BrickSet,
         events: &mut Vec<Event>,
     ) {
@@ -178,7 +179,7 @@ impl Hand {
             self.release(params, bricks, events);
         }
         if !prev.hold && grip.hold {
-            self.grab(params, bricks, events);
+            self.grab(params, limits, bricks, events);
         }
         for (now, before, axis) in [
             (grip.turn_x, prev.turn_x, Axis::X),
@@ -469,6 +470,49 @@ impl Hand {
         out
     }
 
+    /// Where the coupling holds a brick of mass `m_kg` at rest: the grip point's lead on it
+    /// under its weight alone, `M g / k` upwards, m (the dashpot relaxed).
+    pub(crate) fn static_lead(params: &Params, limits: &Limits, m_kg: f64) -> Vector {
+        let k = Self::coupling_stiffness(params, limits).min(m_kg / (params.dt_s * params.dt_s));
+        if k > 0.0 && m_kg.is_finite() {
+            Vector::new(0.0, 0.0, m_kg * params.gravity_m_per_s2 / k)
+        } else {
+            Vector::ZERO
+        }
+    }
+
+    /// The carried brick's static lead (zero unless carried through the coupling), m: with its
+    /// mass now, or with `mass_kg` (a mass just set, which the engine applies at its next
+    /// step).
+    pub(crate) fn held_static_lead(
+        &self,
+        params: &Params,
+        limits: &Limits,
+        bricks: &BrickSet,
+        mass_kg: Option<f64>,
+    ) -> Vector {
+        match self.held.filter(|h| h.coupled) {
+            Some(h) => bricks
+                .phys
+                .bodies
+                .get(bricks.body(h.brick))
+                .map_or(Vector::ZERO, |rb| {
+                    Self::static_lead(params, limits, mass_kg.unwrap_or(rb.mass()))
+                }),
+            None => Vector::ZERO,
+        }
+    }
+
+    /// A switch changed the carried brick's load (gravity, mass) from one static lead to
+    /// another: the grip point and the relaxed dashpot move by the difference, so the felt
+    /// force steps to the new weight at once and the brick does not ring on its coupling.
+    pub(crate) fn rebalance(&mut self, from: Vector, to: Vector) {
+        if let Some(h) = self.held.as_mut().filter(|h| h.coupled) {
+            h.offset += to - from;
+            self.damper += to - from;
+        }
+    }
+
     /// Stiffness of the coupling spring, N/m (world units): a fraction of the device's
     /// largest stable stiffness.
     pub(crate) fn coupling_stiffness(params: &Params, limits: &Limits) -> f64 {
@@ -534,14 +578,14 @@ impl Hand {
     }
 
     /// Applies a change of the `inertia` switch to a carried brick: it becomes a coupled body
-    /// or a kinematically carried one, where it is.
-    pub(crate) fn set_inertia(&mut self, mode: Inertia, bricks: &mut BrickSet) {
+    /// or a kinematically carried one, where it is. Whether it changed.
+    pub(crate) fn set_inertia(&mut self, mode: Inertia, bricks: &mut BrickSet) -> bool {
         let Some(h) = self.held else {
-            return;
+            return false;
         };
         let coupled = mode == Inertia::Coupling;
         if coupled == h.coupled {
-            return;
+            return false;
         }
         if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
             if coupled {
@@ -562,6 +606,7 @@ impl Hand {
         }
         self.grip_velocity.reset(self.proxy.to_array());
         self.damper = Vector::ZERO;
+        true
     }
 
     fn held_shape(&self, params: &Params) -> Option<HeldShape> {
@@ -576,7 +621,13 @@ impl Hand {
     }
 
     /// `hold` pressed: carry the nearest brick within reach (ties: the lower id).
-    fn grab(&mut self, params: &Params, bricks: &mut BrickSet, events: &mut Vec<Event>) {
+    fn grab(
+        &mut self,
+        params: &Params,
+        limits: &Limits,
+        bricks: &mut BrickSet,
+        events: &mut Vec<Event>,
+    ) {
         if self.held.is_some() {
             return;
         }
@@ -611,14 +662,23 @@ impl Hand {
                 rb.set_linvel(Vector::ZERO, true);
                 rb.set_angvel(Vector::ZERO, true);
             }
+            // A coupled brick is taken with its coupling already at rest under the brick's
+            // weight (the grip point its static lead above it, the dashpot relaxed): the hand
+            // feels the weight from the grab on, and the brick does not drop into the
+            // coupling and ring.
+            let lead = if coupled {
+                Self::static_lead(params, limits, rb.mass())
+            } else {
+                Vector::ZERO
+            };
             self.held = Some(Held {
                 brick: id,
-                offset: pos.translation - self.proxy,
+                offset: pos.translation - self.proxy + lead,
                 rotation: pos.rotation,
                 coupled,
             });
             self.grip_velocity.reset(self.proxy.to_array());
-            self.damper = Vector::ZERO;
+            self.damper = lead;
             events.push(Event::Grabbed { brick: id });
         }
     }
@@ -629,12 +689,14 @@ impl Hand {
         let Some(h) = self.held.take() else {
             return;
         };
-        let mut v = Vector::from_array(self.grip_velocity.velocity());
+        let v = Vector::from_array(self.grip_velocity.velocity());
         if let Some(rb) = bricks.phys.bodies.get_mut(bricks.body(h.brick)) {
             if h.coupled {
-                // A coupled brick leaves the hand with its own velocity: nothing to estimate.
+                // A coupled brick leaves with the hand's velocity, as a rigidly carried one
+                // does: the coupling's own motion (its lag behind a hand that speeds up, its
+                // swing) is not thrown with it.
                 rb.lock_rotations(false, true);
-                v = rb.linvel();
+                rb.set_linvel(v, true);
             } else {
                 rb.set_body_type(RigidBodyType::Dynamic, true);
                 rb.set_linvel(v, true);

@@ -123,8 +123,10 @@ impl World {
     /// Sets the magnitude of gravity, m/s² in `[0, 100]` (0 = off). Wakes every brick.
     pub fn set_gravity(&mut self, g_m_per_s2: f64) -> Result<(), ParamError> {
         range("gravity_m_per_s2", g_m_per_s2, Lo::Closed(0.0), 100.0)?;
+        let before = self.held_static_lead(None);
         self.params.gravity_m_per_s2 = g_m_per_s2;
         self.bricks.set_gravity(g_m_per_s2);
+        self.hand.rebalance(before, self.held_static_lead(None));
         Ok(())
     }
 
@@ -149,14 +151,27 @@ impl World {
     /// between coupled and rigidly carried where it is.
     pub fn set_inertia(&mut self, mode: Inertia) {
         self.params.inertia = mode;
-        self.hand.set_inertia(mode, &mut self.bricks);
+        if self.hand.set_inertia(mode, &mut self.bricks) {
+            // A brick that becomes coupled in the hand starts at rest on its coupling.
+            let lead = self.held_static_lead(None);
+            self.hand.rebalance(Vector::ZERO, lead);
+        }
+    }
+
+    /// The carried brick's static lead on its coupling (zero unless coupled), m; with
+    /// `mass_kg` when its mass was just set.
+    fn held_static_lead(&self, mass_kg: Option<f64>) -> Vector {
+        self.hand
+            .held_static_lead(&self.params, &self.limits, &self.bricks, mass_kg)
     }
 
     /// Sets the mass of every brick, kg in `[1e-3, 100]` (inertia tensor scales with it).
     pub fn set_brick_mass(&mut self, kg: f64) -> Result<(), ParamError> {
         range("brick_mass_kg", kg, Lo::Closed(1e-3), 100.0)?;
+        let before = self.held_static_lead(None);
         self.params.brick_mass_kg = kg;
         self.bricks.set_brick_mass(kg);
+        self.hand.rebalance(before, self.held_static_lead(Some(kg)));
         Ok(())
     }
 

@@ -174,10 +174,10 @@ fn a_brick_set_down_at_half_a_metre_per_second_is_felt_no_stiffer_than_the_devic
     assert!(sink < 1e-3);
 }
 
-/// Let go while swinging: the brick keeps its own velocity (no estimate), which matches the
-/// hand's after the coupling settled, then flies as a projectile.
+/// Let go while swinging: the brick leaves with the hand's velocity (issue 31: not with the
+/// coupling's own swing on top of it), then flies as a projectile.
 #[test]
-fn a_coupled_throw_leaves_with_the_brick_s_own_velocity() {
+fn a_coupled_throw_leaves_with_the_hands_velocity() {
     let (mut w, mut c) = holding(0.2);
     let dt = w.params().dt_s;
     let v = [1.0, 0.3, 0.6];
@@ -188,7 +188,6 @@ fn a_coupled_throw_leaves_with_the_brick_s_own_velocity() {
         }
         hold(&mut w, c, true);
     }
-    let before = w.brick(BrickId(0)).unwrap().velocity_m_per_s;
     let rel = hold(&mut w, c, false);
     let v0 = rel
         .events
@@ -200,18 +199,15 @@ fn a_coupled_throw_leaves_with_the_brick_s_own_velocity() {
             _ => None,
         })
         .expect("a throw");
+    let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     for k in 0..3 {
-        assert!((v0[k] - v[k]).abs() < 0.01 * 1.2, "{v0:?} vs hand {v:?}");
-        // The release tick's own step added at most the coupling's last impulse.
-        assert!(
-            (v0[k] - before[k]).abs() < 0.05,
-            "{v0:?} vs brick {before:?}"
-        );
+        assert!((v0[k] - v[k]).abs() < 0.02 * speed, "{v0:?} vs hand {v:?}");
     }
-    assert_eq!(
-        rel.force_n, [0.0; 3],
-        "nothing held, nothing touched: no force"
-    );
+    // Nothing held. The brick was taken from above with the cursor on its top face and stays
+    // there in the hand (its coupling starts at rest under its weight, issue 31), so at the
+    // release the cursor may still touch it: a light push, not the weight.
+    let f = (rel.force_n[0].powi(2) + rel.force_n[1].powi(2) + rel.force_n[2].powi(2)).sqrt();
+    assert!(f < 1.0, "{:?}", rel.force_n);
     // Flight: gravity only (no contact within 0.1 s).
     let b0 = w.brick(BrickId(0)).unwrap();
     for _ in 0..100 {

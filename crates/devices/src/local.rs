@@ -19,10 +19,10 @@
 //! Both run behind the **two-port passivity layer** (after Ryu, Artigas and Preusche 2010):
 //! the device counts the work its motors did on the hand, `W_dev = Σ F·Δp` over its servo
 //! periods, and the simulator reports the work its answers did on the readings it received,
-//! `W_world`. Whatever the link's delay, loss or jitter, the device never lets `W_dev` exceed
-//! `W_world + reserve`: beyond that it scales its force down on the servo period where the
-//! force would do positive work, so the excess is never delivered (an intervention is counted,
-//! and reported with the status bit [`PASSIVITY_TWO_PORT`]).
+//! `W_world`. Whatever the link's delay, loss or jitter, once `W_dev` exceeds
+//! `W_world + reserve` the device adds damping to take the surplus back, and past a second
+//! reserve scales its force down, to zero at three: the hand never receives more than the
+//! world delivered plus three reserves (each servo period of intervention is counted).
 
 use haptic_types::device::ForceCommand;
 use haptic_types::local::{Body, LocalModel};
@@ -47,9 +47,6 @@ impl Protocol {
         }
     }
 }
-
-/// Status bit the device side reports when its two-port layer held the force back.
-pub const PASSIVITY_TWO_PORT: u8 = 64;
 
 /// Energy the device may give the hand beyond what the world delivered, J (the single-port
 /// layer's default reserve).
@@ -228,16 +225,26 @@ impl DeviceSide {
     /// The two-port layer: while the hand has received more than the world delivered plus the
     /// reserve, a damper on the stylus's motion (from the last servo period's readings) takes
     /// the surplus back over the next period, at most [`DEVICE_MAX_DAMPING_N_S_PER_M`] (more,
-    /// and the damper rendered through a held force chatters itself).
+    /// and the damper rendered through a held force chatters itself); and when the surplus
+    /// passes a second reserve the force itself is scaled down, to zero at three reserves, so
+    /// the energy the hand can receive beyond the world's is bounded whatever the link does.
     fn bound(&mut self, f: Vec3, v: Vec3, servo_s: f64) -> Vec3 {
         let surplus = self.work_j - self.world_j - self.reserve_j;
-        let v2 = vec3::dot(v, v);
-        if surplus <= 0.0 || v2 == 0.0 {
+        if surplus <= 0.0 {
             return f;
         }
         self.interventions += 1;
-        let alpha = (surplus / (servo_s * v2)).min(DEVICE_MAX_DAMPING_N_S_PER_M);
-        let g = vec3::sub(f, vec3::scale(v, alpha));
+        let v2 = vec3::dot(v, v);
+        let mut g = if v2 > 0.0 {
+            let alpha = (surplus / (servo_s * v2)).min(DEVICE_MAX_DAMPING_N_S_PER_M);
+            vec3::sub(f, vec3::scale(v, alpha))
+        } else {
+            f
+        };
+        if surplus > self.reserve_j {
+            let scale = (1.0 - (surplus - self.reserve_j) / (2.0 * self.reserve_j)).max(0.0);
+            g = vec3::scale(g, scale);
+        }
         let n = vec3::norm(g);
         if n > self.max_force_n {
             vec3::scale(g, self.max_force_n / n)
