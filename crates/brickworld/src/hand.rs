@@ -4,7 +4,9 @@
 
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::parry::shape::{Ball, Cuboid};
-use rapier3d_f64::prelude::{QueryFilter, RigidBodyHandle, RigidBodyType};
+use rapier3d_f64::prelude::{
+    Collider, ColliderHandle, QueryFilter, RigidBodyHandle, RigidBodyType,
+};
 use world_form::Limits;
 
 use crate::bricks::BrickSet;
@@ -72,6 +74,10 @@ pub(crate) struct Hand {
     touching: Vec<Touch>,
     /// Outward normals of the surfaces the god-object touched in the last update.
     contact_normals: Vec<Vector>,
+    /// A brick just let go of that the cursor sphere still overlaps (a coupled brick's
+    /// coupling lets the hand sink into it): passed through until they separate, so letting
+    /// go never kicks the hand out of the brick.
+    letting_go: Option<ColliderHandle>,
     /// The proxy's speed over the last tick, m/s (for cursor impacts).
     proxy_speed: f64,
     /// Whether a sample has arrived.
@@ -96,6 +102,7 @@ impl Hand {
             held: None,
             touching: Vec::new(),
             contact_normals: Vec::new(),
+            letting_go: None,
             proxy_speed: 0.0,
             started: false,
         }
@@ -207,14 +214,31 @@ impl Hand {
             .filter(|h| !h.coupled)
             .and(self.held_shape(params));
         let exclude = self.held.map(|h| bricks.collider(h.brick));
+        let ghost = self.letting_go;
+        let pass = move |h: ColliderHandle, _: &Collider| Some(h) != ghost;
         let upd = {
-            let mut filter = QueryFilter::default();
+            let mut filter = QueryFilter::default().predicate(&pass);
             if let Some(ex) = exclude {
                 filter = filter.exclude_collider(ex);
             }
             let qp = bricks.phys.query_pipeline_with_filter(filter);
             proxy::update_proxy(&qp, &ball, &held_shape, self.proxy, c)
         };
+        // The brick let go of is solid again once the cursor sphere has left it.
+        if let Some(g) = self.letting_go {
+            let apart = bricks.phys.colliders.get(g).is_none_or(|co| {
+                rapier3d_f64::parry::query::intersection_test(
+                    &Pose::from_translation(upd.position),
+                    &ball,
+                    co.position(),
+                    co.shape(),
+                )
+                .map_or(true, |hit| !hit.intersecting)
+            });
+            if apart {
+                self.letting_go = None;
+            }
+        }
         let moved = (upd.position - self.proxy).length() / params.dt_s;
         let approach_speed = moved.max(self.proxy_speed);
         self.proxy_speed = if tick == 0 { 0.0 } else { moved };
@@ -338,7 +362,9 @@ impl Hand {
     /// Distance from the cursor sphere's surface to the nearest solid other than the carried
     /// brick, m: 0 when touching, `f64::INFINITY` beyond [`NEAREST_MAX_M`].
     pub(crate) fn nearest_m(&self, params: &Params, bricks: &BrickSet) -> f64 {
-        let mut filter = QueryFilter::default();
+        let ghost = self.letting_go;
+        let pass = move |h: ColliderHandle, _: &Collider| Some(h) != ghost;
+        let mut filter = QueryFilter::default().predicate(&pass);
         if let Some(h) = self.held {
             filter = filter.exclude_collider(bricks.collider(h.brick));
         }
@@ -364,7 +390,9 @@ impl Hand {
         bricks: &BrickSet,
         range_m: f64,
     ) -> Option<(Vector, Vector)> {
-        let mut filter = QueryFilter::default();
+        let ghost = self.letting_go;
+        let pass = move |h: ColliderHandle, _: &Collider| Some(h) != ghost;
+        let mut filter = QueryFilter::default().predicate(&pass);
         if let Some(h) = self.held {
             filter = filter.exclude_collider(bricks.collider(h.brick));
         }
@@ -704,6 +732,7 @@ impl Hand {
             }
         }
         bricks.wake_neighbours(bricks.collider(h.brick));
+        self.letting_go = Some(bricks.collider(h.brick));
         events.push(Event::Released {
             brick: h.brick,
             velocity_m_per_s: v.to_array(),

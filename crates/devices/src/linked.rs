@@ -29,6 +29,8 @@ pub struct LinkedDevice {
     now_ns: u64,
     /// The force the motors rendered when each sample was read, N.
     felt: Vec<Vec3>,
+    /// Each sample's reading, m.
+    readings: Vec<Vec3>,
 }
 
 impl LinkedDevice {
@@ -58,6 +60,7 @@ impl LinkedDevice {
             period_ns: 1_000_000_000 / u64::from(rate_hz.max(1)),
             now_ns: 0,
             felt: Vec::new(),
+            readings: Vec::new(),
         }
     }
 
@@ -82,6 +85,11 @@ impl LinkedDevice {
         &self.felt
     }
 
+    /// Each sample's encoder reading, m (device frame).
+    pub fn readings(&self) -> &[Vec3] {
+        &self.readings
+    }
+
     /// Loop period, ns.
     pub fn period_ns(&self) -> u64 {
         self.period_ns
@@ -93,6 +101,7 @@ impl LinkedDevice {
         let t = k * self.period_ns;
         let reading = self.plant.reading_m();
         self.felt.push(self.plant.last_force_n());
+        self.readings.push(reading);
         self.side.record_reading(k, reading);
         let s = DeviceSample {
             position_m: reading,

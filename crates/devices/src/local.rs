@@ -20,9 +20,10 @@
 //! the device counts the work its motors did on the hand, `W_dev = Σ F·Δp` over its servo
 //! periods, and the simulator reports the work its answers did on the readings it received,
 //! `W_world`. Whatever the link's delay, loss or jitter, once `W_dev` exceeds
-//! `W_world + reserve` the device adds damping to take the surplus back, and past a second
-//! reserve scales its force down, to zero at three: the hand never receives more than the
-//! world delivered plus three reserves (each servo period of intervention is counted).
+//! `W_world + R` (the reserve) the device adds damping to take the surplus back, and once the
+//! surplus passes a second reserve it scales its force down, to zero at `W_world + 4R`: the
+//! hand never receives more than the world delivered plus four reserves, 0.08 J (each servo
+//! period of intervention is counted).
 
 use haptic_types::device::ForceCommand;
 use haptic_types::local::{Body, LocalModel};
@@ -89,6 +90,10 @@ pub struct DeviceSide {
     last_p: Option<Vec3>,
     last_f: Vec3,
     interventions: u64,
+    /// The smallest `tick − seq` of the answers so far: an on-time answer's. A stale tick
+    /// answers an older sample (its `tick − seq` is larger by the sample's age): its state
+    /// belongs to its tick, not to the sample it answers.
+    tick_offset: Option<i128>,
 }
 
 impl DeviceSide {
@@ -108,6 +113,7 @@ impl DeviceSide {
             last_p: None,
             last_f: [0.0; 3],
             interventions: 0,
+            tick_offset: None,
         }
     }
 
@@ -125,32 +131,34 @@ impl DeviceSide {
         self.catch_up(seq);
     }
 
-    /// Steps the body with every kept reading before `seq` it has not met yet.
+    /// Steps the body with every kept reading before `seq` it has not met yet (a number the
+    /// device skipped holds the reading before it).
     fn catch_up(&mut self, seq: u64) {
         if let Some((body, next)) = self.body.as_mut() {
+            let planes = self
+                .answer
+                .as_ref()
+                .and_then(|a| a.local.as_ref())
+                .map_or(&[][..], |m| &m.body_planes[..]);
             while *next < seq {
-                let Some(p) = reading_of(&self.readings, *next) else {
+                let Some(p) = reading_at_or_before(&self.readings, *next) else {
                     break;
                 };
-                let planes = self
-                    .answer
-                    .as_ref()
-                    .and_then(|a| a.local.as_ref())
-                    .map_or(&[][..], |m| &m.body_planes[..]);
                 body.step(p, self.period_s, planes);
                 *next += 1;
             }
         }
     }
 
-    /// An answer arrived: rendered from now on if it is newer than the one rendered (answers
-    /// overtaken by a newer one are dropped). Protocol 2's body restarts from the state the
-    /// answer reports and replays the readings sent since.
+    /// An answer arrived: rendered from now on if it is newer than the one rendered (by tick:
+    /// answers overtaken by a newer one are dropped). Protocol 2's body restarts from the
+    /// state the answer reports for the sample after its tick and replays the readings sent
+    /// since; the world's reported energy becomes the two-port layer's budget.
     pub fn receive(&mut self, cmd: &ForceCommand, local: Option<LocalModel>) {
-        if self.answer.as_ref().is_some_and(|a| a.cmd.seq > cmd.seq) {
+        if self.answer.as_ref().is_some_and(|a| a.cmd.tick > cmd.tick) {
             return;
         }
-        let p0 = reading_of(&self.readings, cmd.seq)
+        let p0 = reading_at_or_before(&self.readings, cmd.seq)
             .or_else(|| self.readings.front().map(|r| r.1))
             .unwrap_or([0.0; 3]);
         let local = if self.protocol == Protocol::V2 {
@@ -158,13 +166,15 @@ impl DeviceSide {
         } else {
             None
         };
+        let lag = i128::from(cmd.tick) - i128::from(cmd.seq);
+        let offset = *self.tick_offset.get_or_insert(lag);
+        self.tick_offset = Some(offset.min(lag));
         if let Some(m) = &local {
             self.world_j = m.world_energy_j;
+            // The sample whose reading the reported state meets next.
+            let next = u64::try_from(i128::from(cmd.tick) - offset.min(lag) + 1).ok();
+            self.body = m.body.zip(next);
         }
-        self.body = local
-            .as_ref()
-            .and_then(|m| m.body)
-            .map(|b| (b, cmd.seq + 1));
         self.answer = Some(Answer {
             cmd: *cmd,
             p0,
@@ -175,17 +185,23 @@ impl DeviceSide {
         }
     }
 
-    /// The force to render at the reading `p` for the next servo period of `dt_s`, N (before
+    /// The force to render at the reading `p` for the next servo period of `servo_s`, N (before
     /// the motors' clamp and resolution): the answer's model, held back by the two-port layer.
     pub fn render(&mut self, p: Vec3, servo_s: f64) -> Vec3 {
         // The work the last period's force did on the hand, and the stylus's velocity.
         let mut v = [0.0; 3];
         if let Some(lp) = self.last_p {
             let d = vec3::sub(p, lp);
-            self.work_j += vec3::dot(self.last_f, d);
-            v = vec3::scale(d, 1.0 / servo_s);
+            let w = vec3::dot(self.last_f, d);
+            // A non-finite reading counts no work (it would poison the budget for good).
+            if w.is_finite() && vec3::is_finite(d) {
+                self.work_j += w;
+                v = vec3::scale(d, 1.0 / servo_s);
+            }
         }
-        self.last_p = Some(p);
+        if vec3::is_finite(p) {
+            self.last_p = Some(p);
+        }
         let Some(a) = &self.answer else {
             self.last_f = [0.0; 3];
             return [0.0; 3];
@@ -217,6 +233,9 @@ impl DeviceSide {
         }
         if self.protocol == Protocol::V2 {
             f = self.bound(f, v, servo_s);
+            if !vec3::is_finite(f) {
+                f = [0.0; 3];
+            }
         }
         self.last_f = f;
         f
@@ -226,8 +245,9 @@ impl DeviceSide {
     /// reserve, a damper on the stylus's motion (from the last servo period's readings) takes
     /// the surplus back over the next period, at most [`DEVICE_MAX_DAMPING_N_S_PER_M`] (more,
     /// and the damper rendered through a held force chatters itself); and when the surplus
-    /// passes a second reserve the force itself is scaled down, to zero at three reserves, so
-    /// the energy the hand can receive beyond the world's is bounded whatever the link does.
+    /// passes a second reserve the force itself is scaled down, to zero when it reaches three
+    /// (`W_dev = W_world + 4R`), so the energy the hand can receive beyond the world's is
+    /// bounded whatever the link does.
     fn bound(&mut self, f: Vec3, v: Vec3, servo_s: f64) -> Vec3 {
         let surplus = self.work_j - self.world_j - self.reserve_j;
         if surplus <= 0.0 {
@@ -264,8 +284,9 @@ impl DeviceSide {
     }
 }
 
-fn reading_of(readings: &VecDeque<(u64, Vec3)>, seq: u64) -> Option<Vec3> {
-    let first = readings.front()?.0;
-    let i = usize::try_from(seq.checked_sub(first)?).ok()?;
-    readings.get(i).filter(|r| r.0 == seq).map(|r| r.1)
+/// The reading sent as `seq`, or the last one before it (a skipped number holds the reading
+/// before it); `None` when `seq` is older than every kept reading.
+fn reading_at_or_before(readings: &VecDeque<(u64, Vec3)>, seq: u64) -> Option<Vec3> {
+    let i = readings.partition_point(|r| r.0 <= seq);
+    i.checked_sub(1).and_then(|i| readings.get(i)).map(|r| r.1)
 }

@@ -22,13 +22,24 @@ impl Pacer {
         }
     }
 
-    fn scheduled(&self, tick: u64) -> Instant {
+    /// When tick 0 starts.
+    pub fn start(&self) -> Instant {
+        self.start
+    }
+
+    /// When `tick` starts.
+    pub fn scheduled(&self, tick: u64) -> Instant {
         self.start + Duration::from_nanos(self.period_ns.saturating_mul(tick))
     }
 
     /// Waits for the start of `tick`; returns how late it actually starts, ns (≥ 0).
     pub fn wait_for(&self, tick: u64) -> i64 {
-        let target = self.scheduled(tick);
+        self.wait_until(self.scheduled(tick))
+    }
+
+    /// Waits until `target` (sleeping, then spinning the last stretch); returns how late it
+    /// woke, ns (≥ 0).
+    pub fn wait_until(&self, target: Instant) -> i64 {
         let now = Instant::now();
         if target > now + self.spin {
             std::thread::sleep(target - now - self.spin);

@@ -145,6 +145,28 @@ pub fn run_linked(
     linked: &Linked,
     seconds: Option<f64>,
 ) -> Result<Report, ClosedLoopError> {
+    run_linked_traced(scene_text, script_text, mech, grip, linked, seconds).map(|(r, _)| r)
+}
+
+/// What the hand met, sample by sample: each encoder reading (m) and the force the motors
+/// rendered when it was read (N), device frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trace {
+    /// Readings, m.
+    pub readings: Vec<[f64; 3]>,
+    /// Forces, N.
+    pub felt: Vec<[f64; 3]>,
+}
+
+/// As [`run_linked`], with the trace of what the hand met.
+pub fn run_linked_traced(
+    scene_text: &str,
+    script_text: &str,
+    mech: Mechanics,
+    grip: Grip,
+    linked: &Linked,
+    seconds: Option<f64>,
+) -> Result<(Report, Trace), ClosedLoopError> {
     linked.link.validate()?;
     let falcon = DeviceModel::Falcon.specs().clone();
     let specs = specs_of(&mech, &falcon);
@@ -197,7 +219,11 @@ pub fn run_linked(
     }
     rep.energy_to_hand_j = dev.plant().energy_to_hand_j();
     rep.device_interventions = dev.device_side().interventions();
-    Ok(rep)
+    let trace = Trace {
+        readings: dev.readings().to_vec(),
+        felt: dev.felt().to_vec(),
+    };
+    Ok((rep, trace))
 }
 
 /// The loop's side of a modelled link: which sample each tick uses and when it runs (the

@@ -103,6 +103,8 @@ pub struct FakeReport {
     pub jumps_over_1n: u64,
     /// Largest change of force between two periods, N.
     pub max_jump_n: f64,
+    /// When the first 100 of those jumps happened, s after the first period.
+    pub jump_times_s: Vec<f64>,
     /// Work the device's motors did on the hand, J (modelled device only; 0 otherwise).
     pub energy_to_hand_j: f64,
     /// Servo periods on which the device side's two-port passivity layer held the force back
@@ -154,7 +156,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         socket: &socket,
         max_force_n: specs.limits.max_force_n,
         rng: ChaCha8Rng::seed_from_u64(cfg.seed),
-        start: Instant::now(),
+        start: pacer.start(),
         pending: BTreeMap::new(),
         sent_at: BTreeMap::new(),
         rtt: Vec::with_capacity(ticks as usize),
@@ -168,12 +170,18 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         outage_begun: false,
         force: [0.0; 3],
         felt: [0.0; 3],
+        period_s: 1.0 / f64::from(rate_hz),
     };
     let dt = 1.0 / f64::from(rate_hz);
     for k in 0..ticks {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) || receiver.done.load(Ordering::Relaxed)
         {
             break;
+        }
+        // Delayed samples leave at their due time, between the servo periods too.
+        while let Some(due) = servo.next_due().filter(|&d| d < pacer.scheduled(k)) {
+            pacer.wait_until(due);
+            servo.send_due();
         }
         pacer.wait_for(k);
         servo.rep.ticks += 1;
@@ -430,6 +438,8 @@ struct Servo<'a> {
     force: [f64; 3],
     /// The force a modelled device's motors rendered last period, N.
     felt: [f64; 3],
+    /// The servo period, s.
+    period_s: f64,
 }
 
 impl Servo<'_> {
@@ -459,9 +469,18 @@ impl Servo<'_> {
                 buttons,
             })
             .encode();
-            let due = self.start.elapsed().as_nanos() as u64 + (delay * 1e9) as u64;
+            // Due the delay after the period's start (when the sample was read).
+            let read_ns = (time_s * 1e9).round() as u64;
+            let due = read_ns + (delay * 1e9).round() as u64;
             self.pending.insert((due, k), pkt);
         }
+    }
+
+    /// When the next delayed sample is due.
+    fn next_due(&self) -> Option<Instant> {
+        self.pending
+            .first_key_value()
+            .map(|((due, _), _)| self.start + Duration::from_nanos(*due))
     }
 
     /// Sends what is due (in due order: jitter may reorder samples).
@@ -524,6 +543,11 @@ impl Servo<'_> {
         self.rep.max_jump_n = self.rep.max_jump_n.max(jump);
         if jump > 1.0 {
             self.rep.jumps_over_1n += 1;
+            if self.rep.jump_times_s.len() < 100 {
+                self.rep
+                    .jump_times_s
+                    .push(self.period_s * self.rep.ticks as f64);
+            }
         }
     }
 }

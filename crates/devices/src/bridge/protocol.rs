@@ -524,7 +524,8 @@ impl Reader<'_> {
             body_planes,
             world_energy_j,
         };
-        // The device checks the stiffnesses against its own cap when it renders the model.
+        // Finite, unit normals, masses and stiffnesses non-negative; the stiffnesses' cap is the
+        // simulator's (it sends only what the device announced it renders).
         m.check(f64::INFINITY).map_err(ProtocolError::Local)?;
         Ok(m)
     }

@@ -449,7 +449,8 @@ impl HapticDevice for UdpDevice {
                 force_n: [0.0; 3],
                 stiffness_n_per_m: [0.0; 9],
                 status: 0,
-                local: (self.version == 2).then(Box::default),
+                // A version-1 packet in either session: a device's two-port budget stays.
+                local: None,
             });
             let _ = sock.send_to(&zero.encode(), peer);
             let _ = sock.send_to(&Packet::Bye { reason: 0 }.encode(), peer);

@@ -28,8 +28,9 @@ simulator's welcome names the session's (the device's, at most 2):
   per sample, re-anchored on every answer) and the body's contact planes, and
   the energy the world has delivered to the hand. The device evaluates it at its
   own servo rate at the position it reads *now*, behind a two-port passivity
-  layer that never lets the work done on the hand run more than 0.02 J past the
-  world's (it adds damping, at most 2 N·s/m, while it does).
+  layer: once the work done on the hand runs more than 0.02 J past the world's
+  it adds damping (at most 2 N·s/m), and past a second 0.02 J it also scales the
+  force down, to zero two reserves further on.
 
 :class:`DeviceSide` is the device's rendering for both versions, a line-by-line
 port of the Rust ``haptic_devices::local::DeviceSide`` (the same forces to the
@@ -166,6 +167,15 @@ def _min(a: float, b: float) -> float:
     if math.isnan(b):
         return a
     return a if a < b else b
+
+
+def _max(a: float, b: float) -> float:
+    """Rust's ``f64::max``: the other value when one is NaN."""
+    if math.isnan(a):
+        return b
+    if math.isnan(b):
+        return a
+    return a if a > b else b
 
 
 def _vec3(v, what: str = "position") -> Vec3:
@@ -574,8 +584,9 @@ def decode(data: bytes):
     if magic != MAGIC:
         raise ValueError(f"bad magic [{', '.join(f'{b:02x}' for b in magic)}] (expected NHDB)")
     if version not in (VERSION, VERSION_2):
-        raise ValueError(f"protocol version {version} (this client speaks 1) and 2 "
-                         "(version 2: force packets with the local model)")
+        # Worded so that "(this client speaks 1)", the text tests/python/test_live.py matches
+        # since version 1, still appears.
+        raise ValueError(f"protocol version {version} (this client speaks 1) and 2")
     r = _Reader(data, _HEADER.size)
     if kind == WELCOME:
         rate, start = r.take(_WELCOME, "welcome")
@@ -623,14 +634,17 @@ class _Answer:
     local: Optional[LocalModel]
 
 
-def _reading_of(readings: Deque[Tuple[int, Vec3]], seq: int) -> Optional[Vec3]:
-    if not readings:
-        return None
-    i = seq - readings[0][0]
-    if i < 0 or i >= len(readings):
-        return None
-    r = readings[i]
-    return r[1] if r[0] == seq else None
+def _reading_at_or_before(readings: Deque[Tuple[int, Vec3]], seq: int) -> Optional[Vec3]:
+    """The reading sent as ``seq``, or the last one before it (a skipped number holds the
+    reading before it); None when ``seq`` is older than every kept reading."""
+    lo, hi = 0, len(readings)
+    while lo < hi:  # partition point: the first reading numbered above seq
+        mid = (lo + hi) // 2
+        if readings[mid][0] <= seq:
+            lo = mid + 1
+        else:
+            hi = mid
+    return readings[lo - 1][1] if lo > 0 else None
 
 
 class DeviceSide:
@@ -649,13 +663,15 @@ class DeviceSide:
       readings sent since. An answer without a local model (a version-1 packet) renders
       ``F0 − K (p − p0)``.
 
-    Answers older than the one rendered are dropped; a non-finite force renders as zero; a
+    Answers of an older tick than the one rendered are dropped; a non-finite force renders
+    as zero (a non-finite reading counts no work); a
     force above ``max_force_n`` is scaled down along its direction. Then (protocol 2) the
     two-port layer: with ``W`` the work the rendered forces did on the hand
     (``Σ F·Δp`` over servo periods) and ``W_world`` the world's (the last answer's
-    ``world_energy_j``), while ``W − W_world − 0.02 J > 0`` the force gets the damping
-    ``α = min(surplus / (servo_s |v|²), 2 N·s/m)`` on the last servo period's velocity
-    ``v`` (and is scaled down to ``max_force_n`` again).
+    ``world_energy_j``), while the surplus ``s = W − W_world − 0.02 J`` is positive the
+    force gets the damping ``α = min(s / (servo_s |v|²), 2 N·s/m)`` on the last servo
+    period's velocity ``v`` (``F − α v``); past ``s > 0.02 J`` that is also scaled by
+    ``max(0, 1 − (s − 0.02 J) / 0.04 J)``; then scaled down to ``max_force_n`` again.
 
     Not thread-safe: a device whose servo runs in another thread holds one lock around
     every call (the adapters do). ``period_s`` is the session's sample period (one sample
@@ -691,8 +707,10 @@ class DeviceSide:
         self._last_p: Optional[Vec3] = None
         self._last_f: Vec3 = _ZERO
         self._interventions = 0
-        # Python only (forget()): the newest answer's number after the answers went silent.
-        self._forgotten_seq: Optional[int] = None
+        # The smallest tick − seq of the answers so far (an on-time answer's).
+        self._tick_offset: Optional[int] = None
+        # Python only (forget()): the newest answer's tick after the answers went silent.
+        self._forgotten_tick: Optional[int] = None
 
     @property
     def work_j(self) -> float:
@@ -728,7 +746,7 @@ class DeviceSide:
         if body is None:
             return
         while self._body_next < seq:
-            p = _reading_of(self._readings, self._body_next)
+            p = _reading_at_or_before(self._readings, self._body_next)
             if p is None:
                 break
             a = self._answer
@@ -737,24 +755,29 @@ class DeviceSide:
             self._body_next += 1
 
     def receive(self, reply: ForceReply) -> bool:
-        """An answer arrived: rendered from now on unless it is older than the one rendered
-        (then dropped: returns False). Protocol 2's body restarts from the state the answer
-        reports and replays the readings sent since."""
-        newest = self._answer.reply.seq if self._answer is not None else self._forgotten_seq
-        if newest is not None and newest > reply.seq:
+        """An answer arrived: rendered from now on unless an answer of a later tick is
+        rendered (then dropped: returns False). Protocol 2's body restarts from the state the
+        answer reports for the sample after its tick (a stale tick answers an older sample:
+        its ``tick − seq`` exceeds an on-time answer's) and replays the readings sent since."""
+        newest = self._answer.reply.tick if self._answer is not None else self._forgotten_tick
+        if newest is not None and newest > reply.tick:
             return False
-        self._forgotten_seq = None
-        p0 = _reading_of(self._readings, reply.seq)
+        self._forgotten_tick = None
+        p0 = _reading_at_or_before(self._readings, reply.seq)
         if p0 is None:
             p0 = self._readings[0][1] if self._readings else _ZERO
         local = reply.local if self.protocol == VERSION_2 else None
+        lag = reply.tick - reply.seq
+        offset = lag if self._tick_offset is None else self._tick_offset
+        self._tick_offset = min(offset, lag)
         if local is not None:
             self._world_j = local.world_energy_j
-        if local is not None and local.body is not None:
-            self._body = dataclasses.replace(local.body)
-            self._body_next = reply.seq + 1
-        else:
-            self._body = None
+            nxt = reply.tick - min(offset, lag) + 1
+            if local.body is not None and nxt >= 0:
+                self._body = dataclasses.replace(local.body)
+                self._body_next = nxt
+            else:
+                self._body = None
         self._answer = _Answer(reply, p0, local)
         if self._readings:
             self._catch_up(self._readings[-1][0])
@@ -765,7 +788,7 @@ class DeviceSide:
         answer arrives (the work done keeps being counted). Not in the Rust device side,
         whose callers never go silent; without calls to it, this class is the Rust one."""
         if self._answer is not None:
-            self._forgotten_seq = self._answer.reply.seq
+            self._forgotten_tick = self._answer.reply.tick
         self._answer = None
         self._body = None
 
@@ -778,9 +801,13 @@ class DeviceSide:
         lp = self._last_p
         if lp is not None:
             d = _sub(p, lp)
-            self._work_j += _dot(self._last_f, d)
-            v = _scale(d, _div(1.0, servo_s))
-        self._last_p = p
+            w = _dot(self._last_f, d)
+            # A non-finite reading counts no work (it would poison the budget for good).
+            if math.isfinite(w) and _finite(d):
+                self._work_j += w
+                v = _scale(d, _div(1.0, servo_s))
+        if _finite(p):
+            self._last_p = p
         a = self._answer
         if a is None:
             self._last_f = _ZERO
@@ -803,6 +830,8 @@ class DeviceSide:
             f = _scale(f, self.max_force_n / n)
         if self.protocol == VERSION_2:
             f = self._bound(f, v, servo_s)
+            if not _finite(f):
+                f = _ZERO
         f = (float(f[0]), float(f[1]), float(f[2]))
         self._last_f = f
         return f
@@ -810,14 +839,21 @@ class DeviceSide:
     def _bound(self, f: Vec3, v: Vec3, servo_s: float) -> Vec3:
         """The two-port layer: while the hand has received more than the world delivered
         plus the reserve, a damper on the last servo period's velocity takes the surplus
-        back over the next period, at most DEVICE_MAX_DAMPING_N_S_PER_M."""
+        back over the next period (at most DEVICE_MAX_DAMPING_N_S_PER_M); past a second
+        reserve the force is also scaled down, to zero two reserves further on."""
         surplus = self._work_j - self._world_j - self._reserve_j
-        v2 = _dot(v, v)
-        if surplus <= 0.0 or v2 == 0.0:
+        if surplus <= 0.0:
             return f
         self._interventions += 1
-        alpha = _min(_div(surplus, servo_s * v2), DEVICE_MAX_DAMPING_N_S_PER_M)
-        g = _sub(f, _scale(v, alpha))
+        v2 = _dot(v, v)
+        if v2 > 0.0:
+            alpha = _min(_div(surplus, servo_s * v2), DEVICE_MAX_DAMPING_N_S_PER_M)
+            g = _sub(f, _scale(v, alpha))
+        else:
+            g = f
+        if surplus > self._reserve_j:
+            scale = _max(1.0 - (surplus - self._reserve_j) / (2.0 * self._reserve_j), 0.0)
+            g = _scale(g, scale)
         n = _norm(g)
         if n > self.max_force_n:
             return _scale(g, self.max_force_n / n)
@@ -1139,7 +1175,8 @@ class _ServoRendering(Device):
         else:
             fresh = time.perf_counter() - self._reply_at <= self.hold_s
             f = local_force(self._reply if fresh else None, self._p0, p, self._specs.max_force_n)
-        # DeviceSide renders a non-finite reading's force as is: never send it to the motors.
+        # Belt and braces: a reading far out of range can make the two-port layer's damping
+        # overflow; the motors never get anything but finite numbers.
         return f if _finite(f) else _ZERO
 
 
