@@ -23,7 +23,7 @@ if [ "$assemble_only" = 0 ] && [ ! -x .venv-bench/bin/python ]; then
 fi
 export NANOHAPTICS_PYTHON="$PWD/.venv-bench/bin/python"
 
-order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live soak determinism zwidth link brickworld nanoworld teaching-game play render sweeps fuzz)
+order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live soak determinism zwidth link adapters brickworld nanoworld teaching-game play render sweeps fuzz)
 for crate in "${order[@]}"; do
   if [ "$assemble_only" = 0 ] && [ -f "crates/$crate/examples/bench_report.rs" ]; then
     echo "==> $crate-report"
@@ -37,6 +37,18 @@ if [ "$assemble_only" = 0 ]; then
   cargo run --release -q -p haptic-loop --example haptic-loop-zwidth-report -- --out docs/bench/zwidth.md > /dev/null
   echo "==> haptic-loop-link-report (stability against delay and transparency behind a link, about 30 s)"
   cargo run --release -q -p haptic-loop --example haptic-loop-link-report -- --out docs/bench/link.md > /dev/null
+  echo "==> the Python device adapters' own latency against their mock SDKs (about 20 s)"
+  {
+    echo "## nanohaptics.bridge — the device adapters' own latency"
+    echo
+    echo "Machine: $(nproc) cores, load average \`$(cut -d' ' -f1-3 /proc/loadavg)\` at start."
+    echo "\`python3 examples/bridge/adapter_latency.py --seconds 3\`: each adapter against a mock of"
+    echo "its vendor SDK driven by a 1 kHz servo thread, and a fake simulator answering every"
+    echo "sample at once (times in ms). A 1 kHz servo applies an answer at its next tick at best,"
+    echo "1 ms after the reading: the adapters add the rest."
+    echo
+    python3 examples/bridge/adapter_latency.py --seconds 3
+  } > docs/bench/adapters.md
   echo "==> haptic-loop-teaching-report (the lesson and the sound, three runs each)"
   cargo run --release -q -p nanohaptics-lesson --example teaching-report -- --out docs/bench/teaching-game.md > /dev/null
   echo "==> play-bench (browser sessions in headless chromium, about 1 minute)"

@@ -295,6 +295,39 @@ def test_a_live_session_on_the_wall_in_each_protocol(tmp_path, protocol):
     assert f[2] == pytest.approx(WALL_K_N_PER_M * 0.0015, rel=0.01)
 
 
+def test_the_wheel_welcomes_a_device_with_the_scenes_rate_name_and_start_time(tmp_path):
+    """Issue 31: run_scene fills the bridge's welcome from the scene (it welcomed every device
+    with 1000 Hz, so a 10 kHz scene ran 9 stale ticks of 10)."""
+    import threading
+
+    import nanohaptics as nh
+
+    port = free_port()
+    scene = ROOT / "scenes" / "optical_tweezers_10khz.toml"
+    result = {}
+
+    def sim():
+        result.update(nh.run_scene(str(scene), device=f"udp:127.0.0.1:{port}",
+                                   out=str(tmp_path / "ten.mcap"), wait_s=20.0))
+
+    t = threading.Thread(target=sim)
+    t.start()
+    specs = bridge.Specs("falcon", 8.0, 3000.0, 0.04, FALCON_BUTTONS)
+    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=2)
+    try:
+        welcome = client.connect(20.0)
+        for k in range(200):  # 20 ms of samples at the welcomed rate
+            client.send((0.0, 0.0, 0.0))
+            client.receive(0.01)
+    finally:
+        client.close()
+    t.join()
+    assert welcome["rate_hz"] == 10_000
+    assert welcome["scene"].startswith("optical tweezers at 10 kHz")
+    assert welcome["version"] == 2
+    assert result["stats"]["link"]["received"] == 200
+
+
 def test_an_adapter_speaks_protocol_1_when_asked(tmp_path, mock_dhd):
     port, out = free_port(), tmp_path / "fd1.mcap"
     t, sim = bridged_session(port, out)

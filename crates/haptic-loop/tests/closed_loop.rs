@@ -165,3 +165,26 @@ fn a_scene_that_refuses_to_be_fitted_names_the_spring_and_the_cap() {
          allowed (0, 160]"
     );
 }
+
+/// A device that announces odd limits (a bridged device: 1.7 N, 137 N/m, a Touch's
+/// mechanics) plays every built-in scene: each scene fits its mapping to it and stays stable,
+/// and both houses complete.
+#[test]
+fn a_device_with_odd_limits_plays_every_built_in_scene() {
+    let mut odd = Mechanics::TOUCH;
+    odd.limits.max_force_n = 1.7;
+    odd.limits.max_stiffness_n_per_m = 137.0;
+    for (scene, script) in SCENES {
+        for grip in [Grip::LOOSE, Grip::FIRM] {
+            let r = play(scene, script, odd, grip, &|t| t);
+            println!("{}", line(&format!("{scene} odd {}", grip.label()), &r));
+            assert!(r.stable(), "{scene}: {r:?}");
+            assert!(r.peak_force_n <= 1.7, "{scene}: {}", r.peak_force_n);
+            assert!(r.max_stiffness_n_per_m <= 137.0 * (1.0 + 1e-9), "{scene}");
+            assert!(
+                r.house_complete_s.is_none_or(|t| t > 0.0),
+                "{scene}: house not built"
+            );
+        }
+    }
+}
