@@ -67,9 +67,9 @@ RANKS = {
         "edit",
     ],
     "haptic-devices": [
-        "mechanics grip plant pacing",
+        "mechanics grip plant pacing link local",
         "script",
-        "operator modelled",
+        "operator modelled linked",
         "bridge",
         "source",
     ],

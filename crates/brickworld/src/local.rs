@@ -1,9 +1,7 @@
 //! What the device may render on its own between two ticks (bridge protocol 2): the planes of
 //! the surfaces at and near the cursor sphere, and the carried brick on its coupling. World
-//! frame and units; the haptic loop maps them to the device.
-
-use crate::world::World;
-use rapier3d_f64::math::Vector;
+//! frame and units; the haptic loop maps them to the device. The types only: the world fills
+//! them (`World::local_primitives`), the hand supplies the carried brick's parts.
 
 /// How far from the cursor sphere a surface is announced before it is touched, m: a contact
 /// that begins between two answers is then felt at once.
@@ -62,47 +60,4 @@ pub struct LocalPrimitives {
     /// The surfaces the carried brick touches or nears, as planes on its grip point
     /// ([`CarriedBody::position_m`]): it stays where `n·x ≥ offset` (at most [`MAX_PLANES`]).
     pub body_planes: Vec<ContactPlane>,
-}
-
-impl World {
-    /// The primitives the device may render until the next tick: a plane for each surface the
-    /// god-object touches (deduplicated by normal) and for the nearest surface within
-    /// [`NEAR_SURFACE_M`], each `n·c ≥ n·proxy` at the proxy stiffness; and the carried brick.
-    pub fn local_primitives(&self) -> LocalPrimitives {
-        let p = self.params();
-        let proxy = Vector::from_array(self.proxy_position_m());
-        let k = p.proxy_stiffness_n_per_m;
-        let mut planes: Vec<ContactPlane> = Vec::with_capacity(MAX_PLANES);
-        let mut push = |n: Vector, offset: f64| {
-            let dup = planes
-                .iter()
-                .any(|q| Vector::from_array(q.normal).dot(n) > 1.0 - 1e-9);
-            if !dup && planes.len() < MAX_PLANES && n.is_finite() && offset.is_finite() {
-                planes.push(ContactPlane {
-                    normal: n.to_array(),
-                    offset_m: offset,
-                    stiffness_n_per_m: k,
-                });
-            }
-        };
-        for n in self.hand_contact_normals() {
-            push(*n, n.dot(proxy));
-        }
-        if let Some((point, n)) = self.nearest_surface(NEAR_SURFACE_M) {
-            push(n, n.dot(point) + p.proxy_radius_m);
-        }
-        let body = self.carried_body();
-        let body_planes = match &body {
-            Some(b) => {
-                let speed = Vector::from_array(b.velocity_m_per_s).length();
-                self.carried_contacts(b.position_m, NEAR_SURFACE_M.max(speed * LOOKAHEAD_S))
-            }
-            None => Vec::new(),
-        };
-        LocalPrimitives {
-            planes,
-            body,
-            body_planes,
-        }
-    }
 }

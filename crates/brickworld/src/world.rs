@@ -360,6 +360,57 @@ impl World {
     }
 }
 
+impl World {
+    /// The primitives the device may render until the next tick: a plane for each surface the
+    /// god-object touches (deduplicated by normal) and for the nearest surface within
+    /// [`crate::local::NEAR_SURFACE_M`], each `n·c ≥ n·proxy` at the proxy stiffness; and the carried brick.
+    pub fn local_primitives(&self) -> crate::local::LocalPrimitives {
+        let p = self.params();
+        let proxy = Vector::from_array(self.proxy_position_m());
+        let k = p.proxy_stiffness_n_per_m;
+        let mut planes: Vec<crate::local::ContactPlane> =
+            Vec::with_capacity(crate::local::MAX_PLANES);
+        let mut push = |n: Vector, offset: f64| {
+            let dup = planes
+                .iter()
+                .any(|q| Vector::from_array(q.normal).dot(n) > 1.0 - 1e-9);
+            if !dup
+                && planes.len() < crate::local::MAX_PLANES
+                && n.is_finite()
+                && offset.is_finite()
+            {
+                planes.push(crate::local::ContactPlane {
+                    normal: n.to_array(),
+                    offset_m: offset,
+                    stiffness_n_per_m: k,
+                });
+            }
+        };
+        for n in self.hand_contact_normals() {
+            push(*n, n.dot(proxy));
+        }
+        if let Some((point, n)) = self.nearest_surface(crate::local::NEAR_SURFACE_M) {
+            push(n, n.dot(point) + p.proxy_radius_m);
+        }
+        let body = self.carried_body();
+        let body_planes = match &body {
+            Some(b) => {
+                let speed = Vector::from_array(b.velocity_m_per_s).length();
+                self.carried_contacts(
+                    b.position_m,
+                    crate::local::NEAR_SURFACE_M.max(speed * crate::local::LOOKAHEAD_S),
+                )
+            }
+            None => Vec::new(),
+        };
+        crate::local::LocalPrimitives {
+            planes,
+            body,
+            body_planes,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

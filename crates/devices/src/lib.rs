@@ -22,6 +22,12 @@
 //!   [`Plant`] held by a [`Grip`] following the script ([`ModelledDevice`]); [`bridge`], a
 //!   device in another process over UDP ([`UdpDevice`]) and the `fake-device` stand-in;
 //! - [`source`]: the one list of device sources a session can be driven by;
+//! - [`local`]: the device side of the bridge — what a device's servo thread renders between
+//!   the simulator's answers (protocol 1's `F0 − K (p − p0)`, protocol 2's local model) and
+//!   the two-port passivity layer — used by `fake-device`, [`linked`] and, ported line by
+//!   line, the Python adapters;
+//! - [`link`]: a network link as a deterministic model (latency, jitter, loss), and
+//!   [`linked`], a modelled device held by a hand at its far end;
 //! - [`pacing`]: real-time pacing of ticks and the tick-time statistics (constant-memory
 //!   histograms, percentiles).
 //!

@@ -10,6 +10,8 @@
 //! - [`device`]: the haptic device interface ([`HapticDevice`], [`DeviceSample`],
 //!   [`DeviceSpecs`], [`ForceCommand`], [`TickTime`]);
 //! - [`tick`]: what one tick of the loop produced ([`TickResult`], its [`tick::status`] bits);
+//! - [`local`]: the local model a device renders between answers (bridge protocol 2): contact
+//!   planes, a carried body on its coupling, the residual and the world's energy;
 //! - [`textpos`]: line and column of a field in a TOML file, for errors;
 //! - [`value`]: the one form of a bad number (`field = v is out of range: allowed …`).
 //!
