@@ -230,6 +230,7 @@ fn duplicate_reordered_malformed_oversized_and_stranger_packets_are_counted_and_
                 device_time_ns: seq * 1_000_000,
                 position_m: [0.0, 0.0, z],
                 buttons: 0,
+                two_port_periods: None,
             })
             .encode()
         };
@@ -393,5 +394,70 @@ fn the_welcome_carries_the_scenes_rate_name_and_start_time() {
         "{stale} stale ticks of {}",
         r.stats.ticks
     );
+    assert_replays(&out);
+}
+
+/// A version-2 device is welcomed with version 2, gets the local model with every answer (the
+/// wall's plane), and its two-port count reaches the session's link counters (and so the
+/// recording's `device_link` metadata).
+#[test]
+fn a_version_2_device_gets_the_local_model_and_reports_its_two_port_periods() {
+    let _serial = serial();
+    let addr = free_port();
+    let out = tmp("v2.mcap");
+    let mut opts = bridged(addr, &out);
+    opts.seconds = Some(0.05);
+    let client = move || {
+        let s = UdpSocket::bind("127.0.0.1:0").unwrap();
+        s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
+        let hello = Packet::Hello {
+            version: 2,
+            rate_hz: 1000,
+            specs: FALCON,
+        }
+        .encode();
+        let mut buf = [0u8; 2048];
+        let version = loop {
+            s.send_to(&hello, addr).unwrap();
+            if let Ok((n, _)) = s.recv_from(&mut buf) {
+                if let Ok(Packet::Welcome { version, .. }) = Packet::decode(&buf[..n]) {
+                    break version;
+                }
+            }
+        };
+        s.set_read_timeout(Some(Duration::from_millis(200)))
+            .unwrap();
+        let mut locals = Vec::new();
+        for seq in 0..50u64 {
+            let p = Packet::Sample(Sample {
+                seq,
+                device_time_ns: seq * 1_000_000,
+                position_m: [0.0, 0.0, -0.006],
+                buttons: 0,
+                two_port_periods: Some(if seq == 20 { 7 } else { 3 }),
+            });
+            s.send_to(&p.encode(), addr).unwrap();
+            while let Ok((n, _)) = s.recv_from(&mut buf) {
+                if let Ok(Packet::Force(f)) = Packet::decode(&buf[..n]) {
+                    if f.seq == seq {
+                        locals.push(f.local);
+                        break;
+                    }
+                }
+            }
+        }
+        (version, locals)
+    };
+    let h = std::thread::spawn(move || run_session(&opts, &mut |_, _| {}));
+    let (version, locals) = client();
+    let r = h.join().unwrap().unwrap();
+    assert_eq!(version, 2);
+    assert_eq!(locals.len(), 50);
+    for m in locals {
+        let m = m.expect("a version-2 answer carries the local model");
+        assert_eq!(m.planes.len(), 1);
+        assert_eq!(m.planes[0].normal, [0.0, 0.0, 1.0]);
+    }
+    assert_eq!(counter(&r, "device_two_port_periods"), 7);
     assert_replays(&out);
 }

@@ -186,7 +186,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         pacer.wait_for(k);
         servo.rep.ticks += 1;
         let t = TickTime::new(k, rate_hz);
-        let (position_m, buttons) = match modelled.as_mut() {
+        let (position_m, buttons, two_port) = match modelled.as_mut() {
             Some(m) => {
                 // The device and hand over the last period, rendered by the device side.
                 if k > 0 {
@@ -202,7 +202,9 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
                 }
                 let reading = m.plant.reading_m();
                 m.side.record_reading(k, reading);
-                (reading, cfg.script.buttons(t.time_s).0)
+                let count = (protocol == Protocol::V2)
+                    .then(|| u32::try_from(m.side.interventions()).unwrap_or(u32::MAX));
+                (reading, cfg.script.buttons(t.time_s).0, count)
             }
             None => {
                 other.set_force(&ForceCommand {
@@ -210,10 +212,10 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
                     ..Default::default()
                 })?;
                 let s = other.sample(t)?;
-                (s.position_m, s.buttons.0)
+                (s.position_m, s.buttons.0, None)
             }
         };
-        servo.queue(k, t.time_s, position_m, buttons);
+        servo.queue(k, t.time_s, position_m, buttons, two_port);
         servo.send_due();
         // A modelled device renders an answer when it arrives, as a driver's servo thread
         // does: wait for the answer to this period's sample for up to half a period, so the
@@ -445,7 +447,14 @@ struct Servo<'a> {
 impl Servo<'_> {
     /// Period `k`'s sample at `time_s`: silent in the outage, dropped with the loss's
     /// probability, or else queued after the latency and a jitter draw.
-    fn queue(&mut self, k: u64, time_s: f64, position_m: [f64; 3], buttons: u32) {
+    fn queue(
+        &mut self,
+        k: u64,
+        time_s: f64,
+        position_m: [f64; 3],
+        buttons: u32,
+        two_port_periods: Option<u32>,
+    ) {
         let cfg = self.cfg;
         let silent = cfg
             .outage
@@ -467,6 +476,7 @@ impl Servo<'_> {
                 device_time_ns: self.start.elapsed().as_nanos() as u64,
                 position_m,
                 buttons,
+                two_port_periods,
             })
             .encode();
             // Due the delay after the period's start (when the sample was read).

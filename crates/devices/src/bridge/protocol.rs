@@ -7,7 +7,9 @@
 //! Version 2 (issue 31) adds the local model a device renders between answers
 //! (`haptic_types::local`): a device that says hello with version 2 is welcomed with version 2
 //! and every force packet it receives carries the local model after the version-1 fields.
-//! Samples and byes are the same in both versions (sent with version 1, read with either).
+//! A version-2 sample also carries the device side's count of servo periods its two-port
+//! layer acted on (the simulator reports the largest in its link counters, which the recording
+//! keeps). Byes are the same in both versions (sent with version 1, read with either).
 //!
 //! | type | name    | direction     | body after the header                                              |
 //! |------|---------|---------------|--------------------------------------------------------------------|
@@ -40,6 +42,9 @@ const BODY_LEN: usize = 16 * 8 + 4 + 8;
 pub const MAX_PACKET: usize = 1200;
 /// Size of a sample packet, bytes.
 pub const SAMPLE_LEN: usize = 52;
+/// Size of a version-2 sample packet, bytes: a version-1 sample and the device side's u32
+/// count of servo periods its two-port layer acted on.
+pub const SAMPLE_V2_LEN: usize = 56;
 /// Size of a force packet, bytes.
 pub const FORCE_LEN: usize = 121;
 /// Size of a bye packet, bytes.
@@ -91,6 +96,9 @@ pub struct Sample {
     pub position_m: Vec3,
     /// Button bits.
     pub buttons: u32,
+    /// Version 2 only: the servo periods the device side's two-port passivity layer has
+    /// acted on since the hello (`None`: a version-1 sample).
+    pub two_port_periods: Option<u32>,
 }
 
 /// The simulator's answer to a sample.
@@ -260,13 +268,21 @@ impl Packet {
                 put_str(v, scene);
             }
             Packet::Sample(s) => {
-                header(v, VERSION, 3);
+                let version = if s.two_port_periods.is_some() {
+                    VERSION_2
+                } else {
+                    VERSION
+                };
+                header(v, version, 3);
                 v.extend_from_slice(&s.seq.to_le_bytes());
                 v.extend_from_slice(&s.device_time_ns.to_le_bytes());
                 for x in s.position_m {
                     v.extend_from_slice(&x.to_le_bytes());
                 }
                 v.extend_from_slice(&s.buttons.to_le_bytes());
+                if let Some(n) = s.two_port_periods {
+                    v.extend_from_slice(&n.to_le_bytes());
+                }
             }
             Packet::Force(f) => {
                 let version = if f.local.is_some() {
@@ -374,12 +390,21 @@ impl Packet {
                 })
             }
             3 => {
-                fixed("sample", SAMPLE_LEN)?;
+                if version == VERSION {
+                    fixed("sample", SAMPLE_LEN)?;
+                } else {
+                    fixed("sample (version 2)", SAMPLE_V2_LEN)?;
+                }
                 Ok(Packet::Sample(Sample {
                     seq: r.u64("sample")?,
                     device_time_ns: r.u64("sample")?,
                     position_m: [r.f64("sample")?, r.f64("sample")?, r.f64("sample")?],
                     buttons: r.u32("sample")?,
+                    two_port_periods: if version == VERSION_2 {
+                        Some(r.u32("sample")?)
+                    } else {
+                        None
+                    },
                 }))
             }
             4 => {
@@ -590,6 +615,7 @@ mod tests {
             device_time_ns: 99,
             position_m: [0.01, -0.02, f64::NAN],
             buttons: 5,
+            two_port_periods: None,
         });
         let b = s.encode();
         assert_eq!(b.len(), SAMPLE_LEN);
@@ -628,6 +654,23 @@ mod tests {
         };
         assert_eq!(Packet::decode(&w.encode()), Ok(w));
         assert_eq!(Packet::Bye { reason: 0 }.encode().len(), BYE_LEN);
+        // A version-2 sample: the version-1 fields, then the two-port count.
+        let s2 = Packet::Sample(Sample {
+            seq: 8,
+            device_time_ns: 1,
+            position_m: [0.0; 3],
+            buttons: 0,
+            two_port_periods: Some(41),
+        });
+        let b = s2.encode();
+        assert_eq!(b.len(), SAMPLE_V2_LEN);
+        assert_eq!(&b[..8], b"NHDB\x02\x03\x00\x00");
+        assert_eq!(&b[52..], &41u32.to_le_bytes());
+        assert_eq!(Packet::decode(&b), Ok(s2));
+        assert_eq!(
+            Packet::decode(&b[..52]).unwrap_err().to_string(),
+            "sample (version 2) packet of 52 bytes is too short (needs 56)"
+        );
     }
 
     #[test]
@@ -637,6 +680,7 @@ mod tests {
             device_time_ns: 0,
             position_m: [0.0; 3],
             buttons: 0,
+            two_port_periods: None,
         })
         .encode();
         let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
@@ -822,7 +866,7 @@ mod tests {
                 h.extend_from_slice(&b);
                 let r = Packet::decode(&h);
                 if let Ok(Packet::Sample(_)) = r {
-                    prop_assert_eq!(h.len(), SAMPLE_LEN);
+                    prop_assert_eq!(h.len(), if v[4] == 1 { SAMPLE_LEN } else { SAMPLE_V2_LEN });
                 }
             }
         }

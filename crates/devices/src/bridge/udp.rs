@@ -76,6 +76,8 @@ struct Counters {
     send_errors: u64,
     stale_ticks: u64,
     resync: u64,
+    /// The largest count of two-port servo periods a version-2 device reported.
+    device_two_port: u64,
 }
 
 #[derive(Default)]
@@ -232,25 +234,30 @@ fn receive(socket: UdpSocket, shared: Arc<Shared>, welcomes: [Vec<u8>; 2]) {
                     continue;
                 }
             }
-            Ok(Packet::Sample(s)) if st.peer == Some(from) => match st.last_seq {
-                Some(l) if s.seq == l => st.c.duplicate += 1,
-                Some(l) if s.seq < l => st.c.reordered += 1,
-                last => {
-                    if let Some(l) = last {
-                        st.c.gap_lost += s.seq - l - 1;
-                    }
-                    st.last_seq = Some(s.seq);
-                    st.c.received += 1;
-                    if st.queue.len() >= QUEUE {
-                        st.queue.pop_front();
-                        st.c.superseded += 1;
-                    }
-                    st.queue.push_back(s);
-                    drop(st);
-                    shared.arrived.notify_all();
-                    continue;
+            Ok(Packet::Sample(s)) if st.peer == Some(from) => {
+                if let Some(n) = s.two_port_periods {
+                    st.c.device_two_port = st.c.device_two_port.max(u64::from(n));
                 }
-            },
+                match st.last_seq {
+                    Some(l) if s.seq == l => st.c.duplicate += 1,
+                    Some(l) if s.seq < l => st.c.reordered += 1,
+                    last => {
+                        if let Some(l) = last {
+                            st.c.gap_lost += s.seq - l - 1;
+                        }
+                        st.last_seq = Some(s.seq);
+                        st.c.received += 1;
+                        if st.queue.len() >= QUEUE {
+                            st.queue.pop_front();
+                            st.c.superseded += 1;
+                        }
+                        st.queue.push_back(s);
+                        drop(st);
+                        shared.arrived.notify_all();
+                        continue;
+                    }
+                }
+            }
             Ok(Packet::Bye { .. }) if st.peer == Some(from) => {
                 st.ended = true;
                 drop(st);
@@ -390,6 +397,7 @@ impl HapticDevice for UdpDevice {
             device_time_ns: 0,
             position_m: [0.0; 3],
             buttons: 0,
+            two_port_periods: None,
         });
         let age = u32::try_from(k.saturating_sub(s.seq)).unwrap_or(u32::MAX);
         if age > 0 {
@@ -477,6 +485,7 @@ impl HapticDevice for UdpDevice {
             ("send_errors", c.send_errors),
             ("stale_ticks", c.stale_ticks),
             ("resync", c.resync),
+            ("device_two_port_periods", c.device_two_port),
         ]
     }
 }

@@ -101,6 +101,7 @@ impl Target {
                     device_time_ns: 1_000_000,
                     position_m: [0.001, -0.002, -0.006],
                     buttons: 1,
+                    two_port_periods: None,
                 };
                 t.seeds = vec![
                     Packet::Hello {

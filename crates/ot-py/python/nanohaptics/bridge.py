@@ -438,12 +438,17 @@ def encode_welcome(rate_hz: int, start_time_ns: int, scene: str, version: int = 
             + struct.pack("<IQ", rate_hz, start_time_ns) + _string(scene))
 
 
-def encode_sample(seq: int, device_time_ns: int, position_m: Sequence[float], buttons: int) -> bytes:
-    """A sample datagram: position in metres (device frame), button bits."""
+def encode_sample(seq: int, device_time_ns: int, position_m: Sequence[float], buttons: int,
+                  two_port_periods: Optional[int] = None) -> bytes:
+    """A sample datagram: position in metres (device frame), button bits; with
+    ``two_port_periods`` (the servo periods the device side's two-port layer has acted on), a
+    version-2 sample, whose count the simulator keeps in its link counters."""
     x, y, z = (float(v) for v in position_m)
-    return _HEADER.pack(MAGIC, VERSION, SAMPLE, 0) + _SAMPLE.pack(
-        seq, device_time_ns, x, y, z, buttons
-    )
+    body = _SAMPLE.pack(seq, device_time_ns, x, y, z, buttons)
+    if two_port_periods is None:
+        return _HEADER.pack(MAGIC, VERSION, SAMPLE, 0) + body
+    n = max(0, min(int(two_port_periods), 0xFFFFFFFF))
+    return _HEADER.pack(MAGIC, VERSION_2, SAMPLE, 0) + body + struct.pack("<I", n)
 
 
 def encode_bye(reason: int = 0) -> bytes:
@@ -610,10 +615,15 @@ def decode(data: bytes):
         _fixed(data, "bye", BYE_LEN)
         return "bye", data[8]
     if kind == SAMPLE:
-        _fixed(data, "sample", SAMPLE_LEN)
+        if version == VERSION_2:
+            _fixed(data, "sample (version 2)", SAMPLE_LEN + 4)
+        else:
+            _fixed(data, "sample", SAMPLE_LEN)
         seq, t_ns, x, y, z, buttons = _SAMPLE.unpack_from(data, _HEADER.size)
-        return "sample", {"seq": seq, "device_time_ns": t_ns, "position_m": (x, y, z),
-                          "buttons": buttons}
+        out = {"seq": seq, "device_time_ns": t_ns, "position_m": (x, y, z), "buttons": buttons}
+        if version == VERSION_2:
+            out["two_port_periods"] = struct.unpack_from("<I", data, SAMPLE_LEN)[0]
+        return "sample", out
     if kind == HELLO:
         rate, fmax, kmax, radius = r.take(_HELLO, "hello")
         name = r.string("hello name")
@@ -914,12 +924,15 @@ class BridgeClient:
                 return value
         raise TimeoutError(f"no welcome from udp:{self.address[0]}:{self.address[1]} within {timeout_s} s")
 
-    def send(self, position_m: Sequence[float], buttons: int = 0) -> int:
-        """Send one sample; returns its sequence number."""
+    def send(self, position_m: Sequence[float], buttons: int = 0,
+             two_port_periods: Optional[int] = None) -> int:
+        """Send one sample; returns its sequence number. In a version-2 session, pass the
+        device side's two-port count (``DeviceSide.interventions``) to report it."""
         seq = self.seq
         self.seq += 1
         t = time.perf_counter_ns() - self._t0
-        self.sock.sendto(encode_sample(seq, t, position_m, buttons), self.address)
+        n = two_port_periods if self.version == VERSION_2 else None
+        self.sock.sendto(encode_sample(seq, t, position_m, buttons, n), self.address)
         return seq
 
     def receive(self, timeout_s: float) -> Optional[ForceReply]:
@@ -1061,7 +1074,9 @@ def run(device: Device, address: Tuple[str, int], *, seconds: Optional[float] = 
             if uses_side:
                 device.record_reading(client.seq, p)
             t_send = time.perf_counter()
-            seq = client.send(p, b)
+            # A device side's two-port count rides on the sample (read without its lock: an
+            # int, at most one period stale).
+            seq = client.send(p, b, side.interventions if uses_side else None)
             sent += 1
             reply = client.receive(period)
             while reply is not None:
