@@ -9,7 +9,6 @@
 
 use haptic_devices::bridge::protocol::{ForceReply, Packet};
 use haptic_devices::local::{DeviceSide, Protocol};
-use haptic_types::device::ForceCommand;
 use haptic_types::local::{Body, LocalModel, Plane};
 use serde_json::{Value, json};
 
@@ -117,14 +116,7 @@ fn case(protocol: Protocol) -> Value {
                 protocol == Protocol::V2,
             );
             let bytes = Packet::Force(reply.clone()).encode();
-            let cmd = ForceCommand {
-                tick: reply.tick,
-                seq: reply.seq,
-                force_n: reply.force_n,
-                stiffness_n_per_m: reply.stiffness_n_per_m,
-                status: reply.status,
-            };
-            side.receive(&cmd, reply.local.as_deref().cloned());
+            side.receive(&reply.command(), reply.local.as_deref().cloned());
             steps.push(json!({"op": "receive", "packet_hex": hex(&bytes)}));
         }
         for j in 0..4 {

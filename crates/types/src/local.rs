@@ -237,19 +237,8 @@ impl LocalModel {
         {
             return Err("a residual force, stiffness or energy is not finite".into());
         }
-        if self.planes.len() > MAX_PLANES {
-            return Err(format!(
-                "{} planes: allowed at most {MAX_PLANES}",
-                self.planes.len()
-            ));
-        }
+        check_planes("plane", &self.planes)?;
         for (i, p) in self.planes.iter().enumerate() {
-            let n = vec3::norm(p.normal);
-            if !finite(&p.normal) || (n - 1.0).abs() > 1e-6 || !p.offset_m.is_finite() {
-                return Err(format!(
-                    "plane {i}: the normal must be a finite unit vector"
-                ));
-            }
             if !(0.0..=max_stiffness_n_per_m).contains(&p.stiffness_n_per_m) {
                 return Err(format!(
                     "plane {i}: stiffness {} N/m is out of range: allowed 0 ≤ k ≤ {} N/m",
@@ -257,20 +246,7 @@ impl LocalModel {
                 ));
             }
         }
-        if self.body_planes.len() > MAX_PLANES {
-            return Err(format!(
-                "{} body planes: allowed at most {MAX_PLANES}",
-                self.body_planes.len()
-            ));
-        }
-        for (i, p) in self.body_planes.iter().enumerate() {
-            let n = vec3::norm(p.normal);
-            if !finite(&p.normal) || (n - 1.0).abs() > 1e-6 || !p.offset_m.is_finite() {
-                return Err(format!(
-                    "body plane {i}: the normal must be a finite unit vector"
-                ));
-            }
-        }
+        check_planes("body plane", &self.body_planes)?;
         if let Some(b) = &self.body {
             if !(0.0..=1.0).contains(&b.restitution) {
                 return Err(format!(
@@ -316,4 +292,24 @@ impl LocalModel {
         }
         Ok(())
     }
+}
+
+/// At most [`MAX_PLANES`] planes (`what`: how errors name them), each with a finite unit
+/// normal and a finite offset.
+fn check_planes(what: &str, planes: &[Plane]) -> Result<(), String> {
+    if planes.len() > MAX_PLANES {
+        return Err(format!(
+            "{} {what}s: allowed at most {MAX_PLANES}",
+            planes.len()
+        ));
+    }
+    for (i, p) in planes.iter().enumerate() {
+        let n = vec3::norm(p.normal);
+        if !vec3::is_finite(p.normal) || (n - 1.0).abs() > 1e-6 || !p.offset_m.is_finite() {
+            return Err(format!(
+                "{what} {i}: the normal must be a finite unit vector"
+            ));
+        }
+    }
+    Ok(())
 }

@@ -228,16 +228,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
             servo.reply(&r, modelled.is_none());
             if let Some(m) = modelled.as_mut() {
                 let f = &r.force;
-                m.side.receive(
-                    &ForceCommand {
-                        tick: f.tick,
-                        seq: f.seq,
-                        force_n: f.force_n,
-                        stiffness_n_per_m: f.stiffness_n_per_m,
-                        status: f.status,
-                    },
-                    f.local.as_deref().cloned(),
-                );
+                m.side.receive(&f.command(), f.local.as_deref().cloned());
             }
         }
         // Forget sends never answered (lost replies) after a second.

@@ -119,6 +119,19 @@ pub struct ForceReply {
     pub local: Option<Box<LocalModel>>,
 }
 
+impl ForceReply {
+    /// The answer as the device interface's command (its local model apart).
+    pub fn command(&self) -> haptic_types::device::ForceCommand {
+        haptic_types::device::ForceCommand {
+            tick: self.tick,
+            seq: self.seq,
+            force_n: self.force_n,
+            stiffness_n_per_m: self.stiffness_n_per_m,
+            status: self.status,
+        }
+    }
+}
+
 /// Why a datagram was refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ProtocolError {

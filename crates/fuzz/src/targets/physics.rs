@@ -2,7 +2,6 @@
 //! script is sampled), and every force must be finite and within the device's limit.
 
 use super::{Outcome, falcon};
-use haptic_devices::ForceCommand;
 use haptic_devices::Script;
 use haptic_devices::bridge::protocol::Packet;
 use haptic_devices::local::{DeviceSide, Protocol};
@@ -168,16 +167,7 @@ pub fn run_bridge(input: &[u8]) -> Outcome {
                 let mut side = DeviceSide::new(protocol, max, 1e-3);
                 side.record_reading(f.seq, [0.0; 3]);
                 side.record_reading(f.seq.saturating_add(1), [0.001, 0.0, -0.002]);
-                side.receive(
-                    &ForceCommand {
-                        tick: f.tick,
-                        seq: f.seq,
-                        force_n: f.force_n,
-                        stiffness_n_per_m: f.stiffness_n_per_m,
-                        status: f.status,
-                    },
-                    f.local.as_deref().cloned(),
-                );
+                side.receive(&f.command(), f.local.as_deref().cloned());
                 for p in [[0.0; 3], [0.001, 0.0, -0.002], [0.03, -0.03, 0.03]] {
                     let g = side.render(p, 2.5e-4);
                     // Within the limit to rounding (the motors clamp exactly).

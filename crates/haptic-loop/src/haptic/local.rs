@@ -32,14 +32,16 @@ impl HapticLoop {
             self.local_gain / fs
         };
         let to_device = |x: Vec3| vec3::scale(vec3::sub(x, m.origin_m), 1.0 / ws);
+        // A plane `n·x ≥ o` in the world is `n·p ≥ (o − n·origin) / ws` at the device.
+        let plane_to_device = |p: &Plane, stiffness_n_per_m: f64| Plane {
+            normal: p.normal,
+            offset_m: (p.offset_m - vec3::dot(p.normal, m.origin_m)) / ws,
+            stiffness_n_per_m,
+        };
         let planes: Vec<Plane> = prims
             .planes
             .iter()
-            .map(|p| Plane {
-                normal: p.normal,
-                offset_m: (p.offset_m - vec3::dot(p.normal, m.origin_m)) / ws,
-                stiffness_n_per_m: p.stiffness_n_per_m * kd * gain,
-            })
+            .map(|p| plane_to_device(p, p.stiffness_n_per_m * kd * gain))
             .collect();
         let body = prims.body.map(|b| Body {
             position_m: to_device(b.position_m),
@@ -56,11 +58,7 @@ impl HapticLoop {
         let body_planes: Vec<Plane> = prims
             .body_planes
             .iter()
-            .map(|p| Plane {
-                normal: p.normal,
-                offset_m: (p.offset_m - vec3::dot(p.normal, m.origin_m)) / ws,
-                stiffness_n_per_m: 0.0,
-            })
+            .map(|p| plane_to_device(p, 0.0))
             .collect();
         let world_energy_j = self.initial_tank_j() - self.tank_j;
         if planes.is_empty() && body.is_none() {
