@@ -362,19 +362,26 @@ impl Hand {
     /// Distance from the cursor sphere's surface to the nearest solid other than the carried
     /// brick, m: 0 when touching, `f64::INFINITY` beyond [`NEAREST_MAX_M`].
     pub(crate) fn nearest_m(&self, params: &Params, bricks: &BrickSet) -> f64 {
+        let r = params.proxy_radius_m;
+        match self.nearest_point(bricks, NEAREST_MAX_M + r) {
+            Some((_, true)) => 0.0,
+            Some((point, false)) => ((point - self.proxy).length() - r).max(0.0),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// The nearest solid's point to the proxy within `max_m` of its centre and whether the
+    /// proxy is inside it; the carried brick and a brick being let go of are not solids here.
+    fn nearest_point(&self, bricks: &BrickSet, max_m: f64) -> Option<(Vector, bool)> {
         let ghost = self.letting_go;
         let pass = move |h: ColliderHandle, _: &Collider| Some(h) != ghost;
         let mut filter = QueryFilter::default().predicate(&pass);
         if let Some(h) = self.held {
             filter = filter.exclude_collider(bricks.collider(h.brick));
         }
-        let r = params.proxy_radius_m;
         let qp = bricks.phys.query_pipeline_with_filter(filter);
-        match qp.project_point(self.proxy, NEAREST_MAX_M + r, true) {
-            Some((_, proj)) if proj.is_inside => 0.0,
-            Some((_, proj)) => ((proj.point - self.proxy).length() - r).max(0.0),
-            None => f64::INFINITY,
-        }
+        qp.project_point(self.proxy, max_m, true)
+            .map(|(_, proj)| (proj.point, proj.is_inside))
     }
 
     /// Outward normals of the surfaces the god-object touched in the last update.
@@ -390,18 +397,10 @@ impl Hand {
         bricks: &BrickSet,
         range_m: f64,
     ) -> Option<(Vector, Vector)> {
-        let ghost = self.letting_go;
-        let pass = move |h: ColliderHandle, _: &Collider| Some(h) != ghost;
-        let mut filter = QueryFilter::default().predicate(&pass);
-        if let Some(h) = self.held {
-            filter = filter.exclude_collider(bricks.collider(h.brick));
-        }
-        let r = params.proxy_radius_m;
-        let qp = bricks.phys.query_pipeline_with_filter(filter);
-        let (_, proj) = qp.project_point(self.proxy, range_m + r, true)?;
-        let d = self.proxy - proj.point;
+        let (point, inside) = self.nearest_point(bricks, range_m + params.proxy_radius_m)?;
+        let d = self.proxy - point;
         let len = d.length();
-        (!proj.is_inside && len > 0.0).then(|| (proj.point, d / len))
+        (!inside && len > 0.0).then(|| (point, d / len))
     }
 
     /// The carried brick's coupling in the state the next tick starts from: the brick's
