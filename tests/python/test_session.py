@@ -104,7 +104,7 @@ def test_session_errors(tmp_path):
          "script: operator: unknown key `stifness` (allowed: mass_kg, stiffness_n_per_m, "
          "damping_n_s_per_m, yield_force_n)"),
         (lambda: nh.run_scene(SCENES / "wall.toml", device="phantom"),
-         'device = "phantom": allowed "falcon", "touch" or "udp:HOST:PORT"'),
+         'device = "phantom": allowed falcon, touch, udp:HOST:PORT or udp:PORT'),
         (lambda: nh.run_scene(42), "scene: expected a path (str or os.PathLike)"),
     ]
     for fn, msg in cases:

@@ -4,6 +4,7 @@
 use crate::run_cmd::parse_operator;
 use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
 use haptic_devices::local::Protocol;
+use haptic_devices::source::DeviceSource;
 use haptic_devices::{DeviceModel, Grip, Mechanics, Script};
 use haptic_loop::session::OperatorChoice;
 use std::path::PathBuf;
@@ -11,7 +12,7 @@ use std::process::ExitCode;
 
 #[derive(clap::Args)]
 pub(crate) struct FakeArgs {
-    /// The simulator's bridge address, `udp:HOST:PORT`.
+    /// The simulator's bridge address, `udp:HOST:PORT` or `udp:PORT` (loopback).
     target: String,
     /// Script file (TOML) the stylus plays (default: the built-in wall-press script).
     #[arg(long)]
@@ -146,12 +147,18 @@ fn script(a: &FakeArgs, model: DeviceModel) -> Result<Script, String> {
 
 /// The fake device's configuration from its flags, every value checked.
 fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), String> {
-    let target = haptic_devices::bridge::parse_endpoint(
-        &a.target,
-        "udp",
-        "fake-device",
-        "udp:127.0.0.1:9870",
-    )?;
+    let target = match DeviceSource::parse(&a.target) {
+        Ok(DeviceSource::Udp(b)) => b.bind,
+        Ok(DeviceSource::Model(m)) => {
+            return Err(format!(
+                "`{}` is a device model: fake-device plays against the simulator's address, \
+                 udp:HOST:PORT or udp:PORT (the model is --model {})",
+                a.target,
+                m.name()
+            ));
+        }
+        Err(e) => return Err(e.to_string()),
+    };
     let protocol = match a.protocol {
         1 => Protocol::V1,
         2 => Protocol::V2,

@@ -1,6 +1,6 @@
 //! `nanohaptics play`: the teaching game in a browser (the `play` crate serves the page).
 
-use haptic_devices::BridgeConfig;
+use haptic_devices::source::DeviceSource;
 use haptic_loop::session::SceneSource;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -14,8 +14,8 @@ pub struct PlayArgs {
     /// Loopback port of the page and its WebSocket (0: any free port).
     #[arg(long, default_value_t = play::DEFAULT_PORT)]
     pub port: u16,
-    /// A real device over the UDP bridge (udp:HOST:PORT) as the hand; the page is then the
-    /// view and the sound.
+    /// A real device over the UDP bridge (udp:HOST:PORT, or udp:PORT on loopback) as the
+    /// hand; the page is then the view and the sound.
     #[arg(long)]
     pub device: Option<String>,
     /// The session's recording (MCAP), also offered for download on the end screen.
@@ -34,12 +34,18 @@ pub fn cmd(a: &PlayArgs) -> Result<ExitCode, String> {
     let mut c = play::PlayConfig::new(scene, a.out.clone());
     c.port = a.port;
     c.seconds = a.seconds;
-    c.device = a
-        .device
-        .as_deref()
-        .map(BridgeConfig::parse)
-        .transpose()
-        .map_err(|e| e.to_string())?;
+    c.device = match a.device.as_deref().map(DeviceSource::parse).transpose() {
+        Ok(None) => None,
+        Ok(Some(DeviceSource::Udp(b))) => Some(b),
+        Ok(Some(DeviceSource::Model(m))) => {
+            return Err(format!(
+                "--device `{}`: play's own hand is the page; --device names a device in \
+                 another process (udp:HOST:PORT or udp:PORT)",
+                m.name()
+            ));
+        }
+        Err(e) => return Err(format!("--device: {e}")),
+    };
     let stop = crate::run_cmd::interrupt_flag()?;
     let s = play::run(&c, &stop, &mut |url| {
         println!("open {url} in a browser (Ctrl-C ends the session)");

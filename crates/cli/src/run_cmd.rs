@@ -1,8 +1,7 @@
 //! `nanohaptics run`: a scene with a script or a device, batch or real time, recorded and
 //! served live, with its summary.
 
-use haptic_devices::DeviceModel;
-use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::source::DeviceSource;
 use haptic_loop::live::LiveConfig;
 use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionError, SessionOptions, SessionReport, run_session_until,
@@ -27,8 +26,8 @@ pub(crate) struct RunArgs {
     #[arg(long, default_value = "hand")]
     operator: String,
     /// Device: a model overriding the scene's (falcon, touch), or a device in another process
-    /// over the UDP bridge, `udp:HOST:PORT` (listen there; waits for its hello; always real
-    /// time; see docs/device-bridge.md).
+    /// over the UDP bridge, `udp:HOST:PORT` or `udp:PORT` on loopback (listen there; waits for
+    /// its hello; always real time; see docs/device-bridge.md).
     #[arg(long)]
     device: Option<String>,
     /// Serve a live Foxglove view at `ws:HOST:PORT` while the session runs (open
@@ -206,9 +205,9 @@ pub(crate) fn cmd(args: RunArgs) -> Result<ExitCode, String> {
     } = args;
     let mut opts = SessionOptions::new(SceneSource::resolve(&scene).map_err(|e| e.to_string())?);
     opts.operator = parse_operator(&operator)?;
-    match device.as_deref() {
-        Some(d) if d.starts_with("udp:") => {
-            let mut b = BridgeConfig::parse(d).map_err(|e| e.to_string())?;
+    if let Some(d) = device.as_deref() {
+        let mut d = DeviceSource::parse(d).map_err(|e| format!("--device: {e}"))?;
+        if let DeviceSource::Udp(b) = &mut d {
             if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
                 return Err(format!(
                     "--wait-s = {wait_s} is out of range: allowed 0–86400"
@@ -221,14 +220,8 @@ pub(crate) fn cmd(args: RunArgs) -> Result<ExitCode, String> {
                     b.bind, b.bind
                 );
             }
-            opts.bridge = Some(b);
         }
-        Some(d) => {
-            opts.device = Some(DeviceModel::from_name(d).map_err(|e| {
-                format!("--device: {e}; or udp:HOST:PORT for a device in another process")
-            })?);
-        }
-        None => {}
+        opts.device = Some(d);
     }
     if let Some(l) = live.as_deref() {
         let mut c = LiveConfig::parse(l).map_err(|e| e.to_string())?;

@@ -45,7 +45,7 @@ fn run_case(c: &Case) -> (SessionReport, FakeReport) {
         SessionOptions::new(SceneSource::from_path(&root().join("scenes/wall.toml")).unwrap());
     let mut b = BridgeConfig::parse(&format!("udp:{addr}")).unwrap();
     b.wait_s = 30.0;
-    o.bridge = Some(b);
+    o.device = Some(haptic_devices::source::DeviceSource::Udp(b));
     o.out = Some(std::env::temp_dir().join(format!("live-report-{}.mcap", std::process::id())));
     if c.live {
         let port = TcpListener::bind("127.0.0.1:0")

@@ -65,8 +65,20 @@ pub enum EndReason {
     Completed,
     /// The device ended the session (a bridged device said goodbye).
     DeviceEnded,
-    /// The stop flag was raised (Ctrl-C, Python interrupt).
+    /// The stop flag was raised (Ctrl-C, Python interrupt, the page's End button).
     Stopped,
+}
+
+impl EndReason {
+    /// The one spelling of the reason, in summaries, reports and the page: `completed`,
+    /// `device_ended` or `stopped`.
+    pub fn name(self) -> &'static str {
+        match self {
+            EndReason::Completed => "completed",
+            EndReason::DeviceEnded => "device_ended",
+            EndReason::Stopped => "stopped",
+        }
+    }
 }
 
 /// What a live session does before each tick's step (see [`Runner::with_live`]): called with

@@ -13,16 +13,15 @@
 
 use crate::haptic::HapticLoop;
 use crate::live::LiveConfig;
-use crate::runner::{EndReason, Pacing, Runner};
+use crate::runner::{Pacing, Runner};
 use crate::scene::{SceneError, SceneFile, Switch};
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::{live_summary, start_live};
 use crate::totals::Totals;
 use haptic_devices::TickTime;
-use haptic_devices::bridge::BridgeConfig;
 use haptic_devices::pacing::TickStats;
 use haptic_devices::script::{OperatorKind, Script};
-use haptic_devices::source::{DeviceSource, open_device};
+use haptic_devices::source::{DeviceSource, Driver, open_device};
 use haptic_devices::{DeviceModel, OperatorParams, ScriptError};
 pub use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
@@ -57,13 +56,12 @@ pub struct SessionOptions {
     pub script: Option<String>,
     /// Where `script` came from, as errors name it (a path); `None`: `script`.
     pub script_origin: Option<String>,
-    /// Device model overriding the scene file's (local devices only: a bridged device announces
-    /// its own specifications).
-    pub device: Option<DeviceModel>,
+    /// The device ([`DeviceSource::parse`]): a model overriding the scene file's, played by
+    /// the script, or a device in another process over the UDP bridge instead of the script
+    /// (it announces its own specifications); `None`: the scene's model.
+    pub device: Option<DeviceSource>,
     /// How the script drives the device (local devices only).
     pub operator: OperatorChoice,
-    /// A device in another process over the UDP bridge instead of the script.
-    pub bridge: Option<BridgeConfig>,
     /// Session length, s; `None`: the script's duration (a bridged device: until it says
     /// goodbye).
     pub seconds: Option<f64>,
@@ -91,7 +89,6 @@ impl SessionOptions {
             script_origin: None,
             device: None,
             operator: OperatorChoice::ScriptHand,
-            bridge: None,
             seconds: None,
             realtime: false,
             out: None,
@@ -266,38 +263,31 @@ pub fn run_session_until(
     let start_time_ns = opts.start_time_ns.unwrap_or_else(now_unix_ns);
     // 1. The device source: a script (rigid or through a simulated hand) or a bridged device,
     //    welcomed with the scene's rate, name and start time.
-    let (source, script) = match &opts.bridge {
-        Some(b) => (
-            DeviceSource::Udp(b.clone().for_session(
-                file.loop_.rate_hz,
-                &file.scene.name,
-                start_time_ns,
-            )),
-            None,
-        ),
-        None => {
-            let model = opts.device.unwrap_or(file.device.model);
-            let (script, text, origin) = load_script(opts, &file, model.specs())?;
-            let source = match &opts.operator {
-                OperatorChoice::Rigid => DeviceSource::Script(model),
-                OperatorChoice::Hand(p) => {
-                    p.validate()?;
-                    DeviceSource::Hand(model, *p)
-                }
-                OperatorChoice::ScriptHand if script.operator_kind == OperatorKind::Rigid => {
-                    DeviceSource::Script(model)
-                }
-                OperatorChoice::ScriptHand => {
-                    DeviceSource::Hand(model, script.operator.unwrap_or_default())
-                }
-            };
-            (source, Some((script, text, origin)))
-        }
-    };
-    let mut dev = open_device(&source, script.as_ref().map(|s| &s.0))?;
+    let (driver, script) =
+        match crate::setup::session_device(&file, opts.device.as_ref(), start_time_ns) {
+            DeviceSource::Udp(b) => (Driver::Udp(b), None),
+            DeviceSource::Model(model) => {
+                let (script, text, origin) = load_script(opts, &file, model.specs())?;
+                let driver = match &opts.operator {
+                    OperatorChoice::Rigid => Driver::Script(model),
+                    OperatorChoice::Hand(p) => {
+                        p.validate()?;
+                        Driver::Hand(model, *p)
+                    }
+                    OperatorChoice::ScriptHand if script.operator_kind == OperatorKind::Rigid => {
+                        Driver::Script(model)
+                    }
+                    OperatorChoice::ScriptHand => {
+                        Driver::Hand(model, script.operator.unwrap_or_default())
+                    }
+                };
+                (driver, Some((script, text, origin)))
+            }
+        };
+    let mut dev = open_device(&driver, script.as_ref().map(|s| &s.0))?;
     let result = run_with_device(
         opts,
-        &source,
+        &driver,
         script,
         start_time_ns,
         dev.as_mut(),
@@ -320,7 +310,7 @@ pub fn run_session(
 
 fn run_with_device(
     opts: &SessionOptions,
-    source: &DeviceSource,
+    driver: &Driver,
     script: Option<(Script, String, String)>,
     start_time_ns: u64,
     dev: &mut dyn haptic_devices::HapticDevice,
@@ -331,19 +321,19 @@ fn run_with_device(
     // hello arrives.
     let live = start_live(opts.live.as_ref())?;
     dev.open()?;
-    let bridged = opts.bridge.is_some();
+    let bridged = matches!(driver, Driver::Udp(_));
     let mode = if bridged || opts.realtime {
         "realtime"
     } else {
         "batch"
     };
     let setup = Setup::new(&SetupOptions {
-        operator: Some(source.describe()),
+        operator: Some(driver.describe()),
         script: script.as_ref().map(|(s, t, _)| (s.name.clone(), t.clone())),
         start_time_ns: Some(start_time_ns),
         keep_arrays: opts.arrays,
         out: opts.out.clone(),
-        ..SetupOptions::new(&opts.scene, dev.specs().clone(), mode, &source.link_name())
+        ..SetupOptions::new(&opts.scene, dev.specs().clone(), mode, &driver.link_name())
     })?;
     let rate = setup.rate_hz();
     let ticks = match (opts.seconds, &script) {
@@ -406,11 +396,7 @@ fn run_with_device(
         totals: sinks.totals,
         stats,
         written,
-        end: match end {
-            EndReason::Completed => "completed",
-            EndReason::DeviceEnded => "device_ended",
-            EndReason::Stopped => "stopped",
-        },
+        end: end.name(),
         link: dev.link_counters(),
         live: live_summary(sinks.live),
         sinks: sink_times,

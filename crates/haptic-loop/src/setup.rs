@@ -24,6 +24,7 @@ use crate::haptic::HapticLoop;
 use crate::scene::{SceneError, SceneFile, load_scene_for};
 use crate::sinks::SessionSinks;
 use haptic_devices::DeviceSpecs;
+use haptic_devices::source::DeviceSource;
 use haptic_types::textpos::Location;
 use recording::channels::messages::{self, DescriptionMsg};
 use std::path::{Path, PathBuf};
@@ -230,6 +231,26 @@ impl Setup {
     /// The loop's tick rate, Hz.
     pub fn rate_hz(&self) -> u32 {
         self.lp.config().rate_hz
+    }
+}
+
+/// The device a session of `file` that starts at `start_time_ns` (ns since the Unix epoch)
+/// is played on: the one named (`None`: the scene's model). A bridged device is welcomed with
+/// the scene's tick rate, name and start time, so every way of running a bridged session
+/// (`run`, `play`, the wheel) tells the device the same.
+pub fn session_device(
+    file: &SceneFile,
+    device: Option<&DeviceSource>,
+    start_time_ns: u64,
+) -> DeviceSource {
+    match device {
+        Some(DeviceSource::Udp(b)) => DeviceSource::Udp(b.clone().for_session(
+            file.loop_.rate_hz,
+            &file.scene.name,
+            start_time_ns,
+        )),
+        Some(DeviceSource::Model(m)) => DeviceSource::Model(*m),
+        None => DeviceSource::Model(file.device.model),
     }
 }
 

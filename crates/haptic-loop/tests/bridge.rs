@@ -46,7 +46,7 @@ fn bridged(addr: SocketAddr, out: &Path) -> SessionOptions {
         SessionOptions::new(SceneSource::from_path(&root().join("scenes/wall.toml")).unwrap());
     let mut b = BridgeConfig::parse(&format!("udp:{addr}")).unwrap();
     b.wait_s = 20.0;
-    o.bridge = Some(b);
+    o.device = Some(haptic_devices::source::DeviceSource::Udp(b));
     o.out = Some(out.to_path_buf());
     o
 }
@@ -334,7 +334,7 @@ fn no_device_is_a_clear_error_after_the_wait() {
     let _serial = serial();
     let addr = free_port();
     let mut o = bridged(addr, &tmp("none.mcap"));
-    if let Some(b) = o.bridge.as_mut() {
+    if let Some(haptic_devices::source::DeviceSource::Udp(b)) = o.device.as_mut() {
         b.wait_s = 0.2;
     }
     let e = run_session(&o, &mut |_, _| {}).unwrap_err().to_string();
@@ -363,7 +363,7 @@ fn the_welcome_carries_the_scenes_rate_name_and_start_time() {
     );
     let mut b = BridgeConfig::parse(&format!("udp:{addr}")).unwrap();
     b.wait_s = 20.0;
-    o.bridge = Some(b);
+    o.device = Some(haptic_devices::source::DeviceSource::Udp(b));
     o.out = Some(out.clone());
     o.start_time_ns = Some(1_700_000_000_123_456_789);
     let text = std::fs::read_to_string(root().join("scenes/optical_tweezers.script.toml")).unwrap();

@@ -138,7 +138,7 @@ fn a_viewer_connects_before_the_device_says_hello() {
         haptic_devices::BridgeConfig::parse(&format!("udp:127.0.0.1:{udp_port}")).unwrap();
     // No device will come: the session gives up after 3 s of waiting for the hello.
     bridge.wait_s = 3.0;
-    o.bridge = Some(bridge);
+    o.device = Some(haptic_devices::source::DeviceSource::Udp(bridge));
     o.live = Some(LiveConfig::parse(&format!("ws:127.0.0.1:{ws_port}")).unwrap());
     let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}));
     let mut ws = foxglove_client(ws_port, Duration::from_secs(2));

@@ -408,7 +408,9 @@ fn realtime_session_replays_exactly_including_its_missed_deadlines() {
 #[test]
 fn touch_device_caps_at_its_own_limits() {
     let mut o = wall_opts(None);
-    o.device = Some(haptic_loop::DeviceModel::Touch);
+    o.device = Some(haptic_devices::source::DeviceSource::Model(
+        haptic_loop::DeviceModel::Touch,
+    ));
     o.operator = OperatorChoice::Rigid;
     o.script = Some(
         "[script]\nname = 'ramp'\n[[waypoint]]\nt_s = 0.0\nposition_mm = [0.0, 0.0, 0.0]\n\

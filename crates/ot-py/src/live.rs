@@ -2,7 +2,7 @@
 //! `mujoco.mj_step` is), with the same sinks as every session (MCAP recorder, per-tick arrays).
 //! A Python driver, a notebook or a test hands in each device reading and gets the force back.
 
-use haptic_loop::DeviceModel;
+use haptic_devices::source::DeviceSource;
 use haptic_loop::session::SceneSource;
 use haptic_loop::stepper::{Stepper, StepperOptions};
 use haptic_loop::{Buttons, DeviceSample};
@@ -94,18 +94,22 @@ impl Session {
     #[pyo3(signature = (scene, *, device=None, out=None, arrays=true))]
     fn new(
         scene: &Bound<'_, PyAny>,
-        device: Option<&str>,
+        device: Option<&Bound<'_, PyAny>>,
         out: Option<&Bound<'_, PyAny>>,
         arrays: bool,
     ) -> PyResult<Self> {
         let source = SceneSource::resolve(&path_arg(scene, "scene")?).map_err(session_error)?;
         let mut o = StepperOptions::new(source);
-        o.device = match device {
+        o.device = match crate::session::device_from_py(device)? {
             None => None,
-            Some(d) => Some(
-                DeviceModel::from_name(d)
-                    .map_err(|e| PyValueError::new_err(format!("device = {d:?}: {e}")))?,
-            ),
+            Some(DeviceSource::Model(m)) => Some(m),
+            Some(DeviceSource::Udp(_)) => {
+                return Err(PyValueError::new_err(format!(
+                    "device = {:?}: a stepped session is driven by its caller, so its device \
+                     is a model: allowed falcon or touch (a bridged device runs with run_scene)",
+                    device.map(|d| d.to_string()).unwrap_or_default()
+                )));
+            }
         };
         o.out = out.map(|p| path_arg(p, "out")).transpose()?;
         o.arrays = arrays;

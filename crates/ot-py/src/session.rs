@@ -1,7 +1,7 @@
 //! Sessions of the haptic loop (`haptic-loop`): run a scene with a script and
 //! get per-tick arrays back; read an MCAP recording into the same arrays.
 
-use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::source::{DEVICE_FORMS, DeviceNameError, DeviceSource};
 use haptic_loop::DeviceModel;
 use haptic_loop::scene::overrides::{is_script_field, override_scene};
 use haptic_loop::session::{
@@ -101,32 +101,21 @@ fn operator_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OperatorChoice> 
     Ok(OperatorChoice::Hand(from_py(obj, "operator")?))
 }
 
-/// The `device` argument: a model name, or `udp:HOST:PORT` for a device in another process.
-enum DeviceArg {
-    Model(Option<DeviceModel>),
-    Bridge(BridgeConfig),
-}
-
-fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<DeviceArg> {
-    let allowed = "allowed \"falcon\", \"touch\" or \"udp:HOST:PORT\"";
-    match obj {
-        None => Ok(DeviceArg::Model(None)),
-        Some(o) => {
-            let name: String = o
-                .extract()
-                .map_err(|_| PyValueError::new_err(format!("device: {allowed}")))?;
-            match name.as_str() {
-                "falcon" => Ok(DeviceArg::Model(Some(DeviceModel::Falcon))),
-                "touch" => Ok(DeviceArg::Model(Some(DeviceModel::Touch))),
-                udp if udp.starts_with("udp:") => BridgeConfig::parse(udp)
-                    .map(DeviceArg::Bridge)
-                    .map_err(|e| PyValueError::new_err(format!("device = {udp:?}: {e}"))),
-                other => Err(PyValueError::new_err(format!(
-                    "device = {other:?}: {allowed}"
-                ))),
-            }
+/// The `device` argument ([`DeviceSource::parse`]): a model name, or `udp:HOST:PORT` /
+/// `udp:PORT` for a device in another process; `None`: the scene's model.
+pub(crate) fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<DeviceSource>> {
+    let Some(o) = obj.filter(|o| !o.is_none()) else {
+        return Ok(None);
+    };
+    let name: String = o
+        .extract()
+        .map_err(|_| PyValueError::new_err(format!("device: allowed {DEVICE_FORMS}")))?;
+    DeviceSource::parse(&name).map(Some).map_err(|e| match e {
+        DeviceNameError::Unknown(_) => {
+            PyValueError::new_err(format!("device = {name:?}: allowed {DEVICE_FORMS}"))
         }
-    }
+        DeviceNameError::Address(m) => PyValueError::new_err(format!("device = {name:?}: {m}")),
+    })
 }
 
 type Overrides = Vec<(String, toml::Value)>;
@@ -239,8 +228,9 @@ pub fn resolve_scene<'py>(
     device: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let model = match device_from_py(device)? {
-        DeviceArg::Model(m) => m,
-        DeviceArg::Bridge(_) => {
+        None => None,
+        Some(DeviceSource::Model(m)) => Some(m),
+        Some(DeviceSource::Udp(_)) => {
             return Err(PyValueError::new_err(
                 "device: resolve_scene takes \"falcon\" or \"touch\" (a bridged device announces its own)",
             ));
@@ -313,14 +303,7 @@ pub fn run_scene<'py>(
         )));
     }
     let mut opts = match device_from_py(device)? {
-        DeviceArg::Model(m) => {
-            let r = resolve(scene, script, overrides, m)?;
-            let mut opts = SessionOptions::new(r.source);
-            opts.script = Some(r.script);
-            opts.device = m;
-            opts
-        }
-        DeviceArg::Bridge(mut b) => {
+        Some(DeviceSource::Udp(mut b)) => {
             // A device in another process: no script, so only the scene's fields change.
             let ov = overrides_from_py(overrides)?;
             if let Some((k, _)) = ov.iter().find(|(k, _)| is_script_field(k)) {
@@ -332,7 +315,18 @@ pub fn run_scene<'py>(
             source.text = override_scene(&source.text, &ov).map_err(value_err)?;
             b.wait_s = wait_s;
             let mut opts = SessionOptions::new(source);
-            opts.bridge = Some(b);
+            opts.device = Some(DeviceSource::Udp(b));
+            opts
+        }
+        model => {
+            let m = match model {
+                Some(DeviceSource::Model(m)) => Some(m),
+                _ => None,
+            };
+            let r = resolve(scene, script, overrides, m)?;
+            let mut opts = SessionOptions::new(r.source);
+            opts.script = Some(r.script);
+            opts.device = model;
             opts
         }
     };
