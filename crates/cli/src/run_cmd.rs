@@ -86,21 +86,21 @@ fn house_score(t: &Totals) -> serde_json::Value {
 pub(crate) fn summary_json(r: &SessionReport) -> serde_json::Value {
     let t = &r.totals;
     serde_json::json!({
-        "scene": r.description.scene_name,
-        "kind": r.description.scene_kind,
-        "device": r.description.device_model,
-        "script": r.description.script_name,
-        "operator": r.description.operator,
-        "mode": r.description.mode,
+        "scene": r.header.scene_name,
+        "kind": r.header.scene_kind,
+        "device": r.header.device.name,
+        "script": r.header.script_name,
+        "operator": r.header.operator,
+        "mode": r.header.mode,
         "ticks": r.stats.ticks,
-        "duration_s": r.stats.ticks as f64 / f64::from(r.description.rate_hz),
+        "duration_s": r.stats.ticks as f64 / f64::from(r.header.rate_hz),
         "peak_device_force_n": t.peak_device_force_n,
         "clamped_ticks": t.clamped_ticks,
         "events": t.events,
         "tick_stats": r.stats,
         "written": r.written,
         "end": r.end,
-        "device_link": r.description.device_link,
+        "device_link": r.header.device_link,
         "link": r.link.iter().map(|(k, v)| (k.to_string(), *v)).collect::<BTreeMap<String, u64>>(),
         "watchdog_ticks": t.watchdog_ticks,
         "live": r.live,
@@ -114,10 +114,7 @@ pub(crate) fn print_summary(r: &SessionReport) {
     let s = &r.stats;
     println!(
         "{} ({}, {} device, {} operator)",
-        r.description.scene_name,
-        r.description.mode,
-        r.description.device_model,
-        r.description.operator
+        r.header.scene_name, r.header.mode, r.header.device.name, r.header.operator
     );
     println!(
         "  {} ticks ({:.3} s), peak force {:.3} N, {} clamped ticks, {} events",
@@ -174,7 +171,7 @@ pub(crate) fn print_summary(r: &SessionReport) {
             "  recorded {} messages, {} bytes ({:.0} bytes per minute)",
             w.messages,
             w.bytes,
-            w.bytes as f64 * 60.0 / (s.ticks as f64 / f64::from(r.description.rate_hz))
+            w.bytes as f64 * 60.0 / (s.ticks as f64 / f64::from(r.header.rate_hz))
         );
     }
 }

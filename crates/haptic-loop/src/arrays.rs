@@ -125,7 +125,7 @@ impl Sink for SessionArrays {
 
     fn start(&mut self, info: &SessionInfo<'_>, _lp: &HapticLoop) -> Result<(), SinkError> {
         self.rate_hz = info.config.rate_hz;
-        self.state_fields = info.description.state_fields.clone();
+        self.state_fields = info.header.state_fields.clone();
         if let Some(n) = info.ticks {
             self.reserve(n.min(1 << 24) as usize);
         }

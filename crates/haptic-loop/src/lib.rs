@@ -35,6 +35,7 @@ pub mod closed_loop;
 pub mod encode;
 pub mod error;
 pub mod haptic;
+pub mod header;
 pub mod live;
 pub mod media;
 pub mod record_sink;

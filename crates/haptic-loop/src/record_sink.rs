@@ -1,10 +1,13 @@
 //! The MCAP recorder as a sink of the runner: encodes each tick's messages and hands them to
-//! the writer thread (never blocking the tick).
+//! the writer thread (never blocking the tick). Also the one conversion between the engine's
+//! [`SessionHeader`] and the file's description ([`description_of`], [`header_of`]).
 
 use crate::encode::LoopEncoder;
 use crate::haptic::HapticLoop;
+use crate::header::SessionHeader;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_devices::pacing::TickStats;
+use recording::channels::messages::DescriptionMsg;
 use recording::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -36,6 +39,48 @@ impl RecorderSink {
     }
 }
 
+/// The recording's description of a session: its header, in the file's current format.
+pub fn description_of(h: &SessionHeader) -> DescriptionMsg {
+    let d = &h.device;
+    DescriptionMsg {
+        format: recording::channels::FORMAT_VERSION.to_string(),
+        scene_name: h.scene_name.clone(),
+        scene_kind: h.scene_kind.clone(),
+        scene_toml: h.scene_toml.clone(),
+        device_model: d.name.to_string(),
+        rate_hz: h.rate_hz,
+        mode: h.mode.clone(),
+        script_name: h.script_name.clone(),
+        script_toml: h.script_toml.clone(),
+        operator: h.operator.clone(),
+        state_fields: h.state_fields.clone(),
+        start_time_ns: h.start_time_ns,
+        device_link: h.device_link.clone(),
+        device_max_force_n: d.limits.max_force_n,
+        device_max_stiffness_n_per_m: d.limits.max_stiffness_n_per_m,
+        device_workspace_radius_m: d.workspace_radius_m,
+        device_buttons: d.button_names.iter().map(|b| b.to_string()).collect(),
+    }
+}
+
+/// The header of a recorded session, read back from its description (a replay runs with it).
+pub fn header_of(d: &DescriptionMsg) -> SessionHeader {
+    SessionHeader {
+        scene_name: d.scene_name.clone(),
+        scene_kind: d.scene_kind.clone(),
+        scene_toml: d.scene_toml.clone(),
+        rate_hz: d.rate_hz,
+        mode: d.mode.clone(),
+        script_name: d.script_name.clone(),
+        script_toml: d.script_toml.clone(),
+        operator: d.operator.clone(),
+        state_fields: d.state_fields.clone(),
+        start_time_ns: d.start_time_ns,
+        device_link: d.device_link.clone(),
+        device: d.device_specs(),
+    }
+}
+
 /// Metadata record `session` of a recording: the tick statistics and the mode.
 pub fn stats_metadata(stats: &TickStats, mode: &str) -> BTreeMap<String, String> {
     let mut m = BTreeMap::new();
@@ -61,14 +106,14 @@ impl Sink for RecorderSink {
             Recorder::create(
                 &self.path,
                 RecorderSetup {
-                    description: info.description.clone(),
+                    description: description_of(info.header),
                     flush_every_ns: 1_000_000_000,
                 },
             )
             .map_err(SinkError::new)?,
         );
-        self.enc = Some(LoopEncoder::new(lp, info.description.start_time_ns));
-        self.mode = info.description.mode.clone();
+        self.enc = Some(LoopEncoder::new(lp, info.header.start_time_ns));
+        self.mode = info.header.mode.clone();
         Ok(())
     }
 

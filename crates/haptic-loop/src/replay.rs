@@ -116,7 +116,7 @@ impl Sink for VerifySink<'_> {
     }
 
     fn start(&mut self, info: &SessionInfo<'_>, lp: &HapticLoop) -> Result<(), SinkError> {
-        self.enc = Some(LoopEncoder::new(lp, info.description.start_time_ns));
+        self.enc = Some(LoopEncoder::new(lp, info.header.start_time_ns));
         Ok(())
     }
 
@@ -253,7 +253,7 @@ impl<'r> Resimulation<'r> {
         Runner::new(sinks).with_switches(self.switches).run(
             &mut self.lp,
             &mut self.dev,
-            &self.rec.description,
+            &crate::record_sink::header_of(&self.rec.description),
             Some(ticks),
             Pacing::Recorded(flags),
             &mut |_, _| {},

@@ -16,11 +16,11 @@
 //! session builds its list of sinks (`session::run_session`).
 
 use crate::haptic::HapticLoop;
+use crate::header::SessionHeader;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_devices::pacing::{DurationHistogram, Pacer, Percentiles, TickStats};
 use haptic_devices::{DeviceError, HapticDevice, TickTime};
 use haptic_types::switch::{Switch, SwitchError};
-use recording::channels::messages::DescriptionMsg;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -147,13 +147,13 @@ impl<'s> Runner<'s> {
         &mut self,
         lp: &mut HapticLoop,
         dev: &mut dyn HapticDevice,
-        description: &DescriptionMsg,
+        header: &SessionHeader,
         ticks: Option<u64>,
         pacing: Pacing,
         progress: &mut dyn FnMut(u64, u64),
     ) -> Result<(TickStats, EndReason), RunError> {
         let info = SessionInfo {
-            description,
+            header,
             config: lp.config(),
             ticks,
         };

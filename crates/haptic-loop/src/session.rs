@@ -12,6 +12,7 @@
 //! ```
 
 use crate::haptic::HapticLoop;
+use crate::header::SessionHeader;
 use crate::live::LiveConfig;
 use crate::runner::{Pacing, Runner};
 use crate::scene::{SceneError, SceneFile, Switch};
@@ -26,7 +27,6 @@ use haptic_devices::{DeviceModel, OperatorParams, ScriptError};
 pub use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
 use recording::WriteSummary;
-use recording::channels::messages::DescriptionMsg;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -100,10 +100,10 @@ impl SessionOptions {
 }
 
 /// What a session produced.
-#[derive(Debug, serde::Serialize)]
+#[derive(Debug)]
 pub struct SessionReport {
-    /// The session's description (as recorded).
-    pub description: DescriptionMsg,
+    /// The session's header (as recorded).
+    pub header: SessionHeader,
     /// Per-tick arrays (empty when turned off).
     pub arrays: SessionArrays,
     /// Running totals (peak force, clamped and watchdog ticks, events, last state), kept
@@ -347,7 +347,7 @@ fn run_with_device(
     };
     let Setup {
         mut lp,
-        description,
+        header,
         mut sinks,
     } = setup;
     sinks.live = live;
@@ -381,7 +381,7 @@ fn run_with_device(
     if let Some(f) = stop {
         runner = runner.stop_on(f);
     }
-    let (stats, end) = runner.run(&mut lp, dev, &description, ticks, pacing, progress)?;
+    let (stats, end) = runner.run(&mut lp, dev, &header, ticks, pacing, progress)?;
     let sink_times = runner.sink_times();
     drop(runner);
     if stats.ticks == 0 {
@@ -391,7 +391,7 @@ fn run_with_device(
     }
     let written = sinks.written();
     Ok(SessionReport {
-        description,
+        header,
         arrays: sinks.arrays,
         totals: sinks.totals,
         stats,

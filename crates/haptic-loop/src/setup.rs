@@ -1,5 +1,5 @@
 //! The one set-up of a session, shared by every way of running one: [`run_session`], the
-//! [`Stepper`] and the browser game all build their loop, description and sinks here, so a
+//! [`Stepper`] and the browser game all build their loop, header and sinks here, so a
 //! session is described, checked and recorded the same way whoever drives it. Also the scene
 //! source every session starts from ([`SceneSource`]).
 //!
@@ -14,19 +14,20 @@
 //! let scene = SceneSource::builtin("wall").unwrap();
 //! let specs = haptic_loop::DeviceModel::Falcon.specs().clone();
 //! let s = Setup::new(&SetupOptions::new(&scene, specs, "batch", "script")).unwrap();
-//! assert_eq!(s.description.scene_kind, "wall");
+//! assert_eq!(s.header.scene_kind, "wall");
 //! assert_eq!(s.rate_hz(), 1000);
 //! ```
 
 use crate::arrays::SessionArrays;
 use crate::error::SessionError;
 use crate::haptic::HapticLoop;
+use crate::header::SessionHeader;
 use crate::scene::{SceneError, SceneFile, load_scene_for};
 use crate::sinks::SessionSinks;
 use haptic_devices::DeviceSpecs;
 use haptic_devices::source::DeviceSource;
 use haptic_types::textpos::Location;
-use recording::channels::messages::{self, DescriptionMsg};
+use recording::channels::messages;
 use std::path::{Path, PathBuf};
 
 /// A scene file's text and the folder it came from (to find its default script).
@@ -183,20 +184,20 @@ impl<'a> SetupOptions<'a> {
     }
 }
 
-/// A session made ready to run: its loop, its description and its sinks (no live view yet:
+/// A session made ready to run: its loop, its header and its sinks (no live view yet:
 /// set [`SessionSinks::live`] to serve one).
 pub struct Setup {
     /// The loop, at tick 0.
     pub lp: HapticLoop,
-    /// The session's description (as it will be recorded).
-    pub description: DescriptionMsg,
+    /// The session's header (the recorder writes it as the file's description).
+    pub header: SessionHeader,
     /// The session's sinks.
     pub sinks: SessionSinks,
 }
 
 impl Setup {
     /// Builds the scene for the device (errors name the scene file's line and column), checks
-    /// its state fields are recordable names, writes the description and makes the sinks.
+    /// its state fields are recordable names, writes the header and makes the sinks.
     pub fn new(o: &SetupOptions) -> Result<Setup, SessionError> {
         let loaded =
             load_scene_for(&o.scene.text, o.specs.clone()).map_err(|e| o.scene.locate(e))?;
@@ -205,27 +206,23 @@ impl Setup {
             return Err(SessionError::StateField(bad.clone()));
         }
         let rate = loaded.config.rate_hz;
-        let mut description = loaded.description(
+        let mut header = loaded.header(
             &o.scene.text,
             o.mode,
             &o.link,
             o.start_time_ns.unwrap_or_else(now_unix_ns),
         );
         if let Some((name, toml)) = &o.script {
-            description.script_name = name.clone();
-            description.script_toml = toml.clone();
+            header.script_name = name.clone();
+            header.script_toml = toml.clone();
         }
         if let Some(op) = &o.operator {
-            description.operator = op.clone();
+            header.operator = op.clone();
         }
         let lp = HapticLoop::new(loaded.config, loaded.scene);
         let arrays = SessionArrays::new(rate, fields);
         let sinks = SessionSinks::new(arrays, o.keep_arrays, o.out.clone());
-        Ok(Setup {
-            lp,
-            description,
-            sinks,
-        })
+        Ok(Setup { lp, header, sinks })
     }
 
     /// The loop's tick rate, Hz.

@@ -6,9 +6,9 @@
 //! list of sinks (`session::run_session`).
 
 use crate::haptic::{HapticLoop, LoopConfig, TickResult};
+use crate::header::SessionHeader;
 use haptic_devices::DeviceSample;
 use haptic_devices::pacing::TickStats;
-use recording::channels::messages::DescriptionMsg;
 
 /// One tick as the sinks see it.
 pub struct TickView<'a> {
@@ -28,8 +28,8 @@ pub struct TickView<'a> {
 
 /// What a sink learns before the first tick.
 pub struct SessionInfo<'a> {
-    /// The session's description (as recorded).
-    pub description: &'a DescriptionMsg,
+    /// The session's header (the recorder writes it as the file's description).
+    pub header: &'a SessionHeader,
     /// The loop's configuration.
     pub config: &'a LoopConfig,
     /// Number of ticks planned (`None`: until the device ends the session).

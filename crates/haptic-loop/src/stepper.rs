@@ -20,6 +20,7 @@
 
 use crate::arrays::SessionArrays;
 use crate::haptic::{HapticLoop, TickResult};
+use crate::header::SessionHeader;
 use crate::session::{SceneSource, SessionError};
 use crate::setup::{Setup, SetupOptions};
 use crate::sink::{SessionInfo, TickView, deliver};
@@ -27,7 +28,6 @@ use crate::sinks::SessionSinks;
 use haptic_devices::pacing::{DurationHistogram, Percentiles, TickStats};
 use haptic_devices::{DeviceModel, DeviceSample, ForceCommand};
 use recording::WriteSummary;
-use recording::channels::messages::DescriptionMsg;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -65,8 +65,8 @@ impl StepperOptions {
 /// What a stepped session produced.
 #[derive(Debug)]
 pub struct StepperReport {
-    /// The session's description (as recorded).
-    pub description: DescriptionMsg,
+    /// The session's header (as recorded).
+    pub header: SessionHeader,
     /// Per-tick arrays (empty when turned off).
     pub arrays: SessionArrays,
     /// Tick-time statistics (work of each `tick` call).
@@ -78,7 +78,7 @@ pub struct StepperReport {
 /// A session stepped by its caller.
 pub struct Stepper {
     lp: HapticLoop,
-    description: DescriptionMsg,
+    header: SessionHeader,
     sinks: SessionSinks,
     compute: DurationHistogram,
     started: Instant,
@@ -91,7 +91,7 @@ impl Stepper {
         let model = opts.device.unwrap_or(file.device.model);
         let Setup {
             lp,
-            description,
+            header,
             mut sinks,
         } = Setup::new(&SetupOptions {
             start_time_ns: opts.start_time_ns,
@@ -100,7 +100,7 @@ impl Stepper {
             ..SetupOptions::new(&opts.scene, model.specs().clone(), "stepped", &opts.link)
         })?;
         let info = SessionInfo {
-            description: &description,
+            header: &header,
             config: lp.config(),
             ticks: None,
         };
@@ -109,7 +109,7 @@ impl Stepper {
         }
         Ok(Stepper {
             lp,
-            description,
+            header,
             sinks,
             compute: DurationHistogram::new(),
             started: Instant::now(),
@@ -153,9 +153,9 @@ impl Stepper {
         &self.lp
     }
 
-    /// The session's description.
-    pub fn description(&self) -> &DescriptionMsg {
-        &self.description
+    /// The session's header.
+    pub fn header(&self) -> &SessionHeader {
+        &self.header
     }
 
     /// Per-tick arrays so far (`None` when turned off).
@@ -177,7 +177,7 @@ impl Stepper {
         }
         let written = self.sinks.written();
         Ok(StepperReport {
-            description: self.description,
+            header: self.header,
             arrays: if self.sinks.keep_arrays {
                 self.sinks.arrays
             } else {

@@ -53,7 +53,7 @@ impl Sink for Totals {
         _lp: &crate::haptic::HapticLoop,
     ) -> Result<(), SinkError> {
         *self = Totals {
-            state_fields: info.description.state_fields.clone(),
+            state_fields: info.header.state_fields.clone(),
             ..Totals::default()
         };
         Ok(())

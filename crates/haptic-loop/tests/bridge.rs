@@ -374,7 +374,7 @@ fn the_welcome_carries_the_scenes_rate_name_and_start_time() {
     assert_eq!(dev.welcome.rate_hz, 10_000);
     assert!(dev.welcome.scene.starts_with("optical tweezers at 10 kHz"));
     assert_eq!(dev.welcome.start_time_ns, 1_700_000_000_123_456_789);
-    assert_eq!(r.description.start_time_ns, 1_700_000_000_123_456_789);
+    assert_eq!(r.header.start_time_ns, 1_700_000_000_123_456_789);
     // 0.5 s at 10 kHz: the device sent 5000 samples and every one arrived (it was welcomed
     // with 1000 Hz and sent 500).
     assert_eq!((dev.ticks, dev.sent), (5000, 5000));

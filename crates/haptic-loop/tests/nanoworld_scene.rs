@@ -23,7 +23,7 @@ fn default_script_builds_the_house_and_replays_bit_exactly() {
     o.out = Some(rec.clone());
     let r = run_session(&o, &mut |_, _| {}).unwrap();
     assert_eq!(
-        r.description.operator, "rigid",
+        r.header.operator, "rigid",
         "the script asks for a rigid stylus"
     );
     let a = &r.arrays;

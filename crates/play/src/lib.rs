@@ -433,7 +433,7 @@ pub fn run(
     let (link, operator) = hand.describe(config);
     let Setup {
         mut lp,
-        description,
+        header,
         mut sinks,
     } = Setup::new(&SetupOptions {
         operator: Some(operator.to_string()),
@@ -484,7 +484,7 @@ pub fn run(
         runner.run(
             &mut lp,
             hand.device(),
-            &description,
+            &header,
             ticks,
             pacing,
             &mut |_, _| {},

@@ -20,7 +20,7 @@ fn live_switches_are_recorded_on_their_tick_and_replay_bit_for_bit() {
     let script_text = &scene.scripts[0].1;
     let script = Script::from_toml(script_text, &FALCON).unwrap();
     let loaded = load_scene_for(&scene.text, FALCON.clone()).unwrap();
-    let description = loaded.description(&scene.text, "batch", "page", 1_000_000_000);
+    let header = loaded.header(&scene.text, "batch", "page", 1_000_000_000);
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let mut dev = ScriptedDevice::new(script, FALCON.clone());
     let out = std::env::temp_dir().join(format!("nh-live-switch-{}.mcap", std::process::id()));
@@ -42,7 +42,7 @@ fn live_switches_are_recorded_on_their_tick_and_replay_bit_for_bit() {
             .run(
                 &mut lp,
                 &mut dev as &mut dyn HapticDevice,
-                &description,
+                &header,
                 Some(3000),
                 Pacing::Batch,
                 &mut |_, _| {},

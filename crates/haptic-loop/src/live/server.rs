@@ -234,7 +234,7 @@ impl Sink for LiveSink {
             state,
         };
         let shared = self.shared.clone();
-        let start_ns = info.description.start_time_ns;
+        let start_ns = info.header.start_time_ns;
         let (period, rate, scale) = (c.period_ns(), c.rate_hz, c.display_scale);
         let scene = lp.scene();
         let values = scene

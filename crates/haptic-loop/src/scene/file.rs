@@ -38,6 +38,7 @@ use super::check::SceneError;
 use super::loop_config::{DisplaySection, LoopConfig, LoopSection, MappingSection};
 use super::registry;
 use super::table;
+use crate::header::SessionHeader;
 use haptic_devices::{DeviceModel, DeviceSpecs};
 use serde::Deserialize;
 
@@ -209,24 +210,20 @@ fn build(file: SceneFile, specs: DeviceSpecs) -> Result<LoadedScene, SceneError>
 }
 
 impl LoadedScene {
-    /// The recording's description of a session of this scene (built from `scene_toml`) in
-    /// `mode`, with the device connected by `link`, started at `start_time_ns` (ns since the
-    /// Unix epoch); no script (set `script_name`, `script_toml` and `operator` for a scripted
-    /// session).
-    pub fn description(
+    /// The header of a session of this scene (built from `scene_toml`) in `mode`, with the
+    /// device connected by `link`, started at `start_time_ns` (ns since the Unix epoch); no
+    /// script (set `script_name`, `script_toml` and `operator` for a scripted session).
+    pub fn header(
         &self,
         scene_toml: &str,
         mode: &str,
         link: &str,
         start_time_ns: u64,
-    ) -> recording::DescriptionMsg {
-        let specs = &self.config.specs;
-        recording::DescriptionMsg {
-            format: recording::channels::FORMAT_VERSION.to_string(),
+    ) -> SessionHeader {
+        SessionHeader {
             scene_name: self.file.scene.name.clone(),
             scene_kind: self.scene.kind().to_string(),
             scene_toml: scene_toml.to_string(),
-            device_model: specs.name.to_string(),
             rate_hz: self.config.rate_hz,
             mode: mode.to_string(),
             script_name: String::new(),
@@ -235,10 +232,7 @@ impl LoadedScene {
             state_fields: self.scene.state_fields(),
             start_time_ns,
             device_link: link.to_string(),
-            device_max_force_n: specs.limits.max_force_n,
-            device_max_stiffness_n_per_m: specs.limits.max_stiffness_n_per_m,
-            device_workspace_radius_m: specs.workspace_radius_m,
-            device_buttons: specs.button_names.iter().map(|b| b.to_string()).collect(),
+            device: self.config.specs.clone(),
         }
     }
 }
