@@ -4,7 +4,7 @@
 //! (bounded queues; a page that cannot keep up loses frames, never the tick's time).
 
 use crate::input::{SharedInput, page_to_device};
-use crate::protocol::{self, PageMsg, ProtocolError};
+use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
 use haptic_loop::scene::SwitchSpec;
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -14,7 +14,7 @@ use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
-use tungstenite::protocol::Role;
+use tungstenite::protocol::Role as WsRole;
 use tungstenite::{Message, WebSocket};
 
 const INDEX_HTML: &str = include_str!("page/index.html");
@@ -107,8 +107,11 @@ impl Shared {
 
     fn error_to(&self, id: u64, field: &str, message: &str) {
         self.refused.fetch_add(1, Ordering::Relaxed);
-        let m = serde_json::json!({"type": "error", "field": field, "message": message});
-        self.send_to(id, Message::text(m.to_string()));
+        let m = ServerMsg::Error {
+            field: field.to_string(),
+            message: message.to_string(),
+        };
+        self.send_to(id, Message::text(m.to_json()));
     }
 }
 
@@ -361,10 +364,7 @@ fn on_message(shared: &Shared, id: u64, text: &str) {
                 *p = Some(id);
             }
             let role = role_of(shared, id, link.as_ref());
-            shared.send_to(
-                id,
-                Message::text(serde_json::json!({"type": "role", "role": role}).to_string()),
-            );
+            shared.send_to(id, Message::text(ServerMsg::Role { role }.to_json()));
         }
         PageMsg::Input(i) => {
             let Some(l) = link else {
@@ -415,18 +415,18 @@ fn on_message(shared: &Shared, id: u64, text: &str) {
     }
 }
 
-fn role_of(shared: &Shared, id: u64, link: Option<&SceneLink>) -> &'static str {
+fn role_of(shared: &Shared, id: u64, link: Option<&SceneLink>) -> Role {
     match link {
-        Some(l) if !l.page_is_hand => "view",
+        Some(l) if !l.page_is_hand => Role::View,
         _ if shared
             .player
             .lock()
             .map(|p| *p == Some(id))
             .unwrap_or(false) =>
         {
-            "hand"
+            Role::Hand
         }
-        _ => "view",
+        _ => Role::View,
     }
 }
 
@@ -438,7 +438,10 @@ fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
     // The greeting first: the hello (or that the session waits), and the end if it is over.
     let hello = shared.hello.lock().ok().and_then(|h| h.clone());
     let _ = tx.try_send(Message::text(hello.unwrap_or_else(|| {
-        serde_json::json!({"type": "waiting", "for": "the device's hello"}).to_string()
+        ServerMsg::Waiting {
+            waiting_for: "the device's hello".into(),
+        }
+        .to_json()
     })));
     if let Some(end) = shared.end.lock().ok().and_then(|e| e.clone()) {
         let _ = tx.try_send(Message::text(end));
@@ -447,7 +450,7 @@ fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
         pages.push(Page { id, tx });
     }
     let _ = stream.set_read_timeout(Some(Duration::from_millis(2)));
-    let mut ws = WebSocket::from_raw_socket(stream, Role::Server, None);
+    let mut ws = WebSocket::from_raw_socket(stream, WsRole::Server, None);
     'link: while !shared.shutdown.load(Ordering::Relaxed) {
         match ws.read() {
             Ok(Message::Text(t)) => on_message(shared, id, t.as_str()),
