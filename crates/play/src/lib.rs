@@ -89,9 +89,9 @@ impl PlayConfig {
 pub struct PlaySummary {
     /// The page's URL.
     pub url: String,
-    /// How it ended: `completed` (its `seconds` ran), `ended` (the player ended it on the
-    /// page, or `stop`), `device_ended` (a bridged device said goodbye): the words of
-    /// [`EndReason::as_str`].
+    /// How it ended: `completed` (its `seconds` ran), `stopped` (the player ended it on the
+    /// page, or `stop`), `device_ended` (a bridged device said goodbye); the words of
+    /// [`EndReason::as_str`], as `haptic_loop::session` reports them.
     pub end: &'static str,
     /// Tick statistics (ticks, missed deadlines, tick work).
     pub stats: TickStats,

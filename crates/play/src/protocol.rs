@@ -112,25 +112,24 @@ pub enum Role {
     View,
 }
 
-/// How a session ended.
+/// How a session ended (the same words as `haptic_loop::session`'s reports).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EndReason {
     /// Its planned length (`--seconds`) ran.
     Completed,
     /// Stopped by the user: the player ended it on the page, or the program was stopped.
-    #[serde(rename = "ended")]
     Stopped,
     /// A bridged device said goodbye.
     DeviceEnded,
 }
 
 impl EndReason {
-    /// The word on the wire and in summaries: `completed`, `ended`, `device_ended`.
+    /// The word on the wire and in summaries: `completed`, `stopped`, `device_ended`.
     pub fn as_str(self) -> &'static str {
         match self {
             EndReason::Completed => "completed",
-            EndReason::Stopped => "ended",
+            EndReason::Stopped => "stopped",
             EndReason::DeviceEnded => "device_ended",
         }
     }
@@ -1122,7 +1121,7 @@ mod tests {
         assert_eq!(
             msgs[6].to_json(),
             concat!(
-                r#"{"type":"end","end":"ended","ticks":2000,"seconds":2.0,"missed_deadlines":0,"#,
+                r#"{"type":"end","end":"stopped","ticks":2000,"seconds":2.0,"missed_deadlines":0,"#,
                 r#""tick_work":{"p50_ms":0.01,"p99_ms":0.05,"max_ms":0.2},"state":{"score":25.0},"#,
                 r#""peak_device_force_n":2.5,"events":4,"#,
                 r#""input_latency_ms":{"n":2,"p50":1.0,"p99":2.0,"max":2.0},"#,
@@ -1131,7 +1130,7 @@ mod tests {
         );
         for (e, word) in [
             (EndReason::Completed, "completed"),
-            (EndReason::Stopped, "ended"),
+            (EndReason::Stopped, "stopped"),
             (EndReason::DeviceEnded, "device_ended"),
         ] {
             assert_eq!(e.as_str(), word);

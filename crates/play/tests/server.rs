@@ -144,7 +144,7 @@ fn the_watchdog_takes_the_force_down_when_the_page_goes_quiet() {
     let msgs = read_for(&mut ws, 0.5);
     assert!(msgs.iter().any(|m| m["type"] == "end"));
     let s = h.join().unwrap().unwrap();
-    assert_eq!(s.end, "ended");
+    assert_eq!(s.end, "stopped");
     let a = read_arrays(&out, false).unwrap();
     let first = |name: &str| a.events.iter().find(|e| e.1 == name).map(|e| e.0);
     let (late, lost, back) = (
