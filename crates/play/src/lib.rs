@@ -18,11 +18,14 @@
 //!   ([`render::audio::StreamSynth`]), streamed to the pages in 5 ms blocks.
 //! - **The live menu**: the scene's switches, set from a page and applied before the next tick
 //!   (through [`haptic_loop::runner::Runner::with_live`]), recorded as switches.
+//! - **The protocol** ([`protocol`]): one typed message enum per direction, [`protocol::ServerMsg`]
+//!   and [`protocol::PageMsg`], tabled in `docs/play.md`.
 //!
-//! What it is not: it is no general web server (loopback only, four paths: `/`, `/play.js`,
-//! `/play.css`, `/ws`, and `/recording.mcap` once the session ended), it has no accounts and
-//! no TLS, and it is not the Foxglove live view (`nanohaptics run --live`). The page is plain
-//! HTML, CSS and JavaScript built into the binary; it needs no npm and no network.
+//! What it is not: it is no general web server (loopback only; the page's fixed files
+//! [`server::PAGE_FILES`], `/ws`, and `/recording.mcap` once the session ended), it has no
+//! accounts and no TLS, and it is not the Foxglove live view (`nanohaptics run --live`). The
+//! page is plain HTML, CSS and JavaScript modules built into the binary; it needs no npm, no
+//! bundler and no network.
 
 pub mod input;
 pub mod protocol;

@@ -17,9 +17,77 @@ use std::time::Duration;
 use tungstenite::protocol::Role as WsRole;
 use tungstenite::{Message, WebSocket};
 
+/// A file of the page, built into the binary.
+#[derive(Clone, Copy, Debug)]
+pub struct PageFile {
+    /// Its path on the server (`/main.js`).
+    pub path: &'static str,
+    /// Its `Content-Type`.
+    pub content_type: &'static str,
+    /// Its text.
+    pub body: &'static str,
+}
+
+const HTML: &str = "text/html; charset=utf-8";
+const CSS: &str = "text/css; charset=utf-8";
+const JS: &str = "text/javascript; charset=utf-8";
 const INDEX_HTML: &str = include_str!("page/index.html");
-const PLAY_JS: &str = include_str!("page/play.js");
-const PLAY_CSS: &str = include_str!("page/play.css");
+
+/// Every file of the page: the HTML, the style sheet and the JavaScript modules (`main.js`
+/// imports the others). These paths, `/ws`, `/favicon.ico` and `/recording.mcap` are all the
+/// server answers; anything else is 404.
+pub const PAGE_FILES: &[PageFile] = &[
+    PageFile {
+        path: "/",
+        content_type: HTML,
+        body: INDEX_HTML,
+    },
+    PageFile {
+        path: "/index.html",
+        content_type: HTML,
+        body: INDEX_HTML,
+    },
+    PageFile {
+        path: "/play.css",
+        content_type: CSS,
+        body: include_str!("page/play.css"),
+    },
+    PageFile {
+        path: "/main.js",
+        content_type: JS,
+        body: include_str!("page/main.js"),
+    },
+    PageFile {
+        path: "/page.js",
+        content_type: JS,
+        body: include_str!("page/page.js"),
+    },
+    PageFile {
+        path: "/camera.js",
+        content_type: JS,
+        body: include_str!("page/camera.js"),
+    },
+    PageFile {
+        path: "/draw.js",
+        content_type: JS,
+        body: include_str!("page/draw.js"),
+    },
+    PageFile {
+        path: "/input.js",
+        content_type: JS,
+        body: include_str!("page/input.js"),
+    },
+    PageFile {
+        path: "/sound.js",
+        content_type: JS,
+        body: include_str!("page/sound.js"),
+    },
+    PageFile {
+        path: "/messages.js",
+        content_type: JS,
+        body: include_str!("page/messages.js"),
+    },
+];
 
 /// Messages queued per page before frames are dropped.
 pub const PAGE_QUEUE: usize = 512;
@@ -257,28 +325,10 @@ fn connection(mut stream: TcpStream, shared: Arc<Shared>) {
         return;
     }
     let path = head.path.split('?').next().unwrap_or("/");
+    if let Some(f) = PAGE_FILES.iter().find(|f| f.path == path) {
+        return respond(&mut stream, "200 OK", f.content_type, "", f.body.as_bytes());
+    }
     match path {
-        "/" | "/index.html" => respond(
-            &mut stream,
-            "200 OK",
-            "text/html; charset=utf-8",
-            "",
-            INDEX_HTML.as_bytes(),
-        ),
-        "/play.js" => respond(
-            &mut stream,
-            "200 OK",
-            "text/javascript; charset=utf-8",
-            "",
-            PLAY_JS.as_bytes(),
-        ),
-        "/play.css" => respond(
-            &mut stream,
-            "200 OK",
-            "text/css; charset=utf-8",
-            "",
-            PLAY_CSS.as_bytes(),
-        ),
         "/favicon.ico" => respond(&mut stream, "204 No Content", "image/x-icon", "", b""),
         "/recording.mcap" => {
             let file = shared.recording.lock().ok().and_then(|r| r.clone());
@@ -521,6 +571,66 @@ mod tests {
             }
         }
         last
+    }
+
+    /// The `'./x.js'` module paths a page file imports (as served paths, `/x.js`).
+    fn imports(body: &str) -> Vec<String> {
+        body.lines()
+            .filter(|l| l.starts_with("import "))
+            .filter_map(|l| l.split("from './").nth(1))
+            .filter_map(|rest| rest.split('\'').next())
+            .map(|m| format!("/{m}"))
+            .collect()
+    }
+
+    #[test]
+    fn the_page_files_are_served_and_import_only_served_modules() {
+        let served: Vec<&str> = PAGE_FILES.iter().map(|f| f.path).collect();
+        // Every file in src/page is served (and nothing else is listed).
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/page");
+        let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| format!("/{}", e.unwrap().file_name().to_string_lossy()))
+            .collect();
+        on_disk.sort();
+        let mut listed: Vec<String> = served
+            .iter()
+            .filter(|p| **p != "/")
+            .map(|p| p.to_string())
+            .collect();
+        listed.sort();
+        assert_eq!(on_disk, listed);
+        // Modules are JavaScript; the page loads main.js as a module and the style sheet.
+        for f in PAGE_FILES {
+            assert_eq!(
+                f.path.ends_with(".js"),
+                f.content_type == "text/javascript; charset=utf-8",
+                "{}",
+                f.path
+            );
+        }
+        let index = PAGE_FILES[0].body;
+        assert!(index.contains(r#"<script type="module" src="/main.js"></script>"#));
+        assert!(index.contains(r#"href="/play.css""#));
+        // Every module is reached from main.js, and every import is served.
+        let mut reached = vec!["/main.js".to_string()];
+        let mut i = 0;
+        while i < reached.len() {
+            let f = PAGE_FILES.iter().find(|f| f.path == reached[i]).unwrap();
+            for m in imports(f.body) {
+                assert!(served.contains(&m.as_str()), "{} imports {m}", f.path);
+                if !reached.contains(&m) {
+                    reached.push(m);
+                }
+            }
+            i += 1;
+        }
+        let js = served.iter().filter(|p| p.ends_with(".js")).count();
+        assert_eq!(
+            reached.len(),
+            js,
+            "modules reached from main.js: {reached:?}"
+        );
     }
 
     #[test]
