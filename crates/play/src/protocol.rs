@@ -91,6 +91,103 @@ impl ServerMsg {
         }
     }
 
+    /// One example of every server message, in [`ServerMsg::TYPES`] order (for tests, docs
+    /// and programs that check what they read).
+    pub fn examples() -> Vec<ServerMsg> {
+        let msgs = vec![
+            ServerMsg::Hello(Hello {
+                scene: "wall".into(),
+                kind: "wall".into(),
+                rate_hz: 1000,
+                device: "falcon".into(),
+                workspace_radius_m: 0.04,
+                max_force_n: 8.0,
+                buttons: vec!["centre".into(), "plus".into()],
+                page_is_hand: true,
+                display_scale: 10.0,
+                mapping: Mapping {
+                    origin_m: [0.0, -0.05, 0.2],
+                    workspace_scale: 20.0,
+                },
+                switches: vec![SwitchInfo {
+                    name: "friction".into(),
+                    min: 0.0,
+                    max: 10.0,
+                    boolean: false,
+                    doc: "friction coefficient of every contact".into(),
+                    value: Some(0.6),
+                }],
+                state_fields: vec!["score".into()],
+                sample_rate_hz: 44_100,
+                seconds: None,
+            }),
+            ServerMsg::Waiting {
+                waiting_for: "the device's hello".into(),
+            },
+            ServerMsg::Role { role: Role::Hand },
+            ServerMsg::Frame(Frame {
+                tick: 32,
+                time_s: 0.032,
+                view: Some(FrameView {
+                    wall_ms: 1_764_000_000_000.5,
+                    prims: vec![Shape::Sphere {
+                        center_m: [0.0, 0.0, 0.1],
+                        radius_m: 0.01,
+                        color: [1.0, 0.5, 0.0, 1.0],
+                    }],
+                    state: [("score".to_string(), 25.0)].into_iter().collect(),
+                    cursor_m: [0.0, 0.0, 0.1],
+                    world_force_n: [0.0, 0.0, 1.5],
+                    device_force_n: [0.0, 0.0, 1.5],
+                    status: 1,
+                }),
+                events: vec![EventAt(20, "brick.grabbed".into(), "0".into())],
+                sounds: vec![SoundAt(21, "thud".into(), 0.25)],
+            }),
+            ServerMsg::Switched {
+                tick: 700,
+                name: "friction".into(),
+                value: 0.2,
+            },
+            ServerMsg::Error {
+                field: "input.pos[2]".into(),
+                message: "out of range".into(),
+            },
+            ServerMsg::End(EndReport {
+                end: EndReason::Stopped,
+                ticks: 2000,
+                seconds: 2.0,
+                missed_deadlines: 0,
+                tick_work: TickWorkMs {
+                    p50_ms: 0.01,
+                    p99_ms: 0.05,
+                    max_ms: 0.2,
+                },
+                state: [("score".to_string(), 25.0)].into_iter().collect(),
+                peak_device_force_n: 2.5,
+                events: 4,
+                input_latency_ms: LatencyMs::of(&[1.0, 2.0]),
+                recording: "/recording.mcap".into(),
+                recording_file: Some("play.mcap".into()),
+                recording_bytes: Some(4096),
+            }),
+        ];
+        // A new variant stops this match from compiling: give it an example above and its
+        // `type` in `ServerMsg::TYPES` (and a row in docs/play.md's table).
+        for m in &msgs {
+            match m {
+                ServerMsg::Hello(_)
+                | ServerMsg::Waiting { .. }
+                | ServerMsg::Role { .. }
+                | ServerMsg::Frame(_)
+                | ServerMsg::Switched { .. }
+                | ServerMsg::Error { .. }
+                | ServerMsg::End(_) => {}
+            }
+        }
+        msgs
+    }
+
     /// The message as the JSON text sent to a page (numbers as `serde_json` writes them: an
     /// `f64` always with a fraction or exponent, `1.0`; a non-finite one as `null`).
     pub fn to_json(&self) -> String {
@@ -647,6 +744,33 @@ impl PageMsg {
         }
     }
 
+    /// One example of every page message, in [`PageMsg::TYPES`] order (for tests, docs and
+    /// programs that play the page's part).
+    pub fn examples() -> Vec<PageMsg> {
+        let msgs = vec![
+            PageMsg::Start,
+            PageMsg::Input(PageInput {
+                seq: 7,
+                pos: [0.6, 0.0, -0.8],
+                buttons: 9,
+                t_ms: 1_764_000_000_000.5,
+            }),
+            PageMsg::Switch {
+                name: "friction".into(),
+                value: 0.5,
+            },
+            PageMsg::End,
+        ];
+        // A new variant stops this match from compiling: give it an example above and its
+        // `type` in `PageMsg::TYPES` (and a row in docs/play.md's table).
+        for m in &msgs {
+            match m {
+                PageMsg::Start | PageMsg::Input(_) | PageMsg::Switch { .. } | PageMsg::End => {}
+            }
+        }
+        msgs
+    }
+
     /// The message as a page sends it (JSON text).
     pub fn to_json(&self) -> String {
         // A non-finite number is written as `null`, which [`parse`] refuses, as it should.
@@ -936,105 +1060,9 @@ mod tests {
         );
     }
 
-    /// One example of every server message, in [`ServerMsg::TYPES`] order.
-    fn server_examples() -> Vec<ServerMsg> {
-        let msgs = vec![
-            ServerMsg::Hello(Hello {
-                scene: "wall".into(),
-                kind: "wall".into(),
-                rate_hz: 1000,
-                device: "falcon".into(),
-                workspace_radius_m: 0.04,
-                max_force_n: 8.0,
-                buttons: vec!["centre".into(), "plus".into()],
-                page_is_hand: true,
-                display_scale: 10.0,
-                mapping: Mapping {
-                    origin_m: [0.0, -0.05, 0.2],
-                    workspace_scale: 20.0,
-                },
-                switches: vec![SwitchInfo {
-                    name: "friction".into(),
-                    min: 0.0,
-                    max: 10.0,
-                    boolean: false,
-                    doc: "friction coefficient of every contact".into(),
-                    value: Some(0.6),
-                }],
-                state_fields: vec!["score".into()],
-                sample_rate_hz: 44_100,
-                seconds: None,
-            }),
-            ServerMsg::Waiting {
-                waiting_for: "the device's hello".into(),
-            },
-            ServerMsg::Role { role: Role::Hand },
-            ServerMsg::Frame(Frame {
-                tick: 32,
-                time_s: 0.032,
-                view: Some(FrameView {
-                    wall_ms: 1_764_000_000_000.5,
-                    prims: vec![Shape::Sphere {
-                        center_m: [0.0, 0.0, 0.1],
-                        radius_m: 0.01,
-                        color: [1.0, 0.5, 0.0, 1.0],
-                    }],
-                    state: [("score".to_string(), 25.0)].into_iter().collect(),
-                    cursor_m: [0.0, 0.0, 0.1],
-                    world_force_n: [0.0, 0.0, 1.5],
-                    device_force_n: [0.0, 0.0, 1.5],
-                    status: 1,
-                }),
-                events: vec![EventAt(20, "brick.grabbed".into(), "0".into())],
-                sounds: vec![SoundAt(21, "thud".into(), 0.25)],
-            }),
-            ServerMsg::Switched {
-                tick: 700,
-                name: "friction".into(),
-                value: 0.2,
-            },
-            ServerMsg::Error {
-                field: "input.pos[2]".into(),
-                message: "out of range".into(),
-            },
-            ServerMsg::End(EndReport {
-                end: EndReason::Stopped,
-                ticks: 2000,
-                seconds: 2.0,
-                missed_deadlines: 0,
-                tick_work: TickWorkMs {
-                    p50_ms: 0.01,
-                    p99_ms: 0.05,
-                    max_ms: 0.2,
-                },
-                state: [("score".to_string(), 25.0)].into_iter().collect(),
-                peak_device_force_n: 2.5,
-                events: 4,
-                input_latency_ms: LatencyMs::of(&[1.0, 2.0]),
-                recording: "/recording.mcap".into(),
-                recording_file: Some("play.mcap".into()),
-                recording_bytes: Some(4096),
-            }),
-        ];
-        // A new variant stops this match from compiling: give it an example above and its
-        // `type` in `ServerMsg::TYPES` (and a row in docs/play.md's table).
-        for m in &msgs {
-            match m {
-                ServerMsg::Hello(_)
-                | ServerMsg::Waiting { .. }
-                | ServerMsg::Role { .. }
-                | ServerMsg::Frame(_)
-                | ServerMsg::Switched { .. }
-                | ServerMsg::Error { .. }
-                | ServerMsg::End(_) => {}
-            }
-        }
-        msgs
-    }
-
     #[test]
     fn every_server_message_is_tagged_by_its_type_and_reads_back() {
-        let msgs = server_examples();
+        let msgs = ServerMsg::examples();
         let names: Vec<&str> = msgs.iter().map(ServerMsg::type_name).collect();
         assert_eq!(names, ServerMsg::TYPES);
         for m in &msgs {
@@ -1049,7 +1077,7 @@ mod tests {
 
     #[test]
     fn the_wire_form_of_small_messages() {
-        let msgs = server_examples();
+        let msgs = ServerMsg::examples();
         assert_eq!(
             msgs[1].to_json(),
             r#"{"type":"waiting","for":"the device's hello"}"#
@@ -1071,7 +1099,7 @@ mod tests {
 
     #[test]
     fn a_frame_and_the_last_frame_on_the_wire() {
-        let msgs = server_examples();
+        let msgs = ServerMsg::examples();
         assert_eq!(
             msgs[3].to_json(),
             concat!(
@@ -1117,7 +1145,7 @@ mod tests {
 
     #[test]
     fn an_end_on_the_wire() {
-        let msgs = server_examples();
+        let msgs = ServerMsg::examples();
         assert_eq!(
             msgs[6].to_json(),
             concat!(
@@ -1221,27 +1249,7 @@ mod tests {
 
     #[test]
     fn every_page_message_reads_back_through_the_checked_parser() {
-        let msgs = [
-            PageMsg::Start,
-            PageMsg::Input(PageInput {
-                seq: 7,
-                pos: [0.6, 0.0, -0.8],
-                buttons: 9,
-                t_ms: 1_764_000_000_000.5,
-            }),
-            PageMsg::Switch {
-                name: "friction".into(),
-                value: 0.5,
-            },
-            PageMsg::End,
-        ];
-        // A new variant stops this match from compiling: give it an example above and its
-        // `type` in `PageMsg::TYPES` (and a row in docs/play.md's table).
-        for m in &msgs {
-            match m {
-                PageMsg::Start | PageMsg::Input(_) | PageMsg::Switch { .. } | PageMsg::End => {}
-            }
-        }
+        let msgs = PageMsg::examples();
         let names: Vec<&str> = msgs.iter().map(PageMsg::type_name).collect();
         assert_eq!(names, PageMsg::TYPES);
         for m in &msgs {
