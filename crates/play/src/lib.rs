@@ -18,11 +18,14 @@
 //!   ([`render::audio::StreamSynth`]), streamed to the pages in 5 ms blocks.
 //! - **The live menu**: the scene's switches, set from a page and applied before the next tick
 //!   (through [`haptic_loop::runner::Runner::with_live`]), recorded as switches.
+//! - **The protocol** ([`protocol`]): one typed message enum per direction, [`protocol::ServerMsg`]
+//!   and [`protocol::PageMsg`], tabled in `docs/play.md`.
 //!
-//! What it is not: it is no general web server (loopback only, four paths: `/`, `/play.js`,
-//! `/play.css`, `/ws`, and `/recording.mcap` once the session ended), it has no accounts and
-//! no TLS, and it is not the Foxglove live view (`nanohaptics run --live`). The page is plain
-//! HTML, CSS and JavaScript built into the binary; it needs no npm and no network.
+//! What it is not: it is no general web server (loopback only; the page's fixed files
+//! [`server::PAGE_FILES`], `/ws`, and `/recording.mcap` once the session ended), it has no
+//! accounts and no TLS, and it is not the Foxglove live view (`nanohaptics run --live`). The
+//! page is plain HTML, CSS and JavaScript modules built into the binary; it needs no npm, no
+//! bundler and no network.
 
 pub mod input;
 pub mod protocol;
@@ -31,21 +34,21 @@ pub mod server;
 
 use haptic_devices::bridge::{BridgeConfig, UdpDevice};
 use haptic_devices::pacing::{Percentiles, TickStats};
-use haptic_loop::runner::{EndReason, Pacing, Runner};
+use haptic_loop::runner::{Pacing, Runner};
 use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
 use haptic_loop::setup::{Setup, SetupOptions};
 use haptic_loop::totals::Totals;
 use haptic_loop::{DeviceSpecs, HapticDevice, HapticLoop};
 use input::PageDevice;
+pub use protocol::LatencyMs;
+use protocol::{EndReason, EndReport, Hello, Mapping, ServerMsg, SwitchInfo, TickWorkMs};
 use publish::{PlaySink, PublishSummary, ToPublisher};
 use recording::WriteSummary;
-use serde_json::json;
 use server::{SceneLink, Server, Shared};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-use world_form::numbers::percentile;
 
 /// Default port of the page.
 pub const DEFAULT_PORT: u16 = 8080;
@@ -84,43 +87,14 @@ impl PlayConfig {
     }
 }
 
-/// Latency figures, ms.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct LatencyMs {
-    /// Samples.
-    pub n: usize,
-    /// Median, ms.
-    pub p50: f64,
-    /// 99th percentile (nearest rank), ms.
-    pub p99: f64,
-    /// Largest, ms.
-    pub max: f64,
-}
-
-impl LatencyMs {
-    /// Figures of `v` (`None` when empty).
-    pub fn of(v: &[f64]) -> Option<Self> {
-        if v.is_empty() {
-            return None;
-        }
-        let mut s = v.to_vec();
-        s.sort_by(f64::total_cmp);
-        Some(LatencyMs {
-            n: s.len(),
-            p50: percentile(&s, 0.5)?,
-            p99: percentile(&s, 0.99)?,
-            max: percentile(&s, 1.0)?,
-        })
-    }
-}
-
 /// What a play session produced.
 #[derive(Debug)]
 pub struct PlaySummary {
     /// The page's URL.
     pub url: String,
-    /// How it ended: `completed` (its `seconds` ran), `ended` (the player ended it on the
-    /// page, or `stop`), `device_ended` (a bridged device said goodbye).
+    /// How it ended: `completed` (its `seconds` ran), `stopped` (the player ended it on the
+    /// page, or `stop`), `device_ended` (a bridged device said goodbye); the words of
+    /// [`EndReason::as_str`], as `haptic_loop::session` reports them.
     pub end: &'static str,
     /// Tick statistics (ticks, missed deadlines, tick work).
     pub stats: TickStats,
@@ -182,8 +156,12 @@ pub enum PlayError {
     NotStarted,
 }
 
-fn stats_ms(p: &Percentiles) -> serde_json::Value {
-    json!({"p50_ms": p.p50_ns as f64 * 1e-6, "p99_ms": p.p99_ns as f64 * 1e-6, "max_ms": p.max_ns as f64 * 1e-6})
+fn stats_ms(p: &Percentiles) -> TickWorkMs {
+    TickWorkMs {
+        p50_ms: p.p50_ns as f64 * 1e-6,
+        p99_ms: p.p99_ns as f64 * 1e-6,
+        max_ms: p.max_ns as f64 * 1e-6,
+    }
 }
 
 /// The hand of a play session: the page, or a device bridged over UDP.
@@ -241,31 +219,42 @@ fn hello_message(
     specs: &DeviceSpecs,
     page_is_hand: bool,
     seconds: Option<f64>,
-) -> serde_json::Value {
+) -> ServerMsg {
     let scene = lp.scene();
     let config = lp.config();
-    json!({
-        "type": "hello",
-        "scene": scene_name,
-        "kind": scene.kind(),
-        "rate_hz": config.rate_hz,
-        "device": specs.name,
-        "workspace_radius_m": specs.workspace_radius_m,
-        "max_force_n": specs.limits.max_force_n,
-        "buttons": specs.button_strs(),
-        "page_is_hand": page_is_hand,
-        "display_scale": config.display_scale,
-        "mapping": {
-            "origin_m": config.mapping.origin_m,
-            "workspace_scale": config.mapping.workspace_scale,
+    ServerMsg::Hello(Hello {
+        scene: scene_name.to_string(),
+        kind: scene.kind().to_string(),
+        rate_hz: config.rate_hz,
+        device: specs.name.to_string(),
+        workspace_radius_m: specs.workspace_radius_m,
+        max_force_n: specs.limits.max_force_n,
+        buttons: specs
+            .button_strs()
+            .into_iter()
+            .map(str::to_string)
+            .collect(),
+        page_is_hand,
+        display_scale: config.display_scale,
+        mapping: Mapping {
+            origin_m: config.mapping.origin_m,
+            workspace_scale: config.mapping.workspace_scale,
         },
-        "switches": scene.switches().iter().map(|s| json!({
-            "name": s.name, "min": s.min, "max": s.max, "boolean": s.boolean, "doc": s.doc,
-            "value": scene.switch_value(s.name),
-        })).collect::<Vec<_>>(),
-        "state_fields": scene.state_fields(),
-        "sample_rate_hz": publish::SAMPLE_RATE_HZ,
-        "seconds": seconds,
+        switches: scene
+            .switches()
+            .iter()
+            .map(|s| SwitchInfo {
+                name: s.name.to_string(),
+                min: s.min,
+                max: s.max,
+                boolean: s.boolean,
+                doc: s.doc.to_string(),
+                value: scene.switch_value(s.name),
+            })
+            .collect(),
+        state_fields: scene.state_fields(),
+        sample_rate_hz: publish::SAMPLE_RATE_HZ,
+        seconds,
     })
 }
 
@@ -289,50 +278,57 @@ fn announce(
             page_is_hand,
         });
     }
-    let hello = hello_message(scene_name, lp, specs, page_is_hand, seconds);
+    let hello = hello_message(scene_name, lp, specs, page_is_hand, seconds).to_json();
     if let Ok(mut h) = shared.hello.lock() {
-        *h = Some(hello.to_string());
+        *h = Some(hello.clone());
     }
-    shared.broadcast(&tungstenite::Message::text(hello.to_string()));
+    shared.broadcast(&tungstenite::Message::text(hello));
 }
 
 /// The page's `end`: the session's figures and where to download its recording.
 fn end_message(
     config: &PlayConfig,
-    end: &str,
+    end: EndReason,
     stats: &TickStats,
     rate_hz: u32,
     totals: &Totals,
     input_latency_ms: Option<LatencyMs>,
     written: Option<&WriteSummary>,
-) -> serde_json::Value {
-    json!({
-        "type": "end",
-        "end": end,
-        "ticks": stats.ticks,
-        "seconds": stats.ticks as f64 / f64::from(rate_hz),
-        "missed_deadlines": stats.missed,
-        "tick_work": stats_ms(&stats.compute),
-        "state": totals.state_fields.iter().zip(&totals.last_state)
-            .map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
-        "peak_device_force_n": totals.peak_device_force_n,
-        "events": totals.events,
-        "input_latency_ms": input_latency_ms,
-        "recording": "/recording.mcap",
-        "recording_file": config.out.file_name().map(|n| n.to_string_lossy().to_string()),
-        "recording_bytes": written.map(|w| w.bytes),
+) -> ServerMsg {
+    ServerMsg::End(EndReport {
+        end,
+        ticks: stats.ticks,
+        seconds: stats.ticks as f64 / f64::from(rate_hz),
+        missed_deadlines: stats.missed,
+        tick_work: stats_ms(&stats.compute),
+        state: totals
+            .state_fields
+            .iter()
+            .cloned()
+            .zip(totals.last_state.iter().copied())
+            .collect(),
+        peak_device_force_n: totals.peak_device_force_n,
+        events: totals.events,
+        input_latency_ms,
+        recording: "/recording.mcap".to_string(),
+        recording_file: config
+            .out
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string()),
+        recording_bytes: written.map(|w| w.bytes),
     })
 }
 
 /// Offers the recording for download and tells every page (and later ones) the end.
-fn offer_end(shared: &Shared, config: &PlayConfig, end_msg: &serde_json::Value) {
+fn offer_end(shared: &Shared, config: &PlayConfig, end_msg: &ServerMsg) {
     if let Ok(mut r) = shared.recording.lock() {
         *r = Some(config.out.clone());
     }
+    let text = end_msg.to_json();
     if let Ok(mut e) = shared.end.lock() {
-        *e = Some(end_msg.to_string());
+        *e = Some(text.clone());
     }
-    shared.broadcast(&tungstenite::Message::text(end_msg.to_string()));
+    shared.broadcast(&tungstenite::Message::text(text));
 }
 
 /// The hook run before each tick's step: raises the end on `stop`, and applies the switches
@@ -497,11 +493,7 @@ pub fn run(
     let published = publisher.join().unwrap_or_default();
     let (stats, end) = result.map_err(SessionError::from)?;
     closed.map_err(SessionError::Device)?;
-    let end = match end {
-        EndReason::Completed => "completed",
-        EndReason::Stopped => "ended",
-        EndReason::DeviceEnded => "device_ended",
-    };
+    let end = EndReason::from(end);
     let totals = &sinks.totals;
     let state = totals.state();
     let input_latency_ms = LatencyMs::of(&latencies);
@@ -520,7 +512,7 @@ pub fn run(
     server.stop();
     Ok(PlaySummary {
         url,
-        end,
+        end: end.as_str(),
         stats,
         state,
         recording: config.out.clone(),

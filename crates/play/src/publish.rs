@@ -11,6 +11,9 @@
 //! anti-clipping scale (the summary's `sound_samples_limited` counts the live samples limited
 //! instead). The frames also carry each sound with its tick, for captions and checks.
 
+use crate::protocol::{
+    EventAt, Frame, FrameView, SOUND_BLOCK_HEADER_BYTES, ServerMsg, Shape, SoundAt,
+};
 use crate::server::Shared;
 use haptic_devices::pacing::TickStats;
 use haptic_loop::HapticLoop;
@@ -18,7 +21,6 @@ use haptic_loop::scene::Primitive;
 use haptic_loop::session::{SessionArrays, now_unix_ns};
 use haptic_loop::sink::{SessionInfo, Sink, SinkError, TickView};
 use render::audio::{Impact, Sound, StreamSynth};
-use serde_json::{Value, json};
 use std::collections::VecDeque;
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender};
@@ -192,64 +194,6 @@ pub struct PublishSummary {
     pub events: u64,
 }
 
-fn rgba(c: &render::Rgba) -> Value {
-    json!(c.0)
-}
-
-/// A primitive as the page draws it.
-pub fn primitive_json(p: &Primitive) -> Value {
-    match p {
-        Primitive::Sphere {
-            center_m,
-            radius_m,
-            color,
-        } => json!({"k": "sphere", "c": center_m, "r": radius_m, "col": rgba(color)}),
-        Primitive::Cursor {
-            center_m,
-            radius_m,
-            color,
-        } => json!({"k": "cursor", "c": center_m, "r": radius_m, "col": rgba(color)}),
-        Primitive::Box {
-            center_m,
-            half_extents_m,
-            rotation,
-            color,
-        } => {
-            json!({"k": "box", "c": center_m, "h": half_extents_m, "q": rotation, "col": rgba(color)})
-        }
-        Primitive::Slot {
-            center_m,
-            half_extents_m,
-            rotation,
-            color,
-        } => {
-            json!({"k": "slot", "c": center_m, "h": half_extents_m, "q": rotation, "col": rgba(color)})
-        }
-        Primitive::Ellipse {
-            center_m,
-            semi_axes_m,
-            color,
-        } => json!({"k": "ellipse", "c": center_m, "ax": semi_axes_m, "col": rgba(color)}),
-        Primitive::Polyline {
-            points_m,
-            closed,
-            color,
-        } => json!({"k": "line", "p": points_m, "closed": closed, "col": rgba(color)}),
-        Primitive::Arrow {
-            from_m,
-            to_m,
-            color,
-        } => {
-            json!({"k": "arrow", "a": from_m, "b": to_m, "col": rgba(color)})
-        }
-        Primitive::Label {
-            position_m,
-            text,
-            color,
-        } => json!({"k": "label", "c": position_m, "text": text, "col": rgba(color)}),
-    }
-}
-
 /// The page's name of a sound.
 pub fn sound_name(s: &Sound) -> (&'static str, f64) {
     match *s {
@@ -282,8 +226,8 @@ pub fn run_publisher(
     let mut pcm: Vec<f32> = Vec::new();
     let mut pcm_first: u64 = 0;
     let mut tick_wall: VecDeque<(u64, f64)> = VecDeque::new();
-    let mut events: Vec<Value> = Vec::new();
-    let mut sounds: Vec<Value> = Vec::new();
+    let mut events: Vec<EventAt> = Vec::new();
+    let mut sounds: Vec<SoundAt> = Vec::new();
     let send_pcm = |pcm: &mut Vec<f32>, first: &mut u64, walls: &mut VecDeque<(u64, f64)>| {
         if pcm.is_empty() {
             return;
@@ -293,7 +237,7 @@ pub fn run_publisher(
             walls.pop_front();
         }
         let wall = walls.front().map_or(0.0, |w| w.1);
-        let mut b = Vec::with_capacity(16 + 4 * pcm.len());
+        let mut b = Vec::with_capacity(SOUND_BLOCK_HEADER_BYTES + 4 * pcm.len());
         b.extend_from_slice(&first.to_le_bytes());
         b.extend_from_slice(&wall.to_le_bytes());
         for s in pcm.iter() {
@@ -317,7 +261,7 @@ pub fn run_publisher(
                     scratch.events.clear();
                     for (name, detail) in evs {
                         sum.events += 1;
-                        events.push(json!([tick, name, detail]));
+                        events.push(EventAt(tick, name.clone(), detail.clone()));
                         scratch.events.push((tick, name, detail));
                     }
                     // The mapping of `render --audio`; an event whose detail it cannot read
@@ -326,7 +270,7 @@ pub fn run_publisher(
                         for s in list {
                             sum.sounds += 1;
                             let (name, amplitude) = sound_name(&s.sound);
-                            sounds.push(json!([tick, name, amplitude]));
+                            sounds.push(SoundAt(tick, name.to_string(), amplitude));
                             if let Some(sy) = synth.as_mut() {
                                 sy.push(&s);
                             }
@@ -340,37 +284,35 @@ pub fn run_publisher(
                     send_pcm(&mut pcm, &mut pcm_first, &mut tick_wall);
                 }
                 if let Some(f) = frame {
-                    let state: serde_json::Map<String, Value> = state_fields
-                        .iter()
-                        .zip(&f.state)
-                        .map(|(k, v)| (k.clone(), json!(v)))
-                        .collect();
-                    let prims: Vec<Value> = f.prims.iter().map(primitive_json).collect();
-                    let msg = json!({
-                        "type": "frame",
-                        "tick": tick,
-                        "time_s": tick as f64 * dt,
-                        "wall_ms": wall_ms,
-                        "prims": prims,
-                        "state": state,
-                        "cursor_m": f.cursor_m,
-                        "world_force_n": f.world_force_n,
-                        "device_force_n": f.device_force_n,
-                        "status": f.status,
-                        "events": std::mem::take(&mut events),
-                        "sounds": std::mem::take(&mut sounds),
+                    let msg = ServerMsg::Frame(Frame {
+                        tick,
+                        time_s: tick as f64 * dt,
+                        view: Some(FrameView {
+                            wall_ms,
+                            prims: f.prims.iter().map(Shape::from).collect(),
+                            state: state_fields.iter().cloned().zip(f.state).collect(),
+                            cursor_m: f.cursor_m,
+                            world_force_n: f.world_force_n,
+                            device_force_n: f.device_force_n,
+                            status: f.status,
+                        }),
+                        events: std::mem::take(&mut events),
+                        sounds: std::mem::take(&mut sounds),
                     });
-                    shared.broadcast(&Message::text(msg.to_string()));
+                    shared.broadcast(&Message::text(msg.to_json()));
                     sum.frames += 1;
                 }
             }
             ToPublisher::Switched { tick, name, value } => {
-                let m = json!({"type": "switched", "tick": tick, "name": name, "value": value});
-                shared.broadcast(&Message::text(m.to_string()));
+                let m = ServerMsg::Switched { tick, name, value };
+                shared.broadcast(&Message::text(m.to_json()));
             }
             ToPublisher::Refused { page, message } => {
-                let m = json!({"type": "error", "field": "switch.value", "message": message});
-                shared.send_to(page, Message::text(m.to_string()));
+                let m = ServerMsg::Error {
+                    field: "switch.value".into(),
+                    message,
+                };
+                shared.send_to(page, Message::text(m.to_json()));
             }
             ToPublisher::Finish { ticks } => {
                 if let Some(sy) = synth.as_mut() {
@@ -378,9 +320,14 @@ pub fn run_publisher(
                 }
                 send_pcm(&mut pcm, &mut pcm_first, &mut tick_wall);
                 // The last events and sounds, in a last frame without drawing.
-                let msg = json!({"type": "frame", "tick": ticks.saturating_sub(1),
-                    "time_s": ticks as f64 * dt, "events": events, "sounds": sounds});
-                shared.broadcast(&Message::text(msg.to_string()));
+                let msg = ServerMsg::Frame(Frame {
+                    tick: ticks.saturating_sub(1),
+                    time_s: ticks as f64 * dt,
+                    view: None,
+                    events: std::mem::take(&mut events),
+                    sounds: std::mem::take(&mut sounds),
+                });
+                shared.broadcast(&Message::text(msg.to_json()));
                 break;
             }
         }

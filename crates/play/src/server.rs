@@ -4,7 +4,7 @@
 //! (bounded queues; a page that cannot keep up loses frames, never the tick's time).
 
 use crate::input::{SharedInput, page_to_device};
-use crate::protocol::{self, PageMsg, ProtocolError};
+use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
 use haptic_loop::scene::SwitchSpec;
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -14,12 +14,80 @@ use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
-use tungstenite::protocol::Role;
+use tungstenite::protocol::Role as WsRole;
 use tungstenite::{Message, WebSocket};
 
+/// A file of the page, built into the binary.
+#[derive(Clone, Copy, Debug)]
+pub struct PageFile {
+    /// Its path on the server (`/main.js`).
+    pub path: &'static str,
+    /// Its `Content-Type`.
+    pub content_type: &'static str,
+    /// Its text.
+    pub body: &'static str,
+}
+
+const HTML: &str = "text/html; charset=utf-8";
+const CSS: &str = "text/css; charset=utf-8";
+const JS: &str = "text/javascript; charset=utf-8";
 const INDEX_HTML: &str = include_str!("page/index.html");
-const PLAY_JS: &str = include_str!("page/play.js");
-const PLAY_CSS: &str = include_str!("page/play.css");
+
+/// Every file of the page: the HTML, the style sheet and the JavaScript modules (`main.js`
+/// imports the others). These paths, `/ws`, `/favicon.ico` and `/recording.mcap` are all the
+/// server answers; anything else is 404.
+pub const PAGE_FILES: &[PageFile] = &[
+    PageFile {
+        path: "/",
+        content_type: HTML,
+        body: INDEX_HTML,
+    },
+    PageFile {
+        path: "/index.html",
+        content_type: HTML,
+        body: INDEX_HTML,
+    },
+    PageFile {
+        path: "/play.css",
+        content_type: CSS,
+        body: include_str!("page/play.css"),
+    },
+    PageFile {
+        path: "/main.js",
+        content_type: JS,
+        body: include_str!("page/main.js"),
+    },
+    PageFile {
+        path: "/page.js",
+        content_type: JS,
+        body: include_str!("page/page.js"),
+    },
+    PageFile {
+        path: "/camera.js",
+        content_type: JS,
+        body: include_str!("page/camera.js"),
+    },
+    PageFile {
+        path: "/draw.js",
+        content_type: JS,
+        body: include_str!("page/draw.js"),
+    },
+    PageFile {
+        path: "/input.js",
+        content_type: JS,
+        body: include_str!("page/input.js"),
+    },
+    PageFile {
+        path: "/sound.js",
+        content_type: JS,
+        body: include_str!("page/sound.js"),
+    },
+    PageFile {
+        path: "/messages.js",
+        content_type: JS,
+        body: include_str!("page/messages.js"),
+    },
+];
 
 /// Messages queued per page before frames are dropped.
 pub const PAGE_QUEUE: usize = 512;
@@ -107,8 +175,11 @@ impl Shared {
 
     fn error_to(&self, id: u64, field: &str, message: &str) {
         self.refused.fetch_add(1, Ordering::Relaxed);
-        let m = serde_json::json!({"type": "error", "field": field, "message": message});
-        self.send_to(id, Message::text(m.to_string()));
+        let m = ServerMsg::Error {
+            field: field.to_string(),
+            message: message.to_string(),
+        };
+        self.send_to(id, Message::text(m.to_json()));
     }
 }
 
@@ -254,28 +325,10 @@ fn connection(mut stream: TcpStream, shared: Arc<Shared>) {
         return;
     }
     let path = head.path.split('?').next().unwrap_or("/");
+    if let Some(f) = PAGE_FILES.iter().find(|f| f.path == path) {
+        return respond(&mut stream, "200 OK", f.content_type, "", f.body.as_bytes());
+    }
     match path {
-        "/" | "/index.html" => respond(
-            &mut stream,
-            "200 OK",
-            "text/html; charset=utf-8",
-            "",
-            INDEX_HTML.as_bytes(),
-        ),
-        "/play.js" => respond(
-            &mut stream,
-            "200 OK",
-            "text/javascript; charset=utf-8",
-            "",
-            PLAY_JS.as_bytes(),
-        ),
-        "/play.css" => respond(
-            &mut stream,
-            "200 OK",
-            "text/css; charset=utf-8",
-            "",
-            PLAY_CSS.as_bytes(),
-        ),
         "/favicon.ico" => respond(&mut stream, "204 No Content", "image/x-icon", "", b""),
         "/recording.mcap" => {
             let file = shared.recording.lock().ok().and_then(|r| r.clone());
@@ -361,10 +414,7 @@ fn on_message(shared: &Shared, id: u64, text: &str) {
                 *p = Some(id);
             }
             let role = role_of(shared, id, link.as_ref());
-            shared.send_to(
-                id,
-                Message::text(serde_json::json!({"type": "role", "role": role}).to_string()),
-            );
+            shared.send_to(id, Message::text(ServerMsg::Role { role }.to_json()));
         }
         PageMsg::Input(i) => {
             let Some(l) = link else {
@@ -415,18 +465,18 @@ fn on_message(shared: &Shared, id: u64, text: &str) {
     }
 }
 
-fn role_of(shared: &Shared, id: u64, link: Option<&SceneLink>) -> &'static str {
+fn role_of(shared: &Shared, id: u64, link: Option<&SceneLink>) -> Role {
     match link {
-        Some(l) if !l.page_is_hand => "view",
+        Some(l) if !l.page_is_hand => Role::View,
         _ if shared
             .player
             .lock()
             .map(|p| *p == Some(id))
             .unwrap_or(false) =>
         {
-            "hand"
+            Role::Hand
         }
-        _ => "view",
+        _ => Role::View,
     }
 }
 
@@ -438,7 +488,10 @@ fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
     // The greeting first: the hello (or that the session waits), and the end if it is over.
     let hello = shared.hello.lock().ok().and_then(|h| h.clone());
     let _ = tx.try_send(Message::text(hello.unwrap_or_else(|| {
-        serde_json::json!({"type": "waiting", "for": "the device's hello"}).to_string()
+        ServerMsg::Waiting {
+            waiting_for: "the device's hello".into(),
+        }
+        .to_json()
     })));
     if let Some(end) = shared.end.lock().ok().and_then(|e| e.clone()) {
         let _ = tx.try_send(Message::text(end));
@@ -447,7 +500,7 @@ fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
         pages.push(Page { id, tx });
     }
     let _ = stream.set_read_timeout(Some(Duration::from_millis(2)));
-    let mut ws = WebSocket::from_raw_socket(stream, Role::Server, None);
+    let mut ws = WebSocket::from_raw_socket(stream, WsRole::Server, None);
     'link: while !shared.shutdown.load(Ordering::Relaxed) {
         match ws.read() {
             Ok(Message::Text(t)) => on_message(shared, id, t.as_str()),
@@ -518,6 +571,66 @@ mod tests {
             }
         }
         last
+    }
+
+    /// The `'./x.js'` module paths a page file imports (as served paths, `/x.js`).
+    fn imports(body: &str) -> Vec<String> {
+        body.lines()
+            .filter(|l| l.starts_with("import "))
+            .filter_map(|l| l.split("from './").nth(1))
+            .filter_map(|rest| rest.split('\'').next())
+            .map(|m| format!("/{m}"))
+            .collect()
+    }
+
+    #[test]
+    fn the_page_files_are_served_and_import_only_served_modules() {
+        let served: Vec<&str> = PAGE_FILES.iter().map(|f| f.path).collect();
+        // Every file in src/page is served (and nothing else is listed).
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/page");
+        let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| format!("/{}", e.unwrap().file_name().to_string_lossy()))
+            .collect();
+        on_disk.sort();
+        let mut listed: Vec<String> = served
+            .iter()
+            .filter(|p| **p != "/")
+            .map(|p| p.to_string())
+            .collect();
+        listed.sort();
+        assert_eq!(on_disk, listed);
+        // Modules are JavaScript; the page loads main.js as a module and the style sheet.
+        for f in PAGE_FILES {
+            assert_eq!(
+                f.path.ends_with(".js"),
+                f.content_type == "text/javascript; charset=utf-8",
+                "{}",
+                f.path
+            );
+        }
+        let index = PAGE_FILES[0].body;
+        assert!(index.contains(r#"<script type="module" src="/main.js"></script>"#));
+        assert!(index.contains(r#"href="/play.css""#));
+        // Every module is reached from main.js, and every import is served.
+        let mut reached = vec!["/main.js".to_string()];
+        let mut i = 0;
+        while i < reached.len() {
+            let f = PAGE_FILES.iter().find(|f| f.path == reached[i]).unwrap();
+            for m in imports(f.body) {
+                assert!(served.contains(&m.as_str()), "{} imports {m}", f.path);
+                if !reached.contains(&m) {
+                    reached.push(m);
+                }
+            }
+            i += 1;
+        }
+        let js = served.iter().filter(|p| p.ends_with(".js")).count();
+        assert_eq!(
+            reached.len(),
+            js,
+            "modules reached from main.js: {reached:?}"
+        );
     }
 
     #[test]

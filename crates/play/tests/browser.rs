@@ -143,7 +143,7 @@ fn end_session(b: &mut Browser, s: Session, shot: &str) -> (PlaySummary, Value) 
         Some(std::fs::metadata(&s.out).unwrap().len()),
         "the download link serves the recording"
     );
-    assert_eq!(summary.end, "ended");
+    assert_eq!(summary.end, "stopped");
     (summary, page)
 }
 

@@ -8,6 +8,7 @@ use haptic_devices::bridge::fake::{FakeConfig, run_fake};
 use haptic_devices::script::Script;
 use haptic_devices::{DeviceModel, FALCON};
 use haptic_loop::session::{SceneSource, read_arrays};
+use play::protocol::ServerMsg;
 use play::{PlayConfig, PlayError, PlaySummary, run};
 use recording::read_recording_file;
 use serde_json::Value;
@@ -68,13 +69,18 @@ fn page(url: &str) -> Ws {
     ws
 }
 
-/// The text messages that arrive within `secs`.
+/// The text messages that arrive within `secs` (each one also read as a typed
+/// [`ServerMsg`]: what the server sends is what the protocol's type says).
 fn read_for(ws: &mut Ws, secs: f64) -> Vec<Value> {
     let t0 = Instant::now();
     let mut out = Vec::new();
     while t0.elapsed().as_secs_f64() < secs {
         if let Ok(Message::Text(t)) = ws.read() {
-            out.push(serde_json::from_str(t.as_str()).unwrap());
+            let typed: ServerMsg = serde_json::from_str(t.as_str())
+                .unwrap_or_else(|e| panic!("not a ServerMsg ({e}): {t}"));
+            let v: Value = serde_json::from_str(t.as_str()).unwrap();
+            assert_eq!(v["type"], typed.type_name());
+            out.push(v);
         }
     }
     out
@@ -94,7 +100,40 @@ fn the_page_is_served_on_its_paths_only() {
         "{index}"
     );
     assert!(index.contains("<canvas id=\"view\""));
-    assert!(get("/play.js").starts_with("HTTP/1.1 200 OK\r\nContent-Type: text/javascript"));
+    assert!(index.contains(r#"<script type="module" src="/main.js">"#));
+    // The page's modules, as JavaScript (a browser runs a module of no other type).
+    for m in play::server::PAGE_FILES
+        .iter()
+        .filter(|f| f.path.ends_with(".js"))
+    {
+        let r = get(m.path);
+        assert!(
+            r.starts_with("HTTP/1.1 200 OK\r\nContent-Type: text/javascript; charset=utf-8\r\n"),
+            "{}: {r}",
+            m.path
+        );
+        assert!(r.ends_with(m.body), "{}", m.path);
+    }
+    for m in [
+        "/main.js",
+        "/camera.js",
+        "/draw.js",
+        "/input.js",
+        "/sound.js",
+        "/messages.js",
+    ] {
+        assert!(get(m).starts_with("HTTP/1.1 200 OK"), "{m}");
+    }
+    // Only the whitelist: the old single script, other files of the crate, paths out.
+    for p in [
+        "/play.js",
+        "/lib.rs",
+        "/page/main.js",
+        "/../Cargo.toml",
+        "/main.js/",
+    ] {
+        assert!(get(p).starts_with("HTTP/1.1 404"), "{p}");
+    }
     assert!(get("/play.css").starts_with("HTTP/1.1 200 OK\r\nContent-Type: text/css"));
     assert!(get("/favicon.ico").starts_with("HTTP/1.1 204"));
     let rec = get("/recording.mcap");
@@ -144,7 +183,7 @@ fn the_watchdog_takes_the_force_down_when_the_page_goes_quiet() {
     let msgs = read_for(&mut ws, 0.5);
     assert!(msgs.iter().any(|m| m["type"] == "end"));
     let s = h.join().unwrap().unwrap();
-    assert_eq!(s.end, "ended");
+    assert_eq!(s.end, "stopped");
     let a = read_arrays(&out, false).unwrap();
     let first = |name: &str| a.events.iter().find(|e| e.1 == name).map(|e| e.0);
     let (late, lost, back) = (

@@ -1,0 +1,40 @@
+// nanohaptics play: the page. Draws the frames the server sends, sends the hand, plays the
+// sound blocks. Plain JavaScript modules, no library, built into the server:
+//   page.js      what the modules share (window.__play, the spoken log)
+//   camera.js    the orbit camera and the projection
+//   draw.js      a frame's shapes on the canvas
+//   input.js     pointer, keyboard and gamepad as the hand
+//   sound.js     the sound blocks on the Web Audio clock
+//   messages.js  the WebSocket and a handler per message type
+// window.__play holds figures for tests and benches.
+
+import { $, P } from './page.js';
+import { canvas, resize } from './camera.js';
+import { draw } from './draw.js';
+import { gripping, installInput, pollKeysAndPad, sendHand } from './input.js';
+import { startAudio } from './sound.js';
+import { connect, send } from './messages.js';
+
+$('go').addEventListener('click', () => {
+  $('start').classList.add('hidden');
+  startAudio();
+  send({ type: 'start' });
+  canvas.focus();
+  setTimeout(() => sendHand(), 0);
+});
+
+// The frame loop: the keys and gamepad (while the hand), then the drawing.
+let lastT = performance.now();
+function loop(t) {
+  const dt = Math.min(0.1, (t - lastT) / 1000); lastT = t;
+  if (P.hello && P.role === 'hand') pollKeysAndPad(dt);
+  if (!P.drawT0 && P.lastFrame) P.drawT0 = t;
+  draw(P.lastFrame, P.hello, gripping());
+  requestAnimationFrame(loop);
+}
+
+window.addEventListener('resize', resize);
+resize();
+installInput();
+connect();
+requestAnimationFrame(loop);

@@ -1,0 +1,27 @@
+// nanohaptics play: what every module of the page shares. The element lookup, the figures the
+// tests and benches read (window.__play), and the spoken log (the Events list, an ARIA live
+// region, and the assertive announcer).
+
+export const $ = (id) => document.getElementById(id);
+
+// Figures for tests and benches; the modules fill them in as messages arrive.
+export const P = (window.__play = {
+  hello: null, role: null, frames: 0, draws: 0, drawT0: 0, lastFrame: null,
+  events: [], sounds: [], switched: [], errors: [], ended: null,
+  pcm: { first: -1, samples: 0, hash: 0x811c9dc5, blocks: 0, underruns: 0, early: 0, rebased: 0 },
+  audioLatencyMs: [], audioParts: [], outputLatencyS: null, inputsSent: 0,
+  said: [],
+});
+
+const logEl = $('log');
+
+// Writes `text` to the Events list (screen readers read it politely).
+export function log(text) {
+  if (P.said.length < 10000) P.said.push(text);
+  const p = document.createElement('p'); p.textContent = text; logEl.appendChild(p);
+  while (logEl.childNodes.length > 60) logEl.removeChild(logEl.firstChild);
+  logEl.scrollTop = logEl.scrollHeight;
+}
+
+// Announces `text` at once (assertive) and writes it to the Events list.
+export function say(text) { $('announce').textContent = text; log(text); }
