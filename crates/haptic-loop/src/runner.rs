@@ -58,8 +58,10 @@ pub enum Pacing {
     Recorded(Vec<bool>),
 }
 
-/// How a run ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How a run ended; written (serde, [`EndReason::name`]) as `completed`, `device_ended` or
+/// `stopped`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum EndReason {
     /// The planned number of ticks ran.
     Completed,

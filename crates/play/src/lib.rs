@@ -34,14 +34,15 @@ pub mod server;
 
 use haptic_devices::bridge::{BridgeConfig, UdpDevice};
 use haptic_devices::pacing::{Percentiles, TickStats};
-use haptic_loop::runner::{Pacing, Runner};
+use haptic_devices::source::DeviceSource;
+use haptic_loop::runner::{EndReason, Pacing, Runner};
 use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
-use haptic_loop::setup::{Setup, SetupOptions};
+use haptic_loop::setup::{Setup, SetupOptions, session_device};
 use haptic_loop::totals::Totals;
 use haptic_loop::{DeviceSpecs, HapticDevice, HapticLoop};
 use input::PageDevice;
 pub use protocol::LatencyMs;
-use protocol::{EndReason, EndReport, Hello, Mapping, ServerMsg, SwitchInfo, TickWorkMs};
+use protocol::{EndReport, Hello, Mapping, ServerMsg, SwitchInfo, TickWorkMs};
 use publish::{PlaySink, PublishSummary, ToPublisher};
 use recording::WriteSummary;
 use server::{SceneLink, Server, Shared};
@@ -94,7 +95,7 @@ pub struct PlaySummary {
     pub url: String,
     /// How it ended: `completed` (its `seconds` ran), `stopped` (the player ended it on the
     /// page, or `stop`), `device_ended` (a bridged device said goodbye); the words of
-    /// [`EndReason::as_str`], as `haptic_loop::session` reports them.
+    /// [`EndReason::name`], as `haptic_loop::session` reports them.
     pub end: &'static str,
     /// Tick statistics (ticks, missed deadlines, tick work).
     pub stats: TickStats,
@@ -171,23 +172,18 @@ enum Hand {
 }
 
 impl Hand {
-    /// Opens the hand `config` asks for: a bridged device (its hello is awaited here, with the
-    /// scene's name and `rate_hz`), or the page with the scene's device `specs`.
-    fn open(
-        config: &PlayConfig,
-        scene: &str,
-        rate_hz: u32,
-        specs: &DeviceSpecs,
-        shared: &Shared,
-    ) -> Result<Hand, PlayError> {
-        Ok(match &config.device {
-            Some(b) => {
-                let b = b.clone().for_session(rate_hz, scene, now_unix_ns());
+    /// Opens the hand of a session: a bridged device (`device` made for the session by
+    /// [`session_device`]: its hello is awaited here), or the page with the scene's model.
+    fn open(device: DeviceSource, shared: &Shared) -> Result<Hand, PlayError> {
+        Ok(match device {
+            DeviceSource::Udp(b) => {
                 let mut dev = UdpDevice::new(b);
                 dev.open().map_err(SessionError::Device)?;
                 Hand::Bridged(Box::new(dev))
             }
-            None => Hand::Page(PageDevice::new(specs.clone(), shared.input.clone())),
+            DeviceSource::Model(m) => {
+                Hand::Page(PageDevice::new(m.specs().clone(), shared.input.clone()))
+            }
         })
     }
 
@@ -411,9 +407,17 @@ pub fn run(
 ) -> Result<PlaySummary, PlayError> {
     let scene_src = &config.scene;
     let file = scene_src.parse()?;
-    // The scene with the file's device model: its rate and, for the page, the device.
-    let model_specs = file.device.model.specs().clone();
-    let rate = Setup::new(&SetupOptions::new(scene_src, model_specs.clone(), "", ""))?.rate_hz();
+    // One start time for a bridged device's welcome and the recording.
+    let start_time_ns = now_unix_ns();
+    let bridge = config.device.clone().map(DeviceSource::Udp);
+    let device = session_device(&file, bridge.as_ref(), start_time_ns);
+    if bridge.is_some() {
+        // The scene's values are checked before waiting for the device (its own limits, which
+        // the device announces, are checked when the session is set up after its hello).
+        haptic_loop::scene::load_scene(&scene_src.text, Some(file.device.model))
+            .map_err(|e| scene_src.locate(e))?;
+    }
+    let rate = file.loop_.rate_hz;
     let ticks = config.seconds.map(|s| ticks_for(s, rate)).transpose()?;
     let shared = Arc::new(Shared::default());
     let mut server = Server::start(config.port, shared.clone()).map_err(|e| PlayError::Serve {
@@ -423,7 +427,7 @@ pub fn run(
     let url = server.url();
     on_ready(&url);
 
-    let mut hand = Hand::open(config, &file.scene.name, rate, &model_specs, &shared)?;
+    let mut hand = Hand::open(device, &shared)?;
     let page_is_hand = hand.is_page();
     let specs = hand.device().specs().clone();
     let (link, operator) = hand.describe(config);
@@ -435,6 +439,7 @@ pub fn run(
         operator: Some(operator.to_string()),
         keep_arrays: false,
         out: Some(config.out.clone()),
+        start_time_ns: Some(start_time_ns),
         ..SetupOptions::new(scene_src, specs.clone(), "realtime", &link)
     })?;
     let fields = lp.scene().state_fields();
@@ -493,7 +498,6 @@ pub fn run(
     let published = publisher.join().unwrap_or_default();
     let (stats, end) = result.map_err(SessionError::from)?;
     closed.map_err(SessionError::Device)?;
-    let end = EndReason::from(end);
     let totals = &sinks.totals;
     let state = totals.state();
     let input_latency_ms = LatencyMs::of(&latencies);
@@ -512,7 +516,7 @@ pub fn run(
     server.stop();
     Ok(PlaySummary {
         url,
-        end: end.as_str(),
+        end: end.name(),
         stats,
         state,
         recording: config.out.clone(),

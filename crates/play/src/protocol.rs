@@ -18,6 +18,7 @@
 //! (f64, ms since the Unix epoch), then the samples (f32 little-endian, mono, at the hello's
 //! `sample_rate_hz`).
 
+use haptic_loop::runner::EndReason;
 use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -207,39 +208,6 @@ pub enum Role {
     Hand,
     /// The page watches and listens (another page or a bridged device is the hand).
     View,
-}
-
-/// How a session ended (the same words as `haptic_loop::session`'s reports).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EndReason {
-    /// Its planned length (`--seconds`) ran.
-    Completed,
-    /// Stopped by the user: the player ended it on the page, or the program was stopped.
-    Stopped,
-    /// A bridged device said goodbye.
-    DeviceEnded,
-}
-
-impl EndReason {
-    /// The word on the wire and in summaries: `completed`, `stopped`, `device_ended`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            EndReason::Completed => "completed",
-            EndReason::Stopped => "stopped",
-            EndReason::DeviceEnded => "device_ended",
-        }
-    }
-}
-
-impl From<haptic_loop::runner::EndReason> for EndReason {
-    fn from(e: haptic_loop::runner::EndReason) -> Self {
-        match e {
-            haptic_loop::runner::EndReason::Completed => EndReason::Completed,
-            haptic_loop::runner::EndReason::Stopped => EndReason::Stopped,
-            haptic_loop::runner::EndReason::DeviceEnded => EndReason::DeviceEnded,
-        }
-    }
 }
 
 /// The `hello` message: the scene, the device, the view's mapping, the menu, the state
@@ -1161,7 +1129,7 @@ mod tests {
             (EndReason::Stopped, "stopped"),
             (EndReason::DeviceEnded, "device_ended"),
         ] {
-            assert_eq!(e.as_str(), word);
+            assert_eq!(e.name(), word);
             assert_eq!(serde_json::to_value(e).unwrap(), word);
         }
     }
