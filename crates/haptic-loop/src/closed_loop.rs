@@ -13,14 +13,17 @@
 //! power above [`BUZZ_HZ`] and an observer that never went below minus its reserve.
 
 use crate::haptic::{HapticLoop, status};
+use crate::runner::{Pacing, RunError, Runner};
 use crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
 use crate::scene::{SceneError, load_scene_for};
+use crate::sink::{Sink, SinkError, TickView};
 use haptic_devices::link::{LinkError, LinkParams};
 use haptic_devices::linked::LinkedDevice;
 use haptic_devices::local::Protocol;
 use haptic_devices::modelled::specs_of;
 use haptic_devices::{DeviceModel, DeviceSample, Script, ScriptError};
 use haptic_devices::{Grip, Mechanics};
+use haptic_types::device::{DeviceError, DeviceSpecs, ForceCommand, HapticDevice, TickTime};
 use rustfft::{FftPlanner, num_complex::Complex};
 
 /// A force change larger than this in one tick is a jump, N.
@@ -98,6 +101,9 @@ pub enum ClosedLoopError {
     /// A link parameter out of range.
     #[error("{0}")]
     Link(#[from] LinkError),
+    /// A scheduled switch or a sink failed during the run.
+    #[error("{0}")]
+    Run(#[from] RunError),
 }
 
 /// Plays `scene_text` with `script_text` (its buttons named for a Falcon) through the device
@@ -182,8 +188,9 @@ pub fn run_linked_traced(
     // A declared event's force reaches the hand a round trip after its tick.
     let round_trip_s = 2.0 * (linked.link.latency_s + linked.link.jitter_s);
     let window = ((EVENT_WINDOW_S + round_trip_s) * f64::from(rate)).round() as u64;
+    let header = loaded.header(scene_text, "batch", "closed-loop", 0);
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
-    let mut dev = LinkedDevice::new(
+    let dev = LinkedDevice::new(
         script,
         mech,
         grip,
@@ -192,20 +199,25 @@ pub fn run_linked_traced(
         rate,
         linked.protocol,
     );
+    let mut link = SimulatedLink {
+        side: LoopSide::new(dev.period_ns()),
+        dev,
+        protocol: linked.protocol,
+        local: None,
+    };
     // The device's local model meets a contact up to a round trip before the world declares
     // it (its body, frictionless on its contact planes, sooner still): a declared event
     // explains the jumps within its window on either side.
     let mut meter = Meter::new(ticks, reserve_j, window, window);
-    let mut sim = LoopSide::new(dev.period_ns());
-    for k in 0..ticks {
-        let sample = sim.wait(k, &mut dev);
-        let r = lp.tick(sample, false);
-        meter.tick(k, r);
-        meter.observe(lp.passivity_tank_j());
-        let cmd = lp.command(sample.seq);
-        let local = (linked.protocol == Protocol::V2).then(|| lp.local_model());
-        dev.send_answer(sim.now_ns, cmd, local);
-    }
+    Runner::new(vec![&mut meter]).run(
+        &mut lp,
+        &mut link,
+        &header,
+        Some(ticks),
+        Pacing::Batch,
+        &mut |_, _| {},
+    )?;
+    let dev = link.dev;
     let mut rep = meter.finish(dev.felt(), f64::from(rate));
     if let Some(i) = lp
         .scene()
@@ -309,14 +321,61 @@ impl LoopSide {
     }
 }
 
-/// What a hand would feel, tick by tick: the declared events and the safety layer's ticks
-/// from the loop, the force from the device (what its motors rendered at each sample).
+/// A modelled device at the far end of a modelled link, in simulated time, as the runner
+/// sees a device: each tick's sample by the bridge's rule ([`LoopSide`]), each answer sent
+/// back over the link with the tick's local model (protocol 2).
+struct SimulatedLink {
+    dev: LinkedDevice,
+    side: LoopSide,
+    protocol: Protocol,
+    local: Option<haptic_types::local::LocalModel>,
+}
+
+impl HapticDevice for SimulatedLink {
+    fn specs(&self) -> &DeviceSpecs {
+        self.dev.specs()
+    }
+
+    fn sample(&mut self, time: TickTime) -> Result<DeviceSample, DeviceError> {
+        Ok(self.side.wait(time.index, &mut self.dev))
+    }
+
+    fn set_force(&mut self, cmd: &ForceCommand) -> Result<(), DeviceError> {
+        self.dev
+            .send_answer(self.side.now_ns, *cmd, self.local.take());
+        Ok(())
+    }
+
+    fn wants_local_model(&self) -> bool {
+        self.protocol == Protocol::V2
+    }
+
+    fn set_local_model(&mut self, model: haptic_types::local::LocalModel) {
+        self.local = Some(model);
+    }
+}
+
+/// What a hand would feel, tick by tick (a sink of the run): the declared events and the
+/// safety layer's ticks from the loop, the force from the device (what its motors rendered at
+/// each sample).
 struct Meter {
     rep: Report,
     window: u64,
     /// Ticks by which a felt jump may precede the tick that declares its event.
     lead: u64,
     declared: Vec<u64>,
+}
+
+impl Sink for Meter {
+    fn name(&self) -> &'static str {
+        "closed-loop meter"
+    }
+
+    fn tick(&mut self, t: &TickView<'_>) -> Result<(), SinkError> {
+        self.tick(t.result.tick, t.result);
+        self.observe(t.lp.passivity_tank_j());
+        Ok(())
+    }
 }
 
 impl Meter {

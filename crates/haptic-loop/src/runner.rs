@@ -6,10 +6,11 @@
 //!   UDP bridge, Python)        stiffness cap, watchdog)     replay verifier, frames, live view)
 //! ```
 //!
-//! Every way a session is driven goes through [`Runner::run`] (or, one tick at a time from
-//! Python, through [`deliver`]): `nanohaptics run`, `replay --verify`, `render`, `demo`, the
-//! wheel's `run_scene` and `Session`. A sink sees each tick once, after the force was sent to the
-//! device, and must not block: the recorder and the live view hand their data to threads of
+//! Every way a session is driven goes through [`TickEngine::tick`], the one way time advances:
+//! from a device by [`Runner::run`] (`nanohaptics run`, `replay --verify`, `render`, `demo`,
+//! `play`, the closed-loop checks), or one tick at a time by the
+//! [`Stepper`](crate::stepper::Stepper) (Python's `Session`). A sink sees each tick once, after
+//! the force was sent to the device, and must not block: the recorder and the live view hand their data to threads of
 //! their own.
 //!
 //! Adding a sink is one new file implementing [`Sink`](crate::sink::Sink) and one line where the
@@ -19,7 +20,7 @@ use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_devices::pacing::{DurationHistogram, Pacer, Percentiles, TickStats};
-use haptic_devices::{DeviceError, HapticDevice, TickTime};
+use haptic_devices::{DeviceError, DeviceSample, HapticDevice, TickTime};
 use haptic_types::switch::{Switch, SwitchError};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -87,12 +88,185 @@ impl EndReason {
 /// the tick's index and the loop.
 pub type LiveHook<'a> = dyn FnMut(u64, &mut HapticLoop) + 'a;
 
+/// When a tick started, as its pacing saw it.
+#[derive(Clone, Copy, Debug)]
+pub struct TickStart {
+    /// When the tick's sample was in hand (its work is timed from here).
+    pub t0: Instant,
+    /// Start lateness against the schedule, ns (0 in batch mode; wall clock).
+    pub late_ns: i64,
+    /// The deadline flag read from a recording (replay), an input of the tick.
+    pub recorded_missed: bool,
+}
+
+impl TickStart {
+    /// A tick starting now, on time, with no recorded deadline flag.
+    pub fn now() -> Self {
+        TickStart {
+            t0: Instant::now(),
+            late_ns: 0,
+            recorded_missed: false,
+        }
+    }
+}
+
+/// The one way a session's time advances: tick by tick, the scheduled switches, the live hook,
+/// the loop's tick, the deadline flag, the force to the device and the hand-off to the sinks,
+/// with the run's statistics. [`Runner::run`] drives it from a device and a pacing policy; the
+/// [`Stepper`](crate::stepper::Stepper) from its caller, one tick per call.
+pub struct TickEngine {
+    switches: Vec<(u64, Switch)>,
+    compute: DurationHistogram,
+    jitter: DurationHistogram,
+    sink_ns: Vec<DurationHistogram>,
+    missed: u64,
+    ticks: u64,
+    timed: bool,
+    started: Instant,
+}
+
+impl TickEngine {
+    /// An engine applying `switches` (tick, switch) before their ticks' steps (sorted by tick;
+    /// several at one tick apply in the given order).
+    pub fn new(mut switches: Vec<(u64, Switch)>) -> Self {
+        switches.sort_by_key(|(t, _)| *t);
+        TickEngine {
+            switches,
+            compute: DurationHistogram::new(),
+            jitter: DurationHistogram::new(),
+            sink_ns: Vec::new(),
+            missed: 0,
+            ticks: 0,
+            timed: false,
+            started: Instant::now(),
+        }
+    }
+
+    /// Starts a run of `ticks` ticks (`None`: open-ended) of `lp`: calls every sink's `start`
+    /// with `header` and resets the statistics; `timed` runs record the start lateness.
+    pub fn start(
+        &mut self,
+        sinks: &mut [&mut dyn Sink],
+        lp: &HapticLoop,
+        header: &SessionHeader,
+        ticks: Option<u64>,
+        timed: bool,
+    ) -> Result<(), RunError> {
+        let info = SessionInfo {
+            header,
+            config: lp.config(),
+            ticks,
+        };
+        for s in sinks.iter_mut() {
+            s.start(&info, lp)?;
+        }
+        // Constant memory whatever the session's length (a soak runs for hours).
+        self.compute = DurationHistogram::new();
+        self.jitter = DurationHistogram::new();
+        self.sink_ns = vec![DurationHistogram::new(); sinks.len()];
+        self.missed = 0;
+        self.ticks = 0;
+        self.timed = timed;
+        self.started = Instant::now();
+        Ok(())
+    }
+
+    /// Ticks run so far.
+    pub fn ticks(&self) -> u64 {
+        self.ticks
+    }
+
+    /// Runs the next tick of `lp` on `sample`: its scheduled switches, then `live`, then the
+    /// step; `deadline(t0)` says whether the force came too late (zero force is then sent);
+    /// `send` hands the command to the device; then every sink sees the tick.
+    #[allow(clippy::too_many_arguments)]
+    pub fn tick(
+        &mut self,
+        sinks: &mut [&mut dyn Sink],
+        lp: &mut HapticLoop,
+        sample: DeviceSample,
+        at: TickStart,
+        live: Option<&mut LiveHook<'_>>,
+        deadline: &mut dyn FnMut(u64, Instant) -> bool,
+        send: &mut dyn FnMut(&HapticLoop, u64) -> Result<(), DeviceError>,
+    ) -> Result<(), RunError> {
+        let n = self.ticks;
+        let due = self.switches.partition_point(|(t, _)| *t < n);
+        for (_, sw) in self.switches[due..].iter().take_while(|(t, _)| *t == n) {
+            lp.switch(&sw.name, sw.value)
+                .map_err(|error| RunError::Switch { tick: n, error })?;
+        }
+        if let Some(hook) = live {
+            hook(n, lp);
+        }
+        lp.tick(sample, at.recorded_missed);
+        let missed = at.recorded_missed || deadline(n, at.t0);
+        if missed && !at.recorded_missed {
+            lp.mark_deadline_missed();
+        }
+        send(lp, sample.seq)?;
+        let compute_ns = at.t0.elapsed().as_nanos() as u64;
+        self.missed += u64::from(missed);
+        let view = TickView {
+            sample,
+            deadline_missed: missed,
+            result: lp.last_result(),
+            lp,
+            start_late_ns: at.late_ns,
+            compute_ns,
+        };
+        for (s, times) in sinks.iter_mut().zip(self.sink_ns.iter_mut()) {
+            let t = Instant::now();
+            s.tick(&view)?;
+            times.record(t.elapsed().as_nanos() as u64);
+        }
+        // The hand-off to the sinks belongs to the tick's cost.
+        self.compute.record(at.t0.elapsed().as_nanos() as u64);
+        if self.timed && n > 0 {
+            self.jitter.record(at.late_ns.unsigned_abs());
+        }
+        self.ticks += 1;
+        Ok(())
+    }
+
+    /// Ends the run: the statistics, handed with the device's link counters to every sink's
+    /// `finish`.
+    pub fn finish(
+        &mut self,
+        sinks: &mut [&mut dyn Sink],
+        link: &[(&'static str, u64)],
+    ) -> Result<TickStats, RunError> {
+        let stats = TickStats {
+            ticks: self.ticks,
+            compute: self.compute.percentiles(),
+            jitter: self.jitter.percentiles(),
+            missed: self.missed,
+            wall_s: self.started.elapsed().as_secs_f64(),
+        };
+        for s in sinks.iter_mut() {
+            s.finish(&stats, link)?;
+        }
+        Ok(stats)
+    }
+
+    /// How long each sink took per tick (the servo tick pays for it), with the sinks' names.
+    pub fn sink_times(&self, sinks: &[&mut dyn Sink]) -> Vec<SinkTime> {
+        sinks
+            .iter()
+            .zip(&self.sink_ns)
+            .map(|(s, t)| SinkTime {
+                sink: s.name(),
+                tick: t.percentiles(),
+            })
+            .collect()
+    }
+}
+
 /// Runs ticks of a loop against a device and hands each to the sinks.
 pub struct Runner<'s> {
     sinks: Vec<&'s mut dyn Sink>,
     stop: Option<&'s AtomicBool>,
-    sink_ns: Vec<DurationHistogram>,
-    switches: Vec<(u64, Switch)>,
+    engine: TickEngine,
     live: Option<&'s mut LiveHook<'s>>,
 }
 
@@ -108,12 +282,10 @@ pub struct SinkTime {
 impl<'s> Runner<'s> {
     /// A runner handing ticks to `sinks`, in order.
     pub fn new(sinks: Vec<&'s mut dyn Sink>) -> Self {
-        let n = sinks.len();
         Runner {
             sinks,
             stop: None,
-            sink_ns: vec![DurationHistogram::new(); n],
-            switches: Vec::new(),
+            engine: TickEngine::new(Vec::new()),
             live: None,
         }
     }
@@ -121,9 +293,8 @@ impl<'s> Runner<'s> {
     /// Sets switches at given ticks (tick, switch): each is applied just before its tick's
     /// step (a script's `[[switch]]` entries, or a recording's `/scene/switch` on replay).
     /// Several at one tick apply in the given order.
-    pub fn with_switches(mut self, mut switches: Vec<(u64, Switch)>) -> Self {
-        switches.sort_by_key(|(t, _)| *t);
-        self.switches = switches;
+    pub fn with_switches(mut self, switches: Vec<(u64, Switch)>) -> Self {
+        self.engine = TickEngine::new(switches);
         self
     }
 
@@ -154,25 +325,11 @@ impl<'s> Runner<'s> {
         pacing: Pacing,
         progress: &mut dyn FnMut(u64, u64),
     ) -> Result<(TickStats, EndReason), RunError> {
-        let info = SessionInfo {
-            header,
-            config: lp.config(),
-            ticks,
-        };
-        for s in self.sinks.iter_mut() {
-            s.start(&info, lp)?;
-        }
+        let timed = !matches!(pacing, Pacing::Batch | Pacing::Recorded(_));
+        self.engine
+            .start(&mut self.sinks, lp, header, ticks, timed)?;
         let rate = lp.config().rate_hz;
         let period_ns = lp.config().period_ns();
-        // Constant memory whatever the session's length (a soak runs for hours).
-        let mut compute = DurationHistogram::new();
-        let timed = !matches!(pacing, Pacing::Batch | Pacing::Recorded(_));
-        let mut jitter = DurationHistogram::new();
-        for t in &mut self.sink_ns {
-            *t = DurationHistogram::new();
-        }
-        let mut missed_count = 0;
-        let start = Instant::now();
         let pacer = matches!(pacing, Pacing::Realtime).then(|| Pacer::new(period_ns));
         let mut prev_start: Option<Instant> = None;
         let mut end = EndReason::Completed;
@@ -207,75 +364,42 @@ impl<'s> Runner<'s> {
                 Pacing::Recorded(flags) => flags.get(n as usize).copied().unwrap_or(false),
                 _ => false,
             };
-            let due = self.switches.partition_point(|(t, _)| *t < n);
-            for (_, sw) in self.switches[due..].iter().take_while(|(t, _)| *t == n) {
-                lp.switch(&sw.name, sw.value)
-                    .map_err(|error| RunError::Switch { tick: n, error })?;
-            }
-            if let Some(hook) = self.live.as_mut() {
-                hook(n, lp);
-            }
-            lp.tick(sample, recorded_missed);
-            let missed = match &pacing {
+            let mut deadline = |n: u64, t0: Instant| match &pacing {
                 Pacing::Realtime => pacer.as_ref().is_some_and(|p| p.deadline_passed(n)),
                 Pacing::DeviceClock => t0.elapsed().as_nanos() as u64 > period_ns,
-                _ => recorded_missed,
+                _ => false,
             };
-            if missed && !recorded_missed {
-                lp.mark_deadline_missed();
-            }
-            if dev.wants_local_model() {
-                dev.set_local_model(lp.local_model());
-            }
-            dev.set_force(&lp.command(sample.seq))?;
-            let compute_ns = t0.elapsed().as_nanos() as u64;
-            missed_count += u64::from(missed);
-            let view = TickView {
-                sample,
-                deadline_missed: missed,
-                result: lp.last_result(),
+            let mut send = |lp: &HapticLoop, seq: u64| {
+                if dev.wants_local_model() {
+                    dev.set_local_model(lp.local_model());
+                }
+                dev.set_force(&lp.command(seq))
+            };
+            self.engine.tick(
+                &mut self.sinks,
                 lp,
-                start_late_ns: late,
-                compute_ns,
-            };
-            for (s, times) in self.sinks.iter_mut().zip(self.sink_ns.iter_mut()) {
-                let t = Instant::now();
-                s.tick(&view)?;
-                times.record(t.elapsed().as_nanos() as u64);
-            }
-            // The hand-off to the sinks belongs to the tick's cost.
-            compute.record(t0.elapsed().as_nanos() as u64);
-            if timed && n > 0 {
-                jitter.record(late.unsigned_abs());
-            }
+                sample,
+                TickStart {
+                    t0,
+                    late_ns: late,
+                    recorded_missed,
+                },
+                self.live.as_deref_mut(),
+                &mut deadline,
+                &mut send,
+            )?;
             n += 1;
             if n % 100 == 0 || ticks == Some(n) {
                 progress(n, ticks.unwrap_or(0));
             }
         }
-        let stats = TickStats {
-            ticks: n,
-            compute: compute.percentiles(),
-            jitter: jitter.percentiles(),
-            missed: missed_count,
-            wall_s: start.elapsed().as_secs_f64(),
-        };
         let link = dev.link_counters();
-        for s in self.sinks.iter_mut() {
-            s.finish(&stats, &link)?;
-        }
+        let stats = self.engine.finish(&mut self.sinks, &link)?;
         Ok((stats, end))
     }
 
     /// How long each sink took per tick in the last run (the servo tick pays for it).
     pub fn sink_times(&self) -> Vec<SinkTime> {
-        self.sinks
-            .iter()
-            .zip(&self.sink_ns)
-            .map(|(s, t)| SinkTime {
-                sink: s.name(),
-                tick: t.percentiles(),
-            })
-            .collect()
+        self.engine.sink_times(&self.sinks)
     }
 }

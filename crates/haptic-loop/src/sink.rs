@@ -69,11 +69,3 @@ impl SinkError {
         SinkError(Box::new(e))
     }
 }
-
-/// Hands one tick to every sink, in order.
-pub fn deliver(sinks: &mut [&mut dyn Sink], view: &TickView<'_>) -> Result<(), SinkError> {
-    for s in sinks.iter_mut() {
-        s.tick(view)?;
-    }
-    Ok(())
-}

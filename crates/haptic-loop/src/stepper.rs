@@ -21,15 +21,14 @@
 use crate::arrays::SessionArrays;
 use crate::haptic::{HapticLoop, TickResult};
 use crate::header::SessionHeader;
+use crate::runner::{TickEngine, TickStart};
 use crate::session::{SceneSource, SessionError};
 use crate::setup::{Setup, SetupOptions};
-use crate::sink::{SessionInfo, TickView, deliver};
 use crate::sinks::SessionSinks;
-use haptic_devices::pacing::{DurationHistogram, Percentiles, TickStats};
+use haptic_devices::pacing::TickStats;
 use haptic_devices::{DeviceModel, DeviceSample, ForceCommand};
 use recording::WriteSummary;
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// Options of a stepped session.
 #[derive(Clone, Debug)]
@@ -80,8 +79,7 @@ pub struct Stepper {
     lp: HapticLoop,
     header: SessionHeader,
     sinks: SessionSinks,
-    compute: DurationHistogram,
-    started: Instant,
+    engine: TickEngine,
 }
 
 impl Stepper {
@@ -99,38 +97,28 @@ impl Stepper {
             out: opts.out.clone(),
             ..SetupOptions::new(&opts.scene, model.specs().clone(), "stepped", &opts.link)
         })?;
-        let info = SessionInfo {
-            header: &header,
-            config: lp.config(),
-            ticks: None,
-        };
-        for s in sinks.list() {
-            s.start(&info, &lp)?;
-        }
+        let mut engine = TickEngine::new(Vec::new());
+        engine.start(&mut sinks.list(), &lp, &header, None, false)?;
         Ok(Stepper {
             lp,
             header,
             sinks,
-            compute: DurationHistogram::new(),
-            started: Instant::now(),
+            engine,
         })
     }
 
-    /// Runs one tick on `sample` and hands it to the sinks.
+    /// Runs one tick on `sample` and hands it to the sinks (the caller renders the force:
+    /// [`command`](Self::command)).
     pub fn tick(&mut self, sample: DeviceSample) -> Result<&TickResult, SessionError> {
-        let t0 = Instant::now();
-        self.lp.tick(sample, false);
-        let compute_ns = t0.elapsed().as_nanos() as u64;
-        let view = TickView {
+        self.engine.tick(
+            &mut self.sinks.list(),
+            &mut self.lp,
             sample,
-            deadline_missed: false,
-            result: self.lp.last_result(),
-            lp: &self.lp,
-            start_late_ns: 0,
-            compute_ns,
-        };
-        deliver(&mut self.sinks.list(), &view)?;
-        self.compute.record(t0.elapsed().as_nanos() as u64);
+            TickStart::now(),
+            None,
+            &mut |_, _| false,
+            &mut |_, _| Ok(()),
+        )?;
         Ok(self.lp.last_result())
     }
 
@@ -165,16 +153,7 @@ impl Stepper {
 
     /// Ends the session: closes the recording and returns what it produced.
     pub fn finish(mut self) -> Result<StepperReport, SessionError> {
-        let stats = TickStats {
-            ticks: self.lp.next_tick(),
-            compute: self.compute.percentiles(),
-            jitter: Percentiles::default(),
-            missed: 0,
-            wall_s: self.started.elapsed().as_secs_f64(),
-        };
-        for s in self.sinks.list() {
-            s.finish(&stats, &[])?;
-        }
+        let stats = self.engine.finish(&mut self.sinks.list(), &[])?;
         let written = self.sinks.written();
         Ok(StepperReport {
             header: self.header,
