@@ -3,11 +3,14 @@
 
 Three rules, each failing with one line per offence (exit status 1):
 
-1. **Crates.** Every crate's `[dependencies]` on workspace crates must be among those that
+1. **Crates.** Every crate's `[dependencies]` on workspace crates must be exactly those that
    `ALLOWED` grants it (the arrows of `docs/extending.md` and `../shared/DESIGN.md`: types <-
    recording, devices <- engine <- lesson, play <- cli; world crates know nothing of devices,
-   logging, sound or Python). A crate missing from `ALLOWED` fails too: a new crate states its
-   place. Dev-dependencies are free (a test may drive a crate from above).
+   logging, sound or Python): a dependency the map does not grant fails, and so does a grant
+   the crate does not use (the map lists only the edges in use). A crate missing from
+   `ALLOWED` fails too: a new crate states its place. A dev-dependency may point anywhere
+   (a test may drive a crate from above) except into a cycle: a crate A dev-depending on B
+   where B depends on A through `[dependencies]` (directly or not) fails, naming the cycle.
 2. **Import circles.** Inside each crate, sibling modules must not import each other in a
    circle. A module `a` depends on a sibling `b` when any file under `a` names an item of `b`
    through a `use` (not a `pub use` re-export, which only forwards a name) or a qualified path
@@ -23,9 +26,8 @@ import re
 import sys
 import tomllib
 
-# Which workspace crates each crate may depend on ([dependencies] only).
-WORLDS = {"world-form", "ot-physics", "ot-envelope", "brickworld", "nanoworld"}
-LIBS = WORLDS | {"haptic-types", "nanohaptics-recording", "haptic-devices", "render", "haptic-loop"}
+# Which workspace crates each crate depends on ([dependencies] only): exactly these, no more,
+# no fewer (dev-dependencies are not listed; they must only not close a cycle).
 ALLOWED = {
     "world-form": set(),
     "ot-physics": {"world-form"},
@@ -33,16 +35,36 @@ ALLOWED = {
     "brickworld": {"world-form"},
     "nanoworld": {"world-form"},
     "haptic-types": {"world-form"},
-    "render": {"haptic-types"},
+    "picture": set(),
+    "chart": {"picture"},
+    "render": {"haptic-types", "picture"},
     "nanohaptics-recording": {"haptic-types", "world-form"},
     "haptic-devices": {"haptic-types", "world-form"},
-    "haptic-loop": LIBS - {"haptic-loop"},
-    "nanohaptics-lesson": LIBS,
-    "nanohaptics-play": LIBS,
-    "nanohaptics-cli": LIBS | {"nanohaptics-lesson", "nanohaptics-play"},
-    "ot-py": LIBS | {"nanohaptics-lesson"},
-    "nanohaptics-fuzz": LIBS,
-    "bench-harness": {"render", "world-form"},
+    "haptic-loop": {
+        "brickworld", "haptic-devices", "haptic-types", "nanohaptics-recording", "nanoworld",
+        "ot-envelope", "ot-physics", "render", "world-form",
+    },
+    "nanohaptics-lesson": {
+        "brickworld", "chart", "haptic-devices", "haptic-loop", "nanohaptics-recording",
+        "nanoworld",
+    },
+    "nanohaptics-play": {
+        "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording", "render",
+        "world-form",
+    },
+    "nanohaptics-cli": {
+        "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-lesson",
+        "nanohaptics-play", "nanohaptics-recording", "render", "world-form",
+    },
+    "ot-py": {
+        "brickworld", "haptic-devices", "haptic-loop", "nanohaptics-recording", "nanoworld",
+        "ot-envelope", "ot-physics", "world-form",
+    },
+    "nanohaptics-fuzz": {
+        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording",
+        "nanoworld", "ot-envelope", "world-form",
+    },
+    "bench-harness": {"chart", "world-form"},
 }
 
 # Top-level modules of a crate from the bottom up (one list entry may hold several modules of
@@ -77,8 +99,22 @@ RANKS = {
 }
 
 
+def dep_names(table, kind):
+    """The package names a manifest lists under `kind` (`dependencies` or
+    `dev-dependencies`), its target-specific tables included; a renamed dependency counts
+    by its package."""
+    tables = [table.get(kind, {})]
+    tables += [t.get(kind, {}) for t in table.get("target", {}).values()]
+    out = set()
+    for deps in tables:
+        for key, spec in deps.items():
+            out.add(spec.get("package", key) if isinstance(spec, dict) else key)
+    return out
+
+
 def crate_deps(crates):
-    """{crate name: (Cargo.toml path, set of workspace crates in [dependencies])}."""
+    """{crate name: (Cargo.toml path, workspace crates in [dependencies], in
+    [dev-dependencies])}."""
     out = {}
     manifests = {}
     for c in sorted(os.listdir(crates)):
@@ -88,21 +124,50 @@ def crate_deps(crates):
                 manifests[m] = tomllib.load(fh)
     names = {t["package"]["name"] for t in manifests.values()}
     for m, t in manifests.items():
-        deps = set(t.get("dependencies", {})) & names
-        out[t["package"]["name"]] = (m, deps)
+        deps = dep_names(t, "dependencies") & names
+        dev = dep_names(t, "dev-dependencies") & names
+        out[t["package"]["name"]] = (m, deps, dev)
     return out
+
+
+def dependency_path(crates, start, goal):
+    """The shortest chain of [dependencies] from `start` to `goal` (both included), or None."""
+    prev = {start: None}
+    queue = [start]
+    for here in queue:
+        if here == goal:
+            path = []
+            while here is not None:
+                path.append(here)
+                here = prev[here]
+            return path[::-1]
+        for d in sorted(crates.get(here, (None, set(), set()))[1]):
+            if d not in prev:
+                prev[d] = here
+                queue.append(d)
+    return None
 
 
 def crate_offences(crates):
     bad = []
-    for name, (path, deps) in sorted(crate_deps(crates).items()):
+    deps_of = crate_deps(crates)
+    for name, (path, deps, dev) in sorted(deps_of.items()):
         if name not in ALLOWED:
             bad.append(f"{path}: crate `{name}` has no place in ALLOWED (scripts/layering.py): "
-                       "add it with the crates it may depend on")
-            continue
-        for d in sorted(deps - ALLOWED[name]):
-            bad.append(f"{path}: `{name}` must not depend on `{d}` "
-                       f"(allowed: {', '.join(sorted(ALLOWED[name])) or 'no workspace crate'})")
+                       "add it with the crates it depends on")
+        else:
+            for d in sorted(deps - ALLOWED[name]):
+                bad.append(f"{path}: `{name}` must not depend on `{d}` "
+                           f"(allowed: {', '.join(sorted(ALLOWED[name])) or 'no workspace crate'})")
+            for d in sorted(ALLOWED[name] - deps):
+                bad.append(f"{path}: ALLOWED (scripts/layering.py) grants `{name}` `{d}`, which "
+                           "its [dependencies] do not use: remove the grant")
+        for d in sorted(dev):
+            back = dependency_path(deps_of, d, name)
+            if back is not None:
+                chain = " -> ".join(back)
+                bad.append(f"{path}: dev-dependency cycle: `{name}` dev-depends on `{d}`, and "
+                           f"{chain} through [dependencies]")
     return bad
 
 
@@ -264,7 +329,7 @@ def crate_cycles(src):
 def main():
     crates = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "crates")
     bad = 0
-    pkg = {os.path.basename(os.path.dirname(m)): n for n, (m, _) in crate_deps(crates).items()}
+    pkg = {os.path.basename(os.path.dirname(m)): n for n, (m, _, _) in crate_deps(crates).items()}
     for line in crate_offences(crates):
         bad += 1
         print(line)
@@ -289,7 +354,8 @@ def main():
             print(f"{c}: import circle between {', '.join(names)} ({'; '.join(detail)})")
     if bad:
         sys.exit(1)
-    print(f"layering: {len(pkg)} crates, dependencies one way, no import circles, no upward imports")
+    print(f"layering: {len(pkg)} crates, dependencies one way and as mapped, no dev-dependency "
+          "cycles, no import circles, no upward imports")
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@
 //!   (`docs/bench/<name>.md`) and its figures (`docs/figures/`) go, and the machine facts
 //!   stated at the top of every section (CPU model, core count, load average at the start and
 //!   at the end of the run);
-//! * [`chart`]: the workspace's one chart engine, `render::chart` re-exported (line, dot and
+//! * [`chart`]: the workspace's one chart engine, the `chart` crate re-exported (line, dot and
 //!   bar charts on linear or log axes, reference lines, legends, rows and grids of charts),
 //!   drawn with tiny-skia and the embedded font: no system fonts, the same PNG bytes
 //!   everywhere.
@@ -35,7 +35,7 @@ pub mod stats;
 pub mod table;
 pub mod timer;
 
-pub use render::chart;
+pub use chart;
 pub use report::Report;
 pub use stats::{Summary, percentile};
 pub use table::{Align, Table};

@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use crate::error::WorldError;
 use crate::event::{Body, BrickId, Touch};
-use crate::impact::ImpactHook;
+use crate::impact::hook::ImpactHook;
 use crate::params::{BrickPlacement, BrickProps, Lo, Params, range};
 
 /// Half-extent of the ground slab in x and y, m (the ground is a 100 m × 100 m slab whose top

@@ -128,7 +128,7 @@ pub enum Event {
         brick: BrickId,
     },
     /// A collision: a contact that began this step with bodies approaching faster than
-    /// [`crate::impact::IMPACT_MIN_SPEED_M_PER_S`] (see [`crate::impacts`]). Between the cursor and what it touches,
+    /// [`crate::impact::IMPACT_MIN_SPEED_M_PER_S`] (see [`crate::impact::events`]). Between the cursor and what it touches,
     /// the impulse is the brick mass × the cursor's approach speed (the cursor has no mass in
     /// the world; this is the impulse that would stop a brick arriving at that speed).
     Impact {

@@ -23,7 +23,7 @@
 //! colliders of ground, obstacles and bricks; placement checks; views), [`hand`] (cursor proxy,
 //! grab / release / throw / turn, the felt force with weight and inertia, scaled to the
 //! device's [`world_form::Limits`]), [`blueprint`] (slots and score), [`spawner`] (the loading zone),
-//! [`impact`] / [`impacts`] (flat-landing restitution and impact events), [`event`] (what a
+//! [`impact`] (what an impact is; its restitution in the solver and its events), [`event`] (what a
 //! step reports) and [`world`], which holds the [`World`] (parameters, limits and those sets)
 //! and orchestrates [`World::step`].
 //!
@@ -43,7 +43,6 @@ pub mod estimator;
 pub mod event;
 pub mod hand;
 pub mod impact;
-pub mod impacts;
 pub mod input;
 pub mod local;
 pub mod params;

@@ -10,7 +10,7 @@
 //! in the report is measured from these runs or read from the scenes' parameters.
 //!
 //! What it is not: no physics and no loop of its own. It drives the engine (`haptic-loop`)
-//! through its sessions, draws its figures with `render`'s one chart engine, and knows the
+//! through its sessions, draws its figures with the one chart engine (`chart`), and knows the
 //! worlds only through their scenes' state fields and events.
 
 pub mod measure;

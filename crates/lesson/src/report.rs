@@ -2,7 +2,7 @@
 
 use crate::measure::{self, events, times};
 use crate::{LessonError, LessonSummary, Run, Runs, write_file};
-use render::chart::{Band, Bar, BarChart, Chart, Figure, Marker, Scale, Series, Style};
+use chart::{Band, Bar, BarChart, Chart, Figure, Marker, Scale, Series, Style};
 use std::fmt::Write;
 use std::path::Path;
 

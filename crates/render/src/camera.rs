@@ -10,8 +10,8 @@ use crate::Primitive;
 use crate::error::{RenderError, finite, finite3};
 use crate::vec3::{Vec3, add, axes, cross, dot, normalize, scale, sub};
 
-/// Largest image side the renderer makes, px.
-pub const MAX_SIDE_PX: u32 = 8192;
+/// Largest image side the renderer makes, px (`picture`'s).
+pub use picture::MAX_SIDE_PX;
 
 /// Where the camera looks from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -391,15 +391,8 @@ impl Camera {
     }
 }
 
-pub(crate) fn check_size(width_px: u32, height_px: u32) -> Result<(), RenderError> {
-    if width_px == 0 || height_px == 0 || width_px > MAX_SIDE_PX || height_px > MAX_SIDE_PX {
-        return Err(RenderError::ImageSize {
-            width_px,
-            height_px,
-            max: MAX_SIDE_PX,
-        });
-    }
-    Ok(())
+fn check_size(width_px: u32, height_px: u32) -> Result<(), RenderError> {
+    Ok(picture::image::check_size(width_px, height_px)?)
 }
 
 #[cfg(test)]

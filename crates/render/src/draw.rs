@@ -9,9 +9,9 @@ use tiny_skia::{
 use crate::ToSkia;
 use crate::error::RenderError;
 use crate::frame::{Frame, ScaleBar, format_length};
-use crate::text;
 use crate::vec3::{Vec3, add, axes, box_corners, dot, normalize, normq, scale};
 use crate::{Primitive, Rgba};
+use picture::text;
 
 impl Frame {
     /// Light direction (unit, world frame): from the viewer's upper left.

@@ -6,10 +6,10 @@ use crate::camera::Camera;
 use crate::error::{RenderError, finite, finite3};
 use crate::image::Image;
 use crate::order::{Item, Shape, back_to_front};
-use crate::text;
 use crate::vec3::{Vec3, add, axes, scale, sub};
 use crate::vec3::{box_corners, normq};
 use crate::{Primitive, Rgba};
+use picture::text;
 
 /// How a frame looks apart from its primitives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -253,7 +253,7 @@ impl Frame {
                 got_height: img.height(),
             });
         }
-        let pm = &mut img.pixmap;
+        let pm = img.pixmap_mut();
         pm.fill(self.style.background.skia());
         let mut solids = Vec::new();
         let mut solid_idx = Vec::new();

@@ -1,126 +1,87 @@
-//! A rendered RGBA image and its PNG encoding.
+//! A rendered RGBA image and its PNG encoding: `picture`'s [`picture::Image`] (the pixels, the
+//! PNG, one image drawn onto another), with the renderer's errors.
 
 use std::path::Path;
 
 use tiny_skia::Pixmap;
 
-use crate::camera::check_size;
 use crate::error::RenderError;
 
-/// An RGBA image, 8 bits per channel, sRGB, top-left origin.
+/// An RGBA image, 8 bits per channel, sRGB, top-left origin (`picture`'s image, whose
+/// errors are [`RenderError`]s).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Image {
-    pub(crate) pixmap: Pixmap,
-}
+pub struct Image(picture::Image);
 
 impl Image {
-    /// A blank (transparent) image of `width_px` × `height_px`.
+    /// A blank (transparent) image of `width_px` × `height_px` (each side in
+    /// 1..=[`crate::MAX_SIDE_PX`]).
     pub fn new(width_px: u32, height_px: u32) -> Result<Image, RenderError> {
-        check_size(width_px, height_px)?;
-        let pixmap = Pixmap::new(width_px, height_px).ok_or(RenderError::ImageSize {
-            width_px,
-            height_px,
-            max: crate::camera::MAX_SIDE_PX,
-        })?;
-        Ok(Image { pixmap })
+        Ok(Image(picture::Image::new(width_px, height_px)?))
     }
 
     /// Width, px.
     pub fn width(&self) -> u32 {
-        self.pixmap.width()
+        self.0.width()
     }
 
     /// Height, px.
     pub fn height(&self) -> u32 {
-        self.pixmap.height()
+        self.0.height()
     }
 
     /// The straight (not premultiplied) RGBA of the pixel at column `x`, row `y`, or `None`
     /// outside the image.
     pub fn pixel(&self, x: u32, y: u32) -> Option<[u8; 4]> {
-        let p = self.pixmap.pixel(x, y)?.demultiply();
-        Some([p.red(), p.green(), p.blue(), p.alpha()])
+        self.0.pixel(x, y)
     }
 
     /// All pixels as straight RGBA bytes, row by row.
     pub fn to_rgba8(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(self.pixmap.data().len());
-        for p in self.pixmap.pixels() {
-            let c = p.demultiply();
-            out.extend_from_slice(&[c.red(), c.green(), c.blue(), c.alpha()]);
-        }
-        out
+        self.0.to_rgba8()
     }
 
     /// Premultiplied RGBA bytes as stored, row by row (equal to straight RGBA where the image
     /// is opaque).
     pub fn data(&self) -> &[u8] {
-        self.pixmap.data()
+        self.0.data()
     }
 
     /// Draws `other` over this image with its top-left corner at column `x`, row `y` (px; parts
     /// outside are clipped), blending by its alpha. Used to put panels side by side.
     pub fn draw_image(&mut self, other: &Image, x: i32, y: i32) {
-        self.pixmap.draw_pixmap(
-            x,
-            y,
-            other.pixmap.as_ref(),
-            &tiny_skia::PixmapPaint::default(),
-            tiny_skia::Transform::identity(),
-            None,
-        );
+        self.0.draw_image(&other.0, x, y);
     }
 
-    /// The image as PNG bytes (8-bit RGBA, the png crate's fast deflate: encoding costs a few
-    /// times less than its default at a slightly larger file).
+    /// The image as PNG bytes (8-bit RGBA, the png crate's fast deflate).
     pub fn encode_png(&self) -> Result<Vec<u8>, RenderError> {
-        let err = |e: png::EncodingError| RenderError::Png(e.to_string());
-        let data = self.to_rgba8();
-        let mut out = Vec::with_capacity(data.len() / 8);
-        let mut enc = png::Encoder::new(&mut out, self.width(), self.height());
-        enc.set_color(png::ColorType::Rgba);
-        enc.set_depth(png::BitDepth::Eight);
-        enc.set_compression(png::Compression::Fast);
-        let mut w = enc.write_header().map_err(err)?;
-        w.write_image_data(&data).map_err(err)?;
-        w.finish().map_err(err)?;
-        Ok(out)
+        Ok(self.0.encode_png()?)
     }
 
     /// Writes the image as a PNG file.
     pub fn save_png(&self, path: impl AsRef<Path>) -> Result<(), RenderError> {
-        let bytes = self.encode_png()?;
-        std::fs::write(path.as_ref(), bytes)
-            .map_err(|e| RenderError::Png(format!("{}: {e}", path.as_ref().display())))
+        Ok(self.0.save_png(path)?)
+    }
+
+    /// The pixels, for drawing.
+    pub(crate) fn pixmap_mut(&mut self) -> &mut Pixmap {
+        self.0.pixmap_mut()
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn panels_land_where_asked_and_clip() {
-        let mut big = Image::new(20, 10).expect("image");
-        big.pixmap.fill(tiny_skia::Color::WHITE);
-        let mut small = Image::new(4, 4).expect("image");
-        small
-            .pixmap
-            .fill(tiny_skia::Color::from_rgba8(200, 0, 0, 255));
-        big.draw_image(&small, 18, 3); // half outside on the right
-        assert_eq!(big.pixel(18, 3), Some([200, 0, 0, 255]));
-        assert_eq!(big.pixel(19, 6), Some([200, 0, 0, 255]));
-        assert_eq!(big.pixel(17, 3), Some([255, 255, 255, 255]));
-        assert_eq!(big.pixel(18, 7), Some([255, 255, 255, 255]));
-    }
-
-    #[test]
-    fn png_round_trip_keeps_the_pixels() {
-        let mut img = Image::new(3, 2).expect("image");
-        img.pixmap
-            .fill(tiny_skia::Color::from_rgba8(10, 20, 30, 255));
-        let png = img.encode_png().expect("png");
-        let back = tiny_skia::Pixmap::decode_png(&png).expect("decode");
-        assert_eq!(back.data(), img.data());
+impl From<picture::PictureError> for RenderError {
+    fn from(e: picture::PictureError) -> Self {
+        match e {
+            picture::PictureError::ImageSize {
+                width_px,
+                height_px,
+                max,
+            } => RenderError::ImageSize {
+                width_px,
+                height_px,
+                max,
+            },
+            picture::PictureError::Font => RenderError::Font,
+            picture::PictureError::Png(m) => RenderError::Png(m),
+        }
     }
 }

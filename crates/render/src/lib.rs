@@ -1,19 +1,27 @@
-//! Headless CPU renderer for nanohaptics: pictures and animations of every world without a
-//! GPU, a window or a browser.
+//! Headless CPU renderer for nanohaptics: pictures, animations and the sound of a world's
+//! session, without a GPU, a window, a browser or a sound card.
 //!
-//! **What it is for.** Drawing a world's primitives — spheres, boxes, the beam ellipse, the
-//! haptic cursor, force arrows, polylines and loops such as the working envelope (drawn ×N
-//! about a point), blueprint slots, text labels and a scale bar — given in world coordinates
-//! (metres, z up), through an orthographic [`Camera`] (top, side or oblique 3D view), with
-//! anti-aliasing (tiny-skia), light shading so solids read as solid, and an exact back-to-front
-//! order for disjoint convex bodies. A [`Frame`] becomes an [`Image`] (RGBA, PNG); a
-//! [`GifWriter`] turns a sequence of images into an animated GIF at a given frame rate.
+//! **What it is for.**
+//!
+//! * Pictures of worlds: `haptic-types`' drawable [`Primitive`]s (spheres, boxes, the beam
+//!   ellipse, the haptic cursor, force arrows, polylines and loops such as the working
+//!   envelope, blueprint slots, text labels) given in world coordinates (metres, z up), seen
+//!   through an orthographic [`Camera`] (top, side or oblique 3D view; [`bounds`] and
+//!   [`action_bounds`] frame a scene), drawn by a [`Frame`] with anti-aliasing (tiny-skia),
+//!   light shading so solids read as solid, an exact back-to-front order for disjoint convex
+//!   bodies and a scale bar, into an [`Image`] (RGBA, PNG: `picture`'s image and font).
+//! * Animations: a [`GifWriter`] turns a sequence of images into an animated GIF at a given
+//!   frame rate (one median-cut palette, frames cropped to what changed).
+//! * Sound: [`audio`] synthesises a session's impacts, contact clicks and proximity tone
+//!   sample by sample, for a whole recording ([`audio::synthesize`], a WAV file) or live
+//!   ([`audio::StreamSynth`], the browser game).
 //!
 //! **What it is not.** It knows nothing of worlds, scenes, recordings or the command line:
-//! the primitives are `haptic-types`' (every scene draws with them); `haptic-loop`
-//! owns MCAP reading and the `nanohaptics render` command. No perspective, no
-//! lighting model beyond one directional light with ambient, no interpenetrating solids (they
-//! are ordered by centre depth).
+//! every scene draws with `haptic-types`' primitives and hands over its sound events;
+//! `haptic-loop` reads recordings and owns the frames and sound of a session, and the
+//! `nanohaptics render` command is the CLI's. No charts (the `chart` crate draws those, on the
+//! same image and font), no perspective, no lighting model beyond one directional light with
+//! ambient, no interpenetrating solids (they are ordered by centre depth).
 //!
 //! ```
 //! use render::{Camera, Frame, Primitive, Rgba, Style, View};
@@ -33,14 +41,12 @@
 
 pub mod audio;
 pub mod camera;
-pub mod chart;
 mod draw;
 pub mod error;
 pub mod frame;
 pub mod gif;
 pub mod image;
 mod order;
-mod text;
 
 pub use camera::{Camera, MAX_SIDE_PX, Projected, View, action_bounds, bounds, is_backdrop};
 pub use error::RenderError;

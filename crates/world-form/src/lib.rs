@@ -1,16 +1,24 @@
-//! # world-form — what every nanohaptics world shares
+//! # world-form — the bottom of the workspace: device limits, numbers, strict arrays
 //!
 //! Every world (optical tweezers, bricks, atoms, the calibration wall) is built from its SI
 //! `Params` and the [`Limits`] of the device it renders to, and steps with
-//! `step(&Input) -> StepReport` (force N, stiffness felt N/m, typed events). This crate holds the
-//! one piece of that form they all need: the device limits, defined once.
+//! `step(&Input) -> StepReport` (force N, stiffness felt N/m, typed events). That form is a
+//! convention each world keeps (`docs/extending.md`), not a trait here; this crate holds the
+//! small pieces every world and most other crates need, each defined once, and depends on no
+//! workspace crate:
 //!
-//! What it is for: the one number formatter and percentile ([`numbers`]); one [`Limits`] type (largest force, N; largest stable stiffness, N/m) with the
-//! shipped device models' figures and one range check, used by `brickworld`, `nanoworld`,
-//! `ot-envelope`'s optical-tweezers world and `haptic-loop`'s device specifications.
+//! * [`Limits`]: what a device can render (largest force, N; largest stable stiffness, N/m),
+//!   the shipped device models' figures ([`Limits::FALCON`], [`Limits::TOUCH`]), its one range
+//!   check ([`Limits::validate`], [`LimitsError`]) and its mapping into a world's units
+//!   ([`Limits::in_world`]). Used by every world, `haptic-types`' device specifications, the
+//!   recording's session header and the engine.
+//! * [`numbers`]: the one way a number is written in a message ([`fmt_num`]) and the one
+//!   percentile (nearest rank), used by errors, reports, pacing statistics and benchmarks.
+//! * [`exact`]: fixed-length arrays read strictly from scene files and Python dicts (a
+//!   `[f64; 3]` given four numbers is an error, not silently cut).
 //!
-//! What it is not: no device I/O, no buttons or workspace (those are `haptic-loop`'s device
-//! specifications), no physics.
+//! What it is not: no device I/O, buttons or workspace (those are `haptic-types`' device
+//! specifications and `haptic-devices`' sources), no physics, no world of its own, no loop.
 //!
 //! ```
 //! use world_form::Limits;

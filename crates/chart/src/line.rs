@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
-use super::canvas::{Canvas, Entry, Swatch, frame, plot_area};
-use super::ticks::{Axis, auto_range, check_range};
-use super::{Chart, ChartError, Legend, Raster, Scale, Series, Style};
-use crate::image::Image;
+use crate::canvas::{Canvas, Entry, Swatch, frame, plot_area};
+use crate::ticks::{Axis, auto_range, check_range};
+use crate::{Chart, ChartError, Legend, Raster, Scale, Series, Style};
+use picture::Image;
 
 /// Pixel sizes of the standard styles relative to the base font: line width, dot radius.
 const LINE: f32 = 0.16;

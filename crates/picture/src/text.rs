@@ -6,15 +6,15 @@ use std::sync::OnceLock;
 use tiny_skia::{Path, PathBuilder};
 use ttf_parser::{Face, GlyphId, OutlineBuilder};
 
-use crate::error::RenderError;
+use crate::PictureError;
 
 static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 
-fn face() -> Result<&'static Face<'static>, RenderError> {
+fn face() -> Result<&'static Face<'static>, PictureError> {
     static FACE: OnceLock<Option<Face<'static>>> = OnceLock::new();
     FACE.get_or_init(|| Face::parse(FONT, 0).ok())
         .as_ref()
-        .ok_or(RenderError::Font)
+        .ok_or(PictureError::Font)
 }
 
 struct Sink<'a> {
@@ -56,7 +56,7 @@ impl OutlineBuilder for Sink<'_> {
 }
 
 /// Laid-out text: its outline path (pixel coordinates) and its advance width, px.
-pub(crate) struct TextPath {
+pub struct TextPath {
     /// Glyph outlines; `None` for text with no visible glyph (e.g. spaces only).
     pub path: Option<Path>,
     /// Width of the text, px.
@@ -66,7 +66,7 @@ pub(crate) struct TextPath {
 /// Lays out one line of `text` with its baseline starting at (`x`, `y`) px, `size_px` pixels
 /// per em. Characters missing from the font draw as the font's missing-glyph box; control
 /// characters (e.g. a newline) are skipped.
-pub(crate) fn layout(text: &str, x: f32, y: f32, size_px: f32) -> Result<TextPath, RenderError> {
+pub fn layout(text: &str, x: f32, y: f32, size_px: f32) -> Result<TextPath, PictureError> {
     let face = face()?;
     let k = size_px / f32::from(face.units_per_em());
     let mut pb = PathBuilder::new();

@@ -12,8 +12,8 @@
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{ColliderHandle, PairContacts, PhysicsWorld, RigidBodyHandle};
 
+use super::IMPACT_MIN_SPEED_M_PER_S;
 use crate::event::{Body, Event};
-use crate::impact::IMPACT_MIN_SPEED_M_PER_S;
 
 /// Tracks the contact pairs that carried impulse, step to step.
 #[derive(Debug, Default, Clone)]

@@ -2,12 +2,12 @@
 
 use std::path::Path;
 
-use super::{Chart, ChartError};
-use crate::image::Image;
+use crate::{Chart, ChartError};
+use picture::Image;
 
 /// Draws `charts` into one `width_px` × `height_px` image, `columns` per row (left to right,
 /// then top to bottom), each panel `width_px / columns` wide and `height_px / rows` high
-/// (each within [`super::SIDE_RANGE_PX`]); pixels a whole number of panels leaves over stay
+/// (each within [`crate::SIDE_RANGE_PX`]); pixels a whole number of panels leaves over stay
 /// white.
 pub fn render_grid(
     charts: &[Chart],
@@ -24,7 +24,7 @@ pub fn render_grid(
     let rows = charts.len().div_ceil(columns);
     let (pw, ph) = (width_px / columns as u32, height_px / rows as u32);
     let mut out = Image::new(width_px, height_px)?;
-    out.pixmap.fill(tiny_skia::Color::WHITE);
+    out.pixmap_mut().fill(tiny_skia::Color::WHITE);
     for (k, c) in charts.iter().enumerate() {
         let panel = c.render(pw, ph)?;
         let (i, j) = ((k % columns) as u32, (k / columns) as u32);

@@ -1,9 +1,8 @@
 //! Charts: data land on the pixels the axes give, each style draws what it says at the size
 //! it says, the legend goes where it is asked, and bad input is a named error.
 
-use render::Image;
-use render::chart::{
-    Chart, Legend, Level, Marker, Raster, Scale, Series, Style, plot_area, render_grid,
+use chart::{
+    Chart, Image, Legend, Level, Marker, Raster, Scale, Series, Style, plot_area, render_grid,
 };
 
 const RED: [u8; 3] = [255, 0, 0];

@@ -1,6 +1,6 @@
 //! Axes: data-to-pixel mapping, automatic ranges, tick positions and tick labels.
 
-use super::{ChartError, Scale};
+use crate::{ChartError, Scale};
 
 /// "Nice" tick positions (1-2-5 steps) covering `[lo, hi]`, about `n` of them.
 pub fn nice_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {

@@ -1,5 +1,7 @@
-//! Small 2D charts for reports and figures, drawn with tiny-skia and the embedded font, so
-//! they need nothing from the system (no fontconfig) and give the same bytes everywhere:
+//! The one chart engine of nanohaptics: small 2D charts for reports and figures (the lesson's,
+//! every benchmark report's through `bench_harness::chart`, the ot-envelope paper figures).
+//!
+//! **What it is for.**
 //!
 //! * [`Chart`]: line, dot, ring, step and filled series on linear or log axes, with vertical
 //!   event markers, horizontal reference lines ([`Level`]), translucent bands, a colour
@@ -8,8 +10,12 @@
 //! * [`render_grid`] / [`write_grid_png`]: several charts side by side (a row) or in a grid,
 //!   in one image.
 //!
+//! Charts are drawn with tiny-skia into `picture`'s [`Image`] with its embedded font, so they
+//! need nothing from the system (no fontconfig) and give the same PNG bytes everywhere. Bad
+//! input is a typed [`ChartError`] naming the field. The user guide is `docs/chart.md`.
+//!
 //! ```no_run
-//! use render::chart::{Chart, Series, Style};
+//! use chart::{Chart, Series, Style};
 //! let mut c = Chart::new("force over time", "time (s)", "force (N)");
 //! c.series.push(Series {
 //!     label: "Fz".into(),
@@ -17,11 +23,14 @@
 //!     color: [31, 119, 180],
 //!     style: Style::Line,
 //! });
-//! c.write_png("force.png".as_ref(), 1000, 500).unwrap();
+//! c.write_png("force.png".as_ref(), 1000, 500)?;
+//! # Ok::<(), chart::ChartError>(())
 //! ```
 //!
-//! Not for: interactive plots, or figures that need a colour bar, contour filling or 3D (use
-//! matplotlib on the recording's arrays for those).
+//! **What it is not.** Not the renderer of worlds (`render` draws world primitives through a
+//! camera) and it knows no world, recording or measurement: callers hand it numbers. No
+//! interactive plots, no colour bar, contour filling or 3D (use matplotlib on a recording's
+//! arrays for those).
 
 mod bar;
 mod canvas;
@@ -31,10 +40,11 @@ mod ticks;
 
 use std::path::Path;
 
-use crate::error::RenderError;
+use picture::PictureError;
 
 pub use canvas::plot_area;
 pub use grid::{render_grid, write_grid_png};
+pub use picture::Image;
 pub use ticks::{Axis, log_ticks, nice_ticks, sci_label, tick_label, value_label};
 
 /// Smallest and largest chart side, px.
@@ -301,9 +311,9 @@ pub enum ChartError {
         /// Columns asked for.
         columns: usize,
     },
-    /// Drawing or writing failed.
+    /// Drawing or writing failed (the font, the image or the PNG file).
     #[error(transparent)]
-    Render(#[from] RenderError),
+    Picture(#[from] PictureError),
 }
 
 /// Anything that draws itself into a PNG file (a [`Chart`] or a [`BarChart`]).
@@ -323,3 +333,8 @@ impl Figure for BarChart {
         BarChart::write_png(self, path, width_px, height_px)
     }
 }
+
+/// The user guide's examples (`docs/chart.md`), compiled as doc-tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/chart.md")]
+pub struct UserGuide;

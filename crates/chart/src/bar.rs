@@ -2,10 +2,10 @@
 
 use std::path::Path;
 
-use super::canvas::{Canvas, INK, font_px, plot_area};
-use super::ticks::{Axis, auto_range, value_label};
-use super::{BarChart, ChartError, Scale};
-use crate::image::Image;
+use crate::canvas::{Canvas, INK, font_px, plot_area};
+use crate::ticks::{Axis, auto_range, value_label};
+use crate::{BarChart, ChartError, Scale};
+use picture::Image;
 
 impl BarChart {
     /// The value axis at this size.
@@ -90,8 +90,8 @@ impl BarChart {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Bar;
     use super::*;
+    use crate::Bar;
 
     #[test]
     fn log_bars_are_proportional_to_their_decades() {

@@ -3,10 +3,10 @@
 
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash, Transform};
 
-use super::ticks::{Axis, sci_label, tick_label};
-use super::{ChartError, Legend, SIDE_RANGE_PX};
-use crate::image::Image;
-use crate::text::layout;
+use crate::ticks::{Axis, sci_label, tick_label};
+use crate::{ChartError, Legend, SIDE_RANGE_PX};
+use picture::Image;
+use picture::text::layout;
 
 /// Grid lines.
 pub(super) const GRID: [u8; 3] = [225, 225, 225];
@@ -330,6 +330,6 @@ impl Canvas {
     }
 
     pub(super) fn image(self) -> Image {
-        Image { pixmap: self.pm }
+        Image::from_pixmap(self.pm)
     }
 }

@@ -22,8 +22,7 @@ use rapier3d_f64::prelude::{
     SolverContact, SolverFlags,
 };
 
-/// Approach speed (m/s) below which a new contact is treated as a gentle placement, not an impact.
-pub const IMPACT_MIN_SPEED_M_PER_S: f64 = 0.05;
+use super::IMPACT_MIN_SPEED_M_PER_S;
 
 /// Separation (m) up to which a contact is always computed and solved; a farther
 /// (speculative) one only if its bodies approach fast enough to close the gap soon

@@ -1,0 +1,22 @@
+//! Impacts, one concept: a contact that begins — its colliders carried no impulse on the
+//! previous step — with its bodies approaching faster than [`IMPACT_MIN_SPEED_M_PER_S`] along
+//! the contact normal. Slower new contacts are gentle placements; resting and sliding contacts
+//! (which carry impulse every step) are never impacts.
+//!
+//! Two jobs follow from it, one submodule each:
+//!
+//! * [`hook`]: what the solver does with an impact, during the step: [`hook::ImpactHook`], the
+//!   rapier contact hook, solves a flat landing as one simultaneous impact (restitution `e v`
+//!   without spin) and, being the one hook rapier takes, also skips the idle speculative
+//!   contacts;
+//! * [`events`]: what the world reports after the step: [`events::ImpactTracker`] finds the
+//!   impacts that happened and raises an [`crate::Event::Impact`] for each, with the impulse
+//!   the solver spent (the loudness of a collision sound).
+//!
+//! The hand uses the same threshold for the cursor's own impacts (`hand`).
+
+pub mod events;
+pub mod hook;
+
+/// Approach speed (m/s) below which a new contact is treated as a gentle placement, not an impact.
+pub const IMPACT_MIN_SPEED_M_PER_S: f64 = 0.05;
