@@ -1,33 +1,31 @@
-//! # haptic-loop: a deterministic haptic loop with MCAP record and bit-exact replay
+//! # haptic-loop: the engine — a deterministic haptic loop, its sessions, record and replay
 //!
 //! What this crate is for:
 //!
-//! - **Devices** ([`device`]): a CHAI3D-like haptic device interface (position in metres in the
-//!   device frame, buttons, force command in newtons, and specifications: maximum force, maximum
-//!   stiffness, workspace radius), with specs for the Novint Falcon and the Touch/Omni class, and
-//!   three headless implementations: a scripted device (TOML waypoints, smooth interpolation,
-//!   button events), a simulated operator (a mass–spring–damper hand pulled toward the script
-//!   and pushed by the rendered force) and a replay device (inputs read back from a recording).
-//! - **The loop** ([`haptic`], [`pacing`]): a fixed tick (default 1 kHz) whose index is the only
-//!   clock the physics sees; device↔world mapping, force clamping by vector scaling, stiffness
-//!   cap, soft engagement, zero force on invalid input or a missed deadline.
-//! - **Scenes** ([`scene`]): one small trait every world plugs into (cursor and buttons in;
-//!   force, events and drawable primitives out), TOML scene files validated with typed errors,
-//!   and a stiff-wall calibration scene.
-//! - **Recording and replay** ([`record`], [`replay`]): every tick into MCAP from a writer
-//!   thread (so writing never stalls a tick), and a replay that recomputes every output from the
-//!   logged inputs alone and compares bit for bit.
-//! - **The runner** ([`runner`]): one loop for every way a session is driven — a device source
-//!   (script, simulated hand, replay, a device in another process over the UDP [`bridge`]), a
-//!   pacing policy (batch, real time, the device's clock) and sinks (the MCAP recorder, the
-//!   per-tick [`arrays`], the replay verifier, the frame renderer, the [`live`] Foxglove view).
-//! - **Sessions** ([`session`]): "run a scene with a script and get per-tick arrays back" and
-//!   "read a recording into arrays", the API the Python wheel wraps.
+//! - **The tick** ([`haptic`]): [`HapticLoop`], a fixed tick (default 1 kHz) whose index is the
+//!   only clock the physics sees; device↔world mapping, force clamping by vector scaling,
+//!   stiffness cap, soft engagement, the passivity layer at the device port, zero force on
+//!   invalid input or a missed deadline, and the local model a protocol-2 device renders.
+//! - **Scenes** ([`scene`]): the one trait every world plugs into (cursor and buttons in; force,
+//!   events and drawable primitives out), TOML scene files validated with typed errors located
+//!   by line and column, the loop configuration, and the calibration wall.
+//! - **Time** ([`runner`]): [`runner::TickEngine::tick`] is the one way a session's time
+//!   advances; [`runner::Runner`] drives it from a device with a pacing policy (batch, real
+//!   time, the device's clock, recorded deadlines), [`stepper::Stepper`] one tick per call.
+//!   Both hand every tick to [`sink::Sink`]s with the engine's [`header::SessionHeader`].
+//! - **Sinks** ([`sinks`]): the MCAP recorder ([`record_sink`], the only module that turns the
+//!   header into the file's description), the per-tick [`arrays`], running [`totals`], the
+//!   replay verifier ([`replay`]), frames and pictures ([`media`]), the [`live`] Foxglove view.
+//! - **Sessions** ([`setup`], [`session`]): the one set-up (scene, device made ready for it,
+//!   header, sinks) and "run a scene with a script or a device and get a report and per-tick
+//!   arrays back" — what `nanohaptics run`, `play` and the Python wheel call.
+//! - **Checks in closed loop** ([`closed_loop`]): a scene played through a modelled device held
+//!   by a hand, over an ideal or a modelled link, judged on what the hand felt.
 //!
-//! What it is not: it holds no world physics (the worlds live in their own crates and are
-//! adapted by a thin scene), no GPU renderer and no driver for real hardware: a real device's
-//! driver runs in its own process and speaks the bridge protocol (the wheel's
-//! `nanohaptics.bridge` has adapters for the Touch and Force Dimension / Falcon SDKs).
+//! What it is not: it holds no world physics (worlds live in their own crates and are adapted
+//! by a thin scene), no device and no device protocol (those are `haptic-devices`, named and
+//! opened by `haptic_devices::source`), no file format (`nanohaptics-recording`), no command
+//! line (`nanohaptics-cli`) and no browser page (`nanohaptics-play`).
 
 pub mod arrays;
 pub mod builtin;
