@@ -12,7 +12,7 @@
 
 use crate::error::{EnvelopeError, Result};
 use ot_physics::{Propagator, TrapModel};
-use world_form::{ValueError, fmt_num};
+use world_form::{ValueError, fmt_sig};
 
 /// Longest tick of a sampling of the map, in periods of the well's fastest small oscillation.
 /// The crossings of the folds' images grow faster than their number: at the paper's constants
@@ -54,8 +54,8 @@ pub fn check_tick<const D: usize>(model: &TrapModel<D>, dt_s: f64, periods: u32)
                     "≤ {} s, {periods} {noun} of the well's fastest oscillation (ω = {} rad/s); \
                      a longer tick folds the map so often that the envelope's boundary search \
                      grows without bound",
-                    fmt_num(round_to(max_dt, 5)),
-                    fmt_num(round_to(omega, 5)),
+                    fmt_sig(max_dt, 5),
+                    fmt_sig(omega, 5),
                 ),
             ),
             max_dt,
@@ -70,14 +70,6 @@ pub fn check_tick<const D: usize>(model: &TrapModel<D>, dt_s: f64, periods: u32)
 /// every sampling of the map.
 pub fn check_tick_length<const D: usize>(prop: &Propagator<D>) -> Result<()> {
     check_tick(prop.model(), prop.dt(), MAX_OSCILLATIONS_PER_TICK)
-}
-
-/// `x` rounded to `digits` significant digits (for showing a computed bound; `x` itself when
-/// the rounding does not parse back, which a finite `x` always does).
-fn round_to(x: f64, digits: usize) -> f64 {
-    format!("{x:.*e}", digits.saturating_sub(1))
-        .parse()
-        .unwrap_or(x)
 }
 
 #[cfg(test)]

@@ -26,7 +26,7 @@ pub mod exact;
 pub mod numbers;
 pub mod value;
 
-pub use numbers::fmt_num;
+pub use numbers::{fmt_num, fmt_sig};
 pub use value::ValueError;
 
 use serde::{Deserialize, Serialize};
