@@ -178,7 +178,7 @@ fn budget_fields_are_validated_with_their_range() {
 }
 
 #[test]
-fn a_tick_longer_than_two_small_oscillations_is_refused() {
+fn a_tick_longer_than_one_period_of_the_fastest_oscillation_is_refused() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../scenes/optical_tweezers.toml"
@@ -197,7 +197,7 @@ fn a_tick_longer_than_two_small_oscillations_is_refused() {
     assert_eq!(
         with("dt_us = 0.2", "dt_us = 5.0").as_deref(),
         Some(
-            "scene: `optical_tweezers.dt_us` = 5 is out of range: allowed 0 < dt_us ≤ 1.6 µs, \
+            "scene: `optical_tweezers.dt_us` = 5 is out of range: allowed 0 < dt_us ≤ 1.60 µs, \
              1 period of the particle's fastest oscillation in this trap (2π·√(mass/κ), κ = \
              2·ln2·depth/waist², narrower waist); a longer tick makes the envelope too costly \
              for a haptic loop"
