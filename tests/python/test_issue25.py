@@ -26,6 +26,22 @@ def test_an_envelope_of_many_oscillations_is_refused_naming_the_limit():
     )
 
 
+def test_the_inverse_solve_refuses_the_envelope_s_tick_bound_quickly():
+    # Issue 34: solve_trap ran for more than 20 s on this tick (62 oscillations); it now meets
+    # the one bound of a tick's length (ot_envelope::tick_length) before sampling the map.
+    import time
+
+    start = time.perf_counter()
+    with pytest.raises(ValueError) as e:
+        nh.solve_trap(nh.paper_trap(), [-0.288, -0.070], 9.97e-5, [-3.6e-144, -2.3e-274])
+    took = time.perf_counter() - start
+    assert str(e.value).startswith(
+        "dt [s] = 9.97e-5 is out of range: allowed ≤ 6.4037e-6 s, 4 periods of the well's "
+        "fastest oscillation (ω = 3.9247e6 rad/s)"
+    )
+    assert took < 2.0, took
+
+
 def test_a_tangled_tick_map_is_refused_and_the_default_one_is_not_tangled():
     trap = nh.paper_trap()
     # 8 fixed RK4 substeps over 5 µs (ω·h = 2.5 rad): the polynomial map folds where the

@@ -1,30 +1,16 @@
 //! Typed errors: every one names the offending field and the allowed range.
 
 use thiserror::Error;
+use world_form::ValueError;
 
 /// A scene parameter (or a run-time switch) is outside its allowed range.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ParamError {
-    /// A number is outside its closed/open range. `range` is human readable, e.g. `"(0, 1e4]"`.
-    #[error("parameter `{field}` = {} is out of range: allowed {range}", num(*value))]
-    OutOfRange {
-        /// Dotted path of the field, e.g. `blueprint.slots[2].center_m[0]`.
-        field: String,
-        /// The rejected value (may be NaN or infinite).
-        value: f64,
-        /// The allowed range, written as an interval.
-        range: String,
-    },
-    /// A count is outside its allowed range.
-    #[error("parameter `{field}` = {value} is out of range: allowed {range}")]
-    CountOutOfRange {
-        /// Dotted path of the field.
-        field: String,
-        /// The rejected count.
-        value: usize,
-        /// The allowed range, written as an interval.
-        range: String,
-    },
+    /// A number (or a count, as f64) outside its range; the field is the dotted path in
+    /// backticks (`` `blueprint.slots[2].center_m[0]` ``), the range an interval, e.g.
+    /// `(0, 1e4]`.
+    #[error("parameter {0}")]
+    Value(ValueError),
     /// A structural constraint between fields does not hold (e.g. `min < max`).
     #[error("parameter `{field}` is invalid: {reason}")]
     Inconsistent {
@@ -36,12 +22,20 @@ pub enum ParamError {
 }
 
 impl ParamError {
+    /// `field` (dotted path) = `value` outside `range` (an interval, e.g. `[0, 100]`).
+    pub fn out_of_range(field: &str, value: f64, range: impl Into<String>) -> Self {
+        ParamError::Value(ValueError::out_of_range(
+            format!("`{field}`"),
+            value,
+            range.into(),
+        ))
+    }
+
     /// The dotted path of the offending field (as in the scene's `[brickworld.params]` table).
     pub fn field(&self) -> &str {
         match self {
-            ParamError::OutOfRange { field, .. }
-            | ParamError::CountOutOfRange { field, .. }
-            | ParamError::Inconsistent { field, .. } => field,
+            ParamError::Value(e) => e.field().trim_matches('`'),
+            ParamError::Inconsistent { field, .. } => field,
         }
     }
 }

@@ -7,7 +7,7 @@
 
 use rapier3d_f64::math::{Rotation, Vector};
 use serde::{Deserialize, Serialize};
-use world_form::Limits;
+use world_form::{Limits, fmt_num};
 
 use crate::error::ParamError;
 
@@ -333,17 +333,17 @@ pub(crate) enum Lo {
 /// Checks `value` lies in `lo .. hi]` (upper bound closed); NaN always fails.
 pub(crate) fn range(field: &str, value: f64, lo: Lo, hi: f64) -> Result<(), ParamError> {
     let (ok_lo, lo_txt) = match lo {
-        Lo::Closed(l) => (value >= l, format!("[{l}")),
-        Lo::Open(l) => (value > l, format!("({l}")),
+        Lo::Closed(l) => (value >= l, format!("[{}", fmt_num(l))),
+        Lo::Open(l) => (value > l, format!("({}", fmt_num(l))),
     };
     if ok_lo && value <= hi {
         Ok(())
     } else {
-        Err(ParamError::OutOfRange {
-            field: field.to_string(),
+        Err(ParamError::out_of_range(
+            field,
             value,
-            range: format!("{lo_txt}, {hi}]"),
-        })
+            format!("{lo_txt}, {}]", fmt_num(hi)),
+        ))
     }
 }
 
@@ -351,11 +351,11 @@ fn count(field: &str, value: usize, lo: usize, hi: usize) -> Result<(), ParamErr
     if (lo..=hi).contains(&value) {
         Ok(())
     } else {
-        Err(ParamError::CountOutOfRange {
-            field: field.to_string(),
-            value,
-            range: format!("[{lo}, {hi}]"),
-        })
+        Err(ParamError::out_of_range(
+            field,
+            value as f64,
+            format!("[{lo}, {hi}]"),
+        ))
     }
 }
 
@@ -523,10 +523,8 @@ impl Params {
     /// `device.max_force_n` / `device.max_stiffness_n_per_m`) and the proxy stiffness, which
     /// must not exceed [`Limits::max_stiffness_n_per_m`].
     pub fn validate_for_device(&self, limits: &Limits) -> Result<(), ParamError> {
-        limits.validate().map_err(|e| ParamError::OutOfRange {
-            field: format!("device.{}", e.field),
-            value: e.value,
-            range: format!("(0, {}]", e.max),
+        limits.validate().map_err(|e| {
+            ParamError::Value(e.map_field(|f| format!("`device.{}`", f.trim_matches('`'))))
         })?;
         range(
             "proxy_stiffness_n_per_m",

@@ -37,7 +37,7 @@ fn old_unit_spellings_still_load_and_device_limits_are_checked_by_name() {
             .err()
             .unwrap()
             .to_string(),
-        "parameter `device.max_force_n` = NaN is out of range: allowed (0, 100000]"
+        "parameter `device.max_force_n` = NaN is out of range: allowed 0 < max_force_n ≤ 100000 N"
     );
 }
 
@@ -145,11 +145,7 @@ fn bad_cursor_input_and_switches_are_typed_errors() {
     );
     assert_eq!(
         w.set_gravity(-1.0).unwrap_err(),
-        ParamError::OutOfRange {
-            field: "gravity_m_per_s2".into(),
-            value: -1.0,
-            range: "[0, 100]".into()
-        }
+        ParamError::out_of_range("gravity_m_per_s2", -1.0, "[0, 100]")
     );
     assert!(w.set_brick_mass(0.0).is_err());
     assert!(w.set_friction(f64::NAN).is_err());

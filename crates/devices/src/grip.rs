@@ -1,6 +1,7 @@
 //! The hand: a spring-damper from the stylus to the operator's intended path.
 
 use serde::{Deserialize, Serialize};
+use world_form::ValueError;
 
 /// How firmly a hand holds the stylus: the impedance of the arm around its intended path
 /// (`F = k (x_intent − x) + b (v_intent − v)`), plus the part of the hand's mass that moves with
@@ -21,16 +22,9 @@ pub struct Grip {
 /// A grip given out of range or in a form that does not parse.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum GripError {
-    /// A number out of range.
-    #[error("grip `{field}` = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        /// `k`, `b` or `m`.
-        field: &'static str,
-        /// The value given.
-        value: f64,
-        /// The allowed range with its unit.
-        allowed: &'static str,
-    },
+    /// A number out of range (`` `k` ``, `` `b` `` or `` `m` ``), its range with the unit.
+    #[error("grip {0}")]
+    OutOfRange(ValueError),
     /// Text that is neither `loose`, `firm` nor `k=…,b=…[,m=…]`.
     #[error(
         "grip `{0}` is not understood (allowed: loose, firm, or k=N/m,b=N·s/m[,m=kg], e.g. k=500,b=4)"
@@ -59,11 +53,11 @@ impl Grip {
             if ok && value.is_finite() {
                 Ok(())
             } else {
-                Err(GripError::OutOfRange {
-                    field,
+                Err(GripError::OutOfRange(ValueError::out_of_range(
+                    format!("`{field}`"),
                     value,
                     allowed,
-                })
+                )))
             }
         };
         let k = self.stiffness_n_per_m;

@@ -55,11 +55,11 @@ impl LinkParams {
             if ok && v.is_finite() {
                 Ok(())
             } else {
-                Err(LinkError {
-                    field,
-                    value: v,
+                Err(LinkError(world_form::ValueError::out_of_range(
+                    format!("`{field}`"),
+                    v,
                     allowed,
-                })
+                )))
             }
         };
         check(
@@ -103,15 +103,8 @@ impl LinkParams {
 
 /// A link parameter out of range.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("link `{field}` = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*.value))]
-pub struct LinkError {
-    /// The field.
-    pub field: &'static str,
-    /// The value given.
-    pub value: f64,
-    /// The allowed range, with its unit.
-    pub allowed: &'static str,
-}
+#[error("link {0}")]
+pub struct LinkError(pub world_form::ValueError);
 
 /// One direction of a link: packets in flight, delivered in order of arrival.
 #[derive(Clone, Debug)]

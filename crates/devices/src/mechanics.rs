@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 use world_form::Limits;
+use world_form::ValueError;
 
 /// The mechanics of a haptic device at its end effector, one translational axis model applied
 /// to each of x, y and z (a 3-DOF device linearised about the centre of its workspace).
@@ -37,16 +38,9 @@ pub struct Mechanics {
 /// A mechanics field out of range, or an unknown preset.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MechanicsError {
-    /// A field out of range.
-    #[error("device `{field}` = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        /// Field name.
-        field: &'static str,
-        /// Value given.
-        value: f64,
-        /// Allowed range with unit.
-        allowed: &'static str,
-    },
+    /// A field (named in backticks) out of range, its allowed range with the unit.
+    #[error("device {0}")]
+    OutOfRange(ValueError),
     /// A preset name that is not known.
     #[error("unknown device model `{0}` (allowed: falcon, touch, delta3, inverse3)")]
     UnknownPreset(String),
@@ -147,11 +141,11 @@ impl Mechanics {
             if ok && value.is_finite() {
                 Ok(())
             } else {
-                Err(MechanicsError::OutOfRange {
-                    field,
+                Err(MechanicsError::OutOfRange(ValueError::out_of_range(
+                    format!("`{field}`"),
                     value,
                     allowed,
-                })
+                )))
             }
         };
         let m = self.moving_mass_kg;
@@ -189,17 +183,7 @@ impl Mechanics {
             (100.0..=1e5).contains(&s),
             "100 ≤ servo_rate_hz ≤ 100000 Hz",
         )?;
-        self.limits
-            .validate()
-            .map_err(|e| MechanicsError::OutOfRange {
-                field: e.field,
-                value: e.value,
-                allowed: if e.field == "max_force_n" {
-                    "0 < max_force_n ≤ 100000 N"
-                } else {
-                    "0 < max_stiffness_n_per_m ≤ 10000000 N/m"
-                },
-            })?;
+        self.limits.validate().map_err(MechanicsError::OutOfRange)?;
         let r = self.workspace_radius_m;
         check(
             "workspace_radius_m",

@@ -35,6 +35,7 @@ use haptic_types::device::{
 };
 use haptic_types::vec3::{self, Vec3};
 use serde::{Deserialize, Serialize};
+use world_form::{ValueError, fmt_num};
 
 /// Errors in a script file; each names the field and the allowed range.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -53,16 +54,10 @@ pub enum ScriptError {
     /// A script needs at least one waypoint.
     #[error("script: `waypoint` must list at least one waypoint")]
     NoWaypoints,
-    /// A number outside its allowed range.
-    #[error("script: `{field}` = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        /// Field path, e.g. `waypoint[2].t_s`.
-        field: String,
-        /// The value found.
-        value: f64,
-        /// The allowed range in words.
-        allowed: String,
-    },
+    /// A number outside its allowed range; the field path in backticks, e.g.
+    /// `` `waypoint[2].t_s` ``.
+    #[error("script: {0}")]
+    OutOfRange(ValueError),
     /// A switch the scene does not have, or a value outside its range.
     #[error("script: `{field}`: {source}")]
     Switch {
@@ -88,9 +83,10 @@ impl ScriptError {
         use haptic_types::textpos::{field_position, position};
         match self {
             ScriptError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
-            ScriptError::OutOfRange { field, .. }
-            | ScriptError::Button { field, .. }
-            | ScriptError::Switch { field, .. } => field_position(text, field),
+            ScriptError::OutOfRange(e) => field_position(text, e.field().trim_matches('`')),
+            ScriptError::Button { field, .. } | ScriptError::Switch { field, .. } => {
+                field_position(text, field)
+            }
             ScriptError::NoWaypoints => field_position(text, "script"),
             ScriptError::Parse(_) => None,
         }
@@ -220,11 +216,11 @@ fn check(field: String, value: f64, ok: bool, allowed: &str) -> Result<(), Scrip
     if ok {
         Ok(())
     } else {
-        Err(ScriptError::OutOfRange {
-            field,
+        Err(ScriptError::OutOfRange(ValueError::out_of_range(
+            format!("`{field}`"),
             value,
-            allowed: allowed.to_string(),
-        })
+            allowed.to_string(),
+        )))
     }
 }
 
@@ -360,15 +356,9 @@ impl Script {
         };
         if let Some(op) = &file.operator {
             op.validate().map_err(|e| match e {
-                ScriptError::OutOfRange {
-                    field,
-                    value,
-                    allowed,
-                } => ScriptError::OutOfRange {
-                    field: format!("operator.{field}"),
-                    value,
-                    allowed,
-                },
+                ScriptError::OutOfRange(e) => ScriptError::OutOfRange(
+                    e.map_field(|f| format!("`operator.{}`", f.trim_matches('`'))),
+                ),
                 other => other,
             })?;
         }
@@ -520,11 +510,11 @@ impl OperatorParams {
         ];
         for (field, value, lo, hi) in fields {
             if !(value.is_finite() && value >= lo && value <= hi) {
-                return Err(ScriptError::OutOfRange {
-                    field: field.to_string(),
+                return Err(ScriptError::OutOfRange(ValueError::out_of_range(
+                    format!("`{field}`"),
                     value,
-                    allowed: format!("{lo} ≤ {field} ≤ {hi}"),
-                });
+                    format!("{} ≤ {field} ≤ {}", fmt_num(lo), fmt_num(hi)),
+                )));
             }
         }
         Ok(())

@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 use crate::error::CurveError;
 use crate::params::Params;
 use crate::world::{Event, TipInput, World};
-use world_form::Limits;
+use world_form::{Limits, ValueError};
 
 /// One vertical approach–retract sweep of the bare tip over the substrate.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,10 +50,8 @@ pub fn force_distance_curve(
     limits: &Limits,
     spec: &CurveSpec,
 ) -> Result<ForceCurve, CurveError> {
-    let bad = |field: &'static str, value: f64, allowed: &str| CurveError::OutOfRange {
-        field,
-        value,
-        allowed: allowed.to_string(),
+    let bad = |field: &'static str, value: f64, allowed: &str| {
+        CurveError::OutOfRange(ValueError::out_of_range(field, value, allowed.to_string()))
     };
     if !spec.xy_m.iter().all(|v| v.is_finite()) {
         let v = if spec.xy_m[0].is_finite() {

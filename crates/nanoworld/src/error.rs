@@ -1,20 +1,16 @@
 //! Typed errors: bad parameters, bad tick input, bad curve requests.
 
 use thiserror::Error;
+use world_form::ValueError;
 
 /// A parameter (scene value or run-time setting) outside its allowed range.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ParamError {
-    /// `field` holds `value`, which is outside `allowed`.
-    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
-    OutOfRange {
-        /// Dotted path of the field, as in the scene table (e.g. `interaction.game.tip_atom.snap_gap_m`).
-        field: String,
-        /// The offending value (counts are converted to f64).
-        value: f64,
-        /// The allowed range, in words and numbers.
-        allowed: String,
-    },
+    /// A field holds a value outside its allowed range; the field is the dotted path as in
+    /// the scene table (e.g. `interaction.game.tip_atom.snap_gap_m`), counts are converted to
+    /// f64.
+    #[error(transparent)]
+    Value(#[from] ValueError),
     /// A field that is no longer a parameter: its value now comes from the device's
     /// [`world_form::Limits`] handed to [`crate::World::new`].
     #[error(
@@ -38,7 +34,7 @@ impl ParamError {
     /// The dotted path of the offending field (as in the scene's `[nanoworld.params]` table).
     pub fn field(&self) -> &str {
         match self {
-            ParamError::OutOfRange { field, .. } => field,
+            ParamError::Value(e) => e.field(),
             ParamError::NotChangeableAtRunTime { field } | ParamError::MovedToDevice { field } => {
                 field
             }
@@ -46,11 +42,11 @@ impl ParamError {
     }
 
     pub(crate) fn range(field: impl Into<String>, value: f64, allowed: impl Into<String>) -> Self {
-        Self::OutOfRange {
-            field: field.into(),
+        Self::Value(ValueError::out_of_range(
+            field.into(),
             value,
-            allowed: allowed.into(),
-        }
+            allowed.into(),
+        ))
     }
 }
 
@@ -58,25 +54,25 @@ impl ParamError {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum StepError {
     /// A tip (cursor) position component is NaN or infinite.
-    #[error("tip position {axis} = {value} is out of range: allowed a finite number of metres")]
+    #[error("{error}")]
     NonFinitePosition {
         /// `x`, `y` or `z`.
         axis: char,
-        /// The offending value (m).
-        value: f64,
+        /// The offending value (m) and its range.
+        error: ValueError,
     },
     /// A tip (cursor) position component is finite but farther than
     /// [`crate::MAX_POSITION_M`] from the origin along its axis.
-    #[error("tip position {axis} = {} is out of range: allowed |{axis}| <= 1 m", world_form::numbers::fmt_num(*value))]
+    #[error("{error}")]
     PositionOutOfRange {
         /// `x`, `y` or `z`.
         axis: char,
-        /// The offending value (m).
-        value: f64,
+        /// The offending value (m) and its range.
+        error: ValueError,
     },
     /// The tick length is not in [[`crate::MIN_DT_S`], 1] s.
-    #[error("dt_s = {} is out of range: allowed 1e-9 <= dt_s <= 1 s", world_form::numbers::fmt_num(*_0))]
-    BadDt(f64),
+    #[error(transparent)]
+    BadDt(ValueError),
 }
 
 /// Bad request to [`crate::force_distance_curve`].
@@ -85,16 +81,9 @@ pub enum CurveError {
     /// The world parameters are invalid.
     #[error(transparent)]
     Params(#[from] ParamError),
-    /// A curve setting is out of range.
-    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
-    OutOfRange {
-        /// Name of the setting in [`crate::CurveSpec`].
-        field: &'static str,
-        /// The offending value.
-        value: f64,
-        /// The allowed range.
-        allowed: String,
-    },
+    /// A curve setting (named as in [`crate::CurveSpec`]) is out of range.
+    #[error(transparent)]
+    OutOfRange(ValueError),
     /// A tick of the sweep failed (cannot happen with a valid spec; kept typed, not panicking).
     #[error(transparent)]
     Step(#[from] StepError),

@@ -8,7 +8,7 @@
 //! device's [`Limits`], handed to [`crate::World::new`] ([`Params::validate_for_device`]).
 
 use serde::{Deserialize, Serialize};
-use world_form::Limits;
+use world_form::{Limits, fmt_num};
 
 use crate::error::ParamError;
 
@@ -279,22 +279,20 @@ fn check(
 
 fn positive_up_to(field: &str, value: f64, max: f64) -> Result<(), ParamError> {
     check(field, value, value > 0.0 && value <= max, || {
-        format!("0 < value <= {max:e}")
+        format!("0 < value <= {}", fmt_num(max))
     })
 }
 
 fn nonneg_up_to(field: &str, value: f64, max: f64) -> Result<(), ParamError> {
     check(field, value, (0.0..=max).contains(&value), || {
-        format!("0 <= value <= {max:e}")
+        format!("0 <= value <= {}", fmt_num(max))
     })
 }
 
-/// `v` in `e` notation with at most 6 significant digits and no trailing zeros (`2e1`).
 /// `v` rounded to six significant digits, in the one number form of errors
-/// ([`world_form::numbers::fmt_num`]): a derived bound reads `20`, not `19.999999999999996`.
+/// ([`world_form::fmt_sig`]): a derived bound reads `20`, not `19.999999999999996`.
 fn short(v: f64) -> String {
-    let rounded: f64 = format!("{v:.5e}").parse().unwrap_or(v);
-    world_form::numbers::fmt_num(rounded)
+    world_form::fmt_sig(v, 6)
 }
 
 fn finite(field: &str, value: f64) -> Result<(), ParamError> {
@@ -331,7 +329,7 @@ impl GamePair {
             &format!("{prefix}.snap_gap_m"),
             self.snap_gap_m,
             self.snap_gap_m > 0.0 && self.snap_gap_m < w,
-            || format!("0 < value < activation_gap_m = {w:e}"),
+            || format!("0 < value < activation_gap_m = {}", fmt_num(w)),
         )?;
         positive_up_to(
             &format!("{prefix}.stiffness_n_per_m"),
@@ -428,7 +426,13 @@ impl Params {
         );
         // One axis at a time, so that the error names the component that is out of range.
         let over_axis = |v: f64, k: usize| v >= 0.0 && v <= if k == 0 { x_max } else { y_max };
-        let sub_range = || format!("inside the substrate, 0..={x_max:e} x 0..={y_max:e} m");
+        let sub_range = || {
+            format!(
+                "inside the substrate, 0..={} x 0..={} m",
+                fmt_num(x_max),
+                fmt_num(y_max)
+            )
+        };
         if let Some(z) = &self.loading_zone {
             for k in 0..2 {
                 finite(&format!("loading_zone.min_xy_m[{k}]"), z.min_xy_m[k])?;
@@ -437,14 +441,21 @@ impl Params {
                     &format!("loading_zone.max_xy_m[{k}]"),
                     z.max_xy_m[k],
                     z.max_xy_m[k] > lo,
-                    || format!("value > min_xy_m[{k}] = {lo:e}"),
+                    || format!("value > min_xy_m[{k}] = {}", fmt_num(lo)),
                 )?;
                 let hi = z.max_xy_m[k];
                 check(
                     &format!("loading_zone.spawn_xy_m[{k}]"),
                     z.spawn_xy_m[k],
                     z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && over_axis(z.spawn_xy_m[k], k),
-                    || format!("inside the zone [{lo:e}, {hi:e}] and {}", sub_range()),
+                    || {
+                        format!(
+                            "inside the zone [{}, {}] and {}",
+                            fmt_num(lo),
+                            fmt_num(hi),
+                            sub_range()
+                        )
+                    },
                 )?;
             }
         }
@@ -519,15 +530,7 @@ impl Params {
     /// ([`Params::max_render_stiffness`]) is within [`Limits::max_stiffness_n_per_m`].
     pub fn validate_for_device(&self, limits: &Limits) -> Result<(), ParamError> {
         limits.validate().map_err(|e| {
-            ParamError::range(
-                format!("device.{}", e.field),
-                e.value,
-                format!(
-                    "0 < value <= {} {}",
-                    world_form::numbers::fmt_num(e.max),
-                    e.unit
-                ),
-            )
+            ParamError::Value(e.map_field(|f| format!("device.{}", f.trim_matches('`'))))
         })?;
         let (field, k) = self.max_render_stiffness();
         let cap = limits.max_stiffness_n_per_m;

@@ -2,6 +2,7 @@
 
 use nalgebra::Vector3;
 use thiserror::Error;
+use world_form::{ValueError, fmt_sig};
 
 use crate::law::PairKind;
 use crate::world::{TipInput, World};
@@ -24,18 +25,13 @@ pub enum ScriptError {
         slot: usize,
     },
     /// `step_m` is not a positive finite length.
-    #[error("step_m = {} is out of range: allowed 0 < step_m <= 1e-6 m", world_form::numbers::fmt_num(*_0))]
-    BadStep(f64),
+    #[error(transparent)]
+    BadStep(ValueError),
     /// `step_m` is so small that the script would exceed [`MAX_SCRIPT_SAMPLES`].
-    #[error(
-        "step_m = {} is out of range for this house: the path is {path_m:e} m long, \
-         so allowed {min_step_m:e} <= step_m <= 1e-6 m (at most {max} samples)",
-        world_form::numbers::fmt_num(*step_m),
-        max = MAX_SCRIPT_SAMPLES
-    )]
+    #[error("{error}")]
     TooManySamples {
-        /// The step asked for, m.
-        step_m: f64,
+        /// The step asked for (m) and the range this house allows.
+        error: ValueError,
         /// The path's length, m.
         path_m: f64,
         /// The smallest step this path allows, m.
@@ -137,7 +133,11 @@ pub fn house_waypoints(world: &World) -> Result<Vec<Vector3<f64>>, ScriptError> 
 /// The house script as cursor inputs at most `step_m` (m) apart.
 pub fn house_script(world: &World, step_m: f64) -> Result<Vec<TipInput>, ScriptError> {
     if !(step_m.is_finite() && step_m > 0.0 && step_m <= 1e-6) {
-        return Err(ScriptError::BadStep(step_m));
+        return Err(ScriptError::BadStep(ValueError::out_of_range(
+            "step_m",
+            step_m,
+            "0 < step_m <= 1e-6 m",
+        )));
     }
     let pts = house_waypoints(world)?;
     if polyline_len(&pts, step_m) > MAX_SCRIPT_SAMPLES as f64 {
@@ -145,7 +145,16 @@ pub fn house_script(world: &World, step_m: f64) -> Result<Vec<TipInput>, ScriptE
         // Each segment rounds up to whole steps: leave room for one extra sample per segment.
         let min_step_m = path_m / (MAX_SCRIPT_SAMPLES - pts.len()) as f64;
         return Err(ScriptError::TooManySamples {
-            step_m,
+            error: ValueError::out_of_range(
+                "step_m",
+                step_m,
+                format!(
+                    "{} <= step_m <= 1e-6 m for this house (its path is {} m long; at most \
+                     {MAX_SCRIPT_SAMPLES} samples)",
+                    fmt_sig(min_step_m, 6),
+                    fmt_sig(path_m, 6)
+                ),
+            ),
             path_m,
             min_step_m,
         });

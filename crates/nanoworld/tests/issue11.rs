@@ -357,8 +357,10 @@ fn a_house_script_step_too_small_for_memory_is_refused_with_the_bound() {
     assert_eq!(
         e.to_string(),
         format!(
-            "step_m = 1e-15 is out of range for this house: the path is {path_m:e} m long, so \
-             allowed {min_step_m:e} <= step_m <= 1e-6 m (at most 10000000 samples)"
+            "step_m = 1e-15 is out of range: allowed {} <= step_m <= 1e-6 m for this house (its \
+             path is {} m long; at most 10000000 samples)",
+            world_form::fmt_sig(min_step_m, 6),
+            world_form::fmt_sig(path_m, 6)
         )
     );
     let pts = nanoworld::house_waypoints(&w).expect("plannable");

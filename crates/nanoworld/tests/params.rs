@@ -42,7 +42,7 @@ fn nan_and_negative_values_are_rejected_not_clamped() {
     let mut p = Params::game_default();
     p.substrate.spacing_m = f64::NAN;
     let e = p.validate().expect_err("NaN");
-    assert!(matches!(&e, ParamError::OutOfRange { field, .. } if field == "substrate.spacing_m"));
+    assert!(matches!(&e, ParamError::Value(v) if v.field() == "substrate.spacing_m"));
     let p = Params::game_default();
     let bad = world_form::Limits {
         max_force_n: -1.0,
@@ -52,7 +52,7 @@ fn nan_and_negative_values_are_rejected_not_clamped() {
         World::new(&p, &bad, start())
             .expect_err("negative")
             .to_string(),
-        "device.max_force_n = -1 is out of range: allowed 0 < value <= 100000 N"
+        "device.max_force_n = -1 is out of range: allowed 0 < max_force_n ≤ 100000 N"
     );
     let mut p = Params::game_default();
     game(&mut p).pull_off_ratio = 0.5;

@@ -1,7 +1,7 @@
 //! Command clipping at the working envelope (paper §2.4, Fig. 1).
 
 use crate::envelope::Envelope;
-use crate::error::{EnvelopeError, Result, finite_vec};
+use crate::error::{EnvelopeError, Result, ValueError, finite_vec};
 use crate::geometry::{contains, first_crossing, nearest_on_boundary};
 use nalgebra::Vector2;
 
@@ -26,11 +26,11 @@ impl ClipMode {
         match name {
             "radial" => Ok(Self::Radial),
             "nearest" => Ok(Self::Nearest),
-            _ => Err(EnvelopeError::OutOfRange {
-                field: "mode (\"radial\" or \"nearest\")",
-                value: f64::NAN,
-                allowed: "\"radial\" | \"nearest\"",
-            }),
+            _ => Err(EnvelopeError::Value(ValueError::out_of_range(
+                "mode (\"radial\" or \"nearest\")",
+                f64::NAN,
+                "\"radial\" | \"nearest\"",
+            ))),
         }
     }
 }
@@ -54,11 +54,11 @@ pub fn clip_command(we: &Envelope, command: &V2, mode: ClipMode) -> Result<Clipp
 pub fn clip_to_polygon(poly: &[V2], free: &V2, command: &V2, mode: ClipMode) -> Result<Clipped> {
     finite_vec("command [m]", command.as_slice())?;
     if poly.len() < 3 {
-        return Err(EnvelopeError::OutOfRange {
-            field: "envelope.polygon (vertices)",
-            value: poly.len() as f64,
-            allowed: ">= 3",
-        });
+        return Err(EnvelopeError::Value(ValueError::out_of_range(
+            "envelope.polygon (vertices)",
+            poly.len() as f64,
+            ">= 3",
+        )));
     }
     if contains(poly, command) {
         return Ok(Clipped {

@@ -14,7 +14,7 @@
 //! 4. take the outer boundary of the arrangement of all image curves
 //!    ([`crate::geometry::outer_boundary`]).
 
-use crate::error::{EnvelopeError, Result, finite_vec, positive};
+use crate::error::{Result, finite_vec, positive};
 use crate::folds::{Traced, hermite_polylines, trace};
 use crate::geometry::{self, try_outer_boundary};
 use crate::region::{DEFAULT_MARGIN_WAISTS, OffsetRegion, free_drift};
@@ -28,34 +28,7 @@ type V2 = Vector2<f64>;
 /// this distance of the map's true fold image (integration error apart).
 pub const DEFAULT_TOL: f64 = 0.5e-9;
 
-/// Longest tick [`working_envelope_with`] accepts for a particle with inertia, in periods of
-/// the well's fastest small oscillation `2π / sqrt(κ_max / m)`. The map folds about once per
-/// half period, and the crossings of the folds' images grow faster than their number: at the
-/// paper's constants 4 periods (6.4 µs) take about 1 s with an accurate tick map, 6 periods
-/// (10 µs) 7 to 14 s, 12 periods (20 µs) up to a minute.
-pub const MAX_OSCILLATIONS_PER_TICK: u32 = 4;
-
-/// [`EnvelopeError::TickTooLong`] when `prop`'s tick spans more than
-/// [`MAX_OSCILLATIONS_PER_TICK`] periods of the well's fastest small oscillation (a particle
-/// without inertia does not oscillate: any tick passes).
-pub fn check_tick_length(prop: &Propagator<2>) -> Result<()> {
-    let model = prop.model();
-    let Some(m) = model.mass else {
-        return Ok(());
-    };
-    let omega = (model.well.stiffness().max() / m).sqrt();
-    let periods = MAX_OSCILLATIONS_PER_TICK;
-    let max_dt = f64::from(periods) * std::f64::consts::TAU / omega;
-    if prop.dt() > max_dt {
-        return Err(EnvelopeError::TickTooLong {
-            dt: prop.dt(),
-            max_dt,
-            periods,
-            omega,
-        });
-    }
-    Ok(())
-}
+pub use crate::tick_length::{MAX_OSCILLATIONS_PER_TICK, check_tick_length};
 
 /// Options of [`working_envelope_with`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,7 +93,7 @@ impl Envelope {
 /// The working envelope of `prop`'s tick for a particle of velocity `v0`
 /// (m/s), over the default region, to `tol` (m; `None`: [`DEFAULT_TOL`]).
 /// A tick longer than [`MAX_OSCILLATIONS_PER_TICK`] oscillation periods is refused
-/// ([`check_tick_length`]).
+/// ([`check_tick_length`], by the grid sampling).
 pub fn working_envelope(prop: &Propagator<2>, v0: &V2, tol: Option<f64>) -> Result<Envelope> {
     working_envelope_with(
         prop,
@@ -140,7 +113,6 @@ pub fn working_envelope_with(
 ) -> Result<Envelope> {
     finite_vec("velocity [m/s]", v0.as_slice())?;
     positive("tol [m]", opt.tol)?;
-    check_tick_length(prop)?;
     let region = match opt.region {
         Some(r) => r,
         None => OffsetRegion::around_drift(prop, v0, DEFAULT_MARGIN_WAISTS)?,

@@ -9,7 +9,7 @@
 //! about one axial period; otherwise [`working_envelope_3d`] returns
 //! [`EnvelopeError::NotStarShaped`].
 
-use crate::error::{EnvelopeError, Result, finite_vec, positive};
+use crate::error::{EnvelopeError, Result, ValueError, finite_vec, positive};
 use nalgebra::{Matrix3, Vector3};
 use ot_physics::Propagator;
 use std::collections::BTreeMap;
@@ -192,11 +192,11 @@ pub fn working_envelope_3d(
     let reach = positive("reach [waists]", reach)?;
     let step = positive("step [waists]", step)?;
     if level > 6 {
-        return Err(EnvelopeError::OutOfRange {
-            field: "level",
-            value: f64::from(level),
-            allowed: "0 ..= 6",
-        });
+        return Err(EnvelopeError::Value(ValueError::out_of_range(
+            "level",
+            f64::from(level),
+            "0 ..= 6",
+        )));
     }
     let w = prop.model().well.waists();
     let centre = v0 * (0.5 * prop.dt());

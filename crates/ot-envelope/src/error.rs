@@ -2,37 +2,29 @@
 
 use ot_physics::PhysicsError;
 use thiserror::Error;
+pub use world_form::ValueError;
 
 /// A bad argument to the envelope, inverse-solver, clipping or steering API.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum EnvelopeError {
-    /// A number outside its allowed range (or NaN / infinite).
-    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
-    OutOfRange {
-        /// Parameter name with its unit, e.g. `tol [m]`.
-        field: &'static str,
-        /// The rejected value.
-        value: f64,
-        /// Human-readable allowed range.
-        allowed: &'static str,
-    },
+    /// A number outside its allowed range (or NaN / infinite), the parameter named with its
+    /// unit, e.g. `tol [m]`.
+    #[error(transparent)]
+    Value(#[from] ValueError),
     /// The physics layer rejected a state or parameter.
     #[error("physics: {0}")]
     Physics(#[from] PhysicsError),
     /// The clarabel subproblem of the constrained solver failed.
     #[error("convex subproblem failed: {0}")]
     Subproblem(String),
-    /// A tick longer than [`crate::envelope::MAX_OSCILLATIONS_PER_TICK`] periods of the well's
-    /// fastest small oscillation (a particle with inertia): the map folds once more per
-    /// half period, and the envelope's boundary search grows without bound with the folds.
-    #[error(
-        "dt [s] = {dt:e} is out of range: allowed ≤ {max_dt:.4e} s, {periods} periods of the \
-         well's fastest oscillation (ω = {omega:.4e} rad/s); a longer tick folds the map so \
-         often that the envelope's boundary search grows without bound"
-    )]
+    /// A tick longer than the bound of [`crate::tick_length`]: more periods of the well's
+    /// fastest small oscillation (a particle with inertia) than allowed. The map folds once
+    /// more per half period, and the envelope's boundary search grows without bound with the
+    /// folds.
+    #[error("{error}")]
     TickTooLong {
-        /// The tick asked for (s).
-        dt: f64,
+        /// The tick refused (`dt [s]`) and its allowed range.
+        error: ValueError,
         /// The longest tick allowed for this trap (s).
         max_dt: f64,
         /// The periods of the fastest oscillation allowed in one tick.
@@ -53,11 +45,11 @@ pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(EnvelopeError::OutOfRange {
+        Err(EnvelopeError::Value(ValueError::out_of_range(
             field,
             value,
-            allowed: "finite and > 0",
-        })
+            "finite and > 0",
+        )))
     }
 }
 
@@ -65,11 +57,9 @@ pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {
 pub(crate) fn finite_vec(field: &'static str, v: &[f64]) -> Result<()> {
     for &x in v {
         if !x.is_finite() {
-            return Err(EnvelopeError::OutOfRange {
-                field,
-                value: x,
-                allowed: "finite",
-            });
+            return Err(EnvelopeError::Value(ValueError::out_of_range(
+                field, x, "finite",
+            )));
         }
     }
     Ok(())

@@ -27,7 +27,7 @@
 //! distance from converged dynamics is budgeted apart (`ot_physics::budget`).
 
 use crate::envelope::{EnvelopeOptions, working_envelope_with};
-use crate::error::{EnvelopeError, Result, positive};
+use crate::error::{EnvelopeError, Result, ValueError, positive};
 use crate::geometry::hausdorff;
 use crate::region::OffsetRegion;
 use nalgebra::Vector2;
@@ -191,11 +191,11 @@ pub fn ladder_errors(
 pub fn choose_grid(prop: &Propagator<2>, tol: f64, v_max: f64) -> Result<GridChoice> {
     let tol = positive("tol [m]", tol)?;
     if !(v_max.is_finite() && v_max >= 0.0) {
-        return Err(EnvelopeError::OutOfRange {
-            field: "v_max [m/s]",
-            value: v_max,
-            allowed: "finite and ≥ 0",
-        });
+        return Err(EnvelopeError::Value(ValueError::out_of_range(
+            "v_max [m/s]",
+            v_max,
+            "finite and ≥ 0",
+        )));
     }
     let key = cache_key(prop, tol, v_max);
     if let Some(g) = CHOICES

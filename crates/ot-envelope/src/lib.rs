@@ -65,6 +65,7 @@ pub mod sample;
 pub mod spread;
 pub mod steer;
 pub mod tick;
+pub mod tick_length;
 pub mod world;
 
 pub use bounded::{Bounded, SteeringRange};

@@ -1,7 +1,7 @@
 //! The bounded region of trap offsets searched by the solver and the
 //! envelope, and the free drift of the particle that positions it.
 
-use crate::error::{EnvelopeError, Result, finite_vec, positive};
+use crate::error::{EnvelopeError, Result, ValueError, finite_vec, positive};
 use nalgebra::Vector2;
 use ot_physics::{Propagator, TrapModel};
 
@@ -26,11 +26,11 @@ impl OffsetRegion {
         finite_vec("region.hi [m]", hi.as_slice())?;
         for i in 0..2 {
             if hi[i] <= lo[i] {
-                return Err(EnvelopeError::OutOfRange {
-                    field: "region.hi - region.lo [m]",
-                    value: hi[i] - lo[i],
-                    allowed: "> 0 on each axis",
-                });
+                return Err(EnvelopeError::Value(ValueError::out_of_range(
+                    "region.hi - region.lo [m]",
+                    hi[i] - lo[i],
+                    "> 0 on each axis",
+                )));
             }
         }
         Ok(Self { lo, hi })

@@ -2,7 +2,7 @@
 //! and its determinant at every vertex. Built once per (propagator,
 //! velocity); the envelope and the inverse solver both read it.
 
-use crate::error::{EnvelopeError, Result, finite_vec, positive};
+use crate::error::{EnvelopeError, Result, ValueError, finite_vec, positive};
 use crate::region::OffsetRegion;
 use nalgebra::{Matrix2, Vector2};
 use ot_physics::{OffsetFlow, Propagator};
@@ -177,7 +177,9 @@ pub(crate) struct MapJob {
 }
 
 impl MapJob {
-    /// Validates the settings and lays out the grid; samples nothing yet.
+    /// Validates the settings (the tick within [`crate::tick_length::check_tick_length`]:
+    /// every sampling of the map, so every envelope, inverse solve and steering step, is
+    /// bounded there) and lays out the grid; samples nothing yet.
     pub(crate) fn new(
         prop: &Propagator<2>,
         coarse: Option<Propagator<2>>,
@@ -185,6 +187,7 @@ impl MapJob {
         region: &OffsetRegion,
         cell_waists: Option<f64>,
     ) -> Result<Self> {
+        crate::tick_length::check_tick_length(prop)?;
         finite_vec("velocity [m/s]", v0.as_slice())?;
         let model = prop.model();
         let s = match cell_waists {
@@ -198,21 +201,21 @@ impl MapJob {
         for i in 0..2 {
             let cells = (ext[i] / (s * w[i])).ceil().max(1.0);
             if cells.is_nan() || cells >= MAX_VERTICES as f64 {
-                return Err(EnvelopeError::OutOfRange {
-                    field: "cell_waists [waists]",
-                    value: s,
-                    allowed: "large enough for at most 4e6 grid vertices",
-                });
+                return Err(EnvelopeError::Value(ValueError::out_of_range(
+                    "cell_waists [waists]",
+                    s,
+                    "large enough for at most 4e6 grid vertices",
+                )));
             }
             n[i] = cells as usize + 1;
             h[i] = ext[i] / cells;
         }
         if n[0] * n[1] > MAX_VERTICES {
-            return Err(EnvelopeError::OutOfRange {
-                field: "cell_waists [waists]",
-                value: s,
-                allowed: "large enough for at most 4e6 grid vertices",
-            });
+            return Err(EnvelopeError::Value(ValueError::out_of_range(
+                "cell_waists [waists]",
+                s,
+                "large enough for at most 4e6 grid vertices",
+            )));
         }
         Ok(Self {
             map: SampledMap {

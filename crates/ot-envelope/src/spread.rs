@@ -34,7 +34,7 @@
 //! ```
 
 use crate::envelope::{Envelope, envelope_from_traced};
-use crate::error::{EnvelopeError, Result, finite_vec, positive};
+use crate::error::{EnvelopeError, Result, ValueError, finite_vec, positive};
 use crate::folds::{TraceJob, Traced};
 use crate::region::OffsetRegion;
 use crate::sample::{MapJob, SampledMap, Slice, coarse_companion};
@@ -138,11 +138,11 @@ impl EnvelopeBuild {
     /// is refused (it would never finish).
     pub fn advance(&mut self, prop: &Propagator<2>, budget: Option<u64>) -> Result<SliceReport> {
         if budget == Some(0) {
-            return Err(EnvelopeError::OutOfRange {
-                field: "budget [force evaluations]",
-                value: 0.0,
-                allowed: "≥ 1",
-            });
+            return Err(EnvelopeError::Value(ValueError::out_of_range(
+                "budget [force evaluations]",
+                0.0,
+                "≥ 1",
+            )));
         }
         let mut slice = budget.map_or_else(Slice::unlimited, Slice::new);
         let mut geometry = false;

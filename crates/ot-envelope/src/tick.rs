@@ -103,28 +103,34 @@ impl TickParams {
         positive("verify_tol [m]", self.verify_tol)?;
         positive("spread_dv [m/s]", self.spread_dv)?;
         if self.spread_dv > self.warm_dv {
-            return Err(crate::error::EnvelopeError::OutOfRange {
-                field: "spread_dv [m/s]",
-                value: self.spread_dv,
-                allowed: "≤ warm_dv",
-            });
+            return Err(crate::error::EnvelopeError::Value(
+                crate::error::ValueError::out_of_range(
+                    "spread_dv [m/s]",
+                    self.spread_dv,
+                    "≤ warm_dv",
+                ),
+            ));
         }
         if self.build_evals_per_tick == Some(0) {
-            return Err(crate::error::EnvelopeError::OutOfRange {
-                field: "build_evals_per_tick",
-                value: 0.0,
-                allowed: "≥ 1 (or none: no spread build)",
-            });
+            return Err(crate::error::EnvelopeError::Value(
+                crate::error::ValueError::out_of_range(
+                    "build_evals_per_tick",
+                    0.0,
+                    "≥ 1 (or none: no spread build)",
+                ),
+            ));
         }
         if let Some(c) = self.cell_waists {
             positive("cell_waists [waists]", c)?;
         }
         if !(1..=64).contains(&self.verify_points) {
-            return Err(crate::error::EnvelopeError::OutOfRange {
-                field: "verify_points",
-                value: self.verify_points as f64,
-                allowed: "1 ..= 64",
-            });
+            return Err(crate::error::EnvelopeError::Value(
+                crate::error::ValueError::out_of_range(
+                    "verify_points",
+                    self.verify_points as f64,
+                    "1 ..= 64",
+                ),
+            ));
         }
         Ok(())
     }

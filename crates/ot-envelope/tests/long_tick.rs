@@ -78,3 +78,32 @@ fn a_tangle_of_fold_images_is_refused_before_its_crossing_search() {
         }
     }
 }
+
+/// The inverse solve refuses the tick the working envelope refuses, by the same bound and
+/// before any work: `nh.solve_trap(nh.paper_trap(), [-0.288, -0.070], 9.97e-5,
+/// [-3.6e-144, -2.3e-274])` ran for more than 20 s (the wheel's default tick map at that Δt:
+/// ⌈ω·Δt / 0.5⌉ = 783 RK4 substeps).
+#[test]
+fn the_inverse_solve_refuses_a_tick_of_many_oscillations_quickly() {
+    let model = ot_physics::paper::model().expect("paper model");
+    let prop = Propagator::new(model, Method::Rk4 { substeps: 783 }, 9.97e-5).expect("tick map");
+    let started = std::time::Instant::now();
+    let e = ot_envelope::solve_trap(
+        &prop,
+        &Vector2::new(-0.288, -0.070),
+        &Vector2::new(-3.6e-144, -2.3e-274),
+    )
+    .expect_err("a 99.7 µs tick holds about 62 oscillations");
+    let took = started.elapsed();
+    assert!(
+        matches!(e, EnvelopeError::TickTooLong { .. }),
+        "expected TickTooLong, got {e}"
+    );
+    assert!(
+        e.to_string()
+            .starts_with("dt [s] = 9.97e-5 is out of range: allowed ≤ 6.4037e-6 s, 4 periods"),
+        "{e}"
+    );
+    // Refused before sampling the map (a bound on work, not a timing target: seconds apart).
+    assert!(took.as_secs_f64() < 2.0, "took {took:?}");
+}

@@ -275,7 +275,7 @@ fn the_world_builds_the_first_envelope_before_the_grab() {
     assert_eq!(
         World::new(&bad, &limits).err().unwrap().to_string(),
         "`envelope_build_evals_per_tick` = 0 is out of range: allowed 1 ≤ \
-         envelope_build_evals_per_tick ≤ 1000000"
+         envelope_build_evals_per_tick ≤ 1e6"
     );
 }
 

@@ -66,7 +66,7 @@ fn bad_clip_input_is_a_typed_error() {
     );
     assert!(matches!(
         ClipMode::from_name("sideways"),
-        Err(EnvelopeError::OutOfRange { .. })
+        Err(EnvelopeError::Value(_))
     ));
     assert_eq!(
         ClipMode::from_name("nearest").expect("mode"),

@@ -11,7 +11,7 @@
 //! within half the tolerance (a safety factor of 2 for the space between
 //! probes).
 
-use crate::error::{PhysicsError, Result, positive};
+use crate::error::{PhysicsError, Result, ValueError, positive};
 use crate::integrate::{Method, Propagator};
 use crate::model::TrapModel;
 use nalgebra::Vector2;
@@ -130,11 +130,11 @@ fn probes(model: &TrapModel<2>, dt: f64, v_max: f64) -> Vec<(Vector2<f64>, Vecto
 /// `tol_m` = the measured error (a map fixed by hand has no budget).
 pub fn measure(model: TrapModel<2>, method: Method, dt: f64, v_max: f64) -> Result<MapChoice> {
     if !(v_max.is_finite() && v_max >= 0.0) {
-        return Err(PhysicsError::OutOfRange {
-            field: "v_max [m/s]",
-            value: v_max,
-            allowed: "finite and >= 0",
-        });
+        return Err(PhysicsError::Value(ValueError::out_of_range(
+            "v_max [m/s]",
+            v_max,
+            "finite and >= 0",
+        )));
     }
     let reference = converged(model, dt)?;
     let p = Propagator::new(model, method, dt)?;
@@ -171,11 +171,11 @@ pub fn choose_tick_map(
 ) -> Result<(Propagator<2>, MapChoice)> {
     let tol_m = positive("tick map tolerance [m]", tol_m)?;
     if !(v_max.is_finite() && v_max >= 0.0) {
-        return Err(PhysicsError::OutOfRange {
-            field: "v_max [m/s]",
-            value: v_max,
-            allowed: "finite and >= 0",
-        });
+        return Err(PhysicsError::Value(ValueError::out_of_range(
+            "v_max [m/s]",
+            v_max,
+            "finite and >= 0",
+        )));
     }
     let reference = converged(model, dt)?;
     let probes = probes(&model, dt, v_max);
@@ -204,9 +204,9 @@ pub fn choose_tick_map(
             },
         ));
     }
-    Err(PhysicsError::OutOfRange {
-        field: "tick map tolerance [m]",
-        value: tol_m,
-        allowed: "reachable by RK4 or RK8 with at most 512 substeps for this model and dt",
-    })
+    Err(PhysicsError::Value(ValueError::out_of_range(
+        "tick map tolerance [m]",
+        tol_m,
+        "reachable by RK4 or RK8 with at most 512 substeps for this model and dt",
+    )))
 }

@@ -1,6 +1,7 @@
 //! Typed errors for every parameter the crate accepts.
 
 use thiserror::Error;
+pub use world_form::ValueError;
 
 /// A bad parameter or an unsupported combination of effects and method.
 ///
@@ -9,16 +10,10 @@ use thiserror::Error;
 /// can show the message unchanged.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PhysicsError {
-    /// A number lies outside its allowed range (or is NaN / infinite).
-    #[error("{field} = {} is out of range: allowed {allowed}", world_form::numbers::fmt_num(*value))]
-    OutOfRange {
-        /// Name of the parameter, with its unit (e.g. `waist_x [m]`).
-        field: &'static str,
-        /// The rejected value.
-        value: f64,
-        /// Human-readable allowed range, e.g. `finite and > 0`.
-        allowed: &'static str,
-    },
+    /// A number lies outside its allowed range (or is NaN / infinite); the field is named
+    /// with its unit (e.g. `waist_x [m]`).
+    #[error(transparent)]
+    Value(#[from] ValueError),
     /// An effect was switched on without a parameter it needs.
     #[error("{field} is required by {needed_by}")]
     Missing {
@@ -66,11 +61,11 @@ pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(PhysicsError::OutOfRange {
+        Err(PhysicsError::Value(ValueError::out_of_range(
             field,
             value,
-            allowed: "finite and > 0",
-        })
+            "finite and > 0",
+        )))
     }
 }
 
@@ -79,10 +74,8 @@ pub(crate) fn finite(field: &'static str, value: f64) -> Result<f64> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(PhysicsError::OutOfRange {
-            field,
-            value,
-            allowed: "finite",
-        })
+        Err(PhysicsError::Value(ValueError::out_of_range(
+            field, value, "finite",
+        )))
     }
 }

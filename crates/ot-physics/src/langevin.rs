@@ -17,7 +17,7 @@
 //! Random numbers: ChaCha8 seeded from a `u64`, standard normals from
 //! `rand_distr` — the same seed gives the same bits on every run.
 
-use crate::error::{PhysicsError, Result, positive};
+use crate::error::{PhysicsError, Result, ValueError, positive};
 use crate::model::TrapModel;
 use crate::state::Phase;
 use nalgebra::{DMatrix, Matrix2, Matrix3, SMatrix, SVector, SymmetricEigen};
@@ -76,19 +76,19 @@ pub fn simulate<const D: usize>(
     let duration = positive("duration [s]", run.duration)?;
     let fs = positive("sample_rate [Hz]", run.sample_rate)?;
     if run.substeps == 0 || run.substeps > 1_000_000 {
-        return Err(PhysicsError::OutOfRange {
-            field: "substeps",
-            value: f64::from(run.substeps),
-            allowed: "1 ..= 1000000",
-        });
+        return Err(PhysicsError::Value(ValueError::out_of_range(
+            "substeps",
+            f64::from(run.substeps),
+            "1 ..= 1000000",
+        )));
     }
     let n_samples = (duration * fs).round();
     if !(1.0..=1e9).contains(&n_samples) {
-        return Err(PhysicsError::OutOfRange {
-            field: "duration [s] × sample_rate [Hz]",
-            value: n_samples,
-            allowed: "1 ..= 1e9 samples",
-        });
+        return Err(PhysicsError::Value(ValueError::out_of_range(
+            "duration [s] × sample_rate [Hz]",
+            n_samples,
+            "1 ..= 1e9 samples",
+        )));
     }
     let (Some(kt), Some(gamma)) = (model.kt, model.drag) else {
         return Err(PhysicsError::Missing {

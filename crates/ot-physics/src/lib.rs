@@ -52,7 +52,7 @@ pub mod state;
 pub mod well;
 
 pub use budget::{MapChoice, choose_tick_map};
-pub use error::{PhysicsError, Result};
+pub use error::{PhysicsError, Result, ValueError};
 pub use flow::{Flow, OffsetFlow};
 pub use integrate::{Composition, DEFAULT_RTOL, DEFAULT_TOL_M, Method, Propagator};
 pub use model::{BOLTZMANN, TrapBuilder, TrapModel};

@@ -437,7 +437,7 @@ fn method_and_interval_errors_are_typed() {
         "substeps = 0 is out of range: allowed 1 ..= 10000000"
     );
     let e = Method::from_name("adaptive", Some(f64::NAN), None).unwrap_err();
-    assert!(matches!(e, PhysicsError::OutOfRange { field: "rtol", .. }));
+    assert!(matches!(e, PhysicsError::Value(ref v) if v.field() == "rtol"));
     let damped = TrapModel::builder(DEPTH, WAISTS)
         .mass(MASS)
         .stokes_drag(0.5e-6, 1e-3)

@@ -159,10 +159,7 @@ fn thermal_run_errors_are_typed() {
     cfg.substeps = 0;
     assert!(matches!(
         simulate(&model, start, &cfg).unwrap_err(),
-        PhysicsError::OutOfRange {
-            field: "substeps",
-            ..
-        }
+        PhysicsError::Value(ref v) if v.field() == "substeps"
     ));
     let cold = TrapModel::builder(1e-15, [1e-6, 1e-6])
         .stokes_drag(RADIUS, ETA)

@@ -83,10 +83,7 @@ fn bad_parameters_give_typed_errors_naming_the_field() {
         let e = Well2::new(DEPTH, [600e-9, v]).unwrap_err();
         assert!(matches!(
             e,
-            PhysicsError::OutOfRange {
-                field: "waist_y [m]",
-                ..
-            }
+            PhysicsError::Value(ref v) if v.field() == "waist_y [m]"
         ));
         let e = TrapModel::builder(DEPTH, WAISTS)
             .mass(v)
@@ -94,10 +91,7 @@ fn bad_parameters_give_typed_errors_naming_the_field() {
             .unwrap_err();
         assert!(matches!(
             e,
-            PhysicsError::OutOfRange {
-                field: "mass [kg]",
-                ..
-            }
+            PhysicsError::Value(ref v) if v.field() == "mass [kg]"
         ));
         let e = TrapModel::builder(DEPTH, WAISTS)
             .mass(MASS)
@@ -106,10 +100,7 @@ fn bad_parameters_give_typed_errors_naming_the_field() {
             .unwrap_err();
         assert!(matches!(
             e,
-            PhysicsError::OutOfRange {
-                field: "radius [m]",
-                ..
-            }
+            PhysicsError::Value(ref v) if v.field() == "radius [m]"
         ));
         let e = TrapModel::builder(DEPTH, WAISTS)
             .mass(MASS)
@@ -118,10 +109,7 @@ fn bad_parameters_give_typed_errors_naming_the_field() {
             .unwrap_err();
         assert!(matches!(
             e,
-            PhysicsError::OutOfRange {
-                field: "viscosity [Pa s]",
-                ..
-            }
+            PhysicsError::Value(ref v) if v.field() == "viscosity [Pa s]"
         ));
         let e = TrapModel::builder(DEPTH, WAISTS)
             .mass(MASS)
@@ -131,10 +119,7 @@ fn bad_parameters_give_typed_errors_naming_the_field() {
             .unwrap_err();
         assert!(matches!(
             e,
-            PhysicsError::OutOfRange {
-                field: "temperature [K]",
-                ..
-            }
+            PhysicsError::Value(ref v) if v.field() == "temperature [K]"
         ));
     }
     let e = Well3::new(DEPTH, [1e-6, 1e-6, -2e-6]).unwrap_err();

@@ -174,8 +174,9 @@ fn displacement_d<const D: usize>(
         .map_err(value_error)?;
     if let Some(i) = out.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
         return Err(PyValueError::new_err(format!(
-            "displacement[{i}] is not finite: dt = {dt:e} s is beyond what the integrator \
-             can follow for this model (use a shorter dt)"
+            "displacement[{i}] is not finite: dt = {} s is beyond what the integrator \
+             can follow for this model (use a shorter dt)",
+            world_form::numbers::fmt_num(dt)
         )));
     }
     Ok(array2(py, &out)?.unbind())

@@ -198,18 +198,18 @@ pub fn synthesize(
     sample_rate_hz: u32,
 ) -> Result<Vec<f32>, RenderError> {
     if !(8_000..=192_000).contains(&sample_rate_hz) {
-        return Err(RenderError::OutOfRange {
-            field: "sample_rate_hz".into(),
-            value: f64::from(sample_rate_hz),
-            allowed: "8000–192000 Hz",
-        });
+        return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+            "sample_rate_hz",
+            f64::from(sample_rate_hz),
+            "8000–192000 Hz",
+        )));
     }
     if !(duration_s.is_finite() && (0.0..=3600.0).contains(&duration_s)) {
-        return Err(RenderError::OutOfRange {
-            field: "duration_s".into(),
-            value: duration_s,
-            allowed: "0–3600 s",
-        });
+        return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+            "duration_s",
+            duration_s,
+            "0–3600 s",
+        )));
     }
     let sr = f64::from(sample_rate_hz);
     let n = (duration_s * sr).round() as usize;
@@ -328,18 +328,18 @@ impl StreamSynth {
         proximity_on_distance_m: Option<f64>,
     ) -> Result<Self, RenderError> {
         if !(8_000..=192_000).contains(&sample_rate_hz) {
-            return Err(RenderError::OutOfRange {
-                field: "sample_rate_hz".into(),
-                value: f64::from(sample_rate_hz),
-                allowed: "8000–192000 Hz",
-            });
+            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "sample_rate_hz",
+                f64::from(sample_rate_hz),
+                "8000–192000 Hz",
+            )));
         }
         if !(dt_s.is_finite() && dt_s > 0.0 && dt_s <= 1.0) {
-            return Err(RenderError::OutOfRange {
-                field: "dt_s".into(),
-                value: dt_s,
-                allowed: "0 < dt_s ≤ 1 s",
-            });
+            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "dt_s",
+                dt_s,
+                "0 < dt_s ≤ 1 s",
+            )));
         }
         Ok(StreamSynth {
             sr: f64::from(sample_rate_hz),

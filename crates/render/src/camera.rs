@@ -69,11 +69,11 @@ impl View {
             finite(|| "view.elevation_rad".into(), elevation_rad)?;
             let lim = std::f64::consts::FRAC_PI_2;
             if elevation_rad.abs() >= lim {
-                return Err(RenderError::OutOfRange {
-                    field: "view.elevation_rad".into(),
-                    value: elevation_rad,
-                    allowed: "(-pi/2, pi/2) rad; use View::Top for straight down",
-                });
+                return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                    "view.elevation_rad",
+                    elevation_rad,
+                    "(-pi/2, pi/2) rad; use View::Top for straight down",
+                )));
             }
         }
         Ok(())
@@ -231,11 +231,11 @@ impl Camera {
         finite3("camera.center_m", center_m)?;
         finite(|| "camera.pixels_per_m".into(), pixels_per_m)?;
         if pixels_per_m <= 0.0 {
-            return Err(RenderError::OutOfRange {
-                field: "camera.pixels_per_m".into(),
-                value: pixels_per_m,
-                allowed: "(0, inf) px/m",
-            });
+            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "camera.pixels_per_m",
+                pixels_per_m,
+                "(0, inf) px/m",
+            )));
         }
         check_size(width_px, height_px)?;
         let (right, up, forward) = view.basis();
@@ -266,19 +266,19 @@ impl Camera {
         finite3("fit.max_m", max_m)?;
         finite(|| "fit.margin".into(), margin)?;
         if !(0.0..=0.45).contains(&margin) {
-            return Err(RenderError::OutOfRange {
-                field: "fit.margin".into(),
-                value: margin,
-                allowed: "[0, 0.45] (fraction of each side)",
-            });
+            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "fit.margin",
+                margin,
+                "[0, 0.45] (fraction of each side)",
+            )));
         }
         for i in 0..3 {
             if max_m[i] < min_m[i] {
-                return Err(RenderError::OutOfRange {
-                    field: format!("fit.max_m[{i}]"),
-                    value: max_m[i],
-                    allowed: "[fit.min_m, inf) m",
-                });
+                return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                    format!("fit.max_m[{i}]"),
+                    max_m[i],
+                    "[fit.min_m, inf) m",
+                )));
             }
         }
         check_size(width_px, height_px)?;
@@ -313,11 +313,11 @@ impl Camera {
         };
         let s = sx.min(sy);
         if !s.is_finite() {
-            return Err(RenderError::OutOfRange {
-                field: "fit.max_m - fit.min_m".into(),
-                value: 0.0,
-                allowed: "a box with non-zero extent on the image plane",
-            });
+            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "fit.max_m - fit.min_m",
+                0.0,
+                "a box with non-zero extent on the image plane",
+            )));
         }
         Camera::new(view, center, s, width_px, height_px)
     }
@@ -332,11 +332,12 @@ impl Camera {
         height_px: u32,
         margin: f64,
     ) -> Result<Camera, RenderError> {
-        let (lo, hi) = bounds(prims).ok_or(RenderError::OutOfRange {
-            field: "fit.primitives".into(),
-            value: 0.0,
-            allowed: "at least one primitive with a position",
-        })?;
+        let (lo, hi) =
+            bounds(prims).ok_or(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "fit.primitives",
+                0.0,
+                "at least one primitive with a position",
+            )))?;
         Camera::fit(view, lo, hi, width_px, height_px, margin)
     }
 
@@ -517,7 +518,7 @@ mod tests {
         let e = Camera::new(View::Top, [0.0; 3], 1.0, 0, 10).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "image size 0x10 px is out of range: allowed 1..=8192 px per side"
+            "image size = 0x10 px is out of range: allowed 1..=8192 px per side"
         );
         let v = View::Oblique {
             azimuth_rad: 0.0,

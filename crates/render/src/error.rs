@@ -7,24 +7,9 @@ use thiserror::Error;
 /// Every variant names the offending field and, where there is one, the allowed range.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum RenderError {
-    /// A number is NaN or infinite.
-    #[error("{field} must be finite, got {value}")]
-    NotFinite {
-        /// Dotted name of the field, e.g. `sphere.center_m[1]`.
-        field: String,
-        /// The value given.
-        value: f64,
-    },
-    /// A number lies outside its allowed range.
-    #[error("{field} = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        /// Dotted name of the field.
-        field: String,
-        /// The value given.
-        value: f64,
-        /// The allowed range, written out, e.g. `(0, 50] frames/s`.
-        allowed: &'static str,
-    },
+    /// A number that is NaN, infinite or outside its allowed range.
+    #[error(transparent)]
+    Value(#[from] haptic_types::ValueError),
     /// A name that is not one of the allowed ones.
     #[error("{field} = {got:?} is not known: allowed {allowed}")]
     UnknownName {
@@ -36,7 +21,11 @@ pub enum RenderError {
         allowed: &'static str,
     },
     /// An image size the renderer cannot make.
-    #[error("image size {width_px}x{height_px} px is out of range: allowed 1..={max} px per side")]
+    #[error("{}", haptic_types::value::out_of_range(
+        "image size",
+        format_args!("{width_px}x{height_px} px"),
+        &format!("1..={max} px per side"),
+    ))]
     ImageSize {
         /// Width asked for, px.
         width_px: u32,
@@ -77,25 +66,6 @@ pub enum RenderError {
         /// What went wrong.
         message: String,
     },
-}
-
-impl From<haptic_types::ValueError> for RenderError {
-    fn from(e: haptic_types::ValueError) -> Self {
-        match e {
-            haptic_types::ValueError::NotFinite { field, value } => {
-                RenderError::NotFinite { field, value }
-            }
-            haptic_types::ValueError::OutOfRange {
-                field,
-                value,
-                allowed,
-            } => RenderError::OutOfRange {
-                field,
-                value,
-                allowed,
-            },
-        }
-    }
 }
 
 /// Checks that `value` is finite.

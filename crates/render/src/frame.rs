@@ -44,11 +44,11 @@ impl Style {
         let pos = |field: &str, v: f32, max: f32| -> Result<(), RenderError> {
             finite(|| field.to_string(), f64::from(v))?;
             if !(v > 0.0 && v <= max) {
-                return Err(RenderError::OutOfRange {
-                    field: field.to_string(),
-                    value: f64::from(v),
-                    allowed: "(0, 200] px",
-                });
+                return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                    field.to_string(),
+                    f64::from(v),
+                    "(0, 200] px",
+                )));
             }
             Ok(())
         };
@@ -57,11 +57,11 @@ impl Style {
         pos("style.arrow_head_px", self.arrow_head_px, 200.0)?;
         finite(|| "style.ambient".into(), self.ambient)?;
         if !(0.0..=1.0).contains(&self.ambient) {
-            return Err(RenderError::OutOfRange {
-                field: "style.ambient".into(),
-                value: self.ambient,
-                allowed: "[0, 1]",
-            });
+            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "style.ambient",
+                self.ambient,
+                "[0, 1]",
+            )));
         }
         Ok(())
     }
@@ -180,11 +180,11 @@ impl Frame {
         finite3("scaled_loop.about_m", about_m)?;
         finite(|| "scaled_loop.factor".into(), factor)?;
         if factor <= 0.0 {
-            return Err(RenderError::OutOfRange {
-                field: "scaled_loop.factor".into(),
-                value: factor,
-                allowed: "(0, inf)",
-            });
+            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                "scaled_loop.factor",
+                factor,
+                "(0, inf)",
+            )));
         }
         let points_m = points_m
             .iter()
@@ -206,11 +206,11 @@ impl Frame {
             Some(l) => {
                 finite(|| "scale_bar.length_m".into(), l)?;
                 if l <= 0.0 {
-                    return Err(RenderError::OutOfRange {
-                        field: "scale_bar.length_m".into(),
-                        value: l,
-                        allowed: "(0, inf) m",
-                    });
+                    return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                        "scale_bar.length_m",
+                        l,
+                        "(0, inf) m",
+                    )));
                 }
                 l
             }

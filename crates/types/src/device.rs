@@ -6,9 +6,10 @@
 //! button bitmask, and accepts a force command (N, device frame). What a real device can render
 //! is described by its [`DeviceSpecs`].
 
+use crate::value::{ValueError, out_of_range};
 use crate::vec3::Vec3;
 use serde::{Deserialize, Serialize};
-use world_form::Limits;
+use world_form::{Limits, fmt_num};
 
 use std::borrow::Cow;
 
@@ -117,16 +118,11 @@ impl DeviceSpecs {
             if v.is_finite() && v >= lo && v <= hi {
                 Ok(())
             } else {
-                let value = if v != 0.0 && v.is_finite() && !(1e-4..1e9).contains(&v.abs()) {
-                    format!("{v:e}")
-                } else {
-                    format!("{v}")
-                };
-                Err(DeviceError::BadSpec {
-                    field,
-                    value,
-                    allowed: format!("{lo} ≤ {field} ≤ {hi}"),
-                })
+                Err(DeviceError::Spec(ValueError::out_of_range(
+                    format!("`{field}`"),
+                    v,
+                    format!("{} ≤ {field} ≤ {}", fmt_num(lo), fmt_num(hi)),
+                )))
             }
         };
         range("max_force_n", self.limits.max_force_n, 1e-3, 1e3)?;
@@ -292,8 +288,11 @@ pub enum DeviceError {
     /// A replay device ran past the end of its recording.
     #[error("the recording has no device input for tick {0}")]
     EndOfRecording(u64),
-    /// Specifications announced by a device out of range.
-    #[error("device specs: `{field}` = {value} is out of range: allowed {allowed}")]
+    /// A number in the specifications announced by a device out of range.
+    #[error("device specs: {0}")]
+    Spec(ValueError),
+    /// A name or a count in the specifications announced by a device out of range.
+    #[error("device specs: {}", out_of_range(&format!("`{field}`"), value, allowed))]
     BadSpec {
         /// Field name.
         field: &'static str,

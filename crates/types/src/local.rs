@@ -25,7 +25,9 @@
 //! assert!((f[2] - 2.0).abs() < 1e-12);
 //! ```
 
+use crate::value::ValueError;
 use crate::vec3::{self, Vec3};
+use world_form::fmt_num;
 
 /// Most planes one answer carries.
 pub const MAX_PLANES: usize = 4;
@@ -240,25 +242,20 @@ impl LocalModel {
         check_planes("plane", &self.planes)?;
         for (i, p) in self.planes.iter().enumerate() {
             if !(0.0..=max_stiffness_n_per_m).contains(&p.stiffness_n_per_m) {
-                return Err(format!(
-                    "plane {i}: stiffness {} N/m is out of range: allowed 0 ≤ k ≤ {} N/m",
-                    p.stiffness_n_per_m, max_stiffness_n_per_m
+                return Err(range(
+                    format!("plane[{i}].stiffness_n_per_m"),
+                    p.stiffness_n_per_m,
+                    format!("0 ≤ k ≤ {} N/m", fmt_num(max_stiffness_n_per_m)),
                 ));
             }
         }
         check_planes("body plane", &self.body_planes)?;
         if let Some(b) = &self.body {
             if !(0.0..=1.0).contains(&b.restitution) {
-                return Err(format!(
-                    "body restitution {} is out of range: allowed 0 ≤ e ≤ 1",
-                    b.restitution
-                ));
+                return Err(range("body.restitution", b.restitution, "0 ≤ e ≤ 1"));
             }
             if !(1..=64).contains(&b.substeps) {
-                return Err(format!(
-                    "body substeps {} is out of range: allowed 1 ≤ n ≤ 64",
-                    b.substeps
-                ));
+                return Err(range("body.substeps", f64::from(b.substeps), "1 ≤ n ≤ 64"));
             }
             if !finite(&b.position_m)
                 || !finite(&b.velocity_m_per_s)
@@ -268,30 +265,45 @@ impl LocalModel {
                 return Err("the body's state or force is not finite".into());
             }
             if !(b.mass_kg > 0.0 && b.mass_kg <= 1e4) {
-                return Err(format!(
-                    "body mass {} kg is out of range: allowed 0 < m ≤ 10000 kg",
-                    b.mass_kg
-                ));
+                return Err(range("body.mass_kg", b.mass_kg, "0 < m ≤ 10000 kg"));
             }
             if !(0.0..=max_stiffness_n_per_m)
                 .contains(&(b.stiffness_n_per_m + b.series_stiffness_n_per_m))
                 || b.stiffness_n_per_m < 0.0
                 || b.series_stiffness_n_per_m < 0.0
             {
-                return Err(format!(
-                    "body stiffness {} + {} N/m is out of range: allowed 0 ≤ k + k_s ≤ {} N/m",
-                    b.stiffness_n_per_m, b.series_stiffness_n_per_m, max_stiffness_n_per_m
+                return Err(range(
+                    format!(
+                        "body.stiffness_n_per_m + body.series_stiffness_n_per_m ({} + {} N/m)",
+                        fmt_num(b.stiffness_n_per_m),
+                        fmt_num(b.series_stiffness_n_per_m)
+                    ),
+                    b.stiffness_n_per_m + b.series_stiffness_n_per_m,
+                    format!(
+                        "0 ≤ k + k_s ≤ {} N/m, each ≥ 0",
+                        fmt_num(max_stiffness_n_per_m)
+                    ),
                 ));
             }
             if !(0.0..=1e4).contains(&b.damping_n_s_per_m) {
-                return Err(format!(
-                    "body damping {} N·s/m is out of range: allowed 0 ≤ b ≤ 10000 N·s/m",
-                    b.damping_n_s_per_m
+                return Err(range(
+                    "body.damping_n_s_per_m",
+                    b.damping_n_s_per_m,
+                    "0 ≤ b ≤ 10000 N·s/m",
                 ));
             }
         }
         Ok(())
     }
+}
+
+/// The message of a local-model number out of range (the one wording, [`ValueError`]).
+fn range(
+    field: impl Into<std::borrow::Cow<'static, str>>,
+    value: f64,
+    allowed: impl Into<std::borrow::Cow<'static, str>>,
+) -> String {
+    ValueError::out_of_range(field, value, allowed).to_string()
 }
 
 /// At most [`MAX_PLANES`] planes (`what`: how errors name them), each with a finite unit

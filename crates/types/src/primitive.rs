@@ -50,11 +50,11 @@ impl Rgba {
         for (i, c) in self.0.iter().enumerate() {
             finite(|| format!("{field}[{i}]"), *c)?;
             if !(0.0..=1.0).contains(c) {
-                return Err(ValueError::OutOfRange {
-                    field: format!("{field}[{i}]"),
-                    value: *c,
-                    allowed: "[0, 1]",
-                });
+                return Err(ValueError::out_of_range(
+                    format!("{field}[{i}]"),
+                    *c,
+                    "[0, 1]",
+                ));
             }
         }
         Ok(())
@@ -148,15 +148,15 @@ pub enum Primitive {
 fn positive(field: &str, v: f64, allow_zero: bool) -> Result<(), ValueError> {
     finite(|| field.to_string(), v)?;
     if v < 0.0 || (!allow_zero && v == 0.0) {
-        return Err(ValueError::OutOfRange {
-            field: field.to_string(),
-            value: v,
-            allowed: if allow_zero {
+        return Err(ValueError::out_of_range(
+            field.to_string(),
+            v,
+            if allow_zero {
                 "[0, inf) m"
             } else {
                 "(0, inf) m"
             },
-        });
+        ));
     }
     Ok(())
 }
@@ -167,11 +167,11 @@ fn quaternion(field: &str, q: [f64; 4]) -> Result<(), ValueError> {
     }
     let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
     if !(0.5..=2.0).contains(&n) {
-        return Err(ValueError::OutOfRange {
-            field: format!("{field} (norm)"),
-            value: n,
-            allowed: "[0.5, 2] (a unit quaternion [x, y, z, w], normalised when drawn)",
-        });
+        return Err(ValueError::out_of_range(
+            format!("{field} (norm)"),
+            n,
+            "[0.5, 2] (a unit quaternion [x, y, z, w], normalised when drawn)",
+        ));
     }
     Ok(())
 }

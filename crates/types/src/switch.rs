@@ -106,18 +106,11 @@ pub enum SwitchError {
         /// The names it has, comma-separated (`none` when it has none).
         allowed: String,
     },
-    /// A value outside the switch's range.
-    #[error("switch `{name}` = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        /// The switch.
-        name: String,
-        /// The value given.
-        value: f64,
-        /// The allowed range in words.
-        allowed: String,
-    },
+    /// A value outside the switch's range (its field is `` switch `name` ``).
+    #[error(transparent)]
+    OutOfRange(crate::ValueError),
     /// The world refused a value its range admits (a combination it cannot hold).
-    #[error("switch `{name}` = {value}: {message}")]
+    #[error("switch `{name}` = {}: {message}", world_form::fmt_num(*value))]
     Refused {
         /// The switch.
         name: String,
@@ -156,11 +149,11 @@ pub fn check(
         });
     };
     if !spec.admits(value) {
-        return Err(SwitchError::OutOfRange {
-            name: name.to_string(),
+        return Err(SwitchError::OutOfRange(crate::ValueError::out_of_range(
+            format!("switch `{name}`"),
             value,
-            allowed: spec.allowed(),
-        });
+            spec.allowed(),
+        )));
     }
     Ok(*spec)
 }

@@ -32,8 +32,10 @@
 
 pub mod exact;
 pub mod numbers;
+pub mod value;
 
-pub use numbers::fmt_num;
+pub use numbers::{fmt_num, fmt_sig};
+pub use value::ValueError;
 
 use serde::{Deserialize, Serialize};
 
@@ -58,19 +60,9 @@ pub const MAX_FORCE_LIMIT_N: f64 = 1e5;
 /// Largest stiffness a [`Limits`] may state, N/m.
 pub const MAX_STIFFNESS_LIMIT_N_PER_M: f64 = 1e7;
 
-/// A limit that is not finite, not positive or beyond the largest allowed value.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("`{field}` = {value} is out of range: allowed 0 < {field} ≤ {max} {unit}")]
-pub struct LimitsError {
-    /// The field's name (`max_force_n` or `max_stiffness_n_per_m`).
-    pub field: &'static str,
-    /// The offending value.
-    pub value: f64,
-    /// The largest allowed value.
-    pub max: f64,
-    /// The field's unit.
-    pub unit: &'static str,
-}
+/// A limit that is not finite, not positive or beyond the largest allowed value: a
+/// [`ValueError`] naming the field (`` `max_force_n` ``) and its range with the unit.
+pub type LimitsError = ValueError;
 
 impl Limits {
     /// Novint Falcon: 8 N, 3000 N/m — the figures of CHAI3D's Falcon driver
@@ -118,12 +110,11 @@ fn check(field: &'static str, value: f64, max: f64, unit: &'static str) -> Resul
     if value.is_finite() && value > 0.0 && value <= max {
         Ok(())
     } else {
-        Err(LimitsError {
-            field,
+        Err(ValueError::out_of_range(
+            format!("`{field}`"),
             value,
-            max,
-            unit,
-        })
+            format!("0 < {field} ≤ {} {unit}", fmt_num(max)),
+        ))
     }
 }
 
@@ -142,8 +133,8 @@ mod tests {
         .unwrap_err();
         assert_eq!(
             e.to_string(),
-            "`max_stiffness_n_per_m` = 0 is out of range: allowed 0 < max_stiffness_n_per_m ≤ \
-             10000000 N/m"
+            "`max_stiffness_n_per_m` = 0 is out of range: allowed 0 < max_stiffness_n_per_m ≤ 1e7 \
+             N/m"
         );
         let e = Limits {
             max_force_n: 2e5,
@@ -151,7 +142,7 @@ mod tests {
         }
         .validate()
         .unwrap_err();
-        assert_eq!(e.field, "max_force_n");
+        assert_eq!(e.field(), "`max_force_n`");
         assert!(Limits::FALCON.validate().is_ok());
         assert!(Limits::TOUCH.validate().is_ok());
     }

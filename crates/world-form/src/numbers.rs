@@ -15,6 +15,13 @@ pub fn fmt_num(x: f64) -> String {
     }
 }
 
+/// [`fmt_num`] of `x` rounded to `digits` (≥ 1) significant digits: a computed bound reads
+/// `6.4037e-6` or `20`, not `6.403735507964395e-6` or `19.999999999999996`.
+pub fn fmt_sig(x: f64, digits: usize) -> String {
+    let rounded: f64 = format!("{x:.*e}", digits.max(1) - 1).parse().unwrap_or(x);
+    fmt_num(rounded)
+}
+
 /// The 1-based rank of the q-quantile of `n` samples by nearest rank: ⌈q·n⌉ clamped to 1…n
 /// (`None` when `n` is 0 or q is outside 0…1 or NaN). The sample of that rank in ascending
 /// order is the percentile.
@@ -52,6 +59,15 @@ mod tests {
         for (x, want) in cases {
             assert_eq!(fmt_num(x), want);
         }
+    }
+
+    #[test]
+    fn significant_digits_then_the_one_form() {
+        assert_eq!(fmt_sig(6.403735507964395e-6, 5), "6.4037e-6");
+        assert_eq!(fmt_sig(19.999999999999996, 6), "20");
+        assert_eq!(fmt_sig(3924700.0750515824, 5), "3.9247e6");
+        assert_eq!(fmt_sig(f64::NAN, 3), "NaN");
+        assert_eq!(fmt_sig(0.0, 0), "0");
     }
 
     #[test]

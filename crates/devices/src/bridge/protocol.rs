@@ -845,7 +845,7 @@ mod tests {
         }
         assert_eq!(
             f(m),
-            "force packet's local model: body mass -1 kg is out of range: allowed 0 < m ≤ 10000 kg"
+            "force packet's local model: body.mass_kg = -1 is out of range: allowed 0 < m ≤ 10000 kg"
         );
         let mut b = Packet::Force(ForceReply {
             seq: 1,

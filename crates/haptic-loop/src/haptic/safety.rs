@@ -55,6 +55,8 @@ impl HapticLoop {
                 r.status |= status::PASSIVITY;
                 passivity_now = true;
                 if !self.passivity_active {
+                    // A recorded event detail: `{:.3e}` stays, so that the recordings replay
+                    // byte for byte (recordings/*.mcap are goldens).
                     r.events.push(Event::new(
                         "safety.passivity",
                         format!(

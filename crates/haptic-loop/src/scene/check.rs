@@ -24,8 +24,9 @@ pub enum SceneError {
         /// The world's own message (names the field and the allowed range).
         message: String,
     },
-    /// A number out of its allowed range.
-    #[error("scene: `{field}` = {value} is out of range: allowed {allowed}")]
+    /// A value out of its allowed range (the one wording of
+    /// [`haptic_types::value::out_of_range`]; a number shown by [`fmt_num`]).
+    #[error("scene: {}", haptic_types::value::out_of_range(&format!("`{field}`"), value, allowed))]
     OutOfRange {
         /// Field path, e.g. `mapping.force_scale`.
         field: String,
@@ -88,7 +89,7 @@ pub fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<(), Scen
     } else {
         Err(out_of_range(
             field,
-            value,
+            fmt_num(value),
             format!("{} ≤ {field} ≤ {}", fmt_num(lo), fmt_num(hi)),
         ))
     }
@@ -101,7 +102,7 @@ pub fn check_positive(field: &str, value: f64, hi: f64) -> Result<(), SceneError
     } else {
         Err(out_of_range(
             field,
-            value,
+            fmt_num(value),
             format!("0 < {field} ≤ {}", fmt_num(hi)),
         ))
     }

@@ -315,6 +315,8 @@ impl Scene for NanoScene {
                     }
                 }
                 if r.saturated && !self.saturated {
+                    // A recorded event detail: `{:e}` stays, so that the recordings replay
+                    // byte for byte (recordings/*.mcap are goldens).
                     out.events.push(Event::new(
                         "nano.saturated",
                         format!(

@@ -2,6 +2,7 @@
 //! bodies' state as callers read it (movable atoms, anchors, the tip's contact).
 
 use nalgebra::Vector3;
+use world_form::ValueError;
 
 use super::{MAX_POSITION_M, MIN_DT_S};
 use crate::error::StepError;
@@ -22,7 +23,11 @@ impl TipInput {
     pub fn check(&self, dt_s: f64) -> Result<(), StepError> {
         check_position(&self.position_m)?;
         if !(MIN_DT_S..=1.0).contains(&dt_s) {
-            return Err(StepError::BadDt(dt_s));
+            return Err(StepError::BadDt(ValueError::out_of_range(
+                "dt_s",
+                dt_s,
+                "1e-9 <= dt_s <= 1 s",
+            )));
         }
         Ok(())
     }
@@ -32,10 +37,24 @@ pub(super) fn check_position(p: &Vector3<f64>) -> Result<(), StepError> {
     for (k, v) in p.iter().enumerate() {
         let axis = ['x', 'y', 'z'][k];
         if !v.is_finite() {
-            return Err(StepError::NonFinitePosition { axis, value: *v });
+            return Err(StepError::NonFinitePosition {
+                axis,
+                error: ValueError::out_of_range(
+                    format!("tip position {axis}"),
+                    *v,
+                    "a finite number of metres",
+                ),
+            });
         }
         if v.abs() > MAX_POSITION_M {
-            return Err(StepError::PositionOutOfRange { axis, value: *v });
+            return Err(StepError::PositionOutOfRange {
+                axis,
+                error: ValueError::out_of_range(
+                    format!("tip position {axis}"),
+                    *v,
+                    format!("|{axis}| <= 1 m"),
+                ),
+            });
         }
     }
     Ok(())

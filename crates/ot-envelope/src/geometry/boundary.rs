@@ -45,7 +45,7 @@ pub fn outer_boundary(polylines: &[(Vec<V2>, bool)], snap: f64) -> Vec<V2> {
     boundary(polylines, snap, u64::MAX).unwrap_or_default()
 }
 
-/// [`outer_boundary`] that stops with [`ot_physics::PhysicsError::OutOfRange`] when the
+/// [`outer_boundary`] that stops with [`ot_physics::PhysicsError::Value`] when the
 /// crossing search would test more than [`MAX_SEGMENT_PAIRS`] segment pairs, and with
 /// [`ot_physics::PhysicsError::Interrupted`] when the
 /// thread's [`ot_physics::cancel`] flag is raised (it checks once per segment of the
@@ -172,12 +172,14 @@ impl Grid {
             .map(|l| (l.len() as u64) * (l.len() as u64).saturating_sub(1) / 2)
             .sum();
         if pairs > max_pairs {
-            return Err(ot_physics::PhysicsError::OutOfRange {
-                field: "envelope boundary: segment pairs to test",
-                value: pairs as f64,
-                allowed: "≤ 2e6 (the images of the map's folds are tangled: take a shorter tick, \
+            return Err(ot_physics::PhysicsError::Value(
+                ot_physics::ValueError::out_of_range(
+                    "envelope boundary: segment pairs to test",
+                    pairs as f64,
+                    "≤ 2e6 (the images of the map's folds are tangled: take a shorter tick, \
                           a slower particle or a tick map with more substeps)",
-            });
+                ),
+            ));
         }
         Ok(())
     }

@@ -41,7 +41,7 @@ use crate::steer::{ParticleState, SteerParams};
 use crate::tick::{TickController, TickParams, TickStats};
 use nalgebra::Vector2;
 use ot_physics::budget::{choose_tick_map, measure};
-use ot_physics::{Method, Propagator, TrapModel};
+use ot_physics::{Method, Propagator};
 use serde::Serialize;
 use world_form::Limits;
 
@@ -180,9 +180,7 @@ impl World {
         limits.validate()?;
         params.validate(limits)?;
         let p = params;
-        let model = TrapModel::builder(p.depth_j, p.waists_m)
-            .mass(p.mass_kg)
-            .build()?;
+        let model = p.model()?;
         let (prop, map, chosen_by) = match &p.tick_map {
             TickMap::Budget { tol_m } => {
                 let (prop, c) = choose_tick_map(model, p.dt_s, *tol_m, p.map_speed_m_per_s)?;

@@ -2,8 +2,11 @@
 //! and the errors a world refuses them with, each naming the field and its range.
 
 use crate::ClipMode;
+use crate::EnvelopeError;
+use crate::tick_length::{HAPTIC_OSCILLATIONS_PER_TICK, check_tick, max_tick_s};
+use ot_physics::TrapModel;
 use serde::{Deserialize, Serialize};
-use world_form::Limits;
+use world_form::{Limits, ValueError, fmt_num};
 
 /// How the tick map (one step of particle time) is integrated.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -38,8 +41,8 @@ pub struct Params {
     pub waists_m: [f64; 2],
     /// Particle mass, kg (paper: 1e-15).
     pub mass_kg: f64,
-    /// Particle time per step, s (paper: 1e-6). At most two periods of the particle's small
-    /// oscillation ([`Params::max_dt_s`]).
+    /// Particle time per step, s (paper: 1e-6). At most one period of the particle's fastest
+    /// small oscillation ([`Params::max_dt_s`]).
     pub dt_s: f64,
     /// How the tick map is integrated.
     pub tick_map: TickMap,
@@ -105,19 +108,28 @@ impl Params {
         }
     }
 
-    /// Period of the particle's small oscillation about the well's centre along the narrower
-    /// waist, s: ω² = 4·P0 / (m·w²) for the well −P0·e^{−2x²/w²} (paper constants: 0.942 µs).
-    pub fn small_oscillation_period_s(&self) -> f64 {
-        let w = self.waists_m[0].min(self.waists_m[1]);
-        let omega = (4.0 * self.depth_j / (self.mass_kg * w * w)).sqrt();
-        2.0 * std::f64::consts::PI / omega
+    /// The trap model of these parameters (the well and the particle's inertia).
+    pub fn model(&self) -> Result<TrapModel<2>, WorldError> {
+        Ok(TrapModel::builder(self.depth_j, self.waists_m)
+            .mass(self.mass_kg)
+            .build()?)
     }
 
-    /// Longest step a haptic loop can afford, s: two small-oscillation periods. The envelope's
-    /// cost grows with the oscillations one step holds (their folds multiply its boundary): at
-    /// paper constants 1 µs steps cost ~2 ms at p99, 5 µs steps up to 0.5 s.
+    /// Period of the particle's fastest small oscillation about the well's centre, s:
+    /// `2π / ω`, `ω` of [`crate::tick_length::oscillation_rate`] (paper constants: 1.6009 µs);
+    /// NaN when the parameters build no model.
+    pub fn small_oscillation_period_s(&self) -> f64 {
+        self.max_dt_s() / f64::from(HAPTIC_OSCILLATIONS_PER_TICK)
+    }
+
+    /// Longest step a haptic loop can afford, s: [`HAPTIC_OSCILLATIONS_PER_TICK`] periods of
+    /// the fastest small oscillation ([`crate::tick_length::max_tick_s`], the one bound of a
+    /// tick's length); NaN when the parameters build no model.
     pub fn max_dt_s(&self) -> f64 {
-        2.0 * self.small_oscillation_period_s()
+        self.model()
+            .ok()
+            .and_then(|m| max_tick_s(&m, HAPTIC_OSCILLATIONS_PER_TICK))
+            .unwrap_or(f64::NAN)
     }
 
     /// Checks every field: finite, in range, `dt_s` within [`Params::max_dt_s`], the spring
@@ -128,16 +140,14 @@ impl Params {
         positive("waists_m[1]", self.waists_m[1], 1e-3)?;
         positive("mass_kg", self.mass_kg, 1e-3)?;
         positive("dt_s", self.dt_s, 1.0)?;
-        let max_dt = self.max_dt_s();
-        if !max_dt.is_finite() || self.dt_s > max_dt {
-            return Err(WorldError::Param {
-                field: "dt_s",
-                value: self.dt_s,
-                allowed: format!(
-                    "0 < dt_s ≤ {max_dt:.3e} s, two periods of the particle's small oscillation"
-                ),
-            });
-        }
+        check_tick(&self.model()?, self.dt_s, HAPTIC_OSCILLATIONS_PER_TICK).map_err(
+            |e| match e {
+                EnvelopeError::TickTooLong { error, .. } => {
+                    WorldError::Param(error.map_field(|_| "`dt_s`".to_string()))
+                }
+                e => WorldError::Envelope(e),
+            },
+        )?;
         match &self.tick_map {
             TickMap::Budget { tol_m } => closed("tick_map.tol_m", *tol_m, 1e-13, 1e-7)?,
             TickMap::Named { substeps, rtol, .. } => {
@@ -177,16 +187,10 @@ impl Params {
 /// A parameter out of range, or a model the trap or envelope code refuses.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WorldError {
-    /// A parameter outside its allowed range (or not finite).
-    #[error("`{field}` = {value} is out of range: allowed {allowed}")]
-    Param {
-        /// The field, as named in [`Params`].
-        field: &'static str,
-        /// Its value.
-        value: f64,
-        /// The allowed range, in words.
-        allowed: String,
-    },
+    /// A parameter outside its allowed range (or not finite), the field named as in
+    /// [`Params`] (`` `dt_s` ``).
+    #[error(transparent)]
+    Param(ValueError),
     /// The device limits themselves are invalid.
     #[error("device limits: {0}")]
     Limits(#[from] world_form::LimitsError),
@@ -202,11 +206,11 @@ fn positive(field: &'static str, value: f64, max: f64) -> Result<(), WorldError>
     if value.is_finite() && value > 0.0 && value <= max {
         Ok(())
     } else {
-        Err(WorldError::Param {
-            field,
+        Err(WorldError::Param(ValueError::out_of_range(
+            format!("`{field}`"),
             value,
-            allowed: format!("0 < {field} ≤ {max}"),
-        })
+            format!("0 < {field} ≤ {}", fmt_num(max)),
+        )))
     }
 }
 
@@ -214,10 +218,10 @@ fn closed(field: &'static str, value: f64, lo: f64, hi: f64) -> Result<(), World
     if value.is_finite() && value >= lo && value <= hi {
         Ok(())
     } else {
-        Err(WorldError::Param {
-            field,
+        Err(WorldError::Param(ValueError::out_of_range(
+            format!("`{field}`"),
             value,
-            allowed: format!("{lo} ≤ {field} ≤ {hi}"),
-        })
+            format!("{} ≤ {field} ≤ {}", fmt_num(lo), fmt_num(hi)),
+        )))
     }
 }

@@ -14,16 +14,18 @@ fn refused(p: Params) -> String {
 #[test]
 fn the_paper_period_and_step_bound() {
     let p = Params::paper();
-    // 2π·√(1e-15 kg · (300 nm)² / (4e-15 J)) = 0.942 µs
-    assert!((p.small_oscillation_period_s() - 0.942_477_796e-6).abs() < 1e-15);
+    // 2π / √(κ_max / m), κ_max = 2 ln2 · 1e-15 J / (300 nm)², m = 1e-15 kg: 1.6009 µs, the
+    // period of the model the world builds (ot_envelope::tick_length, the one bound).
+    assert!((p.small_oscillation_period_s() - 1.600_933_877e-6).abs() < 1e-15);
     let e = refused(Params {
         dt_s: 5e-6,
         ..Params::paper()
     });
     assert_eq!(
         e,
-        "`dt_s` = 0.000005 is out of range: allowed 0 < dt_s ≤ 1.885e-6 s, two periods of \
-         the particle's small oscillation"
+        "`dt_s` = 5e-6 is out of range: allowed ≤ 1.6009e-6 s, 1 period of the well's fastest \
+         oscillation (ω = 3.9247e6 rad/s); a longer tick folds the map so often that the \
+         envelope's boundary search grows without bound"
     );
 }
 
@@ -43,7 +45,7 @@ fn a_spring_stiffer_than_the_device_is_refused() {
     });
     assert_eq!(
         e,
-        "`depth_j` = NaN is out of range: allowed 0 < depth_j ≤ 0.000001"
+        "`depth_j` = NaN is out of range: allowed 0 < depth_j ≤ 1e-6"
     );
 }
 

@@ -26,7 +26,7 @@ pub use rk4::{rk4, rk4_step};
 pub use symplectic::{Composition, symplectic};
 
 use crate::dynamics::{Dynamics, OffsetVariational, Variational};
-use crate::error::{PhysicsError, Result, positive};
+use crate::error::{PhysicsError, Result, ValueError, positive};
 use crate::model::TrapModel;
 use crate::state::{LaneSystem, Lanes, Phase, PhaseSens, PhaseVar, Tolerance};
 
@@ -145,20 +145,20 @@ impl Method {
         match *self {
             Self::Rk4 { substeps } | Self::Rk8 { substeps } | Self::Symplectic { substeps, .. } => {
                 if substeps == 0 || substeps > 10_000_000 {
-                    return Err(PhysicsError::OutOfRange {
-                        field: "substeps",
-                        value: f64::from(substeps),
-                        allowed: "1 ..= 10000000",
-                    });
+                    return Err(PhysicsError::Value(ValueError::out_of_range(
+                        "substeps",
+                        f64::from(substeps),
+                        "1 ..= 10000000",
+                    )));
                 }
             }
             Self::Dopri5 { rtol } | Self::Adaptive { rtol } => {
                 if !(rtol.is_finite() && (1e-14..=1e-1).contains(&rtol)) {
-                    return Err(PhysicsError::OutOfRange {
-                        field: "rtol",
-                        value: rtol,
-                        allowed: "1e-14 ..= 0.1",
-                    });
+                    return Err(PhysicsError::Value(ValueError::out_of_range(
+                        "rtol",
+                        rtol,
+                        "1e-14 ..= 0.1",
+                    )));
                 }
             }
             Self::PaperRk4 => {}

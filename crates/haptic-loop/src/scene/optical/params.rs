@@ -204,18 +204,19 @@ impl OtParams {
             envelope_margin_waists: p.envelope_margin_waists,
             envelope_build_evals_per_tick: build_evals,
         };
-        // A haptic tick must be cheap: refuse a tick longer than two small oscillations, in
-        // the scene's unit (the world's own check would speak in seconds).
+        // A haptic tick must be cheap: the world's bound (ot_envelope::tick_length, the one
+        // bound of a tick's length), said in the scene's unit.
         let max_dt_us = params.max_dt_s() * 1e6;
         if !max_dt_us.is_finite() || p.dt_us > max_dt_us {
             return Err(out_of_range(
                 "optical_tweezers.dt_us",
                 p.dt_us,
                 format!(
-                    "0 < dt_us ≤ {} µs, two periods of the particle's small oscillation in \
-                     this trap (period 2π·√(mass·waist²/(4·depth)), narrower waist); a longer \
+                    "0 < dt_us ≤ {} µs, {} period of the particle's fastest oscillation in \
+                     this trap (2π·√(mass/κ), κ = 2·ln2·depth/waist², narrower waist); a longer \
                      tick makes the envelope too costly for a haptic loop",
-                    three_digits_down(max_dt_us)
+                    three_digits_down(max_dt_us),
+                    ot_envelope::tick_length::HAPTIC_OSCILLATIONS_PER_TICK
                 ),
             ));
         }

@@ -178,7 +178,7 @@ fn budget_fields_are_validated_with_their_range() {
 }
 
 #[test]
-fn a_tick_longer_than_two_small_oscillations_is_refused() {
+fn a_tick_longer_than_one_period_of_the_fastest_oscillation_is_refused() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../scenes/optical_tweezers.toml"
@@ -193,19 +193,19 @@ fn a_tick_longer_than_two_small_oscillations_is_refused() {
             .unwrap();
         OpticalScene::new(p, &limits()).err().map(|e| e.to_string())
     };
-    // Paper constants: period 2π·√(1e-15 kg · (300 nm)² / (4e-15 J)) = 0.942 µs.
+    // Paper constants: κ = 2·ln2·1e-15 J / (300 nm)², period 2π·√(1e-15 kg / κ) = 1.6009 µs.
     assert_eq!(
         with("dt_us = 0.2", "dt_us = 5.0").as_deref(),
         Some(
-            "scene: `optical_tweezers.dt_us` = 5 is out of range: allowed 0 < dt_us ≤ 1.88 \
-             µs, two periods of the particle's small oscillation in this trap (period \
-             2π·√(mass·waist²/(4·depth)), narrower waist); a longer tick makes the envelope \
-             too costly for a haptic loop"
+            "scene: `optical_tweezers.dt_us` = 5 is out of range: allowed 0 < dt_us ≤ 1.60 µs, \
+             1 period of the particle's fastest oscillation in this trap (2π·√(mass/κ), κ = \
+             2·ln2·depth/waist², narrower waist); a longer tick makes the envelope too costly \
+             for a haptic loop"
         )
     );
     // The fuzz finding: a particle 1000× lighter at the default 0.2 µs tick.
     let light = with("mass_g = 1.0e-12", "mass_g = 1e-15").unwrap_or_default();
-    assert!(light.contains("≤ 0.0596 µs"), "{light}");
+    assert!(light.contains("≤ 0.0506 µs"), "{light}");
     assert_eq!(with("dt_us = 0.2", "dt_us = 1.0"), None);
     assert_eq!(three_digits_down(1.8849), "1.88");
     assert_eq!(three_digits_down(0.059605), "0.0596");
