@@ -57,7 +57,7 @@ ALLOWED = {
         "nanohaptics-play", "nanohaptics-recording", "render", "world-form",
     },
     "ot-py": {
-        "brickworld", "haptic-devices", "haptic-loop", "nanohaptics-recording", "nanoworld",
+        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording", "nanoworld",
         "ot-envelope", "ot-physics", "world-form",
     },
     "nanohaptics-fuzz": {

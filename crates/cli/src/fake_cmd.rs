@@ -5,8 +5,9 @@ use crate::run_cmd::parse_operator;
 use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
 use haptic_devices::local::Protocol;
 use haptic_devices::source::DeviceSource;
-use haptic_devices::{DeviceModel, Grip, Mechanics, Script};
+use haptic_devices::{Grip, Mechanics, Script};
 use haptic_loop::session::OperatorChoice;
+use haptic_types::DeviceModel;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -137,7 +138,7 @@ fn script(a: &FakeArgs, model: DeviceModel) -> Result<Script, String> {
         ),
     };
     Script::from_toml(&text, model.specs()).map_err(|e| {
-        let at = haptic_loop::session::Location {
+        let at = haptic_types::textpos::Location {
             file: origin,
             at: e.position(&text),
         };

@@ -73,12 +73,3 @@ pub use modelled::ModelledDevice;
 pub use operator::SimulatedOperator;
 pub use script::{OperatorParams, Script, ScriptError, ScriptedDevice};
 pub use source::{DeviceSource, open_device};
-
-/// The device interface these devices implement (defined in `haptic-types`).
-pub use haptic_types::device::{
-    Buttons, DeviceError, DeviceModel, DeviceSample, DeviceSpecs, FALCON, ForceCommand,
-    HapticDevice, TOUCH, TickTime,
-};
-
-/// A 3-vector, SI units as named where it is used.
-pub type Vec3 = [f64; 3];

@@ -1,7 +1,8 @@
 //! The device and the hand between two ticks of the loop: moving mass, friction, a held force
 //! rendered at the device's servo rate, encoder counts, and the hand's spring-damper.
 
-use crate::{Grip, Mechanics, Vec3};
+use crate::{Grip, Mechanics};
+use haptic_types::Vec3;
 
 /// What the loop commanded until its next tick: the force `F0` (N, device frame) computed at
 /// the reading `p0` (m), and the local stiffness `K` (N/m, row-major 3×3) the device renders

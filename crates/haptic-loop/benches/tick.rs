@@ -3,10 +3,11 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use haptic_devices::{Buttons, DeviceSample};
 use haptic_loop::encode::LoopEncoder;
 use haptic_loop::haptic::HapticLoop;
 use haptic_loop::scene::load_scene;
+use haptic_types::Buttons;
+use haptic_types::DeviceSample;
 use recording::TickEncoder;
 use recording::channels::messages::ForceMsg;
 use std::hint::black_box;

@@ -3,9 +3,11 @@
 //! [counts|ideal] [safety|nosafety] [impedance scale]`.
 #![allow(clippy::unwrap_used)]
 use haptic_devices::{Grip, Mechanics};
-use haptic_devices::{HapticDevice, ModelledDevice, Script, TickTime};
+use haptic_devices::{ModelledDevice, Script};
 use haptic_loop::haptic::HapticLoop;
 use haptic_loop::scene::load_scene_for;
+use haptic_types::HapticDevice;
+use haptic_types::TickTime;
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
@@ -27,7 +29,7 @@ fn main() {
         // Scale the device-side impedance by `scale` (as the Z-width report's margins do).
         (text, mech) = haptic_loop::closed_loop::scale_impedance(&text, mech, scale);
     }
-    let falcon = haptic_devices::DeviceModel::Falcon.specs().clone();
+    let falcon = haptic_types::DeviceModel::Falcon.specs().clone();
     let specs = haptic_devices::modelled::specs_of(&mech, &falcon);
     let l = load_scene_for(&text, specs.clone()).unwrap();
     let stext = std::fs::read_to_string(root.join(format!("{scene}.script.toml"))).unwrap();

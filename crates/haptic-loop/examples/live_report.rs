@@ -14,12 +14,14 @@
 use bench_harness::report::out_arg;
 use bench_harness::{Report, Table};
 
+use haptic_devices::Script;
 use haptic_devices::bridge::BridgeConfig;
 use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
-use haptic_devices::{DeviceModel, FALCON, Script};
-use haptic_loop::haptic::status;
 use haptic_loop::live::LiveConfig;
 use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
+use haptic_types::DeviceModel;
+use haptic_types::device::FALCON;
+use haptic_types::tick::status;
 use std::net::{TcpListener, UdpSocket};
 use std::path::{Path, PathBuf};
 
@@ -216,7 +218,7 @@ fn main() {
                 .rev()
                 .find(|&i| a.device_age_ticks[i] == 0)
                 .unwrap();
-            let f0 = haptic_loop::vec3::norm(a.device_force_n[last_fresh]);
+            let f0 = haptic_types::vec3::norm(a.device_force_n[last_fresh]);
             let dev_zero = d
                 .outage_force
                 .iter()

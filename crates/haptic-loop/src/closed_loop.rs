@@ -12,7 +12,8 @@
 //! A run is [`Report::stable`] when it has no such jump, at most [`MAX_HF_FRACTION`] of its
 //! power above [`BUZZ_HZ`] and an observer that never went below minus its reserve.
 
-use crate::haptic::{HapticLoop, status};
+use crate::haptic::HapticLoop;
+
 use crate::runner::{Pacing, RunError, Runner};
 use crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
 use crate::scene::{SceneError, load_scene_for};
@@ -21,9 +22,12 @@ use haptic_devices::link::{LinkError, LinkParams};
 use haptic_devices::linked::LinkedDevice;
 use haptic_devices::local::Protocol;
 use haptic_devices::modelled::specs_of;
-use haptic_devices::{DeviceModel, DeviceSample, Script, ScriptError};
 use haptic_devices::{Grip, Mechanics};
+use haptic_devices::{Script, ScriptError};
+use haptic_types::DeviceModel;
+use haptic_types::DeviceSample;
 use haptic_types::device::{DeviceError, DeviceSpecs, ForceCommand, HapticDevice, TickTime};
+use haptic_types::tick::status;
 use rustfft::{FftPlanner, num_complex::Complex};
 
 /// A force change larger than this in one tick is a jump, N.

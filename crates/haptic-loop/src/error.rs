@@ -4,7 +4,8 @@ use crate::live::LiveError;
 use crate::runner::RunError;
 use crate::scene::SceneError;
 use crate::sink::SinkError;
-use haptic_devices::{DeviceError, ScriptError};
+use haptic_devices::ScriptError;
+use haptic_types::DeviceError;
 use haptic_types::textpos::Location;
 use recording::RecordingError;
 use recording::writer::RecordError;
@@ -116,7 +117,7 @@ pub enum SessionError {
         /// The tick it was to apply to.
         tick: u64,
         /// Why it was refused.
-        error: crate::scene::SwitchError,
+        error: haptic_types::SwitchError,
     },
 }
 

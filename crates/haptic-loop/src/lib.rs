@@ -48,9 +48,7 @@ pub mod sinks;
 pub mod sound;
 pub mod stepper;
 pub mod totals;
-pub use haptic_types::{switch, textpos, vec3};
 
-pub use haptic::{HapticLoop, LoopConfig, TickResult};
-pub use haptic_types::{Buttons, DeviceModel, DeviceSample, DeviceSpecs, HapticDevice};
-pub use scene::{Event, Primitive, Scene, SceneInput, SceneOutput};
+pub use haptic::{HapticLoop, LoopConfig};
+pub use scene::{Scene, SceneInput, SceneOutput};
 pub use session::{SessionArrays, SessionOptions};

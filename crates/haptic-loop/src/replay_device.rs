@@ -1,8 +1,18 @@
 //! The replay device: plays back the device inputs of a recording, tick by tick.
 
-use haptic_devices::{
-    Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
-};
+use haptic_types::Buttons;
+
+use haptic_types::DeviceError;
+
+use haptic_types::DeviceSample;
+
+use haptic_types::DeviceSpecs;
+
+use haptic_types::ForceCommand;
+
+use haptic_types::HapticDevice;
+
+use haptic_types::TickTime;
 use haptic_types::vec3::Vec3;
 use recording::channels::messages::{Channel, DeviceInputMsg};
 use recording::{Recording, RecordingError};

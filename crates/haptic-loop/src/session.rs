@@ -15,16 +15,18 @@ use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
 use crate::live::LiveConfig;
 use crate::runner::{Pacing, Runner};
-use crate::scene::{SceneError, SceneFile, Switch};
+use crate::scene::{SceneError, SceneFile};
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::{live_summary, start_live};
 use crate::totals::Totals;
-use haptic_devices::TickTime;
 use haptic_devices::pacing::TickStats;
 use haptic_devices::script::{OperatorKind, Script};
 use haptic_devices::source::{DeviceSource, Driver, open_device};
-use haptic_devices::{DeviceModel, OperatorParams, ScriptError};
-pub use haptic_types::textpos::Location;
+use haptic_devices::{OperatorParams, ScriptError};
+use haptic_types::DeviceModel;
+use haptic_types::Switch;
+use haptic_types::TickTime;
+use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
 use recording::WriteSummary;
 use std::path::{Path, PathBuf};
@@ -176,7 +178,7 @@ pub fn script_source(
 fn load_script(
     opts: &SessionOptions,
     file: &SceneFile,
-    specs: &haptic_devices::DeviceSpecs,
+    specs: &haptic_types::DeviceSpecs,
 ) -> Result<(Script, String, String), SessionError> {
     let (text, origin) = script_source(opts, file)?;
     let script = Script::from_toml(&text, specs).map_err(|error| SessionError::ScriptFile {
@@ -218,7 +220,7 @@ fn script_switches(
         {
             let i = sw.index;
             let field = match e {
-                crate::scene::SwitchError::Unknown { .. } => format!("switch[{i}].name"),
+                haptic_types::SwitchError::Unknown { .. } => format!("switch[{i}].name"),
                 _ => format!("switch[{i}].value"),
             };
             return Err(SessionError::ScriptFile {
@@ -313,7 +315,7 @@ fn run_with_device(
     driver: &Driver,
     script: Option<(Script, String, String)>,
     start_time_ns: u64,
-    dev: &mut dyn haptic_devices::HapticDevice,
+    dev: &mut dyn haptic_types::HapticDevice,
     progress: &mut dyn FnMut(u64, u64),
     stop: Option<&AtomicBool>,
 ) -> Result<SessionReport, SessionError> {

@@ -12,7 +12,7 @@
 //! ```
 //! use haptic_loop::setup::{SceneSource, Setup, SetupOptions};
 //! let scene = SceneSource::builtin("wall").unwrap();
-//! let specs = haptic_loop::DeviceModel::Falcon.specs().clone();
+//! let specs = haptic_types::DeviceModel::Falcon.specs().clone();
 //! let s = Setup::new(&SetupOptions::new(&scene, specs, "batch", "script")).unwrap();
 //! assert_eq!(s.header.scene_kind, "wall");
 //! assert_eq!(s.rate_hz(), 1000);
@@ -24,8 +24,8 @@ use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
 use crate::scene::{SceneError, SceneFile, load_scene_for};
 use crate::sinks::SessionSinks;
-use haptic_devices::DeviceSpecs;
 use haptic_devices::source::DeviceSource;
+use haptic_types::DeviceSpecs;
 use haptic_types::textpos::Location;
 use recording::channels::messages;
 use std::path::{Path, PathBuf};

@@ -5,10 +5,12 @@
 //! Adding a sink is one new file implementing [`Sink`] and one line where the session builds its
 //! list of sinks (`session::run_session`).
 
-use crate::haptic::{HapticLoop, LoopConfig, TickResult};
+use crate::haptic::{HapticLoop, LoopConfig};
+
 use crate::header::SessionHeader;
-use haptic_devices::DeviceSample;
 use haptic_devices::pacing::TickStats;
+use haptic_types::DeviceSample;
+use haptic_types::TickResult;
 
 /// One tick as the sinks see it.
 pub struct TickView<'a> {

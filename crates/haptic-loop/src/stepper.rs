@@ -6,7 +6,7 @@
 //! ```
 //! use haptic_loop::stepper::{Stepper, StepperOptions};
 //! use haptic_loop::session::SceneSource;
-//! use haptic_loop::{Buttons, DeviceSample};
+//! use haptic_types::{Buttons, DeviceSample};
 //! let scene = SceneSource::from_path("../../scenes/wall.toml".as_ref()).unwrap();
 //! let mut s = Stepper::new(StepperOptions::new(scene)).unwrap();
 //! for k in 0..500 {
@@ -19,14 +19,17 @@
 //! ```
 
 use crate::arrays::SessionArrays;
-use crate::haptic::{HapticLoop, TickResult};
+use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
 use crate::runner::{TickEngine, TickStart};
 use crate::session::{SceneSource, SessionError};
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::SessionSinks;
 use haptic_devices::pacing::TickStats;
-use haptic_devices::{DeviceModel, DeviceSample, ForceCommand};
+use haptic_types::DeviceModel;
+use haptic_types::DeviceSample;
+use haptic_types::ForceCommand;
+use haptic_types::TickResult;
 use recording::WriteSummary;
 use std::path::PathBuf;
 

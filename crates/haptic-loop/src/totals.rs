@@ -2,8 +2,8 @@
 //! watchdog ticks, events, the house score from the last state), kept in constant memory so a
 //! session of any length can summarise itself without per-tick arrays.
 
-use crate::haptic::status;
 use crate::sink::{Sink, SinkError, TickView};
+use haptic_types::tick::status;
 
 /// Running totals of a session, updated every tick.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]

@@ -4,14 +4,16 @@
 //! ramps the force to zero within 10 ms of the last sample and engages softly again.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use haptic_devices::Script;
 use haptic_devices::bridge::BridgeConfig;
 use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
 use haptic_devices::bridge::protocol::{Packet, Sample};
-use haptic_devices::{DeviceModel, FALCON, Script};
-use haptic_loop::haptic::status;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
-use haptic_loop::vec3;
+use haptic_types::DeviceModel;
+use haptic_types::device::FALCON;
+use haptic_types::tick::status;
+use haptic_types::vec3;
 use recording::read_recording_file;
 use std::net::{SocketAddr, UdpSocket};
 use std::path::{Path, PathBuf};

@@ -409,7 +409,7 @@ fn realtime_session_replays_exactly_including_its_missed_deadlines() {
 fn touch_device_caps_at_its_own_limits() {
     let mut o = wall_opts(None);
     o.device = Some(haptic_devices::source::DeviceSource::Model(
-        haptic_loop::DeviceModel::Touch,
+        haptic_types::DeviceModel::Touch,
     ));
     o.operator = OperatorChoice::Rigid;
     o.script = Some(
@@ -452,7 +452,7 @@ fn touch_device_caps_at_its_own_limits() {
     // Buttons of the Falcon script do not exist on a Touch: the script is refused by name.
     let e = haptic_devices::Script::from_toml(
         &std::fs::read_to_string(root().join("scenes/wall.script.toml")).unwrap(),
-        haptic_loop::DeviceModel::Touch.specs(),
+        haptic_types::DeviceModel::Touch.specs(),
     );
     assert_eq!(
         e.unwrap_err().to_string(),

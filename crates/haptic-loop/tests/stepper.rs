@@ -5,7 +5,8 @@
 use haptic_loop::replay::verify;
 use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
 use haptic_loop::stepper::{Stepper, StepperOptions};
-use haptic_loop::{Buttons, DeviceSample};
+use haptic_types::Buttons;
+use haptic_types::DeviceSample;
 use recording::read_recording_file;
 use std::path::Path;
 

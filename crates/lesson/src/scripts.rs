@@ -145,7 +145,8 @@ pub fn approach_retract(switches: &[(&str, f64)]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use haptic_devices::{FALCON, Script};
+    use haptic_devices::Script;
+    use haptic_types::device::FALCON;
 
     #[test]
     fn every_lesson_script_is_a_valid_falcon_script() {

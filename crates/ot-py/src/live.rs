@@ -5,7 +5,8 @@
 use haptic_devices::source::DeviceSource;
 use haptic_loop::session::SceneSource;
 use haptic_loop::stepper::{Stepper, StepperOptions};
-use haptic_loop::{Buttons, DeviceSample};
+use haptic_types::Buttons;
+use haptic_types::DeviceSample;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;

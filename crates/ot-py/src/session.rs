@@ -2,12 +2,12 @@
 //! get per-tick arrays back; read an MCAP recording into the same arrays.
 
 use haptic_devices::source::{DEVICE_FORMS, DeviceNameError, DeviceSource};
-use haptic_loop::DeviceModel;
 use haptic_loop::scene::overrides::{is_script_field, override_scene};
 use haptic_loop::session::{
     OperatorChoice, Resolved, SceneSource, SessionArrays, SessionError, SessionOptions,
     read_arrays, read_toml_text, run_session_until,
 };
+use haptic_types::DeviceModel;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -487,7 +487,7 @@ mod tests {
         // No overrides: the files as written, the scene's device.
         let r = resolve(wall.clone(), None, &[], None).unwrap();
         assert_eq!(r.source.text, wall.text);
-        assert_eq!(r.model, haptic_loop::DeviceModel::Falcon);
+        assert_eq!(r.model, haptic_types::DeviceModel::Falcon);
         // A range error: the scene's own, naming the field.
         let e = resolve(
             wall,

@@ -13,8 +13,17 @@
 //!   ramps the force to zero within its timeout (10 ms at 1 kHz) when the page goes away, and
 //!   soft engagement restarts when it comes back, as for a bridged device whose packets stop.
 
-use haptic_devices::{DeviceError, DeviceSample, DeviceSpecs, ForceCommand, TickTime};
-use haptic_loop::{Buttons, HapticDevice};
+use haptic_types::DeviceError;
+
+use haptic_types::DeviceSample;
+
+use haptic_types::DeviceSpecs;
+
+use haptic_types::ForceCommand;
+
+use haptic_types::Buttons;
+use haptic_types::HapticDevice;
+use haptic_types::TickTime;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -165,7 +174,7 @@ impl HapticDevice for PageDevice {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use haptic_devices::FALCON;
+    use haptic_types::device::FALCON;
 
     #[test]
     fn the_unit_ball_maps_inside_the_workspace() {

@@ -17,9 +17,9 @@ use crate::protocol::{
 use crate::server::Shared;
 use haptic_devices::pacing::TickStats;
 use haptic_loop::HapticLoop;
-use haptic_loop::scene::Primitive;
 use haptic_loop::session::{SessionArrays, now_unix_ns};
 use haptic_loop::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_types::Primitive;
 use render::audio::{Impact, Sound, StreamSynth};
 use std::collections::VecDeque;
 use std::sync::Arc;

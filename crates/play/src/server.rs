@@ -5,7 +5,7 @@
 
 use crate::input::{SharedInput, page_to_device};
 use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
-use haptic_loop::scene::SwitchSpec;
+use haptic_types::SwitchSpec;
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::path::PathBuf;
@@ -448,7 +448,7 @@ fn on_message(shared: &Shared, id: u64, text: &str) {
                 }
                 Err(e) => {
                     let field = match e {
-                        haptic_loop::scene::SwitchError::Unknown { .. } => "switch.name",
+                        haptic_types::SwitchError::Unknown { .. } => "switch.name",
                         _ => "switch.value",
                     };
                     shared.error_to(id, field, &e.to_string());

@@ -4,14 +4,16 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use haptic_devices::ScriptedDevice;
 use haptic_devices::script::Script;
-use haptic_devices::{FALCON, ScriptedDevice};
+use haptic_loop::HapticLoop;
 use haptic_loop::record_sink::RecorderSink;
 use haptic_loop::runner::{Pacing, Runner};
 use haptic_loop::scene::load_scene_for;
 use haptic_loop::session::SceneSource;
 use haptic_loop::sink::Sink;
-use haptic_loop::{HapticDevice, HapticLoop};
+use haptic_types::HapticDevice;
+use haptic_types::device::FALCON;
 use recording::{read_recording_file, switch_schedule};
 
 #[test]

@@ -6,8 +6,9 @@
 use haptic_devices::bridge::BridgeConfig;
 use haptic_devices::bridge::fake::{FakeConfig, run_fake};
 use haptic_devices::script::Script;
-use haptic_devices::{DeviceModel, FALCON};
 use haptic_loop::session::{SceneSource, read_arrays};
+use haptic_types::DeviceModel;
+use haptic_types::device::FALCON;
 use play::protocol::ServerMsg;
 use play::{PlayConfig, PlayError, PlaySummary, run};
 use recording::read_recording_file;

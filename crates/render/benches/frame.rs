@@ -2,7 +2,9 @@
 //! and adding one frame to a GIF.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use render::{Camera, Frame, GifWriter, Palette, Primitive, Rgba, Style, View};
+use haptic_types::Primitive;
+use haptic_types::Rgba;
+use render::{Camera, Frame, GifWriter, Palette, Style, View};
 use std::hint::black_box;
 
 fn tweezers(t: f64) -> Frame {

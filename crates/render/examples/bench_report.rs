@@ -11,7 +11,8 @@ mod scenes;
 
 use bench_harness::chart::{Bar, BarChart, PALETTE, Scale};
 use bench_harness::{Align, Report, Span, Table, span};
-use render::{Camera, Frame, GifWriter, Image, Palette, Rgba, Style, View};
+use haptic_types::Rgba;
+use render::{Camera, Frame, GifWriter, Image, Palette, Style, View};
 use scenes::*;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -6,9 +6,9 @@
 //! metre in any plane facing the camera is `pixels_per_m` pixels everywhere on the image and a
 //! scale bar is exact.
 
-use crate::Primitive;
 use crate::error::{RenderError, finite, finite3};
-use crate::vec3::{Vec3, add, axes, cross, dot, normalize, scale, sub};
+use haptic_types::Primitive;
+use haptic_types::vec3::{Vec3, add, axes, cross, dot, normalize, scale, sub};
 
 /// Largest image side the renderer makes, px (`picture`'s).
 pub use picture::MAX_SIDE_PX;
@@ -455,7 +455,7 @@ mod tests {
 
     #[test]
     fn fitted_primitives_land_inside_the_margin() {
-        use crate::Rgba;
+        use haptic_types::Rgba;
         let c = Rgba([1.0, 0.0, 0.0, 1.0]);
         let h = std::f64::consts::FRAC_1_SQRT_2;
         let prims = vec![

@@ -9,8 +9,9 @@ use tiny_skia::{
 use crate::ToSkia;
 use crate::error::RenderError;
 use crate::frame::{Frame, ScaleBar, format_length};
-use crate::vec3::{Vec3, add, axes, box_corners, dot, normalize, normq, scale};
-use crate::{Primitive, Rgba};
+use haptic_types::Primitive;
+use haptic_types::Rgba;
+use haptic_types::vec3::{Vec3, add, axes, box_corners, dot, normalize, normq, scale};
 use picture::text;
 
 impl Frame {

@@ -6,9 +6,10 @@ use crate::camera::Camera;
 use crate::error::{RenderError, finite, finite3};
 use crate::image::Image;
 use crate::order::{Item, Shape, back_to_front};
-use crate::vec3::{Vec3, add, axes, scale, sub};
-use crate::vec3::{box_corners, normq};
-use crate::{Primitive, Rgba};
+use haptic_types::Primitive;
+use haptic_types::Rgba;
+use haptic_types::vec3::{Vec3, add, axes, scale, sub};
+use haptic_types::vec3::{box_corners, normq};
 use picture::text;
 
 /// How a frame looks apart from its primitives.

@@ -24,7 +24,8 @@
 //! ambient, no interpenetrating solids (they are ordered by centre depth).
 //!
 //! ```
-//! use render::{Camera, Frame, Primitive, Rgba, Style, View};
+//! use haptic_types::{Primitive, Rgba};
+//! use render::{Camera, Frame, Style, View};
 //! let cam = Camera::new(View::Top, [0.0; 3], 1e8, 320, 240)?; // 1 px = 10 nm
 //! let mut f = Frame::new(cam, Style::default())?;
 //! f.push(Primitive::Sphere {
@@ -52,17 +53,15 @@ pub use camera::{Camera, MAX_SIDE_PX, Projected, View, action_bounds, bounds, is
 pub use error::RenderError;
 pub use frame::{Frame, Style, format_length, nice_length_m};
 pub use gif::{BAD_PIXEL_ERROR, BAD_PIXEL_SHARE, GifWriter, Palette, frame_delays_cs};
-pub use haptic_types::vec3;
-pub use haptic_types::{Primitive, Rgba, Vec3};
 pub use image::Image;
 
-/// An [`Rgba`] as tiny-skia's colour (channels clamped to 0–1).
+/// An [`Rgba`](haptic_types::Rgba) as tiny-skia's colour (channels clamped to 0–1).
 pub(crate) trait ToSkia {
     /// The colour for tiny-skia.
     fn skia(self) -> tiny_skia::Color;
 }
 
-impl ToSkia for Rgba {
+impl ToSkia for haptic_types::Rgba {
     fn skia(self) -> tiny_skia::Color {
         let [r, g, b, a] = self.0.map(|c| c.clamp(0.0, 1.0) as f32);
         tiny_skia::Color::from_rgba(r, g, b, a).unwrap_or(tiny_skia::Color::BLACK)

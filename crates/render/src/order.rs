@@ -13,7 +13,7 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use crate::vec3::{Vec3, add, cross, dot, norm, scale, sub};
+use haptic_types::vec3::{Vec3, add, cross, dot, norm, scale, sub};
 
 /// A solid as the sorter sees it.
 #[derive(Clone, Copy, Debug)]

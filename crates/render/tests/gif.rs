@@ -1,8 +1,10 @@
 //! Animated GIF output: frame count, size, timing, and what a decoder composites.
 
-use render::{
-    Camera, Frame, GifWriter, Image, Palette, Primitive, Rgba, Style, View, frame_delays_cs,
-};
+use render::{Camera, Frame, GifWriter, Image, Palette, Style, View, frame_delays_cs};
+
+use haptic_types::Primitive;
+
+use haptic_types::Rgba;
 
 const W: u32 = 160;
 const H: u32 = 120;

@@ -1,8 +1,10 @@
 //! Pixel checks at known positions: things are drawn where the camera says, in the right
 //! colour, pointing the right way, in the right depth order, at the right size.
 
+use haptic_types::Primitive;
+use haptic_types::Rgba;
 use proptest::prelude::*;
-use render::{Camera, Frame, Image, Primitive, Rgba, Style, View};
+use render::{Camera, Frame, Image, Style, View};
 
 const RED: Rgba = Rgba([0.85, 0.15, 0.1, 1.0]);
 const BLUE: Rgba = Rgba([0.1, 0.2, 0.85, 1.0]);

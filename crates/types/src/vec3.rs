@@ -2,7 +2,7 @@
 //! units of its own: the caller's vectors carry them (metres for points, newtons for forces).
 //!
 //! This is the one vector type at the seams between crates (scene primitives, device samples,
-//! recorded messages); `haptic_loop::vec3` is this module. Worlds use nalgebra (nanoworld,
+//! recorded messages), imported from here by every crate. Worlds use nalgebra (nanoworld,
 //! ot-physics) or rapier's types (brickworld) inside and convert at their edge.
 
 /// A point or vector, world frame (m for points).

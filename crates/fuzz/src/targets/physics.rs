@@ -5,8 +5,11 @@ use super::{Outcome, falcon};
 use haptic_devices::Script;
 use haptic_devices::bridge::protocol::Packet;
 use haptic_devices::local::{DeviceSide, Protocol};
+use haptic_loop::HapticLoop;
 use haptic_loop::scene::load_scene_for;
-use haptic_loop::{Buttons, DeviceSample, DeviceSpecs, HapticLoop};
+use haptic_types::Buttons;
+use haptic_types::DeviceSample;
+use haptic_types::DeviceSpecs;
 
 fn finite3(v: [f64; 3]) -> bool {
     v.iter().all(|x| x.is_finite())

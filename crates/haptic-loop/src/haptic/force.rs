@@ -3,7 +3,8 @@
 //! the device's maximum along the force's direction).
 
 use super::{HapticLoop, smoothstep};
-use crate::scene::{Event, SceneInput};
+use crate::scene::SceneInput;
+use haptic_types::Event;
 use haptic_types::tick::status;
 use haptic_types::vec3::{self, Vec3};
 

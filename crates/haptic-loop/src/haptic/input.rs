@@ -3,8 +3,8 @@
 //! on the sample's age.
 
 use super::HapticLoop;
-use crate::scene::Event;
-use haptic_devices::DeviceSample;
+use haptic_types::DeviceSample;
+use haptic_types::Event;
 use haptic_types::switch;
 use haptic_types::tick::status;
 use haptic_types::vec3::{self, Vec3};

@@ -35,12 +35,16 @@
 //! [`TickResult`]; the sent force is always finite and of norm ≤ the device maximum.
 
 pub use crate::scene::loop_config::{LoopConfig, Mapping};
-use crate::scene::{Event, Scene, SceneOutput};
-use haptic_devices::{Buttons, DeviceSample, DeviceSpecs, ForceCommand};
+use crate::scene::{Scene, SceneOutput};
+use haptic_types::Buttons;
+use haptic_types::DeviceSample;
+use haptic_types::DeviceSpecs;
+use haptic_types::Event;
+use haptic_types::ForceCommand;
 use haptic_types::switch::{self, Switch, SwitchError};
 use haptic_types::vec3::{self, Vec3};
 
-pub use haptic_types::tick::{TickResult, status};
+use haptic_types::tick::{TickResult, status};
 
 mod force;
 mod input;
@@ -74,7 +78,7 @@ pub struct HapticLoop {
     /// local model's primitives are felt through it.
     local_gain: f64,
     /// The scene's local primitives (reused).
-    primitives: std::cell::RefCell<crate::scene::WorldPrimitives>,
+    primitives: std::cell::RefCell<haptic_types::local::WorldPrimitives>,
 }
 
 /// Largest damping the passivity controller adds, N·s/m (device side): the damping of a loose

@@ -3,7 +3,7 @@
 //! below zero; the rate limiter holds the change of force per tick.
 
 use super::{HapticLoop, PASSIVITY_MAX_DAMPING_N_S_PER_M};
-use crate::scene::Event;
+use haptic_types::Event;
 use haptic_types::tick::status;
 use haptic_types::vec3::{self, Vec3};
 

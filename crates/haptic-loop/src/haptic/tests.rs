@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::scene::load_scene;
-use haptic_devices::FALCON;
+use haptic_types::device::FALCON;
 
 const WALL: &str = r#"
 [scene]

@@ -7,9 +7,11 @@ use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_devices::pacing::TickStats;
 use recording::foxglove_out;
 
-use crate::scene::{Event, Primitive};
+use haptic_types::Event;
+
 use foxglove::schemas::{FrameTransform, Log, SceneUpdate};
 use foxglove::{Context, PartialMetadata, RawChannel, Schema, WebSocketServerHandle};
+use haptic_types::Primitive;
 use haptic_types::vec3::Vec3;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};

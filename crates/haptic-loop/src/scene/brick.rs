@@ -11,10 +11,12 @@
 
 use super::check::{SceneError, check_positive, out_of_range};
 use super::score::{self, DROP_HEIGHT_M, HouseScore};
-use super::{
-    Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
-};
+use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use brickworld::{CursorInput, Grip, Params, World};
+use haptic_types::Event;
+use haptic_types::Primitive;
+use haptic_types::Rgba;
+use haptic_types::SwitchSpec;
 use haptic_types::vec3::Vec3;
 use serde::Deserialize;
 use world_form::Limits;
@@ -261,7 +263,7 @@ impl Scene for BrickScene {
         })
     }
 
-    fn local_primitives(&self, out: &mut super::WorldPrimitives) {
+    fn local_primitives(&self, out: &mut haptic_types::local::WorldPrimitives) {
         use haptic_types::local::{Body, Plane};
         let l = self.world.local_primitives();
         out.planes.extend(l.planes.iter().map(|p| Plane {

@@ -39,7 +39,8 @@ use super::loop_config::{DisplaySection, LoopConfig, LoopSection, MappingSection
 use super::registry;
 use super::table;
 use crate::header::SessionHeader;
-use haptic_devices::{DeviceModel, DeviceSpecs};
+use haptic_types::DeviceModel;
+use haptic_types::DeviceSpecs;
 use serde::Deserialize;
 
 /// `[scene]`.

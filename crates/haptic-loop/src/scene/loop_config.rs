@@ -2,7 +2,7 @@
 //! checked, and what the haptic loop makes of them ([`LoopConfig`]).
 
 use super::check::{SceneError, check_range, out_of_range};
-use haptic_devices::DeviceSpecs;
+use haptic_types::DeviceSpecs;
 use haptic_types::vec3::{self, Vec3};
 use serde::Deserialize;
 use world_form::Limits;

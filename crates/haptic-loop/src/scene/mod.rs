@@ -17,12 +17,12 @@ pub mod score;
 pub mod table;
 pub mod wall;
 
-use haptic_devices::Buttons;
+use haptic_types::Buttons;
 use haptic_types::vec3::Vec3;
 
 pub use check::SceneError;
 pub use file::{SceneFile, load_scene, load_scene_for};
-pub use haptic_types::switch::{Switch, SwitchError, SwitchSpec};
+use haptic_types::switch::SwitchSpec;
 pub use loop_config::{LoopConfig, Mapping};
 
 /// What the loop tells the scene each tick.
@@ -40,7 +40,7 @@ pub struct SceneInput {
     pub input_valid: bool,
 }
 
-pub use haptic_types::Event;
+use haptic_types::Event;
 
 /// What a scene answers each tick.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -67,9 +67,10 @@ impl SceneOutput {
     }
 }
 
-/// Drawable primitives and colours (world frame, metres; RGBA in 0–1), shared with the renderer
-/// and the Foxglove channels, so a scene's drawing goes to both without conversion.
-pub use haptic_types::{Primitive, Rgba};
+// Drawable primitives and colours (world frame, metres; RGBA in 0–1) are haptic-types', shared
+// with the renderer and the Foxglove channels, so a scene's drawing goes to both without
+// conversion.
+use haptic_types::Primitive;
 
 /// A world as the haptic loop sees it.
 ///
@@ -112,7 +113,7 @@ pub trait Scene {
     fn local_primitives(&self, _out: &mut WorldPrimitives) {}
 }
 
-pub use haptic_types::local::WorldPrimitives;
+use haptic_types::local::WorldPrimitives;
 
 /// A world constructor: a scene file's text and the checked loop configuration → the world.
 pub type BuildWorld = fn(&str, &LoopConfig) -> Result<Box<dyn Scene>, SceneError>;

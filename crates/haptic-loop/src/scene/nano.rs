@@ -16,9 +16,11 @@
 
 use super::check::{SceneError, check_positive, out_of_range};
 use super::score::{self, HouseScore};
-use super::{
-    Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, SwitchSpec, WorldKind, world_table,
-};
+use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use haptic_types::Event;
+use haptic_types::Primitive;
+use haptic_types::Rgba;
+use haptic_types::SwitchSpec;
 use haptic_types::vec3::Vec3;
 use nalgebra::Vector3;
 use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};

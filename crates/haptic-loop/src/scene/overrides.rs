@@ -23,8 +23,8 @@
 
 use super::check::SceneError;
 use super::file::SceneFile;
-use haptic_devices::DeviceSpecs;
 use haptic_devices::script::{Script, ScriptError};
+use haptic_types::DeviceSpecs;
 use toml::{Table, Value};
 
 /// Errors of an override.
@@ -206,8 +206,8 @@ pub fn override_script(
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use super::*;
-    use crate::DeviceModel;
     use crate::scene::load_scene;
+    use haptic_types::DeviceModel;
 
     const OT: &str = include_str!("../../../../scenes/optical_tweezers.toml");
     const SCRIPT: &str = include_str!("../../../../scenes/optical_tweezers.script.toml");

@@ -10,7 +10,10 @@
 //! `k` gives `k·d` until the device maximum, then exactly the maximum, in the same direction.
 
 use super::check::{SceneError, check_positive, check_range, out_of_range};
-use super::{Event, Primitive, Rgba, Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use haptic_types::Event;
+use haptic_types::Primitive;
+use haptic_types::Rgba;
 use haptic_types::vec3::{self, Vec3};
 use serde::{Deserialize, Serialize};
 use world_form::Limits;
@@ -187,7 +190,7 @@ impl Scene for WallScene {
             .collect()
     }
 
-    fn local_primitives(&self, out: &mut super::WorldPrimitives) {
+    fn local_primitives(&self, out: &mut haptic_types::local::WorldPrimitives) {
         // The wall's face as a plane (its damper stays with the simulator).
         out.planes.push(haptic_types::local::Plane {
             normal: self.normal,

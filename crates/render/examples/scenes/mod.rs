@@ -4,7 +4,11 @@
 
 #![allow(dead_code)]
 
-use render::{Camera, Frame, Primitive, RenderError, Rgba, Style, View};
+use render::{Camera, Frame, RenderError, Style, View};
+
+use haptic_types::Primitive;
+
+use haptic_types::Rgba;
 
 pub type Vec3 = [f64; 3];
 

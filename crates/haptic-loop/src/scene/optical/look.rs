@@ -2,7 +2,8 @@
 //! without the physics.
 
 use super::{OtParams, STATE_FIELDS, V2};
-use crate::scene::{Primitive, Rgba};
+use haptic_types::Primitive;
+use haptic_types::Rgba;
 use haptic_types::vec3::Vec3;
 
 /// The parts of the picture that never change during a session: sizes, the envelope's drawing

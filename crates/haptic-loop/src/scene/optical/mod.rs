@@ -22,7 +22,9 @@ pub use look::RecordedPicture;
 pub use params::OtParams;
 
 use crate::scene::check::SceneError;
-use crate::scene::{Event, Primitive, Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use crate::scene::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use haptic_types::Event;
+use haptic_types::Primitive;
 use haptic_types::vec3::Vec3;
 use look::{Look, Shown};
 use nalgebra::Vector2;

@@ -29,7 +29,7 @@ fn first_events(p: OtParams) -> Vec<Event> {
         tick: 0,
         dt_s: 1e-3,
         cursor_m: [0.0; 3],
-        buttons: haptic_devices::Buttons(0),
+        buttons: haptic_types::Buttons(0),
         input_valid: true,
     };
     s.step(&input, &mut out);
