@@ -71,7 +71,7 @@ ALLOWED = {
 # the same rank, written "a b"); a module may import only modules of its rank or below.
 RANKS = {
     "haptic-loop": [
-        "header",
+        "header pacing",
         "scene",
         "haptic",
         "encode sink totals arrays",

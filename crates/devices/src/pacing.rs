@@ -193,21 +193,6 @@ impl DurationHistogram {
     }
 }
 
-/// Tick-time statistics of a session.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
-pub struct TickStats {
-    /// Ticks run.
-    pub ticks: u64,
-    /// Work per tick (device read, world step, force, encoding, hand-off to the writer), ns.
-    pub compute: Percentiles,
-    /// Start lateness against the schedule (real-time mode only; zeros in batch), ns.
-    pub jitter: Percentiles,
-    /// Ticks whose deadline was missed (real-time mode only).
-    pub missed: u64,
-    /// Wall time of the whole run, s.
-    pub wall_s: f64,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,7 +14,8 @@
 
 use crate::haptic::HapticLoop;
 
-use crate::runner::{Pacing, RunError, Runner};
+use crate::pacing::Pacing;
+use crate::runner::{RunError, Runner};
 use crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
 use crate::scene::{SceneError, load_scene_for};
 use crate::sink::{Sink, SinkError, TickView};

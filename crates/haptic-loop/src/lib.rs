@@ -36,6 +36,7 @@ pub mod haptic;
 pub mod header;
 pub mod live;
 pub mod media;
+pub mod pacing;
 pub mod record_sink;
 pub mod replay;
 pub mod replay_device;

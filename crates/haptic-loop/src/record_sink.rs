@@ -5,8 +5,8 @@
 use crate::encode::LoopEncoder;
 use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
+use crate::pacing::TickStats;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
-use haptic_devices::pacing::TickStats;
 use recording::channels::messages::DescriptionMsg;
 use recording::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
 use std::collections::BTreeMap;

@@ -9,8 +9,9 @@
 use crate::encode::LoopEncoder;
 use crate::error::SessionError;
 use crate::haptic::HapticLoop;
+use crate::pacing::Pacing;
 use crate::replay_device::ReplayDevice;
-use crate::runner::{Pacing, Runner};
+use crate::runner::Runner;
 use crate::scene::load_scene_for;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use recording::channels::messages::{Channel, ForceMsg, StateMsg};

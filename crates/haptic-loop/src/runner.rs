@@ -18,8 +18,9 @@
 
 use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
+use crate::pacing::{Pacing, TickStats};
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
-use haptic_devices::pacing::{DurationHistogram, Pacer, Percentiles, TickStats};
+use haptic_devices::pacing::{DurationHistogram, Pacer, Percentiles};
 use haptic_types::DeviceError;
 use haptic_types::DeviceSample;
 use haptic_types::HapticDevice;
@@ -45,21 +46,6 @@ pub enum RunError {
         /// Why the world refused it.
         error: SwitchError,
     },
-}
-
-/// How ticks are paced and where the deadline flag comes from.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Pacing {
-    /// As fast as possible; no deadline.
-    Batch,
-    /// Tick `n` starts at `start + n · period` by the wall clock; a tick whose force is ready
-    /// after the start of the next one sends zero force (`deadline.missed`).
-    Realtime,
-    /// The device's samples are the clock (a bridged device: `sample` returns when a reading
-    /// arrives or the watchdog's wait expires); the deadline is one period after the tick starts.
-    DeviceClock,
-    /// Deadline flags read from a recording (replay).
-    Recorded(Vec<bool>),
 }
 
 /// How a run ended; written (serde, [`EndReason::name`]) as `completed`, `device_ended` or

@@ -14,12 +14,13 @@
 use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
 use crate::live::LiveConfig;
-use crate::runner::{Pacing, Runner};
+use crate::pacing::Pacing;
+use crate::pacing::TickStats;
+use crate::runner::Runner;
 use crate::scene::{SceneError, SceneFile};
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::{live_summary, start_live};
 use crate::totals::Totals;
-use haptic_devices::pacing::TickStats;
 use haptic_devices::script::{OperatorKind, Script};
 use haptic_devices::source::{DeviceSource, Driver, open_device};
 use haptic_devices::{OperatorParams, ScriptError};

@@ -8,7 +8,7 @@
 use crate::haptic::{HapticLoop, LoopConfig};
 
 use crate::header::SessionHeader;
-use haptic_devices::pacing::TickStats;
+use crate::pacing::TickStats;
 use haptic_types::DeviceSample;
 use haptic_types::TickResult;
 

@@ -21,11 +21,11 @@
 use crate::arrays::SessionArrays;
 use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
+use crate::pacing::TickStats;
 use crate::runner::{TickEngine, TickStart};
 use crate::session::{SceneSource, SessionError};
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::SessionSinks;
-use haptic_devices::pacing::TickStats;
 use haptic_types::DeviceModel;
 use haptic_types::DeviceSample;
 use haptic_types::ForceCommand;

@@ -33,10 +33,11 @@ pub mod publish;
 pub mod server;
 
 use haptic_devices::bridge::{BridgeConfig, UdpDevice};
-use haptic_devices::pacing::{Percentiles, TickStats};
+use haptic_devices::pacing::Percentiles;
 use haptic_devices::source::DeviceSource;
 use haptic_loop::HapticLoop;
-use haptic_loop::runner::{EndReason, Pacing, Runner};
+use haptic_loop::pacing::{Pacing, TickStats};
+use haptic_loop::runner::{EndReason, Runner};
 use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
 use haptic_loop::setup::{Setup, SetupOptions, session_device};
 use haptic_loop::totals::Totals;

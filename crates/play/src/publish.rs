@@ -15,8 +15,8 @@ use crate::protocol::{
     EventAt, Frame, FrameView, SOUND_BLOCK_HEADER_BYTES, ServerMsg, Shape, SoundAt,
 };
 use crate::server::Shared;
-use haptic_devices::pacing::TickStats;
 use haptic_loop::HapticLoop;
+use haptic_loop::pacing::TickStats;
 use haptic_loop::session::{SessionArrays, now_unix_ns};
 use haptic_loop::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_types::Primitive;

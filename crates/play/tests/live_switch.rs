@@ -7,8 +7,9 @@
 use haptic_devices::ScriptedDevice;
 use haptic_devices::script::Script;
 use haptic_loop::HapticLoop;
+use haptic_loop::pacing::Pacing;
 use haptic_loop::record_sink::RecorderSink;
-use haptic_loop::runner::{Pacing, Runner};
+use haptic_loop::runner::Runner;
 use haptic_loop::scene::load_scene_for;
 use haptic_loop::session::SceneSource;
 use haptic_loop::sink::Sink;

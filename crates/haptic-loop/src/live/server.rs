@@ -3,8 +3,8 @@
 
 use super::{LiveConfig, LiveError, LiveSummary};
 use crate::haptic::HapticLoop;
+use crate::pacing::TickStats;
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
-use haptic_devices::pacing::TickStats;
 use recording::foxglove_out;
 
 use haptic_types::Event;
