@@ -1,19 +1,28 @@
-//! `nanohaptics`: run scenes headless, record them to MCAP, replay and verify recordings.
+//! `nanohaptics`: the program of the project — run scenes (batch, real time, against a device
+//! in another process), play the teaching game in a browser, teach the lesson, record to MCAP,
+//! replay and verify, draw and sound recordings.
 //!
 //! ```text
 //! nanohaptics run SCENE [--script S] [--operator rigid|hand|hand:key=value,...]
-//!                 [--device falcon|touch|udp:HOST:PORT] [--seconds T] [--out REC.mcap]
-//!                 [--realtime] [--live ws:HOST:PORT] [--json]
-//! nanohaptics fake-device udp:HOST:PORT [--script S] [--hand|--hand key=value,...|--rigid]
-//!                 [--model M] [--loss P] [--jitter-ms J] [--latency-ms L] [--seed N]
-//!                 [--seconds T] [--outage START:SECONDS] [--json]
+//!                 [--device falcon|touch|udp:HOST:PORT|udp:PORT] [--wait-s S] [--seconds T]
+//!                 [--out REC.mcap] [--realtime] [--live ws:HOST:PORT] [--live-hz N] [--json]
+//! nanohaptics play [SCENE] [--port P] [--device udp:HOST:PORT|udp:PORT] [--out REC.mcap]
+//!                 [--seconds T]
+//! nanohaptics lesson [--out DIR] [--width W] [--sample-rate HZ] [--json]
+//! nanohaptics fake-device udp:HOST:PORT|udp:PORT [--script S] [--operator rigid|hand|hand:k=v,...]
+//!                 [--model falcon|touch|delta3|inverse3] [--grip loose|firm|k=...,b=...[,m=...]]
+//!                 [--ideal] [--protocol 1|2] [--loss P] [--jitter-ms J] [--latency-ms L]
+//!                 [--seed N] [--seconds T] [--outage START:SECONDS] [--wait-s S] [--json]
 //! nanohaptics replay REC.mcap [--verify] [--salvage] [--json]
 //! nanohaptics info REC.mcap [--salvage] [--json]
+//! nanohaptics render REC.mcap --out DIR|FILE.png|FILE.gif [--every N] [--width W] [--gif FILE]
+//!                 [--view top|side|oblique] [--audio FILE.wav [--proximity] [--sample-rate HZ]]
+//! nanohaptics render SCENE --out FILE.png [--width W] [--view V]
+//! nanohaptics scenes [export DIR]
 //! nanohaptics demo [--scenes DIR] [--out DIR] [--json]
-//! nanohaptics render REC.mcap --out DIR [--every N] [--width W] [--gif FILE] [--view V]
-//! nanohaptics render SCENE.toml --out FILE.png [--width W] [--view V]
 //! ```
-//! Exit status: 0 success, 1 error (bad input, unreadable file), 2 replay diverged.
+//! Every command's own `--help` gives each option's unit, range and default. Exit status: 0
+//! success, 1 error (bad input, unreadable file), 2 replay diverged, 130 stopped by Ctrl-C.
 
 mod demo_cmd;
 mod fake_cmd;
@@ -33,7 +42,7 @@ use std::sync::atomic::AtomicBool;
 #[command(
     name = "nanohaptics",
     version,
-    about = "Deterministic haptic sessions: run, record, replay, verify"
+    about = "Deterministic haptic sessions: run, play, teach, record, replay, verify, draw"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -131,6 +140,29 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(1)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    /// The usage block of this crate's doc names every command the program has.
+    #[test]
+    fn the_usage_text_lists_every_command() {
+        let usage = include_str!("main.rs")
+            .lines()
+            .take_while(|l| l.starts_with("//!"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        for c in Cli::command().get_subcommands() {
+            let name = c.get_name();
+            assert!(
+                usage.contains(&format!("//! nanohaptics {name} ")),
+                "the usage text in main.rs does not list `nanohaptics {name}`"
+            );
         }
     }
 }
