@@ -28,7 +28,7 @@ pub use symplectic::{Composition, symplectic};
 use crate::dynamics::{Dynamics, OffsetVariational, Variational};
 use crate::error::{PhysicsError, Result, ValueError, positive};
 use crate::model::TrapModel;
-use crate::state::{LaneSystem, Lanes, Phase, PhaseSens, PhaseVar, Tolerance};
+use crate::state::{LaneSystem, Lanes, OdeSystem, Phase, PhaseSens, PhaseVar, Tolerance};
 
 /// Displacement error the default method guarantees (m): 1e-11 m = 0.01 nm
 /// from converged dynamics on every hard-case family (Δt 0.2–20 µs at the
@@ -366,27 +366,39 @@ impl<const D: usize> Propagator<D> {
         self.dt
     }
 
-    /// Propagate a phase over Δt.
-    pub fn phase(&self, y0: &Phase<D>) -> Result<Propagated<Phase<D>>> {
-        let sys = Dynamics::new(&self.model);
+    /// The one dispatch over the methods: `sys` from `y0` over Δt by the
+    /// bound method, `h0` (s) the first trial step of the adaptive ones.
+    /// Returns the end state and the force evaluations spent. A symplectic
+    /// method runs here as RK4 with its substeps (how the sensitivities are
+    /// integrated); [`Propagator::phase`] runs the composition itself.
+    #[inline]
+    fn integrate<S: OdeSystem>(&self, sys: &S, y0: &S::State, h0: f64) -> Result<(S::State, u64)> {
         let dt = self.dt;
-        let (end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, y0, dt, 1), 4),
-            Method::Rk4 { substeps } => (rk4(&sys, y0, dt, substeps), 4 * u64::from(substeps)),
-            Method::Rk8 { substeps } => (rk8(&sys, y0, dt, substeps), 12 * u64::from(substeps)),
+        Ok(match self.method {
+            Method::PaperRk4 => (rk4(sys, y0, dt, 1), 4),
+            Method::Rk4 { substeps } | Method::Symplectic { substeps, .. } => {
+                (rk4(sys, y0, dt, substeps), 4 * u64::from(substeps))
+            }
+            Method::Rk8 { substeps } => (rk8(sys, y0, dt, substeps), 12 * u64::from(substeps)),
             Method::Dopri5 { .. } => {
-                let h0 = self.first_step(y0);
-                let (y, s) = dopri5(&sys, y0, dt, &self.tol, h0, &self.ctl)?;
+                let (y, s) = dopri5(sys, y0, dt, &self.tol, h0, &self.ctl)?;
                 (y, s.evals)
             }
             Method::Adaptive { .. } => {
-                let (y, s) = dop853(&sys, y0, dt, &self.tol, self.h0, &self.ctl)?;
+                let (y, s) = dop853(sys, y0, dt, &self.tol, h0, &self.ctl)?;
                 (y, s.evals)
             }
+        })
+    }
+
+    /// Propagate a phase over Δt.
+    pub fn phase(&self, y0: &Phase<D>) -> Result<Propagated<Phase<D>>> {
+        let (end, evals) = match self.method {
             Method::Symplectic {
                 substeps,
                 composition,
-            } => symplectic(&self.model, y0, dt, substeps, composition),
+            } => symplectic(&self.model, y0, self.dt, substeps, composition),
+            _ => self.integrate(&Dynamics::new(&self.model), y0, self.first_step(y0))?,
         };
         Ok(Propagated {
             end: self.finish(end, y0),
@@ -399,16 +411,17 @@ impl<const D: usize> Propagator<D> {
     /// [`Propagator::phase`], faster because the lanes overlap. `None` for
     /// the adaptive and symplectic methods (their lanes would share steps).
     pub fn phase_lanes<const L: usize>(&self, y0: &[Phase<D>; L]) -> Option<([Phase<D>; L], u64)> {
+        if !matches!(
+            self.method,
+            Method::PaperRk4 | Method::Rk4 { .. } | Method::Rk8 { .. }
+        ) {
+            return None;
+        }
         let inner = Dynamics::new(&self.model);
-        let sys = LaneSystem::<_, L>(&inner);
-        let y = Lanes(*y0);
-        let dt = self.dt;
-        let (end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, &y, dt, 1), 4),
-            Method::Rk4 { substeps } => (rk4(&sys, &y, dt, substeps), 4 * u64::from(substeps)),
-            Method::Rk8 { substeps } => (rk8(&sys, &y, dt, substeps), 12 * u64::from(substeps)),
-            _ => return None,
-        };
+        // fixed steps have no error control: they cannot fail
+        let (end, evals) = self
+            .integrate(&LaneSystem::<_, L>(&inner), &Lanes(*y0), self.h0)
+            .ok()?;
         let mut out = end.0;
         for (o, y0) in out.iter_mut().zip(y0) {
             *o = self.finish(*o, y0);
@@ -464,51 +477,17 @@ impl<const D: usize> Propagator<D> {
     /// the sensitivities.
     pub fn phase_var(&self, y0: &Phase<D>) -> Result<Propagated<PhaseVar<D>>> {
         let sys = Variational::new(&self.model);
-        let dt = self.dt;
-        let yv = PhaseVar::identity(*y0);
-        let (mut end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, &yv, dt, 1), 4),
-            Method::Rk4 { substeps } | Method::Symplectic { substeps, .. } => {
-                (rk4(&sys, &yv, dt, substeps), 4 * u64::from(substeps))
-            }
-            Method::Rk8 { substeps } => (rk8(&sys, &yv, dt, substeps), 12 * u64::from(substeps)),
-            Method::Dopri5 { .. } => {
-                let (y, s) = dopri5(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-            Method::Adaptive { .. } => {
-                let (y, s) = dop853(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-        };
+        let (mut end, evals) = self.integrate(&sys, &PhaseVar::identity(*y0), self.h0)?;
         end.p = self.finish(end.p, y0);
         Ok(Propagated { end, evals })
     }
-}
 
-impl<const D: usize> Propagator<D> {
     /// Propagate a phase and its sensitivity to the initial position only
     /// (the offset Jacobian), over Δt. Fixed-step methods give the exact
     /// derivative of their own discrete map, as [`Propagator::phase_var`].
     pub fn phase_sens(&self, y0: &Phase<D>) -> Result<Propagated<PhaseSens<D>>> {
         let sys = OffsetVariational::new(&self.model);
-        let dt = self.dt;
-        let yv = PhaseSens::identity(*y0);
-        let (mut end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, &yv, dt, 1), 4),
-            Method::Rk4 { substeps } | Method::Symplectic { substeps, .. } => {
-                (rk4(&sys, &yv, dt, substeps), 4 * u64::from(substeps))
-            }
-            Method::Rk8 { substeps } => (rk8(&sys, &yv, dt, substeps), 12 * u64::from(substeps)),
-            Method::Dopri5 { .. } => {
-                let (y, s) = dopri5(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-            Method::Adaptive { .. } => {
-                let (y, s) = dop853(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-        };
+        let (mut end, evals) = self.integrate(&sys, &PhaseSens::identity(*y0), self.h0)?;
         end.p = self.finish(end.p, y0);
         Ok(Propagated { end, evals })
     }
