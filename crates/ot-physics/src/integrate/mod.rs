@@ -25,10 +25,10 @@ pub use dopri5::dopri5;
 pub use rk4::{rk4, rk4_step};
 pub use symplectic::{Composition, symplectic};
 
-use crate::dynamics::{Dynamics, OffsetVariational, Variational};
+use crate::dynamics::{Dynamics, Variational};
 use crate::error::{PhysicsError, Result, ValueError, positive};
 use crate::model::TrapModel;
-use crate::state::{LaneSystem, Lanes, OdeSystem, Phase, PhaseSens, PhaseVar, Tolerance};
+use crate::state::{LaneSystem, Lanes, OdeSystem, Phase, PhaseJac, PhaseSens, PhaseVar, Tolerance};
 
 /// Displacement error the default method guarantees (m): 1e-11 m = 0.01 nm
 /// from converged dynamics on every hard-case family (Δt 0.2–20 µs at the
@@ -476,18 +476,22 @@ impl<const D: usize> Propagator<D> {
     /// discrete map; symplectic methods use RK4 with the same substeps for
     /// the sensitivities.
     pub fn phase_var(&self, y0: &Phase<D>) -> Result<Propagated<PhaseVar<D>>> {
-        let sys = Variational::new(&self.model);
-        let (mut end, evals) = self.integrate(&sys, &PhaseVar::identity(*y0), self.h0)?;
-        end.p = self.finish(end.p, y0);
-        Ok(Propagated { end, evals })
+        self.sensitivities(y0)
     }
 
     /// Propagate a phase and its sensitivity to the initial position only
     /// (the offset Jacobian), over Δt. Fixed-step methods give the exact
     /// derivative of their own discrete map, as [`Propagator::phase_var`].
     pub fn phase_sens(&self, y0: &Phase<D>) -> Result<Propagated<PhaseSens<D>>> {
-        let sys = OffsetVariational::new(&self.model);
-        let (mut end, evals) = self.integrate(&sys, &PhaseSens::identity(*y0), self.h0)?;
+        self.sensitivities(y0)
+    }
+
+    /// The phase and its sensitivities by the first `N` blocks of the
+    /// initial phase, over Δt: [`Propagator::phase_sens`] (`N` = 1) and
+    /// [`Propagator::phase_var`] (`N` = 2).
+    fn sensitivities<const N: usize>(&self, y0: &Phase<D>) -> Result<Propagated<PhaseJac<D, N>>> {
+        let sys = Variational::<D, N>::new(&self.model);
+        let (mut end, evals) = self.integrate(&sys, &PhaseJac::identity(*y0), self.h0)?;
         end.p = self.finish(end.p, y0);
         Ok(Propagated { end, evals })
     }
