@@ -250,23 +250,16 @@ pub(crate) fn ln_step(x: f64) -> Option<f64> {
 /// `x^p` for the step-size controller, to ~1e-6 relative (x > 0): a
 /// step-size factor needs no more, and libm's `powf` was a visible share of
 /// a short adaptive integration. `ln x = e·ln2 + 2·atanh((m−1)/(m+1))` with
-/// the mantissa `m ∈ [1, 2)`, then the crate's inlined `exp`.
+/// the mantissa `m ∈ [1, 2)` ([`ln_step`]), then the crate's inlined `exp`.
 #[inline]
 fn pow_step(x: f64, p: f64) -> f64 {
     if p == 0.0 {
         return 1.0;
     }
-    if !(x.is_normal() && x > 0.0) {
-        return x.powf(p);
+    match ln_step(x) {
+        Some(ln_x) => crate::fastexp::exp(p * ln_x),
+        None => x.powf(p),
     }
-    let bits = x.to_bits();
-    let e = ((bits >> 52) & 0x7ff) as i64 - 1023;
-    let m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
-    let s = (m - 1.0) / (m + 1.0);
-    let s2 = s * s;
-    let ln_m = 2.0 * s * (1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 / 9.0))));
-    let ln_x = e as f64 * std::f64::consts::LN_2 + ln_m;
-    crate::fastexp::exp(p * ln_x)
 }
 
 /// A method bound to a model and an interval Δt, validated once, then
