@@ -37,7 +37,7 @@ ALLOWED = {
     "haptic-types": {"world-form"},
     "picture": set(),
     "chart": {"picture"},
-    "render": {"haptic-types", "picture"},
+    "render": {"haptic-types", "picture", "world-form"},
     "nanohaptics-recording": {"haptic-types", "world-form"},
     "haptic-devices": {"haptic-types", "world-form"},
     "haptic-loop": {
@@ -46,7 +46,7 @@ ALLOWED = {
     },
     "nanohaptics-lesson": {
         "brickworld", "chart", "haptic-devices", "haptic-loop", "nanohaptics-recording",
-        "nanoworld",
+        "nanoworld", "world-form",
     },
     "nanohaptics-play": {
         "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording", "render",

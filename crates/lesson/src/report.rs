@@ -5,6 +5,7 @@ use crate::{LessonError, LessonSummary, Run, Runs, write_file};
 use chart::{Band, Bar, BarChart, Chart, Figure, Marker, Scale, Series, Style};
 use std::fmt::Write;
 use std::path::Path;
+use world_form::numbers::{SiStyle, fmt_si};
 
 const BLUE: [u8; 3] = [31, 119, 180];
 const ORANGE: [u8; 3] = [255, 127, 14];
@@ -96,34 +97,10 @@ fn branches(r: &Run) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
     )
 }
 
-/// Short form of a number with its unit: `4.91 N`, `3 nN`, `1.2e-24 N`.
+/// Short form of a number with its unit: `4.91 N`, `3.00 nN`, `1.00e-24 N` ([`fmt_si`] in
+/// the [`SiStyle::QUANTITY`] style).
 pub fn si(v: f64, unit: &str) -> String {
-    if !v.is_finite() {
-        return format!("{v} {unit}");
-    }
-    let a = v.abs();
-    let prefixes = [(1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, ""), (1e3, "k")];
-    if a == 0.0 {
-        return format!("0 {unit}");
-    }
-    if !(1e-10..1e6).contains(&a) {
-        return format!("{v:.2e} {unit}");
-    }
-    let (scale, p) = prefixes
-        .iter()
-        .rev()
-        .find(|(s, _)| a >= *s * 0.9995)
-        .copied()
-        .unwrap_or((1e-9, "n"));
-    let x = v / scale;
-    let digits = if x.abs() >= 100.0 {
-        0
-    } else if x.abs() >= 10.0 {
-        1
-    } else {
-        2
-    };
-    format!("{x:.digits$} {p}{unit}")
+    fmt_si(v, unit, SiStyle::QUANTITY)
 }
 
 /// Draws the figures and writes `lesson.md`; returns the files written.

@@ -2,7 +2,7 @@
 //! equations, for the effects a [`TrapModel`] switched on.
 
 use crate::model::TrapModel;
-use crate::state::{OdeSystem, Phase, PhaseSens, PhaseVar};
+use crate::state::{OdeSystem, Partials, Phase, PhaseJac};
 use nalgebra::{SMatrix, SVector};
 
 /// Which equations of motion a model needs, with its coefficients
@@ -45,9 +45,11 @@ pub struct Dynamics<'a, const D: usize> {
     kind: Kind,
 }
 
-/// The equations of motion together with their variational equations.
+/// The equations of motion together with their variational equations: by
+/// the whole initial phase (`N` = 2, the default: [`crate::PhaseVar`]) or by
+/// the initial position only (`N` = 1: [`OffsetVariational`]).
 #[derive(Debug, Clone, Copy)]
-pub struct Variational<'a, const D: usize> {
+pub struct Variational<'a, const D: usize, const N: usize = 2> {
     model: &'a TrapModel<D>,
     kind: Kind,
 }
@@ -55,14 +57,10 @@ pub struct Variational<'a, const D: usize> {
 /// The equations of motion with the variational equations of `∂/∂r0` only
 /// (what `∂ displacement/∂ offset` needs): `D²·2` fewer products per
 /// evaluation than [`Variational`].
-#[derive(Debug, Clone, Copy)]
-pub struct OffsetVariational<'a, const D: usize> {
-    model: &'a TrapModel<D>,
-    kind: Kind,
-}
+pub type OffsetVariational<'a, const D: usize> = Variational<'a, D, 1>;
 
-impl<'a, const D: usize> OffsetVariational<'a, D> {
-    /// The offset-only variational equations of `model`.
+impl<'a, const D: usize, const N: usize> Variational<'a, D, N> {
+    /// The variational equations of `model`.
     pub fn new(model: &'a TrapModel<D>) -> Self {
         Self {
             model,
@@ -71,40 +69,49 @@ impl<'a, const D: usize> OffsetVariational<'a, D> {
     }
 }
 
-impl<const D: usize> OdeSystem for OffsetVariational<'_, D> {
-    type State = PhaseSens<D>;
+impl<const D: usize, const N: usize> OdeSystem for Variational<'_, D, N> {
+    type State = PhaseJac<D, N>;
     #[inline]
-    fn max_step(&self, y: &PhaseSens<D>) -> f64 {
+    fn max_step(&self, y: &PhaseJac<D, N>) -> f64 {
         crossing_limit(self.model, &y.p)
     }
+    /// Each block of sensitivities `(∂r, ∂v)` by `x0` follows the linearised
+    /// motion: `∂ṙ = ∂v`, `∂v̇ = (H ∂r)/m − (γ/m) ∂v` (overdamped:
+    /// `∂ṙ = (H ∂r)/γ`), with `H` the force Jacobian at `r`.
     #[inline(always)]
-    fn rhs(&self, y: &PhaseSens<D>) -> PhaseSens<D> {
+    fn rhs(&self, y: &PhaseJac<D, N>) -> PhaseJac<D, N> {
         let (fw, h) = self.model.well.force_and_gradient(&y.p.r);
         let f = fw + self.model.external_force;
         match self.kind {
-            Kind::Conservative { inv_mass } => PhaseSens {
+            Kind::Conservative { inv_mass } => PhaseJac {
                 p: Phase {
                     r: y.p.v,
                     v: f * inv_mass,
                 },
-                jrr: y.jvr,
-                jvr: (h * y.jrr) * inv_mass,
+                d: y.d.map(|c| Partials {
+                    r: c.v,
+                    v: (h * c.r) * inv_mass,
+                }),
             },
-            Kind::Damped { inv_mass, rate } => PhaseSens {
+            Kind::Damped { inv_mass, rate } => PhaseJac {
                 p: Phase {
                     r: y.p.v,
                     v: f * inv_mass - y.p.v * rate,
                 },
-                jrr: y.jvr,
-                jvr: (h * y.jrr) * inv_mass - y.jvr * rate,
+                d: y.d.map(|c| Partials {
+                    r: c.v,
+                    v: (h * c.r) * inv_mass - c.v * rate,
+                }),
             },
-            Kind::Overdamped { inv_drag } => PhaseSens {
+            Kind::Overdamped { inv_drag } => PhaseJac {
                 p: Phase {
                     r: f * inv_drag,
                     v: SVector::zeros(),
                 },
-                jrr: (h * y.jrr) * inv_drag,
-                jvr: SMatrix::zeros(),
+                d: y.d.map(|c| Partials {
+                    r: (h * c.r) * inv_drag,
+                    v: SMatrix::zeros(),
+                }),
             },
         }
     }
@@ -112,16 +119,6 @@ impl<const D: usize> OdeSystem for OffsetVariational<'_, D> {
 
 impl<'a, const D: usize> Dynamics<'a, D> {
     /// The equations of motion of `model`.
-    pub fn new(model: &'a TrapModel<D>) -> Self {
-        Self {
-            model,
-            kind: Kind::of(model),
-        }
-    }
-}
-
-impl<'a, const D: usize> Variational<'a, D> {
-    /// The variational equations of `model`.
     pub fn new(model: &'a TrapModel<D>) -> Self {
         Self {
             model,
@@ -171,51 +168,6 @@ impl<const D: usize> OdeSystem for Dynamics<'_, D> {
             Kind::Overdamped { inv_drag } => Phase {
                 r: f * inv_drag,
                 v: SVector::zeros(),
-            },
-        }
-    }
-}
-
-impl<const D: usize> OdeSystem for Variational<'_, D> {
-    type State = PhaseVar<D>;
-    #[inline]
-    fn max_step(&self, y: &PhaseVar<D>) -> f64 {
-        crossing_limit(self.model, &y.p)
-    }
-    #[inline(always)]
-    fn rhs(&self, y: &PhaseVar<D>) -> PhaseVar<D> {
-        let (fw, h) = self.model.well.force_and_gradient(&y.p.r);
-        let f = fw + self.model.external_force;
-        match self.kind {
-            Kind::Conservative { inv_mass } => PhaseVar {
-                p: Phase {
-                    r: y.p.v,
-                    v: f * inv_mass,
-                },
-                jrr: y.jvr,
-                jrv: y.jvv,
-                jvr: (h * y.jrr) * inv_mass,
-                jvv: (h * y.jrv) * inv_mass,
-            },
-            Kind::Damped { inv_mass, rate } => PhaseVar {
-                p: Phase {
-                    r: y.p.v,
-                    v: f * inv_mass - y.p.v * rate,
-                },
-                jrr: y.jvr,
-                jrv: y.jvv,
-                jvr: (h * y.jrr) * inv_mass - y.jvr * rate,
-                jvv: (h * y.jrv) * inv_mass - y.jvv * rate,
-            },
-            Kind::Overdamped { inv_drag } => PhaseVar {
-                p: Phase {
-                    r: f * inv_drag,
-                    v: SVector::zeros(),
-                },
-                jrr: (h * y.jrr) * inv_drag,
-                jrv: (h * y.jrv) * inv_drag,
-                jvr: SMatrix::zeros(),
-                jvv: SMatrix::zeros(),
             },
         }
     }

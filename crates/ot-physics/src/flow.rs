@@ -77,9 +77,9 @@ impl<const D: usize> Propagator<D> {
         Ok(Flow {
             displacement: e.p.r - y0.r,
             velocity: e.p.v,
-            d_offset: SMatrix::identity() - e.jrr,
-            d_velocity: e.jrv,
-            dv_offset: -e.jvr,
+            d_offset: SMatrix::identity() - e.d[0].r,
+            d_velocity: e.d[1].r,
+            dv_offset: -e.d[0].v,
             evals: p.evals,
         })
     }
@@ -102,7 +102,7 @@ impl<const D: usize> Propagator<D> {
         Ok(OffsetFlow {
             displacement: e.p.r - y0.r,
             velocity: e.p.v,
-            d_offset: SMatrix::identity() - e.jrr,
+            d_offset: SMatrix::identity() - e.d[0].r,
             evals: p.evals,
         })
     }

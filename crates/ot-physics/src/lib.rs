@@ -56,5 +56,5 @@ pub use error::{PhysicsError, Result, ValueError};
 pub use flow::{Flow, OffsetFlow};
 pub use integrate::{Composition, DEFAULT_RTOL, DEFAULT_TOL_M, Method, Propagator};
 pub use model::{BOLTZMANN, TrapBuilder, TrapModel};
-pub use state::{Phase, PhaseSens, PhaseVar};
+pub use state::{Partials, Phase, PhaseJac, PhaseSens, PhaseVar};
 pub use well::{GaussianWell, Well2, Well3};

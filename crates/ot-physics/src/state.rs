@@ -49,97 +49,55 @@ pub struct Phase<const D: usize> {
     pub v: SVector<f64, D>,
 }
 
-/// Phase plus its sensitivity to the initial phase: the four `D×D` blocks
-/// of `∂(r, v)(t) / ∂(r0, v0)` (dimensionless, s, 1/s, dimensionless).
+/// The sensitivity of the phase to one block `x0` of the initial phase
+/// (`r0` or `v0`): the two `D×D` blocks `∂r/∂x0` and `∂v/∂x0`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PhaseVar<const D: usize> {
-    /// The phase itself.
-    pub p: Phase<D>,
-    /// `∂r/∂r0` (dimensionless).
-    pub jrr: SMatrix<f64, D, D>,
-    /// `∂r/∂v0` (s).
-    pub jrv: SMatrix<f64, D, D>,
-    /// `∂v/∂r0` (1/s).
-    pub jvr: SMatrix<f64, D, D>,
-    /// `∂v/∂v0` (dimensionless).
-    pub jvv: SMatrix<f64, D, D>,
+pub struct Partials<const D: usize> {
+    /// `∂r/∂x0` (dimensionless by `r0`, s by `v0`).
+    pub r: SMatrix<f64, D, D>,
+    /// `∂v/∂x0` (1/s by `r0`, dimensionless by `v0`).
+    pub v: SMatrix<f64, D, D>,
 }
 
-/// Phase plus its sensitivity to the initial position only: the two `D×D`
-/// blocks `∂r/∂r0` and `∂v/∂r0` (dimensionless, 1/s). What the envelope and
-/// the inverse solver need (∂/∂offset = −∂/∂r0): half the variational work of
-/// [`PhaseVar`], which also carries `∂/∂v0`.
+/// Phase plus its sensitivity to the first `N` blocks of the initial phase
+/// `(r0, v0)`: `d[0]` = `(∂r/∂r0, ∂v/∂r0)` (dimensionless, 1/s) and, with
+/// `N` = 2, `d[1]` = `(∂r/∂v0, ∂v/∂v0)` (s, dimensionless). `N` is 1 or 2.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PhaseSens<const D: usize> {
+pub struct PhaseJac<const D: usize, const N: usize> {
     /// The phase itself.
     pub p: Phase<D>,
-    /// `∂r/∂r0` (dimensionless).
-    pub jrr: SMatrix<f64, D, D>,
-    /// `∂v/∂r0` (1/s).
-    pub jvr: SMatrix<f64, D, D>,
+    /// The sensitivities by `r0` and (`N` = 2) by `v0`.
+    pub d: [Partials<D>; N],
 }
 
-impl<const D: usize> PhaseSens<D> {
-    /// Start from `p` with `∂r/∂r0 = I`, `∂v/∂r0 = 0`.
+/// Phase plus its sensitivity to the whole initial phase: the four `D×D`
+/// blocks of `∂(r, v)(t) / ∂(r0, v0)` (dimensionless, s, 1/s, dimensionless).
+pub type PhaseVar<const D: usize> = PhaseJac<D, 2>;
+
+/// Phase plus its sensitivity to the initial position only: `∂r/∂r0` and
+/// `∂v/∂r0` (dimensionless, 1/s). What the envelope and the inverse solver
+/// need (∂/∂offset = −∂/∂r0): half the variational work of [`PhaseVar`],
+/// which also carries `∂/∂v0`.
+pub type PhaseSens<const D: usize> = PhaseJac<D, 1>;
+
+impl<const D: usize, const N: usize> PhaseJac<D, N> {
+    /// Sensitivities by `r0` or by `(r0, v0)`, nothing else.
+    const BLOCKS: () = assert!(N == 1 || N == 2, "PhaseJac: N is 1 (r0) or 2 (r0, v0)");
+
+    /// Start from `p` with `∂r/∂r0 = I`, `∂v/∂r0 = 0` and, with `N` = 2,
+    /// `∂r/∂v0 = 0`, `∂v/∂v0 = I`.
     pub fn identity(p: Phase<D>) -> Self {
+        let () = Self::BLOCKS;
         Self {
             p,
-            jrr: SMatrix::identity(),
-            jvr: SMatrix::zeros(),
-        }
-    }
-}
-
-impl<const D: usize> OdeState for PhaseSens<D> {
-    #[inline(always)]
-    fn zero_like(&self) -> Self {
-        Self {
-            p: self.p.zero_like(),
-            jrr: SMatrix::zeros(),
-            jvr: SMatrix::zeros(),
-        }
-    }
-    #[inline(always)]
-    fn combine(&self, h: f64, terms: &[(f64, &Self)]) -> Self {
-        let mut out = *self;
-        for (c, k) in terms {
-            let s = h * c;
-            out.p.r.axpy(s, &k.p.r, 1.0);
-            out.p.v.axpy(s, &k.p.v, 1.0);
-            out.jrr += k.jrr * s;
-            out.jvr += k.jvr * s;
-        }
-        out
-    }
-
-    /// As [`PhaseVar`]'s error control, on the two blocks carried.
-    #[inline]
-    fn error_ratio(err: &Self, y0: &Self, y1: &Self, tol: &Tolerance) -> f64 {
-        let w = tol.atol_v / tol.atol_r;
-        let block =
-            |e: &SMatrix<f64, D, D>, a: &SMatrix<f64, D, D>, b: &SMatrix<f64, D, D>, atol: f64| {
-                let mut worst: f64 = 0.0;
-                for i in 0..D * D {
-                    let sc = atol + tol.rtol * a[i].abs().max(b[i].abs());
-                    worst = worst.max((e[i] / sc).abs());
+            d: std::array::from_fn(|k| {
+                let (one, zero) = (SMatrix::identity(), SMatrix::zeros());
+                if k == 0 {
+                    Partials { r: one, v: zero }
+                } else {
+                    Partials { r: zero, v: one }
                 }
-                worst
-            };
-        Phase::error_ratio(&err.p, &y0.p, &y1.p, tol)
-            .max(block(&err.jrr, &y0.jrr, &y1.jrr, tol.rtol))
-            .max(block(&err.jvr, &y0.jvr, &y1.jvr, tol.rtol * w))
-    }
-}
-
-impl<const D: usize> PhaseVar<D> {
-    /// Start from `p` with identity sensitivities.
-    pub fn identity(p: Phase<D>) -> Self {
-        Self {
-            p,
-            jrr: SMatrix::identity(),
-            jrv: SMatrix::zeros(),
-            jvr: SMatrix::zeros(),
-            jvv: SMatrix::identity(),
+            }),
         }
     }
 }
@@ -182,15 +140,15 @@ impl<const D: usize> OdeState for Phase<D> {
     }
 }
 
-impl<const D: usize> OdeState for PhaseVar<D> {
+impl<const D: usize, const N: usize> OdeState for PhaseJac<D, N> {
     #[inline(always)]
     fn zero_like(&self) -> Self {
         Self {
             p: self.p.zero_like(),
-            jrr: SMatrix::zeros(),
-            jrv: SMatrix::zeros(),
-            jvr: SMatrix::zeros(),
-            jvv: SMatrix::zeros(),
+            d: [Partials {
+                r: SMatrix::zeros(),
+                v: SMatrix::zeros(),
+            }; N],
         }
     }
     #[inline(always)]
@@ -200,10 +158,10 @@ impl<const D: usize> OdeState for PhaseVar<D> {
             let s = h * c;
             out.p.r.axpy(s, &k.p.r, 1.0);
             out.p.v.axpy(s, &k.p.v, 1.0);
-            out.jrr += k.jrr * s;
-            out.jrv += k.jrv * s;
-            out.jvr += k.jvr * s;
-            out.jvv += k.jvv * s;
+            for (o, kd) in out.d.iter_mut().zip(&k.d) {
+                o.r += kd.r * s;
+                o.v += kd.v * s;
+            }
         }
         out
     }
@@ -214,7 +172,10 @@ impl<const D: usize> OdeState for PhaseVar<D> {
     /// `∂r/∂v0`, `rtol·ω` for `∂v/∂r0`, with `ω = atol_v/atol_r`.
     #[inline]
     fn error_ratio(err: &Self, y0: &Self, y1: &Self, tol: &Tolerance) -> f64 {
+        let () = Self::BLOCKS;
         let w = tol.atol_v / tol.atol_r;
+        // absolute scales of (∂r, ∂v): by r0, then by v0
+        let atol = [(tol.rtol, tol.rtol * w), (tol.rtol / w, tol.rtol)];
         let block =
             |e: &SMatrix<f64, D, D>, a: &SMatrix<f64, D, D>, b: &SMatrix<f64, D, D>, atol: f64| {
                 let mut worst: f64 = 0.0;
@@ -224,11 +185,14 @@ impl<const D: usize> OdeState for PhaseVar<D> {
                 }
                 worst
             };
-        Phase::error_ratio(&err.p, &y0.p, &y1.p, tol)
-            .max(block(&err.jrr, &y0.jrr, &y1.jrr, tol.rtol))
-            .max(block(&err.jrv, &y0.jrv, &y1.jrv, tol.rtol / w))
-            .max(block(&err.jvr, &y0.jvr, &y1.jvr, tol.rtol * w))
-            .max(block(&err.jvv, &y0.jvv, &y1.jvv, tol.rtol))
+        let mut worst = Phase::error_ratio(&err.p, &y0.p, &y1.p, tol);
+        for (k, (ar, av)) in atol.into_iter().enumerate().take(N) {
+            let (e, a, b) = (&err.d[k], &y0.d[k], &y1.d[k]);
+            worst = worst
+                .max(block(&e.r, &a.r, &b.r, ar))
+                .max(block(&e.v, &a.v, &b.v, av));
+        }
+        worst
     }
 }
 

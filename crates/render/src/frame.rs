@@ -11,6 +11,7 @@ use haptic_types::Rgba;
 use haptic_types::vec3::{Vec3, add, axes, scale, sub};
 use haptic_types::vec3::{box_corners, normq};
 use picture::text;
+use world_form::numbers::{SiStyle, fmt_si};
 
 /// How a frame looks apart from its primitives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,28 +102,10 @@ pub fn nice_length_m(pixels_per_m: f64, max_px: f64) -> f64 {
     p
 }
 
-/// Writes a length in metres with an SI prefix, e.g. `2 µm`, `100 nm`, `5 cm`.
+/// Writes a length in metres with an SI prefix, e.g. `2 µm`, `100 nm`, `5 cm`
+/// ([`fmt_si`] in the [`SiStyle::LENGTH`] style).
 pub fn format_length(length_m: f64) -> String {
-    let units = [
-        (1.0, "m"),
-        (1e-2, "cm"),
-        (1e-3, "mm"),
-        (1e-6, "µm"),
-        (1e-9, "nm"),
-        (1e-12, "pm"),
-    ];
-    let a = length_m.abs();
-    let (k, u) = units
-        .iter()
-        .find(|(k, _)| a >= *k * 0.999_999)
-        .copied()
-        .unwrap_or((1e-12, "pm"));
-    let v = length_m / k;
-    if (v - v.round()).abs() < 1e-6 * v.abs().max(1.0) {
-        format!("{} {u}", v.round())
-    } else {
-        format!("{v:.3} {u}")
-    }
+    fmt_si(length_m, "m", SiStyle::LENGTH)
 }
 
 impl Frame {

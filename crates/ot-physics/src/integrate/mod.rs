@@ -25,10 +25,10 @@ pub use dopri5::dopri5;
 pub use rk4::{rk4, rk4_step};
 pub use symplectic::{Composition, symplectic};
 
-use crate::dynamics::{Dynamics, OffsetVariational, Variational};
+use crate::dynamics::{Dynamics, Variational};
 use crate::error::{PhysicsError, Result, ValueError, positive};
 use crate::model::TrapModel;
-use crate::state::{LaneSystem, Lanes, Phase, PhaseSens, PhaseVar, Tolerance};
+use crate::state::{LaneSystem, Lanes, OdeSystem, Phase, PhaseJac, PhaseSens, PhaseVar, Tolerance};
 
 /// Displacement error the default method guarantees (m): 1e-11 m = 0.01 nm
 /// from converged dynamics on every hard-case family (Δt 0.2–20 µs at the
@@ -250,23 +250,16 @@ pub(crate) fn ln_step(x: f64) -> Option<f64> {
 /// `x^p` for the step-size controller, to ~1e-6 relative (x > 0): a
 /// step-size factor needs no more, and libm's `powf` was a visible share of
 /// a short adaptive integration. `ln x = e·ln2 + 2·atanh((m−1)/(m+1))` with
-/// the mantissa `m ∈ [1, 2)`, then the crate's inlined `exp`.
+/// the mantissa `m ∈ [1, 2)` ([`ln_step`]), then the crate's inlined `exp`.
 #[inline]
 fn pow_step(x: f64, p: f64) -> f64 {
     if p == 0.0 {
         return 1.0;
     }
-    if !(x.is_normal() && x > 0.0) {
-        return x.powf(p);
+    match ln_step(x) {
+        Some(ln_x) => crate::fastexp::exp(p * ln_x),
+        None => x.powf(p),
     }
-    let bits = x.to_bits();
-    let e = ((bits >> 52) & 0x7ff) as i64 - 1023;
-    let m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
-    let s = (m - 1.0) / (m + 1.0);
-    let s2 = s * s;
-    let ln_m = 2.0 * s * (1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 / 9.0))));
-    let ln_x = e as f64 * std::f64::consts::LN_2 + ln_m;
-    crate::fastexp::exp(p * ln_x)
 }
 
 /// A method bound to a model and an interval Δt, validated once, then
@@ -366,27 +359,39 @@ impl<const D: usize> Propagator<D> {
         self.dt
     }
 
-    /// Propagate a phase over Δt.
-    pub fn phase(&self, y0: &Phase<D>) -> Result<Propagated<Phase<D>>> {
-        let sys = Dynamics::new(&self.model);
+    /// The one dispatch over the methods: `sys` from `y0` over Δt by the
+    /// bound method, `h0` (s) the first trial step of the adaptive ones.
+    /// Returns the end state and the force evaluations spent. A symplectic
+    /// method runs here as RK4 with its substeps (how the sensitivities are
+    /// integrated); [`Propagator::phase`] runs the composition itself.
+    #[inline]
+    fn integrate<S: OdeSystem>(&self, sys: &S, y0: &S::State, h0: f64) -> Result<(S::State, u64)> {
         let dt = self.dt;
-        let (end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, y0, dt, 1), 4),
-            Method::Rk4 { substeps } => (rk4(&sys, y0, dt, substeps), 4 * u64::from(substeps)),
-            Method::Rk8 { substeps } => (rk8(&sys, y0, dt, substeps), 12 * u64::from(substeps)),
+        Ok(match self.method {
+            Method::PaperRk4 => (rk4(sys, y0, dt, 1), 4),
+            Method::Rk4 { substeps } | Method::Symplectic { substeps, .. } => {
+                (rk4(sys, y0, dt, substeps), 4 * u64::from(substeps))
+            }
+            Method::Rk8 { substeps } => (rk8(sys, y0, dt, substeps), 12 * u64::from(substeps)),
             Method::Dopri5 { .. } => {
-                let h0 = self.first_step(y0);
-                let (y, s) = dopri5(&sys, y0, dt, &self.tol, h0, &self.ctl)?;
+                let (y, s) = dopri5(sys, y0, dt, &self.tol, h0, &self.ctl)?;
                 (y, s.evals)
             }
             Method::Adaptive { .. } => {
-                let (y, s) = dop853(&sys, y0, dt, &self.tol, self.h0, &self.ctl)?;
+                let (y, s) = dop853(sys, y0, dt, &self.tol, h0, &self.ctl)?;
                 (y, s.evals)
             }
+        })
+    }
+
+    /// Propagate a phase over Δt.
+    pub fn phase(&self, y0: &Phase<D>) -> Result<Propagated<Phase<D>>> {
+        let (end, evals) = match self.method {
             Method::Symplectic {
                 substeps,
                 composition,
-            } => symplectic(&self.model, y0, dt, substeps, composition),
+            } => symplectic(&self.model, y0, self.dt, substeps, composition),
+            _ => self.integrate(&Dynamics::new(&self.model), y0, self.first_step(y0))?,
         };
         Ok(Propagated {
             end: self.finish(end, y0),
@@ -399,16 +404,17 @@ impl<const D: usize> Propagator<D> {
     /// [`Propagator::phase`], faster because the lanes overlap. `None` for
     /// the adaptive and symplectic methods (their lanes would share steps).
     pub fn phase_lanes<const L: usize>(&self, y0: &[Phase<D>; L]) -> Option<([Phase<D>; L], u64)> {
+        if !matches!(
+            self.method,
+            Method::PaperRk4 | Method::Rk4 { .. } | Method::Rk8 { .. }
+        ) {
+            return None;
+        }
         let inner = Dynamics::new(&self.model);
-        let sys = LaneSystem::<_, L>(&inner);
-        let y = Lanes(*y0);
-        let dt = self.dt;
-        let (end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, &y, dt, 1), 4),
-            Method::Rk4 { substeps } => (rk4(&sys, &y, dt, substeps), 4 * u64::from(substeps)),
-            Method::Rk8 { substeps } => (rk8(&sys, &y, dt, substeps), 12 * u64::from(substeps)),
-            _ => return None,
-        };
+        // fixed steps have no error control: they cannot fail
+        let (end, evals) = self
+            .integrate(&LaneSystem::<_, L>(&inner), &Lanes(*y0), self.h0)
+            .ok()?;
         let mut out = end.0;
         for (o, y0) in out.iter_mut().zip(y0) {
             *o = self.finish(*o, y0);
@@ -463,52 +469,22 @@ impl<const D: usize> Propagator<D> {
     /// discrete map; symplectic methods use RK4 with the same substeps for
     /// the sensitivities.
     pub fn phase_var(&self, y0: &Phase<D>) -> Result<Propagated<PhaseVar<D>>> {
-        let sys = Variational::new(&self.model);
-        let dt = self.dt;
-        let yv = PhaseVar::identity(*y0);
-        let (mut end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, &yv, dt, 1), 4),
-            Method::Rk4 { substeps } | Method::Symplectic { substeps, .. } => {
-                (rk4(&sys, &yv, dt, substeps), 4 * u64::from(substeps))
-            }
-            Method::Rk8 { substeps } => (rk8(&sys, &yv, dt, substeps), 12 * u64::from(substeps)),
-            Method::Dopri5 { .. } => {
-                let (y, s) = dopri5(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-            Method::Adaptive { .. } => {
-                let (y, s) = dop853(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-        };
-        end.p = self.finish(end.p, y0);
-        Ok(Propagated { end, evals })
+        self.sensitivities(y0)
     }
-}
 
-impl<const D: usize> Propagator<D> {
     /// Propagate a phase and its sensitivity to the initial position only
     /// (the offset Jacobian), over Δt. Fixed-step methods give the exact
     /// derivative of their own discrete map, as [`Propagator::phase_var`].
     pub fn phase_sens(&self, y0: &Phase<D>) -> Result<Propagated<PhaseSens<D>>> {
-        let sys = OffsetVariational::new(&self.model);
-        let dt = self.dt;
-        let yv = PhaseSens::identity(*y0);
-        let (mut end, evals) = match self.method {
-            Method::PaperRk4 => (rk4(&sys, &yv, dt, 1), 4),
-            Method::Rk4 { substeps } | Method::Symplectic { substeps, .. } => {
-                (rk4(&sys, &yv, dt, substeps), 4 * u64::from(substeps))
-            }
-            Method::Rk8 { substeps } => (rk8(&sys, &yv, dt, substeps), 12 * u64::from(substeps)),
-            Method::Dopri5 { .. } => {
-                let (y, s) = dopri5(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-            Method::Adaptive { .. } => {
-                let (y, s) = dop853(&sys, &yv, dt, &self.tol, self.h0, &self.ctl)?;
-                (y, s.evals)
-            }
-        };
+        self.sensitivities(y0)
+    }
+
+    /// The phase and its sensitivities by the first `N` blocks of the
+    /// initial phase, over Δt: [`Propagator::phase_sens`] (`N` = 1) and
+    /// [`Propagator::phase_var`] (`N` = 2).
+    fn sensitivities<const N: usize>(&self, y0: &Phase<D>) -> Result<Propagated<PhaseJac<D, N>>> {
+        let sys = Variational::<D, N>::new(&self.model);
+        let (mut end, evals) = self.integrate(&sys, &PhaseJac::identity(*y0), self.h0)?;
         end.p = self.finish(end.p, y0);
         Ok(Propagated { end, evals })
     }
