@@ -264,7 +264,7 @@ pub fn resolve_scene<'py>(
 ///         simulated hand with those of mass_kg, stiffness_n_per_m,
 ///         damping_n_s_per_m, yield_force_n changed from the defaults), or a
 ///         dict of those hand parameters (the same as "hand:...").
-///     device: None (the scene's), "falcon", "touch", or "udp:HOST:PORT":
+///     device: None (the scene's), "falcon", "touch", "udp:HOST:PORT" or "udp:PORT":
 ///         wait there for a device in another process (see
 ///         ``nanohaptics.bridge``) and run in real time against it until it
 ///         says goodbye or ``seconds`` pass.
