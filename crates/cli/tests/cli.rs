@@ -762,3 +762,55 @@ fn lesson_audio_and_score_work_from_any_directory() {
     let wall = json(&nh(&["run", "wall", "--json", "--seconds", "0.1"]));
     assert!(wall["house_score"].is_null());
 }
+
+/// A device is named one way in every command (`DeviceSource::parse`): the same forms, the
+/// same error listing them, and each command's own refusal of a form it cannot use.
+#[test]
+fn every_command_names_a_device_the_same_way() {
+    let forms = "allowed falcon, touch, udp:HOST:PORT or udp:PORT";
+    for (args, err) in [
+        (
+            vec!["run", "wall", "--device", "phantom"],
+            format!("error: --device: device `phantom` is not known: {forms}"),
+        ),
+        (
+            vec!["play", "wall", "--device", "phantom"],
+            format!("error: --device: device `phantom` is not known: {forms}"),
+        ),
+        (
+            vec!["fake-device", "phantom"],
+            format!("error: device `phantom` is not known: {forms}"),
+        ),
+        (
+            vec!["play", "wall", "--device", "touch"],
+            "error: --device `touch`: play's own hand is the page; --device names a device in \
+             another process (udp:HOST:PORT or udp:PORT)"
+                .to_string(),
+        ),
+        (
+            vec!["fake-device", "touch"],
+            "error: `touch` is a device model: fake-device plays against the simulator's \
+             address, udp:HOST:PORT or udp:PORT (the model is --model touch)"
+                .to_string(),
+        ),
+        (
+            vec!["run", "wall", "--device", "udp:host"],
+            "error: --device: device `udp:host`: `host` is not an IP address and port \
+             (e.g. 127.0.0.1:9870)"
+                .to_string(),
+        ),
+    ] {
+        let o = nh(&args);
+        assert_eq!(o.status.code(), Some(1), "{args:?}");
+        assert_eq!(String::from_utf8_lossy(&o.stderr).trim(), err, "{args:?}");
+    }
+    // The loopback shorthand is accepted everywhere: `run` waits on it (here for no time).
+    let o = nh(&[
+        "run", "wall", "--device", "udp:1", "--wait-s", "0", "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: device: device link: no device said hello on udp:127.0.0.1:1 within 0 s"
+    );
+}

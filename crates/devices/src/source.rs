@@ -157,7 +157,7 @@ mod tests {
         );
         assert_eq!(
             DeviceSource::parse("udp:host").unwrap_err().to_string(),
-            "--device `udp:host`: `host` is not an IP address and port (e.g. 127.0.0.1:9870)"
+            "device `udp:host`: `host` is not an IP address and port (e.g. 127.0.0.1:9870)"
         );
     }
 }

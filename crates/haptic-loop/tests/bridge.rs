@@ -348,7 +348,7 @@ fn no_device_is_a_clear_error_after_the_wait() {
         BridgeConfig::parse("udp:localhost")
             .unwrap_err()
             .to_string(),
-        "device link: --device `udp:localhost`: `localhost` is not an IP address and port (e.g. 127.0.0.1:9870)"
+        "device link: device `udp:localhost`: `localhost` is not an IP address and port (e.g. 127.0.0.1:9870)"
     );
 }
 

@@ -39,7 +39,7 @@ pub struct BridgeConfig {
 impl BridgeConfig {
     /// Parses `udp:HOST:PORT`, or `udp:PORT` for loopback (the `--device` option).
     pub fn parse(spec: &str) -> Result<Self, DeviceError> {
-        let bind = super::parse_endpoint(spec, "udp", "--device", "udp:127.0.0.1:9870")
+        let bind = super::parse_endpoint(spec, "udp", "device", "udp:127.0.0.1:9870")
             .map_err(DeviceError::Link)?;
         Ok(BridgeConfig {
             bind,
