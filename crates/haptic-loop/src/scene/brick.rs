@@ -9,7 +9,7 @@
 //! `turn_z`.
 //! The world's `dt_s` must equal the loop's tick.
 
-use super::check::{SceneError, check_positive, out_of_range};
+use super::check::{SceneError, check_positive, fmt_num, out_of_range};
 use super::score::{self, DROP_HEIGHT_M, HouseScore};
 use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use brickworld::{CursorInput, Grip, Params, World};
@@ -103,7 +103,7 @@ impl BrickScene {
             return Err(out_of_range(
                 "brickworld.params.dt_s",
                 s.params.dt_s,
-                format!("{dt_s} s, the loop's tick (1 / loop.rate_hz)"),
+                format!("{} s, the loop's tick (1 / loop.rate_hz)", fmt_num(dt_s)),
             ));
         }
         check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;

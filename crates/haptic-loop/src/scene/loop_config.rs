@@ -1,7 +1,7 @@
 //! The loop's configuration: the `[mapping]`, `[loop]` and `[display]` tables of a scene file,
 //! checked, and what the haptic loop makes of them ([`LoopConfig`]).
 
-use super::check::{SceneError, check_range, out_of_range};
+use super::check::{SceneError, check_range, fmt_num, out_of_range};
 use haptic_types::DeviceSpecs;
 use haptic_types::vec3::{self, Vec3};
 use serde::Deserialize;
@@ -241,7 +241,7 @@ impl LoopConfig {
         if !(100..=20_000).contains(&l.rate_hz) || 1_000_000_000 % l.rate_hz != 0 {
             return Err(out_of_range(
                 "loop.rate_hz",
-                l.rate_hz,
+                f64::from(l.rate_hz),
                 "100 ≤ rate_hz ≤ 20000 with 10^9 / rate_hz a whole number",
             ));
         }
@@ -265,8 +265,11 @@ impl LoopConfig {
         if d.rate_hz == 0 || d.rate_hz > l.rate_hz || l.rate_hz % d.rate_hz != 0 {
             return Err(out_of_range(
                 "display.rate_hz",
-                d.rate_hz,
-                format!("a divisor of loop.rate_hz = {}", l.rate_hz),
+                f64::from(d.rate_hz),
+                format!(
+                    "a divisor of loop.rate_hz = {}",
+                    fmt_num(f64::from(l.rate_hz))
+                ),
             ));
         }
         check_range("display.scale", d.scale, 1e-3, 1e12)?;

@@ -2,7 +2,7 @@
 //! to the world's SI parameters and tick map, every field checked with its range.
 
 use super::three_digits_down;
-use crate::scene::check::{SceneError, check_positive, check_range, out_of_range};
+use crate::scene::check::{SceneError, check_positive, check_range, fmt_num, out_of_range};
 use ot_envelope::ClipMode;
 use ot_envelope::world::{Params, TickMap};
 use serde::Deserialize;
@@ -133,7 +133,10 @@ impl OtParams {
             out_of_range(
                 "optical_tweezers.stiffness_n_per_m",
                 p.stiffness_n_per_m,
-                format!("0 < stiffness ≤ {cap} N/m, the device's limit mapped to the world"),
+                format!(
+                    "0 < stiffness ≤ {} N/m, the device's limit mapped to the world",
+                    fmt_num(cap)
+                ),
             )
         })?;
         check_range(
