@@ -3,6 +3,7 @@
 use crate::measure::{self, events, times};
 use crate::{LessonError, LessonSummary, Run, Runs, write_file};
 use chart::{Band, Bar, BarChart, Chart, Figure, Marker, Scale, Series, Style};
+use haptic_loop::scene::check::{fmt_num, fmt_sig};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -107,6 +108,9 @@ pub fn si(v: f64, unit: &str) -> String {
         return format!("0 {unit}");
     }
     if !(1e-10..1e6).contains(&a) {
+        // Three significant digits like the prefixed forms (`3.00 nN`), trailing zeros kept:
+        // docs/lesson/lesson.md holds this form (`2.00e23 m/s²`, where fmt_sig would write
+        // `2e23`), and that committed report is not regenerated for a number format.
         return format!("{v:.2e} {unit}");
     }
     let (scale, p) = prefixes
@@ -525,9 +529,9 @@ fn md_throw(m: &mut String, s: &LessonSummary) {
          {:.2} s{}.\n\n\
          **An atom stays.** The same hand motion in the nano world with an atom on the tip: the \
          atom {}. Its inertia is {} and its weight {}, while the tip holds it with {} \
-         (the tip–atom pull-off force): {:.1e} times more than both. To throw it off, the hand \
+         (the tip–atom pull-off force): {} times more than both. To throw it off, the hand \
          would have to accelerate at {} — adhesion beats inertia at this scale.\n\n\
-         **The threshold, shown.** Make the atom {} kg ({:.0e} times heavier) and switch gravity \
+         **The threshold, shown.** Make the atom {} kg ({} times heavier) and switch gravity \
          off, and the threshold comes within reach: predicted {} of hand acceleration \
          (hold / mass / workspace scale). In {} throws, the atom stayed on up to {} and left \
          the tip from {}.\n\n![throw threshold](throw_threshold.png)\n",
@@ -548,10 +552,10 @@ fn md_throw(m: &mut String, s: &LessonSummary) {
         si(s.atom_inertia_n, "N"),
         si(s.atom_mass_kg * 9.81, "N"),
         si(s.atom_hold_n, "N"),
-        s.atom_hold_n / s.atom_load_n,
+        fmt_sig(s.atom_hold_n / s.atom_load_n, 2),
         si(s.atom_threshold_hand_m_per_s2, "m/s²"),
-        sw.mass_kg,
-        sw.mass_kg / s.atom_mass_kg,
+        fmt_num(sw.mass_kg),
+        fmt_sig(sw.mass_kg / s.atom_mass_kg, 1),
         si(sw.predicted_hand_m_per_s2, "m/s²"),
         sw.runs.len(),
         si(sw.kept_below_m_per_s2, "m/s²"),
