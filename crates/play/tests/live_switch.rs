@@ -54,7 +54,7 @@ fn live_switches_are_recorded_on_their_tick_and_replay_bit_for_bit() {
     }
     assert_eq!(
         refused,
-        ["switch `brick_mass_kg` = 1000000000 is out of range: allowed 0.001 ≤ value ≤ 100"]
+        ["switch `brick_mass_kg` = 1e9 is out of range: allowed 0.001 ≤ value ≤ 100"]
     );
     let r = read_recording_file(&out, false).unwrap();
     let sched = switch_schedule(&r, 1_000_000).unwrap();
