@@ -92,7 +92,7 @@ def test_session_errors(tmp_path):
         nh.run_scene(SCENES / "nope.toml")
     cases = [
         (lambda: nh.run_scene(SCENES / "wall.toml", seconds=0.0),
-         "session length 0 s is out of range: allowed 0 < seconds ≤ 3600"),
+         "session length [s] = 0 is out of range: allowed 0 < length ≤ 3600 s"),
         (lambda: nh.run_scene(SCENES / "wall.toml", operator="robot"),
          "operator `robot` is not one of: rigid, hand, hand:key=value,..."),
         # "script" was Python's own name for what the command line calls "hand"

@@ -8,8 +8,10 @@ use haptic_devices::source::DeviceSource;
 use haptic_devices::{Grip, Mechanics, Script};
 use haptic_loop::session::OperatorChoice;
 use haptic_types::DeviceModel;
+use haptic_types::value::{ValueError, out_of_range};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use world_form::fmt_num;
 
 #[derive(clap::Args)]
 pub(crate) struct FakeArgs {
@@ -82,12 +84,18 @@ pub(crate) fn cmd(a: FakeArgs) -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// A flag's value checked against its range.
-fn check(flag: &str, v: f64, lo: f64, hi: f64) -> Result<f64, String> {
+/// A flag's value checked against its range `lo`–`hi` in `unit` (empty for a plain number).
+fn check(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<f64, String> {
     if v.is_finite() && (lo..=hi).contains(&v) {
         Ok(v)
     } else {
-        Err(format!("--{flag} = {v} is out of range: allowed {lo}–{hi}"))
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        let allowed = format!("{}–{}{unit}", fmt_num(lo), fmt_num(hi));
+        Err(ValueError::out_of_range(format!("--{flag}"), v, allowed).to_string())
     }
 }
 
@@ -98,8 +106,8 @@ fn outage(o: &str) -> Result<(f64, f64), String> {
     let s: f64 = s.parse().map_err(|_| bad())?;
     let d: f64 = d.parse().map_err(|_| bad())?;
     Ok((
-        check("outage start", s, 0.0, 86400.0)?,
-        check("outage seconds", d, 0.0, 86400.0)?,
+        check("outage start", s, 0.0, 86400.0, "s")?,
+        check("outage seconds", d, 0.0, 86400.0, "s")?,
     ))
 }
 
@@ -163,7 +171,7 @@ fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), Strin
     let protocol = match a.protocol {
         1 => Protocol::V1,
         2 => Protocol::V2,
-        p => return Err(format!("--protocol = {p} is out of range: allowed 1 or 2")),
+        p => return Err(out_of_range("--protocol", p, "1 or 2")),
     };
     let physical = physical(a)?;
     // Scripts name the buttons of the device they were written for: a Falcon's, or a Touch's.
@@ -183,13 +191,13 @@ fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), Strin
         OperatorChoice::Hand(p) => Some(p),
         OperatorChoice::ScriptHand => Some(script.operator.unwrap_or_default()),
     };
-    let loss = check("loss", a.loss, 0.0, 1.0)?;
-    let jitter = check("jitter-ms", a.jitter_ms, 0.0, 1000.0)?;
-    let latency = check("latency-ms", a.latency_ms, 0.0, 1000.0)?;
+    let loss = check("loss", a.loss, 0.0, 1.0, "(a probability)")?;
+    let jitter = check("jitter-ms", a.jitter_ms, 0.0, 1000.0, "ms")?;
+    let latency = check("latency-ms", a.latency_ms, 0.0, 1000.0, "ms")?;
     let outage = a.outage.as_deref().map(outage).transpose()?;
     if let Some(s) = a.seconds {
         // Up to a day: a soak plays for hours.
-        check("seconds", s, 1e-3, 86400.0)?;
+        check("seconds", s, 1e-3, 86400.0, "s")?;
     }
     let cfg = FakeConfig {
         target,
@@ -203,7 +211,7 @@ fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), Strin
         seed: a.seed,
         seconds: a.seconds,
         outage,
-        wait_s: check("wait-s", a.wait_s, 0.0, 86400.0)?,
+        wait_s: check("wait-s", a.wait_s, 0.0, 86400.0, "s")?,
         bye: true,
         protocol,
     };

@@ -1,5 +1,6 @@
 //! `nanohaptics lesson`: the macro-vs-nano lesson report (see `lesson`).
 
+use haptic_types::value::ValueError;
 use indicatif::{ProgressBar, ProgressStyle};
 use lesson::{LessonOptions, report::si, run_lesson};
 use std::path::PathBuf;
@@ -25,16 +26,17 @@ pub struct LessonArgs {
 /// Runs the lesson and prints where the report is.
 pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
     if !(200..=4000).contains(&args.width) {
-        return Err(format!(
-            "--width = {} is out of range: allowed 200–4000 px",
-            args.width
-        ));
+        return Err(
+            ValueError::out_of_range("--width", f64::from(args.width), "200–4000 px").to_string(),
+        );
     }
     if !(8_000..=192_000).contains(&args.sample_rate) {
-        return Err(format!(
-            "--sample-rate = {} is out of range: allowed 8000–192000 Hz",
-            args.sample_rate
-        ));
+        return Err(ValueError::out_of_range(
+            "--sample-rate",
+            f64::from(args.sample_rate),
+            "8000–192000 Hz",
+        )
+        .to_string());
     }
     let pb = (!args.json).then(|| {
         let pb = ProgressBar::new(1);

@@ -7,6 +7,7 @@ use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionError, SessionOptions, SessionReport, run_session_until,
 };
 use haptic_loop::totals::Totals;
+use haptic_types::value::ValueError;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -206,9 +207,7 @@ pub(crate) fn cmd(args: RunArgs) -> Result<ExitCode, String> {
         let mut d = DeviceSource::parse(d).map_err(|e| format!("--device: {e}"))?;
         if let DeviceSource::Udp(b) = &mut d {
             if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
-                return Err(format!(
-                    "--wait-s = {wait_s} is out of range: allowed 0–86400"
-                ));
+                return Err(ValueError::out_of_range("--wait-s", wait_s, "0–86400 s").to_string());
             }
             b.wait_s = wait_s;
             if !json {
@@ -223,9 +222,9 @@ pub(crate) fn cmd(args: RunArgs) -> Result<ExitCode, String> {
     if let Some(l) = live.as_deref() {
         let mut c = LiveConfig::parse(l).map_err(|e| e.to_string())?;
         if !(1..=1000).contains(&live_hz) {
-            return Err(format!(
-                "--live-hz = {live_hz} is out of range: allowed 1–1000"
-            ));
+            return Err(
+                ValueError::out_of_range("--live-hz", f64::from(live_hz), "1–1000 Hz").to_string(),
+            );
         }
         c.display_hz = live_hz;
         if !json {

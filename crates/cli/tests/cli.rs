@@ -629,12 +629,12 @@ fn a_session_shorter_than_one_tick_is_refused() {
     let _shared = beside_others();
     assert_eq!(
         error_in(&root(), &["run", "wall", "--seconds", "0.0004"]),
-        "error: session length 4e-4 s is shorter than one tick (1 ms at 1000 Hz): allowed \
-         5e-4 ≤ seconds ≤ 3600"
+        "error: session length [s] = 4e-4 is out of range: allowed 5e-4 ≤ length ≤ 3600 s, one \
+         tick or more (a tick is 1 ms at 1000 Hz)"
     );
     assert_eq!(
         error_in(&root(), &["run", "wall", "--seconds", "1e308"]),
-        "error: session length 1e308 s is out of range: allowed 0 < seconds ≤ 3600"
+        "error: session length [s] = 1e308 is out of range: allowed 0 < length ≤ 3600 s"
     );
     // Half a tick rounds to one tick.
     let run = json(&nh(&["run", "wall", "--seconds", "0.0005", "--json"]));

@@ -71,26 +71,11 @@ pub enum SessionError {
         /// OS error.
         message: String,
     },
-    /// Session length out of range.
-    #[error(
-        "session length {} s is out of range: allowed 0 < seconds ≤ 3600",
-        crate::scene::check::fmt_num(*.0)
-    )]
-    Seconds(f64),
-    /// A session shorter than one tick.
-    #[error(
-        "session length {} s is shorter than one tick ({} ms at {rate_hz} Hz): allowed \
-         {} ≤ seconds ≤ 3600",
-        crate::scene::check::fmt_num(*seconds),
-        1e3 / f64::from(*rate_hz),
-        crate::scene::check::fmt_num(0.5 / f64::from(*rate_hz))
-    )]
-    TooShort {
-        /// The length asked for, s.
-        seconds: f64,
-        /// The loop rate, Hz.
-        rate_hz: u32,
-    },
+    /// Session length out of range (not finite, not in `0 < length ≤ 3600 s`, or shorter
+    /// than half a tick, which would round to no tick at all), in the one wording of
+    /// [`ValueError`](haptic_types::value::ValueError).
+    #[error(transparent)]
+    Seconds(haptic_types::value::ValueError),
     /// A scene reported a state field name that cannot be a message field.
     #[error("scene state field `{0}` is not a lower-snake-case field name")]
     StateField(String),

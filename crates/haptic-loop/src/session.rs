@@ -29,9 +29,11 @@ use haptic_types::Switch;
 use haptic_types::TickTime;
 use haptic_types::textpos::Location;
 use haptic_types::textpos::field_position;
+use haptic_types::value::ValueError;
 use recording::WriteSummary;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
+use world_form::fmt_num;
 
 pub use crate::arrays::SessionArrays;
 pub use crate::error::SessionError;
@@ -243,14 +245,31 @@ fn script_switches(
     Ok(out)
 }
 
-/// Validates a session length and turns it into ticks.
+/// The field a session length is named by in its errors.
+const SESSION_LENGTH: &str = "session length [s]";
+
+/// Validates a session length (s) and turns it into ticks at `rate_hz`: the length must be
+/// finite, `0 < seconds ≤ 3600` and at least half a tick (it rounds to one tick or more).
 pub fn ticks_for(seconds: f64, rate_hz: u32) -> Result<u64, SessionError> {
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
-        return Err(SessionError::Seconds(seconds));
+        return Err(SessionError::Seconds(ValueError::out_of_range(
+            SESSION_LENGTH,
+            seconds,
+            "0 < length ≤ 3600 s",
+        )));
     }
     let ticks = (seconds * f64::from(rate_hz)).round() as u64;
     if ticks == 0 {
-        return Err(SessionError::TooShort { seconds, rate_hz });
+        let rate = f64::from(rate_hz);
+        return Err(SessionError::Seconds(ValueError::out_of_range(
+            SESSION_LENGTH,
+            seconds,
+            format!(
+                "{} ≤ length ≤ 3600 s, one tick or more (a tick is {} ms at {rate_hz} Hz)",
+                fmt_num(0.5 / rate),
+                fmt_num(1e3 / rate)
+            ),
+        )));
     }
     Ok(ticks)
 }

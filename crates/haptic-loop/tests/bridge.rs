@@ -390,7 +390,8 @@ fn the_welcome_carries_the_scenes_rate_name_and_start_time() {
         r.stats.ticks,
         counter(&r, "superseded")
     );
-    assert!(r.stats.ticks >= 4000, "{} ticks", r.stats.ticks);
+    // Paced at 1 kHz (the bug) the loop would run about 500 ticks in 0.5 s.
+    assert!(r.stats.ticks >= 2500, "{} ticks", r.stats.ticks);
     assert!(
         stale * 10 < r.stats.ticks * 9,
         "{stale} stale ticks of {}",

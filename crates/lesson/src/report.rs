@@ -5,7 +5,7 @@ use crate::{LessonError, LessonSummary, Run, Runs, write_file};
 use chart::{Band, Bar, BarChart, Chart, Figure, Marker, Scale, Series, Style};
 use std::fmt::Write;
 use std::path::Path;
-use world_form::numbers::{SiStyle, fmt_si};
+use world_form::numbers::{SiStyle, fmt_num, fmt_si, fmt_sig};
 
 const BLUE: [u8; 3] = [31, 119, 180];
 const ORANGE: [u8; 3] = [255, 127, 14];
@@ -502,9 +502,9 @@ fn md_throw(m: &mut String, s: &LessonSummary) {
          {:.2} s{}.\n\n\
          **An atom stays.** The same hand motion in the nano world with an atom on the tip: the \
          atom {}. Its inertia is {} and its weight {}, while the tip holds it with {} \
-         (the tip–atom pull-off force): {:.1e} times more than both. To throw it off, the hand \
+         (the tip–atom pull-off force): {} times more than both. To throw it off, the hand \
          would have to accelerate at {} — adhesion beats inertia at this scale.\n\n\
-         **The threshold, shown.** Make the atom {} kg ({:.0e} times heavier) and switch gravity \
+         **The threshold, shown.** Make the atom {} kg ({} times heavier) and switch gravity \
          off, and the threshold comes within reach: predicted {} of hand acceleration \
          (hold / mass / workspace scale). In {} throws, the atom stayed on up to {} and left \
          the tip from {}.\n\n![throw threshold](throw_threshold.png)\n",
@@ -525,10 +525,10 @@ fn md_throw(m: &mut String, s: &LessonSummary) {
         si(s.atom_inertia_n, "N"),
         si(s.atom_mass_kg * 9.81, "N"),
         si(s.atom_hold_n, "N"),
-        s.atom_hold_n / s.atom_load_n,
+        fmt_sig(s.atom_hold_n / s.atom_load_n, 2),
         si(s.atom_threshold_hand_m_per_s2, "m/s²"),
-        sw.mass_kg,
-        sw.mass_kg / s.atom_mass_kg,
+        fmt_num(sw.mass_kg),
+        fmt_sig(sw.mass_kg / s.atom_mass_kg, 1),
         si(sw.predicted_hand_m_per_s2, "m/s²"),
         sw.runs.len(),
         si(sw.kept_below_m_per_s2, "m/s²"),

@@ -67,22 +67,26 @@ pub struct GridChoice {
     pub v_max: f64,
 }
 
+/// The choice in words, its numbers by [`fmt_num`](world_form::fmt_num) (measured ones to
+/// three significant digits). Only printed: the scenes record the choice as a typed event (its
+/// fields), not this text.
 impl std::fmt::Display for GridChoice {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let num = |x: f64| world_form::fmt_sig(x, 3);
         write!(
             f,
-            "envelope grid: region {} waists beyond the drift path (cut ≤ {:.2e} m), cell {} \
-             waists ({:.2e} m from a {} waist grid at {} speeds ≤ {:.2e} m/s; budget {:.2e} m \
-             of tol {:.2e} m), {} vertices at rest",
-            self.margin_waists,
-            self.region_bound_m,
-            self.cell_waists,
-            self.grid_error_m,
-            REFERENCE_CELL_WAISTS,
+            "envelope grid: region {} waists beyond the drift path (cut ≤ {} m), cell {} \
+             waists ({} m from a {} waist grid at {} speeds ≤ {} m/s; budget {} m of tol {} m), \
+             {} vertices at rest",
+            world_form::fmt_num(self.margin_waists),
+            num(self.region_bound_m),
+            world_form::fmt_num(self.cell_waists),
+            num(self.grid_error_m),
+            world_form::fmt_num(REFERENCE_CELL_WAISTS),
             self.velocities,
-            self.v_max,
-            self.tol_m / 2.0,
-            self.tol_m,
+            num(self.v_max),
+            num(self.tol_m / 2.0),
+            num(self.tol_m),
             self.vertices
         )
     }

@@ -60,21 +60,25 @@ pub struct MapChoice {
     pub v_max: f64,
 }
 
+/// The choice in words, its numbers to three significant digits by
+/// [`fmt_sig`](world_form::fmt_sig). Only printed: the scenes record the choice as a typed
+/// event (its fields), not this text.
 impl std::fmt::Display for MapChoice {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let n = match self.method {
             Method::Rk4 { substeps } | Method::Rk8 { substeps } => substeps,
             _ => 1,
         };
+        let num = |x: f64| world_form::fmt_sig(x, 3);
         write!(
             f,
-            "tick map {}×{n}: {:.2e} m from converged dynamics at {} probes (budget {:.2e} m, \
-             speeds ≤ {:.2e} m/s), {} force evaluations per flow",
+            "tick map {}×{n}: {} m from converged dynamics at {} probes (budget {} m, \
+             speeds ≤ {} m/s), {} force evaluations per flow",
             self.method.name(),
-            self.error_m,
+            num(self.error_m),
             self.probes,
-            self.tol_m,
-            self.v_max,
+            num(self.tol_m),
+            num(self.v_max),
             self.evals_per_flow
         )
     }

@@ -5,6 +5,7 @@
 //! physical ranges are checked by the wrapped crates and their typed errors are
 //! raised unchanged as `ValueError`.
 
+use haptic_types::value::{ValueError, out_of_range};
 use nalgebra::SVector;
 use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -64,10 +65,10 @@ fn all_finite(n: &Numbers, name: &str, unit: &str) -> PyResult<()> {
         idx.push((rest / stride).to_string());
         rest %= stride;
     }
-    Err(PyValueError::new_err(format!(
-        "{name}[{}] = {} is out of range: allowed finite ({unit})",
-        idx.join(", "),
-        world_form::numbers::fmt_num(n.data[k])
+    Err(value_error(ValueError::out_of_range(
+        format!("{name}[{}]", idx.join(", ")),
+        n.data[k],
+        format!("finite ({unit})"),
     )))
 }
 
@@ -161,8 +162,10 @@ pub(crate) fn int_in(obj: &Bound<'_, PyAny>, name: &str, lo: i128, hi: i128) -> 
     let v: i128 = match obj.extract() {
         Ok(v) => v,
         Err(_) if obj.is_instance_of::<PyInt>() => {
-            return Err(PyValueError::new_err(format!(
-                "{name} = {obj} is out of range: allowed {lo} ..= {hi}"
+            return Err(PyValueError::new_err(out_of_range(
+                name,
+                obj,
+                &format!("{lo} ..= {hi}"),
             )));
         }
         Err(_) => {
@@ -175,8 +178,10 @@ pub(crate) fn int_in(obj: &Bound<'_, PyAny>, name: &str, lo: i128, hi: i128) -> 
     if (lo..=hi).contains(&v) {
         Ok(v)
     } else {
-        Err(PyValueError::new_err(format!(
-            "{name} = {v} is out of range: allowed {lo} ..= {hi}"
+        Err(PyValueError::new_err(out_of_range(
+            name,
+            v,
+            &format!("{lo} ..= {hi}"),
         )))
     }
 }
@@ -219,6 +224,9 @@ pub(crate) fn mode_arg(obj: &Bound<'_, PyAny>) -> PyResult<String> {
     text(obj, "mode")
 }
 
+/// The sample rates `render_audio` accepts.
+pub(crate) const SAMPLE_RATES: &str = "8000–192000 Hz";
+
 /// `sample_rate` of `render_audio`: a whole number of Hz, 8000 ..= 192000.
 pub(crate) fn sample_rate_arg(obj: &Bound<'_, PyAny>) -> PyResult<i64> {
     int_in(obj, "sample_rate", 8_000, 192_000)
@@ -226,9 +234,7 @@ pub(crate) fn sample_rate_arg(obj: &Bound<'_, PyAny>) -> PyResult<i64> {
         .map_err(|e| {
             Python::attach(|py| {
                 if e.is_instance_of::<PyValueError>(py) {
-                    PyValueError::new_err(format!(
-                        "sample_rate = {obj} is out of range: allowed 8000–192000 Hz"
-                    ))
+                    PyValueError::new_err(out_of_range("sample_rate", obj, SAMPLE_RATES))
                 } else {
                     e
                 }

@@ -2,6 +2,7 @@
 //! a scene through it (`haptic_loop::closed_loop`).
 
 use haptic_devices::{Grip, Hold, Mechanics, Plant};
+use haptic_types::value::{ValueError, finite3};
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -17,10 +18,10 @@ fn vec3_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 3]> {
         .extract()
         .map_err(|_| value_err(format!("{name}: expected 3 numbers")))?;
     match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
-        [_, _, _] => Err(value_err(format!(
-            "{name} = {v:?}: every element must be finite"
-        ))),
+        [x, y, z] => {
+            finite3(name, [*x, *y, *z]).map_err(value_err)?;
+            Ok([*x, *y, *z])
+        }
         _ => Err(value_err(format!(
             "{name}: expected 3 numbers, got {}",
             v.len()
@@ -93,8 +94,10 @@ impl DeviceModel {
         stiffness: Option<PyReadonlyArray2<'_, f64>>,
     ) -> PyResult<()> {
         if !(dt_s.is_finite() && dt_s > 0.0 && dt_s <= 1.0) {
-            return Err(value_err(format!(
-                "dt_s = {dt_s} is out of range: allowed 0 < dt_s ≤ 1 s"
+            return Err(value_err(ValueError::out_of_range(
+                "dt_s",
+                dt_s,
+                "0 < dt_s ≤ 1 s",
             )));
         }
         let f = vec3_arg(force, "force")?;
@@ -222,8 +225,10 @@ pub fn check_closed_loop<'py>(
     if let Some(s) = seconds
         && !(s.is_finite() && s > 0.0 && s <= 3600.0)
     {
-        return Err(value_err(format!(
-            "seconds = {s} is out of range: allowed 0 < seconds ≤ 3600"
+        return Err(value_err(ValueError::out_of_range(
+            "seconds",
+            s,
+            "0 < seconds ≤ 3600 s",
         )));
     }
     let r = crate::session::resolve(scene, script, None, None)?;

@@ -1,6 +1,7 @@
 //! The inverse trap solver, working envelope and command clipping of
 //! `ot-envelope`, on a [`GaussianTrap`].
 
+use haptic_types::value::{ValueError, out_of_range};
 use nalgebra::{SVector, Vector3};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use ot_envelope::envelope3::working_envelope_3d as envelope3;
@@ -315,16 +316,17 @@ pub fn polygon_radius<'py>(
         ));
     }
     if let Some(k) = a.data.iter().position(|v| !v.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "angles[{k}] = {} is out of range: allowed finite (rad)",
-            world_form::numbers::fmt_num(a.data[k])
+        return Err(value_error(ValueError::out_of_range(
+            format!("angles[{k}]"),
+            a.data[k],
+            "finite (rad)",
         )));
     }
     if poly.len().saturating_mul(a.data.len()) > MAX_RADIUS_PAIRS {
-        return Err(PyValueError::new_err(format!(
-            "polygon × angles: {} vertices × {} angles is out of range: allowed at most {MAX_RADIUS_PAIRS} pairs",
-            poly.len(),
-            a.data.len()
+        return Err(PyValueError::new_err(out_of_range(
+            "polygon × angles",
+            format!("{} vertices × {} angles", poly.len(), a.data.len()),
+            &format!("at most {MAX_RADIUS_PAIRS} pairs"),
         )));
     }
     let r = py.detach(|| radius_of(&poly, &centre, &a.data));

@@ -4,6 +4,7 @@
 //! file's table have: `{"type": "snap", "member": "tip", "target": {"substrate_atom": 0}}`),
 //! and a dict comes back through serde, so what a getter returns is accepted as it is.
 
+use haptic_types::value::out_of_range;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyInt, PyList, PyString, PyTuple};
@@ -60,11 +61,10 @@ pub(crate) fn py_to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::V
         return Ok(toml::Value::Boolean(obj.extract()?));
     }
     if obj.is_instance_of::<PyInt>() {
-        return obj.extract::<i64>().map(toml::Value::Integer).map_err(|_| {
-            PyValueError::new_err(format!(
-                "{path} = {obj} is out of range: allowed a 64-bit integer"
-            ))
-        });
+        return obj
+            .extract::<i64>()
+            .map(toml::Value::Integer)
+            .map_err(|_| PyValueError::new_err(out_of_range(path, obj, "a 64-bit integer")));
     }
     if let Ok(s) = obj.cast::<PyString>() {
         return Ok(toml::Value::String(s.to_cow()?.into_owned()));

@@ -7,6 +7,7 @@ use haptic_loop::session::SceneSource;
 use haptic_loop::stepper::{Stepper, StepperOptions};
 use haptic_types::Buttons;
 use haptic_types::DeviceSample;
+use haptic_types::value::out_of_range;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -53,10 +54,10 @@ fn buttons_arg(obj: Option<&Bound<'_, PyAny>>, names: &[String]) -> PyResult<u32
             (1i64 << names.len()) - 1
         };
         if !(0..=allowed).contains(&bits) {
-            return Err(PyValueError::new_err(format!(
-                "buttons = {bits}: allowed 0–{allowed} (bit i is button {}: {})",
-                "i",
-                names.join(", ")
+            return Err(PyValueError::new_err(out_of_range(
+                "buttons",
+                bits,
+                &format!("0–{allowed} (bit i is button i: {})", names.join(", ")),
             )));
         }
         return Ok(bits as u32);

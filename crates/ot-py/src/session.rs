@@ -8,6 +8,7 @@ use haptic_loop::session::{
     read_arrays, read_toml_text, run_session_until,
 };
 use haptic_types::DeviceModel;
+use haptic_types::value::{ValueError, out_of_range};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -298,8 +299,10 @@ pub fn run_scene<'py>(
     overrides: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
-        return Err(PyValueError::new_err(format!(
-            "wait_s = {wait_s}: allowed 0–86400 s"
+        return Err(value_err(ValueError::out_of_range(
+            "wait_s",
+            wait_s,
+            "0–86400 s",
         )));
     }
     let mut opts = match device_from_py(device)? {
@@ -401,8 +404,10 @@ pub fn render_audio<'py>(
     let p = path_arg(path, "path")?;
     let out = out.map(|o| path_arg(o, "out")).transpose()?;
     if !(8_000..=192_000).contains(&sample_rate) {
-        return Err(PyValueError::new_err(format!(
-            "sample_rate = {sample_rate} is out of range: allowed 8000–192000 Hz"
+        return Err(PyValueError::new_err(out_of_range(
+            "sample_rate",
+            sample_rate,
+            crate::convert::SAMPLE_RATES,
         )));
     }
     let rate = sample_rate as u32;

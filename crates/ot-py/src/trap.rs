@@ -4,6 +4,7 @@
 // Python signatures with keyword options map to long Rust parameter lists.
 #![allow(clippy::too_many_arguments)]
 
+use haptic_types::value::ValueError;
 use nalgebra::SVector;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use ot_physics::langevin::{Scheme, ThermalRun, simulate};
@@ -146,9 +147,10 @@ fn positive(value: f64, name: &str, unit: &str) -> PyResult<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(PyValueError::new_err(format!(
-            "{name} = {} is out of range: allowed finite and > 0 ({unit})",
-            world_form::numbers::fmt_num(value)
+        Err(value_error(ValueError::out_of_range(
+            name.to_string(),
+            value,
+            format!("finite and > 0 ({unit})"),
         )))
     }
 }
@@ -409,11 +411,10 @@ impl GaussianTrap {
         let waists = [a, b, axial_waist.unwrap_or(1.0)];
         for (i, ki) in k.iter().enumerate() {
             if !ki.is_finite() {
-                return Err(PyValueError::new_err(format!(
-                    "{} = {} is out of range: allowed a waist whose stiffness \
-                     2*ln2*depth/waist**2 is finite (m)",
+                return Err(value_error(ValueError::out_of_range(
                     names[i],
-                    world_form::numbers::fmt_num(waists[i])
+                    waists[i],
+                    "a waist whose stiffness 2*ln2*depth/waist**2 is finite (m)",
                 )));
             }
         }
@@ -652,16 +653,18 @@ impl GaussianTrap {
     fn __repr__(&self) -> String {
         let w = with_model!(&self.model, m => m.well.waists().as_slice().to_vec());
         let mass = with_model!(&self.model, m => m.mass);
-        let opt = |v: Option<f64>| v.map_or("None".to_string(), |x| format!("{x:e}"));
+        // Numbers by fmt_num: its shortest round-trip form is a Python literal of the value.
+        let num = world_form::numbers::fmt_num;
+        let opt = |v: Option<f64>| v.map_or("None".to_string(), num);
         let mut s = format!(
-            "GaussianTrap(depth={:e}, waist=({:e}, {:e}), mass={}",
-            self.depth(),
-            w[0],
-            w[1],
+            "GaussianTrap(depth={}, waist=({}, {}), mass={}",
+            num(self.depth()),
+            num(w[0]),
+            num(w[1]),
             opt(mass)
         );
         if let Some(c) = w.get(2) {
-            s.push_str(&format!(", axial_waist={c:e}"));
+            s.push_str(&format!(", axial_waist={}", num(*c)));
         }
         for (name, v) in [
             ("radius", self.radius),

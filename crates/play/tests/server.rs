@@ -296,6 +296,6 @@ fn a_busy_port_and_a_bad_length_are_named() {
     c.seconds = Some(-1.0);
     assert_eq!(
         run(&c, &stop, &mut |_| {}).unwrap_err().to_string(),
-        "session length -1 s is out of range: allowed 0 < seconds ≤ 3600"
+        "session length [s] = -1 is out of range: allowed 0 < length ≤ 3600 s"
     );
 }

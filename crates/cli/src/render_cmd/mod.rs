@@ -4,6 +4,7 @@
 
 use haptic_loop::media::{self, FramesOptions, MediaError};
 use haptic_loop::session::SceneSource;
+use haptic_types::value::ValueError;
 use recording::{RecordingError, read_recording_file};
 use render::View;
 use std::path::{Path, PathBuf};
@@ -49,15 +50,16 @@ pub struct RenderArgs {
 /// Why `render` failed.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderCmdError {
-    /// A command-line value out of its range.
-    #[error("--{flag} = {value} is out of range: allowed {allowed}")]
-    Arg {
+    /// A command-line value out of its range, named by its flag (`--width`).
+    #[error(transparent)]
+    Arg(ValueError),
+    /// A flag given without the flag it works with.
+    #[error("--{flag} is allowed only with {needs}")]
+    Needs {
         /// The flag, without dashes.
         flag: &'static str,
-        /// The value given.
-        value: String,
-        /// The allowed range.
-        allowed: String,
+        /// What it needs, e.g. `--audio FILE.wav`.
+        needs: &'static str,
     },
     /// The input is neither `.mcap` nor `.toml`.
     #[error("{0}: expected a recording (.mcap) or a scene file (.toml)")]
@@ -93,15 +95,9 @@ impl From<MediaError> for RenderCmdError {
     /// A media option out of range is the flag's error (`--width`, `--every`).
     fn from(e: MediaError) -> Self {
         match e {
-            MediaError::Range {
-                option,
-                value,
-                allowed,
-            } => RenderCmdError::Arg {
-                flag: option,
-                value,
-                allowed,
-            },
+            MediaError::Range(v) => {
+                RenderCmdError::Arg(v.map_field(|option| format!("--{option}")))
+            }
             e => RenderCmdError::Media(e),
         }
     }
@@ -176,10 +172,9 @@ pub fn output_for(recording: bool, out: &Path) -> Result<Output, RenderCmdError>
 pub fn run(args: &RenderArgs) -> Result<RenderSummary, RenderCmdError> {
     media::check_width(args.width)?;
     if args.proximity && args.audio.is_none() {
-        return Err(RenderCmdError::Arg {
+        return Err(RenderCmdError::Needs {
             flag: "proximity",
-            value: "set".into(),
-            allowed: "only with --audio FILE.wav".into(),
+            needs: "--audio FILE.wav",
         });
     }
     let mut summary = match &args.out {
@@ -209,11 +204,11 @@ fn write_audio(args: &RenderArgs, wav: &Path) -> Result<String, RenderCmdError> 
         });
     }
     if !(8_000..=192_000).contains(&args.sample_rate) {
-        return Err(RenderCmdError::Arg {
-            flag: "sample-rate",
-            value: args.sample_rate.to_string(),
-            allowed: "8000–192000 Hz".into(),
-        });
+        return Err(RenderCmdError::Arg(ValueError::out_of_range(
+            "--sample-rate",
+            f64::from(args.sample_rate),
+            "8000–192000 Hz",
+        )));
     }
     let rec = read_recording_file(&args.input, false)?;
     let arrays = haptic_loop::session::SessionArrays::from_recording(&rec)?;

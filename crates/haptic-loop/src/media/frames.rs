@@ -6,6 +6,7 @@ use crate::scene::Scene;
 use crate::scene::optical::RecordedPicture;
 use crate::sink::{Sink, SinkError, TickView};
 use haptic_types::Primitive;
+use haptic_types::value::ValueError;
 use recording::channels::messages::DescriptionMsg;
 use recording::{Recording, RecordingError};
 use render::{Frame, GifWriter, Image, Palette, View};
@@ -155,15 +156,16 @@ fn cadence(
     });
     let min_every = rate.div_ceil(50).max(1);
     if every == 0 || (opts.gif.is_some() && every < min_every) {
-        return Err(MediaError::Range {
-            option: "every",
-            value: every.to_string(),
-            allowed: if opts.gif.is_some() {
+        // Only small counts are refused (0, or under `min_every`): exact as an f64.
+        return Err(MediaError::Range(ValueError::out_of_range(
+            "every",
+            every as f64,
+            if opts.gif.is_some() {
                 format!("{min_every} or more ticks (a GIF plays at most 50 frames/s)")
             } else {
                 "1 or more ticks".into()
             },
-        });
+        )));
     }
     Ok(every)
 }

@@ -14,6 +14,7 @@ pub mod frames;
 pub mod picture;
 
 use crate::error::SessionError;
+use haptic_types::value::ValueError;
 use haptic_types::{Primitive, Rgba};
 use recording::RecordingError;
 use render::{Camera, Frame, RenderError, Style, View};
@@ -29,16 +30,10 @@ pub const WIDTH_PX: RangeInclusive<u32> = 64..=4096;
 /// Why a picture or an animation could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum MediaError {
-    /// An option out of its range (`width`, `every`).
-    #[error("{option} = {value} is out of range: allowed {allowed}")]
-    Range {
-        /// The option's name.
-        option: &'static str,
-        /// The value given.
-        value: String,
-        /// The allowed range, with its unit.
-        allowed: String,
-    },
+    /// An option out of its range (`width`, `every`), named as the option; the one wording
+    /// of [`ValueError`] (the program renames the field to its flag).
+    #[error(transparent)]
+    Range(ValueError),
     /// Reading or writing a file.
     #[error("{path}: {source}")]
     Io {
@@ -64,11 +59,11 @@ pub enum MediaError {
 /// Checks a picture width against [`WIDTH_PX`].
 pub fn check_width(width: u32) -> Result<(), MediaError> {
     if !WIDTH_PX.contains(&width) {
-        return Err(MediaError::Range {
-            option: "width",
-            value: width.to_string(),
-            allowed: format!("{}–{} px", WIDTH_PX.start(), WIDTH_PX.end()),
-        });
+        return Err(MediaError::Range(ValueError::out_of_range(
+            "width",
+            f64::from(width),
+            format!("{}–{} px", WIDTH_PX.start(), WIDTH_PX.end()),
+        )));
     }
     Ok(())
 }

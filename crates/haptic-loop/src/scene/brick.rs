@@ -20,6 +20,7 @@ use haptic_types::SwitchSpec;
 use haptic_types::vec3::Vec3;
 use serde::Deserialize;
 use world_form::Limits;
+use world_form::fmt_num;
 
 /// The brick world in the scene registry: `kind = "brickworld"`, table `[brickworld]`.
 pub const WORLD: WorldKind = WorldKind {
@@ -103,7 +104,7 @@ impl BrickScene {
             return Err(out_of_range(
                 "brickworld.params.dt_s",
                 s.params.dt_s,
-                format!("{dt_s} s, the loop's tick (1 / loop.rate_hz)"),
+                format!("{} s, the loop's tick (1 / loop.rate_hz)", fmt_num(dt_s)),
             ));
         }
         check_positive("brickworld.draw_ground_half_m", s.draw_ground_half_m, 50.0)?;

@@ -30,7 +30,7 @@ pub enum SceneError {
     OutOfRange {
         /// Field path, e.g. `mapping.force_scale`.
         field: String,
-        /// The value found, as written.
+        /// The value found, as shown: a number by [`fmt_num`], other values as written.
         value: String,
         /// The allowed range in words.
         allowed: String,
@@ -70,17 +70,26 @@ impl SceneError {
     }
 }
 
-/// Builds an out-of-range error.
-pub fn out_of_range(field: &str, value: impl ToString, allowed: impl Into<String>) -> SceneError {
+/// Builds the out-of-range error of a number, shown by [`fmt_num`].
+pub fn out_of_range(field: &str, value: f64, allowed: impl Into<String>) -> SceneError {
+    out_of_range_text(field, fmt_num(value), allowed)
+}
+
+/// Builds the out-of-range error of a value that is not one number (a name, a vector, a
+/// table), `shown` as written (numbers in it by [`fmt_num`]).
+pub fn out_of_range_text(
+    field: &str,
+    shown: impl Into<String>,
+    allowed: impl Into<String>,
+) -> SceneError {
     SceneError::OutOfRange {
         field: field.to_string(),
-        value: value.to_string(),
+        value: shown.into(),
         allowed: allowed.into(),
     }
 }
 
-/// Formats a bound for an error message (the project's one number form).
-pub use world_form::fmt_num;
+use world_form::fmt_num;
 
 /// Checks `lo ≤ value ≤ hi` (and finite).
 pub fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<(), SceneError> {
@@ -89,7 +98,7 @@ pub fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<(), Scen
     } else {
         Err(out_of_range(
             field,
-            fmt_num(value),
+            value,
             format!("{} ≤ {field} ≤ {}", fmt_num(lo), fmt_num(hi)),
         ))
     }
@@ -102,7 +111,7 @@ pub fn check_positive(field: &str, value: f64, hi: f64) -> Result<(), SceneError
     } else {
         Err(out_of_range(
             field,
-            fmt_num(value),
+            value,
             format!("0 < {field} ≤ {}", fmt_num(hi)),
         ))
     }

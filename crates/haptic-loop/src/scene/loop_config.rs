@@ -6,6 +6,7 @@ use haptic_types::DeviceSpecs;
 use haptic_types::vec3::{self, Vec3};
 use serde::Deserialize;
 use world_form::Limits;
+use world_form::fmt_num;
 
 /// `[mapping]`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -241,7 +242,7 @@ impl LoopConfig {
         if !(100..=20_000).contains(&l.rate_hz) || 1_000_000_000 % l.rate_hz != 0 {
             return Err(out_of_range(
                 "loop.rate_hz",
-                l.rate_hz,
+                f64::from(l.rate_hz),
                 "100 ≤ rate_hz ≤ 20000 with 10^9 / rate_hz a whole number",
             ));
         }
@@ -265,8 +266,11 @@ impl LoopConfig {
         if d.rate_hz == 0 || d.rate_hz > l.rate_hz || l.rate_hz % d.rate_hz != 0 {
             return Err(out_of_range(
                 "display.rate_hz",
-                d.rate_hz,
-                format!("a divisor of loop.rate_hz = {}", l.rate_hz),
+                f64::from(d.rate_hz),
+                format!(
+                    "a divisor of loop.rate_hz = {}",
+                    fmt_num(f64::from(l.rate_hz))
+                ),
             ));
         }
         check_range("display.scale", d.scale, 1e-3, 1e12)?;

@@ -14,7 +14,7 @@
 //! `mapping.workspace_scale`). Each tick the scene reports the adhesion `k` of the anchored
 //! contact (game mode) or `k_c` (physical).
 
-use super::check::{SceneError, check_positive, out_of_range};
+use super::check::{SceneError, check_positive, out_of_range, out_of_range_text};
 use super::score::{self, HouseScore};
 use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use haptic_types::Event;
@@ -26,6 +26,7 @@ use nalgebra::Vector3;
 use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};
 use serde::Deserialize;
 use world_form::Limits;
+use world_form::fmt_num;
 
 /// The nano world in the scene registry: `kind = "nanoworld"`, table `[nanoworld]`.
 pub const WORLD: WorldKind = WorldKind {
@@ -139,7 +140,7 @@ impl NanoScene {
                 "game" => Params::game_default(),
                 "physical" => Params::physical_default(),
                 other => {
-                    return Err(out_of_range(
+                    return Err(out_of_range_text(
                         "nanoworld.preset",
                         format!("\"{other}\""),
                         "\"game\" or \"physical\"",
@@ -148,7 +149,7 @@ impl NanoScene {
             },
             (None, Some(p)) => p,
             _ => {
-                return Err(out_of_range(
+                return Err(out_of_range_text(
                     "nanoworld",
                     "a table with both or neither of `preset` and `params`",
                     "exactly one of `preset` or `[nanoworld.params]`",
@@ -167,8 +168,9 @@ impl NanoScene {
                 &format!("nanoworld.params.{field}"),
                 k,
                 format!(
-                    "≤ {cap_n_per_m} N/m, the device's stiffness limit mapped to the world \
-                     (lower mapping.force_scale or mapping.workspace_scale)"
+                    "≤ {} N/m, the device's stiffness limit mapped to the world \
+                     (lower mapping.force_scale or mapping.workspace_scale)",
+                    fmt_num(cap_n_per_m)
                 ),
             ));
         }

@@ -115,7 +115,15 @@ fn set(table: &mut Table, path: &str, value: Value) -> Result<(), String> {
                 };
                 let len = arr.len();
                 let item = arr.get_mut(k).ok_or_else(|| {
-                    format!("`{walked}` has {len} elements: index {k} is out of range")
+                    let allowed = match len.checked_sub(1) {
+                        Some(top) => format!("0 ≤ index ≤ {top} (`{walked}` has {len} elements)"),
+                        None => format!("none (`{walked}` is empty)"),
+                    };
+                    haptic_types::value::out_of_range(
+                        &format!("index into `{walked}`"),
+                        k,
+                        &allowed,
+                    )
                 })?;
                 walked.push_str(&format!("[{k}]"));
                 if i == last {
@@ -308,8 +316,8 @@ mod tests {
         );
         assert_eq!(
             err(OT, &[("optical_tweezers.start_um[2]", Value::Float(1.0))]),
-            "override `optical_tweezers.start_um[2]`: `optical_tweezers.start_um` has 2 \
-             elements: index 2 is out of range"
+            "override `optical_tweezers.start_um[2]`: index into `optical_tweezers.start_um` = 2 \
+             is out of range: allowed 0 ≤ index ≤ 1 (`optical_tweezers.start_um` has 2 elements)"
         );
         assert_eq!(
             err(OT, &[("optical_tweezers.depth_nj[0]", Value::Float(1.0))]),

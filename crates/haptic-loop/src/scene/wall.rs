@@ -9,7 +9,7 @@
 //! It checks the loop's stiffness cap and force clamp: pressed `d` deep, a wall of stiffness
 //! `k` gives `k·d` until the device maximum, then exactly the maximum, in the same direction.
 
-use super::check::{SceneError, check_positive, check_range, out_of_range};
+use super::check::{SceneError, check_positive, check_range, out_of_range_text};
 use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
 use haptic_types::Event;
 use haptic_types::Primitive;
@@ -17,6 +17,7 @@ use haptic_types::Rgba;
 use haptic_types::vec3::{self, Vec3};
 use serde::{Deserialize, Serialize};
 use world_form::Limits;
+use world_form::fmt_num;
 
 /// The wall in the scene registry: `kind = "wall"`, table `[wall]`.
 pub const WORLD: WorldKind = WorldKind {
@@ -86,11 +87,13 @@ impl WallScene {
         let cap_n_per_m = limits.max_stiffness_n_per_m;
         let len = vec3::norm(params.normal);
         if !(len.is_finite() && len > 0.0) {
-            return Err(out_of_range(
+            return Err(out_of_range_text(
                 "wall.normal",
                 format!(
                     "[{}, {}, {}]",
-                    params.normal[0], params.normal[1], params.normal[2]
+                    fmt_num(params.normal[0]),
+                    fmt_num(params.normal[1]),
+                    fmt_num(params.normal[2])
                 ),
                 "a non-zero finite vector",
             ));

@@ -148,12 +148,12 @@ impl Scene for OpticalScene {
     }
 }
 
-/// `x` (> 0) rounded down to three significant digits, as text (a bound stated inside itself).
+/// `x` (> 0) rounded down to three significant digits, as text (a bound stated inside
+/// itself), written by [`fmt_sig`](world_form::fmt_sig) (`1.6`, `12.3`, `1.23e7`).
 fn three_digits_down(x: f64) -> String {
     let e = x.log10().floor() as i32;
     let unit = 10f64.powi(e - 2);
-    let decimals = usize::try_from(2 - e).unwrap_or(0);
-    format!("{:.*}", decimals, (x / unit).floor() * unit)
+    world_form::fmt_sig((x / unit).floor() * unit, 3)
 }
 
 /// An optical-tweezers model or steering error as a scene error (located at the

@@ -7,6 +7,7 @@ use ot_envelope::ClipMode;
 use ot_envelope::world::{Params, TickMap};
 use serde::Deserialize;
 use world_form::Limits;
+use world_form::fmt_num;
 
 /// `[optical_tweezers]`: what a human types, with units in the names.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -133,7 +134,10 @@ impl OtParams {
             out_of_range(
                 "optical_tweezers.stiffness_n_per_m",
                 p.stiffness_n_per_m,
-                format!("0 < stiffness ≤ {cap} N/m, the device's limit mapped to the world"),
+                format!(
+                    "0 < stiffness ≤ {} N/m, the device's limit mapped to the world",
+                    fmt_num(cap)
+                ),
             )
         })?;
         check_range(

@@ -197,7 +197,7 @@ fn a_tick_longer_than_one_period_of_the_fastest_oscillation_is_refused() {
     assert_eq!(
         with("dt_us = 0.2", "dt_us = 5.0").as_deref(),
         Some(
-            "scene: `optical_tweezers.dt_us` = 5 is out of range: allowed 0 < dt_us ≤ 1.60 µs, \
+            "scene: `optical_tweezers.dt_us` = 5 is out of range: allowed 0 < dt_us ≤ 1.6 µs, \
              1 period of the particle's fastest oscillation in this trap (2π·√(mass/κ), κ = \
              2·ln2·depth/waist², narrower waist); a longer tick makes the envelope too costly \
              for a haptic loop"
@@ -209,5 +209,6 @@ fn a_tick_longer_than_one_period_of_the_fastest_oscillation_is_refused() {
     assert_eq!(with("dt_us = 0.2", "dt_us = 1.0"), None);
     assert_eq!(three_digits_down(1.8849), "1.88");
     assert_eq!(three_digits_down(0.059605), "0.0596");
+    assert_eq!(three_digits_down(1.6009), "1.6");
     assert_eq!(three_digits_down(123456.0), "123000");
 }
