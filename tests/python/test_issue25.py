@@ -39,7 +39,9 @@ def test_the_inverse_solve_refuses_the_envelope_s_tick_bound_quickly():
         "dt [s] = 9.97e-5 is out of range: allowed ≤ 6.4037e-6 s, 4 periods of the well's "
         "fastest oscillation (ω = 3.9247e6 rad/s)"
     )
-    assert took < 2.0, took
+    # A hang guard, not a speed target: the refusal comes before any map is sampled (µs);
+    # the hang it replaces ran for more than 20 s.
+    assert took < 10.0, took
 
 
 def test_a_tangled_tick_map_is_refused_and_the_default_one_is_not_tangled():
