@@ -233,8 +233,9 @@ def test_a_house_script_step_too_small_for_memory_names_the_bound():
     with pytest.raises(ValueError) as e:
         w.house_script(1e-15)
     msg = str(e.value)
-    assert msg.startswith("step_m = 1e-15 is out of range for this house: the path is ")
-    assert msg.endswith("<= step_m <= 1e-6 m (at most 10000000 samples)")
+    assert msg.startswith("step_m = 1e-15 is out of range: allowed ")
+    assert "<= step_m <= 1e-6 m for this house (its path is " in msg
+    assert msg.endswith(" m long; at most 10000000 samples)")
 
 
 def test_tick_map_substeps_are_bounded_where_every_call_runs_hundreds_of_flows():
