@@ -84,10 +84,7 @@ impl ImpactTracker {
             let PairContacts::Rigid(rc) = &pair.contacts else {
                 continue;
             };
-            let (Some(c1), Some(c2)) = (
-                phys.colliders.get(pair.collider1),
-                phys.colliders.get(pair.collider2),
-            ) else {
+            let Some((c1, c2)) = super::pair_colliders(phys, pair) else {
                 continue;
             };
             let mut impulse = 0.0;

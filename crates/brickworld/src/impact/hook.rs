@@ -342,10 +342,7 @@ fn for_each_support(
                 continue;
             }
         }
-        let (Some(c1), Some(c2)) = (
-            phys.colliders.get(pair.collider1),
-            phys.colliders.get(pair.collider2),
-        ) else {
+        let Some((c1, c2)) = super::pair_colliders(phys, pair) else {
             continue;
         };
         for m in &rc.manifolds {

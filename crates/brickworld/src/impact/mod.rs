@@ -18,5 +18,19 @@
 pub mod events;
 pub mod hook;
 
+use rapier3d_f64::prelude::{Collider, ContactPair, PhysicsWorld};
+
+/// The two colliders of a contact pair (`None` when either was removed), as both jobs read
+/// them.
+fn pair_colliders<'a>(
+    phys: &'a PhysicsWorld,
+    pair: &ContactPair,
+) -> Option<(&'a Collider, &'a Collider)> {
+    Some((
+        phys.colliders.get(pair.collider1)?,
+        phys.colliders.get(pair.collider2)?,
+    ))
+}
+
 /// Approach speed (m/s) below which a new contact is treated as a gentle placement, not an impact.
 pub const IMPACT_MIN_SPEED_M_PER_S: f64 = 0.05;
