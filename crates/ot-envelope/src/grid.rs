@@ -156,6 +156,35 @@ fn build(
     .polygon)
 }
 
+/// Most boundary points one comparison of two envelopes samples (both boundaries together).
+pub const MAX_BOUNDARY_SAMPLES: f64 = 1e6;
+
+fn perimeter(p: &[V2]) -> f64 {
+    (0..p.len()).map(|i| (p[(i + 1) % p.len()] - p[i]).norm()).sum()
+}
+
+/// Refuses a comparison of `a` and `b` sampled every `step` m that would take more than
+/// [`MAX_BOUNDARY_SAMPLES`] points: a tolerance far finer than the boundary's length (1 pm on a
+/// micrometre envelope is 10⁸ points, minutes of work for an envelope no display resolves).
+fn check_samples(a: &[V2], b: &[V2], step: f64) -> Result<()> {
+    let length = perimeter(a) + perimeter(b);
+    let samples = (length / step).ceil();
+    if samples > MAX_BOUNDARY_SAMPLES {
+        return Err(EnvelopeError::Value(ValueError::out_of_range(
+            "envelope grid choice: boundary samples",
+            samples,
+            format!(
+                "≤ 1e6 (the boundaries are compared every tol/8 = {} m along {} m of \
+                 boundary: choose a tolerance ≥ {} m for this envelope)",
+                world_form::fmt_num(step),
+                world_form::fmt_sig(length, 3),
+                world_form::fmt_sig(8.0 * length / MAX_BOUNDARY_SAMPLES, 3),
+            ),
+        )));
+    }
+    Ok(())
+}
+
 /// The Hausdorff distance (m) of the envelope on the spacings of
 /// [`CELL_LADDER`] from the reference grid's, worst over the velocities
 /// probed, for `prop` at tolerance `tol` (m) with region margin `margin`,
@@ -179,6 +208,7 @@ pub fn ladder_errors(
         let mut worst: f64 = 0.0;
         for (v0, region, reference) in &cases {
             let poly = build(prop, v0, region, cell, tol)?;
+            check_samples(&poly, reference, tol / 8.0)?;
             worst = worst.max(hausdorff(&poly, reference, tol / 8.0));
         }
         out[k] = Some(worst);
