@@ -165,6 +165,11 @@ impl TickEngine {
         self.ticks
     }
 
+    /// Ticks so far whose force came too late (zero force was sent).
+    pub fn missed(&self) -> u64 {
+        self.missed
+    }
+
     /// Runs the next tick of `lp` on `sample`: its scheduled switches, then `live`, then the
     /// step; `deadline(t0)` says whether the force came too late (zero force is then sent);
     /// `send` hands the command to the device; then every sink sees the tick.

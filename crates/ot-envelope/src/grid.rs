@@ -160,7 +160,9 @@ fn build(
 pub const MAX_BOUNDARY_SAMPLES: f64 = 1e6;
 
 fn perimeter(p: &[V2]) -> f64 {
-    (0..p.len()).map(|i| (p[(i + 1) % p.len()] - p[i]).norm()).sum()
+    (0..p.len())
+        .map(|i| (p[(i + 1) % p.len()] - p[i]).norm())
+        .sum()
 }
 
 /// Refuses a comparison of `a` and `b` sampled every `step` m that would take more than

@@ -27,11 +27,15 @@
 //! page is plain HTML, CSS and JavaScript modules built into the binary; it needs no npm, no
 //! bundler and no network.
 
+pub mod classroom;
+pub mod gate;
+pub mod http;
 pub mod input;
 pub mod protocol;
 pub mod publish;
 pub mod server;
 
+use gate::{Limits, RefusedCounts};
 use haptic_devices::bridge::{BridgeConfig, UdpDevice};
 use haptic_devices::pacing::Percentiles;
 use haptic_devices::source::DeviceSource;
@@ -74,6 +78,8 @@ pub struct PlayConfig {
     /// After the session, keep serving the end screen and the recording's download this long,
     /// s (`None`: until `stop` is raised).
     pub keep_serving_s: Option<f64>,
+    /// What the server accepts (connections, message size and rate).
+    pub limits: Limits,
 }
 
 impl PlayConfig {
@@ -87,6 +93,7 @@ impl PlayConfig {
             out,
             seconds: None,
             keep_serving_s: None,
+            limits: Limits::default(),
         }
     }
 }
@@ -118,6 +125,9 @@ pub struct PlaySummary {
     pub messages_dropped: u64,
     /// Page messages refused (protocol and switch errors), each answered with its error.
     pub page_messages_refused: u64,
+    /// Requests, connections and messages the server refused, by reason (forged `Host` or
+    /// `Origin`, limits).
+    pub refused: RefusedCounts,
 }
 
 impl PlaySummary {
@@ -259,7 +269,7 @@ fn hello_message(
 
 /// Tells the server and every page what is played: the scene's switches and the device (for
 /// checking page messages), and the `hello` (kept for pages that connect later).
-fn announce(
+pub(crate) fn announce(
     shared: &Shared,
     scene_name: &str,
     lp: &HapticLoop,
@@ -284,9 +294,12 @@ fn announce(
     shared.broadcast(&tungstenite::Message::text(hello));
 }
 
-/// The page's `end`: the session's figures and where to download its recording.
-fn end_message(
-    config: &PlayConfig,
+/// The page's `end`: the session's figures and where to download its recording (`url`, the
+/// file `out`).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn end_message(
+    url: &str,
+    out: &std::path::Path,
     end: EndReason,
     stats: &TickStats,
     rate_hz: u32,
@@ -309,19 +322,16 @@ fn end_message(
         peak_device_force_n: totals.peak_device_force_n,
         events: totals.events,
         input_latency_ms,
-        recording: "/recording.mcap".to_string(),
-        recording_file: config
-            .out
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string()),
+        recording: url.to_string(),
+        recording_file: out.file_name().map(|n| n.to_string_lossy().to_string()),
         recording_bytes: written.map(|w| w.bytes),
     })
 }
 
-/// Offers the recording for download and tells every page (and later ones) the end.
-fn offer_end(shared: &Shared, config: &PlayConfig, end_msg: &ServerMsg) {
+/// Offers the recording `out` for download and tells every page (and later ones) the end.
+pub(crate) fn offer_end(shared: &Shared, out: &std::path::Path, end_msg: &ServerMsg) {
     if let Ok(mut r) = shared.recording.lock() {
-        *r = Some(config.out.clone());
+        *r = Some(out.to_path_buf());
     }
     let text = end_msg.to_json();
     if let Ok(mut e) = shared.end.lock() {
@@ -330,8 +340,33 @@ fn offer_end(shared: &Shared, config: &PlayConfig, end_msg: &ServerMsg) {
     shared.broadcast(&tungstenite::Message::text(text));
 }
 
+/// Applies before tick `tick` the switches pages (or a teacher) asked for: each told to the
+/// publisher as applied on `tick`, or refused with the reason (to the page that asked).
+pub(crate) fn apply_page_switches(
+    shared: &Shared,
+    tx: &std::sync::mpsc::Sender<ToPublisher>,
+    tick: u64,
+    lp: &mut HapticLoop,
+) {
+    // Never wait for a page's thread: a busy queue waits for the next tick.
+    let reqs = match shared.switches.try_lock() {
+        Ok(mut q) if !q.is_empty() => std::mem::take(&mut *q),
+        _ => return,
+    };
+    for (page, name, value) in reqs {
+        let m = match lp.switch(&name, value) {
+            Ok(()) => ToPublisher::Switched { tick, name, value },
+            Err(e) => ToPublisher::Refused {
+                page,
+                message: e.to_string(),
+            },
+        };
+        let _ = tx.send(m);
+    }
+}
+
 /// The hook run before each tick's step: raises the end on `stop`, and applies the switches
-/// pages asked for (told to the publisher as applied on `tick`, or refused with the reason).
+/// pages asked for.
 fn switch_hook<'a>(
     stop: &'a AtomicBool,
     shared: Arc<Shared>,
@@ -341,21 +376,7 @@ fn switch_hook<'a>(
         if stop.load(Ordering::Relaxed) {
             shared.end_requested.store(true, Ordering::Relaxed);
         }
-        // Never wait for a page's thread: a busy queue waits for the next tick.
-        let reqs = match shared.switches.try_lock() {
-            Ok(mut q) if !q.is_empty() => std::mem::take(&mut *q),
-            _ => return,
-        };
-        for (page, name, value) in reqs {
-            let m = match lp.switch(&name, value) {
-                Ok(()) => ToPublisher::Switched { tick, name, value },
-                Err(e) => ToPublisher::Refused {
-                    page,
-                    message: e.to_string(),
-                },
-            };
-            let _ = tx.send(m);
-        }
+        apply_page_switches(&shared, &tx, tick, lp);
     }
 }
 
@@ -423,10 +444,13 @@ pub fn run(
     let rate = file.loop_.rate_hz;
     let ticks = config.seconds.map(|s| ticks_for(s, rate)).transpose()?;
     let shared = Arc::new(Shared::default());
-    let mut server = Server::start(config.port, shared.clone()).map_err(|e| PlayError::Serve {
-        port: config.port,
-        message: e.to_string(),
-    })?;
+    let mut server =
+        Server::start(config.port, shared.clone(), config.limits.clone()).map_err(|e| {
+            PlayError::Serve {
+                port: config.port,
+                message: e.to_string(),
+            }
+        })?;
     let url = server.url();
     on_ready(&url);
 
@@ -456,7 +480,7 @@ pub fn run(
         config.seconds,
     );
     if page_is_hand && !shared.input.wait_first(stop) {
-        server.stop();
+        server.stop(&shared);
         return Err(PlayError::NotStarted);
     }
 
@@ -506,7 +530,8 @@ pub fn run(
     let input_latency_ms = LatencyMs::of(&latencies);
     let written = sinks.written();
     let end_msg = end_message(
-        config,
+        "/recording.mcap",
+        &config.out,
         end,
         &stats,
         rate,
@@ -514,9 +539,9 @@ pub fn run(
         input_latency_ms,
         written.as_ref(),
     );
-    offer_end(&shared, config, &end_msg);
+    offer_end(&shared, &config.out, &end_msg);
     serve_end_screen(config, stop);
-    server.stop();
+    server.stop(&shared);
     Ok(PlaySummary {
         url,
         end: end.name(),
@@ -529,6 +554,7 @@ pub fn run(
         pages_served: shared.pages_served.load(Ordering::Relaxed),
         messages_dropped: shared.dropped.load(Ordering::Relaxed),
         page_messages_refused: shared.refused.load(Ordering::Relaxed),
+        refused: server.gate().refused.snapshot(),
     })
 }
 

@@ -210,6 +210,26 @@ pub fn sound_name(s: &Sound) -> (&'static str, f64) {
     }
 }
 
+/// Keeps the `hello` a page gets on connecting up to date with switch `name` = `value`, so a
+/// page that joins after a switch (or reloads) shows its value now.
+fn refresh_hello(shared: &Shared, name: &str, value: f64) {
+    let Ok(mut h) = shared.hello.lock() else {
+        return;
+    };
+    let Some(mut hello) = h
+        .as_deref()
+        .and_then(|t| serde_json::from_str::<ServerMsg>(t).ok())
+    else {
+        return;
+    };
+    if let ServerMsg::Hello(ref mut hi) = hello
+        && let Some(sw) = hi.switches.iter_mut().find(|s| s.name == name)
+    {
+        sw.value = Some(value);
+        *h = Some(hello.to_json());
+    }
+}
+
 /// The publisher thread's loop: runs until the session's `Finish` (or the channel closes).
 pub fn run_publisher(
     rx: Receiver<ToPublisher>,
@@ -304,6 +324,7 @@ pub fn run_publisher(
                 }
             }
             ToPublisher::Switched { tick, name, value } => {
+                refresh_hello(&shared, &name, value);
                 let m = ServerMsg::Switched { tick, name, value };
                 shared.broadcast(&Message::text(m.to_json()));
             }

@@ -3,18 +3,20 @@
 //! hands its data to the publisher thread ([`crate::publish`]), which queues it for each page
 //! (bounded queues; a page that cannot keep up loses frames, never the tick's time).
 
+use crate::gate::{Gate, Limits, RateLimit};
+use crate::http::{Guard, Head, HeadError, accept_upgrade, read_head, respond, respond_text};
 use crate::input::{SharedInput, page_to_device};
 use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
 use haptic_types::SwitchSpec;
-use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 use tungstenite::protocol::Role as WsRole;
+use tungstenite::protocol::WebSocketConfig;
 use tungstenite::{Message, WebSocket};
 
 /// A file of the page, built into the binary.
@@ -91,6 +93,9 @@ pub const PAGE_FILES: &[PageFile] = &[
 
 /// Messages queued per page before frames are dropped.
 pub const PAGE_QUEUE: usize = 512;
+/// A page whose connection accepts nothing for this long is closed, s (its queue dropped
+/// frames meanwhile; the tick never waits for it).
+pub const WRITE_TIMEOUT_S: u64 = 5;
 
 /// What the scene offers the page, known once the scene is built.
 #[derive(Clone, Debug)]
@@ -137,7 +142,8 @@ pub struct Shared {
     pub dropped: AtomicU64,
     /// Page messages refused (protocol or switch errors).
     pub refused: AtomicU64,
-    shutdown: AtomicBool,
+    /// Set when the server stops: every page link closes.
+    pub shutdown: AtomicBool,
     next_id: AtomicU64,
 }
 
@@ -183,26 +189,49 @@ impl Shared {
     }
 }
 
-/// The running server.
-pub struct Server {
+/// What a listening server does with a request that passed its [`Gate`] and its
+/// `Host`/`Origin` check: the play session's routes, or the classroom's.
+pub trait Routes: Send + Sync + 'static {
+    /// Answers `head` on `stream` (a WebSocket upgrade keeps the stream until it closes).
+    fn route(&self, stream: TcpStream, head: Head, gate: &Arc<Gate>);
+}
+
+/// A listening page server: one thread accepting, one per connection, each connection
+/// admitted by the [`Gate`] (limits) and checked (`Host`, `Origin`) before it is routed.
+pub struct Listener {
     addr: SocketAddr,
-    shared: Arc<Shared>,
+    gate: Arc<Gate>,
+    shutdown: Arc<AtomicBool>,
     accept: Option<JoinHandle<()>>,
 }
 
-impl Server {
-    /// Binds `127.0.0.1:port` (0: any free port) and starts serving.
-    pub fn start(port: u16, shared: Arc<Shared>) -> std::io::Result<Server> {
-        let listener = TcpListener::bind(("127.0.0.1", port))?;
+impl Listener {
+    /// Binds `bind` (port 0: any free port) and serves `routes` behind a gate of `limits`; a
+    /// loopback address answers only to loopback host names, any other to IP addresses too.
+    pub fn start(
+        bind: SocketAddr,
+        limits: Limits,
+        routes: Arc<dyn Routes>,
+        shutdown: Arc<AtomicBool>,
+    ) -> std::io::Result<Listener> {
+        let listener = TcpListener::bind(bind)?;
         listener.set_nonblocking(true)?;
         let addr = listener.local_addr()?;
-        let sh = shared.clone();
+        let gate = Arc::new(Gate::new(
+            Guard {
+                port: addr.port(),
+                loopback_only: bind.ip().is_loopback(),
+            },
+            limits,
+        ));
+        let (g, sd) = (gate.clone(), shutdown.clone());
         let accept = std::thread::Builder::new()
-            .name("play-accept".into())
-            .spawn(move || accept_loop(listener, sh))?;
-        Ok(Server {
+            .name("page-accept".into())
+            .spawn(move || accept_loop(listener, g, routes, sd))?;
+        Ok(Listener {
             addr,
-            shared,
+            gate,
+            shutdown,
             accept: Some(accept),
         })
     }
@@ -212,35 +241,53 @@ impl Server {
         self.addr
     }
 
-    /// The page's URL.
-    pub fn url(&self) -> String {
-        format!("http://{}/", self.addr)
+    /// The gate (limits and refusal counts).
+    pub fn gate(&self) -> &Arc<Gate> {
+        &self.gate
     }
 
-    /// Stops accepting, closes the pages and joins the threads.
+    /// Stops accepting, closes the connections and joins the threads.
     pub fn stop(&mut self) {
-        self.shared.shutdown.store(true, Ordering::Relaxed);
+        self.shutdown.store(true, Ordering::Relaxed);
         if let Some(h) = self.accept.take() {
             let _ = h.join();
         }
     }
 }
 
-impl Drop for Server {
+impl Drop for Listener {
     fn drop(&mut self) {
         self.stop();
     }
 }
 
-fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
+fn accept_loop(
+    listener: TcpListener,
+    gate: Arc<Gate>,
+    routes: Arc<dyn Routes>,
+    shutdown: Arc<AtomicBool>,
+) {
     let mut conns: Vec<JoinHandle<()>> = Vec::new();
-    while !shared.shutdown.load(Ordering::Relaxed) {
+    while !shutdown.load(Ordering::Relaxed) {
         match listener.accept() {
-            Ok((stream, _)) => {
-                let sh = shared.clone();
-                if let Ok(h) = std::thread::Builder::new()
-                    .name("play-conn".into())
-                    .spawn(move || connection(stream, sh))
+            Ok((mut stream, peer)) => {
+                let _ = stream.set_nonblocking(false);
+                let _ = stream.set_write_timeout(Some(Duration::from_secs(WRITE_TIMEOUT_S)));
+                let ticket = match gate.admit(peer.ip()) {
+                    Ok(t) => t,
+                    Err(message) => {
+                        respond_text(&mut stream, "503 Service Unavailable", &message);
+                        continue;
+                    }
+                };
+                let (g, r) = (gate.clone(), routes.clone());
+                if let Ok(h) =
+                    std::thread::Builder::new()
+                        .name("page-conn".into())
+                        .spawn(move || {
+                            connection(stream, &g, r.as_ref());
+                            drop(ticket);
+                        })
                 {
                     conns.push(h);
                 }
@@ -257,142 +304,140 @@ fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
     }
 }
 
-/// A request's head: method, path and headers (names lower-cased).
-struct Head {
-    method: String,
-    path: String,
-    headers: Vec<(String, String)>,
-}
-
-impl Head {
-    fn header(&self, name: &str) -> Option<&str> {
-        self.headers
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, v)| v.as_str())
-    }
-}
-
-fn read_head(stream: &mut TcpStream) -> Option<Head> {
-    stream.set_read_timeout(Some(Duration::from_secs(5))).ok()?;
-    let mut buf = Vec::with_capacity(1024);
-    let mut byte = [0u8; 1];
-    while !buf.ends_with(b"\r\n\r\n") {
-        if buf.len() > 16 * 1024 || stream.read(&mut byte).ok()? == 0 {
-            return None;
-        }
-        buf.push(byte[0]);
-    }
-    let text = String::from_utf8(buf).ok()?;
-    let mut lines = text.split("\r\n");
-    let mut first = lines.next()?.split(' ');
-    let method = first.next()?.to_string();
-    let path = first.next()?.to_string();
-    let headers = lines
-        .filter_map(|l| l.split_once(':'))
-        .map(|(n, v)| (n.trim().to_ascii_lowercase(), v.trim().to_string()))
-        .collect();
-    Some(Head {
-        method,
-        path,
-        headers,
-    })
-}
-
-fn respond(stream: &mut TcpStream, status: &str, ctype: &str, extra: &str, body: &[u8]) {
-    let head = format!(
-        "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n{extra}Connection: close\r\n\r\n",
-        body.len()
-    );
-    let _ = stream.write_all(head.as_bytes());
-    let _ = stream.write_all(body);
-    let _ = stream.flush();
-}
-
-fn connection(mut stream: TcpStream, shared: Arc<Shared>) {
+/// Reads and checks one request, then routes it.
+fn connection(mut stream: TcpStream, gate: &Arc<Gate>, routes: &dyn Routes) {
     let _ = stream.set_nodelay(true);
-    let Some(head) = read_head(&mut stream) else {
-        return;
+    let head = match read_head(&mut stream) {
+        Ok(h) => h,
+        Err(HeadError::Closed) => return gate.refused.count("head"),
+        Err(e) => {
+            gate.refused.count("head");
+            return respond_text(&mut stream, "400 Bad Request", &e.to_string());
+        }
     };
+    if let Err(r) = gate.guard.check(&head) {
+        gate.refused.count(r.kind());
+        return respond_text(&mut stream, "403 Forbidden", &r.to_string());
+    }
     if head.method != "GET" {
-        respond(
-            &mut stream,
-            "405 Method Not Allowed",
-            "text/plain",
-            "",
-            b"GET only\n",
-        );
-        return;
+        return respond_text(&mut stream, "405 Method Not Allowed", "GET only");
     }
-    let path = head.path.split('?').next().unwrap_or("/");
-    if let Some(f) = PAGE_FILES.iter().find(|f| f.path == path) {
-        return respond(&mut stream, "200 OK", f.content_type, "", f.body.as_bytes());
+    routes.route(stream, head, gate);
+}
+
+/// Serves a page file of [`PAGE_FILES`] at `path`; false when there is none.
+pub fn serve_page_file(stream: &mut TcpStream, path: &str) -> bool {
+    match PAGE_FILES.iter().find(|f| f.path == path) {
+        Some(f) => {
+            respond(stream, "200 OK", f.content_type, "", f.body.as_bytes());
+            true
+        }
+        None => false,
     }
-    match path {
-        "/favicon.ico" => respond(&mut stream, "204 No Content", "image/x-icon", "", b""),
-        "/recording.mcap" => {
-            let file = shared.recording.lock().ok().and_then(|r| r.clone());
-            match file.map(|p| (std::fs::read(&p), p)) {
-                Some((Ok(bytes), p)) => {
-                    let name = p
-                        .file_name()
-                        .map(|n| n.to_string_lossy().replace('"', ""))
-                        .unwrap_or_else(|| "recording.mcap".into());
-                    respond(
-                        &mut stream,
-                        "200 OK",
-                        "application/octet-stream",
-                        &format!("Content-Disposition: attachment; filename=\"{name}\"\r\n"),
-                        &bytes,
-                    );
-                }
-                Some((Err(e), _)) => respond(
-                    &mut stream,
-                    "500 Internal Server Error",
-                    "text/plain",
-                    "",
-                    format!("cannot read the recording: {e}\n").as_bytes(),
-                ),
-                None => respond(
-                    &mut stream,
-                    "404 Not Found",
-                    "text/plain",
-                    "",
-                    b"the recording is served once the session has ended\n",
-                ),
-            }
+}
+
+/// Serves the file at `file` as a download (`404` with `missing` when there is none yet).
+pub fn serve_download(stream: &mut TcpStream, file: Option<PathBuf>, missing: &str) {
+    match file.map(|p| (std::fs::read(&p), p)) {
+        Some((Ok(bytes), p)) => {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().replace(['"', '\\', '\r', '\n'], "_"))
+                .unwrap_or_else(|| "recording.mcap".into());
+            respond(
+                stream,
+                "200 OK",
+                "application/octet-stream",
+                &format!("Content-Disposition: attachment; filename=\"{name}\"\r\n"),
+                &bytes,
+            );
         }
-        "/ws" => {
-            let key = head.header("sec-websocket-key").map(str::to_string);
-            let upgrade = head
-                .header("upgrade")
-                .is_some_and(|u| u.eq_ignore_ascii_case("websocket"));
-            match key {
-                Some(k) if upgrade => {
-                    let accept = tungstenite::handshake::derive_accept_key(k.as_bytes());
-                    let resp = format!(
-                        "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
-                    );
-                    if stream.write_all(resp.as_bytes()).is_ok() {
-                        page_link(stream, &shared);
-                    }
-                }
-                _ => respond(
-                    &mut stream,
-                    "400 Bad Request",
-                    "text/plain",
-                    "",
-                    b"a WebSocket upgrade is expected here\n",
-                ),
-            }
-        }
-        _ => respond(
-            &mut stream,
-            "404 Not Found",
-            "text/plain",
-            "",
-            b"not found\n",
+        Some((Err(e), _)) => respond_text(
+            stream,
+            "500 Internal Server Error",
+            &format!("cannot read the recording: {e}"),
         ),
+        None => respond_text(stream, "404 Not Found", missing),
+    }
+}
+
+/// The routes of a play session: the page, `/ws`, `/favicon.ico` and `/recording.mcap`.
+pub struct PlayRoutes {
+    /// The session.
+    pub shared: Arc<Shared>,
+}
+
+impl Routes for PlayRoutes {
+    fn route(&self, mut stream: TcpStream, head: Head, gate: &Arc<Gate>) {
+        let path = head.path();
+        if serve_page_file(&mut stream, path) {
+            return;
+        }
+        match path {
+            "/favicon.ico" => respond(&mut stream, "204 No Content", "image/x-icon", "", b""),
+            "/recording.mcap" => {
+                let file = self.shared.recording.lock().ok().and_then(|r| r.clone());
+                serve_download(
+                    &mut stream,
+                    file,
+                    "the recording is served once the session has ended",
+                );
+            }
+            "/ws" if head.is_upgrade() => {
+                if accept_upgrade(&mut stream, &head).is_ok() {
+                    page_link(stream, &self.shared, gate);
+                }
+            }
+            "/ws" => respond_text(
+                &mut stream,
+                "400 Bad Request",
+                "a WebSocket upgrade is expected here",
+            ),
+            _ => respond_text(&mut stream, "404 Not Found", "not found"),
+        }
+    }
+}
+
+/// The running play server: a [`Listener`] on loopback with the [`PlayRoutes`].
+pub struct Server {
+    listener: Listener,
+}
+
+impl Server {
+    /// Binds `127.0.0.1:port` (0: any free port) and starts serving, with `limits`.
+    pub fn start(port: u16, shared: Arc<Shared>, limits: Limits) -> std::io::Result<Server> {
+        let routes = Arc::new(PlayRoutes {
+            shared: shared.clone(),
+        });
+        let shutdown = Arc::new(AtomicBool::new(false));
+        let listener = Listener::start(
+            SocketAddr::from(([127, 0, 0, 1], port)),
+            limits,
+            routes,
+            shutdown,
+        )?;
+        Ok(Server { listener })
+    }
+
+    /// The address served.
+    pub fn addr(&self) -> SocketAddr {
+        self.listener.addr()
+    }
+
+    /// The gate (limits and refusal counts).
+    pub fn gate(&self) -> &Arc<Gate> {
+        self.listener.gate()
+    }
+
+    /// The page's URL.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.addr())
+    }
+
+    /// Stops accepting, closes the pages and joins the threads.
+    pub fn stop(&mut self, shared: &Shared) {
+        shared.shutdown.store(true, Ordering::Relaxed);
+        self.listener.stop();
     }
 }
 
@@ -481,7 +526,11 @@ fn role_of(shared: &Shared, id: u64, link: Option<&SceneLink>) -> Role {
 }
 
 /// A page's WebSocket: reads its messages, writes its queue.
-fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
+///
+/// The page's messages are bounded by the gate's limits: larger than
+/// [`Limits::max_message_bytes`] closes the link (counted), faster than
+/// [`Limits::messages_per_s`] is refused message by message (counted, one error a second).
+pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
     let id = shared.next_id.fetch_add(1, Ordering::Relaxed) + 1;
     shared.pages_served.fetch_add(1, Ordering::Relaxed);
     let (tx, rx): (SyncSender<Message>, Receiver<Message>) = sync_channel(PAGE_QUEUE);
@@ -500,9 +549,28 @@ fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
         pages.push(Page { id, tx });
     }
     let _ = stream.set_read_timeout(Some(Duration::from_millis(2)));
-    let mut ws = WebSocket::from_raw_socket(stream, WsRole::Server, None);
+    let max = gate.limits.max_message_bytes;
+    let config = WebSocketConfig::default()
+        .max_message_size(Some(max))
+        .max_frame_size(Some(max));
+    let mut ws = WebSocket::from_raw_socket(stream, WsRole::Server, Some(config));
+    let mut rate = RateLimit::new(gate.limits.messages_per_s);
+    let mut told_rate: Option<Instant> = None;
     'link: while !shared.shutdown.load(Ordering::Relaxed) {
-        match ws.read() {
+        let mut msg = ws.read();
+        if matches!(msg, Ok(Message::Text(_) | Message::Binary(_))) && !rate.take(Instant::now()) {
+            msg = Ok(Message::Pong(Default::default()));
+            gate.refused.count("rate");
+            if told_rate.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
+                told_rate = Some(Instant::now());
+                let m = format!(
+                    "too many messages: at most {} per second (this one was dropped)",
+                    gate.limits.messages_per_s
+                );
+                shared.error_to(id, "type", &m);
+            }
+        }
+        match msg {
             Ok(Message::Text(t)) => on_message(shared, id, t.as_str()),
             Ok(Message::Binary(_)) => {
                 shared.error_to(id, "type", &ProtocolError::Binary.to_string());
@@ -514,6 +582,10 @@ fn page_link(stream: TcpStream, shared: &Arc<Shared>) {
                     e.kind(),
                     std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
                 ) => {}
+            Err(tungstenite::Error::Capacity(_)) => {
+                gate.refused.count("size");
+                break;
+            }
             Err(_) => break,
         }
         let mut wrote = false;

@@ -94,7 +94,16 @@ fn send(ws: &mut Ws, v: Value) {
 #[test]
 fn the_page_is_served_on_its_paths_only() {
     let (url, stop, h, _) = start("brickworld", "http", None);
-    let get = |path: &str| http(&url, &format!("GET {path} HTTP/1.1\r\nHost: x\r\n\r\n"));
+    let host = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    let get = |path: &str| {
+        http(
+            &url,
+            &format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n"),
+        )
+    };
     let index = get("/");
     assert!(
         index.starts_with("HTTP/1.1 200 OK\r\nContent-Type: text/html"),
@@ -144,7 +153,7 @@ fn the_page_is_served_on_its_paths_only() {
     assert!(get("/ws").starts_with("HTTP/1.1 400"));
     let post = http(
         &url,
-        "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\n\r\n",
+        &format!("POST / HTTP/1.1\r\nHost: {host}\r\nContent-Length: 0\r\n\r\n"),
     );
     assert!(post.starts_with("HTTP/1.1 405"));
     // Loopback only.
@@ -298,4 +307,120 @@ fn a_busy_port_and_a_bad_length_are_named() {
         run(&c, &stop, &mut |_| {}).unwrap_err().to_string(),
         "session length [s] = -1 is out of range: allowed 0 < length ≤ 3600 s"
     );
+}
+
+/// A WebSocket upgrade to `url`'s `/ws` with `host` and `origin` as sent by a browser: the
+/// answer's head, and its body when refused.
+fn upgrade(url: &str, host: &str, origin: &str) -> String {
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    s.write_all(
+        format!(
+            "GET /ws HTTP/1.1\r\nHost: {host}\r\nOrigin: {origin}\r\nUpgrade: websocket\r\n\
+             Connection: Upgrade\r\nSec-WebSocket-Version: 13\r\n\
+             Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+        )
+        .as_bytes(),
+    )
+    .unwrap();
+    let mut out = Vec::new();
+    let mut b = [0u8; 1];
+    while let Ok(1) = s.read(&mut b) {
+        out.push(b[0]);
+        // A switched connection stays open: its head is the answer.
+        if out.ends_with(b"\r\n\r\n") && out.starts_with(b"HTTP/1.1 101") {
+            break;
+        }
+    }
+    String::from_utf8(out).unwrap()
+}
+
+#[test]
+fn forged_origin_and_host_are_refused_counted_and_change_nothing() {
+    let (url, stop, h, _) = start("brickworld", "forged", None);
+    let host = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    let port = host.rsplit(':').next().unwrap().to_string();
+    // Cross-site WebSocket hijacking: a page of another site opens our /ws.
+    let r = upgrade(&url, &host, "https://evil.example");
+    assert!(r.starts_with("HTTP/1.1 403 Forbidden"), "{r}");
+    assert!(r.ends_with(&format!(
+        "Origin `https://evil.example` is not this page's own origin `http://{host}`: a page \
+         from another site may not use this server\n"
+    )));
+    // DNS rebinding: the attacker's host name resolving to 127.0.0.1.
+    for path in ["/", "/ws", "/recording.mcap"] {
+        let r = http(
+            &url,
+            &format!("GET {path} HTTP/1.1\r\nHost: rebind.evil.example:{port}\r\n\r\n"),
+        );
+        assert!(r.starts_with("HTTP/1.1 403 Forbidden"), "{path}: {r}");
+        assert!(r.contains("Host `rebind.evil.example:"), "{r}");
+    }
+    let r = upgrade(
+        &url,
+        &format!("rebind.evil.example:{port}"),
+        &format!("http://rebind.evil.example:{port}"),
+    );
+    assert!(r.starts_with("HTTP/1.1 403 Forbidden"), "{r}");
+    // No Host at all, and a malformed head.
+    assert!(http(&url, "GET / HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 403"));
+    assert!(http(&url, "GET / HTTP/1.1 x\r\n\r\n").starts_with("HTTP/1.1 400"));
+    // The page's own origin is served, by loopback name or address.
+    let r = upgrade(&url, &host, &format!("http://{host}"));
+    assert!(r.starts_with("HTTP/1.1 101 Switching Protocols"), "{r}");
+    let lh = format!("localhost:{port}");
+    assert!(upgrade(&url, &lh, &format!("http://{lh}")).starts_with("HTTP/1.1 101"));
+    // A real page plays; too big a message closes only its own link.
+    let mut p = page(&url);
+    send(&mut p, serde_json::json!({"type": "start"}));
+    send(
+        &mut p,
+        serde_json::json!({"type": "input", "seq": 1, "pos": [0, 0, 0], "buttons": 0, "t_ms": 1}),
+    );
+    let _ = read_for(&mut p, 0.3);
+    let mut big = page(&url);
+    let _ = big.send(Message::text("x".repeat(5000)));
+    let t0 = Instant::now();
+    let closed = loop {
+        match big.read() {
+            Err(tungstenite::Error::Io(e))
+                if e.kind() == std::io::ErrorKind::WouldBlock
+                    || e.kind() == std::io::ErrorKind::TimedOut =>
+            {
+                if t0.elapsed() > Duration::from_secs(10) {
+                    break false;
+                }
+            }
+            Err(_) | Ok(Message::Close(_)) => break true,
+            Ok(_) => {}
+        }
+    };
+    assert!(closed, "a 5000-byte message closes its link");
+    // A page flooding messages is refused beyond its rate, and told so.
+    let mut flood = page(&url);
+    for _ in 0..1500 {
+        let _ = flood.send(Message::text(r#"{"type":"start"}"#));
+    }
+    let msgs = read_for(&mut flood, 1.0);
+    assert!(
+        msgs.iter()
+            .any(|m| m["message"]
+                == "too many messages: at most 500 per second (this one was dropped)"),
+        "{msgs:?}"
+    );
+    send(&mut p, serde_json::json!({"type": "end"}));
+    let _ = read_for(&mut p, 0.5);
+    stop.store(true, Ordering::Relaxed);
+    let s = h.join().unwrap().unwrap();
+    assert_eq!(s.refused.origin, 1, "{:?}", s.refused);
+    assert_eq!(s.refused.host, 5, "{:?}", s.refused);
+    assert_eq!(s.refused.head, 1, "{:?}", s.refused);
+    assert_eq!(s.refused.size, 1, "{:?}", s.refused);
+    assert!(s.refused.rate >= 400, "{:?}", s.refused);
+    // Only the real page and the two good upgrades connected (and the flooder, the big one).
+    assert_eq!(s.pages_served, 5);
 }

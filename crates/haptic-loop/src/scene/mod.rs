@@ -75,8 +75,9 @@ use haptic_types::Primitive;
 /// A world as the haptic loop sees it.
 ///
 /// Implementations hold their world's parameters and state; `step` advances by one tick of
-/// `input.dt_s`. It must be deterministic: same inputs, same bits.
-pub trait Scene {
+/// `input.dt_s`. It must be deterministic: same inputs, same bits. A scene is `Send`: a session
+/// may be set up on one thread and ticked on another (the classroom's workers).
+pub trait Scene: Send {
     /// Short scene kind name, e.g. `wall`.
     fn kind(&self) -> &'static str;
     /// Names of the state fields, in the order [`Scene::state`] writes them (lower snake case,

@@ -1,0 +1,558 @@
+//! # The classroom: one server for a whole class
+//!
+//! `nanohaptics classroom [SCENE]` serves one address for a class. Each student opens it,
+//! enters a name and gets their own world, their own page as the hand, their own sound and
+//! their own recording (`DIR/NAME-START.mcap`), which replays bit for bit like any `play`
+//! session. A teacher page (`/teacher`, behind a code printed at start) shows every student's
+//! score, blueprint, time, force and connection, sets the class's switches for everyone or one
+//! student, ends every session and downloads every recording as one zip.
+//!
+//! - **Pacing** ([`sched`]): a few worker threads (one per core, at most four) tick every
+//!   session at the scene's rate against one schedule, not a thread per student.
+//! - **Safety**: the same gate as `play` ([`crate::gate`], [`crate::http`]): `Host` and
+//!   `Origin` checked on every request and upgrade, limits on students, connections per
+//!   address, message size and rate, names of bounded length and characters that never become
+//!   a path ([`names`]), every refusal answered and counted.
+//! - **Where it listens**: loopback by default (a student needs only a name); on a class
+//!   network (`--listen 0.0.0.0` or an interface address) students also need the join code.
+//!
+//! What it is not: no accounts, no TLS, no persistence across restarts (the recordings stay in
+//! the folder); a bridged device cannot join as a student yet (use `play --device`).
+
+mod live;
+pub mod names;
+mod routes;
+mod sched;
+mod teacher;
+pub mod zip;
+
+use crate::gate::{Limits, RefusedCounts};
+use crate::input::PageDevice;
+use crate::protocol::LatencyMs;
+use crate::publish::PublishSummary;
+use crate::server::{Listener, Shared};
+use crate::{PlayError, announce};
+use haptic_loop::pacing::TickStats;
+use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
+use haptic_loop::setup::{Setup, SetupOptions};
+use live::Live;
+pub use live::Phase;
+use recording::WriteSummary;
+use std::hash::{BuildHasher, Hasher};
+use std::net::{IpAddr, SocketAddr};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc::Sender;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// Ticks between two updates of what the teacher page shows of a student (50 ms at 1 kHz).
+pub const STATUS_EVERY_TICKS: u64 = 50;
+/// Most students a class may be started with.
+pub const MAX_CLASS: usize = 200;
+
+/// A class to serve.
+#[derive(Clone, Debug)]
+pub struct ClassConfig {
+    /// The scene every student plays.
+    pub scene: SceneSource,
+    /// The address listened on (loopback by default; `0.0.0.0` or an interface address for a
+    /// class network).
+    pub listen: IpAddr,
+    /// The port (0: any free port).
+    pub port: u16,
+    /// Students playing at once (1 to 200).
+    pub max_students: usize,
+    /// The folder of the recordings (created if missing).
+    pub out_dir: PathBuf,
+    /// Each student's session length, s (0 < s ≤ 3600; `None`: until the student or the
+    /// teacher ends it).
+    pub seconds: Option<f64>,
+    /// The teacher's code (`None`: drawn at random, printed at start).
+    pub teacher_code: Option<String>,
+    /// The students' join code on a class network (`None`: drawn at random; never asked on
+    /// loopback).
+    pub join_code: Option<String>,
+    /// Worker threads ticking the sessions (`None`: one per core, at most four).
+    pub workers: Option<usize>,
+}
+
+impl ClassConfig {
+    /// A class of up to 40 on loopback port 8080, recordings in `out_dir`.
+    pub fn new(scene: SceneSource, out_dir: PathBuf) -> Self {
+        ClassConfig {
+            scene,
+            listen: IpAddr::from([127, 0, 0, 1]),
+            port: crate::DEFAULT_PORT,
+            max_students: 40,
+            out_dir,
+            seconds: None,
+            teacher_code: None,
+            join_code: None,
+            workers: None,
+        }
+    }
+}
+
+/// The addresses of a class, as printed at start.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClassAddresses {
+    /// Where students join.
+    pub student_url: String,
+    /// The teacher page, with its code.
+    pub teacher_url: String,
+    /// The teacher's code.
+    pub teacher_code: String,
+    /// The students' join code (`None` on loopback).
+    pub join_code: Option<String>,
+}
+
+/// What the teacher page shows of a student now.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Status {
+    /// Waiting, playing or ended.
+    pub phase: Phase,
+    /// Ticks run.
+    pub ticks: u64,
+    /// Session time, s.
+    pub time_s: f64,
+    /// Missed deadlines.
+    pub missed: u64,
+    /// Force sent to the hand now, N.
+    pub force_n: f64,
+    /// The scene's state (name, value): score, slots filled, …
+    pub state: Vec<(String, f64)>,
+    /// The switches' values now (name, value).
+    pub switches: Vec<(String, f64)>,
+}
+
+/// A student of the class.
+pub struct Student {
+    /// Their name as they typed it (checked).
+    pub name: String,
+    /// Their session's token (the page's `?s=`).
+    pub token: String,
+    /// Their recording.
+    pub out: PathBuf,
+    /// Their session's link to their pages.
+    pub shared: Arc<Shared>,
+    /// What the teacher sees.
+    pub status: Mutex<Status>,
+}
+
+impl Student {
+    fn set_phase(&self, p: Phase) {
+        if let Ok(mut s) = self.status.lock() {
+            s.phase = p;
+        }
+    }
+
+    /// Pages connected now.
+    pub fn pages(&self) -> usize {
+        self.shared.pages.lock().map(|p| p.len()).unwrap_or(0)
+    }
+}
+
+/// What a student's session produced.
+#[derive(Debug)]
+pub struct StudentSummary {
+    /// The student.
+    pub name: String,
+    /// How it ended (`completed`, `stopped`).
+    pub end: &'static str,
+    /// Tick statistics (ticks, missed deadlines, tick work).
+    pub stats: TickStats,
+    /// The scene's state after the last tick.
+    pub state: Vec<(String, f64)>,
+    /// The recording.
+    pub recording: PathBuf,
+    /// What the recorder wrote.
+    pub written: Option<WriteSummary>,
+    /// Page input to force, ms.
+    pub input_latency_ms: Option<LatencyMs>,
+    /// What the pages were sent.
+    pub published: PublishSummary,
+    /// A failure that ended the session early, if any.
+    pub error: Option<String>,
+}
+
+impl StudentSummary {
+    /// One line for a person.
+    pub fn line(&self) -> String {
+        let score = self
+            .state
+            .iter()
+            .find(|(n, _)| n == "score")
+            .map_or(0.0, |(_, v)| *v);
+        format!(
+            "{}: {}, {} ticks, {} missed deadlines, score {}, recording {}{}",
+            self.name,
+            self.end,
+            self.stats.ticks,
+            self.stats.missed,
+            score,
+            self.recording.display(),
+            self.error
+                .as_deref()
+                .map(|e| format!(" (error: {e})"))
+                .unwrap_or_default()
+        )
+    }
+}
+
+/// What a class produced.
+#[derive(Debug)]
+pub struct ClassSummary {
+    /// Where it was served.
+    pub addresses: ClassAddresses,
+    /// Every student's session, in the order they ended.
+    pub students: Vec<StudentSummary>,
+    /// What the server refused, by reason.
+    pub refused: RefusedCounts,
+    /// Worker threads that ticked the sessions.
+    pub workers: usize,
+}
+
+/// Why a student could not join.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum JoinError {
+    /// The name.
+    #[error(transparent)]
+    Name(#[from] names::NameError),
+    /// A wrong join code.
+    #[error("the join code is wrong: ask your teacher for the class's code")]
+    Code,
+    /// The class is full.
+    #[error("the class is full ({max} students playing): wait for a place or ask your teacher")]
+    Full {
+        /// The limit.
+        max: usize,
+    },
+    /// A student of that name is playing.
+    #[error("`{name}` is already playing in this class: choose another name")]
+    Taken {
+        /// The name.
+        name: String,
+    },
+    /// The session could not be set up.
+    #[error("cannot start your session: {0}")]
+    Setup(String),
+}
+
+/// A random code of `n` characters from `alphabet` (the process's OS-seeded hasher keys).
+fn random_code(n: usize, alphabet: &[u8]) -> String {
+    let mut out = String::new();
+    while out.len() < n {
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u64(now_unix_ns());
+        let mut x = h.finish();
+        for _ in 0..8 {
+            if out.len() == n {
+                break;
+            }
+            out.push(alphabet[(x % alphabet.len() as u64) as usize] as char);
+            x /= alphabet.len() as u64;
+        }
+    }
+    out
+}
+
+/// The class's state shared by the routes, the workers and the finisher.
+pub(crate) struct Class {
+    config: ClassConfig,
+    scene_name: String,
+    kind: &'static str,
+    switches: &'static [haptic_types::SwitchSpec],
+    rate_hz: u32,
+    ticks: Option<u64>,
+    teacher_code: String,
+    join_code: Option<String>,
+    students: Mutex<Vec<Arc<Student>>>,
+    workers: Vec<(Mutex<Sender<Box<Live>>>, Arc<AtomicUsize>)>,
+    pub(crate) finished: Mutex<Vec<StudentSummary>>,
+    ended: AtomicUsize,
+    shutdown: Arc<AtomicBool>,
+}
+
+impl Class {
+    /// Joins `name` (with `code` on a class network): their session is set up and handed to
+    /// the least busy worker; it starts at their page's Start.
+    pub(crate) fn join(&self, name: &str, code: Option<&str>) -> Result<Arc<Student>, JoinError> {
+        if let Some(c) = &self.join_code
+            && code != Some(c.as_str())
+        {
+            return Err(JoinError::Code);
+        }
+        let name = names::check_name(name)?;
+        let mut students = self
+            .students
+            .lock()
+            .map_err(|_| JoinError::Setup("the class is shutting down".into()))?;
+        let playing: Vec<&Arc<Student>> = students
+            .iter()
+            .filter(|s| {
+                s.status
+                    .lock()
+                    .map(|st| st.phase != Phase::Ended)
+                    .unwrap_or(false)
+            })
+            .collect();
+        if playing.iter().any(|s| s.name == name) {
+            return Err(JoinError::Taken { name });
+        }
+        if playing.len() >= self.config.max_students {
+            return Err(JoinError::Full {
+                max: self.config.max_students,
+            });
+        }
+        let taken: Vec<PathBuf> = students.iter().map(|s| s.out.clone()).collect();
+        let start_ns = now_unix_ns();
+        let out = names::recording_path(
+            &self.config.out_dir,
+            &name,
+            start_ns / 1_000_000_000,
+            &taken,
+        );
+        let file = self
+            .config
+            .scene
+            .parse()
+            .map_err(|e| JoinError::Setup(e.to_string()))?;
+        let specs = file.device.model.specs().clone();
+        let Setup { lp, header, sinks } = Setup::new(&SetupOptions {
+            operator: Some(format!("person (browser page, classroom student `{name}`)")),
+            keep_arrays: false,
+            out: Some(out.clone()),
+            start_time_ns: Some(start_ns),
+            ..SetupOptions::new(&self.config.scene, specs.clone(), "realtime", "page")
+        })
+        .map_err(|e| JoinError::Setup(e.to_string()))?;
+        let shared = Arc::new(Shared::default());
+        announce(
+            &shared,
+            &self.scene_name,
+            &lp,
+            &specs,
+            true,
+            self.config.seconds,
+        );
+        let student = Arc::new(Student {
+            name,
+            token: random_code(24, b"0123456789abcdefghijklmnopqrstuvwxyz"),
+            out,
+            shared: shared.clone(),
+            status: Mutex::new(Status {
+                phase: Phase::Waiting,
+                ticks: 0,
+                time_s: 0.0,
+                missed: 0,
+                force_n: 0.0,
+                state: Vec::new(),
+                switches: Vec::new(),
+            }),
+        });
+        let device = PageDevice::new(specs, shared.input.clone());
+        let live = Box::new(Live::new(
+            student.clone(),
+            lp,
+            header,
+            sinks,
+            device,
+            self.ticks,
+        ));
+        let (tx, load) = self
+            .workers
+            .iter()
+            .min_by_key(|(_, l)| l.load(Ordering::Relaxed))
+            .ok_or_else(|| JoinError::Setup("the class has no worker".into()))?;
+        load.fetch_add(1, Ordering::Relaxed);
+        tx.lock()
+            .map_err(|_| JoinError::Setup("the class is shutting down".into()))?
+            .send(live)
+            .map_err(|_| JoinError::Setup("the class is shutting down".into()))?;
+        students.push(student.clone());
+        Ok(student)
+    }
+
+    /// The student whose session token is `token`.
+    pub(crate) fn student(&self, token: &str) -> Option<Arc<Student>> {
+        self.students
+            .lock()
+            .ok()?
+            .iter()
+            .find(|s| s.token == token)
+            .cloned()
+    }
+
+    /// Every student so far.
+    pub(crate) fn students(&self) -> Vec<Arc<Student>> {
+        self.students.lock().map(|s| s.clone()).unwrap_or_default()
+    }
+}
+
+/// Runs a class: serves the join page, the students' pages and the teacher page (their
+/// addresses are given to `on_ready` as soon as the port is bound), ticks every student's
+/// session, and on `stop` ends every session cleanly (each recording complete) and returns
+/// every student's summary.
+pub fn run(
+    config: &ClassConfig,
+    stop: &AtomicBool,
+    on_ready: &mut dyn FnMut(&ClassAddresses),
+) -> Result<ClassSummary, PlayError> {
+    if !(1..=MAX_CLASS).contains(&config.max_students) {
+        return Err(PlayError::Session(SessionError::Option(
+            haptic_types::value::ValueError::out_of_range(
+                "--max-students",
+                config.max_students as f64,
+                "1 ≤ students ≤ 200",
+            )
+            .to_string(),
+        )));
+    }
+    let file = config.scene.parse()?;
+    // The scene is checked whole before anyone joins.
+    let loaded = haptic_loop::scene::load_scene(&config.scene.text, Some(file.device.model))
+        .map_err(|e| config.scene.locate(e))?;
+    let (switches, kind) = (loaded.scene.switches(), loaded.scene.kind());
+    drop(loaded);
+    let rate = file.loop_.rate_hz;
+    let ticks = config.seconds.map(|s| ticks_for(s, rate)).transpose()?;
+    std::fs::create_dir_all(&config.out_dir).map_err(|e| {
+        PlayError::Session(SessionError::Option(format!(
+            "cannot create the recordings' folder {}: {e}",
+            config.out_dir.display()
+        )))
+    })?;
+    let n_workers = config
+        .workers
+        .unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        })
+        .clamp(1, 4);
+    let worker_stop = Arc::new(AtomicBool::new(false));
+    let (fin_tx, fin_rx) = std::sync::mpsc::channel::<Box<Live>>();
+    let period_ns = 1_000_000_000 / u64::from(rate.max(1));
+    let mut workers = Vec::new();
+    let mut handles = Vec::new();
+    for i in 0..n_workers {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let load = Arc::new(AtomicUsize::new(0));
+        let (l, f, s) = (load.clone(), fin_tx.clone(), worker_stop.clone());
+        let h = std::thread::Builder::new()
+            .name(format!("class-tick-{i}"))
+            .spawn(move || sched::worker(rx, f, period_ns, l, s))
+            .map_err(|e| PlayError::Serve {
+                port: config.port,
+                message: e.to_string(),
+            })?;
+        workers.push((Mutex::new(tx), load));
+        handles.push(h);
+    }
+    drop(fin_tx);
+    let loopback = config.listen.is_loopback();
+    let shutdown = Arc::new(AtomicBool::new(false));
+    let class = Arc::new(Class {
+        config: config.clone(),
+        scene_name: file.scene.name.clone(),
+        kind,
+        switches,
+        rate_hz: rate,
+        ticks,
+        teacher_code: config
+            .teacher_code
+            .clone()
+            .unwrap_or_else(|| random_code(8, b"ABCDEFGHJKLMNPQRSTUVWXYZ23456789")),
+        join_code: if loopback {
+            None
+        } else {
+            Some(
+                config
+                    .join_code
+                    .clone()
+                    .unwrap_or_else(|| random_code(6, b"0123456789")),
+            )
+        },
+        students: Mutex::new(Vec::new()),
+        workers,
+        finished: Mutex::new(Vec::new()),
+        ended: AtomicUsize::new(0),
+        shutdown: shutdown.clone(),
+    });
+    let c2 = class.clone();
+    let finisher = std::thread::Builder::new()
+        .name("class-finish".into())
+        .spawn(move || {
+            while let Ok(l) = fin_rx.recv() {
+                let s = l.finish();
+                c2.ended.fetch_add(1, Ordering::Relaxed);
+                if let Ok(mut f) = c2.finished.lock() {
+                    f.push(s);
+                }
+            }
+        })
+        .map_err(|e| PlayError::Serve {
+            port: config.port,
+            message: e.to_string(),
+        })?;
+    // A connection per page file, a link per page: four per student from one address on
+    // loopback (every student of a test or a one-machine class shares 127.0.0.1).
+    let limits = Limits {
+        max_connections: 8 * config.max_students + 16,
+        max_per_address: if loopback {
+            8 * config.max_students + 16
+        } else {
+            16
+        },
+        ..Limits::default()
+    };
+    let mut listener = Listener::start(
+        SocketAddr::new(config.listen, config.port),
+        limits,
+        Arc::new(routes::ClassRoutes {
+            class: class.clone(),
+        }),
+        shutdown.clone(),
+    )
+    .map_err(|e| PlayError::Serve {
+        port: config.port,
+        message: e.to_string(),
+    })?;
+    let addr = listener.addr();
+    let shown = if config.listen.is_unspecified() {
+        SocketAddr::new(IpAddr::from([127, 0, 0, 1]), addr.port())
+    } else {
+        addr
+    };
+    let addresses = ClassAddresses {
+        student_url: format!("http://{shown}/"),
+        teacher_url: format!("http://{shown}/teacher?code={}", class.teacher_code),
+        teacher_code: class.teacher_code.clone(),
+        join_code: class.join_code.clone(),
+    };
+    on_ready(&addresses);
+    while !stop.load(Ordering::Relaxed) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    worker_stop.store(true, Ordering::Relaxed);
+    for h in handles {
+        let _ = h.join();
+    }
+    let _ = finisher.join();
+    for s in class.students() {
+        s.shared.shutdown.store(true, Ordering::Relaxed);
+    }
+    listener.stop();
+    let students = class
+        .finished
+        .lock()
+        .map(|mut f| std::mem::take(&mut *f))
+        .unwrap_or_default();
+    Ok(ClassSummary {
+        addresses,
+        students,
+        refused: listener.gate().refused.snapshot(),
+        workers: n_workers,
+    })
+}

@@ -1,0 +1,196 @@
+//! The classroom's paths: the join page and `/join`, each student's page (`/play?s=TOKEN`,
+//! the page's modules, `/ws?s=TOKEN`, `/recording.mcap?s=TOKEN`), and the teacher's
+//! (`/teacher?code=…`, `/teacher/ws?code=…`, `/recordings.zip?code=…`). Every request passed
+//! the listener's gate and its `Host`/`Origin` check before it reaches these.
+
+use super::{Class, JoinError, teacher};
+use crate::gate::Gate;
+use crate::http::{Head, accept_upgrade, respond, respond_text};
+use crate::server::{PAGE_FILES, Routes, page_link, serve_download, serve_page_file};
+use std::net::TcpStream;
+use std::sync::Arc;
+
+/// The classroom's files besides the play page's.
+const JOIN_CSS: &str = include_str!("page/class.css");
+const TEACHER_HTML: &str = include_str!("page/teacher.html");
+const TEACHER_JS: &str = include_str!("page/teacher.js");
+
+/// The classroom's routes.
+pub(crate) struct ClassRoutes {
+    pub(crate) class: Arc<Class>,
+}
+
+/// Escapes text for HTML.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+        .replace('\'', "&#39;")
+}
+
+/// The join page, with `error` above the form when a join was refused.
+fn join_page(class: &Class, error: Option<&str>, name: &str) -> String {
+    let code = if class.join_code.is_some() {
+        r#"<label>Join code <input name="code" inputmode="numeric" autocomplete="off" required maxlength="12"></label>"#
+    } else {
+        ""
+    };
+    let error = error
+        .map(|e| format!(r#"<p class="error" role="alert">{}</p>"#, esc(e)))
+        .unwrap_or_default();
+    format!(
+        r#"<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>nanohaptics classroom: join</title><link rel="stylesheet" href="/class.css"></head>
+<body><main class="join"><h1>Join the class</h1>
+<p>Scene: <b>{scene}</b>. Enter your name: you get your own world and your own recording.</p>
+{error}<form method="get" action="/join">
+<label>Your name <input name="name" value="{name}" required maxlength="32" autocomplete="off" autofocus></label>
+{code}<button type="submit">Join</button></form></main></body></html>
+"#,
+        scene = esc(&class.scene_name),
+        name = esc(name),
+    )
+}
+
+fn html(stream: &mut TcpStream, status: &str, body: &str) {
+    respond(
+        stream,
+        status,
+        "text/html; charset=utf-8",
+        "",
+        body.as_bytes(),
+    );
+}
+
+impl ClassRoutes {
+    fn teacher_ok(&self, head: &Head, gate: &Gate) -> bool {
+        let ok = head.query("code").as_deref() == Some(self.class.teacher_code.as_str());
+        if !ok {
+            gate.refused.count("code");
+        }
+        ok
+    }
+}
+
+impl Routes for ClassRoutes {
+    fn route(&self, mut stream: TcpStream, head: Head, gate: &Arc<Gate>) {
+        let class = &self.class;
+        let path = head.path().to_string();
+        match path.as_str() {
+            "/" | "/index.html" => html(&mut stream, "200 OK", &join_page(class, None, "")),
+            "/join" => {
+                let name = head.query("name").unwrap_or_default();
+                match class.join(&name, head.query("code").as_deref()) {
+                    Ok(s) => respond(
+                        &mut stream,
+                        "303 See Other",
+                        "text/plain; charset=utf-8",
+                        &format!("Location: /play?s={}\r\n", s.token),
+                        b"joined\n",
+                    ),
+                    Err(e) => {
+                        gate.refused.count(match e {
+                            JoinError::Code => "code",
+                            _ => "join",
+                        });
+                        let status = match e {
+                            JoinError::Code => "403 Forbidden",
+                            JoinError::Full { .. } => "503 Service Unavailable",
+                            JoinError::Taken { .. } => "409 Conflict",
+                            _ => "400 Bad Request",
+                        };
+                        let shown: String = name.chars().take(32).collect();
+                        html(
+                            &mut stream,
+                            status,
+                            &join_page(class, Some(&e.to_string()), &shown),
+                        );
+                    }
+                }
+            }
+            "/play" | "/ws" | "/recording.mcap" => {
+                let student = head.query("s").and_then(|t| class.student(&t));
+                let Some(s) = student else {
+                    return respond_text(
+                        &mut stream,
+                        "404 Not Found",
+                        "no such session in this class: join again at /",
+                    );
+                };
+                match path.as_str() {
+                    "/play" => {
+                        serve_page_file(&mut stream, "/index.html");
+                    }
+                    "/ws" if head.is_upgrade() => {
+                        if accept_upgrade(&mut stream, &head).is_ok() {
+                            page_link(stream, &s.shared, gate);
+                        }
+                    }
+                    "/ws" => respond_text(
+                        &mut stream,
+                        "400 Bad Request",
+                        "a WebSocket upgrade is expected here",
+                    ),
+                    _ => {
+                        let file = s.shared.recording.lock().ok().and_then(|r| r.clone());
+                        serve_download(
+                            &mut stream,
+                            file,
+                            "the recording is served once the session has ended",
+                        );
+                    }
+                }
+            }
+            "/class.css" => respond(
+                &mut stream,
+                "200 OK",
+                "text/css; charset=utf-8",
+                "",
+                JOIN_CSS.as_bytes(),
+            ),
+            "/teacher" if self.teacher_ok(&head, gate) => html(&mut stream, "200 OK", TEACHER_HTML),
+            "/teacher.js" => respond(
+                &mut stream,
+                "200 OK",
+                "text/javascript; charset=utf-8",
+                "",
+                TEACHER_JS.as_bytes(),
+            ),
+            "/teacher/ws" if self.teacher_ok(&head, gate) => {
+                if head.is_upgrade() && accept_upgrade(&mut stream, &head).is_ok() {
+                    teacher::link(stream, class, gate);
+                } else {
+                    respond_text(
+                        &mut stream,
+                        "400 Bad Request",
+                        "a WebSocket upgrade is expected here",
+                    );
+                }
+            }
+            "/recordings.zip" if self.teacher_ok(&head, gate) => {
+                match teacher::zip_of_recordings(class) {
+                    Ok(bytes) => respond(
+                        &mut stream,
+                        "200 OK",
+                        "application/zip",
+                        "Content-Disposition: attachment; filename=\"class-recordings.zip\"\r\n",
+                        &bytes,
+                    ),
+                    Err(e) => respond_text(&mut stream, "500 Internal Server Error", &e),
+                }
+            }
+            "/teacher" | "/teacher/ws" | "/recordings.zip" => respond_text(
+                &mut stream,
+                "403 Forbidden",
+                "the teacher's code is wrong or missing: use the teacher address printed at start",
+            ),
+            "/favicon.ico" => respond(&mut stream, "204 No Content", "image/x-icon", "", b""),
+            p if p != "/index.html" && PAGE_FILES.iter().any(|f| f.path == p) => {
+                serve_page_file(&mut stream, p);
+            }
+            _ => respond_text(&mut stream, "404 Not Found", "not found"),
+        }
+    }
+}
