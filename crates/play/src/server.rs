@@ -89,6 +89,11 @@ pub const PAGE_FILES: &[PageFile] = &[
         content_type: JS,
         body: include_str!("page/messages.js"),
     },
+    PageFile {
+        path: "/events.js",
+        content_type: JS,
+        body: include_str!("page/events.js"),
+    },
 ];
 
 /// Messages queued per page before frames are dropped.

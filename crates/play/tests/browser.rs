@@ -1,8 +1,11 @@
 //! The game in a real browser: Debian's headless `chromium`, driven through the DevTools
 //! Protocol. A pointer session and a keyboard-only session each fill a blueprint slot of the
 //! brick world; their recordings replay bit for bit; the page received every sound event at its
-//! tick and the sound samples of `render --audio --proximity`; page errors fail the tests;
-//! screenshots go to docs/figures/play/.
+//! tick and the sound samples of `render --audio --proximity`; the Events list (the live
+//! region) speaks of the game only; the menu shows each switch's value as it changes; a
+//! scripted gamepad (injected through the DevTools Protocol: headless Chromium has none) moves
+//! the hand, grips and rumbles with the force; page errors fail the tests; screenshots go to
+//! docs/figures/play/.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -124,7 +127,7 @@ fn wheel_to(b: &mut Browser, px: f64, py: f64, z_m: f64, steps: u32, secs: f64, 
     }
 }
 
-fn end_session(b: &mut Browser, s: Session, shot: &str) -> (PlaySummary, Value) {
+fn end_session(b: &mut Browser, s: Session, shot: Option<&str>) -> (PlaySummary, Value) {
     b.key("e", true, false).unwrap();
     b.key("e", false, false).unwrap();
     b.wait_for("window.__play.ended !== null", 10.0).unwrap();
@@ -132,9 +135,16 @@ fn end_session(b: &mut Browser, s: Session, shot: &str) -> (PlaySummary, Value) 
     let bytes = b
         .eval("fetch(document.getElementById('download').href).then(r => r.arrayBuffer()).then(a => a.byteLength)")
         .unwrap();
-    sleep(Duration::from_millis(300));
-    b.screenshot(&figures().join(shot)).unwrap();
+    if let Some(shot) = shot {
+        sleep(Duration::from_millis(300));
+        b.screenshot(&figures().join(shot)).unwrap();
+    }
     let page = b.eval("JSON.parse(JSON.stringify(window.__play, (k, v) => k === 'lastFrame' ? undefined : v))").unwrap();
+    // The link is the one the `end` message names.
+    let href = b
+        .eval("document.getElementById('download').getAttribute('href')")
+        .unwrap();
+    assert_eq!(href, page["ended"]["recording"], "the download link");
     b.check().unwrap();
     s.stop.store(true, Ordering::Relaxed);
     let summary = s.handle.join().unwrap().unwrap();
@@ -145,6 +155,50 @@ fn end_session(b: &mut Browser, s: Session, shot: &str) -> (PlaySummary, Value) 
     );
     assert_eq!(summary.end, "stopped");
     (summary, page)
+}
+
+/// What the page wrote to its Events list (the live region) and announced.
+fn said(page: &Value) -> Vec<String> {
+    page["said"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap().to_string())
+        .collect()
+}
+
+/// The Events list and the announcer spoke of the game only: short sentences, never the
+/// loop's timing, safety or device reports (which the page did receive: the first tick's
+/// `safety.config` is in its events, and stays in the recording).
+fn assert_only_the_game_said(page: &Value) {
+    let names: Vec<&str> = page["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e[1].as_str().unwrap())
+        .collect();
+    assert!(
+        names.contains(&"safety.config"),
+        "the page got the loop's reports: {names:?}"
+    );
+    for s in said(page) {
+        for word in [
+            "deadline",
+            "safety",
+            "watchdog",
+            "clamped",
+            "device",
+            "config",
+            "passivity",
+            "sample",
+            "{",
+            "}",
+            "\"",
+            "impact",
+        ] {
+            assert!(!s.contains(word), "`{word}` said: {s}");
+        }
+    }
 }
 
 /// Replays the recording bit for bit and checks the sounds the page got against it.
@@ -194,6 +248,30 @@ fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
     );
 }
 
+/// The gravity switch's line in the menu (its value now and its range) and its input's value.
+fn menu_value(b: &mut Browser) -> (String, String) {
+    let v = b
+        .eval("[document.getElementById('now-gravity_m_per_s2').textContent, document.getElementById('sw-gravity_m_per_s2').value]")
+        .unwrap();
+    (
+        v[0].as_str().unwrap().to_string(),
+        v[1].as_str().unwrap().to_string(),
+    )
+}
+
+/// Another page of the session: a WebSocket client of the page's origin (as a second
+/// browser tab would open).
+fn other_page(
+    url: &str,
+) -> tungstenite::WebSocket<tungstenite::stream::MaybeTlsStream<std::net::TcpStream>> {
+    use tungstenite::client::IntoClientRequest;
+    let host = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut req = format!("ws://{host}/ws").into_client_request().unwrap();
+    req.headers_mut()
+        .insert("Origin", format!("http://{host}").parse().unwrap());
+    tungstenite::connect(req).unwrap().0
+}
+
 #[test]
 fn a_pointer_grabs_a_brick_and_places_it_in_a_slot() {
     let _one = serial();
@@ -234,10 +312,23 @@ fn a_pointer_grabs_a_brick_and_places_it_in_a_slot() {
     wheel_to(&mut b, bx, by, 0.0075, 10, 0.4, false);
     b.wait_for("window.__play.lastFrame.state.slots_filled >= 1", 3.0)
         .unwrap();
-    // The menu: gravity to 5 m/s², recorded as a switch on the tick it applied to.
+    // The menu shows each switch's value now beside its range: the hello's value first.
+    let g0 = b
+        .eval("window.__play.hello.switches.find(s => s.name === 'gravity_m_per_s2').value")
+        .unwrap();
+    assert_eq!(g0.as_f64(), Some(9.81));
+    assert_eq!(
+        menu_value(&mut b),
+        ("now 9.81 · allowed 0 to 100".into(), "9.81".into())
+    );
+    // Gravity to 5 m/s², recorded as a switch on the tick it applied to; the menu follows.
     b.eval("document.getElementById('sw-gravity_m_per_s2').value = '5'; document.querySelector('#menu button').click(); 0").unwrap();
     b.wait_for("window.__play.switched.length === 1", 3.0)
         .unwrap();
+    assert_eq!(
+        menu_value(&mut b),
+        ("now 5 · allowed 0 to 100".into(), "5".into())
+    );
     // A value out of range is refused with the switch's range, and the session goes on.
     b.eval("document.getElementById('sw-gravity_m_per_s2').value = '1000'; document.querySelector('#menu button').click(); 0").unwrap();
     b.wait_for("window.__play.errors.length === 1", 3.0)
@@ -247,10 +338,29 @@ fn a_pointer_grabs_a_brick_and_places_it_in_a_slot() {
         err,
         "switch `gravity_m_per_s2` = 1000 is out of range: allowed 0 ≤ value ≤ 100"
     );
+    // The refused value stays in the input to be corrected; the value now is still 5.
+    assert_eq!(
+        menu_value(&mut b),
+        ("now 5 · allowed 0 to 100".into(), "1000".into())
+    );
+    // Another page sets gravity to 3 m/s²: this page's menu shows it.
+    let mut other = other_page(&s.url);
+    other
+        .send(tungstenite::Message::text(
+            r#"{"type":"switch","name":"gravity_m_per_s2","value":3}"#,
+        ))
+        .unwrap();
+    b.wait_for("window.__play.switched.length === 2", 3.0)
+        .unwrap();
+    assert_eq!(
+        menu_value(&mut b),
+        ("now 3 · allowed 0 to 100".into(), "3".into())
+    );
+    drop(other);
     sleep(Duration::from_millis(300));
     b.screenshot(&figures().join("placed.png")).unwrap();
     let out = s.out.clone();
-    let (summary, page) = end_session(&mut b, s, "end.png");
+    let (summary, page) = end_session(&mut b, s, Some("end.png"));
     assert!(
         summary.state("slots_filled").unwrap() >= 1.0,
         "{:?}",
@@ -263,15 +373,33 @@ fn a_pointer_grabs_a_brick_and_places_it_in_a_slot() {
     );
     assert!(summary.input_latency_ms.is_some());
     assert_eq!(summary.page_messages_refused, 1);
-    let sw = &page["switched"][0];
     let rec = read_recording_file(&out, false).unwrap();
     let sched = recording::switch_schedule(&rec, 1_000_000).unwrap();
-    assert_eq!(sched.len(), 1);
-    assert_eq!(Some(sched[0].0), sw["tick"].as_u64());
-    assert_eq!(
-        (sched[0].1.name.as_str(), sched[0].1.value),
-        ("gravity_m_per_s2", 5.0)
-    );
+    assert_eq!(sched.len(), 2);
+    for (k, want) in [5.0, 3.0].into_iter().enumerate() {
+        let sw = &page["switched"][k];
+        assert_eq!(Some(sched[k].0), sw["tick"].as_u64());
+        assert_eq!(
+            (sched[k].1.name.as_str(), sched[k].1.value),
+            ("gravity_m_per_s2", want)
+        );
+    }
+    assert_eq!(page["menu"]["gravity_m_per_s2"].as_f64(), Some(3.0));
+    let said = said(&page);
+    for want in [
+        "grip on",
+        "grabbed brick 1",
+        "let go of brick 1",
+        "slot 1 filled with brick 1",
+        "gravity_m_per_s2 set to 5",
+        "gravity_m_per_s2 set to 3",
+    ] {
+        assert!(
+            said.iter().any(|s| s.contains(want)),
+            "`{want}` not said: {said:?}"
+        );
+    }
+    assert_only_the_game_said(&page);
     check_recording(&out, &summary, &page);
 }
 
@@ -306,7 +434,16 @@ fn a_keyboard_only_session_fills_a_slot() {
     let _one = serial();
     let s = start("brickworld", "keys");
     let mut b = browser();
-    open_and_start(&mut b, &s.url, true);
+    // The page served at another path than `/`, with a query (as a classroom serves it):
+    // its modules load by absolute path and its link is `/ws` with the page's query.
+    open_and_start(&mut b, &format!("{}index.html?s=tok-3", s.url), true);
+    assert_eq!(
+        b.websockets,
+        [format!(
+            "ws://{}/ws?s=tok-3",
+            s.url.trim_start_matches("http://").trim_end_matches('/')
+        )]
+    );
     key_to(&mut b, 2, 0.0075);
     key_to(&mut b, 0, -0.0225);
     key_to(&mut b, 1, 0.0025);
@@ -328,21 +465,16 @@ fn a_keyboard_only_session_fills_a_slot() {
     b.wait_for("window.__play.lastFrame.state.slots_filled >= 1", 3.0)
         .unwrap();
     let out = s.out.clone();
-    let (summary, page) = end_session(&mut b, s, "end-keyboard.png");
+    let (summary, page) = end_session(&mut b, s, Some("end-keyboard.png"));
     assert!(summary.state("slots_filled").unwrap() >= 1.0);
-    // The log (the ARIA live region) announced the grab and the slot.
-    let said: Vec<String> = page["said"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().unwrap().to_string())
-        .collect();
+    // The log (the ARIA live region) announced the grab and the slot, in words.
+    let said = said(&page);
     for want in [
         "you are the hand",
         "grip on",
         "grip off",
-        "brick grabbed",
-        "slot filled",
+        "grabbed brick 1",
+        "slot 1 filled with brick 1",
         "score 25",
     ] {
         assert!(
@@ -350,6 +482,7 @@ fn a_keyboard_only_session_fills_a_slot() {
             "`{want}` not announced: {said:?}"
         );
     }
+    assert_only_the_game_said(&page);
     let rec = read_recording_file(&out, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
     assert!(page["inputsSent"].as_u64().unwrap() > 10);
@@ -362,9 +495,9 @@ fn the_nano_world_plays_in_the_page() {
     let mut b = browser();
     open_and_start(&mut b, &s.url, false);
     let (cx, cy, k) = canvas_geometry(&mut b);
-    // Down towards the substrate and across it.
+    // Down onto the substrate (the tip snaps to it) and across it.
     b.mouse("mouseMoved", cx, cy, false, 0.0).unwrap();
-    wheel_to(&mut b, cx, cy, -0.012, 20, 1.0, false);
+    wheel_to(&mut b, cx, cy, -0.021, 20, 1.0, false);
     for i in 0..=30 {
         let f = f64::from(i) / 30.0;
         b.mouse("mouseMoved", cx + 0.3 * k * f, cy - 0.2 * k * f, false, 0.0)
@@ -376,9 +509,26 @@ fn the_nano_world_plays_in_the_page() {
     let drawn = b.eval("window.__play.draws").unwrap().as_u64().unwrap();
     assert!(drawn > 30, "{drawn} draws");
     let out = s.out.clone();
-    let (summary, page) = end_session(&mut b, s, "end-nano.png");
+    let (summary, page) = end_session(&mut b, s, Some("end-nano.png"));
     assert!(summary.stats.ticks > 1500);
     assert_eq!(page["hello"]["kind"], "nanoworld");
+    assert_only_the_game_said(&page);
+    // The tip snapped to the substrate (and, pulled across it, maybe came off): said in words.
+    let names: Vec<&str> = page["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e[1].as_str().unwrap())
+        .collect();
+    assert!(names.contains(&"nano.snap"), "{names:?}");
+    let said = said(&page);
+    assert!(
+        said.iter().any(|s| s.contains("snap: tip to the surface")),
+        "{said:?}"
+    );
+    if names.contains(&"nano.pull_off") {
+        assert!(said.iter().any(|s| s.contains("pull-off: ")), "{said:?}");
+    }
     let rec = read_recording_file(&out, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }
@@ -405,6 +555,423 @@ fn page_errors_and_failed_loads_fail_the_harness() {
     // A page that cannot be reached fails to open.
     let dead = "http://127.0.0.1:9/";
     assert!(b.open(dead).is_err() || b.check().is_err());
+    s.stop.store(true, Ordering::Relaxed);
+    assert!(matches!(
+        s.handle.join().unwrap(),
+        Err(PlayError::NotStarted)
+    ));
+}
+
+/// A scripted standard-mapping gamepad, injected before the page's scripts (headless Chromium
+/// has no gamepad): `navigator.getGamepads()` returns it; the test sets its axes and buttons
+/// over time (`window.__pad.axis(i, v)`, `window.__pad.button(i, v)`); its
+/// `vibrationActuator.playEffect` records each request with the tick of the frame the page
+/// shows (`rumbles`: [tick, strong, weak, duration ms, type]); and each poll records the
+/// frame's time (the animation timeline's, the time the page's frame loop steps with), the
+/// page's last input (`seq`, `n`) and what the pad returned (`polls`: [t ms, seq, n, axes,
+/// button values]).
+const GAMEPAD: &str = r#"(() => {
+  const buttons = Array.from({ length: 17 }, () => ({ pressed: false, touched: false, value: 0 }));
+  const S = { polls: [], rumbles: [] };
+  const pad = {
+    id: 'nanohaptics scripted gamepad (STANDARD GAMEPAD)', index: 0, connected: true,
+    mapping: 'standard', timestamp: 0, axes: [0, 0, 0, 0], buttons,
+    vibrationActuator: {
+      type: 'dual-rumble', effects: ['dual-rumble'],
+      playEffect(type, p) {
+        const P = window.__play;
+        S.rumbles.push([P && P.lastFrame ? P.lastFrame.tick : -1, p.strongMagnitude, p.weakMagnitude, p.duration, type]);
+        return Promise.resolve('complete');
+      },
+      reset() { S.rumbles.push([-1, 0, 0, 0, 'reset']); return Promise.resolve('complete'); },
+    },
+  };
+  S.axis = (i, v) => { pad.axes[i] = v; };
+  S.button = (i, v) => { buttons[i] = { pressed: v > 0.5, touched: v > 0, value: v }; };
+  window.__pad = S;
+  Object.defineProperty(Navigator.prototype, 'getGamepads', { configurable: true, value() {
+    const P = window.__play;
+    if (P && P.hand && S.polls.length < 100000) {
+      S.polls.push([document.timeline.currentTime, P.hand.seq, P.hand.n.slice(), pad.axes.slice(), buttons.map((b) => b.value)]);
+    }
+    pad.timestamp = performance.now();
+    return [pad, null, null, null];
+  } });
+})();"#;
+
+/// One poll of the scripted gamepad.
+struct Poll {
+    t_ms: f64,
+    seq: u64,
+    n: [f64; 3],
+    axes: [f64; 4],
+    buttons: Vec<f64>,
+}
+
+fn f3(v: &Value) -> [f64; 3] {
+    [
+        v[0].as_f64().unwrap(),
+        v[1].as_f64().unwrap(),
+        v[2].as_f64().unwrap(),
+    ]
+}
+
+/// input.js's gamepad mapping, stated again: the left stick moves the hand in the view's plane
+/// (right; up is away), the right stick's y moves it up (stick up: hand up), at 0.5 unit-ball
+/// radii per second at full tilt, with a dead zone of 0.12; the camera's yaw turns "right".
+fn stick_velocity(axes: [f64; 4], yaw: f64) -> [f64; 3] {
+    let dz = |v: f64| if v.abs() < 0.12 { 0.0 } else { v };
+    let (u, v) = (dz(axes[0]), -dz(axes[1]));
+    let (cy, sy) = (yaw.cos(), yaw.sin());
+    [
+        0.5 * (u * -sy + v * -cy),
+        0.5 * (u * cy + v * -sy),
+        0.5 * -dz(axes[3]),
+    ]
+}
+
+#[test]
+fn a_gamepad_moves_the_hand_grips_and_rumbles_with_the_force() {
+    let _one = serial();
+    let s = start("brickworld", "gamepad");
+    let mut b = browser();
+    b.inject(GAMEPAD).unwrap();
+    open_and_start(&mut b, &s.url, false);
+    let hello = b.eval("window.__play.hello").unwrap();
+    let radius_m = hello["workspace_radius_m"].as_f64().unwrap();
+    let max_force_n = hello["max_force_n"].as_f64().unwrap();
+    let set = |b: &mut Browser, what: &str| {
+        b.eval(&format!("window.__pad.{what}; 0")).unwrap();
+    };
+    // The sticks, one at a time, each held a while and let go: right at full tilt, up (away)
+    // at half tilt, right inside the dead zone, and the right stick up (the hand rises).
+    sleep(Duration::from_millis(300));
+    let strokes: [(usize, f64, u64); 4] =
+        [(0, 1.0, 400), (1, -0.5, 400), (0, 0.1, 300), (3, -1.0, 300)];
+    for (axis, v, ms) in strokes {
+        set(&mut b, &format!("axis({axis}, {v})"));
+        sleep(Duration::from_millis(ms));
+        set(&mut b, &format!("axis({axis}, 0)"));
+        sleep(Duration::from_millis(250));
+    }
+    // The right trigger grips (button 0 of the device); LB turns (button 1).
+    set(&mut b, "button(7, 1)");
+    sleep(Duration::from_millis(300));
+    set(&mut b, "button(7, 0)");
+    sleep(Duration::from_millis(250));
+    set(&mut b, "button(4, 1)");
+    sleep(Duration::from_millis(200));
+    set(&mut b, "button(4, 0)");
+    sleep(Duration::from_millis(250));
+    // So far the hand was free: no force, no rumble.
+    let before = b.eval("window.__pad.rumbles.length").unwrap();
+    assert_eq!(before.as_u64(), Some(0), "a rumble while the hand was free");
+    let strokes_end = b
+        .eval("window.__pad.polls.length")
+        .unwrap()
+        .as_u64()
+        .unwrap() as usize;
+    // Down into the floor until the force is a third of the device's largest, held, then up
+    // to the height it started from, free again (a frame's force alone cannot tell: a tick
+    // that misses its deadline sends zero force).
+    let z0 = b.eval("window.__play.hand.n[2]").unwrap().as_f64().unwrap();
+    set(&mut b, "axis(3, 1)");
+    b.wait_for(
+        "(() => { const f = window.__play.lastFrame.device_force_n; return Math.hypot(...f) > window.__play.hello.max_force_n / 3; })()",
+        10.0,
+    )
+    .unwrap();
+    set(&mut b, "axis(3, 0)");
+    sleep(Duration::from_millis(300));
+    set(&mut b, "axis(3, -1)");
+    b.wait_for(&format!("window.__play.hand.n[2] >= {z0}"), 10.0)
+        .unwrap();
+    set(&mut b, "axis(3, 0)");
+    b.wait_for(
+        "Math.hypot(...window.__play.lastFrame.device_force_n) === 0",
+        10.0,
+    )
+    .unwrap();
+    sleep(Duration::from_millis(300));
+    let pad = b
+        .eval("({ polls: window.__pad.polls, rumbles: window.__pad.rumbles })")
+        .unwrap();
+    let out = s.out.clone();
+    let (summary, page) = end_session(&mut b, s, None);
+    assert!(summary.stats.ticks > 1000);
+
+    let polls: Vec<Poll> = pad["polls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| Poll {
+            t_ms: p[0].as_f64().unwrap(),
+            seq: p[1].as_u64().unwrap(),
+            n: f3(&p[2]),
+            axes: [0, 1, 2, 3].map(|i| p[3][i].as_f64().unwrap()),
+            buttons: p[4]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect(),
+        })
+        .collect();
+    assert!(polls.len() > 60, "{} polls", polls.len());
+    let a = read_arrays(&out, false).unwrap();
+    let ticks = a.tick.len();
+    assert!(a.tick.iter().enumerate().all(|(i, t)| *t == i as u64));
+    // Every tick's recorded input is the page's hand at the input the tick read: the page's
+    // point of the unit ball on the device workspace, bit for bit.
+    let mut checked = 0;
+    for p in polls.iter().filter(|p| p.seq > 0) {
+        for i in (0..ticks).filter(|&i| a.device_seq[i] == p.seq) {
+            assert_eq!(
+                a.device_position_m[i],
+                play::input::page_to_device(p.n, radius_m),
+                "tick {i}, input {}",
+                p.seq
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000, "{checked} ticks checked");
+    // The position at the last tick that read input `seq` or an earlier one, and at the first
+    // that read `seq` or a later one.
+    let at_or_before = |seq: u64| {
+        let i = (0..ticks).rev().find(|&i| a.device_seq[i] <= seq).unwrap();
+        a.device_position_m[i]
+    };
+    let at_or_after = |seq: u64| {
+        let i = (0..ticks).find(|&i| a.device_seq[i] >= seq).unwrap();
+        a.device_position_m[i]
+    };
+    // Each stroke: the recorded hand moved as input.js's mapping says over the frames the
+    // stick was held (each frame steps by the time since the last, at most 0.1 s).
+    let yaw = -std::f64::consts::FRAC_PI_2; // the camera's yaw (the test does not orbit)
+    for (axis, v, _) in strokes {
+        let held: Vec<usize> = (1..strokes_end)
+            .filter(|&k| polls[k].axes[axis] == v)
+            .collect();
+        assert!(held.len() > 3, "stroke {axis} = {v}: {} frames", held.len());
+        let (k0, k1) = (held[0], *held.last().unwrap());
+        assert_eq!(k1 - k0 + 1, held.len(), "one stroke of axis {axis}");
+        let secs: f64 = (k0..=k1)
+            .map(|k| ((polls[k].t_ms - polls[k - 1].t_ms) / 1000.0).min(0.1))
+            .sum();
+        let vel = stick_velocity(polls[k0].axes, yaw);
+        let want = play::input::page_to_device(vel.map(|x| x * secs), radius_m);
+        let p0 = at_or_before(polls[k0].seq);
+        let p1 = at_or_after(polls[k1 + 1].seq);
+        assert_eq!(p0, play::input::page_to_device(polls[k0].n, radius_m));
+        assert_eq!(p1, play::input::page_to_device(polls[k1 + 1].n, radius_m));
+        let got = [p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]];
+        eprintln!("stroke axis {axis} = {v}: {secs:.3} s held, moved {got:?} m, want {want:?} m");
+        for c in 0..3 {
+            assert!(
+                (got[c] - want[c]).abs() <= 1e-12,
+                "stroke axis {axis} = {v}: moved {got:?} m, the mapping says {want:?} m"
+            );
+        }
+        // In words: full right moves right only; half up moves away at half the speed; the
+        // dead zone does not move; the right stick up raises the hand.
+        let speed =
+            [got[0].abs(), got[1].abs(), got[2].abs()].map(|d| d / secs / (0.999 * radius_m));
+        let (dir, sign, want_speed) = match (axis, v) {
+            (0, 1.0) => (0, 1.0, 0.5),
+            (1, -0.5) => (1, 1.0, 0.25),
+            (0, 0.1) => (0, 0.0, 0.0),
+            _ => (2, 1.0, 0.5),
+        };
+        assert!((speed[dir] - want_speed).abs() < 1e-9, "{speed:?}");
+        assert!(got[dir] * sign >= 0.0 && (0..3).all(|c| c == dir || speed[c] < 1e-12));
+        eprintln!("  {speed:?} unit-ball radii per second");
+    }
+    // The right trigger is the grip (button 0 of the recorded input), LB button 1: on from the
+    // input the page sent at the first frame it was held, off from the first after.
+    for (pad_button, bit) in [(7usize, 0u32), (4, 1)] {
+        let held: Vec<usize> = (0..polls.len())
+            .filter(|&k| polls[k].buttons[pad_button] > 0.5)
+            .collect();
+        assert!(held.len() > 3, "button {pad_button}: {} frames", held.len());
+        let (k0, k1) = (held[0], *held.last().unwrap());
+        let (on, off) = (polls[k0].seq + 1, polls[k1 + 1].seq + 1);
+        let mut on_ticks = 0;
+        for i in 0..ticks {
+            let pressed = a.device_buttons[i] & (1 << bit) != 0;
+            assert_eq!(
+                pressed,
+                (on..off).contains(&a.device_seq[i]),
+                "tick {i} (input {}): pad button {pad_button} → device button {bit}",
+                a.device_seq[i]
+            );
+            on_ticks += u32::from(pressed);
+        }
+        assert!(on_ticks > 100, "button {bit} held {on_ticks} ticks");
+    }
+    let grip = &page["hello"]["buttons"][0];
+    assert!(
+        a.events
+            .iter()
+            .any(|(_, n, d)| n == "button.down" && Some(d.as_str()) == grip.as_str())
+    );
+    let said = said(&page);
+    for want in ["grip on", "grip off", "grab missed: no brick in reach"] {
+        assert!(
+            said.iter().any(|s| s.contains(want)),
+            "`{want}` not said: {said:?}"
+        );
+    }
+    assert_only_the_game_said(&page);
+
+    // The rumble follows the force: each request's magnitude is the force of the frame the
+    // page showed, as a share of the device's largest (the weak motor half of it); none while
+    // the hand was free; it rose as the hand pressed into the floor, and the last request,
+    // once the hand was free, is zero.
+    let rumbles: Vec<(usize, f64, f64)> = pad["rumbles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            assert_eq!(r[4], "dual-rumble");
+            (
+                r[0].as_u64().unwrap() as usize,
+                r[1].as_f64().unwrap(),
+                r[2].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    assert!(rumbles.len() > 3, "{rumbles:?}");
+    eprintln!(
+        "{} rumble requests: {:?}",
+        rumbles.len(),
+        rumbles
+            .iter()
+            .map(|r| (r.0, (r.1 * 1000.0).round() / 1000.0))
+            .collect::<Vec<_>>()
+    );
+    let share = |i: usize| {
+        let f = a.device_force_n[i];
+        ((f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt() / max_force_n).min(1.0)
+    };
+    for &(tick, strong, weak) in &rumbles {
+        let m = share(tick);
+        if strong > 0.0 {
+            assert!(
+                (strong - m).abs() <= 1e-9 && m > 0.02,
+                "tick {tick}: rumble {strong}, force share {m}"
+            );
+            assert_eq!(weak, strong * 0.5);
+        } else {
+            assert!(m <= 0.02, "tick {tick}: rumble stopped at force share {m}");
+            assert_eq!(weak, 0.0);
+        }
+    }
+    let (imax, &(_, peak, _)) = rumbles
+        .iter()
+        .enumerate()
+        .max_by(|x, y| x.1.1.total_cmp(&y.1.1))
+        .unwrap();
+    assert!(peak > 0.3, "peak rumble {peak}");
+    assert!(rumbles[0].1 < peak, "the rumble rose: {rumbles:?}");
+    assert!(imax < rumbles.len() - 1);
+    assert_eq!(rumbles.last().unwrap().1, 0.0, "the rumble fell to zero");
+    // Free again at the end: no force over the session's last 100 ticks.
+    assert!((ticks - 100..ticks).all(|i| share(i) == 0.0));
+    let rec = read_recording_file(&out, false).unwrap();
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
+}
+
+/// The page's words for every game event of the golden recordings (recordings/*.mcap: the
+/// brick and nano worlds, the wall, the optical tweezers): a short sentence, never JSON, and
+/// nothing for the loop's reports and the events the player hears or feels.
+#[test]
+fn every_game_event_of_the_golden_recordings_reads_as_a_short_sentence() {
+    let _one = serial();
+    let s = start("brickworld", "words");
+    let mut b = browser();
+    b.open(&s.url).unwrap();
+    b.wait_for("window.__play.hello !== null", 10.0).unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../recordings");
+    let mut said_names = std::collections::BTreeSet::new();
+    for file in [
+        "brickworld.mcap",
+        "nanoworld.mcap",
+        "wall.mcap",
+        "optical_tweezers.mcap",
+    ] {
+        let rec = read_recording_file(&root.join(file), false).unwrap();
+        let a = haptic_loop::SessionArrays::from_recording(&rec).unwrap();
+        // Each distinct event, at most 30 of a name.
+        let mut count = std::collections::BTreeMap::<&str, usize>::new();
+        let mut distinct = std::collections::BTreeSet::new();
+        for (_, n, d) in &a.events {
+            let c = count.entry(n.as_str()).or_default();
+            if *c < 30 && distinct.insert((n.as_str(), d.as_str())) {
+                *c += 1;
+            }
+        }
+        let events: Vec<(&str, &str)> = distinct.into_iter().collect();
+        let hello = serde_json::json!({ "buttons": rec.description.device_buttons });
+        let words = b
+            .eval(&format!(
+                "import('/events.js').then((m) => {}.map(([n, d]) => [m.eventClass(n), m.sentence(n, d, {hello})]))",
+                serde_json::to_string(&events).unwrap()
+            ))
+            .unwrap();
+        for ((name, detail), w) in events.iter().zip(words.as_array().unwrap()) {
+            let class = w[0].as_str().unwrap();
+            let grip_button = rec.description.device_buttons.first().map(String::as_str);
+            match (class, w[1].as_str()) {
+                ("game", Some(text)) | ("now", Some(text)) => {
+                    assert!(
+                        !text.is_empty() && text.chars().count() <= 60,
+                        "{file}: {name} {detail} → `{text}`"
+                    );
+                    for bad in [
+                        "{",
+                        "}",
+                        "\"",
+                        "_",
+                        "?",
+                        "undefined",
+                        "NaN",
+                        "null",
+                        "object",
+                    ] {
+                        assert!(
+                            !text.contains(bad),
+                            "{file}: {name} {detail} → `{text}` ({bad})"
+                        );
+                    }
+                    said_names.insert(name.to_string());
+                }
+                ("now", None) => assert!(
+                    name.starts_with("button.") && Some(*detail) != grip_button,
+                    "{file}: {name} {detail} said nothing"
+                ),
+                ("quiet", None) | ("loop", None) => {}
+                (c, t) => panic!("{file}: {name} {detail}: class {c}, said {t:?}"),
+            }
+        }
+    }
+    eprintln!("game events said in the golden recordings: {said_names:?}");
+    for n in [
+        "brick.grabbed",
+        "brick.released",
+        "brick.slot_filled",
+        "nano.snap",
+        "nano.pull_off",
+        "wall.contact_begin",
+        "ot.grab",
+        "button.down",
+    ] {
+        assert!(
+            said_names.contains(n),
+            "{n} not in the golden recordings' words"
+        );
+    }
+    b.check().unwrap();
     s.stop.store(true, Ordering::Relaxed);
     assert!(matches!(
         s.handle.join().unwrap(),

@@ -3,7 +3,7 @@
 // page is the hand it sends that point as `input` messages. Keys and the right mouse button
 // also orbit, tilt and zoom the camera.
 
-import { P, say } from './page.js';
+import { P } from './page.js';
 import { canvas, cam, horiz } from './camera.js';
 import { send } from './messages.js';
 import { toggleMute } from './sound.js';
@@ -12,7 +12,7 @@ import { toggleMute } from './sound.js';
 export const hand = { n: [0, 0, 0], grip: false, pointerGrip: false, turn: [false, false, false], dirty: true, seq: 0, lastSent: 0 };
 P.hand = hand;
 const held = new Map(); // key → speed factor (Shift: fine moves)
-let gpGrip = false, lastRumble = 0;
+let gpGrip = false, gpTurn = [false, false, false], lastRumble = 0, rumbling = false;
 
 // Whether the hand grips (the pointer's button, Space, or the gamepad's right trigger).
 export function gripping() { return hand.grip || hand.pointerGrip || gpGrip; }
@@ -27,7 +27,7 @@ function clampBall() {
 function buttons() {
   let b = gripping() ? 1 : 0;
   const nb = P.hello ? P.hello.buttons.length : 1;
-  for (let i = 0; i < 3; i++) if (hand.turn[i] && i + 1 < nb) b |= 1 << (i + 1);
+  for (let i = 0; i < 3; i++) if ((hand.turn[i] || gpTurn[i]) && i + 1 < nb) b |= 1 << (i + 1);
   return b;
 }
 
@@ -94,7 +94,7 @@ export function installInput() {
     if (e.target && (e.target.tagName === 'INPUT' || e.target.tagName === 'BUTTON' || e.target.tagName === 'A')) return;
     const k = e.key;
     if (MOVE[k]) { held.set(k, e.shiftKey ? 0.2 : 1); e.preventDefault(); }
-    else if (k === ' ') { if (!e.repeat) { hand.grip = !hand.grip; say(hand.grip ? 'grip on' : 'grip off'); sendHand(e.timeStamp); } e.preventDefault(); }
+    else if (k === ' ') { if (!e.repeat) { hand.grip = !hand.grip; sendHand(e.timeStamp); } e.preventDefault(); }
     else if (k === '1' || k === '2' || k === '3') { hand.turn[+k - 1] = true; sendHand(e.timeStamp); }
     else if (k === 'a' || k === 'A') cam.yaw += 0.08;
     else if (k === 'd' || k === 'D') cam.yaw -= 0.08;
@@ -130,12 +130,17 @@ export function pollKeysAndPad(dt) {
     if (x || y || h) { hand.n[0] += x * KEY_SPEED * dt; hand.n[1] += y * KEY_SPEED * dt; hand.n[2] += h * KEY_SPEED * dt; moved = true; }
     const grip = !!(gp.buttons[7] && gp.buttons[7].value > 0.5);
     const turns = [4, 5, 3].map((i) => !!(gp.buttons[i] && gp.buttons[i].pressed));
-    if (grip !== gpGrip || turns.some((t, i) => t !== hand.turn[i])) { gpGrip = grip; hand.turn = turns; moved = true; }
+    if (grip !== gpGrip || turns.some((t, i) => t !== gpTurn[i])) { gpGrip = grip; gpTurn = turns; moved = true; }
+    // The rumble follows the force of the last frame (its share of the device's largest),
+    // renewed every 60 ms or more; a force under 2 % stops it (one request of magnitude 0).
     const f = P.lastFrame && P.lastFrame.device_force_n;
     if (gp.vibrationActuator && f && performance.now() - lastRumble > 60) {
       const m = Math.min(1, Math.hypot(...f) / P.hello.max_force_n);
-      lastRumble = performance.now();
-      if (m > 0.02) gp.vibrationActuator.playEffect('dual-rumble', { duration: 80, strongMagnitude: m, weakMagnitude: m * 0.5 }).catch(() => {});
+      const strong = m > 0.02 ? m : 0;
+      if (strong > 0 || rumbling) {
+        lastRumble = performance.now(); rumbling = strong > 0;
+        gp.vibrationActuator.playEffect('dual-rumble', { duration: 80, strongMagnitude: strong, weakMagnitude: strong * 0.5 }).catch(() => {});
+      }
     }
     break;
   }

@@ -6,6 +6,7 @@
 //   input.js     pointer, keyboard and gamepad as the hand
 //   sound.js     the sound blocks on the Web Audio clock
 //   messages.js  the WebSocket and a handler per message type
+//   events.js    the events in words: which the player hears, which stay in the recording
 // window.__play holds figures for tests and benches.
 
 import { $, P } from './page.js';

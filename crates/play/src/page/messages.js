@@ -1,35 +1,60 @@
-// nanohaptics play: the link to the server. One WebSocket (/ws): JSON text messages tagged by
-// `type` (docs/play.md's table; crates/play/src/protocol.rs's ServerMsg and PageMsg), each
-// handled by its entry in HANDLERS, and binary sound blocks for the sound module.
+// nanohaptics play: the link to the server. One WebSocket (`/ws` and the page's own query):
+// JSON text messages tagged by `type` (docs/play.md's table; crates/play/src/protocol.rs's
+// ServerMsg and PageMsg), each handled by its entry in HANDLERS, and binary sound blocks for
+// the sound module. The events' words are events.js's.
 
 import { $, P, log, say } from './page.js';
 import { aimAtWorkspace } from './camera.js';
 import { onPcm } from './sound.js';
+import { eventClass, sentence } from './events.js';
 
 let ws = null;
 
 // Sends a page message (an object with its `type`) if the link is open.
 export function send(o) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(o)); }
 
-const WORDS = {
-  'brick.grabbed': 'brick grabbed', 'brick.released': 'brick let go', 'brick.impact': 'impact',
-  'brick.slot_filled': 'slot filled', 'brick.slot_emptied': 'slot emptied', 'button.down': 'button down',
-  'button.up': 'button up', 'nano.snap': 'snap', 'nano.pull_off': 'pull-off', 'force.clamped': 'force at the limit',
-  'switch.set': 'switch set', 'device.lost': 'hand lost', 'device.resumed': 'hand back',
-};
-// Every event is announced: those of half a second in one sentence, repeats counted, so a
-// screen reader is not flooded.
+// The events of a frame, in words (events.js classes them): the game's events of half a
+// second in one sentence, repeats counted ("grabbed brick 1; slot 1 filled with brick 1"),
+// so a screen reader is not flooded; the grip at once. The loop's timing, safety and device
+// reports are never said: they stay in the recording and the end summary.
 const pending = new Map();
 let lastAnnounce = 0;
-function announceEvents(evs, now_) {
-  for (const [, name] of evs) pending.set(name, (pending.get(name) || 0) + 1);
+function announceEvents(evs, flush) {
+  for (const [, name, detail] of evs) {
+    const s = sentence(name, detail, P.hello);
+    if (s === null) continue;
+    if (eventClass(name) === 'now') say(s);
+    else pending.set(s, (pending.get(s) || 0) + 1);
+  }
   const now = performance.now();
-  if ((!now_ && now - lastAnnounce < 500) || pending.size === 0) return;
+  if ((!flush && now - lastAnnounce < 500) || pending.size === 0) return;
   lastAnnounce = now;
   const parts = [];
-  for (const [name, c] of pending) parts.push((WORDS[name] || name.replace(/[._]/g, ' ')) + (c > 1 ? ` ×${c}` : ''));
+  for (const [s, c] of pending) parts.push(c > 1 ? `${s} ×${c}` : s);
   pending.clear();
   log(parts.join('; '));
+}
+
+// A switch's value in words: on/off for a boolean switch, else the number (6 digits at most).
+function valueText(s, v) {
+  if (v === null || v === undefined || !Number.isFinite(v)) return 'not known';
+  if (s.boolean) return v !== 0 ? 'on' : 'off';
+  return String(+v.toPrecision(6));
+}
+// The menu's switches by name: the hello's entry, its input and its value line.
+const menuRows = new Map();
+// Shows switch `name`'s value now (from the hello, then from each `switched`); the input
+// takes it too unless the player is typing in it.
+function showSwitch(name, v) {
+  const row = menuRows.get(name);
+  if (!row) return;
+  const { s, inp, now } = row;
+  now.textContent = `now ${valueText(s, v)} · ${s.boolean ? 'on or off' : `allowed ${valueText(s, s.min)} to ${valueText(s, s.max)}`}`;
+  if (document.activeElement !== inp && v !== null && v !== undefined) {
+    if (s.boolean) inp.checked = v !== 0;
+    else inp.value = String(v);
+  }
+  P.menu[name] = v;
 }
 
 // `hello`: the scene, the device, the menu; the Start button opens.
@@ -37,16 +62,13 @@ function onHello(h) {
   P.hello = h;
   $('title').textContent = h.scene;
   aimAtWorkspace(h);
-  const menu = $('menu'); menu.textContent = '';
+  const menu = $('menu'); menu.textContent = ''; menuRows.clear(); P.menu = {};
   for (const s of h.switches) {
     const lab = document.createElement('label');
     const span = document.createElement('span'); span.textContent = s.name; span.title = s.doc; lab.appendChild(span);
     const inp = document.createElement('input');
-    if (s.boolean) { inp.type = 'checkbox'; inp.checked = s.value == null ? true : s.value !== 0; }
-    else {
-      inp.type = 'number'; inp.min = s.min; inp.max = s.max; inp.step = 'any'; inp.placeholder = `${s.min}–${s.max}`;
-      if (s.value != null) inp.value = String(s.value);
-    }
+    if (s.boolean) { inp.type = 'checkbox'; inp.checked = true; } // on unless the hello says
+    else { inp.type = 'number'; inp.min = s.min; inp.max = s.max; inp.step = 'any'; inp.placeholder = `${s.min}–${s.max}`; }
     inp.setAttribute('aria-label', `${s.name}: ${s.doc}`); inp.id = 'sw-' + s.name;
     const b = document.createElement('button'); b.type = 'button'; b.textContent = 'set';
     b.setAttribute('aria-label', `set ${s.name}`);
@@ -55,7 +77,12 @@ function onHello(h) {
       if (!s.boolean && (inp.value === '' || !Number.isFinite(v))) { say(`${s.name}: enter a number from ${s.min} to ${s.max}`); return; }
       send({ type: 'switch', name: s.name, value: v });
     });
-    lab.appendChild(inp); lab.appendChild(b); menu.appendChild(lab);
+    // The value now and the range, beside the input (the input's description).
+    const now = document.createElement('output'); now.className = 'now'; now.id = 'now-' + s.name;
+    inp.setAttribute('aria-describedby', now.id);
+    lab.appendChild(inp); lab.appendChild(b); lab.appendChild(now); menu.appendChild(lab);
+    menuRows.set(s.name, { s, inp, now });
+    showSwitch(s.name, s.value);
   }
   const nb = h.buttons.length;
   $('turnkeys').textContent = nb > 1 ? `keys 1–${Math.min(3, nb - 1)}: ${h.buttons.slice(1, 4).join(', ')} (held)` : 'no turn buttons on this device';
@@ -105,10 +132,21 @@ function onEnd(m) {
   if (m.recording_bytes) rows.push(['recording', `${m.recording_file} (${(m.recording_bytes / 1024).toFixed(0)} KiB)`]);
   const t = $('figs'); t.textContent = '';
   for (const [k, v] of rows) { const tr = t.insertRow(); tr.insertCell().textContent = k; tr.insertCell().textContent = v; }
+  // The recording's link is the one the server names (its path depends on the server).
+  if (m.recording) $('download').setAttribute('href', m.recording);
   $('download').setAttribute('download', m.recording_file || 'recording.mcap');
   $('end').classList.remove('hidden'); $('start').classList.add('hidden');
   say(`session over: score ${(m.state.score ?? 0).toFixed(0)}`);
   $('download').focus();
+}
+
+// `switched`: a switch applied (set by this page, another page or the teacher): the menu
+// shows its value now.
+function onSwitched(m) {
+  P.switched.push(m);
+  showSwitch(m.name, m.value);
+  const row = menuRows.get(m.name);
+  say(`${m.name} set to ${row ? valueText(row.s, m.value) : m.value}`);
 }
 
 // One handler per server message type (a Map: no inherited keys). A type the page does not
@@ -118,14 +156,16 @@ const HANDLERS = new Map([
   ['waiting', (m) => { $('start-msg').textContent = `Waiting for ${m.for}…`; }],
   ['role', (m) => { P.role = m.role; $('role').textContent = m.role === 'hand' ? 'the hand' : 'watching'; say(m.role === 'hand' ? 'you are the hand' : 'you are watching'); }],
   ['frame', onFrame],
-  ['switched', (m) => { P.switched.push(m); say(`${m.name} set to ${m.value}`); }],
+  ['switched', onSwitched],
   ['error', (m) => { P.errors.push(m); say(m.message); }],
   ['end', onEnd],
 ]);
 
 // Opens the link: text messages to their handlers, binary ones to the sound.
 export function connect() {
-  ws = new WebSocket(`ws://${location.host}/ws`);
+  // `/ws` with the page's own query (a classroom's `?s=TOKEN` comes back with the link).
+  const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
+  ws = new WebSocket(`${scheme}://${location.host}/ws${location.search}`);
   ws.binaryType = 'arraybuffer';
   ws.onmessage = (ev) => {
     if (typeof ev.data !== 'string') { onPcm(ev.data); return; }

@@ -10,7 +10,7 @@ export const P = (window.__play = {
   events: [], sounds: [], switched: [], errors: [], ended: null,
   pcm: { first: -1, samples: 0, hash: 0x811c9dc5, blocks: 0, underruns: 0, early: 0, rebased: 0 },
   audioLatencyMs: [], audioParts: [], outputLatencyS: null, inputsSent: 0,
-  said: [],
+  said: [], menu: {},
 });
 
 const logEl = $('log');

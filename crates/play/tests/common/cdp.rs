@@ -27,6 +27,8 @@ pub struct Browser {
     pub errors: Vec<String>,
     /// Events of the page not yet looked at.
     pub events: Vec<Value>,
+    /// The URL of every WebSocket the page opened, in order (kept however many events come).
+    pub websockets: Vec<String>,
 }
 
 fn chromium() -> Result<PathBuf, String> {
@@ -105,6 +107,7 @@ impl Browser {
             session: String::new(),
             errors: Vec::new(),
             events: Vec::new(),
+            websockets: Vec::new(),
         };
         let t = b.call_browser("Target.createTarget", json!({"url": "about:blank"}))?;
         let target = t["targetId"].as_str().ok_or("no targetId")?.to_string();
@@ -151,6 +154,10 @@ impl Browser {
                 "load failed: {}",
                 p["errorText"].as_str().unwrap_or("?")
             )),
+            "Network.webSocketCreated" => {
+                self.websockets
+                    .push(p["url"].as_str().unwrap_or("?").to_string());
+            }
             "Network.responseReceived" => {
                 let status = p["response"]["status"].as_u64().unwrap_or(0);
                 if status >= 400 {
@@ -227,6 +234,16 @@ impl Browser {
             std::thread::sleep(Duration::from_millis(20));
         }
         Ok(())
+    }
+
+    /// Runs `source` in every document this page opens from now on, before the document's
+    /// own scripts (a scripted browser API, e.g. a gamepad).
+    pub fn inject(&mut self, source: &str) -> Result<(), String> {
+        self.call(
+            "Page.addScriptToEvaluateOnNewDocument",
+            json!({ "source": source }),
+        )
+        .map(drop)
     }
 
     /// Evaluates a JavaScript expression in the page and returns its value (JSON).
