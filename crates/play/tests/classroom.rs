@@ -1,0 +1,273 @@
+//! The classroom without a browser: students join by name, each plays their own world through
+//! their own page link, the teacher's link sees them and sets a switch for everyone, ends
+//! every session and downloads the recordings as one zip; every recording replays bit for bit.
+//! Forged `Origin`/`Host`, wrong codes and bad names are refused and counted.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use haptic_loop::session::SceneSource;
+use play::classroom::{ClassAddresses, ClassConfig, ClassSummary, run};
+use play::protocol::ServerMsg;
+use recording::read_recording_file;
+use serde_json::{Value, json};
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::{Message, WebSocket};
+
+type Ws = WebSocket<MaybeTlsStream<TcpStream>>;
+
+struct Running {
+    addr: ClassAddresses,
+    host: String,
+    stop: Arc<AtomicBool>,
+    handle: JoinHandle<Result<ClassSummary, play::PlayError>>,
+    dir: PathBuf,
+}
+
+fn start(name: &str, max: usize) -> Running {
+    let dir = std::env::temp_dir().join(format!("nh-class-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut c = ClassConfig::new(
+        SceneSource::resolve("brickworld".as_ref()).unwrap(),
+        dir.clone(),
+    );
+    c.port = 0;
+    c.max_students = max;
+    c.teacher_code = Some("TEACH123".into());
+    let stop = Arc::new(AtomicBool::new(false));
+    let s2 = stop.clone();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let handle = std::thread::spawn(move || {
+        run(&c, &s2, &mut |a| {
+            let _ = tx.send(a.clone());
+        })
+    });
+    let addr = rx.recv_timeout(Duration::from_secs(20)).unwrap();
+    let host = addr
+        .student_url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    Running {
+        addr,
+        host,
+        stop,
+        handle,
+        dir,
+    }
+}
+
+fn http(host: &str, request: &str) -> String {
+    let mut s = TcpStream::connect(host).unwrap();
+    s.write_all(request.as_bytes()).unwrap();
+    let mut out = Vec::new();
+    s.read_to_end(&mut out).unwrap();
+    String::from_utf8_lossy(&out).to_string()
+}
+
+fn get(host: &str, path: &str) -> String {
+    http(
+        host,
+        &format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n"),
+    )
+}
+
+/// Joins as `name`; the session token from the redirect.
+fn join(host: &str, name: &str) -> String {
+    let r = get(host, &format!("/join?name={name}"));
+    assert!(r.starts_with("HTTP/1.1 303 See Other"), "{r}");
+    let loc = r
+        .lines()
+        .find_map(|l| l.strip_prefix("Location: /play?s="))
+        .unwrap();
+    loc.trim().to_string()
+}
+
+fn ws(host: &str, path: &str) -> Ws {
+    let (ws, _) = tungstenite::connect(format!("ws://{host}{path}").as_str()).unwrap();
+    if let MaybeTlsStream::Plain(s) = ws.get_ref() {
+        s.set_read_timeout(Some(Duration::from_millis(5))).unwrap();
+    }
+    ws
+}
+
+fn read_for(ws: &mut Ws, secs: f64) -> Vec<Value> {
+    let t0 = Instant::now();
+    let mut out = Vec::new();
+    while t0.elapsed().as_secs_f64() < secs {
+        if let Ok(Message::Text(t)) = ws.read() {
+            out.push(serde_json::from_str(t.as_str()).unwrap());
+        }
+    }
+    out
+}
+
+fn send(ws: &mut Ws, v: Value) {
+    ws.send(Message::text(v.to_string())).unwrap();
+}
+
+#[test]
+fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
+    let c = start("three", 3);
+    let host = c.host.clone();
+    assert_eq!(c.addr.join_code, None, "loopback: a name is enough");
+    assert!(c.addr.teacher_url.ends_with("/teacher?code=TEACH123"));
+    // The join page, and a student's page with its modules.
+    let j = get(&host, "/");
+    assert!(j.starts_with("HTTP/1.1 200 OK"), "{j}");
+    assert!(j.contains(r#"<form method="get" action="/join">"#));
+    assert!(!j.contains(r#"name="code""#));
+    let names = ["Ada", "Grace", "Zo%C3%AB"];
+    let tokens: Vec<String> = names.iter().map(|n| join(&host, n)).collect();
+    let page = get(&host, &format!("/play?s={}", tokens[0]));
+    assert!(
+        page.contains(r#"<script type="module" src="/main.js">"#),
+        "{page}"
+    );
+    assert!(get(&host, "/main.js").starts_with("HTTP/1.1 200 OK"));
+    // Refusals: the class is full, a taken name, a name that would be a path, no session.
+    let full = get(&host, "/join?name=Dan");
+    assert!(full.starts_with("HTTP/1.1 503"), "{full}");
+    assert!(full.contains("the class is full (3 students playing)"));
+    let taken = get(&host, "/join?name=Ada");
+    assert!(taken.starts_with("HTTP/1.1 409"), "{taken}");
+    let bad = get(&host, "/join?name=..%2Fetc%2Fpasswd");
+    assert!(bad.starts_with("HTTP/1.1 400"), "{bad}");
+    assert!(bad.contains("name contains `/`: allowed letters, digits, spaces and - _ . &#39;"));
+    assert!(get(&host, "/play?s=nope").starts_with("HTTP/1.1 404"));
+    // The teacher page: its code, never without.
+    assert!(get(&host, "/teacher?code=TEACH123").contains("<title>nanohaptics classroom: teacher"));
+    assert!(get(&host, "/teacher?code=WRONG").starts_with("HTTP/1.1 403"));
+    assert!(get(&host, "/recordings.zip").starts_with("HTTP/1.1 403"));
+    // A forged origin may not drive a student's session or the teacher's link.
+    let forged = http(
+        &host,
+        &format!(
+            "GET /teacher/ws?code=TEACH123 HTTP/1.1\r\nHost: {host}\r\nOrigin: https://evil.example\r\n\
+             Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\n\
+             Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+        ),
+    );
+    assert!(forged.starts_with("HTTP/1.1 403"), "{forged}");
+
+    // Each student plays: Start, then a hand that moves down onto the floor.
+    let mut pages: Vec<Ws> = tokens
+        .iter()
+        .map(|t| ws(&host, &format!("/ws?s={t}")))
+        .collect();
+    for p in pages.iter_mut() {
+        let hello = read_for(p, 0.2);
+        assert_eq!(hello[0]["type"], "hello", "{hello:?}");
+        send(p, json!({"type": "start"}));
+    }
+    let mut teacher = ws(&host, "/teacher/ws?code=TEACH123");
+    for k in 0..40u32 {
+        for (i, p) in pages.iter_mut().enumerate() {
+            let z = 0.2 - 0.02 * f64::from(k);
+            let x = 0.1 * i as f64;
+            send(
+                p,
+                json!({"type": "input", "seq": k + 1, "pos": [x, 0.0, z], "buttons": 0, "t_ms": f64::from(k)}),
+            );
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // The teacher sees three students playing, and sets the friction for everyone.
+    let seen = read_for(&mut teacher, 0.6);
+    let class = seen.iter().rev().find(|m| m["type"] == "class").unwrap();
+    let students = class["students"].as_array().unwrap();
+    assert_eq!(students.len(), 3);
+    for s in students {
+        assert_eq!(s["status"]["phase"], "playing", "{s}");
+        assert_eq!(s["pages"], 1);
+        assert!(s["status"]["ticks"].as_u64().unwrap() > 0);
+    }
+    assert_eq!(students[2]["name"], "Zoë");
+    send(
+        &mut teacher,
+        json!({"type": "switch", "name": "friction", "value": 0.25}),
+    );
+    send(
+        &mut teacher,
+        json!({"type": "switch", "name": "friction", "value": 11}),
+    );
+    let r = read_for(&mut teacher, 0.5);
+    assert!(
+        r.iter()
+            .any(|m| m["type"] == "done" && m["message"] == "friction = 0.25 for 3 students"),
+        "{r:?}"
+    );
+    assert!(r.iter().any(|m| m["type"] == "error"
+        && m["message"] == "switch `friction` = 11 is out of range: allowed 0 ≤ value ≤ 10"));
+    for p in pages.iter_mut() {
+        let got = read_for(p, 0.3);
+        let sw = got
+            .iter()
+            .find(|m| m["type"] == "switched")
+            .expect("switched");
+        assert_eq!(
+            (sw["name"].as_str(), sw["value"].as_f64()),
+            (Some("friction"), Some(0.25))
+        );
+        // Every message a student's page gets is a ServerMsg.
+        for m in &got {
+            serde_json::from_value::<ServerMsg>(m.clone()).unwrap();
+        }
+    }
+    // The teacher ends every session; each page gets its end and its own recording.
+    send(&mut teacher, json!({"type": "end_all"}));
+    let r = read_for(&mut teacher, 0.5);
+    assert!(
+        r.iter().any(|m| m["message"] == "ended 3 sessions"),
+        "{r:?}"
+    );
+    for (p, t) in pages.iter_mut().zip(&tokens) {
+        let got = read_for(p, 1.0);
+        let end = got.iter().find(|m| m["type"] == "end").expect("end");
+        assert_eq!(end["end"], "stopped");
+        assert_eq!(end["recording"], format!("/recording.mcap?s={t}"));
+        let dl = get(&host, &format!("/recording.mcap?s={t}"));
+        assert!(
+            dl.starts_with("HTTP/1.1 200 OK"),
+            "{}",
+            &dl[..60.min(dl.len())]
+        );
+    }
+    let zip = get(&host, "/recordings.zip?code=TEACH123");
+    assert!(zip.starts_with("HTTP/1.1 200 OK\r\nContent-Type: application/zip"));
+
+    c.stop.store(true, Ordering::Relaxed);
+    let summary = c.handle.join().unwrap().unwrap();
+    assert_eq!(summary.students.len(), 3);
+    assert!(
+        summary.refused.join >= 2 && summary.refused.code >= 2,
+        "{:?}",
+        summary.refused
+    );
+    assert_eq!(summary.refused.origin, 1);
+    for s in &summary.students {
+        assert_eq!(s.end, "stopped", "{}", s.line());
+        assert!(s.stats.ticks > 100, "{}", s.line());
+        assert!(s.error.is_none(), "{}", s.line());
+        // Each recording is the student's own, named for them, and replays bit for bit.
+        assert_eq!(s.recording.parent(), Some(c.dir.as_path()));
+        let stem = s
+            .recording
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .to_string();
+        assert!(stem.starts_with(&format!("{}-", play::classroom::names::file_stem(&s.name))));
+        let rec = read_recording_file(&s.recording, false).unwrap();
+        let v = haptic_loop::replay::verify(&rec).unwrap();
+        assert!(v.ok(), "{}: {:?}", s.name, v);
+        assert_eq!(v.ticks, s.stats.ticks);
+    }
+    let _ = std::fs::remove_dir_all(&c.dir);
+}
