@@ -9,7 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 secs=${FUZZ_SECONDS:-30}
-targets=${FUZZ_TARGETS:-"scene script recording verify bridge params"}
+targets=${FUZZ_TARGETS:-"scene script recording verify bridge params page"}
 
 if ! command -v cargo-fuzz > /dev/null; then
   echo "==> installing cargo-fuzz"

@@ -61,8 +61,8 @@ ALLOWED = {
         "ot-envelope", "ot-physics", "world-form",
     },
     "nanohaptics-fuzz": {
-        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording",
-        "nanoworld", "ot-envelope", "world-form",
+        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-play",
+        "nanohaptics-recording", "nanoworld", "ot-envelope", "world-form",
     },
     "bench-harness": {"chart", "world-form"},
 }

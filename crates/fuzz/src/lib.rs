@@ -12,5 +12,6 @@
 pub mod libfuzzer;
 pub mod mutate;
 pub mod outcome;
+pub mod page;
 pub mod params;
 pub mod targets;

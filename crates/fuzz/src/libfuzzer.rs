@@ -36,6 +36,12 @@ pub fn bridge(data: &[u8]) {
     check(run_bridge(data));
 }
 
+/// What the page servers read from the network (an HTTP head, a page message, a student's
+/// name): see [`crate::page`].
+pub fn page(data: &[u8]) {
+    check(crate::page::run_page(data));
+}
+
 /// A world parameter table (the Python wheel's dicts): see [`crate::params`].
 pub fn params(data: &[u8]) {
     check(crate::params::run_params(data));

@@ -29,6 +29,7 @@ pub const TARGETS: &[&str] = &[
     "verify",
     "bridge",
     "params",
+    "page",
     "cli",
 ];
 
@@ -95,6 +96,7 @@ impl Target {
                 t.seeds = vec![b];
             }
             "params" => t.seeds = crate::params::seeds(),
+            "page" => t.seeds = crate::page::seeds(),
             "bridge" => {
                 let sample = Sample {
                     seq: 7,
@@ -189,6 +191,7 @@ impl Target {
             "verify" => self.run_verify(input, index),
             "bridge" => run_bridge(input),
             "params" => crate::params::run_params(input),
+            "page" => crate::page::run_page(input),
             "selftest" => selftest(index, self.timeout),
             _ => self.run_cli(input),
         }
