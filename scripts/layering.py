@@ -36,13 +36,14 @@ ALLOWED = {
     "nanoworld": {"world-form"},
     "haptic-types": {"world-form"},
     "picture": set(),
+    "webguard": set(),
     "chart": {"picture"},
     "render": {"haptic-types", "picture", "world-form"},
     "nanohaptics-recording": {"haptic-types", "world-form"},
     "haptic-devices": {"haptic-types", "world-form"},
     "haptic-loop": {
         "brickworld", "haptic-devices", "haptic-types", "nanohaptics-recording", "nanoworld",
-        "ot-envelope", "ot-physics", "render", "world-form",
+        "ot-envelope", "ot-physics", "render", "webguard", "world-form",
     },
     "nanohaptics-lesson": {
         "brickworld", "chart", "haptic-devices", "haptic-loop", "nanohaptics-recording",
@@ -50,7 +51,7 @@ ALLOWED = {
     },
     "nanohaptics-play": {
         "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording", "render",
-        "world-form",
+        "webguard", "world-form",
     },
     "nanohaptics-cli": {
         "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-lesson",
@@ -62,7 +63,7 @@ ALLOWED = {
     },
     "nanohaptics-fuzz": {
         "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-play",
-        "nanohaptics-recording", "nanoworld", "ot-envelope", "world-form",
+        "nanohaptics-recording", "nanoworld", "ot-envelope", "webguard", "world-form",
     },
     "bench-harness": {"chart", "world-form"},
 }

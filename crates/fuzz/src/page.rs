@@ -3,7 +3,7 @@
 //! The first byte picks which; nothing may panic, and what is accepted must read back the same.
 
 use crate::outcome::Outcome;
-use play::http::{Guard, parse_head, percent_decode};
+use webguard::{Guard, parse_head, percent_decode};
 
 /// One input: byte 0 selects the reader (even: an HTTP head, 1 mod 4: a page message, 3 mod 4:
 /// a student's name), the rest is its text.
@@ -46,10 +46,12 @@ fn head(bytes: &[u8]) -> Outcome {
         let lo = Guard {
             port,
             loopback_only: true,
+            other_origins: Vec::new(),
         };
         let net = Guard {
             port,
             loopback_only: false,
+            other_origins: Vec::new(),
         };
         if lo.check(&h).is_ok() && net.check(&h).is_err() {
             return finding(

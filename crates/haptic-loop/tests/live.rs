@@ -291,3 +291,75 @@ fn the_shipped_foxglove_layout_uses_only_published_topics_and_fields() {
         assert!(layout.contains(id.as_str()), "{id} not in the layout");
     }
 }
+
+/// A WebSocket upgrade to the live view on `port` with `host` and `origin` (none: `None`), as
+/// a browser page would send it: the answer's status line.
+fn upgrade_status(port: u16, host: &str, origin: Option<&str>) -> String {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    let o = origin
+        .map(|o| format!("Origin: {o}\r\n"))
+        .unwrap_or_default();
+    s.write_all(
+        format!(
+            "GET / HTTP/1.1\r\nHost: {host}\r\n{o}Upgrade: websocket\r\nConnection: Upgrade\r\n\
+             Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: foxglove.sdk.v1\r\n\
+             Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+        )
+        .as_bytes(),
+    )
+    .unwrap();
+    let mut line = Vec::new();
+    let mut b = [0u8; 1];
+    while let Ok(1) = s.read(&mut b) {
+        if b[0] == b'\n' {
+            break;
+        }
+        line.push(b[0]);
+    }
+    String::from_utf8(line).unwrap().trim_end().to_string()
+}
+
+#[test]
+fn another_sites_page_and_a_rebinding_host_cannot_reach_the_live_view() {
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut o =
+        SessionOptions::new(SceneSource::from_path(&root.join("scenes/wall.toml")).unwrap());
+    o.realtime = true;
+    o.seconds = Some(2.0);
+    o.live = Some(LiveConfig::parse(&format!("ws:127.0.0.1:{port}")).unwrap());
+    let session = std::thread::spawn(move || run_session(&o, &mut |_, _| {}).unwrap());
+    let _first = foxglove_client(port, Duration::from_secs(10));
+    let host = format!("127.0.0.1:{port}");
+    // Another site's page (cross-site WebSocket hijacking could set switches).
+    assert_eq!(
+        upgrade_status(port, &host, Some("https://evil.example")),
+        "HTTP/1.1 403 Forbidden"
+    );
+    // A DNS-rebinding page: its own name as Host.
+    assert_eq!(
+        upgrade_status(port, &format!("rebind.evil.example:{port}"), None),
+        "HTTP/1.1 403 Forbidden"
+    );
+    // Foxglove's web app, the desktop app (no Origin) and localhost are let through.
+    for (h, origin) in [
+        (host.clone(), Some("https://app.foxglove.dev")),
+        (host.clone(), None),
+        (format!("localhost:{port}"), None),
+    ] {
+        assert_eq!(
+            upgrade_status(port, &h, origin),
+            "HTTP/1.1 101 Switching Protocols",
+            "{h} {origin:?}"
+        );
+    }
+    let report = session.join().unwrap();
+    let live = report.live.expect("the live view's summary");
+    assert_eq!((live.refused_origin, live.refused_host), (1, 1));
+}

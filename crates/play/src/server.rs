@@ -4,7 +4,7 @@
 //! (bounded queues; a page that cannot keep up loses frames, never the tick's time).
 
 use crate::gate::{Gate, Limits, RateLimit};
-use crate::http::{Guard, Head, HeadError, accept_upgrade, read_head, respond, respond_text};
+use crate::http::{accept_upgrade, respond, respond_text};
 use crate::input::{SharedInput, page_to_device};
 use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
 use haptic_types::SwitchSpec;
@@ -18,6 +18,7 @@ use std::time::{Duration, Instant};
 use tungstenite::protocol::Role as WsRole;
 use tungstenite::protocol::WebSocketConfig;
 use tungstenite::{Message, WebSocket};
+use webguard::{Guard, Head, HeadError, read_head};
 
 /// A file of the page, built into the binary.
 #[derive(Clone, Copy, Debug)]
@@ -226,6 +227,7 @@ impl Listener {
             Guard {
                 port: addr.port(),
                 loopback_only: bind.ip().is_loopback(),
+                other_origins: Vec::new(),
             },
             limits,
         ));

@@ -19,6 +19,7 @@
 //! dropped and counted (`dropped` in `/live/state` and in the summary).
 
 #[cfg(feature = "live")]
+pub mod guard;
 pub mod menu;
 #[cfg(feature = "live")]
 mod server;
@@ -83,4 +84,9 @@ pub struct LiveSummary {
     pub dropped: u64,
     /// Clients connected at the end.
     pub clients_at_end: usize,
+    /// Connections refused for a `Host` that is not this machine's (DNS rebinding).
+    pub refused_host: u64,
+    /// Connections refused for an `Origin` of another site (neither the page's own nor
+    /// Foxglove's web app).
+    pub refused_origin: u64,
 }

@@ -48,6 +48,7 @@ pub struct LiveSink {
     config: LiveConfig,
     menu: Arc<Mutex<super::menu::Menu>>,
     server: Option<WebSocketServerHandle>,
+    guard: Option<super::guard::LiveGuard>,
     ctx: Arc<Context>,
     shared: Arc<Shared>,
     local: Vec<Snapshot>,
@@ -66,13 +67,18 @@ impl LiveSink {
             .name("nanohaptics")
             .capabilities([foxglove::websocket::Capability::Parameters])
             .listener(Arc::new(super::menu::MenuListener(menu.clone())))
-            .bind(config.bind.ip().to_string(), config.bind.port())
+            // A private loopback port: clients reach it only through the guard.
+            .bind("127.0.0.1", 0)
             .start_blocking()
+            .map_err(|e| LiveError::Serve(format!("cannot serve on ws:{}: {e}", config.bind)))?;
+        let backend = std::net::SocketAddr::from(([127, 0, 0, 1], server.port()));
+        let guard = super::guard::LiveGuard::start(config.bind, backend)
             .map_err(|e| LiveError::Serve(format!("cannot serve on ws:{}: {e}", config.bind)))?;
         Ok(LiveSink {
             config,
             menu,
             server: Some(server),
+            guard: Some(guard),
             ctx,
             shared: Arc::new(Shared {
                 queue: Mutex::new(Vec::with_capacity(CAP)),
@@ -95,9 +101,10 @@ impl LiveSink {
         self.menu.clone()
     }
 
-    /// The port the server listens on (useful with port 0).
+    /// The port the view is served on (useful with port 0): the guard's, which checks every
+    /// connection's `Host` and `Origin` before passing it to the Foxglove server.
     pub fn port(&self) -> Option<u16> {
-        self.server.as_ref().map(|s| s.port())
+        self.guard.as_ref().map(|g| g.addr().port())
     }
 
     /// What was published so far.
@@ -109,6 +116,14 @@ impl LiveSink {
             logs: s.logs.load(Ordering::Relaxed),
             dropped: s.dropped.load(Ordering::Relaxed),
             clients_at_end: self.server.as_ref().map_or(0, |h| h.client_count()),
+            refused_host: self
+                .guard
+                .as_ref()
+                .map_or(0, |g| g.counts.host.load(Ordering::Relaxed)),
+            refused_origin: self
+                .guard
+                .as_ref()
+                .map_or(0, |g| g.counts.origin.load(Ordering::Relaxed)),
         }
     }
 
@@ -315,6 +330,7 @@ impl Drop for LiveSink {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
+        self.guard.take();
         if let Some(s) = self.server.take() {
             drop(s.stop());
         }

@@ -5,10 +5,11 @@
 
 use super::{Class, JoinError, teacher};
 use crate::gate::Gate;
-use crate::http::{Head, accept_upgrade, respond, respond_text};
+use crate::http::{accept_upgrade, respond, respond_text};
 use crate::server::{PAGE_FILES, Routes, page_link, serve_download, serve_page_file};
 use std::net::TcpStream;
 use std::sync::Arc;
+use webguard::Head;
 
 /// The classroom's files besides the play page's.
 const JOIN_CSS: &str = include_str!("page/class.css");

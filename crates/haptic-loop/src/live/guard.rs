@@ -1,0 +1,191 @@
+//! The live view's door: the Foxglove server listens on a private loopback port, and this
+//! guard on the address the user asked for. Each connection's request head is checked —
+//! `Host` one of this machine's addresses (never a rebinding page's name), `Origin` absent (the
+//! Foxglove desktop app), the Foxglove web app's or the page's own — and only then passed on,
+//! byte for byte, to the server. A page of another site in the same browser can therefore
+//! neither watch the session nor set its switches (the Parameters panel drives the live menu).
+
+use std::io::{Read, Write};
+use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::thread::JoinHandle;
+use std::time::Duration;
+use webguard::{Guard, HeadError, read_head_bytes};
+
+/// The Foxglove web app's origin, allowed to connect (Foxglove's desktop app sends none).
+pub const FOXGLOVE_APP_ORIGIN: &str = "https://app.foxglove.dev";
+/// Connections open at once through the guard.
+pub const MAX_CONNECTIONS: u64 = 32;
+
+/// What the guard refused.
+#[derive(Debug, Default)]
+pub struct GuardCounts {
+    /// A `Host` that is not this machine's (DNS rebinding), or none.
+    pub host: AtomicU64,
+    /// An `Origin` of another site.
+    pub origin: AtomicU64,
+    /// A malformed head, or over [`MAX_CONNECTIONS`].
+    pub other: AtomicU64,
+}
+
+/// The running guard.
+pub struct LiveGuard {
+    addr: SocketAddr,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+    /// What it refused.
+    pub counts: Arc<GuardCounts>,
+}
+
+impl LiveGuard {
+    /// Listens on `bind` and passes checked connections to `backend`.
+    pub fn start(bind: SocketAddr, backend: SocketAddr) -> std::io::Result<LiveGuard> {
+        let listener = TcpListener::bind(bind)?;
+        listener.set_nonblocking(true)?;
+        let addr = listener.local_addr()?;
+        let guard = Guard {
+            port: addr.port(),
+            loopback_only: bind.ip().is_loopback(),
+            other_origins: vec![FOXGLOVE_APP_ORIGIN.to_string()],
+        };
+        let stop = Arc::new(AtomicBool::new(false));
+        let counts = Arc::new(GuardCounts::default());
+        let (s, c) = (stop.clone(), counts.clone());
+        let thread = std::thread::Builder::new()
+            .name("live-guard".into())
+            .spawn(move || accept(listener, guard, backend, s, c))?;
+        Ok(LiveGuard {
+            addr,
+            stop,
+            thread: Some(thread),
+            counts,
+        })
+    }
+
+    /// The address it listens on.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+}
+
+impl Drop for LiveGuard {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn accept(
+    listener: TcpListener,
+    guard: Guard,
+    backend: SocketAddr,
+    stop: Arc<AtomicBool>,
+    counts: Arc<GuardCounts>,
+) {
+    let open = Arc::new(AtomicU64::new(0));
+    let guard = Arc::new(guard);
+    while !stop.load(Ordering::Relaxed) {
+        match listener.accept() {
+            Ok((stream, _)) => {
+                if open.load(Ordering::Relaxed) >= MAX_CONNECTIONS {
+                    counts.other.fetch_add(1, Ordering::Relaxed);
+                    refuse(stream, "503 Service Unavailable", "too many connections");
+                    continue;
+                }
+                open.fetch_add(1, Ordering::Relaxed);
+                let (g, c, o, s) = (guard.clone(), counts.clone(), open.clone(), stop.clone());
+                let _ = std::thread::Builder::new()
+                    .name("live-guard-conn".into())
+                    .spawn(move || {
+                        connection(stream, &g, backend, &c, &s);
+                        o.fetch_sub(1, Ordering::Relaxed);
+                    });
+            }
+            Err(_) => std::thread::sleep(Duration::from_millis(10)),
+        }
+    }
+}
+
+fn refuse(mut stream: TcpStream, status: &str, message: &str) {
+    let _ = stream.set_nonblocking(false);
+    let body = format!("{message}\n");
+    let head = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: {}\r\nConnection: close\r\n\r\n",
+        body.len()
+    );
+    let _ = stream.write_all(head.as_bytes());
+    let _ = stream.write_all(body.as_bytes());
+}
+
+fn connection(
+    mut client: TcpStream,
+    guard: &Guard,
+    backend: SocketAddr,
+    counts: &GuardCounts,
+    stop: &AtomicBool,
+) {
+    let _ = client.set_nonblocking(false);
+    let (bytes, head) = match read_head_bytes(&mut client) {
+        Ok(x) => x,
+        Err(HeadError::Closed) => return,
+        Err(e) => {
+            counts.other.fetch_add(1, Ordering::Relaxed);
+            return refuse(client, "400 Bad Request", &e.to_string());
+        }
+    };
+    if let Err(r) = guard.check(&head) {
+        let c = if r.kind() == "origin" {
+            &counts.origin
+        } else {
+            &counts.host
+        };
+        c.fetch_add(1, Ordering::Relaxed);
+        return refuse(client, "403 Forbidden", &r.to_string());
+    }
+    let Ok(mut server) = TcpStream::connect(backend) else {
+        return refuse(client, "502 Bad Gateway", "the live view is not serving");
+    };
+    let _ = server.set_nodelay(true);
+    let _ = client.set_nodelay(true);
+    if server.write_all(&bytes).is_err() {
+        return;
+    }
+    // Both directions, until either side closes (or the session ends).
+    let (Ok(mut c2), Ok(mut s2)) = (client.try_clone(), server.try_clone()) else {
+        return;
+    };
+    let up = std::thread::spawn(move || {
+        let _ = std::io::copy(&mut c2, &mut s2);
+        let _ = s2.shutdown(Shutdown::Write);
+    });
+    let _ = client.set_read_timeout(None);
+    let _ = server.set_read_timeout(Some(Duration::from_millis(200)));
+    let mut buf = [0u8; 16 * 1024];
+    loop {
+        match server.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => {
+                if client.write_all(&buf[..n]).is_err() {
+                    break;
+                }
+            }
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
+            }
+            Err(_) => break,
+        }
+    }
+    let _ = client.shutdown(Shutdown::Both);
+    let _ = server.shutdown(Shutdown::Both);
+    let _ = up.join();
+}
