@@ -20,6 +20,7 @@
 
 #[cfg(feature = "live")]
 pub mod guard;
+#[cfg(feature = "live")]
 pub mod menu;
 #[cfg(feature = "live")]
 mod server;
