@@ -8,6 +8,8 @@
 //!                 [--out REC.mcap] [--realtime] [--live ws:HOST:PORT] [--live-hz N] [--json]
 //! nanohaptics play [SCENE] [--port P] [--device udp:HOST:PORT|udp:PORT] [--out REC.mcap]
 //!                 [--seconds T]
+//! nanohaptics classroom [SCENE] [--port P] [--listen ADDR] [--max-students N] [--out-dir DIR]
+//!                 [--seconds T]
 //! nanohaptics lesson [--out DIR] [--width W] [--sample-rate HZ] [--json]
 //! nanohaptics fake-device udp:HOST:PORT|udp:PORT [--script S] [--operator rigid|hand|hand:k=v,...]
 //!                 [--model falcon|touch|delta3|inverse3] [--grip loose|firm|k=...,b=...[,m=...]]
@@ -24,6 +26,7 @@
 //! Every command's own `--help` gives each option's unit, range and default. Exit status: 0
 //! success, 1 error (bad input, unreadable file), 2 replay diverged, 130 stopped by Ctrl-C.
 
+mod classroom_cmd;
 mod demo_cmd;
 mod fake_cmd;
 mod lesson_cmd;
@@ -96,6 +99,9 @@ enum Cmd {
     /// Play the teaching game in a browser: serves one page on loopback (pointer, keyboard or
     /// gamepad as the hand, live sound, the menu, the score) and records the session.
     Play(play_cmd::PlayArgs),
+    /// One server for a whole class: each student joins by name and plays their own world
+    /// with their own recording; a teacher page watches, switches, ends and collects.
+    Classroom(classroom_cmd::ClassroomArgs),
     /// Run every scene with its default script, record, verify, and summarise.
     Demo {
         /// Folder of scene files (default: `./scenes` if it exists, else the built-in scenes,
@@ -131,6 +137,7 @@ fn main() -> ExitCode {
         Cmd::Info { rec, salvage, json } => recording_cmd::info(&rec, salvage, json),
         Cmd::Lesson(a) => lesson_cmd::cmd(&a),
         Cmd::Play(a) => play_cmd::cmd(&a),
+        Cmd::Classroom(a) => classroom_cmd::cmd(&a),
         Cmd::Demo { scenes, out, json } => demo_cmd::demo(scenes.as_deref(), &out, json),
         Cmd::Scenes { action, dir } => demo_cmd::scenes(action.as_deref(), dir.as_deref()),
         Cmd::FakeDevice(a) => fake_cmd::cmd(a),

@@ -1,0 +1,114 @@
+//! `nanohaptics classroom`: one server for a whole class (the `play` crate's
+//! [`play::classroom`]).
+
+use haptic_loop::session::SceneSource;
+use std::net::{IpAddr, UdpSocket};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `nanohaptics classroom`.
+#[derive(clap::Args, Debug)]
+pub struct ClassroomArgs {
+    /// Scene file or built-in scene name (brickworld, nanoworld, wall, optical_tweezers).
+    #[arg(default_value = "brickworld")]
+    pub scene: PathBuf,
+    /// Port of the class's pages (0: any free port).
+    #[arg(long, default_value_t = play::DEFAULT_PORT)]
+    pub port: u16,
+    /// Address to listen on: 127.0.0.1 (this computer only, the default), 0.0.0.0 (every
+    /// network of this computer) or one interface's address. Off loopback, students need the
+    /// join code printed at start.
+    #[arg(long, default_value = "127.0.0.1")]
+    pub listen: IpAddr,
+    /// Students playing at once (1 to 200).
+    #[arg(long, default_value_t = 40)]
+    pub max_students: usize,
+    /// Folder of the recordings, one per student session (NAME-START.mcap).
+    #[arg(long, default_value = "class")]
+    pub out_dir: PathBuf,
+    /// Each student's session length, s (0 < s ≤ 3600); without it a session ends when the
+    /// student or the teacher ends it, or at Ctrl-C.
+    #[arg(long)]
+    pub seconds: Option<f64>,
+}
+
+/// This computer's address on its default route (no packet is sent: a UDP socket is only
+/// pointed at a documentation address to learn which local address the system would use).
+fn lan_address() -> Option<IpAddr> {
+    let s = UdpSocket::bind("0.0.0.0:0").ok()?;
+    s.connect("192.0.2.1:9").ok()?;
+    s.local_addr()
+        .ok()
+        .map(|a| a.ip())
+        .filter(|ip| !ip.is_unspecified())
+}
+
+/// Runs `nanohaptics classroom`: prints the students' and the teacher's addresses, serves the
+/// class until Ctrl-C, then ends every session and prints each student's figures.
+pub fn cmd(a: &ClassroomArgs) -> Result<ExitCode, String> {
+    let scene = SceneSource::resolve(&a.scene).map_err(|e| e.to_string())?;
+    let mut c = play::classroom::ClassConfig::new(scene, a.out_dir.clone());
+    c.port = a.port;
+    c.listen = a.listen;
+    c.max_students = a.max_students;
+    c.seconds = a.seconds;
+    let stop = crate::run_cmd::interrupt_flag()?;
+    let listen = a.listen;
+    let s = play::classroom::run(&c, &stop, &mut |addr| {
+        println!(
+            "classroom: up to {} students, recordings in {}",
+            c.max_students,
+            c.out_dir.display()
+        );
+        if listen.is_loopback() {
+            println!(
+                "  students open  {}  (on this computer a name is enough)",
+                addr.student_url
+            );
+        } else {
+            let port = addr
+                .student_url
+                .rsplit(':')
+                .next()
+                .unwrap_or("")
+                .trim_end_matches('/');
+            let shown = if listen.is_unspecified() {
+                lan_address().unwrap_or(listen)
+            } else {
+                listen
+            };
+            let host = match shown {
+                IpAddr::V6(v6) => format!("[{v6}]"),
+                v4 => v4.to_string(),
+            };
+            println!("  students open  http://{host}:{port}/  on the class network");
+            if let Some(code) = &addr.join_code {
+                println!("  join code      {code}  (write it on the board)");
+            }
+        }
+        println!(
+            "  teacher page   {}  (keep its code, {}, to yourself)",
+            addr.teacher_url, addr.teacher_code
+        );
+        println!("Ctrl-C ends every session and prints the class's figures.");
+    })
+    .map_err(|e| e.to_string())?;
+    println!("{} student sessions", s.students.len());
+    for st in &s.students {
+        println!("  {}", st.line());
+    }
+    let r = s.refused;
+    println!(
+        "refused: {} in all ({} host, {} origin, {} join, {} code, {} connections, {} size, {} rate, {} head)",
+        r.total(),
+        r.host,
+        r.origin,
+        r.join,
+        r.code,
+        r.connections,
+        r.size,
+        r.rate,
+        r.head
+    );
+    Ok(ExitCode::SUCCESS)
+}
