@@ -46,7 +46,7 @@ function row(s) {
       if (k < filled) b.className = 'on';
       bp.appendChild(b);
     }
-    bp.title = `${filled} slots filled`;
+    bp.append(` ${filled}${slots !== undefined ? ` of ${slots}` : ''} filled`);
   } else bp.textContent = '–';
   if (st && st.phase !== 'ended') {
     const b = document.createElement('button');
