@@ -27,6 +27,7 @@
 //! page is plain HTML, CSS and JavaScript modules built into the binary; it needs no npm, no
 //! bundler and no network.
 
+pub mod background;
 pub mod classroom;
 pub mod gate;
 pub mod http;

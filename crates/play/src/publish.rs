@@ -74,6 +74,9 @@ pub enum ToPublisher {
         /// Why.
         message: String,
     },
+    /// Several of the above in order: the tick thread hands its ticks over once per sound
+    /// block (or frame) instead of waking the publisher every tick.
+    Batch(Vec<ToPublisher>),
     /// The session ended after `ticks` ticks.
     Finish {
         /// Ticks run.
@@ -88,6 +91,7 @@ pub struct PlaySink {
     nearest: Option<usize>,
     state: Vec<f64>,
     last_seq: u64,
+    pending: Vec<ToPublisher>,
     /// Input-to-force latencies, ms (page event to the force of the first tick that used it).
     pub input_latency_ms: Vec<f64>,
 }
@@ -101,6 +105,7 @@ impl PlaySink {
             nearest: None,
             state: Vec::new(),
             last_seq: 0,
+            pending: Vec::with_capacity(SOUND_BLOCK_TICKS as usize),
             input_latency_ms: Vec::new(),
         }
     }
@@ -158,14 +163,20 @@ impl Sink for PlaySink {
             .iter()
             .map(|e| (e.name.clone(), e.detail.clone()))
             .collect();
-        // A closed channel means the publisher is gone: the session goes on without pages.
-        let _ = self.tx.send(ToPublisher::Tick {
+        let flush = frame.is_some() || r.tick % SOUND_BLOCK_TICKS == SOUND_BLOCK_TICKS - 1;
+        self.pending.push(ToPublisher::Tick {
             tick: r.tick,
             wall_ms,
             events,
             nearest_m,
             frame,
         });
+        if flush {
+            // A closed channel means the publisher is gone: the session goes on without pages.
+            let _ = self
+                .tx
+                .send(ToPublisher::Batch(std::mem::take(&mut self.pending)));
+        }
         Ok(())
     }
 
@@ -174,6 +185,11 @@ impl Sink for PlaySink {
         stats: &TickStats,
         _link: &[(&'static str, u64)],
     ) -> Result<(), SinkError> {
+        if !self.pending.is_empty() {
+            let _ = self
+                .tx
+                .send(ToPublisher::Batch(std::mem::take(&mut self.pending)));
+        }
         let _ = self.tx.send(ToPublisher::Finish { ticks: stats.ticks });
         Ok(())
     }
@@ -267,8 +283,22 @@ pub fn run_publisher(
         *first += pcm.len() as u64;
         pcm.clear();
     };
-    while let Ok(m) = rx.recv() {
+    crate::background::lower_priority();
+    let mut queue: VecDeque<ToPublisher> = VecDeque::new();
+    loop {
+        let m = match queue.pop_front() {
+            Some(m) => m,
+            None => match rx.recv() {
+                Ok(m) => m,
+                Err(_) => break,
+            },
+        };
         match m {
+            ToPublisher::Batch(list) => {
+                for (k, x) in list.into_iter().enumerate() {
+                    queue.insert(k, x);
+                }
+            }
             ToPublisher::Tick {
                 tick,
                 wall_ms,

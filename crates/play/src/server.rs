@@ -538,6 +538,7 @@ fn role_of(shared: &Shared, id: u64, link: Option<&SceneLink>) -> Role {
 /// [`Limits::max_message_bytes`] closes the link (counted), faster than
 /// [`Limits::messages_per_s`] is refused message by message (counted, one error a second).
 pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
+    crate::background::lower_priority();
     let id = shared.next_id.fetch_add(1, Ordering::Relaxed) + 1;
     shared.pages_served.fetch_add(1, Ordering::Relaxed);
     let (tx, rx): (SyncSender<Message>, Receiver<Message>) = sync_channel(PAGE_QUEUE);

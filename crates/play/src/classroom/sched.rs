@@ -13,6 +13,10 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
 use std::time::Duration;
 
+/// How long a worker spins before each cycle (the rest it sleeps): its sessions' deadlines are
+/// a whole period away, so the cores go to the other workers and the pages instead.
+const SPIN: Duration = Duration::from_micros(20);
+
 /// One worker's loop: takes new sessions from `inbox`, ticks every session each cycle, hands
 /// ended ones to `finished`; on `stop` it ends every session and returns.
 pub(crate) fn worker(
@@ -22,7 +26,7 @@ pub(crate) fn worker(
     load: Arc<AtomicUsize>,
     stop: Arc<AtomicBool>,
 ) {
-    let mut pacer = Pacer::new(period_ns);
+    let mut pacer = Pacer::with_spin(period_ns, SPIN);
     let mut k: u64 = 0;
     let mut lives: Vec<Box<Live>> = Vec::new();
     loop {
@@ -33,7 +37,7 @@ pub(crate) fn worker(
                 Err(RecvTimeoutError::Timeout) if !stop.load(Ordering::Relaxed) => continue,
                 Err(_) => return,
             }
-            pacer = Pacer::new(period_ns);
+            pacer = Pacer::with_spin(period_ns, SPIN);
             k = 0;
         }
         while let Ok(l) = inbox.try_recv() {

@@ -1,0 +1,318 @@
+//! The classroom bench (docs/bench/classroom.md): N students on one machine, each a page
+//! client on loopback playing the brick world, measured from both ends.
+//!
+//! `cargo run --release -p nanohaptics-play --example classroom-bench -- [--students N]
+//! [--seconds S] [--runs R] [--out FILE]` (defaults 30 students, 20 s, 3 runs).
+//!
+//! The server (`play::classroom::run`) runs in this process; the students run in a child
+//! process (this program with `--clients`), so the server's CPU time is this process's alone.
+//! Each student joins by name, opens its page link, presses Start and moves its hand at 60
+//! inputs/s (each stamped with its wall time) while it reads every frame and sound block.
+//!
+//! Figures per run: missed 1 ms deadlines over every session's ticks, input → force (the
+//! input's wall time to the tick whose force used it, from the server), frames/s each page
+//! received, and the server's CPU use (user + system, in cores).
+
+use haptic_loop::session::SceneSource;
+use play::classroom::{ClassConfig, run};
+use serde_json::json;
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::process::Command;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::{Message, WebSocket};
+
+fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+fn unix_ms() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64() * 1e3)
+        .unwrap_or(0.0)
+}
+
+/// One student: joins, plays for `secs`, returns the frames it received per second of play.
+fn student(host: &str, name: &str, secs: f64) -> Result<f64, String> {
+    let mut s = TcpStream::connect(host).map_err(|e| e.to_string())?;
+    s.write_all(format!("GET /join?name={name} HTTP/1.1\r\nHost: {host}\r\n\r\n").as_bytes())
+        .map_err(|e| e.to_string())?;
+    let mut r = String::new();
+    s.read_to_string(&mut r).map_err(|e| e.to_string())?;
+    let token = r
+        .lines()
+        .find_map(|l| l.strip_prefix("Location: /play?s="))
+        .ok_or_else(|| format!("{name} could not join: {}", r.lines().next().unwrap_or("")))?
+        .trim()
+        .to_string();
+    let (mut ws, _) = tungstenite::connect(format!("ws://{host}/ws?s={token}").as_str())
+        .map_err(|e| e.to_string())?;
+    if let MaybeTlsStream::Plain(s) = ws.get_ref() {
+        let _ = s.set_read_timeout(Some(Duration::from_millis(2)));
+    }
+    let send = |ws: &mut WebSocket<MaybeTlsStream<TcpStream>>, v: serde_json::Value| {
+        ws.send(Message::text(v.to_string()))
+            .map_err(|e| e.to_string())
+    };
+    send(&mut ws, json!({"type": "start"}))?;
+    let t0 = Instant::now();
+    let mut next = t0;
+    let mut k = 0u64;
+    let mut frames = 0u64;
+    let mut first_frame: Option<Instant> = None;
+    while t0.elapsed().as_secs_f64() < secs {
+        if Instant::now() >= next {
+            k += 1;
+            next += Duration::from_micros(16_667);
+            let a = k as f64 * 0.02;
+            let pos = [0.3 * a.cos(), 0.3 * a.sin(), -0.2 + 0.2 * (0.5 * a).sin()];
+            send(
+                &mut ws,
+                json!({"type": "input", "seq": k, "pos": pos, "buttons": 0, "t_ms": unix_ms()}),
+            )?;
+        }
+        // Read until the next input is due (a page's own loop: it sleeps between events).
+        let wait = next.saturating_duration_since(Instant::now());
+        if let MaybeTlsStream::Plain(s) = ws.get_ref() {
+            let _ = s.set_read_timeout(Some(wait.max(Duration::from_micros(500))));
+        }
+        match ws.read() {
+            Ok(Message::Text(t)) if t.as_str().starts_with(r#"{"type":"frame""#) => {
+                frames += 1;
+                first_frame.get_or_insert_with(Instant::now);
+            }
+            _ => {}
+        }
+    }
+    let played = first_frame.map_or(0.0, |f| f.elapsed().as_secs_f64());
+    Ok(if played > 0.0 {
+        frames as f64 / played
+    } else {
+        0.0
+    })
+}
+
+/// The child process: `n` students on `host` for `secs`; prints each one's frames/s.
+fn clients(host: &str, n: usize, secs: f64) {
+    let handles: Vec<_> = (0..n)
+        .map(|i| {
+            let h = host.to_string();
+            std::thread::spawn(move || student(&h, &format!("student{i:02}"), secs))
+        })
+        .collect();
+    for h in handles {
+        match h.join() {
+            Ok(Ok(fps)) => println!("fps {fps}"),
+            Ok(Err(e)) => println!("error {e}"),
+            Err(_) => println!("error a student thread panicked"),
+        }
+    }
+}
+
+/// This process's CPU time (user + system), s.
+fn cpu_s() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    // Fields 14 and 15 of stat (utime, stime), in clock ticks of 100 Hz.
+    (t(11) + t(12)) / 100.0
+}
+
+struct RunFigures {
+    ticks: u64,
+    missed: u64,
+    worst_missed_pct: f64,
+    p99_ms: f64,
+    worst_p99_ms: f64,
+    fps_min: f64,
+    fps_median: f64,
+    cpu_cores: f64,
+    sessions: usize,
+    errors: usize,
+    workers: usize,
+}
+
+fn one_run(n: usize, secs: f64) -> RunFigures {
+    let dir = std::env::temp_dir().join(format!("nh-class-bench-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut c = ClassConfig::new(
+        SceneSource::resolve("brickworld".as_ref()).expect("the built-in brick world"),
+        dir.clone(),
+    );
+    c.port = 0;
+    c.max_students = n;
+    let stop = Arc::new(AtomicBool::new(false));
+    let s2 = stop.clone();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let server = std::thread::spawn(move || {
+        run(&c, &s2, &mut |a| {
+            let _ = tx.send(a.student_url.clone());
+        })
+    });
+    let url = rx
+        .recv_timeout(Duration::from_secs(30))
+        .expect("the class serves");
+    let host = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    let exe = std::env::current_exe().expect("this program");
+    let cpu0 = cpu_s();
+    let w0 = Instant::now();
+    let nice = std::env::var("CLIENT_NICE").unwrap_or_else(|_| "0".into());
+    let out = Command::new("nice")
+        .args(["-n", &nice])
+        .arg(exe)
+        .args([
+            "--clients",
+            &n.to_string(),
+            "--host",
+            &host,
+            "--seconds",
+            &secs.to_string(),
+        ])
+        .output()
+        .expect("the students' process");
+    let wall = w0.elapsed().as_secs_f64();
+    let cpu = cpu_s() - cpu0;
+    stop.store(true, Ordering::Relaxed);
+    let summary = server
+        .join()
+        .expect("the class thread")
+        .expect("the class ran");
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut fps: Vec<f64> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("fps "))
+        .filter_map(|v| v.parse().ok())
+        .collect();
+    let errors = text.lines().filter(|l| l.starts_with("error")).count();
+    for l in text.lines().filter(|l| l.starts_with("error")) {
+        eprintln!("{l}");
+    }
+    fps.sort_by(f64::total_cmp);
+    let ticks: u64 = summary.students.iter().map(|s| s.stats.ticks).sum();
+    let missed: u64 = summary.students.iter().map(|s| s.stats.missed).sum();
+    let worst_missed_pct = summary
+        .students
+        .iter()
+        .map(|s| 100.0 * s.stats.missed as f64 / s.stats.ticks.max(1) as f64)
+        .fold(0.0, f64::max);
+    let p99s: Vec<f64> = summary
+        .students
+        .iter()
+        .filter_map(|s| s.input_latency_ms.map(|l| l.p99))
+        .collect();
+    let mut p99_sorted = p99s.clone();
+    p99_sorted.sort_by(f64::total_cmp);
+    let _ = std::fs::remove_dir_all(&dir);
+    RunFigures {
+        ticks,
+        missed,
+        worst_missed_pct,
+        p99_ms: p99_sorted
+            .get(p99_sorted.len() / 2)
+            .copied()
+            .unwrap_or(f64::NAN),
+        worst_p99_ms: p99_sorted.last().copied().unwrap_or(f64::NAN),
+        fps_min: fps.first().copied().unwrap_or(0.0),
+        fps_median: fps.get(fps.len() / 2).copied().unwrap_or(0.0),
+        cpu_cores: cpu / wall,
+        sessions: summary.students.len(),
+        errors,
+        workers: summary.workers,
+    }
+}
+
+fn load() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_default()
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--clients") {
+        let n = args.get(i + 1).and_then(|v| v.parse().ok()).unwrap_or(1);
+        let host: String = arg(&args, "--host", String::new());
+        let secs = arg(&args, "--seconds", 10.0);
+        clients(&host, n, secs);
+        return;
+    }
+    let n = arg(&args, "--students", 30usize);
+    let secs = arg(&args, "--seconds", 20.0);
+    let runs = arg(&args, "--runs", 3usize);
+    let out: String = arg(&args, "--out", String::new());
+    let load0 = load();
+    let mut rows = Vec::new();
+    for r in 0..runs {
+        eprintln!("run {}/{runs}: {n} students for {secs} s …", r + 1);
+        let f = one_run(n, secs);
+        eprintln!(
+            "  {} sessions, missed {:.3} %, input → force p99 {:.1} ms, {:.1} frames/s (min), {:.2} cores",
+            f.sessions,
+            100.0 * f.missed as f64 / f.ticks.max(1) as f64,
+            f.worst_p99_ms,
+            f.fps_min,
+            f.cpu_cores
+        );
+        rows.push(f);
+    }
+    let load1 = load();
+    let mut md = format!(
+        "# Classroom bench: {n} students on one machine\n\n\
+         Machine: {} cores, shared. Load average (1, 5, 15 min) at start `{load0}`, at end \
+         `{load1}`. Command: `cargo run --release -p nanohaptics-play --example classroom-bench \
+         -- --students {n} --seconds {secs} --runs {runs} --out docs/bench/classroom.md`.\n\n\
+         Each run serves one class (`play::classroom::run`, the built-in brick world at 1 kHz, \
+         loopback) to {n} students in a second process: each joins by name, presses Start and \
+         moves its hand at 60 inputs/s for {secs} s while reading every frame and sound block. \
+         Missed deadlines are over every tick of every session (a missed tick sends zero force \
+         and is recorded, so each session replays bit for bit); input → force is the input's \
+         wall time to the tick whose force used it, per session (median and worst session's \
+         p99); frames/s is what each page received; CPU is the server process's user + system \
+         time over the run's wall time, in cores (the students' process not included).\n\n\
+         | run | sessions | worker threads | ticks | missed deadlines | worst session | input → force p99, median session (ms) | worst session (ms) | frames/s per page, min / median | server CPU (cores) | client errors |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    );
+    for (i, f) in rows.iter().enumerate() {
+        md.push_str(&format!(
+            "| {} | {} | {} | {} | {} ({:.3} %) | {:.3} % | {:.1} | {:.1} | {:.1} / {:.1} | {:.2} | {} |\n",
+            i + 1,
+            f.sessions,
+            f.workers,
+            f.ticks,
+            f.missed,
+            100.0 * f.missed as f64 / f.ticks.max(1) as f64,
+            f.worst_missed_pct,
+            f.p99_ms,
+            f.worst_p99_ms,
+            f.fps_min,
+            f.fps_median,
+            f.cpu_cores,
+            f.errors
+        ));
+    }
+    md.push_str(
+        "\nTargets (issue 32): every session at 1 kHz with ≤ 0.1 % missed deadlines, input → \
+         force p99 ≤ 20 ms, 60 frames/s to each page.\n",
+    );
+    if out.is_empty() {
+        print!("{md}");
+    } else if let Err(e) = std::fs::write(&out, &md) {
+        eprintln!("cannot write {out}: {e}");
+        std::process::exit(1);
+    } else {
+        eprintln!("wrote {out}");
+    }
+}
