@@ -1,6 +1,7 @@
 //! `nanohaptics classroom`: one server for a whole class (the `play` crate's
 //! [`play::classroom`]).
 
+use haptic_devices::source::DeviceSource;
 use haptic_loop::session::SceneSource;
 use std::net::{IpAddr, UdpSocket};
 use std::path::PathBuf;
@@ -30,6 +31,13 @@ pub struct ClassroomArgs {
     /// student or the teacher ends it, or at Ctrl-C.
     #[arg(long)]
     pub seconds: Option<f64>,
+    /// A real device over the UDP bridge (udp:HOST:PORT, or udp:PORT on loopback) that joins
+    /// as a student, paced by the device; the class's pages may watch it.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// The name the bridged device plays under.
+    #[arg(long, default_value = "device")]
+    pub device_name: String,
 }
 
 /// This computer's address on its default route (no packet is sent: a UDP socket is only
@@ -52,6 +60,19 @@ pub fn cmd(a: &ClassroomArgs) -> Result<ExitCode, String> {
     c.listen = a.listen;
     c.max_students = a.max_students;
     c.seconds = a.seconds;
+    c.device_name = a.device_name.clone();
+    c.device = match a.device.as_deref().map(DeviceSource::parse).transpose() {
+        Ok(None) => None,
+        Ok(Some(DeviceSource::Udp(b))) => Some(b),
+        Ok(Some(DeviceSource::Model(m))) => {
+            return Err(format!(
+                "--device `{}`: the students' hands are their pages; --device names a device in \
+                 another process (udp:HOST:PORT or udp:PORT)",
+                m.name()
+            ));
+        }
+        Err(e) => return Err(format!("--device: {e}")),
+    };
     let stop = crate::run_cmd::interrupt_flag()?;
     let listen = a.listen;
     let s = play::classroom::run(&c, &stop, &mut |addr| {
@@ -85,6 +106,12 @@ pub fn cmd(a: &ClassroomArgs) -> Result<ExitCode, String> {
             if let Some(code) = &addr.join_code {
                 println!("  join code      {code}  (write it on the board)");
             }
+        }
+        if let Some(b) = &c.device {
+            println!(
+                "  device         `{}` joins from udp:{} once it says hello",
+                c.device_name, b.bind
+            );
         }
         println!(
             "  teacher page   {}  (keep its code, {}, to yourself)",

@@ -9,7 +9,7 @@
 //! nanohaptics play [SCENE] [--port P] [--device udp:HOST:PORT|udp:PORT] [--out REC.mcap]
 //!                 [--seconds T]
 //! nanohaptics classroom [SCENE] [--port P] [--listen ADDR] [--max-students N] [--out-dir DIR]
-//!                 [--seconds T]
+//!                 [--seconds T] [--device udp:HOST:PORT|udp:PORT] [--device-name NAME]
 //! nanohaptics lesson [--out DIR] [--width W] [--sample-rate HZ] [--json]
 //! nanohaptics fake-device udp:HOST:PORT|udp:PORT [--script S] [--operator rigid|hand|hand:k=v,...]
 //!                 [--model falcon|touch|delta3|inverse3] [--grip loose|firm|k=...,b=...[,m=...]]

@@ -271,3 +271,115 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
     }
     let _ = std::fs::remove_dir_all(&c.dir);
 }
+
+#[test]
+fn a_bridged_device_joins_as_a_student_and_the_teacher_sees_and_ends_it() {
+    use haptic_devices::bridge::BridgeConfig;
+    use haptic_devices::bridge::fake::{FakeConfig, run_fake};
+    use haptic_devices::script::Script;
+    use haptic_types::DeviceModel;
+    use haptic_types::device::FALCON;
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let dir = std::env::temp_dir().join(format!("nh-class-{}-device", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut c = ClassConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), dir.clone());
+    c.port = 0;
+    c.teacher_code = Some("T".into());
+    let mut b = BridgeConfig::parse(&format!("udp:127.0.0.1:{port}")).unwrap();
+    b.wait_s = 30.0;
+    c.device = Some(b);
+    c.device_name = "Falcon lab 2".into();
+    let stop = Arc::new(AtomicBool::new(false));
+    let s2 = stop.clone();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let handle = std::thread::spawn(move || {
+        run(&c, &s2, &mut |a| {
+            let _ = tx.send(a.clone());
+        })
+    });
+    let addr = rx.recv_timeout(Duration::from_secs(20)).unwrap();
+    let host = addr
+        .student_url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    let text = SceneSource::builtin("wall").unwrap().scripts[0].1.clone();
+    let fake = FakeConfig {
+        target: format!("127.0.0.1:{port}").parse().unwrap(),
+        model: DeviceModel::Falcon,
+        script: Script::from_toml(&text, &FALCON).unwrap(),
+        hand: None,
+        physical: None,
+        loss: 0.0,
+        jitter_s: 0.0,
+        latency_s: 0.0,
+        seed: 1,
+        seconds: Some(30.0),
+        outage: None,
+        wait_s: 20.0,
+        bye: true,
+        protocol: haptic_devices::local::Protocol::V2,
+    };
+    let dev = std::thread::spawn(move || run_fake(&fake, None));
+    // The teacher sees the device playing, and its page link lets a page watch it.
+    let mut teacher = ws(&host, "/teacher/ws?code=T");
+    let t0 = Instant::now();
+    let device = loop {
+        let seen = read_for(&mut teacher, 0.3);
+        let playing = seen
+            .iter()
+            .rev()
+            .find(|m| m["type"] == "class")
+            .and_then(|c| {
+                c["students"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .find(|s| s["name"] == "Falcon lab 2" && s["status"]["phase"] == "playing")
+                    .cloned()
+            });
+        if let Some(p) = playing {
+            break p;
+        }
+        assert!(
+            t0.elapsed() < Duration::from_secs(20),
+            "the device never played"
+        );
+    };
+    assert_eq!(device["pages"], 0);
+    // The teacher ends it like any student's.
+    send(
+        &mut teacher,
+        json!({"type": "end", "student": "Falcon lab 2"}),
+    );
+    let r = read_for(&mut teacher, 1.0);
+    assert!(
+        r.iter()
+            .any(|m| m["message"] == "ended Falcon lab 2's session"),
+        "{r:?}"
+    );
+    stop.store(true, Ordering::Relaxed);
+    let summary = handle.join().unwrap().unwrap();
+    let _ = dev.join();
+    let s = summary
+        .students
+        .iter()
+        .find(|s| s.name == "Falcon lab 2")
+        .expect("the device's session");
+    assert_eq!(s.end, "stopped", "{}", s.line());
+    assert!(s.stats.ticks > 0, "{}", s.line());
+    assert!(
+        s.recording
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .starts_with("Falcon_lab_2-")
+    );
+    let rec = read_recording_file(&s.recording, false).unwrap();
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -19,6 +19,7 @@
 //! What it is not: no accounts, no TLS, no persistence across restarts (the recordings stay in
 //! the folder); a bridged device cannot join as a student yet (use `play --device`).
 
+mod device;
 mod live;
 pub mod names;
 mod routes;
@@ -75,6 +76,11 @@ pub struct ClassConfig {
     pub join_code: Option<String>,
     /// Worker threads ticking the sessions (`None`: one per core, at most four).
     pub workers: Option<usize>,
+    /// A real device over the UDP bridge that joins as a student (its session paced by the
+    /// device, on its own thread), named [`ClassConfig::device_name`].
+    pub device: Option<haptic_devices::bridge::BridgeConfig>,
+    /// The name the bridged device plays under.
+    pub device_name: String,
 }
 
 impl ClassConfig {
@@ -90,6 +96,8 @@ impl ClassConfig {
             teacher_code: None,
             join_code: None,
             workers: None,
+            device: None,
+            device_name: "device".into(),
         }
     }
 }
@@ -531,6 +539,24 @@ pub fn run(
         teacher_code: class.teacher_code.clone(),
         join_code: class.join_code.clone(),
     };
+    let device = match config.device.clone() {
+        Some(b) => {
+            let name = names::check_name(&config.device_name).map_err(|e| {
+                PlayError::Session(SessionError::Option(format!("--device-name: {e}")))
+            })?;
+            let (c, s) = (class.clone(), worker_stop.clone());
+            Some(
+                std::thread::Builder::new()
+                    .name("class-device".into())
+                    .spawn(move || device::run_device_student(&c, b, &name, &s))
+                    .map_err(|e| PlayError::Serve {
+                        port: config.port,
+                        message: e.to_string(),
+                    })?,
+            )
+        }
+        None => None,
+    };
     on_ready(&addresses);
     while !stop.load(Ordering::Relaxed) {
         std::thread::sleep(Duration::from_millis(20));
@@ -538,6 +564,18 @@ pub fn run(
     worker_stop.store(true, Ordering::Relaxed);
     for h in handles {
         let _ = h.join();
+    }
+    if let Some(d) = device {
+        // A device that never said hello is not waited for (its own wait may be long): its
+        // session never began and has nothing to write.
+        let waiting = class
+            .students()
+            .iter()
+            .find(|s| s.name == config.device_name.trim())
+            .is_some_and(|s| s.status.lock().is_ok_and(|st| st.phase == Phase::Waiting));
+        if !waiting {
+            let _ = d.join();
+        }
     }
     let _ = finisher.join();
     for s in class.students() {
