@@ -21,11 +21,16 @@
 //! - **The protocol** ([`protocol`]): one typed message enum per direction, [`protocol::ServerMsg`]
 //!   and [`protocol::PageMsg`], tabled in `docs/play.md`.
 //!
-//! What it is not: it is no general web server (loopback only; the page's fixed files
-//! [`server::PAGE_FILES`], `/ws`, and `/recording.mcap` once the session ended), it has no
-//! accounts and no TLS, and it is not the Foxglove live view (`nanohaptics run --live`). The
-//! page is plain HTML, CSS and JavaScript modules built into the binary; it needs no npm, no
-//! bundler and no network.
+//! - **The classroom** ([`classroom`]): one server for a whole class, a session per student
+//!   ticked by shared workers, a teacher page, the recordings as one zip.
+//! - **Safe to reach** ([`gate`], `webguard`): `Host` and `Origin` checked on every request and
+//!   upgrade, limits on connections, message size and rate, every refusal answered and counted.
+//!
+//! What it is not: it is no general web server (the page's fixed files
+//! [`server::PAGE_FILES`], `/ws`, and `/recording.mcap` once the session ended; `play` on
+//! loopback only), it has no accounts and no TLS, and it is not the Foxglove live view
+//! (`nanohaptics run --live`). The page is plain HTML, CSS and JavaScript modules built into
+//! the binary; it needs no npm, no bundler and no network.
 
 pub mod background;
 pub mod classroom;

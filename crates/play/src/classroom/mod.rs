@@ -16,8 +16,11 @@
 //! - **Where it listens**: loopback by default (a student needs only a name); on a class
 //!   network (`--listen 0.0.0.0` or an interface address) students also need the join code.
 //!
+//! - **A real device** ([`ClassConfig::device`]): a device bridged over UDP joins as a student,
+//!   its session paced by the device on its own thread.
+//!
 //! What it is not: no accounts, no TLS, no persistence across restarts (the recordings stay in
-//! the folder); a bridged device cannot join as a student yet (use `play --device`).
+//! the folder).
 
 mod device;
 mod live;
