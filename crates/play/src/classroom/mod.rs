@@ -268,6 +268,9 @@ fn random_code(n: usize, alphabet: &[u8]) -> String {
     out
 }
 
+/// A worker's inbox and its count of sessions.
+type WorkerLink = (Mutex<Sender<Box<Live>>>, Arc<AtomicUsize>);
+
 /// The class's state shared by the routes, the workers and the finisher.
 pub(crate) struct Class {
     config: ClassConfig,
@@ -279,7 +282,7 @@ pub(crate) struct Class {
     teacher_code: String,
     join_code: Option<String>,
     students: Mutex<Vec<Arc<Student>>>,
-    workers: Vec<(Mutex<Sender<Box<Live>>>, Arc<AtomicUsize>)>,
+    workers: Vec<WorkerLink>,
     pub(crate) finished: Mutex<Vec<StudentSummary>>,
     ended: AtomicUsize,
     shutdown: Arc<AtomicBool>,
