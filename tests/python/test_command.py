@@ -9,13 +9,14 @@ What each test expects is what the cargo-built binary does (its Ctrl-C handling 
 from __future__ import annotations
 
 import os
+import queue
 import re
-import select
 import signal
 import socket
 import subprocess
 import sys
 import sysconfig
+import threading
 import time
 import urllib.request
 from importlib.metadata import entry_points
@@ -46,19 +47,61 @@ def commands_in_help(text: str) -> list[str]:
     return [line.split()[0] for line in section.splitlines() if line.startswith("  ")]
 
 
-def read_line(stream, seconds: float) -> str:
-    """One line of a child's pipe, or a failure after `seconds`."""
-    ready, _, _ = select.select([stream], [], [], seconds)
-    assert ready, f"no line within {seconds} s"
-    return stream.readline()
+class Lines:
+    """A child's text pipe read line by line on a thread, so a test can wait for a line with a
+    time limit (select() on the pipe misses lines already in the reader's buffer)."""
+
+    def __init__(self, stream):
+        self.queue: queue.Queue[str] = queue.Queue()
+        self.thread = threading.Thread(target=self._pump, args=(stream,), daemon=True)
+        self.thread.start()
+
+    def _pump(self, stream) -> None:
+        for line in stream:
+            self.queue.put(line)
+        self.queue.put("")  # end of the stream
+
+    def next(self, seconds: float) -> str:
+        """The next line, or a failure after `seconds`."""
+        try:
+            return self.queue.get(timeout=seconds)
+        except queue.Empty:
+            raise AssertionError(f"no line within {seconds} s") from None
+
+    def rest(self) -> str:
+        """Everything after the lines read so far, once the stream has ended."""
+        out = []
+        while (line := self.queue.get(timeout=30)) != "":
+            out.append(line)
+        return "".join(out)
 
 
 def wait_for(path: Path, proc: subprocess.Popen, seconds: float) -> None:
-    end = time.monotonic() + seconds
+    deadline = time.monotonic() + seconds
     while not path.exists():
         assert proc.poll() is None, proc.communicate()
-        assert time.monotonic() < end, f"{path.name} did not appear within {seconds} s"
+        assert time.monotonic() < deadline, f"{path.name} did not appear within {seconds} s"
         time.sleep(0.05)
+
+
+def interrupt(p: subprocess.Popen, seconds: float = 10) -> float:
+    """Ctrl-C to `p`; how long it took to end, s (a failure after `seconds`)."""
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    p.wait(timeout=seconds)
+    return time.monotonic() - sent
+
+
+def end(p: subprocess.Popen, *readers: Lines) -> None:
+    """No child and no open pipe left behind, whatever failed."""
+    if p.poll() is None:
+        p.kill()
+        p.wait()
+    for r in readers:
+        r.thread.join(timeout=10)
+    for stream in (p.stdout, p.stderr):
+        if stream is not None:
+            stream.close()
 
 
 @pytest.fixture
@@ -191,12 +234,10 @@ def test_ctrl_c_stops_run_cleanly_with_a_verifiable_recording(scratch, sigint_ra
         # The recording's file appears once the session runs (its Ctrl-C handler is set).
         wait_for(scratch / "rec.mcap", p, 60)
         time.sleep(1.0)
-        sent = time.monotonic()
-        p.send_signal(signal.SIGINT)
+        took = interrupt(p)
         out, err = p.communicate(timeout=10)
-        took = time.monotonic() - sent
     finally:
-        p.kill()
+        end(p)
     assert p.returncode == 130, err
     assert took < 5, f"{took:.1f} s after Ctrl-C"
     m = re.search(
@@ -226,8 +267,9 @@ def test_play_serves_the_built_in_page_and_ctrl_c_ends_it(scratch, sigint_raises
         [str(COMMAND), "play", "--port", "0", "--out", "play.mcap"],
         cwd=scratch, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
+    stdout = Lines(p.stdout)
     try:
-        line = read_line(p.stdout, 60)
+        line = stdout.next(60)
         m = re.fullmatch(r"open (http://127\.0\.0\.1:\d+/) in a browser \(Ctrl-C ends the session\)\n", line)
         assert m, line
         url = m.group(1)
@@ -248,12 +290,10 @@ def test_play_serves_the_built_in_page_and_ctrl_c_ends_it(scratch, sigint_raises
             assert text == (PAGE / name).read_text(encoding="utf-8"), name
             todo |= page_files(text, name) - seen
         assert len(seen) >= 4, seen
-        sent = time.monotonic()
-        p.send_signal(signal.SIGINT)
-        out, err = p.communicate(timeout=10)
-        took = time.monotonic() - sent
+        took = interrupt(p)
+        out, err = stdout.rest(), p.stderr.read()
     finally:
-        p.kill()
+        end(p, stdout)
     assert took < 5, f"{took:.1f} s after Ctrl-C"
     # As the binary: no page pressed Start, so the session ends with this error and no file.
     assert (p.returncode, out, err) == (
@@ -271,15 +311,12 @@ def test_ctrl_c_ends_a_command_without_its_own_handler_at_once(scratch, sigint_r
             [str(COMMAND), "fake-device", f"udp:127.0.0.1:{port}", "--wait-s", "30"],
             cwd=scratch, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         )
+        stderr = Lines(p.stderr)
         try:
-            assert read_line(p.stderr, 60) == f"fake-device: saying hello to 127.0.0.1:{port} ...\n"
-            sent = time.monotonic()
-            p.send_signal(signal.SIGINT)
-            p.wait(timeout=10)
-            took = time.monotonic() - sent
+            assert stderr.next(60) == f"fake-device: saying hello to 127.0.0.1:{port} ...\n"
+            took = interrupt(p)
         finally:
-            p.kill()
-            p.communicate()
+            end(p, stderr)
     # Ended by the signal, as the binary is (a shell reports 130), not after the 30 s wait.
     assert p.returncode == -signal.SIGINT
     assert took < 2, f"{took:.1f} s after Ctrl-C"
