@@ -302,6 +302,41 @@ def test_play_serves_the_built_in_page_and_ctrl_c_ends_it(scratch, sigint_raises
     assert not (scratch / "play.mcap").exists()
 
 
+def test_classroom_serves_the_class_and_ctrl_c_ends_it(scratch, sigint_raises):
+    p = subprocess.Popen(
+        [str(COMMAND), "classroom", "--port", "0", "--out-dir", "class"],
+        cwd=scratch, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    stdout = Lines(p.stdout)
+    try:
+        head = [stdout.next(60) for _ in range(4)]
+        assert head[0] == "classroom: up to 40 students, recordings in class\n", head
+        student = re.fullmatch(
+            r"  students open  (http://127\.0\.0\.1:\d+/)  \(on this computer a name is enough\)\n",
+            head[1],
+        )
+        teacher = re.fullmatch(
+            r"  teacher page   (http://127\.0\.0\.1:\d+/teacher\?code=(\w+))  \(keep its code, "
+            r"(\w+), to yourself\)\n",
+            head[2],
+        )
+        assert student and teacher and teacher.group(2) == teacher.group(3), head
+        assert head[3] == "Ctrl-C ends every session and prints the class's figures.\n"
+        # The join page and the teacher page come from inside the program.
+        for url in (student.group(1), teacher.group(1)):
+            with urllib.request.urlopen(url, timeout=10) as r:
+                assert r.status == 200 and r.headers["Content-Type"].startswith("text/html"), url
+                assert "<html" in r.read().decode("utf-8").lower(), url
+        took = interrupt(p)
+        out, err = stdout.rest(), p.stderr.read()
+    finally:
+        end(p, stdout)
+    assert took < 5, f"{took:.1f} s after Ctrl-C"
+    # As the binary: Ctrl-C ends every session and prints the class's figures (none joined).
+    assert (p.returncode, err) == (0, ""), err
+    assert out.startswith("0 student sessions\nrefused: 0 in all (0 host, 0 origin, "), out
+
+
 def test_ctrl_c_ends_a_command_without_its_own_handler_at_once(scratch, sigint_raises):
     # fake-device waits up to 30 s for a simulator's welcome; this socket never answers.
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as silent:
