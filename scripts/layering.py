@@ -5,8 +5,9 @@ Three rules, each failing with one line per offence (exit status 1):
 
 1. **Crates.** Every crate's `[dependencies]` on workspace crates must be exactly those that
    `ALLOWED` grants it (the arrows of `docs/extending.md` and `../shared/DESIGN.md`: types <-
-   recording, devices <- engine <- lesson, play <- cli; world crates know nothing of devices,
-   logging, sound or Python): a dependency the map does not grant fails, and so does a grant
+   recording, devices <- engine <- lesson, play <- cli <- the wheel (ot-py runs the program as
+   its `nanohaptics` command); world crates know nothing of devices, logging, sound or
+   Python): a dependency the map does not grant fails, and so does a grant
    the crate does not use (the map lists only the edges in use). A crate missing from
    `ALLOWED` fails too: a new crate states its place. A dev-dependency may point anywhere
    (a test may drive a crate from above) except into a cycle: a crate A dev-depending on B
@@ -57,9 +58,12 @@ ALLOWED = {
         "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-lesson",
         "nanohaptics-play", "nanohaptics-recording", "render", "world-form",
     },
+    # The wheel sits on top: besides its bindings it carries the whole program (the
+    # `nanohaptics` command of `pip install nanohaptics`, docs/python.md), so it depends on the
+    # cli crate and nothing depends on it.
     "ot-py": {
-        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording", "nanoworld",
-        "ot-envelope", "ot-physics", "world-form",
+        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-cli",
+        "nanohaptics-recording", "nanoworld", "ot-envelope", "ot-physics", "world-form",
     },
     "nanohaptics-fuzz": {
         "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-play",

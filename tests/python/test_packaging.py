@@ -81,7 +81,7 @@ def test_the_python_sources_are_in_the_sdist_where_pyproject_says(sdist):
     (source,) = re.findall(r'^python-source = "([^"]+)"$', conf, re.M)
     pkg = sdist / source / "nanohaptics"
     src = ROOT / "crates" / "ot-py" / "python" / "nanohaptics"
-    names = ["__init__.py", "bridge.py", "sweeps.py", "closed_loop.py", "py.typed"]
+    names = ["__init__.py", "__main__.py", "bridge.py", "sweeps.py", "closed_loop.py", "py.typed"]
     for name in names:
         assert (pkg / name).read_bytes() == (src / name).read_bytes(), name
     stub = (ROOT / "crates" / "ot-py" / "nanohaptics.pyi").read_bytes()

@@ -1,11 +1,11 @@
 //! `nanohaptics classroom`: one server for a whole class (the `play` crate's
 //! [`play::classroom`]).
 
+use crate::status;
 use haptic_devices::source::DeviceSource;
 use haptic_loop::session::SceneSource;
 use std::net::{IpAddr, UdpSocket};
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 /// Arguments of `nanohaptics classroom`.
 #[derive(clap::Args, Debug)]
@@ -53,7 +53,7 @@ fn lan_address() -> Option<IpAddr> {
 
 /// Runs `nanohaptics classroom`: prints the students' and the teacher's addresses, serves the
 /// class until Ctrl-C, then ends every session and prints each student's figures.
-pub fn cmd(a: &ClassroomArgs) -> Result<ExitCode, String> {
+pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
     let scene = SceneSource::resolve(&a.scene).map_err(|e| e.to_string())?;
     let mut c = play::classroom::ClassConfig::new(scene, a.out_dir.clone());
     c.port = a.port;
@@ -137,5 +137,5 @@ pub fn cmd(a: &ClassroomArgs) -> Result<ExitCode, String> {
         r.rate,
         r.head
     );
-    Ok(ExitCode::SUCCESS)
+    Ok(status::SUCCESS)
 }

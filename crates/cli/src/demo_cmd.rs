@@ -3,13 +3,13 @@
 
 use crate::render_cmd;
 use crate::run_cmd::{print_summary, progress_bar, summary_json};
+use crate::status;
 use haptic_loop::replay::verify;
 use haptic_loop::session::{SceneSource, SessionError, SessionOptions, run_session};
 use recording::read_recording_file;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
-pub(crate) fn scenes(action: Option<&str>, dir: Option<&Path>) -> Result<ExitCode, String> {
+pub(crate) fn scenes(action: Option<&str>, dir: Option<&Path>) -> Result<u8, String> {
     match (action, dir) {
         (None, _) => {
             for b in haptic_loop::builtin::SCENES {
@@ -18,14 +18,14 @@ pub(crate) fn scenes(action: Option<&str>, dir: Option<&Path>) -> Result<ExitCod
                     .unwrap_or_default();
                 println!("{:<18} {name} (script: {})", b.name, b.script_file);
             }
-            Ok(ExitCode::SUCCESS)
+            Ok(status::SUCCESS)
         }
         (Some("export"), Some(d)) => {
             let files = haptic_loop::builtin::export(d)?;
             for f in &files {
                 println!("{}", f.display());
             }
-            Ok(ExitCode::SUCCESS)
+            Ok(status::SUCCESS)
         }
         (Some("export"), None) => {
             Err("scenes export: give the folder, e.g. `nanohaptics scenes export my-scenes`".into())
@@ -34,7 +34,7 @@ pub(crate) fn scenes(action: Option<&str>, dir: Option<&Path>) -> Result<ExitCod
     }
 }
 
-pub(crate) fn demo(scenes: Option<&Path>, out: &Path, json: bool) -> Result<ExitCode, String> {
+pub(crate) fn demo(scenes: Option<&Path>, out: &Path, json: bool) -> Result<u8, String> {
     // Scene files on disk (`--scenes`, or `./scenes` when it exists: files on disk override),
     // or else the built-in scenes.
     let local = Path::new("scenes");
@@ -126,8 +126,8 @@ pub(crate) fn demo(scenes: Option<&Path>, out: &Path, json: bool) -> Result<Exit
         );
     }
     Ok(if all_ok {
-        ExitCode::SUCCESS
+        status::SUCCESS
     } else {
-        ExitCode::from(2)
+        status::DIVERGED
     })
 }

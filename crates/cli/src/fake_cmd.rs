@@ -2,6 +2,7 @@
 //! script through a simulated hand or a modelled device, with loss, jitter and outages.
 
 use crate::run_cmd::parse_operator;
+use crate::status;
 use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
 use haptic_devices::local::Protocol;
 use haptic_devices::source::DeviceSource;
@@ -10,7 +11,6 @@ use haptic_loop::session::OperatorChoice;
 use haptic_types::DeviceModel;
 use haptic_types::value::{ValueError, out_of_range};
 use std::path::PathBuf;
-use std::process::ExitCode;
 use world_form::fmt_num;
 
 #[derive(clap::Args)]
@@ -70,7 +70,7 @@ pub(crate) struct FakeArgs {
 /// The default script of `fake-device`: press the wall scene's surface, as its own script does.
 const FAKE_SCRIPT: &str = include_str!("../../../scenes/wall.script.toml");
 
-pub(crate) fn cmd(a: FakeArgs) -> Result<ExitCode, String> {
+pub(crate) fn cmd(a: FakeArgs) -> Result<u8, String> {
     let (cfg, physical) = config(&a)?;
     if !a.json {
         eprintln!("fake-device: saying hello to {} ...", cfg.target);
@@ -81,7 +81,7 @@ pub(crate) fn cmd(a: FakeArgs) -> Result<ExitCode, String> {
     } else {
         print_report(&r, physical, a.ideal);
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(status::SUCCESS)
 }
 
 /// A flag's value checked against its range `lo`–`hi` in `unit` (empty for a plain number).

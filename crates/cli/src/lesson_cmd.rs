@@ -1,10 +1,10 @@
 //! `nanohaptics lesson`: the macro-vs-nano lesson report (see `lesson`).
 
+use crate::status;
 use haptic_types::value::ValueError;
 use indicatif::{ProgressBar, ProgressStyle};
 use lesson::{LessonOptions, report::si, run_lesson};
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 /// Arguments of `nanohaptics lesson`.
 #[derive(clap::Args)]
@@ -24,7 +24,7 @@ pub struct LessonArgs {
 }
 
 /// Runs the lesson and prints where the report is.
-pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
+pub fn cmd(args: &LessonArgs) -> Result<u8, String> {
     if !(200..=4000).contains(&args.width) {
         return Err(
             ValueError::out_of_range("--width", f64::from(args.width), "200–4000 px").to_string(),
@@ -65,7 +65,7 @@ pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
     }
     if args.json {
         println!("{}", serde_json::to_string(&s).map_err(|e| e.to_string())?);
-        return Ok(ExitCode::SUCCESS);
+        return Ok(status::SUCCESS);
     }
     println!(
         "bricks: {} of 4 slots, score {:.1}; atoms: {} of 7 slots, score {:.1}",
@@ -94,5 +94,5 @@ pub fn cmd(args: &LessonArgs) -> Result<ExitCode, String> {
         args.out.join("lesson.md").display(),
         s.files.len()
     );
-    Ok(ExitCode::SUCCESS)
+    Ok(status::SUCCESS)
 }

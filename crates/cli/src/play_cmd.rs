@@ -1,9 +1,9 @@
 //! `nanohaptics play`: the teaching game in a browser (the `play` crate serves the page).
 
+use crate::status;
 use haptic_devices::source::DeviceSource;
 use haptic_loop::session::SceneSource;
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 /// Arguments of `nanohaptics play`.
 #[derive(clap::Args, Debug)]
@@ -29,7 +29,7 @@ pub struct PlayArgs {
 
 /// Runs `nanohaptics play`: prints the page's address, runs the session, prints its figures.
 /// After the session the end screen and the download stay up until Ctrl-C.
-pub fn cmd(a: &PlayArgs) -> Result<ExitCode, String> {
+pub fn cmd(a: &PlayArgs) -> Result<u8, String> {
     let scene = SceneSource::resolve(&a.scene).map_err(|e| e.to_string())?;
     let mut c = play::PlayConfig::new(scene, a.out.clone());
     c.port = a.port;
@@ -52,5 +52,5 @@ pub fn cmd(a: &PlayArgs) -> Result<ExitCode, String> {
     })
     .map_err(|e| e.to_string())?;
     println!("{}", s.line());
-    Ok(ExitCode::SUCCESS)
+    Ok(status::SUCCESS)
 }

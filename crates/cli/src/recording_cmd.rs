@@ -1,20 +1,15 @@
 //! `nanohaptics replay` and `info`: a recording re-simulated and compared bit for bit, and
 //! what a recording holds.
 
+use crate::status;
 use haptic_loop::replay::verify;
 use haptic_loop::session::SessionArrays;
 use recording::channels::messages::Channel;
 use recording::read_recording_file;
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::ExitCode;
 
-pub(crate) fn replay(
-    rec: &Path,
-    strict: bool,
-    salvage: bool,
-    json: bool,
-) -> Result<ExitCode, String> {
+pub(crate) fn replay(rec: &Path, strict: bool, salvage: bool, json: bool) -> Result<u8, String> {
     let r = read_recording_file(rec, salvage).map_err(|e| format!("{}: {e}", rec.display()))?;
     let report = verify(&r).map_err(|e| format!("{}: replay failed: {e}", rec.display()))?;
     if json {
@@ -66,13 +61,13 @@ pub(crate) fn replay(
         }
     }
     Ok(if report.ok() || !strict {
-        ExitCode::SUCCESS
+        status::SUCCESS
     } else {
-        ExitCode::from(2)
+        status::DIVERGED
     })
 }
 
-pub(crate) fn info(rec: &Path, salvage: bool, json: bool) -> Result<ExitCode, String> {
+pub(crate) fn info(rec: &Path, salvage: bool, json: bool) -> Result<u8, String> {
     let r = read_recording_file(rec, salvage).map_err(|e| format!("{}: {e}", rec.display()))?;
     let mut counts: BTreeMap<&str, u64> = BTreeMap::new();
     for m in &r.messages {
@@ -105,7 +100,7 @@ pub(crate) fn info(rec: &Path, salvage: bool, json: bool) -> Result<ExitCode, St
                 "channels": channels, "tick_compute": pct, "session_metadata": session,
             })
         );
-        return Ok(ExitCode::SUCCESS);
+        return Ok(status::SUCCESS);
     }
     println!("{} ({} bytes)", rec.display(), r.bytes);
     println!(
@@ -143,5 +138,5 @@ pub(crate) fn info(rec: &Path, salvage: bool, json: bool) -> Result<ExitCode, St
             c["messages"]
         );
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(status::SUCCESS)
 }

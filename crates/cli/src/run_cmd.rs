@@ -1,6 +1,7 @@
 //! `nanohaptics run`: a scene with a script or a device, batch or real time, recorded and
 //! served live, with its summary.
 
+use crate::status;
 use haptic_devices::source::DeviceSource;
 use haptic_loop::live::LiveConfig;
 use haptic_loop::session::{
@@ -11,7 +12,6 @@ use haptic_types::value::ValueError;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
@@ -187,7 +187,7 @@ pub(crate) fn progress_bar(len: u64, label: &str) -> ProgressBar {
     pb
 }
 
-pub(crate) fn cmd(args: RunArgs) -> Result<ExitCode, String> {
+pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
     let RunArgs {
         scene,
         script,
@@ -276,9 +276,9 @@ pub(crate) fn cmd(args: RunArgs) -> Result<ExitCode, String> {
                 None => String::new(),
             }
         );
-        return Ok(ExitCode::from(130));
+        return Ok(status::INTERRUPTED);
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(status::SUCCESS)
 }
 
 /// A flag raised by the first Ctrl-C (SIGINT) or SIGTERM: the session stops cleanly after
@@ -287,9 +287,13 @@ pub(crate) fn interrupt_flag() -> Result<Arc<AtomicBool>, String> {
     use signal_hook::consts::{SIGINT, SIGTERM};
     let stop = Arc::new(AtomicBool::new(false));
     for sig in [SIGINT, SIGTERM] {
-        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&stop))
-            .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&stop)))
-            .map_err(|e| format!("cannot watch for Ctrl-C: {e}"))?;
+        signal_hook::flag::register_conditional_shutdown(
+            sig,
+            i32::from(status::INTERRUPTED),
+            Arc::clone(&stop),
+        )
+        .and_then(|_| signal_hook::flag::register(sig, Arc::clone(&stop)))
+        .map_err(|e| format!("cannot watch for Ctrl-C: {e}"))?;
     }
     Ok(stop)
 }

@@ -23,8 +23,13 @@
 //! `crates/ot-py/python/nanohaptics/` (`pyproject.toml`'s `python-source`), whose
 //! `__init__.py` re-exports the extension's names and adds the Python modules
 //! `bridge`, `sweeps` and `closed_loop`.
+//!
+//! The wheel also carries the whole `nanohaptics` program ([`cli`]): its console script
+//! `nanohaptics` and `python -m nanohaptics` call `nanohaptics.nanohaptics._cli`, which runs
+//! the `nanohaptics-cli` crate's `main_with_args` in the Python process.
 
 pub mod brick;
+pub mod cli;
 mod convert;
 pub mod device_model;
 pub mod envelope;
@@ -65,6 +70,9 @@ fn nanohaptics(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<live::Session>()?;
     m.add_class::<device_model::DeviceModel>()?;
     m.add_function(wrap_pyfunction!(device_model::check_closed_loop, m)?)?;
+    // The program behind the `nanohaptics` command: a private name, set without `add_function`
+    // so it stays out of `__all__` (and so out of `from nanohaptics import *` and the stub).
+    m.setattr("_cli", wrap_pyfunction!(cli::run_cli, m)?)?;
     m.add("DEFAULT_RTOL", ot_physics::DEFAULT_RTOL)?;
     m.add("PAPER_DT", ot_physics::paper::DT)?;
     let [vx, vy] = ot_physics::paper::V0_MOVING;

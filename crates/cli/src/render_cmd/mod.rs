@@ -346,7 +346,7 @@ fn final_picture_view(
 }
 
 /// `nanohaptics render` as the program runs it: prints what was written.
-pub fn cmd(args: &RenderArgs) -> Result<std::process::ExitCode, String> {
+pub fn cmd(args: &RenderArgs) -> Result<u8, String> {
     let s = run(args).map_err(|e| e.to_string())?;
     if s.ticks > 0 {
         println!(
@@ -363,7 +363,7 @@ pub fn cmd(args: &RenderArgs) -> Result<std::process::ExitCode, String> {
     for w in &s.written {
         println!("wrote {w}");
     }
-    Ok(std::process::ExitCode::SUCCESS)
+    Ok(crate::status::SUCCESS)
 }
 
 #[cfg(test)]
