@@ -43,15 +43,7 @@ pub(crate) fn run_device_student(
         token: super::random_code(24, b"0123456789abcdefghijklmnopqrstuvwxyz"),
         out: out.clone(),
         shared: shared.clone(),
-        status: Mutex::new(Status {
-            phase: Phase::Waiting,
-            ticks: 0,
-            time_s: 0.0,
-            missed: 0,
-            force_n: 0.0,
-            state: Vec::new(),
-            switches: Vec::new(),
-        }),
+        status: Mutex::new(Status::waiting()),
     });
     if let Ok(mut s) = class.students.lock() {
         s.push(student.clone());
@@ -141,7 +133,7 @@ fn session(
         }
         apply_page_switches(&shared, &tx, tick, lp);
         if tick % super::STATUS_EVERY_TICKS == 0 {
-            report(&st, tick + 1, lp);
+            st.report(tick + 1, 0, lp);
         }
     };
     let result = {
@@ -166,10 +158,7 @@ fn session(
     let published = publisher.join().unwrap_or_default();
     let (stats, end) = result.map_err(|e| SessionError::from(e).to_string())?;
     closed.map_err(|e| e.to_string())?;
-    report(student, stats.ticks, &lp);
-    if let Ok(mut s) = student.status.lock() {
-        s.missed = stats.missed;
-    }
+    student.report(stats.ticks, stats.missed, &lp);
     let written = sinks.written();
     let input_latency_ms = LatencyMs::of(&latencies);
     let url = format!("/recording.mcap?s={}", student.token);
@@ -195,24 +184,4 @@ fn session(
         published,
         error: None,
     })
-}
-
-/// Updates what the teacher sees of the device's student.
-fn report(student: &Student, ticks: u64, lp: &HapticLoop) {
-    let mut state = Vec::new();
-    lp.scene().state(&mut state);
-    let f = lp.last_result().device_force_n;
-    let scene = lp.scene();
-    let switches = scene
-        .switches()
-        .iter()
-        .filter_map(|s| Some((s.name.to_string(), scene.switch_value(s.name)?)))
-        .collect();
-    if let Ok(mut st) = student.status.lock() {
-        st.ticks = ticks;
-        st.time_s = ticks as f64 / f64::from(lp.config().rate_hz);
-        st.force_n = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-        st.state = scene.state_fields().into_iter().zip(state).collect();
-        st.switches = switches;
-    }
 }

@@ -49,7 +49,6 @@ pub struct Live {
     publisher: Option<JoinHandle<PublishSummary>>,
     prox: Option<f64>,
     fields: Vec<String>,
-    state: Vec<f64>,
     error: Option<String>,
 }
 
@@ -85,7 +84,6 @@ impl Live {
             publisher: None,
             prox,
             fields,
-            state: Vec::new(),
             error: None,
         }
     }
@@ -198,35 +196,7 @@ impl Live {
             return;
         }
         if n % super::STATUS_EVERY_TICKS == 0 {
-            self.report(n + 1);
-        }
-    }
-
-    /// Updates what the teacher page shows of this student.
-    fn report(&mut self, ticks: u64) {
-        self.state.clear();
-        self.lp.scene().state(&mut self.state);
-        let r = self.lp.last_result();
-        let f = r.device_force_n;
-        let scene = self.lp.scene();
-        let switches = scene
-            .switches()
-            .iter()
-            .filter_map(|s| Some((s.name.to_string(), scene.switch_value(s.name)?)))
-            .collect();
-        let rate = f64::from(self.lp.config().rate_hz);
-        if let Ok(mut st) = self.student.status.lock() {
-            st.ticks = ticks;
-            st.time_s = ticks as f64 / rate;
-            st.missed = self.engine.missed();
-            st.force_n = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-            st.state = self
-                .fields
-                .iter()
-                .cloned()
-                .zip(self.state.iter().copied())
-                .collect();
-            st.switches = switches;
+            self.student.report(n + 1, self.engine.missed(), &self.lp);
         }
     }
 
@@ -234,7 +204,7 @@ impl Live {
     /// publisher's last frame, and the end screen with the recording's download for its pages.
     pub fn finish(mut self: Box<Self>) -> super::StudentSummary {
         let ticks = self.engine.ticks();
-        self.report(ticks);
+        self.student.report(ticks, self.engine.missed(), &self.lp);
         let link = self.device.link_counters();
         let mut list = self.sinks.list();
         list.push(&mut self.play_sink);

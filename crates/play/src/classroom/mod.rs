@@ -151,7 +151,44 @@ pub struct Student {
     pub status: Mutex<Status>,
 }
 
+impl Status {
+    /// A student who joined and has not started.
+    fn waiting() -> Self {
+        Status {
+            phase: Phase::Waiting,
+            ticks: 0,
+            time_s: 0.0,
+            missed: 0,
+            force_n: 0.0,
+            state: Vec::new(),
+            switches: Vec::new(),
+        }
+    }
+}
+
 impl Student {
+    /// Updates what the teacher sees: `ticks` run (`missed` of them late) of `lp`, and its
+    /// state, force and switches after the last.
+    fn report(&self, ticks: u64, missed: u64, lp: &haptic_loop::HapticLoop) {
+        let mut state = Vec::new();
+        lp.scene().state(&mut state);
+        let f = lp.last_result().device_force_n;
+        let scene = lp.scene();
+        let switches = scene
+            .switches()
+            .iter()
+            .filter_map(|s| Some((s.name.to_string(), scene.switch_value(s.name)?)))
+            .collect();
+        if let Ok(mut st) = self.status.lock() {
+            st.ticks = ticks;
+            st.time_s = ticks as f64 / f64::from(lp.config().rate_hz);
+            st.missed = missed;
+            st.force_n = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+            st.state = scene.state_fields().into_iter().zip(state).collect();
+            st.switches = switches;
+        }
+    }
+
     fn set_phase(&self, p: Phase) {
         if let Ok(mut s) = self.status.lock() {
             s.phase = p;
@@ -355,15 +392,7 @@ impl Class {
             token: random_code(24, b"0123456789abcdefghijklmnopqrstuvwxyz"),
             out,
             shared: shared.clone(),
-            status: Mutex::new(Status {
-                phase: Phase::Waiting,
-                ticks: 0,
-                time_s: 0.0,
-                missed: 0,
-                force_n: 0.0,
-                state: Vec::new(),
-                switches: Vec::new(),
-            }),
+            status: Mutex::new(Status::waiting()),
         });
         let device = PageDevice::new(specs, shared.input.clone());
         let live = Box::new(Live::new(
