@@ -20,16 +20,25 @@ pub struct Limits {
     pub max_message_bytes: usize,
     /// Messages a page may send per second (sustained; a burst of as many is allowed).
     pub messages_per_s: u32,
+    /// Bytes written to a page but not yet taken by its socket, kept at most: beyond, the
+    /// messages for that page are dropped (counted) until it reads again.
+    pub max_write_buffer_bytes: usize,
+    /// The kernel's send buffer of each connection, bytes (`None`: the system's own, which
+    /// grows to a few MiB).
+    pub send_buffer_bytes: Option<usize>,
 }
 
 impl Default for Limits {
-    /// One player: 64 connections, 16 per address, 4 KiB messages, 500 messages/s.
+    /// One player: 64 connections, 16 per address, 4 KiB messages, 500 messages/s, 256 KiB
+    /// waiting to be written per page, the system's send buffers.
     fn default() -> Self {
         Limits {
             max_connections: 64,
             max_per_address: 16,
             max_message_bytes: 4096,
             messages_per_s: 500,
+            max_write_buffer_bytes: 256 * 1024,
+            send_buffer_bytes: None,
         }
     }
 }
@@ -199,6 +208,26 @@ impl Gate {
             gate: self.clone(),
             peer,
         })
+    }
+}
+
+/// Sets the kernel's send buffer of `stream` to `bytes` (best effort).
+#[allow(unsafe_code)] // one setsockopt on a socket this server owns
+pub fn set_send_buffer(stream: &std::net::TcpStream, bytes: usize) {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsRawFd;
+        let v = libc::c_int::try_from(bytes).unwrap_or(libc::c_int::MAX);
+        // SAFETY: a valid socket descriptor and a c_int option value of the right size.
+        unsafe {
+            let _ = libc::setsockopt(
+                stream.as_raw_fd(),
+                libc::SOL_SOCKET,
+                libc::SO_SNDBUF,
+                (&v as *const libc::c_int).cast(),
+                std::mem::size_of::<libc::c_int>() as libc::socklen_t,
+            );
+        }
     }
 }
 

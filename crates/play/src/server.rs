@@ -280,6 +280,9 @@ fn accept_loop(
             Ok((mut stream, peer)) => {
                 let _ = stream.set_nonblocking(false);
                 let _ = stream.set_write_timeout(Some(Duration::from_secs(WRITE_TIMEOUT_S)));
+                if let Some(b) = gate.limits.send_buffer_bytes {
+                    crate::gate::set_send_buffer(&stream, b);
+                }
                 let ticket = match gate.admit(peer.ip()) {
                     Ok(t) => t,
                     Err(message) => {
@@ -558,9 +561,12 @@ pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
     }
     let _ = stream.set_read_timeout(Some(Duration::from_millis(2)));
     let max = gate.limits.max_message_bytes;
+    let wmax = gate.limits.max_write_buffer_bytes.max(2 * max);
     let config = WebSocketConfig::default()
         .max_message_size(Some(max))
-        .max_frame_size(Some(max));
+        .max_frame_size(Some(max))
+        .write_buffer_size((wmax / 2).min(128 * 1024))
+        .max_write_buffer_size(wmax);
     let mut ws = WebSocket::from_raw_socket(stream, WsRole::Server, Some(config));
     let mut rate = RateLimit::new(gate.limits.messages_per_s);
     let mut told_rate: Option<Instant> = None;
@@ -602,6 +608,13 @@ pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
                 Ok(()) => wrote = true,
                 Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {
                     wrote = true;
+                }
+                // The page has not taken what was written (Limits::max_write_buffer_bytes):
+                // this message is dropped, counted, and the rest wait in the bounded queue.
+                Err(tungstenite::Error::WriteBufferFull(_)) => {
+                    shared.dropped.fetch_add(1, Ordering::Relaxed);
+                    wrote = true;
+                    break;
                 }
                 Err(_) => break 'link,
             }

@@ -35,11 +35,26 @@ fn start(
     JoinHandle<Result<PlaySummary, PlayError>>,
     PathBuf,
 ) {
+    start_with(scene, name, device, play::gate::Limits::default())
+}
+
+fn start_with(
+    scene: &str,
+    name: &str,
+    device: Option<BridgeConfig>,
+    limits: play::gate::Limits,
+) -> (
+    String,
+    Arc<AtomicBool>,
+    JoinHandle<Result<PlaySummary, PlayError>>,
+    PathBuf,
+) {
     let out = std::env::temp_dir().join(format!("nh-play-srv-{}-{name}.mcap", std::process::id()));
     let mut c = PlayConfig::new(SceneSource::resolve(scene.as_ref()).unwrap(), out.clone());
     c.port = 0;
     c.device = device;
     c.keep_serving_s = Some(0.0);
+    c.limits = limits;
     let stop = Arc::new(AtomicBool::new(false));
     let s2 = stop.clone();
     let (tx, rx) = std::sync::mpsc::channel();
@@ -423,4 +438,62 @@ fn forged_origin_and_host_are_refused_counted_and_change_nothing() {
     assert!(s.refused.rate >= 400, "{:?}", s.refused);
     // Only the real page and the two good upgrades connected (and the flooder, the big one).
     assert_eq!(s.pages_served, 5);
+}
+
+#[test]
+#[allow(unsafe_code)] // one setsockopt on a socket this test owns
+fn a_page_that_stops_reading_loses_frames_never_the_loop() {
+    use std::os::fd::AsRawFd;
+    // Small buffers (8 KiB in the kernel, 32 KiB in the link) so a stalled page fills them in
+    // a second instead of the system's few MiB.
+    let limits = play::gate::Limits {
+        send_buffer_bytes: Some(8192),
+        max_write_buffer_bytes: 32 * 1024,
+        ..play::gate::Limits::default()
+    };
+    let (url, stop, h, _) = start_with("brickworld", "stalled", None, limits);
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    // The player's page.
+    let mut p = page(&url);
+    send(&mut p, serde_json::json!({"type": "start"}));
+    // A page that opens its link and then never reads, with a small receive buffer so its
+    // socket fills within a second.
+    let raw = TcpStream::connect(addr).unwrap();
+    let small: libc::c_int = 4096;
+    // SAFETY: a valid socket and a c_int option value of the right size.
+    unsafe {
+        libc::setsockopt(
+            raw.as_raw_fd(),
+            libc::SOL_SOCKET,
+            libc::SO_RCVBUF,
+            (&small as *const libc::c_int).cast(),
+            std::mem::size_of::<libc::c_int>() as libc::socklen_t,
+        );
+    }
+    let (_stalled, _) = tungstenite::client(format!("ws://{addr}/ws").as_str(), raw).unwrap();
+    // The player keeps playing for 4 s; it keeps getting frames all along.
+    let mut frames_late = 0;
+    let t0 = Instant::now();
+    let mut k = 0u64;
+    while t0.elapsed() < Duration::from_secs(4) {
+        k += 1;
+        send(
+            &mut p,
+            serde_json::json!({"type": "input", "seq": k, "pos": [0, 0, 0], "buttons": 0, "t_ms": k as f64}),
+        );
+        let got = read_for(&mut p, 0.05);
+        if t0.elapsed() > Duration::from_secs(3) {
+            frames_late += got.iter().filter(|m| m["type"] == "frame").count();
+        }
+    }
+    send(&mut p, serde_json::json!({"type": "end"}));
+    let _ = read_for(&mut p, 0.3);
+    stop.store(true, Ordering::Relaxed);
+    let s = h.join().unwrap().unwrap();
+    // The stalled page's queue overflowed: its frames were dropped, counted…
+    assert!(s.messages_dropped > 0, "{s:?}");
+    // …while the player's page kept receiving them in the last second,
+    assert!(frames_late > 10, "{frames_late} frames in the last second");
+    // and the loop ran every tick of the session (none waited for the stalled page).
+    assert!(s.stats.ticks > 3000, "{}", s.line());
 }
