@@ -95,8 +95,9 @@ RANKS = {
         "edit",
     ],
     "haptic-devices": [
+        "realtime",
         "mechanics grip plant pacing link local",
-        "script",
+        "script wakeup",
         "operator modelled linked",
         "bridge",
         "source",

@@ -38,6 +38,8 @@ pub struct ClassroomArgs {
     /// The name the bridged device plays under.
     #[arg(long, default_value = "device")]
     pub device_name: String,
+    #[command(flatten)]
+    pub(crate) rt: crate::rt_args::RtArgs,
 }
 
 /// This computer's address on its default route (no packet is sent: a UDP socket is only
@@ -61,6 +63,7 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
     c.max_students = a.max_students;
     c.seconds = a.seconds;
     c.device_name = a.device_name.clone();
+    c.rt = a.rt.request()?;
     c.device = match a.device.as_deref().map(DeviceSource::parse).transpose() {
         Ok(None) => None,
         Ok(Some(DeviceSource::Udp(b))) => Some(b),
@@ -120,7 +123,12 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
         println!("Ctrl-C ends every session and prints the class's figures.");
     })
     .map_err(|e| e.to_string())?;
-    println!("{} student sessions", s.students.len());
+    println!(
+        "{} student sessions on {} tick workers; real time: {}",
+        s.students.len(),
+        s.workers,
+        s.realtime.describe()
+    );
     for st in &s.students {
         println!("  {}", st.line());
     }

@@ -6,10 +6,13 @@
 //! nanohaptics run SCENE [--script S] [--operator rigid|hand|hand:key=value,...]
 //!                 [--device falcon|touch|udp:HOST:PORT|udp:PORT] [--wait-s S] [--seconds T]
 //!                 [--out REC.mcap] [--realtime] [--live ws:HOST:PORT] [--live-hz N] [--json]
+//!                 [--no-rt] [--rt-priority N]
 //! nanohaptics play [SCENE] [--port P] [--device udp:HOST:PORT|udp:PORT] [--out REC.mcap]
-//!                 [--seconds T]
+//!                 [--seconds T] [--no-rt] [--rt-priority N]
 //! nanohaptics classroom [SCENE] [--port P] [--listen ADDR] [--max-students N] [--out-dir DIR]
 //!                 [--seconds T] [--device udp:HOST:PORT|udp:PORT] [--device-name NAME]
+//!                 [--no-rt] [--rt-priority N]
+//! nanohaptics doctor [--seconds T] [--interval-us N] [--rt-priority N] [--json]
 //! nanohaptics lesson [--out DIR] [--width W] [--sample-rate HZ] [--json]
 //! nanohaptics fake-device udp:HOST:PORT|udp:PORT [--script S] [--operator rigid|hand|hand:k=v,...]
 //!                 [--model falcon|touch|delta3|inverse3] [--grip loose|firm|k=...,b=...[,m=...]]
@@ -35,11 +38,13 @@
 
 mod classroom_cmd;
 mod demo_cmd;
+mod doctor_cmd;
 mod fake_cmd;
 mod lesson_cmd;
 mod play_cmd;
 mod recording_cmd;
 mod render_cmd;
+mod rt_args;
 mod run_cmd;
 
 use clap::{Parser, Subcommand};
@@ -125,6 +130,9 @@ enum Cmd {
     /// One server for a whole class: each student joins by name and plays their own world
     /// with their own recording; a teacher page watches, switches, ends and collects.
     Classroom(classroom_cmd::ClassroomArgs),
+    /// What this machine allows a tick thread: real-time permissions, wake-up latency with
+    /// and without real-time priority, the tick rates it can hold, and what to change.
+    Doctor(doctor_cmd::DoctorArgs),
     /// Run every scene with its default script, record, verify, and summarise.
     Demo {
         /// Folder of scene files (default: `./scenes` if it exists, else the built-in scenes,
@@ -198,6 +206,7 @@ where
         Cmd::Info { rec, salvage, json } => recording_cmd::info(&rec, salvage, json),
         Cmd::Lesson(a) => lesson_cmd::cmd(&a),
         Cmd::Play(a) => play_cmd::cmd(&a),
+        Cmd::Doctor(a) => doctor_cmd::cmd(&a),
         Cmd::Classroom(a) => classroom_cmd::cmd(&a),
         Cmd::Demo { scenes, out, json } => demo_cmd::demo(scenes.as_deref(), &out, json),
         Cmd::Scenes { action, dir } => demo_cmd::scenes(action.as_deref(), dir.as_deref()),

@@ -25,6 +25,8 @@ pub struct PlayArgs {
     /// on the page or presses Ctrl-C.
     #[arg(long)]
     pub seconds: Option<f64>,
+    #[command(flatten)]
+    pub(crate) rt: crate::rt_args::RtArgs,
 }
 
 /// Runs `nanohaptics play`: prints the page's address, runs the session, prints its figures.
@@ -34,6 +36,7 @@ pub fn cmd(a: &PlayArgs) -> Result<u8, String> {
     let mut c = play::PlayConfig::new(scene, a.out.clone());
     c.port = a.port;
     c.seconds = a.seconds;
+    c.rt = a.rt.request()?;
     c.device = match a.device.as_deref().map(DeviceSource::parse).transpose() {
         Ok(None) => None,
         Ok(Some(DeviceSource::Udp(b))) => Some(b),

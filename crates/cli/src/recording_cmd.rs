@@ -128,6 +128,28 @@ pub(crate) fn info(rec: &Path, salvage: bool, json: bool) -> Result<u8, String> 
     ) {
         println!("  jitter p99 {j} ns, missed deadlines {m}");
     }
+    // Recordings since issue 33 say what scheduling the tick thread had and how late it woke.
+    if let Some(policy) = session.get("rt_policy") {
+        let get = |k: &str| session.get(k).map_or("?", String::as_str);
+        let ns = |k: &str| {
+            session
+                .get(k)
+                .and_then(|v| v.parse::<f64>().ok())
+                .map_or("?".to_string(), |v| format!("{:.1}", v / 1e3))
+        };
+        println!(
+            "  real time: {policy} (priority {}, memory locked {}, CPU {}, refused: {}); wake-up \
+             p50 {} µs, p99 {} µs, p99.9 {} µs, max {} µs",
+            get("rt_priority"),
+            get("rt_memory_locked"),
+            get("rt_cpu"),
+            get("rt_refused"),
+            ns("wakeup_p50_ns"),
+            ns("wakeup_p99_ns"),
+            ns("wakeup_p999_ns"),
+            ns("wakeup_max_ns")
+        );
+    }
     println!("  channels:");
     for c in &channels {
         println!(

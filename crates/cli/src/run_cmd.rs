@@ -50,6 +50,8 @@ pub(crate) struct RunArgs {
     /// Pace ticks against the wall clock (zero force on a missed deadline).
     #[arg(long)]
     realtime: bool,
+    #[command(flatten)]
+    rt: crate::rt_args::RtArgs,
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
@@ -133,6 +135,16 @@ pub(crate) fn print_summary(r: &SessionReport) {
         s.jitter.p99_ns as f64 / 1e3,
         s.missed
     );
+    if r.header.mode == "realtime" {
+        println!(
+            "  real time: {}; wake-up p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs",
+            s.realtime.describe(),
+            s.wakeup.p50_ns as f64 / 1e3,
+            s.wakeup.p99_ns as f64 / 1e3,
+            s.wakeup.p999_ns as f64 / 1e3,
+            s.wakeup.max_ns as f64 / 1e3
+        );
+    }
     let h = &j["house_score"];
     if let Some(score) = h["score"].as_f64() {
         let complete = h["complete_s"].as_f64().unwrap_or(-1.0);
@@ -199,6 +211,7 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
         seconds,
         out,
         realtime,
+        rt,
         json,
     } = args;
     let mut opts = SessionOptions::new(SceneSource::resolve(&scene).map_err(|e| e.to_string())?);
@@ -242,6 +255,7 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
     }
     opts.seconds = seconds;
     opts.realtime = realtime;
+    opts.rt = rt.request()?;
     opts.out = out;
     // The summary comes from the running totals: no per-tick arrays, so memory stays flat
     // however long the session runs.

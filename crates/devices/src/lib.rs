@@ -28,8 +28,12 @@
 //!   line, the Python adapters;
 //! - [`link`]: a network link as a deterministic model (latency, jitter, loss), and
 //!   [`linked`], a modelled device held by a hand at its far end;
-//! - [`pacing`]: real-time pacing of ticks and the tick-time statistics (constant-memory
-//!   histograms, percentiles).
+//! - [`pacing`]: real-time pacing of ticks (sleeps to absolute deadlines, spins the last
+//!   stretch, measures its own wake-up latency) and the tick-time statistics (constant-memory
+//!   histograms, percentiles);
+//! - [`realtime`]: the tick thread's real-time set-up (`SCHED_FIFO`, locked memory, a core of
+//!   its own), what the system granted and how to allow what it refused; [`wakeup`], this
+//!   machine's wake-up latency and the tick rates it allows (`nanohaptics doctor`).
 //!
 //! What it is not: no haptic loop, no worlds, no recording. The device interface itself (the
 //! trait, samples, force commands, specifications) is `haptic-types`'; the engine
@@ -61,8 +65,10 @@ pub mod modelled;
 pub mod operator;
 pub mod pacing;
 mod plant;
+pub mod realtime;
 pub mod script;
 pub mod source;
+pub mod wakeup;
 
 pub use grip::{Grip, GripError};
 pub use mechanics::{Mechanics, MechanicsError, PRESETS};

@@ -4,34 +4,57 @@
 use std::time::{Duration, Instant};
 
 /// Paces ticks against the wall clock: tick `n` starts at `start + n · period`.
+///
+/// Each wait sleeps to an absolute time (`clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME)` on
+/// Linux, so a late wake-up never shifts the schedule) a short stretch before the start time,
+/// then spins the rest. How late each sleep woke is the machine's wake-up latency, kept as a
+/// histogram ([`Pacer::wakeups`]), as cyclictest measures it.
 #[derive(Debug)]
 pub struct Pacer {
     start: Instant,
     period_ns: u64,
     spin: Duration,
+    wakeups: DurationHistogram,
 }
 
+/// The spin a normal-priority thread needs: the scheduler's wake-up latency is often tens of
+/// µs, and a 10 kHz tick has 100 µs.
+const SPIN_NORMAL: Duration = Duration::from_micros(100);
+
 impl Pacer {
-    /// A pacer starting now with tick length `period_ns`.
+    /// A pacer starting now with tick length `period_ns`, spinning the last 100 µs before each
+    /// start (the precision a 10 kHz loop needs at normal priority).
     pub fn new(period_ns: u64) -> Self {
-        Pacer {
-            start: Instant::now(),
-            period_ns,
-            // Sleep until this close to the start time, then spin (sleep granularity).
-            spin: Duration::from_micros(100),
-        }
+        Self::with_spin(period_ns, SPIN_NORMAL)
+    }
+
+    /// A pacer for a thread in the scheduling `rt` describes: with `SCHED_FIFO` the wake-up
+    /// comes within tens of µs, so it spins a quarter of the period, at most 50 µs, and leaves the
+    /// core to others for the rest; at normal priority as [`Pacer::new`].
+    pub fn for_thread(period_ns: u64, rt: &crate::realtime::RtStatus) -> Self {
+        let spin = if rt.priority.is_some() {
+            Duration::from_nanos((period_ns / 4).min(50_000))
+        } else {
+            SPIN_NORMAL
+        };
+        Self::with_spin(period_ns, spin)
     }
 
     /// A pacer starting now with tick length `period_ns` that sleeps until `spin` before each
-    /// start time and spins the rest (`Pacer::new` spins 100 µs: the precision a 10 kHz loop
-    /// needs; a scheduler of many sessions at 1 kHz sleeps all the way and leaves the core to
-    /// the others).
+    /// start time and spins the rest (a scheduler of many sessions at 1 kHz spins little and
+    /// leaves the core to the others).
     pub fn with_spin(period_ns: u64, spin: Duration) -> Self {
         Pacer {
             start: Instant::now(),
             period_ns,
             spin,
+            wakeups: DurationHistogram::new(),
         }
+    }
+
+    /// How long it spins before each start time.
+    pub fn spin(&self) -> Duration {
+        self.spin
     }
 
     /// When tick 0 starts.
@@ -45,16 +68,20 @@ impl Pacer {
     }
 
     /// Waits for the start of `tick`; returns how late it actually starts, ns (≥ 0).
-    pub fn wait_for(&self, tick: u64) -> i64 {
+    pub fn wait_for(&mut self, tick: u64) -> i64 {
         self.wait_until(self.scheduled(tick))
     }
 
-    /// Waits until `target` (sleeping, then spinning the last stretch); returns how late it
-    /// woke, ns (≥ 0).
-    pub fn wait_until(&self, target: Instant) -> i64 {
+    /// Waits until `target` (sleeping to `target − spin`, then spinning); returns how late it
+    /// started, ns (≥ 0). The sleep's own lateness goes to [`Pacer::wakeups`].
+    pub fn wait_until(&mut self, target: Instant) -> i64 {
         let now = Instant::now();
         if target > now + self.spin {
-            std::thread::sleep(target - now - self.spin);
+            let wake_at = target - self.spin;
+            sleep_until(wake_at);
+            let woke = Instant::now();
+            self.wakeups
+                .record(woke.saturating_duration_since(wake_at).as_nanos() as u64);
         }
         while Instant::now() < target {
             std::hint::spin_loop();
@@ -62,10 +89,59 @@ impl Pacer {
         Instant::now().duration_since(target).as_nanos() as i64
     }
 
+    /// How late each sleep woke against the time it asked for, ns: the machine's wake-up
+    /// latency as this thread sees it (p50 / p99 / p99.9 / max).
+    pub fn wakeups(&self) -> &DurationHistogram {
+        &self.wakeups
+    }
+
     /// True when the deadline of `tick` (the start of the next tick) has passed.
     pub fn deadline_passed(&self, tick: u64) -> bool {
         Instant::now() > self.scheduled(tick + 1)
     }
+}
+
+/// Sleeps until `at` by the monotonic clock (which `Instant` reads on Linux): an absolute
+/// sleep, resumed after a signal.
+#[cfg(target_os = "linux")]
+#[allow(unsafe_code)]
+pub fn sleep_until(at: Instant) {
+    // The monotonic time of `at`: now's, plus the distance to `at`.
+    let mut now = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes one timespec into a local.
+    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut now) };
+    let ahead = at.saturating_duration_since(Instant::now());
+    if ahead.is_zero() {
+        return;
+    }
+    let ns = now.tv_nsec as u64 + u64::from(ahead.subsec_nanos());
+    let ts = libc::timespec {
+        tv_sec: now.tv_sec + ahead.as_secs() as libc::time_t + (ns / 1_000_000_000) as libc::time_t,
+        tv_nsec: (ns % 1_000_000_000) as libc::c_long,
+    };
+    loop {
+        // SAFETY: an absolute sleep on a local timespec; no remainder is written.
+        let r = unsafe {
+            libc::clock_nanosleep(
+                libc::CLOCK_MONOTONIC,
+                libc::TIMER_ABSTIME,
+                &ts,
+                std::ptr::null_mut(),
+            )
+        };
+        if r != libc::EINTR {
+            return;
+        }
+    }
+}
+
+/// Sleeps until `at` (other systems: a relative sleep).
+#[cfg(not(target_os = "linux"))]
+pub fn sleep_until(at: Instant) {
+    std::thread::sleep(at.saturating_duration_since(Instant::now()));
 }
 
 /// Summary of a distribution of durations, ns.
@@ -270,7 +346,7 @@ mod tests {
 
     #[test]
     fn pacer_never_starts_early() {
-        let p = Pacer::new(200_000);
+        let mut p = Pacer::new(200_000);
         let mut prev = Instant::now();
         for n in 0..20 {
             let late = p.wait_for(n);
@@ -279,6 +355,17 @@ mod tests {
             assert!(now >= p.scheduled(n));
             assert!(now >= prev);
             prev = now;
+        }
+        // Every 200 µs wait beyond the first slept, and the sleeps' lateness was measured.
+        assert!(p.wakeups().len() >= 10, "{}", p.wakeups().len());
+    }
+
+    #[test]
+    fn absolute_sleep_never_wakes_early() {
+        for us in [0u64, 50, 300, 2000] {
+            let at = Instant::now() + Duration::from_micros(us);
+            sleep_until(at);
+            assert!(Instant::now() >= at, "{us} µs");
         }
     }
 }

@@ -6,6 +6,7 @@
 //! fake device) or the percentile arithmetic (`haptic_devices::pacing::Percentiles`).
 
 use haptic_devices::pacing::Percentiles;
+use haptic_devices::realtime::RtStatus;
 
 /// How ticks are paced and where the deadline flag comes from.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,6 +34,12 @@ pub struct TickStats {
     pub jitter: Percentiles,
     /// Ticks whose deadline was missed (real-time mode only).
     pub missed: u64,
+    /// How late the tick thread's sleeps woke against the time they asked for (wall-clock
+    /// pacing only; zeros otherwise), ns: the machine's wake-up latency as cyclictest reports
+    /// it.
+    pub wakeup: Percentiles,
+    /// The real-time scheduling the tick thread asked for and got.
+    pub realtime: RtStatus,
     /// Wall time of the whole run, s.
     pub wall_s: f64,
 }

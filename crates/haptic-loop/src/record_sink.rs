@@ -92,6 +92,13 @@ pub fn stats_metadata(stats: &TickStats, mode: &str) -> BTreeMap<String, String>
     m.insert("jitter_p99_ns".into(), stats.jitter.p99_ns.to_string());
     m.insert("jitter_max_ns".into(), stats.jitter.max_ns.to_string());
     m.insert("missed_deadlines".into(), stats.missed.to_string());
+    m.insert("wakeup_p50_ns".into(), stats.wakeup.p50_ns.to_string());
+    m.insert("wakeup_p99_ns".into(), stats.wakeup.p99_ns.to_string());
+    m.insert("wakeup_p999_ns".into(), stats.wakeup.p999_ns.to_string());
+    m.insert("wakeup_max_ns".into(), stats.wakeup.max_ns.to_string());
+    for (k, v) in stats.realtime.metadata() {
+        m.insert(k.into(), v);
+    }
     m.insert("wall_s".into(), format!("{:.6}", stats.wall_s));
     m
 }

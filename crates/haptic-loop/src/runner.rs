@@ -21,6 +21,7 @@ use crate::header::SessionHeader;
 use crate::pacing::{Pacing, TickStats};
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_devices::pacing::{DurationHistogram, Pacer, Percentiles};
+use haptic_devices::realtime::{self, RtRequest, RtStatus};
 use haptic_types::DeviceError;
 use haptic_types::DeviceSample;
 use haptic_types::HapticDevice;
@@ -112,6 +113,8 @@ pub struct TickEngine {
     ticks: u64,
     timed: bool,
     started: Instant,
+    wakeup: Percentiles,
+    realtime: RtStatus,
 }
 
 impl TickEngine {
@@ -128,6 +131,8 @@ impl TickEngine {
             ticks: 0,
             timed: false,
             started: Instant::now(),
+            wakeup: Percentiles::default(),
+            realtime: RtStatus::default(),
         }
     }
 
@@ -157,7 +162,16 @@ impl TickEngine {
         self.ticks = 0;
         self.timed = timed;
         self.started = Instant::now();
+        self.wakeup = Percentiles::default();
+        self.realtime = RtStatus::default();
         Ok(())
+    }
+
+    /// What the pacing measured and got, for the run's statistics: the tick thread's wake-up
+    /// latency and its real-time scheduling.
+    pub fn set_pacing_report(&mut self, wakeup: Percentiles, realtime: RtStatus) {
+        self.wakeup = wakeup;
+        self.realtime = realtime;
     }
 
     /// Ticks run so far.
@@ -235,6 +249,8 @@ impl TickEngine {
             compute: self.compute.percentiles(),
             jitter: self.jitter.percentiles(),
             missed: self.missed,
+            wakeup: self.wakeup,
+            realtime: self.realtime,
             wall_s: self.started.elapsed().as_secs_f64(),
         };
         for s in sinks.iter_mut() {
@@ -262,6 +278,7 @@ pub struct Runner<'s> {
     stop: Option<&'s AtomicBool>,
     engine: TickEngine,
     live: Option<&'s mut LiveHook<'s>>,
+    rt: Option<RtRequest>,
 }
 
 /// Time each sink took per tick (its `tick` call), ns.
@@ -281,7 +298,18 @@ impl<'s> Runner<'s> {
             stop: None,
             engine: TickEngine::new(Vec::new()),
             live: None,
+            rt: Some(RtRequest::default()),
         }
+    }
+
+    /// The real-time scheduling the tick thread asks for in a wall-clock or device-clock run
+    /// (default: [`RtRequest::default`], `SCHED_FIFO` 50 with memory locked and a core of its
+    /// own); `None` asks for nothing (`--no-rt`). A refusal is said once per process on standard
+    /// error, with its fix, and the run goes on at normal priority; the statistics say what was
+    /// granted. Batch and replay runs never ask.
+    pub fn with_realtime(mut self, rt: Option<RtRequest>) -> Self {
+        self.rt = rt;
+        self
     }
 
     /// Sets switches at given ticks (tick, switch): each is applied just before its tick's
@@ -324,7 +352,12 @@ impl<'s> Runner<'s> {
             .start(&mut self.sinks, lp, header, ticks, timed)?;
         let rate = lp.config().rate_hz;
         let period_ns = lp.config().period_ns();
-        let pacer = matches!(pacing, Pacing::Realtime).then(|| Pacer::new(period_ns));
+        // The tick thread in real time for the run (the sinks' threads, started above, and any
+        // it starts later stay at normal priority); back as it was when the guard drops.
+        let rt = realtime::enter_if(self.rt.as_ref().filter(|_| timed));
+        realtime::advise_once(&rt.status());
+        let mut pacer =
+            matches!(pacing, Pacing::Realtime).then(|| Pacer::for_thread(period_ns, &rt.status()));
         let mut prev_start: Option<Instant> = None;
         let mut end = EndReason::Completed;
         let mut n = 0u64;
@@ -333,7 +366,7 @@ impl<'s> Runner<'s> {
                 end = EndReason::Stopped;
                 break;
             }
-            let late = match &pacer {
+            let late = match &mut pacer {
                 Some(p) => p.wait_for(n),
                 None => 0,
             };
@@ -388,6 +421,12 @@ impl<'s> Runner<'s> {
             }
         }
         let link = dev.link_counters();
+        self.engine.set_pacing_report(
+            pacer
+                .as_ref()
+                .map_or_else(Percentiles::default, |p| p.wakeups().percentiles()),
+            rt.status(),
+        );
         let stats = self.engine.finish(&mut self.sinks, &link)?;
         Ok((stats, end))
     }

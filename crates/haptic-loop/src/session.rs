@@ -21,6 +21,7 @@ use crate::scene::{SceneError, SceneFile};
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::{live_summary, start_live};
 use crate::totals::Totals;
+use haptic_devices::realtime::RtRequest;
 use haptic_devices::script::{OperatorKind, Script};
 use haptic_devices::source::{DeviceSource, Driver, open_device};
 use haptic_devices::{OperatorParams, ScriptError};
@@ -73,6 +74,10 @@ pub struct SessionOptions {
     /// Pace ticks against the wall clock (a bridged device is always real time: its samples
     /// are the clock).
     pub realtime: bool,
+    /// The real-time scheduling the tick thread asks for in a real-time session (default
+    /// `SCHED_FIFO` 50, memory locked, pinned; see `haptic_devices::realtime`); `None`: ask for
+    /// nothing (`--no-rt`). Batch sessions never ask.
+    pub rt: Option<RtRequest>,
     /// Record to this MCAP file.
     pub out: Option<PathBuf>,
     /// Serve a live Foxglove view while the session runs.
@@ -96,6 +101,7 @@ impl SessionOptions {
             operator: OperatorChoice::ScriptHand,
             seconds: None,
             realtime: false,
+            rt: Some(RtRequest::default()),
             out: None,
             live: None,
             arrays: true,
@@ -396,7 +402,9 @@ fn run_with_device(
             }
         }
     };
-    let mut runner = Runner::new(sinks.list()).with_switches(switches);
+    let mut runner = Runner::new(sinks.list())
+        .with_switches(switches)
+        .with_realtime(opts.rt);
     if menu.is_some() {
         runner = runner.with_live(&mut apply_menu);
     }

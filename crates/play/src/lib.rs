@@ -86,6 +86,10 @@ pub struct PlayConfig {
     pub keep_serving_s: Option<f64>,
     /// What the server accepts (connections, message size and rate).
     pub limits: Limits,
+    /// The tick thread's real-time scheduling (default `SCHED_FIFO` 50, memory locked, pinned;
+    /// the server's, publisher's and pages' threads stay at normal priority); `None`: ask for
+    /// nothing (`--no-rt`). What it got is in [`PlaySummary::stats`]`.realtime`.
+    pub rt: Option<haptic_devices::realtime::RtRequest>,
 }
 
 impl PlayConfig {
@@ -100,6 +104,7 @@ impl PlayConfig {
             seconds: None,
             keep_serving_s: None,
             limits: Limits::default(),
+            rt: Some(haptic_devices::realtime::RtRequest::default()),
         }
     }
 }
@@ -140,12 +145,13 @@ impl PlaySummary {
     /// One line for a person: how it ended, ticks, missed deadlines, score and recording.
     pub fn line(&self) -> String {
         format!(
-            "{}: {} ticks, {} missed deadlines, score {}, recording {}",
+            "{}: {} ticks, {} missed deadlines, score {}, recording {}; real time: {}",
             self.end,
             self.stats.ticks,
             self.stats.missed,
             self.state("score").unwrap_or(0.0),
-            self.recording.display()
+            self.recording.display(),
+            self.stats.realtime.describe()
         )
     }
 
@@ -514,7 +520,8 @@ pub fn run(
         list.push(&mut play_sink);
         let mut runner = Runner::new(list)
             .with_live(&mut hook)
-            .stop_on(&shared.end_requested);
+            .stop_on(&shared.end_requested)
+            .with_realtime(config.rt);
         runner.run(
             &mut lp,
             hand.device(),

@@ -150,7 +150,7 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     };
     let seconds = cfg.seconds.unwrap_or(cfg.script.duration_s);
     let ticks = (seconds * f64::from(rate_hz)).round().max(0.0) as u64;
-    let pacer = Pacer::new(1_000_000_000 / u64::from(rate_hz));
+    let mut pacer = Pacer::new(1_000_000_000 / u64::from(rate_hz));
     let mut servo = Servo {
         cfg,
         socket: &socket,

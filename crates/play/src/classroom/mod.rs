@@ -84,6 +84,9 @@ pub struct ClassConfig {
     pub device: Option<haptic_devices::bridge::BridgeConfig>,
     /// The name the bridged device plays under.
     pub device_name: String,
+    /// The tick workers' real-time scheduling (default `SCHED_FIFO` 50 and memory locked; the
+    /// workers are not pinned, so each core can take one); `None`: ask for nothing (`--no-rt`).
+    pub rt: Option<haptic_devices::realtime::RtRequest>,
 }
 
 impl ClassConfig {
@@ -101,6 +104,7 @@ impl ClassConfig {
             workers: None,
             device: None,
             device_name: "device".into(),
+            rt: Some(haptic_devices::realtime::RtRequest::default()),
         }
     }
 }
@@ -259,6 +263,8 @@ pub struct ClassSummary {
     pub refused: RefusedCounts,
     /// Worker threads that ticked the sessions.
     pub workers: usize,
+    /// The real-time scheduling the workers got (the first worker's; they all ask alike).
+    pub realtime: haptic_devices::realtime::RtStatus,
 }
 
 /// Why a student could not join.
@@ -483,9 +489,12 @@ pub fn run(
         let (tx, rx) = std::sync::mpsc::channel();
         let load = Arc::new(AtomicUsize::new(0));
         let (l, f, s) = (load.clone(), fin_tx.clone(), worker_stop.clone());
+        let rt = config
+            .rt
+            .map(|r| haptic_devices::realtime::RtRequest { pin: false, ..r });
         let h = std::thread::Builder::new()
             .name(format!("class-tick-{i}"))
-            .spawn(move || sched::worker(rx, f, period_ns, l, s))
+            .spawn(move || sched::worker(rx, f, period_ns, l, s, rt))
             .map_err(|e| PlayError::Serve {
                 port: config.port,
                 message: e.to_string(),
@@ -597,8 +606,13 @@ pub fn run(
         std::thread::sleep(Duration::from_millis(20));
     }
     worker_stop.store(true, Ordering::Relaxed);
-    for h in handles {
-        let _ = h.join();
+    let mut realtime = haptic_devices::realtime::RtStatus::default();
+    for (i, h) in handles.into_iter().enumerate() {
+        if let Ok(st) = h.join()
+            && i == 0
+        {
+            realtime = st;
+        }
     }
     if let Some(d) = device {
         // A device that never said hello is not waited for (its own wait may be long): its
@@ -627,5 +641,6 @@ pub fn run(
         students,
         refused: listener.gate().refused.snapshot(),
         workers: n_workers,
+        realtime,
     })
 }

@@ -8,6 +8,7 @@
 
 use super::live::Live;
 use haptic_devices::pacing::Pacer;
+use haptic_devices::realtime::{self, RtRequest, RtStatus};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
@@ -17,9 +18,24 @@ use std::time::Duration;
 /// a whole period away, so the cores go to the other workers and the pages instead.
 const SPIN: Duration = Duration::from_micros(20);
 
-/// One worker's loop: takes new sessions from `inbox`, ticks every session each cycle, hands
-/// ended ones to `finished`; on `stop` it ends every session and returns.
+/// One worker's loop: asks for real time (`rt`), takes new sessions from `inbox`, ticks every
+/// session each cycle, hands ended ones to `finished`; on `stop` it ends every session and
+/// returns what real time it got.
 pub(crate) fn worker(
+    inbox: Receiver<Box<Live>>,
+    finished: Sender<Box<Live>>,
+    period_ns: u64,
+    load: Arc<AtomicUsize>,
+    stop: Arc<AtomicBool>,
+    rt: Option<RtRequest>,
+) -> RtStatus {
+    let guard = realtime::enter_if(rt.as_ref());
+    realtime::advise_once(&guard.status());
+    run_worker(inbox, finished, period_ns, load, stop);
+    guard.status()
+}
+
+fn run_worker(
     inbox: Receiver<Box<Live>>,
     finished: Sender<Box<Live>>,
     period_ns: u64,

@@ -1,0 +1,264 @@
+//! Real-time scheduling as the program asks for it: granted where permitted, refused with its
+//! fix (said once) where not, off with `--no-rt`, recorded either way; and `doctor`.
+//!
+//! The refusal is tested as an unprivileged user: as root, the program is started through
+//! `prlimit --rtprio=0` and `setpriv` as `nobody` with every capability dropped; as any other
+//! user with `RLIMIT_RTPRIO` 0 and no capability, it is started as it is.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_nanohaptics")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("nh-rt-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[allow(unsafe_code)]
+fn is_root() -> bool {
+    // SAFETY: geteuid takes no arguments and cannot fail.
+    unsafe { libc::geteuid() == 0 }
+}
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn info_session(rec: &Path) -> Value {
+    let o = Command::new(bin())
+        .args(["info", "--json"])
+        .arg(rec)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{:?}", text(&o));
+    let j: Value = serde_json::from_slice(&o.stdout).unwrap();
+    j["session_metadata"].clone()
+}
+
+/// The program as a user the system refuses real time: `None` when this machine cannot make
+/// one (neither root nor already unprivileged).
+fn unprivileged() -> Option<Command> {
+    let has = |p: &str| Path::new(p).exists();
+    if is_root() {
+        if !(has("/usr/bin/prlimit") && has("/usr/bin/setpriv")) {
+            return None;
+        }
+        let mut c = Command::new("/usr/bin/prlimit");
+        c.args([
+            "--rtprio=0:0",
+            "/usr/bin/setpriv",
+            "--reuid=65534",
+            "--regid=65534",
+            "--clear-groups",
+            "--inh-caps=-all",
+            "--bounding-set=-all",
+            bin(),
+        ]);
+        return Some(c);
+    }
+    let p = haptic_devices::realtime::permissions();
+    (!p.cap_sys_nice && p.rlimit_rtprio == Some(0)).then(|| Command::new(bin()))
+}
+
+#[test]
+fn a_refused_request_is_said_once_with_its_fix_and_the_session_runs_as_before() {
+    let Some(mut cmd) = unprivileged() else {
+        eprintln!("skipped: not root, and this user may use real-time priority");
+        return;
+    };
+    let dir = scratch("refused");
+    // The unprivileged user writes the recording here.
+    std::fs::set_permissions(
+        &dir,
+        std::os::unix::fs::PermissionsExt::from_mode(0o777),
+    )
+    .unwrap();
+    let rec = dir.join("refused.mcap");
+    let o = cmd
+        .args(["run", "brickworld", "--realtime", "--seconds", "0.3", "--json"])
+        .arg("--out")
+        .arg(&rec)
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    // Said once, on standard error, with what was refused and the fix.
+    assert_eq!(err.matches("nanohaptics: real time:").count(), 1, "{err}");
+    assert!(
+        err.contains(
+            "normal priority, SCHED_FIFO refused: no CAP_SYS_NICE, and RLIMIT_RTPRIO is below \
+             the priority asked for"
+        ),
+        "{err}"
+    );
+    for fix in ["rtprio 95", "setcap cap_sys_nice", "rtkit", "--no-rt"] {
+        assert!(err.contains(fix), "{fix}: {err}");
+    }
+    // The summary and the recording say what it got; the session ran every tick.
+    let j: Value = serde_json::from_str(&out).unwrap();
+    let rt = &j["tick_stats"]["realtime"];
+    assert_eq!(rt["requested"], true);
+    assert_eq!(rt["priority"], Value::Null);
+    assert_eq!(rt["sched_refused"], "no_permission");
+    assert_eq!(rt["cpu"], Value::Null, "pinned without SCHED_FIFO");
+    assert_eq!(j["ticks"], 300);
+    let s = info_session(&rec);
+    assert_eq!(s["rt_policy"], "normal");
+    assert_eq!(s["rt_priority"], "none");
+    assert!(
+        s["rt_refused"]
+            .as_str()
+            .unwrap()
+            .starts_with("no CAP_SYS_NICE"),
+        "{s}"
+    );
+    // It replays bit for bit like any session.
+    let o = Command::new(bin())
+        .args(["replay", "--verify"])
+        .arg(&rec)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{:?}", text(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn granted_where_permitted_off_with_no_rt_and_the_priority_checked() {
+    let dir = scratch("granted");
+    let p = haptic_devices::realtime::permissions();
+    let permitted = p.cap_sys_nice || p.rlimit_rtprio.is_none_or(|l| l >= 50);
+    let rec = dir.join("rt.mcap");
+    let o = Command::new(bin())
+        .args(["run", "brickworld", "--realtime", "--seconds", "0.3", "--json"])
+        .arg("--out")
+        .arg(&rec)
+        .output()
+        .unwrap();
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    let j: Value = serde_json::from_str(&out).unwrap();
+    let rt = &j["tick_stats"]["realtime"];
+    let s = info_session(&rec);
+    // Wake-ups were measured (300 ticks, nearly all slept) and recorded.
+    assert!(j["tick_stats"]["wakeup"]["max_ns"].as_u64().unwrap() > 0);
+    assert!(s["wakeup_p99_ns"].as_str().unwrap().parse::<u64>().unwrap() > 0);
+    if permitted && rt["sched_refused"] != "no_runtime" {
+        assert_eq!(rt["priority"], 50, "{rt}");
+        assert!(!err.contains("nanohaptics: real time:"), "{err}");
+        assert_eq!(s["rt_policy"], "fifo");
+        assert_eq!(s["rt_priority"], "50");
+        if p.cores > 1 {
+            assert!(rt["cpu"].is_u64(), "{rt}");
+        }
+    }
+    // --no-rt asks for nothing and says nothing.
+    let o = Command::new(bin())
+        .args([
+            "run",
+            "brickworld",
+            "--realtime",
+            "--seconds",
+            "0.2",
+            "--json",
+            "--no-rt",
+        ])
+        .output()
+        .unwrap();
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains("real time"), "{err}");
+    let j: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["tick_stats"]["realtime"]["requested"], false);
+    assert_eq!(j["tick_stats"]["realtime"]["priority"], Value::Null);
+    // Batch runs never ask.
+    let o = Command::new(bin())
+        .args(["run", "brickworld", "--seconds", "0.1", "--json"])
+        .output()
+        .unwrap();
+    let j: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["tick_stats"]["realtime"]["requested"], false);
+    // The priority's range, by name.
+    for cmd in [&["run", "brickworld"][..], &["play"], &["classroom"]] {
+        let o = Command::new(bin())
+            .args(cmd)
+            .args(["--rt-priority", "0"])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{cmd:?}");
+        assert_eq!(
+            text(&o).1.trim(),
+            "error: --rt-priority = 0 is out of range: allowed 1 to 99",
+            "{cmd:?}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn doctor_measures_both_ways_and_judges_each_rate_by_its_wakeups() {
+    let o = Command::new(bin())
+        .args(["doctor", "--seconds", "0.4", "--json"])
+        .output()
+        .unwrap();
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    let j: Value = serde_json::from_str(&out).unwrap();
+    for half in ["normal", "realtime"] {
+        let m = &j[half];
+        // 0.2 s of wake-ups every 500 µs.
+        assert_eq!(m["samples"], 400, "{half}");
+        let l = &m["latency"];
+        let (p50, p99, p999, max) = (
+            l["p50_ns"].as_u64().unwrap(),
+            l["p99_ns"].as_u64().unwrap(),
+            l["p999_ns"].as_u64().unwrap(),
+            l["max_ns"].as_u64().unwrap(),
+        );
+        assert!(p50 <= p99 && p99 <= p999 && p999 <= max, "{half}: {l}");
+        // A rate whose half period exceeds the largest wake-up holds.
+        for r in j["rates"].as_array().unwrap() {
+            let hz = r["rate_hz"].as_u64().unwrap();
+            let key = if half == "normal" {
+                "normal"
+            } else {
+                "realtime"
+            };
+            if max <= 500_000_000 / hz {
+                assert_eq!(r[key]["verdict"], "holds", "{hz} Hz {half}: {r}");
+            } else {
+                assert_eq!(r[key]["verdict"], "misses", "{hz} Hz {half}: {r}");
+                assert!(r[key]["per_minute"].as_f64().unwrap() > 0.0);
+            }
+        }
+    }
+    assert_eq!(j["normal"]["realtime"]["requested"], false);
+    assert_eq!(j["realtime"]["realtime"]["requested"], true);
+    assert!(j["permissions"]["cores"].as_u64().unwrap() >= 1);
+    // The text report names every rate.
+    let o = Command::new(bin())
+        .args(["doctor", "--seconds", "0.2"])
+        .output()
+        .unwrap();
+    let (out, _) = text(&o);
+    for rate in ["1 kHz", "4 kHz", "10 kHz", "p99.9"] {
+        assert!(out.contains(rate), "{rate}: {out}");
+    }
+    let o = Command::new(bin())
+        .args(["doctor", "--seconds", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        text(&o).1.trim(),
+        "error: --seconds = 0 is out of range: allowed 0.1–3600 s"
+    );
+}
