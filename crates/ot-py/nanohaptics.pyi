@@ -412,6 +412,7 @@ def run_scene(
     out: Optional[PathLike] = None,
     wait_s: float = 120.0,
     overrides: Optional[Mapping[str, Any]] = None,
+    rt_priority: Optional[int] = 50,
 ) -> dict:
     """Run a scene in batch mode with a script, or in real time against a
     device in another process (device="udp:HOST:PORT", see nanohaptics.bridge;
@@ -424,7 +425,11 @@ def run_scene(
     compute_ns, start_late_ns, events [(tick, name, detail)], rate_hz, stats
     (tick timing, "link" counters, "end", per-sink "sinks" timing). Optionally records to `out`.
     `scene` may also be a dict of resolve_scene; `overrides` changes fields by
-    dotted name, validated like a scene file (see resolve_scene)."""
+    dotted name, validated like a scene file (see resolve_scene). A real-time
+    session's tick thread asks for SCHED_FIFO at `rt_priority` (1–99; None:
+    ask for nothing), says once on stderr with the fix when refused, and
+    reports what it got in stats["realtime"] and its wake-up latency (ns) in
+    stats["wakeup"]."""
 
 def resolve_scene(
     scene: Union[PathLike, dict],

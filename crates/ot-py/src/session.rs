@@ -274,6 +274,12 @@ pub fn resolve_scene<'py>(
 ///     overrides: dict of dotted field name → value changing the scene (and,
 ///         with ``operator.*`` names, the simulated hand), validated as in
 ///         :func:`resolve_scene`.
+///     rt_priority: the SCHED_FIFO priority (1–99) the tick thread asks for
+///         in a real-time session (a bridged device), with memory locked and
+///         a core of its own; None asks for nothing (the command line's
+///         ``--no-rt``). A refusal is said once on stderr with its fix;
+///         ``stats["realtime"]`` says what was granted and
+///         ``stats["wakeup"]`` how late the thread woke (ns).
 ///
 /// Returns:
 ///     dict: "rate_hz", "state_fields" (names of the state columns), per-tick
@@ -286,7 +292,7 @@ pub fn resolve_scene<'py>(
 ///     timing). The GIL is released while the session runs.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments
-#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None, wait_s=120.0, overrides=None))]
+#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None, wait_s=120.0, overrides=None, rt_priority=Some(i64::from(haptic_devices::realtime::DEFAULT_PRIORITY))))]
 pub fn run_scene<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -297,7 +303,12 @@ pub fn run_scene<'py>(
     out: Option<&Bound<'py, PyAny>>,
     wait_s: f64,
     overrides: Option<&Bound<'py, PyAny>>,
+    rt_priority: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let rt = rt_priority
+        .map(haptic_devices::realtime::RtRequest::with_priority)
+        .transpose()
+        .map_err(|e| value_err(e.map_field(|_| "rt_priority".into())))?;
     if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
         return Err(value_err(ValueError::out_of_range(
             "wait_s",
@@ -334,6 +345,7 @@ pub fn run_scene<'py>(
         }
     };
     opts.seconds = seconds;
+    opts.rt = rt;
     opts.operator = operator_from_py(operator)?;
     opts.out = match out {
         Some(o) => Some(path_arg(o, "out")?),
