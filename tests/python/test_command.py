@@ -334,7 +334,10 @@ def test_classroom_serves_the_class_and_ctrl_c_ends_it(scratch, sigint_raises):
     assert took < 5, f"{took:.1f} s after Ctrl-C"
     # As the binary: Ctrl-C ends every session and prints the class's figures (none joined).
     assert (p.returncode, err) == (0, ""), err
-    assert out.startswith("0 student sessions\nrefused: 0 in all (0 host, 0 origin, "), out
+    # The first line says how many sessions, on how many tick workers, with what real time.
+    first, rest = out.split("\n", 1)
+    assert re.fullmatch(r"0 student sessions on \d tick workers?; real time: .+", first), out
+    assert rest.startswith("refused: 0 in all (0 host, 0 origin, "), out
 
 
 def test_ctrl_c_ends_a_command_without_its_own_handler_at_once(scratch, sigint_raises):

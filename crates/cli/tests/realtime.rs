@@ -77,14 +77,17 @@ fn a_refused_request_is_said_once_with_its_fix_and_the_session_runs_as_before() 
     };
     let dir = scratch("refused");
     // The unprivileged user writes the recording here.
-    std::fs::set_permissions(
-        &dir,
-        std::os::unix::fs::PermissionsExt::from_mode(0o777),
-    )
-    .unwrap();
+    std::fs::set_permissions(&dir, std::os::unix::fs::PermissionsExt::from_mode(0o777)).unwrap();
     let rec = dir.join("refused.mcap");
     let o = cmd
-        .args(["run", "brickworld", "--realtime", "--seconds", "0.3", "--json"])
+        .args([
+            "run",
+            "brickworld",
+            "--realtime",
+            "--seconds",
+            "0.3",
+            "--json",
+        ])
         .arg("--out")
         .arg(&rec)
         .current_dir(&dir)
@@ -139,7 +142,14 @@ fn granted_where_permitted_off_with_no_rt_and_the_priority_checked() {
     let permitted = p.cap_sys_nice || p.rlimit_rtprio.is_none_or(|l| l >= 50);
     let rec = dir.join("rt.mcap");
     let o = Command::new(bin())
-        .args(["run", "brickworld", "--realtime", "--seconds", "0.3", "--json"])
+        .args([
+            "run",
+            "brickworld",
+            "--realtime",
+            "--seconds",
+            "0.3",
+            "--json",
+        ])
         .arg("--out")
         .arg(&rec)
         .output()
