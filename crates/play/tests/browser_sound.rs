@@ -4,11 +4,14 @@
 //! sounds on their ticks), sample by sample against the Rust synthesis of the same recording at
 //! the same sample rate.
 //!
-//! Tolerance: the worklet computes in f64 as the Rust code does, with the same formulas in the
-//! same order, and writes Float32 (the same round-to-nearest as Rust's `as f32`); only the
-//! transcendental functions differ (V8's `Math.sin`/`exp`/`pow` against glibc's, each within
-//! an ulp of f64). So each sample must be the Rust sample or, where the f64 results straddle
-//! an f32 rounding boundary, its f32 neighbour: at most 1 f32 ulp apart (`MAX_ULPS`).
+//! Tolerance: none. The worklet computes in f64 as the Rust code does, with the same formulas
+//! in the same order, and writes Float32 (the same round-to-nearest as Rust's `as f32`); only
+//! the transcendental functions could differ (V8's `Math.sin`/`exp`/`pow` against glibc's,
+//! each within an ulp of f64), and an f64 difference would show only where it straddles an
+//! f32 rounding boundary, as a 1-ulp difference. On these recordings no sample differs at all
+//! (Chromium 156, glibc 2.36), so the test asks for the same bits (`MAX_ULPS` = 0); should
+//! another browser's libm differ in a last f64 bit, the bound to allow is 1 f32 ulp, about
+//! 6e-8 of full scale.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -23,8 +26,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// The largest difference allowed between a worklet sample and the Rust sample, in f32 ulps.
-const MAX_ULPS: u32 = 1;
+/// The largest difference allowed between a worklet sample and the Rust sample, in f32 ulps
+/// (0: the same bits).
+const MAX_ULPS: u32 = 0;
 
 fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -112,6 +116,20 @@ fn compare(b: &mut Browser, rec: &Path, kind: &str, sr: u32) -> (usize, usize, u
         f64::from(peak) <= render::audio::CEILING,
         "no anti-clipping scale"
     );
+    // The recording's sounds: the brick world's impacts, the nano world's snap and pull-off.
+    let names: std::collections::BTreeSet<&str> = haptic_loop::sound::sound_events(&a)
+        .unwrap()
+        .iter()
+        .map(|e| SoundKind::of(&e.sound).0.name())
+        .collect();
+    let expected: &[&str] = if kind == "nanoworld" {
+        &["snap", "pull_off"]
+    } else {
+        &["thud"]
+    };
+    for n in expected {
+        assert!(names.contains(n), "{kind}: {names:?}");
+    }
     let blocks: Vec<String> = sound_ticks(&a, on)
         .iter()
         .map(|m| base64(&m.encode()))
@@ -177,6 +195,7 @@ fn the_pages_worklet_makes_the_samples_of_render_audio() {
             );
             println!("{line}");
             assert!(max_ulps <= MAX_ULPS, "{line}");
+            assert_eq!(differ, 0, "{line}");
             report.push(line);
         }
     }
