@@ -9,8 +9,9 @@
 //! 3. brickworld, one page that plays and two more that watch (and again with the browsers at
 //!    `nice 19`).
 //!
-//! The playing page's pointer circles and its wheel lowers and raises the hand about three times
-//! a second, so the hand taps what is under it (the sounds whose latency is measured).
+//! The playing page's pointer circles and its wheel lowers and raises the hand about four times
+//! a second, so the hand taps what is under it (the sounds whose latency is measured); the
+//! pointer and the wheel take turns, 60 events/s in all.
 //!
 //! Figures: browser input → force (the page's event time to the tick whose force used it,
 //! from the server), frames drawn per second by each page (requestAnimationFrame draws with a
@@ -45,7 +46,7 @@ struct Outcome {
     sample_rate: Option<f64>,
     lead_ms: Option<f64>,
     underruns: u64,
-    dropped: u64,
+    samples_dropped: u64,
     ticks: u64,
     missed: u64,
     tick_p99_us: f64,
@@ -86,11 +87,19 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         let a = i as f64 * 0.05;
         let rr = 0.4 * k;
         let (x, y) = (cx + rr * a.cos(), cy + rr * a.sin());
-        browsers[0].mouse("mouseMoved", x, y, false, 0.0)?;
-        // Down for 10 events, up for 10 (0.25 of the ball's radius each: the wheel's 0.0015
-        // per unit): the hand taps the ground, or what lies on it, three times a second.
-        let dy = if i % 20 < 10 { 166.7 } else { -166.7 };
-        browsers[0].mouse("mouseWheel", x, y, false, dy)?;
+        if i % 2 == 0 {
+            browsers[0].mouse("mouseMoved", x, y, false, 0.0)?;
+        } else {
+            // The wheel, every other event: 0.5 of the ball's radius (the wheel's 0.0015 per
+            // unit) down twice, up twice, between heights -0.7 and 0.3 (the first step is up
+            // 0.3): the hand taps the ground, or what lies on it, about four times a second.
+            let dy = match (i / 2) % 4 {
+                _ if i == 1 => -200.0,
+                0 | 1 => 333.3,
+                _ => -333.3,
+            };
+            browsers[0].mouse("mouseWheel", x, y, false, dy)?;
+        }
         i += 1;
         let next = Duration::from_secs_f64(i as f64 / 60.0);
         if let Some(w) = next.checked_sub(t0.elapsed()) {
@@ -102,7 +111,7 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
     let mut audio_ts = Vec::new();
     let mut parts: [Vec<f64>; 3] = Default::default();
     let (mut out_lat, mut base_lat, mut rate, mut lead) = (None, None, None, None);
-    let (mut underruns, mut dropped) = (0, 0);
+    let (mut underruns, mut samples_dropped) = (0, 0);
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
@@ -125,7 +134,7 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         base_lat = v[7].as_f64().or(base_lat);
         rate = v[8].as_f64().or(rate);
         underruns += v[4].as_u64().unwrap_or(0);
-        dropped += v[9].as_u64().unwrap_or(0);
+        samples_dropped += v[9].as_u64().unwrap_or(0);
         lead = v[10].as_f64().or(lead);
         b.check()?;
     }
@@ -154,7 +163,7 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         sample_rate: rate,
         lead_ms: lead,
         underruns,
-        dropped,
+        samples_dropped,
         ticks: s.stats.ticks,
         missed: s.stats.missed,
         tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
@@ -239,7 +248,7 @@ fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
         sample_rate: None,
         lead_ms: None,
         underruns: 0,
-        dropped: 0,
+        samples_dropped: 0,
         ticks: s.stats.ticks,
         missed: s.stats.missed,
         tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
@@ -328,7 +337,7 @@ fn main() {
                     format!(
                         "{} / {} / {}",
                         o.underruns,
-                        o.dropped,
+                        o.samples_dropped,
                         o.lead_ms.map_or("–".into(), |l| format!("{l:.0}"))
                     ),
                     o.ticks,

@@ -9,13 +9,15 @@
 //
 // The samples go through a FIFO to the output: playback starts once `leadS` of sound is
 // queued; an underrun plays silence, lengthens the lead by 1 ms (up to 50 ms) and waits for
-// it again; a FIFO that stays fuller than the lead for 0.1 s drops the excess (counted). For each sound's first sample the processor reports
+// it again, and each second without one shortens it by 1 ms (down to `leadS`); a FIFO that
+// stays fuller than the lead for 0.1 s drops the excess (counted). For each sound's first sample the processor reports
 // when it was rendered (Date.now() at the render quantum, the frame within it, the context
 // time) so the page can measure tick → output. With `offline` options (a test's
 // OfflineAudioContext) it takes all its ticks at construction and plays from sample 0.
 
 const A_MAX = 0.8, CEILING = 0.98, ATTACK_S = 5e-4, TONE_AMPLITUDE = 0.12;
 const TAU = 2 * Math.PI; // std::f64::consts::TAU
+const SILENT = [0, 0];
 const HEADER = 24, TICK = 16, SOUND = 24;
 
 // 64-bit unsigned arithmetic on [hi, lo] 32-bit halves (the noise is xorshift64*).
@@ -127,11 +129,14 @@ class StreamSynth {
       this.pending[at] += s[k];
     }
   }
-  tick(d) { this.distances.push(d); this.ticks++; this.emit(-1); }
+  // The tone's (pitch, amplitude) at each tick are kept rather than its distance: the same
+  // values, computed once per tick.
+  tick(d) { this.distances.push(this.on === null ? null : toneAt(d, this.on)); this.ticks++; this.emit(-1); }
   finish(durationS) { this.emit(Math.round(durationS * this.sr)); }
   at(j) {
     const r = j - this.baseTick;
-    return toneAt(r >= 0 ? this.distances[this.dh + r] : undefined, this.on);
+    const v = r >= 0 ? this.distances[this.dh + r] : undefined;
+    return v === undefined ? SILENT : v;
   }
   emit(end) {
     const sr = this.sr, dt = this.dt;
@@ -201,7 +206,8 @@ class Synth extends AudioWorkletProcessor {
     this.fifo = new Fifo();
     this.synth = null;
     this.onsets = []; // [sample index, tick, tick wall ms, arrival ms]
-    this.lead = Math.round((o.leadS || 0) * sampleRate);
+    this.lead = this.lead0 = Math.round((o.leadS || 0) * sampleRate);
+    this.calm = 0; // samples played since the last underrun or lead change
     this.primed = false;
     this.underruns = 0; this.dropped = 0;
     this.minLevel = Infinity; this.quanta = 0;
@@ -274,7 +280,12 @@ class Synth extends AudioWorkletProcessor {
         // An underrun: wait for the lead again, a millisecond longer (up to 50 ms).
         this.underruns++; this.primed = false;
         this.lead = Math.min(this.lead + Math.round(0.001 * sampleRate), Math.round(0.05 * sampleRate));
+        this.calm = 0;
       }
+    } else if (!this.offline && (this.calm += n) >= sampleRate && this.lead > this.lead0) {
+      // A second without an underrun: a millisecond shorter, down to the first lead.
+      this.lead = Math.max(this.lead0, this.lead - Math.round(0.001 * sampleRate));
+      this.calm = 0;
     }
     // Report the sounds whose first sample is in this quantum (or was dropped).
     if (this.onsets.length && this.onsets[0][0] < from + n) {
