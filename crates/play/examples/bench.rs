@@ -93,10 +93,13 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
             // The wheel, every other event: 0.5 of the ball's radius (the wheel's 0.0015 per
             // unit) down twice, up twice, between heights -0.7 and 0.3 (the first step is up
             // 0.3): the hand taps the ground, or what lies on it, about four times a second.
-            let dy = match (i / 2) % 4 {
-                _ if i == 1 => -200.0,
-                0 | 1 => 333.3,
-                _ => -333.3,
+            let w = i / 2;
+            let dy = if w == 0 {
+                -200.0
+            } else if (w - 1) % 4 < 2 {
+                333.3
+            } else {
+                -333.3
             };
             browsers[0].mouse("mouseWheel", x, y, false, dy)?;
         }
@@ -115,7 +118,7 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
-        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs]; })()")?;
+        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks]; })()")?;
         for p in v[5].as_array().into_iter().flatten() {
             for (k, part) in parts.iter_mut().enumerate() {
                 if let Some(x) = p[k].as_f64() {
@@ -136,6 +139,11 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         underruns += v[4].as_u64().unwrap_or(0);
         samples_dropped += v[9].as_u64().unwrap_or(0);
         lead = v[10].as_f64().or(lead);
+        eprintln!(
+            "{scene}: a page got {} sounds in {} ticks",
+            v[11].as_u64().unwrap_or(0),
+            v[12].as_u64().unwrap_or(0)
+        );
         b.check()?;
     }
     browsers[0].key("e", true, false)?;
