@@ -322,7 +322,7 @@ fn main() {
                     parts.push((o.scene, label.clone(), o.sound_parts));
                 }
                 rows.push(format!(
-                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} / {} | {} | {} | {:.0} | {} |",
                     o.scene,
                     label,
                     fmt(o.input),
@@ -336,18 +336,16 @@ fn main() {
                             .join(", ")
                     },
                     fmt(o.sound),
-                    o.sound_ts.map_or("–".into(), |l| format!("{:.1} / {:.1}", l.p50, l.p99)),
+                    o.sound_ts
+                        .map_or("–".into(), |l| format!("{:.1} / {:.1}", l.p50, l.p99)),
                     match (o.output_latency_s, o.base_latency_s) {
                         (Some(a), Some(b)) => format!("{:.1} + {:.1}", a * 1e3, b * 1e3),
                         _ => "–".into(),
                     },
                     o.sample_rate.map_or("–".into(), |r| format!("{r:.0}")),
-                    format!(
-                        "{} / {} / {}",
-                        o.underruns,
-                        o.samples_dropped,
-                        o.lead_ms.map_or("–".into(), |l| format!("{l:.0}"))
-                    ),
+                    o.underruns,
+                    o.samples_dropped,
+                    o.lead_ms.map_or("–".into(), |l| format!("{l:.0}")),
                     o.ticks,
                     o.missed,
                     o.tick_p99_us,
@@ -371,7 +369,8 @@ fn main() {
     line(format!(
         "Each row is one real-time session of {seconds} s of the built-in scene at 1 kHz, served by `play::run` on 127.0.0.1 to \
          Debian's `chromium --headless=new` pages driven through the DevTools Protocol. The first page plays: its pointer circles \
-         at 60 events/s (the page sends each move at once); the other pages watch and listen. Pages 0: a Rust WebSocket client \
+         and its wheel lowers and raises the hand about four times a second, tapping the ground or what lies on it (pointer \
+         and wheel take turns, 60 events/s in all; the page sends each at once); the other pages watch and listen. Pages 0: a Rust WebSocket client \
          sends the same moves instead of a browser (the loop and the server alone)."
     ));
     line(String::new());

@@ -211,9 +211,8 @@ impl SoundTicks {
             sounds.push(SoundOn {
                 tick: u64_at(b, at).ok_or_else(short)?,
                 index: u32_at(b, at + 8).ok_or_else(short)?,
-                kind: SoundKind::from_code(code).ok_or_else(|| {
-                    SoundTicksError(format!("sound kind {code} (allowed: 0–4)"))
-                })?,
+                kind: SoundKind::from_code(code)
+                    .ok_or_else(|| SoundTicksError(format!("sound kind {code} (allowed: 0–4)")))?,
                 amplitude: f64_at(at + 16).ok_or_else(short)?,
             });
         }

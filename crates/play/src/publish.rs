@@ -17,8 +17,7 @@
 //! tick, for captions and checks.
 
 use crate::protocol::{
-    EventAt, Frame, FrameView, ServerMsg, Shape, SoundAt, SoundKind, SoundOn, SoundTick,
-    SoundTicks,
+    EventAt, Frame, FrameView, ServerMsg, Shape, SoundAt, SoundKind, SoundOn, SoundTick, SoundTicks,
 };
 use crate::server::Shared;
 use haptic_loop::HapticLoop;

@@ -296,7 +296,10 @@ fn the_binary_row_gives_the_sound_ticks_layout_the_page_reads() {
     }
     for code in 0..5u32 {
         let k = SoundKind::from_code(code).unwrap();
-        assert!(row.fields.contains(&format!("{code} {}", k.name())), "{code}");
+        assert!(
+            row.fields.contains(&format!("{code} {}", k.name())),
+            "{code}"
+        );
     }
     assert_eq!(SoundKind::from_code(5), None);
     // The worklet reads the same sizes.
@@ -350,7 +353,9 @@ fn the_binary_row_gives_the_sound_ticks_layout_the_page_reads() {
         "sound ticks message: 10 bytes is too short"
     );
     assert_eq!(
-        SoundTicks::decode(&b[..b.len() - 1]).unwrap_err().to_string(),
+        SoundTicks::decode(&b[..b.len() - 1])
+            .unwrap_err()
+            .to_string(),
         "sound ticks message: 79 bytes for 2 ticks and 1 sounds (allowed: 80)"
     );
     let mut bad = b.clone();
