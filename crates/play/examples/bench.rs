@@ -466,7 +466,7 @@ fn main() {
     line(String::new());
     line(
         "Notes. The sound is synthesised on the page (an AudioWorklet running `render --audio`'s synthesis) from \
-         the ticks' sound input, which the server sends at once for a tick with events; the worklet keeps a 6 ms lead of \
+         the ticks' sound input, which the server sends at once for a tick with a sound; the worklet keeps a 6 ms lead of \
          samples. The sound's own path is the first two columns of the second table; the rest is the browser's output \
          latency, here headless Chromium's fake output device; a real sound card's latency takes its place. Missed \
          deadlines: the real-time loop waits for each period by sleeping and then spinning on one core; on this shared \

@@ -9,12 +9,12 @@
 //! [`haptic_loop::sound::sound_events`], the mapping `render --audio` uses, each with its index
 //! in the session's list of sounds) and its `nearest_m` (the proximity tone), with the tick's
 //! wall time, in a binary [`SoundTicks`] message. The tick thread hands its ticks over every
-//! [`SOUND_BLOCK_TICKS`] ticks, and at once for a tick with events and the tick after it (whose
-//! distance the tone needs to finish the sound's tick). The page's samples are therefore those
-//! of `nanohaptics render REC --audio OUT.wav --proximity` at the page's sample rate (the
-//! browser test compares them), except where that track needed its anti-clipping scale (live,
-//! samples beyond the ceiling are limited instead). The frames also carry each sound with its
-//! tick, for captions and checks.
+//! [`SOUND_BLOCK_TICKS`] ticks, and at once for a tick with a sound ([`SOUND_EVENTS`]) and the
+//! tick after it (whose distance the tone needs to finish the sound's tick). The page's
+//! samples are therefore those of `nanohaptics render REC --audio OUT.wav --proximity` at the
+//! page's sample rate (the browser test compares them), except where that track needed its
+//! anti-clipping scale (live, samples beyond the ceiling are limited instead). The frames also
+//! carry each sound with its tick, for captions and checks.
 
 use crate::protocol::{
     EventAt, Frame, FrameView, ServerMsg, Shape, SoundAt, SoundKind, SoundOn, SoundTick, SoundTicks,
@@ -36,6 +36,10 @@ pub const FRAME_EVERY_TICKS: u64 = 16;
 /// Ticks the tick thread hands over at once when nothing sounds (5 ms at 1 kHz): the most a
 /// [`SoundTicks`] message holds, short of a frame's.
 pub const SOUND_BLOCK_TICKS: u64 = 5;
+
+/// The events that make a sound (those [`haptic_loop::sound::sound_events`] reads): a tick
+/// with one is handed to the publisher at once.
+pub const SOUND_EVENTS: &[&str] = &["brick.impact", "nano.snap", "nano.pull_off"];
 
 /// A frame's drawing and state.
 pub struct FrameData {
@@ -79,7 +83,7 @@ pub enum ToPublisher {
         message: String,
     },
     /// Several of the above in order: the tick thread hands its ticks over every
-    /// [`SOUND_BLOCK_TICKS`] ticks, on a frame, and at once around a tick with events,
+    /// [`SOUND_BLOCK_TICKS`] ticks, on a frame, and at once around a tick with a sound,
     /// instead of waking the publisher every tick.
     Batch(Vec<ToPublisher>),
     /// The session ended after `ticks` ticks.
@@ -97,7 +101,7 @@ pub struct PlaySink {
     state: Vec<f64>,
     last_seq: u64,
     pending: Vec<ToPublisher>,
-    /// The last tick had events: hand this one over at once too.
+    /// The last tick had a sound: hand this one over at once too.
     flush_next: bool,
     /// Input-to-force latencies, ms (page event to the force of the first tick that used it).
     pub input_latency_ms: Vec<f64>,
@@ -171,14 +175,17 @@ impl Sink for PlaySink {
             .iter()
             .map(|e| (e.name.clone(), e.detail.clone()))
             .collect();
-        // A tick with events (a sound, perhaps) goes at once, and so does the next one (the
-        // proximity tone needs its distance to finish the sound's tick).
-        let has_events = !r.events.is_empty();
+        // A tick with a sound goes at once, and so does the next one (the proximity tone needs
+        // its distance to finish the sound's tick).
+        let sounds = r
+            .events
+            .iter()
+            .any(|e| SOUND_EVENTS.contains(&e.name.as_str()));
         let flush = frame.is_some()
-            || has_events
+            || sounds
             || self.flush_next
             || r.tick % SOUND_BLOCK_TICKS == SOUND_BLOCK_TICKS - 1;
-        self.flush_next = has_events;
+        self.flush_next = sounds;
         self.pending.push(ToPublisher::Tick {
             tick: r.tick,
             wall_ms,
