@@ -243,8 +243,24 @@ fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
         page["sound"]["messages"].as_u64(),
         Some(summary.published.sound_messages)
     );
-    // The page's audio ran at its context's rate, and reported the sounds it played.
+    // The page's audio ran at its context's rate, and its worklet played sounds: each one's
+    // tick → output latency measured once, a positive time under the session's length.
     assert!(page["sound"]["sampleRate"].as_f64().unwrap() >= 8000.0);
+    let played: Vec<f64> = page["sound"]["latencyMs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(
+        !played.is_empty() && played.len() <= want.len(),
+        "{} sounds played of {}",
+        played.len(),
+        want.len()
+    );
+    for ms in played {
+        assert!(ms > 0.0 && ms < 60_000.0, "{ms} ms");
+    }
 }
 
 /// The gravity switch's line in the menu (its value now and its range) and its input's value.
