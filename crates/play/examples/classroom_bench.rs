@@ -7,7 +7,7 @@
 //! The server (`play::classroom::run`) runs in this process; the students run in a child
 //! process (this program with `--clients`), so the server's CPU time is this process's alone.
 //! Each student joins by name, opens its page link, presses Start and moves its hand at 60
-//! inputs/s (each stamped with its wall time) while it reads every frame and sound block.
+//! inputs/s (each stamped with its wall time) while it reads every frame and sound-ticks message.
 //!
 //! Figures per run: missed 1 ms deadlines over every session's ticks, input → force (the
 //! input's wall time to the tick whose force used it, from the server), frames/s each page
@@ -275,7 +275,7 @@ fn main() {
          -- --students {n} --seconds {secs} --runs {runs} --out docs/bench/classroom.md`.\n\n\
          Each run serves one class (`play::classroom::run`, the built-in brick world at 1 kHz, \
          loopback) to {n} students in a second process: each joins by name, presses Start and \
-         moves its hand at 60 inputs/s for {secs} s while reading every frame and sound block. \
+         moves its hand at 60 inputs/s for {secs} s while reading every frame and sound-ticks message. \
          Missed deadlines are over every tick of every session (a missed tick sends zero force \
          and is recorded, so each session replays bit for bit); input → force is the input's \
          wall time to the tick whose force used it, per session (median and worst session's \

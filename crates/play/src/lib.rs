@@ -14,8 +14,9 @@
 //!   goes away.
 //! - **A real device too**: with [`PlayConfig::device`] a device bridged over UDP is the hand
 //!   and the pages only watch and listen.
-//! - **Live sound** ([`publish`]): the same synthesis as `render --audio --proximity`
-//!   ([`render::audio::StreamSynth`]), streamed to the pages in 5 ms blocks.
+//! - **Live sound** ([`publish`]): the pages synthesise it from each tick's sounds and distance
+//!   (sent as binary sound ticks), in an AudioWorklet that runs the same synthesis as
+//!   `render --audio --proximity` ([`render::audio::StreamSynth`]) at the page's sample rate.
 //! - **The live menu**: the scene's switches, set from a page and applied before the next tick
 //!   (through [`haptic_loop::runner::Runner::with_live`]), recorded as switches.
 //! - **The protocol** ([`protocol`]): one typed message enum per direction, [`protocol::ServerMsg`]
@@ -233,7 +234,7 @@ impl Hand {
 }
 
 /// The page's `hello`: the scene, the device, the view's mapping, the menu of switches with
-/// their values now, the state fields and the sound's sample rate.
+/// their values now and the state fields.
 fn hello_message(
     scene_name: &str,
     lp: &HapticLoop,
@@ -274,7 +275,6 @@ fn hello_message(
             })
             .collect(),
         state_fields: scene.state_fields(),
-        sample_rate_hz: publish::SAMPLE_RATE_HZ,
         seconds,
     })
 }

@@ -1,18 +1,23 @@
 //! What the pages see and hear: a sink on the tick thread that hands each tick's data to the
 //! publisher thread (an unbounded channel: the tick never waits), and the publisher, which
-//! builds the frames (about 60 per second), streams the sound and queues both for every page.
+//! builds the frames (about 60 per second) and the sound ticks and queues both for every page.
 //!
-//! **Sound.** The publisher feeds each tick's sounds (the recording's `brick.impact`,
-//! `nano.snap`, `nano.pull_off` events through [`haptic_loop::sound::sound_events`], the mapping
-//! `render --audio` uses) and its `nearest_m` (the proximity tone) to a
-//! [`render::audio::StreamSynth`] and sends the samples as they complete, in blocks of 5 ms.
-//! The samples a page receives are therefore those of `nanohaptics render REC --audio OUT.wav
-//! --proximity` for the session's recording, sample for sample, unless that track needed its
-//! anti-clipping scale (the summary's `sound_samples_limited` counts the live samples limited
-//! instead). The frames also carry each sound with its tick, for captions and checks.
+//! **Sound.** The page synthesises the sound itself, in an AudioWorklet (`synth.js`, a port of
+//! [`render::audio::StreamSynth`] run at the page's own sample rate). The publisher sends it,
+//! as soon as the tick thread hands them over, what that synthesis consumes of each tick: the
+//! tick's sounds (the recording's `brick.impact`, `nano.snap`, `nano.pull_off` events through
+//! [`haptic_loop::sound::sound_events`], the mapping `render --audio` uses, each with its index
+//! in the session's list of sounds) and its `nearest_m` (the proximity tone), with the tick's
+//! wall time, in a binary [`SoundTicks`] message. The tick thread hands its ticks over every
+//! [`SOUND_BLOCK_TICKS`] ticks, and at once for a tick with a sound ([`SOUND_EVENTS`]) and the
+//! tick after it (whose distance the tone needs to finish the sound's tick). The page's
+//! samples are therefore those of `nanohaptics render REC --audio OUT.wav --proximity` at the
+//! page's sample rate (the browser test compares them), except where that track needed its
+//! anti-clipping scale (live, samples beyond the ceiling are limited instead). The frames also
+//! carry each sound with its tick, for captions and checks.
 
 use crate::protocol::{
-    EventAt, Frame, FrameView, SOUND_BLOCK_HEADER_BYTES, ServerMsg, Shape, SoundAt,
+    EventAt, Frame, FrameView, ServerMsg, Shape, SoundAt, SoundKind, SoundOn, SoundTick, SoundTicks,
 };
 use crate::server::Shared;
 use haptic_loop::HapticLoop;
@@ -20,7 +25,7 @@ use haptic_loop::pacing::TickStats;
 use haptic_loop::session::{SessionArrays, now_unix_ns};
 use haptic_loop::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_types::Primitive;
-use render::audio::{Impact, Sound, StreamSynth};
+use render::audio::Sound;
 use std::collections::VecDeque;
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender};
@@ -28,10 +33,13 @@ use tungstenite::Message;
 
 /// Ticks between two frames (16 ticks: 62.5 frames/s at 1 kHz).
 pub const FRAME_EVERY_TICKS: u64 = 16;
-/// Ticks between two sound blocks (5 ms at 1 kHz).
+/// Ticks the tick thread hands over at once when nothing sounds (5 ms at 1 kHz): the most a
+/// [`SoundTicks`] message holds, short of a frame's.
 pub const SOUND_BLOCK_TICKS: u64 = 5;
-/// Sample rate of the live sound, Hz (the default of `render --audio`).
-pub const SAMPLE_RATE_HZ: u32 = render::audio::SAMPLE_RATE_HZ;
+
+/// The events that make a sound (those [`haptic_loop::sound::sound_events`] reads): a tick
+/// with one is handed to the publisher at once.
+pub const SOUND_EVENTS: &[&str] = &["brick.impact", "nano.snap", "nano.pull_off"];
 
 /// A frame's drawing and state.
 pub struct FrameData {
@@ -74,8 +82,9 @@ pub enum ToPublisher {
         /// Why.
         message: String,
     },
-    /// Several of the above in order: the tick thread hands its ticks over once per sound
-    /// block (or frame) instead of waking the publisher every tick.
+    /// Several of the above in order: the tick thread hands its ticks over every
+    /// [`SOUND_BLOCK_TICKS`] ticks, on a frame, and at once around a tick with a sound,
+    /// instead of waking the publisher every tick.
     Batch(Vec<ToPublisher>),
     /// The session ended after `ticks` ticks.
     Finish {
@@ -92,6 +101,8 @@ pub struct PlaySink {
     state: Vec<f64>,
     last_seq: u64,
     pending: Vec<ToPublisher>,
+    /// The last tick had a sound: hand this one over at once too.
+    flush_next: bool,
     /// Input-to-force latencies, ms (page event to the force of the first tick that used it).
     pub input_latency_ms: Vec<f64>,
 }
@@ -106,6 +117,7 @@ impl PlaySink {
             state: Vec::new(),
             last_seq: 0,
             pending: Vec::with_capacity(SOUND_BLOCK_TICKS as usize),
+            flush_next: false,
             input_latency_ms: Vec::new(),
         }
     }
@@ -163,7 +175,17 @@ impl Sink for PlaySink {
             .iter()
             .map(|e| (e.name.clone(), e.detail.clone()))
             .collect();
-        let flush = frame.is_some() || r.tick % SOUND_BLOCK_TICKS == SOUND_BLOCK_TICKS - 1;
+        // A tick with a sound goes at once, and so does the next one (the proximity tone needs
+        // its distance to finish the sound's tick).
+        let sounds = r
+            .events
+            .iter()
+            .any(|e| SOUND_EVENTS.contains(&e.name.as_str()));
+        let flush = frame.is_some()
+            || sounds
+            || self.flush_next
+            || r.tick % SOUND_BLOCK_TICKS == SOUND_BLOCK_TICKS - 1;
+        self.flush_next = sounds;
         self.pending.push(ToPublisher::Tick {
             tick: r.tick,
             wall_ms,
@@ -200,30 +222,21 @@ impl Sink for PlaySink {
 pub struct PublishSummary {
     /// Frames sent.
     pub frames: u64,
-    /// Sound samples streamed.
-    pub sound_samples: u64,
-    /// Live samples limited to the ceiling (0: the stream equals `render --audio`).
-    pub sound_samples_limited: u64,
+    /// Binary sound-tick messages sent.
+    pub sound_messages: u64,
+    /// Ticks the sound-tick messages carried.
+    pub sound_ticks: u64,
     /// Sounds (impacts, snaps, pull-offs) placed.
     pub sounds: u64,
     /// Events published.
     pub events: u64,
 }
 
-/// The page's name of a sound.
+/// The page's name of a sound (`thud`, `clack`, `tap`, `snap`, `pull_off`) and its peak
+/// amplitude (0–1 of full scale).
 pub fn sound_name(s: &Sound) -> (&'static str, f64) {
-    match *s {
-        Sound::Impact { kind, amplitude } => (
-            match kind {
-                Impact::BrickGround => "thud",
-                Impact::BrickBrick => "clack",
-                Impact::Cursor => "tap",
-            },
-            amplitude,
-        ),
-        Sound::Snap { amplitude } => ("snap", amplitude),
-        Sound::PullOff { amplitude } => ("pull_off", amplitude),
-    }
+    let (kind, amplitude) = SoundKind::of(s);
+    (kind.name(), amplitude)
 }
 
 /// Keeps the `hello` a page gets on connecting up to date with switch `name` = `value`, so a
@@ -247,6 +260,8 @@ fn refresh_hello(shared: &Shared, name: &str, value: f64) {
 }
 
 /// The publisher thread's loop: runs until the session's `Finish` (or the channel closes).
+/// `proximity_on_distance_m`: the distance below which the proximity tone sounds, m (`None`:
+/// no tone), sent to the pages with the ticks.
 pub fn run_publisher(
     rx: Receiver<ToPublisher>,
     shared: Arc<Shared>,
@@ -256,42 +271,40 @@ pub fn run_publisher(
 ) -> PublishSummary {
     let dt = 1.0 / f64::from(rate_hz.max(1));
     let mut sum = PublishSummary::default();
-    let mut synth = StreamSynth::new(SAMPLE_RATE_HZ, dt, proximity_on_distance_m).ok();
-    let sr = f64::from(SAMPLE_RATE_HZ);
     let mut scratch = SessionArrays::new(rate_hz, Vec::new());
-    let mut pcm: Vec<f32> = Vec::new();
-    let mut pcm_first: u64 = 0;
-    let mut tick_wall: VecDeque<(u64, f64)> = VecDeque::new();
     let mut events: Vec<EventAt> = Vec::new();
     let mut sounds: Vec<SoundAt> = Vec::new();
-    let send_pcm = |pcm: &mut Vec<f32>, first: &mut u64, walls: &mut VecDeque<(u64, f64)>| {
-        if pcm.is_empty() {
+    // The ticks not yet sent to the pages' synthesis.
+    let mut ticks = SoundTicks {
+        first_tick: 0,
+        tone_on_distance_m: proximity_on_distance_m,
+        ticks: Vec::new(),
+        sounds: Vec::new(),
+    };
+    let send_ticks = |ticks: &mut SoundTicks, sum: &mut PublishSummary| {
+        if ticks.ticks.is_empty() {
             return;
         }
-        let tick = (*first as f64 / sr / dt).floor() as u64;
-        while walls.len() > 1 && walls[0].0 < tick {
-            walls.pop_front();
-        }
-        let wall = walls.front().map_or(0.0, |w| w.1);
-        let mut b = Vec::with_capacity(SOUND_BLOCK_HEADER_BYTES + 4 * pcm.len());
-        b.extend_from_slice(&first.to_le_bytes());
-        b.extend_from_slice(&wall.to_le_bytes());
-        for s in pcm.iter() {
-            b.extend_from_slice(&s.to_le_bytes());
-        }
-        shared.broadcast(&Message::binary(b));
-        *first += pcm.len() as u64;
-        pcm.clear();
+        shared.broadcast(&Message::binary(ticks.encode()));
+        sum.sound_messages += 1;
+        sum.sound_ticks += ticks.ticks.len() as u64;
+        ticks.first_tick += ticks.ticks.len() as u64;
+        ticks.ticks.clear();
+        ticks.sounds.clear();
     };
     crate::background::lower_priority();
     let mut queue: VecDeque<ToPublisher> = VecDeque::new();
     loop {
         let m = match queue.pop_front() {
             Some(m) => m,
-            None => match rx.recv() {
-                Ok(m) => m,
-                Err(_) => break,
-            },
+            None => {
+                // All that was handed over is done: its sound goes out now.
+                send_ticks(&mut ticks, &mut sum);
+                match rx.recv() {
+                    Ok(m) => m,
+                    Err(_) => break,
+                }
+            }
         };
         match m {
             ToPublisher::Batch(list) => {
@@ -306,7 +319,12 @@ pub fn run_publisher(
                 nearest_m,
                 frame,
             } => {
-                tick_wall.push_back((tick, wall_ms));
+                if ticks.ticks.is_empty() || ticks.first_tick + ticks.ticks.len() as u64 != tick {
+                    // Ticks are consecutive; a message starts at the first tick it holds.
+                    send_ticks(&mut ticks, &mut sum);
+                    ticks.first_tick = tick;
+                }
+                ticks.ticks.push(SoundTick { wall_ms, nearest_m });
                 if !evs.is_empty() {
                     scratch.events.clear();
                     for (name, detail) in evs {
@@ -318,22 +336,21 @@ pub fn run_publisher(
                     // makes no sound (the recording keeps it; `render --audio` names it).
                     if let Ok(list) = haptic_loop::sound::sound_events(&scratch) {
                         for s in list {
+                            let (kind, amplitude) = SoundKind::of(&s.sound);
+                            sounds.push(SoundAt(tick, kind.name().to_string(), amplitude));
+                            ticks.sounds.push(SoundOn {
+                                tick,
+                                index: u32::try_from(sum.sounds).unwrap_or(u32::MAX),
+                                kind,
+                                amplitude,
+                            });
                             sum.sounds += 1;
-                            let (name, amplitude) = sound_name(&s.sound);
-                            sounds.push(SoundAt(tick, name.to_string(), amplitude));
-                            if let Some(sy) = synth.as_mut() {
-                                sy.push(&s);
-                            }
                         }
                     }
                 }
-                if let Some(sy) = synth.as_mut() {
-                    sy.tick(nearest_m, &mut pcm);
-                }
-                if tick % SOUND_BLOCK_TICKS == SOUND_BLOCK_TICKS - 1 {
-                    send_pcm(&mut pcm, &mut pcm_first, &mut tick_wall);
-                }
                 if let Some(f) = frame {
+                    // The sound first: the frame takes a while to write.
+                    send_ticks(&mut ticks, &mut sum);
                     let msg = ServerMsg::Frame(Frame {
                         tick,
                         time_s: tick as f64 * dt,
@@ -365,15 +382,12 @@ pub fn run_publisher(
                 };
                 shared.send_to(page, Message::text(m.to_json()));
             }
-            ToPublisher::Finish { ticks } => {
-                if let Some(sy) = synth.as_mut() {
-                    sy.finish(ticks as f64 * dt, &mut pcm);
-                }
-                send_pcm(&mut pcm, &mut pcm_first, &mut tick_wall);
+            ToPublisher::Finish { ticks: n } => {
+                send_ticks(&mut ticks, &mut sum);
                 // The last events and sounds, in a last frame without drawing.
                 let msg = ServerMsg::Frame(Frame {
-                    tick: ticks.saturating_sub(1),
-                    time_s: ticks as f64 * dt,
+                    tick: n.saturating_sub(1),
+                    time_s: n as f64 * dt,
                     view: None,
                     events: std::mem::take(&mut events),
                     sounds: std::mem::take(&mut sounds),
@@ -382,10 +396,6 @@ pub fn run_publisher(
                 break;
             }
         }
-    }
-    if let Some(sy) = synth.as_ref() {
-        sum.sound_samples = sy.emitted() as u64;
-        sum.sound_samples_limited = sy.limited();
     }
     sum
 }

@@ -86,6 +86,11 @@ pub const PAGE_FILES: &[PageFile] = &[
         body: include_str!("page/sound.js"),
     },
     PageFile {
+        path: "/synth.js",
+        content_type: JS,
+        body: include_str!("page/synth.js"),
+    },
+    PageFile {
         path: "/messages.js",
         content_type: JS,
         body: include_str!("page/messages.js"),
@@ -666,11 +671,16 @@ mod tests {
         last
     }
 
-    /// The `'./x.js'` module paths a page file imports (as served paths, `/x.js`).
+    /// The modules `body` imports, and those it loads by URL (`new URL('./synth.js',
+    /// import.meta.url)`: the AudioWorklet's module).
     fn imports(body: &str) -> Vec<String> {
-        body.lines()
+        let imported = body
+            .lines()
             .filter(|l| l.starts_with("import "))
-            .filter_map(|l| l.split("from './").nth(1))
+            .filter_map(|l| l.split("from './").nth(1));
+        let by_url = body.split("new URL('./").skip(1);
+        imported
+            .chain(by_url)
             .filter_map(|rest| rest.split('\'').next())
             .map(|m| format!("/{m}"))
             .collect()

@@ -1,7 +1,7 @@
 //! The game in a real browser: Debian's headless `chromium`, driven through the DevTools
 //! Protocol. A pointer session and a keyboard-only session each fill a blueprint slot of the
 //! brick world; their recordings replay bit for bit; the page received every sound event at its
-//! tick and the sound samples of `render --audio --proximity`; the Events list (the live
+//! tick and every tick's input of its sound synthesis; the Events list (the live
 //! region) speaks of the game only; the menu shows each switch's value as it changes; a
 //! scripted gamepad (injected through the DevTools Protocol: headless Chromium has none) moves
 //! the hand, grips and rumbles with the force; page errors fail the tests; screenshots go to
@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::cdp::{Browser, fnv1a};
+use common::cdp::Browser;
 use haptic_loop::session::{SceneSource, read_arrays};
 use play::{PlayConfig, PlayError, PlaySummary};
 use recording::read_recording_file;
@@ -232,20 +232,35 @@ fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
         "a session that places a brick makes sounds"
     );
     assert_eq!(got, want);
-    // And the samples: the page hashed every sample it received.
-    let track = haptic_loop::sound::session_sound(&arrays, "brickworld", true, 44_100).unwrap();
-    assert_eq!(summary.published.sound_samples_limited, 0);
-    assert_eq!(page["pcm"]["first"], 0);
+    // And the synthesis's input: every tick once, in order, each sound with it (the page
+    // synthesises the samples; tests/browser_sound.rs compares them with `render --audio`).
+    assert_eq!(summary.published.sound_ticks, summary.stats.ticks);
+    assert_eq!(page["sound"]["firstTick"], 0);
+    assert_eq!(page["sound"]["gaps"], 0);
+    assert_eq!(page["sound"]["ticks"].as_u64(), Some(summary.stats.ticks));
+    assert_eq!(page["sound"]["sounds"].as_u64(), Some(want.len() as u64));
     assert_eq!(
-        page["pcm"]["samples"].as_u64(),
-        Some(track.samples.len() as u64)
+        page["sound"]["messages"].as_u64(),
+        Some(summary.published.sound_messages)
     );
-    let h = fnv1a(track.samples.iter().flat_map(|s| s.to_le_bytes()));
-    assert_eq!(
-        page["pcm"]["hash"].as_u64(),
-        Some(u64::from(h)),
-        "the page's sound equals render --audio"
+    // The page's audio ran at its context's rate, and its worklet played sounds: each one's
+    // tick → output latency measured once, a positive time under the session's length.
+    assert!(page["sound"]["sampleRate"].as_f64().unwrap() >= 8000.0);
+    let played: Vec<f64> = page["sound"]["latencyMs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(
+        !played.is_empty() && played.len() <= want.len(),
+        "{} sounds played of {}",
+        played.len(),
+        want.len()
     );
+    for ms in played {
+        assert!(ms > 0.0 && ms < 60_000.0, "{ms} ms");
+    }
 }
 
 /// The gravity switch's line in the menu (its value now and its range) and its input's value.

@@ -63,7 +63,7 @@ fn link_student(
             if ws.send(Message::text(m.to_string())).is_err() {
                 break;
             }
-            // Everything waiting (frames, sound blocks, switches), until the socket is empty.
+            // Everything waiting (frames, sound ticks, switches), until the socket is empty.
             loop {
                 match ws.read() {
                     Ok(Message::Text(t)) => {

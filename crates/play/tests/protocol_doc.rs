@@ -14,7 +14,7 @@ const HEADER: &str = "| direction | type | fields (units) | when sent |";
 const SERVER: &str = "server → page";
 const PAGE: &str = "page → server";
 /// The one row whose message is not JSON (it has no `type`).
-const BINARY: &str = "binary sound block";
+const BINARY: &str = "binary sound ticks";
 
 fn crate_file(rel: &str) -> String {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(rel);
@@ -264,4 +264,104 @@ fn the_page_handles_every_server_message_and_sends_only_page_messages() {
     }
     let page: BTreeSet<String> = PageMsg::TYPES.iter().map(|s| s.to_string()).collect();
     assert_eq!(sent, page, "the page sends every page message and no other");
+}
+
+#[test]
+fn the_binary_row_gives_the_sound_ticks_layout_the_page_reads() {
+    use play::protocol::{
+        SOUND_ON_BYTES, SOUND_TICK_BYTES, SOUND_TICKS_HEADER_BYTES, SoundKind, SoundOn, SoundTick,
+        SoundTicks,
+    };
+    let rows = table(&crate_file("../../docs/play.md"));
+    let row = rows.iter().find(|r| r.kind == BINARY).unwrap();
+    // The sizes, the fields and the kinds' codes of the layout.
+    for s in [
+        format!("{SOUND_TICKS_HEADER_BYTES}-byte header"),
+        format!("{SOUND_TICK_BYTES} bytes per tick"),
+        format!("{SOUND_ON_BYTES} bytes per sound"),
+    ] {
+        assert!(row.fields.contains(&s), "the binary row says `{s}`");
+    }
+    for f in [
+        "first_tick",
+        "tone_on_distance_m",
+        "wall_ms",
+        "nearest_m",
+        "tick",
+        "index",
+        "kind",
+        "amplitude",
+    ] {
+        assert!(row.fields.contains(&format!("`{f}`")), "field `{f}`");
+    }
+    for code in 0..5u32 {
+        let k = SoundKind::from_code(code).unwrap();
+        assert!(
+            row.fields.contains(&format!("{code} {}", k.name())),
+            "{code}"
+        );
+    }
+    assert_eq!(SoundKind::from_code(5), None);
+    // The worklet reads the same sizes.
+    let synth = crate_file("src/page/synth.js");
+    assert!(synth.contains(&format!(
+        "const HEADER = {SOUND_TICKS_HEADER_BYTES}, TICK = {SOUND_TICK_BYTES}, SOUND = {SOUND_ON_BYTES};"
+    )));
+    // A message's bytes: the header, 16 per tick, 24 per sound; and back.
+    let m = SoundTicks {
+        first_tick: 417,
+        tone_on_distance_m: Some(0.1),
+        ticks: vec![
+            SoundTick {
+                wall_ms: 1.7e12 + 0.25,
+                nearest_m: 0.05,
+            },
+            SoundTick {
+                wall_ms: 1.7e12 + 1.25,
+                nearest_m: f64::NAN,
+            },
+        ],
+        sounds: vec![SoundOn {
+            tick: 418,
+            index: 3,
+            kind: SoundKind::Clack,
+            amplitude: 0.25,
+        }],
+    };
+    let b = m.encode();
+    assert_eq!(b.len(), 24 + 2 * 16 + 24);
+    assert_eq!(&b[0..8], &417u64.to_le_bytes());
+    assert_eq!(&b[16..20], &2u32.to_le_bytes());
+    assert_eq!(&b[20..24], &1u32.to_le_bytes());
+    assert_eq!(&b[56..64], &418u64.to_le_bytes());
+    assert_eq!(&b[68..72], &1u32.to_le_bytes());
+    let back = SoundTicks::decode(&b).unwrap();
+    assert_eq!(back.first_tick, 417);
+    assert_eq!(back.tone_on_distance_m, Some(0.1));
+    assert_eq!(back.sounds, m.sounds);
+    assert_eq!(back.ticks[0], m.ticks[0]);
+    assert!(back.ticks[1].nearest_m.is_nan());
+    // No tone: NaN on the wire. Bad bytes are errors, never a panic.
+    let none = SoundTicks {
+        tone_on_distance_m: None,
+        ticks: vec![m.ticks[0]],
+        ..m.clone()
+    };
+    assert_eq!(SoundTicks::decode(&none.encode()).unwrap(), none);
+    assert_eq!(
+        SoundTicks::decode(&b[..10]).unwrap_err().to_string(),
+        "sound ticks message: 10 bytes is too short"
+    );
+    assert_eq!(
+        SoundTicks::decode(&b[..b.len() - 1])
+            .unwrap_err()
+            .to_string(),
+        "sound ticks message: 79 bytes for 2 ticks and 1 sounds (allowed: 80)"
+    );
+    let mut bad = b.clone();
+    bad[68] = 9;
+    assert_eq!(
+        SoundTicks::decode(&bad).unwrap_err().to_string(),
+        "sound ticks message: sound kind 9 (allowed: 0–4)"
+    );
 }

@@ -300,6 +300,11 @@ fn tone(out: &mut [f64], p: &Proximity, sr: f64) {
 ///
 /// Latency: sample `k` needs the distance of the tick after the one it falls in (the tone is
 /// interpolated between tick centres), so it comes out at most two ticks after its time.
+///
+/// The browser game synthesises its sound with a port of this type, formula for formula, at
+/// the page's sample rate: `crates/play/src/page/synth.js` (an AudioWorklet processor). A
+/// change here is a change there; `crates/play/tests/browser_sound.rs` compares the two sample
+/// by sample on the golden recordings.
 #[derive(Debug)]
 pub struct StreamSynth {
     sr: f64,

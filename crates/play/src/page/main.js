@@ -1,10 +1,11 @@
-// nanohaptics play: the page. Draws the frames the server sends, sends the hand, plays the
-// sound blocks. Plain JavaScript modules, no library, built into the server:
+// nanohaptics play: the page. Draws the frames the server sends, sends the hand, synthesises
+// the sound from the server's sound ticks. Plain JavaScript modules, no library, built into the server:
 //   page.js      what the modules share (window.__play, the spoken log)
 //   camera.js    the orbit camera and the projection
 //   draw.js      a frame's shapes on the canvas
 //   input.js     pointer, keyboard and gamepad as the hand
-//   sound.js     the sound blocks on the Web Audio clock
+//   sound.js     the audio output and the sound ticks to the synthesis
+//   synth.js     the synthesis, an AudioWorklet processor (render --audio's, ported)
 //   messages.js  the WebSocket and a handler per message type
 //   events.js    the events in words: which the player hears, which stay in the recording
 // window.__play holds figures for tests and benches.

@@ -1,11 +1,11 @@
 // nanohaptics play: the link to the server. One WebSocket (`/ws` and the page's own query):
 // JSON text messages tagged by `type` (docs/play.md's table; crates/play/src/protocol.rs's
-// ServerMsg and PageMsg), each handled by its entry in HANDLERS, and binary sound blocks for
+// ServerMsg and PageMsg), each handled by its entry in HANDLERS, and binary sound ticks for
 // the sound module. The events' words are events.js's.
 
 import { $, P, log, say } from './page.js';
 import { aimAtWorkspace } from './camera.js';
-import { onPcm } from './sound.js';
+import { onSoundTicks } from './sound.js';
 import { eventClass, sentence } from './events.js';
 
 let ws = null;
@@ -161,14 +161,14 @@ const HANDLERS = new Map([
   ['end', onEnd],
 ]);
 
-// Opens the link: text messages to their handlers, binary ones to the sound.
+// Opens the link: text messages to their handlers, binary ones (sound ticks) to the sound.
 export function connect() {
   // `/ws` with the page's own query (a classroom's `?s=TOKEN` comes back with the link).
   const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
   ws = new WebSocket(`${scheme}://${location.host}/ws${location.search}`);
   ws.binaryType = 'arraybuffer';
   ws.onmessage = (ev) => {
-    if (typeof ev.data !== 'string') { onPcm(ev.data); return; }
+    if (typeof ev.data !== 'string') { onSoundTicks(ev.data); return; }
     const m = JSON.parse(ev.data);
     const handle = HANDLERS.get(m.type);
     if (handle) handle(m);

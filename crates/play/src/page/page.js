@@ -8,8 +8,12 @@ export const $ = (id) => document.getElementById(id);
 export const P = (window.__play = {
   hello: null, role: null, frames: 0, draws: 0, drawT0: 0, lastFrame: null,
   events: [], sounds: [], switched: [], errors: [], ended: null,
-  pcm: { first: -1, samples: 0, hash: 0x811c9dc5, blocks: 0, underruns: 0, early: 0, rebased: 0 },
-  audioLatencyMs: [], audioParts: [], outputLatencyS: null, inputsSent: 0,
+  sound: {
+    messages: 0, ticks: 0, sounds: 0, firstTick: -1, nextTick: 0, gaps: 0, sampleRate: null,
+    underruns: 0, dropped: 0, limited: 0, leadMs: null, outputLatencyS: null, baseLatencyS: null,
+    latencyMs: [], latencyTsMs: [], parts: [],
+  },
+  inputsSent: 0,
   said: [], menu: {},
 });
 

@@ -1,20 +1,37 @@
-// nanohaptics play: sound. Plays the server's binary sound blocks (a 16-byte header: the first
-// sample's index, u64 little-endian, and its tick's wall time, f64 ms since the Unix epoch;
-// then f32 little-endian mono samples at the hello's sample_rate_hz) on a Web Audio clock a
-// little ahead of now, and measures tick-to-speaker latency for the benches.
+// nanohaptics play: sound. The page synthesises it: the server's binary sound ticks (per tick
+// its wall time and the distance to the nearest object, and the sounds that start on it; see
+// protocol.rs's SoundTicks) go to an AudioWorklet (synth.js), which runs the same synthesis as
+// `nanohaptics render REC --audio OUT.wav --proximity` at the AudioContext's own sample rate.
+// The audio starts on the Start press (a user gesture); `m` mutes it. For the benches, each
+// sound's tick → output latency is measured when the worklet renders its first sample.
 
 import { P, say } from './page.js';
 
-const HEADER_BYTES = 16;
-let actx = null, gain = null, muted = false, base = null;
-const LEAD_S = 0.02; // jitter buffer: the blocks' arrival jitter on loopback is ~10 ms
+let actx = null, gain = null, node = null, muted = false;
+let waiting = []; // sound ticks received while the worklet loads
+// Sound queued before playback starts (and kept at most), s: covers the ticks' arrival
+// jitter and the audio thread's bursts; the worklet lengthens it after an underrun.
+const LEAD_S = 0.006;
+const SYNTH_URL = new URL('./synth.js', import.meta.url);
 
-// Opens the audio output at the hello's sample rate (on the Start press: a user gesture).
+// Opens the audio output (on the Start press: a user gesture) and loads the synthesis.
 export function startAudio() {
   try {
-    actx = new AudioContext({ sampleRate: P.hello.sample_rate_hz, latencyHint: 'interactive' });
-    gain = actx.createGain(); gain.connect(actx.destination);
+    actx = new AudioContext({ latencyHint: 'interactive' });
+    gain = actx.createGain(); gain.gain.value = muted ? 0 : 1; gain.connect(actx.destination);
     actx.resume();
+    P.sound.sampleRate = actx.sampleRate;
+    P.sound.baseLatencyS = actx.baseLatency || 0;
+    actx.audioWorklet.addModule(SYNTH_URL).then(() => {
+      node = new AudioWorkletNode(actx, 'nh-synth', {
+        numberOfInputs: 0, numberOfOutputs: 1, outputChannelCount: [1],
+        processorOptions: { rateHz: P.hello ? P.hello.rate_hz : 1000, leadS: LEAD_S },
+      });
+      node.port.onmessage = (e) => onRendered(e.data);
+      node.connect(gain);
+      for (const b of waiting) node.port.postMessage(b, [b]);
+      waiting = [];
+    }).catch(() => { node = null; say('sound is not available in this browser'); });
   } catch (err) { actx = null; say('sound is not available in this browser'); }
 }
 
@@ -25,47 +42,41 @@ export function toggleMute() {
   say(muted ? 'sound off' : 'sound on');
 }
 
-// One binary sound block (an ArrayBuffer): hashed for the tests, then scheduled.
-export function onPcm(buf) {
-  const dv = new DataView(buf);
-  const first = Number(dv.getBigUint64(0, true));
-  const wallMs = dv.getFloat64(8, true);
-  const bytes = new Uint8Array(buf, HEADER_BYTES);
-  const n = bytes.length / 4;
-  const pc = P.pcm;
-  if (pc.first < 0) pc.first = first;
-  let h = pc.hash;
-  for (let i = 0; i < bytes.length; i++) { h ^= bytes[i]; h = Math.imul(h, 0x01000193) >>> 0; }
-  pc.hash = h; pc.samples += n; pc.blocks++;
-  if (!actx || n === 0) return;
-  const sr = P.hello.sample_rate_hz;
-  const data = new Float32Array(buf.slice(HEADER_BYTES));
-  const ab = actx.createBuffer(1, n, sr);
-  ab.copyToChannel(data, 0);
-  if (base === null || base + first / sr < actx.currentTime + 0.005) {
-    if (base !== null) pc.underruns++;
-    base = actx.currentTime + LEAD_S - first / sr;
+// One binary sound-ticks message (an ArrayBuffer): counted, then to the worklet.
+export function onSoundTicks(buf) {
+  const s = P.sound;
+  if (buf.byteLength >= 24) {
+    const dv = new DataView(buf);
+    const first = Number(dv.getBigUint64(0, true));
+    if (s.firstTick < 0) s.firstTick = first;
+    else if (first !== s.nextTick) s.gaps++;
+    const nt = dv.getUint32(16, true);
+    s.nextTick = first + nt; s.ticks += nt; s.sounds += dv.getUint32(20, true);
   }
-  let at = base + first / sr;
-  // Blocks that keep arriving early (a late first block, clock drift): come back to the lead.
-  const slack = at - actx.currentTime;
-  if (slack > LEAD_S + 0.008) {
-    if (++pc.early > 20) { base -= slack - LEAD_S; at = base + first / sr; pc.early = 0; pc.rebased++; }
-  } else pc.early = 0;
-  const src = actx.createBufferSource(); src.buffer = ab; src.connect(gain); src.start(at);
-  // Tick to speaker: when this block's first sample leaves the output (the output timestamp
-  // maps the context's clock to the page's; it already counts the output device's latency),
-  // minus its tick's wall time. Parts: tick → block here, the scheduling lead, and the
-  // browser's output pipeline (the rest).
-  if (actx.getOutputTimestamp && wallMs > 0) {
-    const ts = actx.getOutputTimestamp();
-    P.outputLatencyS = actx.outputLatency || 0;
-    if (ts.performanceTime > 0 && P.audioLatencyMs.length < 100000) {
-      const nowWall = performance.timeOrigin + performance.now();
-      const playWall = performance.timeOrigin + ts.performanceTime + (at - ts.contextTime) * 1000;
-      const total = playWall - wallMs, arrive = nowWall - wallMs, lead = (at - actx.currentTime) * 1000;
-      P.audioLatencyMs.push(total);
-      P.audioParts.push([arrive, lead, total - arrive - lead]);
-    }
+  s.messages++;
+  if (!actx) return;
+  if (node) node.port.postMessage(buf, [buf]);
+  else if (waiting.length < 2000) waiting.push(buf);
+}
+
+// The worklet rendered a sound's first sample: tick → output, two ways. `latencyMs`: the
+// render time (the audio thread's Date.now() for the render quantum, plus the frame's place
+// in it) plus the context's baseLatency and outputLatency, minus the tick's wall time.
+// `latencyTsMs`: the frame's context time mapped to the page's clock through
+// getOutputTimestamp() (the output's own estimate of when it plays), minus the same.
+function onRendered(m) {
+  const s = P.sound;
+  s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs;
+  if (s.latencyMs.length >= 100000) return;
+  const outS = actx.outputLatency || 0, baseS = actx.baseLatency || 0;
+  s.outputLatencyS = outS; s.baseLatencyS = baseS;
+  const rendered = m.renderMs + (m.frame / m.sampleRate) * 1000;
+  s.latencyMs.push(rendered + (outS + baseS) * 1000 - m.wallMs);
+  // Parts: tick → the worklet has it, queued in the worklet, the output's latency.
+  s.parts.push([m.gotMs - m.wallMs, rendered - m.gotMs, (outS + baseS) * 1000]);
+  const ts = actx.getOutputTimestamp ? actx.getOutputTimestamp() : null;
+  if (ts && ts.performanceTime > 0) {
+    const out = performance.timeOrigin + ts.performanceTime + (m.contextTime - ts.contextTime) * 1000;
+    s.latencyTsMs.push(out - m.wallMs);
   }
 }

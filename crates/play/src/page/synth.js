@@ -1,0 +1,309 @@
+// nanohaptics play: the sound synthesis, an AudioWorklet processor (loaded by sound.js with
+// audioWorklet.addModule; it runs on the audio thread). A port of crates/render/src/audio.rs's
+// StreamSynth, formula for formula in the same f64 arithmetic, at the AudioContext's sample
+// rate: impacts, snap and pull-off voices (0.5 ms attack, exponential decay, each normalised to
+// its peak amplitude), the proximity tone (220 Hz → 880 Hz below the on-distance, pitch and
+// amplitude interpolated between tick centres, phase continuous), and samples beyond the
+// ±0.98 ceiling limited to it. Its input is the server's binary sound ticks (protocol.rs's
+// SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it.
+//
+// The samples go through a FIFO to the output: playback starts once `leadS` of sound is
+// queued; an underrun plays silence, lengthens the lead by 1 ms (up to 50 ms) and waits for
+// it again, and each second without one shortens it by 1 ms (down to `leadS`); a FIFO that
+// stays fuller than the lead for 0.1 s drops the excess (counted). For each sound's first sample the processor reports
+// when it was rendered (Date.now() at the render quantum, the frame within it, the context
+// time) so the page can measure tick → output. With `offline` options (a test's
+// OfflineAudioContext) it takes all its ticks at construction and plays from sample 0.
+
+const A_MAX = 0.8, CEILING = 0.98, ATTACK_S = 5e-4, TONE_AMPLITUDE = 0.12;
+const TAU = 2 * Math.PI; // std::f64::consts::TAU
+const SILENT = [0, 0];
+const HEADER = 24, TICK = 16, SOUND = 24;
+
+// 64-bit unsigned arithmetic on [hi, lo] 32-bit halves (the noise is xorshift64*).
+function mul64(ah, al, bh, bl) {
+  const a48 = ah >>> 16, a32 = ah & 0xffff, a16 = al >>> 16, a00 = al & 0xffff;
+  const b48 = bh >>> 16, b32 = bh & 0xffff, b16 = bl >>> 16, b00 = bl & 0xffff;
+  let c48 = 0, c32 = 0, c16 = 0, c00 = 0;
+  c00 += a00 * b00; c16 += c00 >>> 16; c00 &= 0xffff;
+  c16 += a16 * b00; c32 += c16 >>> 16; c16 &= 0xffff;
+  c16 += a00 * b16; c32 += c16 >>> 16; c16 &= 0xffff;
+  c32 += a32 * b00; c48 += c32 >>> 16; c32 &= 0xffff;
+  c32 += a16 * b16; c48 += c32 >>> 16; c32 &= 0xffff;
+  c32 += a00 * b32; c48 += c32 >>> 16; c32 &= 0xffff;
+  c48 += a48 * b00 + a32 * b16 + a16 * b32 + a00 * b48; c48 &= 0xffff;
+  return [((c48 << 16) | c32) >>> 0, ((c16 << 16) | c00) >>> 0];
+}
+
+// audio.rs's Noise: xorshift64* seeded with seed · 0x9E3779B97F4A7C15 | 1, values in [-1, 1).
+class Noise {
+  constructor(seed) {
+    const [h, l] = mul64(0, seed >>> 0, 0x9e3779b9, 0x7f4a7c15);
+    this.h = h; this.l = (l | 1) >>> 0;
+  }
+  next() {
+    let h = this.h, l = this.l, nh, nl;
+    // x ^= x >> 12
+    nl = (l >>> 12) | (h << 20); nh = h >>> 12; h = (h ^ nh) >>> 0; l = (l ^ nl) >>> 0;
+    // x ^= x << 25
+    nh = (h << 25) | (l >>> 7); nl = l << 25; h = (h ^ nh) >>> 0; l = (l ^ nl) >>> 0;
+    // x ^= x >> 27
+    nl = (l >>> 27) | (h << 5); nh = h >>> 27; h = (h ^ nh) >>> 0; l = (l ^ nl) >>> 0;
+    this.h = h; this.l = l;
+    const [mh, ml] = mul64(h, l, 0x2545f491, 0x4f6cdd1d);
+    // v = x · 0x2545F4914F6CDD1D >> 11 (53 bits: exact as a double)
+    const v = (mh >>> 11) * 4294967296 + (((ml >>> 11) | (mh << 21)) >>> 0);
+    return v / 9007199254740992 * 2 - 1;
+  }
+}
+
+// audio.rs's voice: (length s, waveform of τ s after the onset, before normalising).
+function voice(kind, seed) {
+  const attack = (tau) => Math.min(tau / ATTACK_S, 1);
+  const noise = new Noise(seed);
+  if (kind <= 2) {
+    const [f1, f2, decay, mix] = [[140.0, 310.0, 0.060, 0.35], [520.0, 1250.0, 0.040, 0.25], [900.0, 2100.0, 0.015, 0.15]][kind];
+    return [6.0 * decay, (tau) => {
+      const env = attack(tau) * Math.exp(-tau / decay);
+      const tone = 0.65 * Math.sin(TAU * f1 * tau) + 0.35 * Math.sin(TAU * f2 * tau);
+      return env * ((1.0 - mix) * tone + mix * noise.next());
+    }];
+  }
+  if (kind === 3) {
+    return [0.012, (tau) => attack(tau) * Math.exp(-tau / 0.002) * Math.sin(TAU * 2400.0 * tau)];
+  }
+  return [0.05, (tau) => {
+    const env = attack(tau) * Math.exp(-tau / 0.008);
+    const phase = TAU * (300.0 * tau + 600.0 * 0.01 * (1.0 - Math.exp(-tau / 0.01)));
+    return env * Math.sin(phase);
+  }];
+}
+
+// audio.rs's event_samples: the first sample index and the samples one sound adds (null: none).
+function eventSamples(tS, kind, amplitude, index, sr) {
+  if (!(Number.isFinite(tS) && tS >= 0)) return null;
+  const a = Math.min(Math.max(amplitude, 0), A_MAX);
+  if (a === 0) return null;
+  const start = Math.round(tS * sr);
+  const [lenS, wave] = voice(kind, index + 1);
+  const len = Math.ceil(lenS * sr);
+  const s = new Float64Array(len);
+  let norm = 0;
+  for (let k = 0; k < len; k++) { const v = wave(k / sr); norm = Math.max(norm, Math.abs(v)); s[k] = v; }
+  const g = norm > 0 ? a / norm : 0;
+  for (let k = 0; k < len; k++) s[k] = g * s[k];
+  return [start, s];
+}
+
+// audio.rs's tone_at: (pitch Hz, amplitude) at distance d, (0, 0) when silent or unknown.
+function toneAt(d, on) {
+  if (d === undefined || !(Number.isFinite(d) && d < on && on > 0)) return [0, 0];
+  const x = Math.min(Math.max(1.0 - Math.max(d, 0) / on, 0), 1);
+  return [220.0 * Math.pow(4, x), TONE_AMPLITUDE];
+}
+
+// audio.rs's StreamSynth, from tick `firstTick` on; samples go to `out(v)` as they complete.
+class StreamSynth {
+  constructor(sr, dt, on, firstTick, out) {
+    this.sr = sr; this.dt = dt; this.on = on; this.out = out;
+    this.pending = []; this.ph = 0; // sums of the sounds from nextSample on
+    this.distances = []; this.dh = 0;
+    this.baseTick = firstTick; this.ticks = firstTick;
+    // The first sample of tick `firstTick` (0 from the session's start).
+    let k = Math.floor(firstTick * dt * sr);
+    while (k > 0 && Math.floor((k - 1) / sr / dt) >= firstTick) k--;
+    while (Math.floor(k / sr / dt) < firstTick) k++;
+    this.nextSample = k;
+    this.phase = 0; this.lastF = 220.0;
+    this.limited = 0;
+  }
+  push(tS, kind, amplitude, index) {
+    const e = eventSamples(tS, kind, amplitude, index, this.sr);
+    if (e === null) return;
+    const [start, s] = e;
+    for (let k = 0; k < s.length; k++) {
+      const rel = start + k - this.nextSample;
+      if (rel < 0) continue;
+      const at = this.ph + rel;
+      while (this.pending.length <= at) this.pending.push(0);
+      this.pending[at] += s[k];
+    }
+  }
+  // The tone's (pitch, amplitude) at each tick are kept rather than its distance: the same
+  // values, computed once per tick.
+  tick(d) { this.distances.push(this.on === null ? null : toneAt(d, this.on)); this.ticks++; this.emit(-1); }
+  finish(durationS) { this.emit(Math.round(durationS * this.sr)); }
+  at(j) {
+    const r = j - this.baseTick;
+    const v = r >= 0 ? this.distances[this.dh + r] : undefined;
+    return v === undefined ? SILENT : v;
+  }
+  emit(end) {
+    const sr = this.sr, dt = this.dt;
+    for (;;) {
+      const k = this.nextSample;
+      if (end >= 0 && k >= end) break;
+      const t = k / sr / dt;
+      const i = Math.floor(t);
+      if (end < 0 && i + 1 >= this.ticks) break;
+      let v = 0;
+      if (this.ph < this.pending.length) v = this.pending[this.ph++];
+      if (this.on !== null) {
+        const w = t - Math.floor(t);
+        const [f0, a0] = this.at(i), [f1, a1] = this.at(i + 1);
+        const amp = a0 * (1.0 - w) + a1 * w;
+        let f;
+        if (a0 > 0 && a1 > 0) f = f0 * (1.0 - w) + f1 * w;
+        else if (a0 > 0) f = f0;
+        else if (a1 > 0) f = f1;
+        else f = this.lastF;
+        this.lastF = f;
+        this.phase = (this.phase + TAU * f / sr) % TAU;
+        v += amp * Math.sin(this.phase);
+      }
+      if (Math.abs(v) > CEILING) { this.limited++; v = v < 0 ? -CEILING : CEILING; }
+      this.out(v);
+      this.nextSample++;
+      while (this.baseTick < i && this.dh < this.distances.length) { this.dh++; this.baseTick++; }
+    }
+    if (this.ph > 4096 && this.ph * 2 > this.pending.length) { this.pending.splice(0, this.ph); this.ph = 0; }
+    if (this.dh > 4096) { this.distances.splice(0, this.dh); this.dh = 0; }
+  }
+}
+
+// The samples waiting for the output (Float32: the cast of StreamSynth's `v as f32`), with the
+// session index of the first one.
+class Fifo {
+  constructor() { this.buf = new Float32Array(1 << 14); this.head = 0; this.tail = 0; this.first = 0; }
+  get length() { return this.tail - this.head; }
+  push(v) {
+    if (this.tail === this.buf.length) {
+      const n = this.length;
+      if (n * 2 > this.buf.length) {
+        const b = new Float32Array(this.buf.length * 2);
+        b.set(this.buf.subarray(this.head, this.tail)); this.buf = b;
+      } else this.buf.copyWithin(0, this.head, this.tail);
+      this.head = 0; this.tail = n;
+    }
+    this.buf[this.tail++] = v;
+  }
+  // Moves up to out.length samples to `out` from `at`; returns how many.
+  take(out, at) {
+    const n = Math.min(out.length - at, this.length);
+    out.set(this.buf.subarray(this.head, this.head + n), at);
+    this.head += n; this.first += n;
+    return n;
+  }
+  drop(n) { n = Math.min(n, this.length); this.head += n; this.first += n; }
+  clear(first) { this.head = 0; this.tail = 0; this.first = first; }
+}
+
+class Synth extends AudioWorkletProcessor {
+  constructor(options) {
+    super();
+    const o = options.processorOptions || {};
+    this.dt = 1 / (o.rateHz || 1000);
+    this.fifo = new Fifo();
+    this.synth = null;
+    this.onsets = []; // [sample index, tick, tick wall ms, arrival ms]
+    this.lead = this.lead0 = Math.round((o.leadS || 0) * sampleRate);
+    this.calm = 0; // samples played since the last underrun or lead change
+    this.primed = false;
+    this.underruns = 0; this.dropped = 0;
+    this.minLevel = Infinity; this.quanta = 0;
+    this.offline = !!o.offline;
+    if (o.offline) {
+      for (const b of o.offline.blocks) this.take(b, 0);
+      if (this.synth) this.synth.finish(o.offline.ticks * this.dt);
+      this.primed = true;
+    }
+    this.port.onmessage = (e) => this.take(e.data, Date.now());
+  }
+
+  // One binary sound-ticks message.
+  take(buf, gotMs) {
+    const dv = new DataView(buf);
+    if (buf.byteLength < HEADER) return;
+    const first = Number(dv.getBigUint64(0, true));
+    const onRaw = dv.getFloat64(8, true);
+    const on = Number.isNaN(onRaw) ? null : onRaw;
+    const nt = dv.getUint32(16, true), ns = dv.getUint32(20, true);
+    if (buf.byteLength !== HEADER + TICK * nt + SOUND * ns) return;
+    let s = this.synth;
+    // A gap (messages the server dropped for this page): silent ticks; a long one, a restart.
+    if (s !== null && first > s.ticks && first - s.ticks > 5000) s = null;
+    if (s === null) {
+      s = this.synth = new StreamSynth(sampleRate, this.dt, on, first, (v) => this.fifo.push(v));
+      this.fifo.clear(s.nextSample); this.primed = this.offline; this.onsets = [];
+    }
+    while (s.ticks < first) s.tick(NaN);
+    let j = 0;
+    const soundAt = HEADER + TICK * nt;
+    for (let i = 0; i < nt; i++) {
+      const tick = first + i;
+      const wallMs = dv.getFloat64(HEADER + TICK * i, true);
+      for (; j < ns; j++) {
+        const at = soundAt + SOUND * j;
+        const st = Number(dv.getBigUint64(at, true));
+        if (st > tick) break;
+        if (st < tick || tick < s.ticks) continue;
+        const tS = st * this.dt;
+        s.push(tS, dv.getUint32(at + 12, true), dv.getFloat64(at + 16, true), dv.getUint32(at + 8, true));
+        const k = Math.round(tS * sampleRate);
+        if (!this.offline && k >= s.nextSample && this.onsets.length < 1000) this.onsets.push([k, st, wallMs, gotMs]);
+      }
+      if (tick < s.ticks) continue; // already had
+      s.tick(dv.getFloat64(HEADER + TICK * i + 8, true));
+    }
+  }
+
+  process(inputs, outputs) {
+    const out = outputs[0][0];
+    if (!out) return true;
+    const fifo = this.fifo;
+    if (!this.primed && fifo.length >= Math.max(this.lead, 1)) this.primed = true;
+    if (!this.primed) { out.fill(0); return true; }
+    // Too much queued for a while: come back to the lead (over ~0.1 s of quanta).
+    this.minLevel = Math.min(this.minLevel, fifo.length);
+    if (++this.quanta >= Math.ceil(0.1 * sampleRate / out.length)) {
+      if (!this.offline && this.minLevel > this.lead + out.length) {
+        const n = this.minLevel - this.lead;
+        fifo.drop(n); this.dropped += n;
+      }
+      this.minLevel = Infinity; this.quanta = 0;
+    }
+    const from = fifo.first;
+    const n = fifo.take(out, 0);
+    if (n < out.length) {
+      out.fill(0, n);
+      if (!this.offline) {
+        // An underrun: wait for the lead again, a millisecond longer (up to 50 ms).
+        this.underruns++; this.primed = false;
+        this.lead = Math.min(this.lead + Math.round(0.001 * sampleRate), Math.round(0.05 * sampleRate));
+        this.calm = 0;
+      }
+    } else if (!this.offline && (this.calm += n) >= sampleRate && this.lead > this.lead0) {
+      // A second without an underrun: a millisecond shorter, down to the first lead.
+      this.lead = Math.max(this.lead0, this.lead - Math.round(0.001 * sampleRate));
+      this.calm = 0;
+    }
+    // Report the sounds whose first sample is in this quantum (or was dropped).
+    if (this.onsets.length && this.onsets[0][0] < from + n) {
+      const renderMs = Date.now();
+      while (this.onsets.length && this.onsets[0][0] < from + n) {
+        const [k, tick, wallMs, gotMs] = this.onsets.shift();
+        if (k < from) continue;
+        const frame = k - from;
+        this.port.postMessage({
+          tick, wallMs, gotMs, renderMs, frame, sampleRate,
+          contextTime: currentTime + frame / sampleRate,
+          underruns: this.underruns, dropped: this.dropped, limited: this.synth ? this.synth.limited : 0,
+          level: fifo.length, leadMs: this.lead / sampleRate * 1000,
+        });
+      }
+    }
+    return true;
+  }
+}
+
+registerProcessor('nh-synth', Synth);
