@@ -1,6 +1,8 @@
 //! The cost of a world where everything is awake: one and two layers of 100 bricks with
 //! sleeping off, and a 200-brick wall knocked over. Prints thread-CPU p50 / p99 / max per tick.
-//! Run: `cargo run --release -p brickworld --example brickworld-awake [-- ticks]`.
+//! Run: `cargo run --release -p brickworld --example brickworld-awake [-- ticks [scene]]`.
+//! `BRICKWORLD_SOLVER=scene` times the shipped brick scene's solver setting; it may also hold
+//! `[brickworld.params]` lines (`solver_iterations = 1`, ...); unset, the defaults.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
@@ -25,9 +27,14 @@ fn main() {
         .unwrap_or(3000);
     // Optional second argument: run only the scenes whose name contains it.
     let only = std::env::args().nth(2).unwrap_or_default();
+    let base = common::solver_from_env();
+    println!(
+        "solver: {} iterations, contacts {} Hz",
+        base.solver_iterations, base.contact_frequency_hz
+    );
     let off = Params {
         sleeping: false,
-        ..Params::default()
+        ..base.clone()
     };
     for (name, k) in [
         ("100 bricks, one layer, sleeping off", 1),
@@ -43,10 +50,7 @@ fn main() {
         line(name, &time_parked(&mut w, n));
     }
     for (name, p) in [
-        (
-            "200-brick wall knocked over, sleeping on",
-            Params::default(),
-        ),
+        ("200-brick wall knocked over, sleeping on", base.clone()),
         ("200-brick wall knocked over, sleeping off", off.clone()),
     ] {
         if !name.contains(&only) {

@@ -110,6 +110,48 @@ fn stack_error(p: &Params) -> (f64, f64) {
     (sink, drift)
 }
 
+/// A 200-brick wall of 20 courses in running bond, sleeping off: (largest motion of any
+/// brick from 1 s to 5 s, m; how far the top course settled below the exact wall, m).
+fn wall_error(p: &Params) -> (f64, f64) {
+    let mut p = Params {
+        sleeping: false,
+        loading_zone: None,
+        ..p.clone()
+    };
+    let h = p.brick_half_extents_m;
+    for c in 0..20 {
+        let shift = if c % 2 == 0 { 0.0 } else { h[0] };
+        for i in 0..10 {
+            p.bricks.push(at([
+                (i as f64 - 4.5) * (2.0 * h[0] + 0.001) + shift - h[0] / 2.0,
+                0.0,
+                h[2] * (2 * c + 1) as f64,
+            ]));
+        }
+    }
+    let top0 = h[2] * 39.0;
+    let mut w = World::new(&p, &Limits::FALCON).unwrap();
+    for _ in 0..1000 {
+        step_idle(&mut w, [1.0, 1.0, 1.0]);
+    }
+    let settled: Vec<[f64; 3]> = w.bricks().map(|b| b.position_m).collect();
+    for _ in 0..4000 {
+        step_idle(&mut w, [1.0, 1.0, 1.0]);
+    }
+    let drift = w
+        .bricks()
+        .zip(&settled)
+        .map(|(b, s)| {
+            (0..3)
+                .map(|k| (b.position_m[k] - s[k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .fold(0.0, f64::max);
+    let top = w.bricks().map(|b| b.position_m[2]).fold(0.0, f64::max);
+    (drift, top0 - top)
+}
+
 /// Worst sink (m) of the cursor sphere into a resting brick pressed at `speed` m/s.
 fn press_error(p: &Params, speed: f64) -> f64 {
     let mut p = p.clone();
@@ -135,12 +177,12 @@ fn press_error(p: &Params, speed: f64) -> f64 {
 }
 
 /// Flat-drop bounce ratio h1/h0 for restitution e.
-fn bounce(e: f64) -> f64 {
+fn bounce(base: &Params, e: f64) -> f64 {
     let mut p = Params {
         loading_zone: None,
         restitution: e,
         sleeping: false,
-        ..Params::default()
+        ..base.clone()
     };
     let hz = p.brick_half_extents_m[2];
     p.bricks = vec![at([0.0, 0.0, hz + 0.5])];
@@ -163,12 +205,12 @@ fn bounce(e: f64) -> f64 {
 }
 
 /// Displacement (m) of a brick left 1 s on a ramp of `theta_deg` with friction `mu`.
-fn slide(mu: f64, theta_deg: f64) -> f64 {
+fn slide(base: &Params, mu: f64, theta_deg: f64) -> f64 {
     let mut p = Params {
         loading_zone: None,
         friction: mu,
         restitution: 0.0,
-        ..Params::default()
+        ..base.clone()
     };
     let h = p.brick_half_extents_m;
     p.obstacles = vec![brickworld::Obstacle {
@@ -192,12 +234,12 @@ fn slide(mu: f64, theta_deg: f64) -> f64 {
 }
 
 /// Smallest ramp angle (deg) at which the brick slides more than 5 mm in 1 s, by bisection.
-fn slide_threshold_deg(mu: f64) -> f64 {
+fn slide_threshold_deg(base: &Params, mu: f64) -> f64 {
     let crit = mu.atan().to_degrees();
     let (mut lo, mut hi) = (crit - 5.0, crit + 5.0);
     for _ in 0..10 {
         let mid = 0.5 * (lo + hi);
-        if slide(mu, mid) > 0.005 {
+        if slide(base, mu, mid) > 0.005 {
             hi = mid;
         } else {
             lo = mid;
@@ -264,7 +306,96 @@ fn estimators() -> Vec<EstimatorRow> {
     out
 }
 
+/// One row of the speed-vs-error table for the solver setting of `p`, and its point on the
+/// figure (iterations, Hz, tick CPU p50 µs, stack sink mm).
+fn speed_error_row(p: &Params) -> ([String; 11], (usize, f64, f64, f64)) {
+    let (it, hz) = (p.solver_iterations, p.contact_frequency_hz);
+    let (sink, drift) = stack_error(p);
+    let cs = press_error(p, 0.5);
+    let (wall_drift, wall_sink) = wall_error(p);
+    let off = Params {
+        sleeping: false,
+        ..p.clone()
+    };
+    let mut w = scene(100, &off);
+    for _ in 0..500 {
+        step_idle(&mut w, PARK);
+    }
+    let tm = time_ticks(&mut w, 1500);
+    let mut w2 = common::layers(&off, 2, 0.005);
+    for _ in 0..300 {
+        common::step_idle(&mut w2, common::PARK);
+    }
+    let tm2 = common::time_parked(&mut w2, 1500);
+    let cells = [
+        format!("{it}{}", if drift > 1e-3 { " (stack falls)" } else { "" }),
+        format!("{hz}"),
+        format!("{:.3}", sink * 1e3),
+        format!("{:.4}", drift * 1e3),
+        format!("{:.4}", cs * 1e3),
+        format!("{:.1}", tm.cpu.median()),
+        format!("{:.1}", tm.cpu.p99()),
+        format!("{:.1}", tm2.cpu.median()),
+        format!("{:.1}", tm2.cpu.p99()),
+        format!("{:.4}", wall_drift * 1e3),
+        format!("{:.3}", wall_sink * 1e3),
+    ];
+    (cells, (it, hz, tm.cpu.median(), sink.abs() * 1e3))
+}
+
+/// The errors of one solver setting (`BRICKWORLD_SOLVER`, `[brickworld.params]` lines),
+/// printed: stack sink and drift, cursor sink, flat-drop restitution, friction onset.
+fn print_errors() {
+    let base = common::solver_from_env();
+    let (sink, drift) = stack_error(&base);
+    let cs = press_error(&base, 0.5);
+    println!(
+        "{} iterations, {} Hz: stack sink {:.3} mm, drift 2-10 s {:.4} mm, cursor sink {:.4} mm",
+        base.solver_iterations,
+        base.contact_frequency_hz,
+        sink * 1e3,
+        drift * 1e3,
+        cs * 1e3
+    );
+    let (wall_drift, wall_sink) = wall_error(&base);
+    println!(
+        "  200-brick wall (20 courses), sleeping off: drift 1-5 s {:.4} mm, top sink {:.3} mm",
+        wall_drift * 1e3,
+        wall_sink * 1e3
+    );
+    match std::env::args().nth(2).as_deref() {
+        Some("wall") => return,
+        Some("row") => {
+            println!("| {} |", speed_error_row(&base).0.join(" | "));
+            return;
+        }
+        _ => {}
+    }
+    for e in [0.3, 0.5, 0.7, 0.9] {
+        let r = bounce(&base, e);
+        println!(
+            "  restitution e = {e}: h1/h0 {r:.4} (e² {:.4}, error {:.2} %)",
+            e * e,
+            100.0 * (r - e * e).abs() / (e * e)
+        );
+    }
+    for mu in [0.3, 0.6, 1.0] {
+        let crit = f64::atan(mu).to_degrees();
+        let th = slide_threshold_deg(&base, mu);
+        let t = (crit + 3.0).to_radians();
+        let exact = 0.5 * 9.81 * (t.sin() - mu * t.cos());
+        println!(
+            "  friction mu = {mu}: slides from {th:.2} deg (atan mu {crit:.2}), at +3 deg {:.4} m in 1 s (exact {exact:.4})",
+            slide(&base, mu, crit + 3.0)
+        );
+    }
+}
+
 fn main() {
+    if std::env::args().nth(1).as_deref() == Some("errors") {
+        print_errors();
+        return;
+    }
     let base = Params::default();
     let mut md =
         Report::start("brickworld", "brickworld — macro world (rapier f64, 1 kHz)").unwrap();
@@ -443,7 +574,9 @@ fn main() {
          Drift: largest motion of any stack brick between 2 s and 10 s. Cursor sink: deepest the cursor sphere \
          gets into a resting brick pressed at 0.5 m/s. Tick: p50/p99 of the 100-brick scene with sleeping \
          disabled, and of the 200 bricks in two layers 5 mm apart with sleeping disabled (worst case: everything simulated). \
-         Defaults: 4 iterations, 500 Hz; the contact hook skips idle speculative contacts in every row.",
+         Wall: a 200-brick wall of 20 courses standing with sleeping disabled, its largest brick motion from 1 s to 5 s \
+         and how far its top settles. Defaults: 4 iterations, 500 Hz; the brick scene ships 1 iteration at 175 Hz \
+         (`scenes/brickworld.toml`); the contact hook skips idle speculative contacts in every row.",
     );
     let mut t = Table::new([
         "iterations",
@@ -455,55 +588,26 @@ fn main() {
         "tick CPU p99 (µs)",
         "200 awake p50 (µs)",
         "200 awake p99 (µs)",
+        "wall drift 1–5 s (mm)",
+        "wall sink (mm)",
     ])
     .align_from(0, Align::Right);
     let mut pts = Vec::new();
-    for it in [1usize, 2, 4, 8] {
-        for hz in [30.0, 120.0, 500.0] {
-            let p = Params {
-                solver_iterations: it,
-                contact_frequency_hz: hz,
-                ..base.clone()
-            };
-            let (sink, drift) = stack_error(&p);
-            let cs = press_error(&p, 0.5);
-            let mut w = scene(
-                100,
-                &Params {
-                    sleeping: false,
-                    ..p.clone()
-                },
-            );
-            for _ in 0..500 {
-                step_idle(&mut w, PARK);
-            }
-            let tm = time_ticks(&mut w, 1500);
-            let mut w2 = common::layers(
-                &Params {
-                    sleeping: false,
-                    ..p.clone()
-                },
-                2,
-                0.005,
-            );
-            for _ in 0..300 {
-                common::step_idle(&mut w2, common::PARK);
-            }
-            let tm2 = common::time_parked(&mut w2, 1500);
-            t.row([
-                format!("{it}{}", if drift > 1e-3 { " (stack falls)" } else { "" }),
-                format!("{hz}"),
-                format!("{:.3}", sink * 1e3),
-                format!("{:.4}", drift * 1e3),
-                format!("{:.4}", cs * 1e3),
-                format!("{:.1}", tm.cpu.median()),
-                format!("{:.1}", tm.cpu.p99()),
-                format!("{:.1}", tm2.cpu.median()),
-                format!("{:.1}", tm2.cpu.p99()),
-            ])
-            .unwrap();
-            pts.push((it, hz, tm.cpu.median(), sink.abs() * 1e3));
-        }
+    // The grid, then the settings around the one the brick scene ships (1 iteration, 175 Hz):
+    // softer contacts sink more, stiffer ones let a tall wall creep at 1 iteration.
+    let grid = [1usize, 2, 4, 8]
+        .into_iter()
+        .flat_map(|it| [30.0, 120.0, 500.0].map(|hz| (it, hz)));
+    let shipped = [(1, 150.0), (1, 175.0), (1, 200.0), (1, 250.0), (2, 250.0)];
+    for (it, hz) in grid.chain(shipped) {
+        let p = Params {
+            solver_iterations: it,
+            contact_frequency_hz: hz,
+            ..base.clone()
+        };
+        let (cells, pt) = speed_error_row(&p);
+        t.row(cells).unwrap();
+        pts.push(pt);
     }
     md.table(&t);
 
@@ -512,7 +616,7 @@ fn main() {
     let mut t = Table::new(["e", "h1/h0", "e²", "relative error"]).align_from(0, Align::Right);
     let mut worst_b = 0.0_f64;
     for e in [0.3, 0.5, 0.7, 0.9] {
-        let r = bounce(e);
+        let r = bounce(&base, e);
         let rel = (r - e * e).abs() / (e * e);
         worst_b = worst_b.max(rel);
         t.row([
@@ -547,10 +651,10 @@ fn main() {
     let mut worst_a = 0.0_f64;
     for mu in [0.3, 0.6, 1.0] {
         let crit = f64::atan(mu).to_degrees();
-        let th = slide_threshold_deg(mu);
+        let th = slide_threshold_deg(&base, mu);
         worst_s = worst_s.max((th - crit).abs());
         let t3 = (crit + 3.0).to_radians();
-        let d = slide(mu, crit + 3.0);
+        let d = slide(&base, mu, crit + 3.0);
         let an = 0.5 * 9.81 * (t3.sin() - mu * t3.cos());
         worst_a = worst_a.max((d - an).abs() / an);
         t.row([

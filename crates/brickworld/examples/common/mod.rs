@@ -6,6 +6,37 @@ use bench_harness::{Summary, Timings};
 use brickworld::{BrickPlacement, BrickProps, Grip, Params, World};
 use world_form::Limits;
 
+/// The default parameters with the solver setting of `BRICKWORLD_SOLVER`: `[brickworld.params]`
+/// lines (e.g. `solver_iterations = 1` and `contact_frequency_hz = 175.0`), or `scene` for
+/// the shipped brick scene's (`scenes/brickworld.toml`); unset: the defaults.
+pub fn solver_from_env() -> Params {
+    let Ok(text) = std::env::var("BRICKWORLD_SOLVER") else {
+        return Params::default();
+    };
+    if text != "scene" {
+        return Params::from_toml(&text).expect("BRICKWORLD_SOLVER: valid parameters");
+    }
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/brickworld.toml");
+    let scene: toml::Value =
+        toml::from_str(&std::fs::read_to_string(path).expect("scenes/brickworld.toml"))
+            .expect("the scene is TOML");
+    let params = &scene["brickworld"]["params"];
+    let d = Params::default();
+    Params {
+        solver_iterations: params
+            .get("solver_iterations")
+            .and_then(toml::Value::as_integer)
+            .map_or(d.solver_iterations, |i| {
+                usize::try_from(i).expect("a count")
+            }),
+        contact_frequency_hz: params
+            .get("contact_frequency_hz")
+            .and_then(toml::Value::as_float)
+            .unwrap_or(d.contact_frequency_hz),
+        ..d
+    }
+}
+
 /// Where the cursor waits, m: above every scene, touching nothing.
 pub const PARK: [f64; 3] = [0.0, 0.0, 1.9];
 

@@ -4,9 +4,38 @@
 use brickworld::{BrickPlacement, Grip, Params, StepReport, World};
 use world_form::Limits;
 
-/// Parameters with no loading zone and no blueprint: only what a test adds.
+/// Parameters with no loading zone and no blueprint: only what a test adds. With
+/// `BRICKWORLD_TEST_SOLVER=scene` in the environment, the shipped brick scene's solver setting
+/// (its `solver_iterations` and `contact_frequency_hz`), to run a suite under it.
 pub fn bare() -> Params {
-    Params::default()
+    if std::env::var("BRICKWORLD_TEST_SOLVER").as_deref() == Ok("scene") {
+        scene_solver()
+    } else {
+        Params::default()
+    }
+}
+
+/// The default parameters with the shipped scene's solver setting (its `solver_iterations`
+/// and `contact_frequency_hz`, read from `scenes/brickworld.toml`).
+pub fn scene_solver() -> Params {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/brickworld.toml");
+    let text = std::fs::read_to_string(path).expect("scenes/brickworld.toml");
+    let scene: toml::Value = toml::from_str(&text).expect("scene is TOML");
+    let params = &scene["brickworld"]["params"];
+    let d = Params::default();
+    Params {
+        solver_iterations: params
+            .get("solver_iterations")
+            .and_then(toml::Value::as_integer)
+            .map_or(d.solver_iterations, |i| {
+                usize::try_from(i).expect("a count")
+            }),
+        contact_frequency_hz: params
+            .get("contact_frequency_hz")
+            .and_then(toml::Value::as_float)
+            .unwrap_or(d.contact_frequency_hz),
+        ..d
+    }
 }
 
 /// A brick at `c` (m), axis aligned.
