@@ -4,7 +4,7 @@ the CPU time the neighbours took; and what a task costs on each executor (a run 
 nothing, one per task and in batches), and what pickling a result costs. Checks that the
 three ways give the same bits. Writes docs/bench/sweeps.md.
 
-    python examples/sweeps/bench.py              # the benchmark: ~10 min on 2 free cores
+    python examples/sweeps/bench.py              # the benchmark: ~10 min on 2 free cores, 40 on busy ones
     python examples/sweeps/bench.py --short      # the same code on a few runs: seconds
 """
 
@@ -124,7 +124,7 @@ def task_costs(client, short: bool) -> list:
     on 2 threads and on Dask, one run per task and in batches: the cost of a task, and what
     batching leaves of it."""
     runs = [{"i": i} for i in range(200 if short else 4000)]
-    few = runs[: 100 if short else 1000]  # one per task on Dask: ~ms each
+    few = runs[: 100 if short else 300]  # one per task on Dask: ~ms each
     cases = [("serial (workers=1)", dict(workers=1), runs, None),
              ("2 threads", dict(workers=2), runs, 1),
              ("2 threads", dict(workers=2), runs, 10),
@@ -210,9 +210,12 @@ def main() -> None:
                              {h: (m.wall, m.cpu, d.attrs["chunksize"], d.attrs["tasks"]) for h, (d, m) in got.items()}))
                 frames.setdefault(name, one)
                 del got, df
-        pickles = pickling_costs(frames)
-        print(uptime(), file=sys.stderr)
-    write(args.out, size, repeats, t_start, costs, pickles, rows)
+            if rep == 1:
+                pickles = pickling_costs(frames)
+                frames.clear()
+            # after every repeat: a long benchmark stopped early keeps the repeats it finished
+            write(args.out, size, rep, t_start, costs, pickles, rows)
+            print(uptime(), file=sys.stderr)
     print(args.out.read_text())
 
 

@@ -33,13 +33,13 @@ GAINS_N_PER_M = [0.1, 0.2, 0.4, 0.8, 1.6, 3.0]  # world; the Falcon's cap maps t
 HANDS_N_PER_M = [100.0, 200.0, 400.0, 800.0, 1600.0, 3200.0]
 YIELD_N = [0.0, 0.5]
 # size → (gains, hands, yield forces). docs: the 6 × 6 × 2 map of docs/sweeps.md (84 runs);
-# large: the same ranges on 24 log-spaced steps each (a factor 1.16 apart) and four hands
-# that yield (0, 0.25, 0.5, 1 N halves the speed): 2400 runs, ≥ 30 s on one core.
+# large: the same ranges on 24 log-spaced steps each (a factor 1.16 apart) and five hands
+# (passive; 0.25, 0.5, 1 or 2 N halves the speed): 3000 runs, ≥ 30 s on one core.
 SIZES = {
     "short": ([0.4, 3.0], [200.0, 1600.0], [0.0, 0.5]),
     "docs": (GAINS_N_PER_M, HANDS_N_PER_M, YIELD_N),
     "large": (np.geomspace(0.1, 3.0, 24).round(4).tolist(), np.geomspace(100.0, 3200.0, 24).round(1).tolist(),
-              [0.0, 0.25, 0.5, 1.0]),
+              [0.0, 0.25, 0.5, 1.0, 2.0]),
 }
 
 

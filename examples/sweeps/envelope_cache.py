@@ -111,7 +111,7 @@ def interpolation_errors(df, dt) -> list:
     r_fine = cache_of(df, dt)
     fine = r_fine.shape[0]
     out = []
-    for every in [2**k for k in range(int(np.log2(fine - 1)), -1, -1)]:  # 3² … fine² velocities
+    for every in [2**k for k in range(int(np.log2(fine - 1)) - 1, -1, -1)]:  # 3² … fine² velocities
         n = (fine - 1) // every + 1
         errs, rels = [], []
         for vx, vy, a in zip(tests["vx_m_per_s"], tests["vy_m_per_s"], tests["arrays"]):
