@@ -601,8 +601,9 @@ def sweep(
     Client; run i gets seed run_seed(seed, i). Returns a pandas DataFrame, one
     row per run: run, seed, the overrides, summary metrics (units in the
     names), and with arrays=True the per-tick arrays; chunksize: runs per
-    task on an executor. Ctrl-C returns the runs that finished
-    (df.attrs["interrupted"]). See docs/sweeps.md."""
+    task on an executor (None: chosen from the first run's measured time and
+    the task's cost; the results do not depend on it). Ctrl-C returns the
+    runs that finished (df.attrs["interrupted"]). See docs/sweeps.md."""
 
 def grid(axes: Mapping[str, Sequence[Any]]) -> List[Dict[str, Any]]:
     """Every combination of the axes (dotted name → values), last axis fastest,

@@ -16,6 +16,18 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 FIGURES = ROOT / "docs" / "sweeps"
+SIZES = ("short", "docs", "large")
+
+
+def check_size(size: str) -> str:
+    if size not in SIZES:
+        raise ValueError(f"size = {size!r}: allowed one of {', '.join(SIZES)}")
+    return size
+
+
+def noop_run(run: dict, seed: int) -> dict:
+    """A run that does nothing: what a task costs on an executor, with nothing to run."""
+    return {"i": run["i"]}
 
 
 def parser(doc: str) -> argparse.ArgumentParser:
@@ -24,6 +36,11 @@ def parser(doc: str) -> argparse.ArgumentParser:
     p.add_argument("--dask", default=None, help="local:N (a LocalCluster of N processes) or a scheduler address")
     p.add_argument("--out", type=Path, default=FIGURES, help="folder of the figure (default docs/sweeps)")
     p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--size", choices=SIZES, default="docs",
+                   help="short (a few runs: a smoke test), docs (the figure and table of docs/sweeps.md, "
+                        "a few seconds), large (the benchmark's: ≥ 30 s on one core)")
+    p.add_argument("--chunksize", type=int, default=None,
+                   help="runs per task (default: chosen from the measured run time)")
     return p
 
 

@@ -12,6 +12,7 @@ computed on line at 200 random velocities (seeded: run_seed of the sweep), as th
 difference of r(θ) over the angles, in nm and relative to the envelope's size.
 
     python examples/sweeps/envelope_cache.py [--workers N | --dask local:2 | --dask tcp://HOST:8786]
+                                             [--size short|docs|large] [--chunksize N]
 """
 
 from __future__ import annotations
@@ -32,6 +33,15 @@ FINE = 33  # points per axis of the finest cache; 2^k + 1 so that coarser ones n
 ANGLES = 256
 TESTS = 200
 THETA = np.linspace(0.0, 2 * np.pi, ANGLES, endpoint=False)
+# size → (points per axis of the finest cache, Δt's, test velocities per Δt). docs: the table
+# of docs/sweeps.md (2578 runs); large: a 129 × 129 cache (step 1.25 nm/µs, 17× the paper's
+# 961 envelopes per Δt) at Δt = 0.2, 0.5 and 1 µs, tested at 400 velocities each: 51 123
+# runs of ~0.7 ms, ≥ 30 s on one core — the study whose runs are too short to send one a task.
+SIZES = {
+    "short": (5, [1e-6], 4),
+    "docs": (FINE, DTS_S, TESTS),
+    "large": (129, [0.2e-6, 0.5e-6, 1e-6], 400),
+}
 
 
 def radial(poly: np.ndarray, centre: np.ndarray) -> np.ndarray:
@@ -52,31 +62,34 @@ def envelope_run(run: dict, seed: int) -> dict:
     return {"vertices": int(len(poly)), "polygon_bytes": int(poly.nbytes), "r_max_m": float(r.max()), "r_m": r}
 
 
-def runs(seed: int = 0) -> list:
-    axis = np.linspace(-V_MAX_M_PER_S, V_MAX_M_PER_S, FINE)
+def runs(seed: int = 0, size: str = "docs") -> list:
+    fine, dts, n_tests = SIZES[common.check_size(size)]
+    axis = np.linspace(-V_MAX_M_PER_S, V_MAX_M_PER_S, fine)
     rng = np.random.default_rng(nh.run_seed(seed, 2**32))  # the test velocities, seeded
-    tests = rng.uniform(-V_MAX_M_PER_S, V_MAX_M_PER_S, size=(TESTS, 2))
+    tests = rng.uniform(-V_MAX_M_PER_S, V_MAX_M_PER_S, size=(n_tests, 2))
     out = []
-    for dt in DTS_S:
+    for dt in dts:
         grid = nh.grid({"dt_s": [dt], "vx_m_per_s": axis.tolist(), "vy_m_per_s": axis.tolist()})
         out += [{**g, "role": "cache"} for g in grid]
         out += [{"dt_s": dt, "vx_m_per_s": float(x), "vy_m_per_s": float(y), "role": "test"} for x, y in tests]
     return out
 
 
-def study(executor=None, workers=None, progress=True):
-    return nh.sweep(envelope_run, runs(), arrays=True, executor=executor, workers=workers, progress=progress)
+def study(executor=None, workers=None, progress=True, size="docs", chunksize=None):
+    return nh.sweep(envelope_run, runs(size=size), arrays=True, executor=executor, workers=workers,
+                    progress=progress, chunksize=chunksize)
 
 
 def cache_of(df, dt):
-    """The finest cache r(θ) at Δt = dt as a (FINE, FINE, ANGLES) array (vx, vy, θ)."""
+    """The finest cache r(θ) at Δt = dt as a (fine, fine, ANGLES) array (vx, vy, θ)."""
     cache = df[(df["role"] == "cache") & (df["dt_s"] == dt)]
-    return np.stack(cache["arrays"].map(lambda a: a["r_m"]).to_list()).reshape(FINE, FINE, ANGLES)
+    fine = int(round(len(cache) ** 0.5))
+    return np.stack(cache["arrays"].map(lambda a: a["r_m"]).to_list()).reshape(fine, fine, ANGLES)
 
 
 def interpolate(r_fine, every, v):
     """Bilinear interpolation of r(θ) at velocity v from every `every`-th cached velocity."""
-    ax = np.linspace(-V_MAX_M_PER_S, V_MAX_M_PER_S, FINE)[::every]
+    ax = np.linspace(-V_MAX_M_PER_S, V_MAX_M_PER_S, r_fine.shape[0])[::every]
     r = r_fine[::every, ::every]
     n = len(ax)
     i = min(int(np.searchsorted(ax, v[0], side="right")) - 1, n - 2)
@@ -87,14 +100,19 @@ def interpolate(r_fine, every, v):
             + (1 - tx) * ty * r[i, j + 1] + tx * ty * r[i + 1, j + 1])
 
 
+def tests_of(df, dt):
+    return df[(df["role"] == "test") & (df["dt_s"] == dt)]
+
+
 def interpolation_errors(df, dt) -> list:
     """Per cache size at Δt = dt: (points per axis, step nm/µs, cache bytes, median and max
     error nm, median and max error relative to the envelope size)."""
     tests = df[(df["role"] == "test") & (df["dt_s"] == dt)]
     r_fine = cache_of(df, dt)
+    fine = r_fine.shape[0]
     out = []
-    for every in (16, 8, 4, 2, 1):
-        n = (FINE - 1) // every + 1
+    for every in [2**k for k in range(int(np.log2(fine - 1)) - 1, -1, -1)]:  # 3² … fine² velocities
+        n = (fine - 1) // every + 1
         errs, rels = [], []
         for vx, vy, a in zip(tests["vx_m_per_s"], tests["vy_m_per_s"], tests["arrays"]):
             ri = interpolate(r_fine, every, (vx, vy))
@@ -114,7 +132,7 @@ def figure(df, tables, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
-    for (dt, rows), colour in zip(tables.items(), ("tab:blue", "tab:red")):
+    for (dt, rows), colour in zip(tables.items(), ("tab:blue", "tab:green", "tab:red")):
         kb = np.array([r[2] for r in rows]) / 1024
         a1.loglog(kb, [r[4] for r in rows], "o-", color=colour, label=f"Δt = {dt * 1e6:g} µs, largest")
         a1.loglog(kb, [r[3] for r in rows], "s--", color=colour, label=f"Δt = {dt * 1e6:g} µs, median")
@@ -122,21 +140,22 @@ def figure(df, tables, path: Path) -> None:
     for r in rows:
         a1.annotate(f"{r[0]}²", (r[2] / 1024, a1.get_ylim()[0]), textcoords="offset points",
                     xytext=(0, 4), ha="center", fontsize=8)
-    a1.set_xlabel("cache size, kB (r(θ) at 256 angles, float64; 3² … 33² velocities)")
+    a1.set_xlabel(f"cache size, kB (r(θ) at 256 angles, float64; 3² … {rows[-1][0]}² velocities)")
     a1.set_ylabel("interpolated vs on-line envelope, max |Δr|, nm")
-    a1.set_title(f"Bilinear interpolation error at {TESTS} random velocities")
+    a1.set_title(f"Bilinear interpolation error at {len(tests_of(df, next(iter(tables))))} random velocities")
     a1.grid(True, which="both", alpha=0.3)
     a1.legend(fontsize=8)
-    dt = DTS_S[-1]
-    tests = df[(df["role"] == "test") & (df["dt_s"] == dt)]
+    dt = list(tables)[-1]
+    tests = tests_of(df, dt)
     k = int(np.argmax(np.hypot(tests["vx_m_per_s"], tests["vy_m_per_s"])))
     row = tests.iloc[k]
     v = np.array([row["vx_m_per_s"], row["vy_m_per_s"]])
     r_fine = cache_of(df, dt)
-    for every, style in ((16, "r-"), (4, "b-"), (1, "g-")):
+    fine = r_fine.shape[0]
+    for every, style in (((fine - 1) // 2, "r-"), (max(1, (fine - 1) // 8), "b-"), (1, "g-")):
         ri = interpolate(r_fine, every, v)
         a2.plot(np.degrees(THETA), (ri - row["arrays"]["r_m"]) * 1e9, style, lw=1,
-                label=f"from the {(FINE - 1) // every + 1}² cache")
+                label=f"from the {(fine - 1) // every + 1}² cache")
     a2.axhline(0, color="k", lw=0.6)
     a2.set_xlabel("angle θ about the free drift v·Δt, degrees")
     a2.set_ylabel("r(θ) interpolated − on line, nm")
@@ -150,9 +169,9 @@ def figure(df, tables, path: Path) -> None:
 def main() -> None:
     args = common.parser(__doc__).parse_args()
     with common.executor(args.dask, __name__) as ex:
-        df = study(ex, args.workers, not args.no_progress)
-    tables = {dt: interpolation_errors(df, dt) for dt in DTS_S}
-    figure(df, tables, args.out / "envelope-cache.png")
+        df = study(ex, args.workers, not args.no_progress, args.size, args.chunksize)
+    tables = {dt: interpolation_errors(df, dt) for dt in SIZES[args.size][1]}
+    figure(df, tables, args.out / ("envelope-cache.png" if args.size == "docs" else f"envelope-cache-{args.size}.png"))
     for dt, rows in tables.items():
         cache = df[(df["role"] == "cache") & (df["dt_s"] == dt)]
         print(f"Δt = {dt * 1e6:g} µs: {len(cache)} envelopes, {cache['vertices'].sum()} vertices, "

@@ -199,8 +199,89 @@ def test_a_failed_run_is_named():
     for workers in (1, 2):
         with pytest.raises(RuntimeError, match=r"^sweep: run 2: ZeroDivisionError: division by zero$"):
             nh.sweep(failing_run, [{"i": i} for i in range(4)], workers=workers, progress=False)
-    with pytest.raises(ValueError, match=r"^chunksize = 0: allowed a whole number ≥ 1$"):
-        nh.sweep(failing_run, [], chunksize=0)
+
+
+# ------------------------------------------------------------------------------ batching
+
+
+def test_batching_gives_identical_dataframes(serial):
+    """Whatever the runs per task — one, a few, uneven chunks, all in one, or chosen from the
+    measured run time — the DataFrame is the serial one, bit for bit and in run order."""
+    ot0, th0 = serial
+    for chunksize in (1, 2, 3, 5, 100, None):
+        ot = nh.sweep(OT, OT_RUNS, seconds=0.7, arrays=True, workers=2, chunksize=chunksize, progress=False)
+        th = nh.sweep(thermal_run, THERMAL_RUNS, seed=11, arrays=True, workers=2, chunksize=chunksize,
+                      progress=False)
+        assert_identical(ot0, ot)
+        assert_identical(th0, th)
+        if chunksize is not None:
+            assert th.attrs["chunksize"] == chunksize
+            assert th.attrs["tasks"] == -(-len(THERMAL_RUNS) // chunksize)
+
+
+def square_run(run, seed):
+    return {"square": run["i"] ** 2, "seed_mod_7": seed % 7}
+
+
+def test_short_runs_are_batched_automatically_with_the_same_results():
+    runs = [{"i": i} for i in range(3000)]
+    one = nh.sweep(square_run, runs, workers=1, progress=False)
+    assert one.attrs["chunksize"] is None and one.attrs["tasks"] == 3000
+    assert one["square"].tolist() == [i * i for i in range(3000)]
+    for kw in (dict(workers=2), dict(workers=2, chunksize=1), dict(workers=2, chunksize=7)):
+        df = nh.sweep(square_run, runs, progress=False, **kw)
+        pd.testing.assert_frame_equal(one, df, check_exact=True)
+    auto = nh.sweep(square_run, runs, workers=2, progress=False)
+    # a µs run against a task's ≥ 20 µs: batched, capped at 16 tasks per thread (3000 // 32)
+    assert 1 < auto.attrs["chunksize"] <= 3000 // 32
+    assert auto.attrs["tasks"] == 2 + -(-(3000 - 2) // auto.attrs["chunksize"])  # 2 probes + chunks
+    pd.testing.assert_frame_equal(one, auto, check_exact=True)
+
+
+def test_auto_chunksize_pays_the_task_cost_once_per_100_and_keeps_16_tasks_per_thread():
+    from nanohaptics.sweeps import auto_chunksize
+
+    assert auto_chunksize(0.0007, 2e-3, 50_000, 2) == 286        # 286 × 0.7 ms ≥ 100 × 2 ms
+    assert auto_chunksize(0.0007, 2e-3, 2_000, 2) == 2_000 // 32  # load balance wins
+    assert auto_chunksize(0.3, 2e-3, 1_000, 2) == 1               # long runs: one per task
+    assert auto_chunksize(0.0, 2e-3, 10, 4) == 1                  # fewer runs than 16 per thread
+    assert auto_chunksize(1e-6, 1e-3, 0, 2) == 1
+
+
+def test_bad_chunksizes_are_refused_naming_the_argument_and_the_range():
+    for bad in (0, -3, 1.5, True, "4", float("nan")):
+        with pytest.raises(ValueError) as e:
+            nh.sweep(failing_run, [{"i": 2}], chunksize=bad, workers=2, progress=False)
+        assert str(e.value) == (
+            f"chunksize = {bad!r}: allowed a whole number ≥ 1 (runs per task), or None (chosen from a "
+            "measured run time)"
+        )
+    # numpy integers are whole numbers
+    df = nh.sweep(square_run, [{"i": 3}], chunksize=np.int64(2), workers=2, progress=False)
+    assert df.attrs["chunksize"] == 2 and df["square"].tolist() == [9]
+
+
+def test_the_benchmark_runs_in_a_short_mode(tmp_path):
+    """examples/sweeps/bench.py --short: the benchmark's code (per-task costs, the three
+    studies serially, on threads and on Dask, the same-bits check) on a few runs each."""
+    pytest.importorskip("distributed")
+    import subprocess
+
+    out = tmp_path / "sweeps.md"
+    p = subprocess.run([sys.executable, str(ROOT / "examples" / "sweeps" / "bench.py"), "--short", "--out", str(out)],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-3000:]
+    text = out.read_text(encoding="utf-8")
+    assert "## What a task costs" in text and "## The studies, three ways" in text
+    study_rows = [line for line in text.splitlines()
+                  if line.startswith(("| drag map | 1 ", "| envelope cache | 1 ", "| calibration | 1 "))]
+    assert len(study_rows) == 3, text
+    assert all(line.endswith("| yes |") for line in study_rows), text
+    cost_rows = [line for line in text.splitlines() if line.startswith(("| 2 threads |", "| Dask, 2 processes |"))]
+    assert len(cost_rows) == 8, text
+    for line in cost_rows:
+        per_run = float(line.split("|")[5])
+        assert 0 < per_run < 1e6, line
 
 
 def test_a_dask_process_cluster_gives_the_serial_bits(serial):
@@ -213,9 +294,15 @@ def test_a_dask_process_cluster_gives_the_serial_bits(serial):
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         ot, th = both(executor=client)
         pids = client.run(lambda: __import__("os").getpid())
+        # batched on Dask, a few runs per task or chosen from the measured run time
+        batched = [nh.sweep(thermal_run, THERMAL_RUNS, seed=11, arrays=True, executor=client,
+                            chunksize=c, progress=False) for c in (4, None)]
     assert len(set(pids.values())) == 2
     assert_identical(serial[0], ot)
     assert_identical(serial[1], th)
+    for df in batched:
+        assert_identical(serial[1], df)
+    assert batched[0].attrs["tasks"] == 2
 
 
 def test_recordings_of_a_sweep_replay_its_arrays(tmp_path, serial):

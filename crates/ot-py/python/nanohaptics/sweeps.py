@@ -28,7 +28,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 
 import numpy as np
 
-__all__ = ["sweep", "grid", "run_seed", "scene_metrics"]
+__all__ = ["sweep", "grid", "run_seed", "scene_metrics", "auto_chunksize"]
 
 Run = Mapping[str, Any]
 
@@ -160,16 +160,18 @@ def _execute(job: tuple) -> tuple:
     return index, scalars, arrays
 
 
-def _execute_many(jobs: list) -> list:
+def _execute_many(jobs: list) -> tuple:
     """Runs a chunk of jobs in order (one task on an executor: fewer, larger tasks when each
-    run is short). A failure names its run."""
+    run is short) and returns ``(results, seconds)``, the seconds spent in the runs as timed
+    on the worker (what the automatic chunk size is chosen from). A failure names its run."""
     out = []
+    t0 = time.perf_counter()
     for job in jobs:
         try:
             out.append(_execute(job))
         except Exception as e:
             raise RuntimeError(f"run {job[0]}: {type(e).__name__}: {e}") from e
-    return out
+    return out, time.perf_counter() - t0
 
 
 # ------------------------------------------------------------------------------ progress
@@ -222,22 +224,47 @@ def _executor_for(executor: Any):
     return executor, False
 
 
-def _auto_chunksize(executor: Any, n: int, workers: Optional[int] = None) -> int:
-    """Runs per task. The default thread pool: about 16 tasks per thread — a task costs a
-    submit, a hand-off and a few GIL acquisitions, comparable to a sub-millisecond run (the
-    envelope study's 0.7 ms runs scaled 1.6× on 2 threads one per task, 1.9× forty per
-    task). Other executors: about 8 tasks per worker thread, so that a cluster's per-task
-    cost (≈ ms) is paid once per chunk while the load stays balanced."""
+# Per-task cost assumed at least this (s), whatever one probe measured: a thread pool's
+# submit + hand-off + result (≈ 10–30 µs measured, docs/bench/sweeps.md) and a process or
+# Dask executor's (≈ 1–3 ms: scheduling, pickling, two messages).
+_MIN_TASK_COST_S = {"threads": 20e-6, "other": 1e-3}
+# A task should run for at least this many times its cost (so the cost is ≤ 1 %) ...
+_COST_FACTOR = 100.0
+# ... and there should be at least this many tasks per worker thread, so that the last
+# task to finish leaves the others idle for at most ~1/16 of a worker's share.
+_TASKS_PER_THREAD = 16
+
+
+def _threads_of(executor: Any, n_workers: Optional[int]) -> int:
+    """Worker threads behind an executor: the default pool's, a Dask cluster's (sum of
+    nthreads), a concurrent.futures pool's ``_max_workers``, else the CPUs here."""
     if executor is None:
-        return max(1, n // (16 * (workers or 1)))
-    threads = None
+        return n_workers or 1
     if hasattr(executor, "nthreads"):  # a Dask Client
         try:
-            threads = sum(executor.nthreads().values())
+            return max(1, sum(executor.nthreads().values()))
         except Exception:  # pragma: no cover - a client without workers yet
-            threads = None
-    threads = threads or getattr(executor, "_max_workers", None) or 1
-    return max(1, n // (8 * threads))
+            pass
+    return getattr(executor, "_max_workers", None) or os.cpu_count() or 1
+
+
+def auto_chunksize(run_s: float, task_cost_s: float, runs: int, threads: int) -> int:
+    """Runs per task for ``runs`` runs of ``run_s`` seconds each (as measured) on ``threads``
+    worker threads whose executor costs ``task_cost_s`` per task: long enough that the cost
+    is ≤ 1 % of a task (100 × the cost), short enough to leave ≥ 16 tasks per thread (load
+    balance), and at least 1.
+
+    >>> auto_chunksize(0.0007, 2e-3, 50_000, 2)   # 0.7 ms runs on Dask: 286 per task
+    286
+    >>> auto_chunksize(0.3, 2e-3, 1000, 2)        # 0.3 s runs: one per task
+    1
+    """
+    if runs <= 0:
+        return 1
+    run_s = max(run_s, 1e-7)
+    want_s = _COST_FACTOR * task_cost_s
+    cap = max(1, runs // (_TASKS_PER_THREAD * max(1, threads)))
+    return int(max(1, min(cap, math.ceil(want_s / run_s))))
 
 
 class _SigintFlag:
@@ -325,16 +352,21 @@ def sweep(
             :func:`scene_metrics`).
         record_dir: a folder: record every scene run to ``run-00000.mcap`` ... there
             (column ``recording``); the folder must be reachable from the workers.
-        chunksize: runs per task handed to the executor (default: about 16 tasks per
-            thread on the thread pool, about 8 tasks per worker thread on other executors,
-            which pays the per-task cost once per chunk). Results do not depend on it.
+        chunksize: runs per task handed to the executor (a whole number ≥ 1). None
+            (the default): the first run on each worker thread goes alone, and the first of
+            those to come back gives the run time (timed on the worker) and the task's cost
+            (its round trip less the run); the rest go in chunks of
+            :func:`auto_chunksize` runs — a task lasting 100 × its cost, but no fewer
+            than 16 tasks per worker thread (load balance). Results, and their order, do not depend on it
+            (``df.attrs["chunksize"]`` says what was used, ``df.attrs["tasks"]`` how many
+            tasks).
 
     Returns:
         DataFrame: columns ``run`` (index), ``seed``, one per override name, then the
         metrics (units in their names); ``df.attrs`` holds ``interrupted`` (True when
         Ctrl-C stopped the sweep: the rows are the runs that had finished),
-        ``wall_s`` and ``workers``. Ctrl-C cancels the runs not started; runs in progress
-        on threads finish in the background.
+        ``wall_s``, ``workers``, ``chunksize`` and ``tasks``. Ctrl-C cancels the runs not
+        started; runs in progress on threads finish in the background.
     """
     try:
         import pandas as pd
@@ -350,8 +382,14 @@ def sweep(
         raise ValueError(f"seed = {seed!r}: allowed a whole number 0 ..= 2**64 - 1")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers = {workers!r}: allowed a whole number ≥ 1")
-    if chunksize is not None and (isinstance(chunksize, bool) or not isinstance(chunksize, int) or chunksize < 1):
-        raise ValueError(f"chunksize = {chunksize!r}: allowed a whole number ≥ 1")
+    if chunksize is not None and (isinstance(chunksize, bool) or not isinstance(chunksize, (int, np.integer))
+                                  or chunksize < 1):
+        raise ValueError(
+            f"chunksize = {chunksize!r}: allowed a whole number ≥ 1 (runs per task), or None "
+            "(chosen from a measured run time)"
+        )
+    if chunksize is not None:
+        chunksize = int(chunksize)
     seeds = [run_seed(int(seed), i) for i in range(len(runs))]
 
     jobs = []
@@ -399,15 +437,14 @@ def sweep(
         if pool is None:
             for job in jobs:
                 try:
-                    ((idx, scal, arr),) = _execute_many([job])
+                    ((idx, scal, arr),), _ = _execute_many([job])
                 except Exception as e:
                     raise RuntimeError(f"sweep: {e}") from e
                 results[idx] = (scal, arr)
                 bar.update()
         else:
-            if chunksize is None:
-                chunksize = _auto_chunksize(executor, len(jobs), n_workers)
-            chunks = [jobs[k:k + chunksize] for k in range(0, len(jobs), chunksize)]
+            threads = _threads_of(executor, n_workers)
+            kind = "threads" if isinstance(pool, cf.ThreadPoolExecutor) else "other"
             with _SigintFlag() as sigint:
                 # Each finished future is queued by its own callback: collecting N futures
                 # costs O(N). (cf.wait(pending, FIRST_COMPLETED) installs a waiter on every
@@ -415,26 +452,51 @@ def sweep(
                 # it made 2 threads slower than 1.)
                 finished: "queue.SimpleQueue[Any]" = queue.SimpleQueue()
                 futures = {}
-                for c in chunks:
-                    f = pool.submit(_execute_many, c)
-                    futures[f] = c
-                    f.add_done_callback(finished.put)
+                submitted: Dict[Any, float] = {}
+
+                def submit(chunk: list) -> None:
+                    f = pool.submit(_execute_many, chunk)
+                    futures[f] = chunk
+                    submitted[f] = time.perf_counter()
+                    f.add_done_callback(lambda f: finished.put((f, time.perf_counter())))
+
+                rest: list = []
+                if chunksize is None and len(jobs) > threads:
+                    # Probe: one run per task on every worker thread; the first to come back
+                    # gives the run time (timed on the worker) and the task's cost (round
+                    # trip − run time), from which the rest is cut into chunks.
+                    for job in jobs[:threads]:
+                        submit([job])
+                    rest = jobs[threads:]
+                else:
+                    size = chunksize or 1
+                    for k in range(0, len(jobs), size):
+                        submit(jobs[k:k + size])
+                    chunksize = size
                 remaining = len(futures)
                 while remaining:
                     if sigint.raised:
                         raise KeyboardInterrupt
                     try:
-                        f = finished.get(timeout=0.25)
+                        f, t_done = finished.get(timeout=0.25)
                     except queue.Empty:
                         continue
                     remaining -= 1
                     try:
-                        got = f.result()
+                        got, work_s = f.result()
                     except Exception as e:
                         raise RuntimeError(f"sweep: {e}") from e
                     for idx, scal, arr in got:
                         results[idx] = (scal, arr)
                     bar.update(len(got))
+                    if rest:
+                        run_s = work_s / max(1, len(got))
+                        cost_s = max(_MIN_TASK_COST_S[kind], t_done - submitted[f] - work_s)
+                        chunksize = auto_chunksize(run_s, cost_s, len(rest), threads)
+                        for k in range(0, len(rest), chunksize):
+                            submit(rest[k:k + chunksize])
+                            remaining += 1
+                        rest = []
     except KeyboardInterrupt:
         interrupted = True
         if pool is not None:
@@ -443,7 +505,7 @@ def sweep(
             # keep every run that had finished, collected or not
             for f in list(futures):
                 if f.done() and not f.cancelled() and f.exception() is None:
-                    for idx, scal, arr in f.result():
+                    for idx, scal, arr in f.result()[0]:
                         results.setdefault(idx, (scal, arr))
     except BaseException:
         if pool is not None:
@@ -491,6 +553,8 @@ def sweep(
     df.attrs["interrupted"] = interrupted
     df.attrs["wall_s"] = wall
     df.attrs["workers"] = n_workers
+    df.attrs["chunksize"] = chunksize if pool is not None else None
+    df.attrs["tasks"] = len(futures) if pool is not None else len(jobs)
     if interrupted:
         sys.stderr.write(
             f"sweep: interrupted; returning the {len(results)} of {len(jobs)} runs that finished\n"
