@@ -2,7 +2,8 @@
 //! loopback, measured from both ends.
 //!
 //! `cargo run --release -p nanohaptics-play --example play-bench -- [--seconds S] [--pages N]
-//! [--out FILE]` (`--pages N`: only the rows with N pages)
+//! [--out FILE]` (`--pages N`: only the rows with N pages; `NH_BENCH_NO_RT=1` in the
+//! environment: the tick thread without real-time scheduling, for comparison)
 //! runs, each for S seconds (default 10) of play:
 //! 0. brickworld with a Rust WebSocket client as the hand and no browser (the baseline);
 //! 1. brickworld, one page that plays (the pointer circles at 60 events/s);
@@ -64,6 +65,10 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
     );
     c.port = 0;
     c.keep_serving_s = Some(0.0);
+    // NH_BENCH_NO_RT=1: the tick thread asks for no real time (`--no-rt`), for comparison.
+    if std::env::var_os("NH_BENCH_NO_RT").is_some() {
+        c.rt = None;
+    }
     let stop = Arc::new(AtomicBool::new(false));
     let Running { url, handle } = start(c, stop.clone()).map_err(|e| e.to_string())?;
     let mut browsers = Vec::new();
@@ -199,6 +204,10 @@ fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
     );
     c.port = 0;
     c.keep_serving_s = Some(0.0);
+    // NH_BENCH_NO_RT=1: the tick thread asks for no real time (`--no-rt`), for comparison.
+    if std::env::var_os("NH_BENCH_NO_RT").is_some() {
+        c.rt = None;
+    }
     let stop = Arc::new(AtomicBool::new(false));
     let Running { url, handle } = start(c, stop.clone()).map_err(|e| e.to_string())?;
     let ws_url = format!("{}ws", url.replace("http://", "ws://"));
