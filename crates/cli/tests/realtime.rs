@@ -4,6 +4,7 @@
 //! The refusal is tested as an unprivileged user: as root, the program is started through
 //! `prlimit --rtprio=0` and `setpriv` as `nobody` with every capability dropped; as any other
 //! user with `RLIMIT_RTPRIO` 0 and no capability, it is started as it is.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
