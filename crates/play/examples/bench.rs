@@ -181,13 +181,7 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         underruns,
         samples_dropped,
         ticks: s.stats.ticks,
-        missed: format!(
-            "{} ({}; wake-up p99 {:.0} µs, max {:.0} µs)",
-            s.stats.missed,
-            s.stats.realtime.describe(),
-            s.stats.wakeup.p99_ns as f64 * 1e-3,
-            s.stats.wakeup.max_ns as f64 * 1e-3
-        ),
+        missed: missed_text(&s.stats),
         missed_n: s.stats.missed,
         tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
         dropped: s.messages_dropped,
@@ -277,13 +271,7 @@ fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
         underruns: 0,
         samples_dropped: 0,
         ticks: s.stats.ticks,
-        missed: format!(
-            "{} ({}; wake-up p99 {:.0} µs, max {:.0} µs)",
-            s.stats.missed,
-            s.stats.realtime.describe(),
-            s.stats.wakeup.p99_ns as f64 * 1e-3,
-            s.stats.wakeup.max_ns as f64 * 1e-3
-        ),
+        missed: missed_text(&s.stats),
         missed_n: s.stats.missed,
         tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
         dropped: s.messages_dropped,
@@ -300,6 +288,17 @@ fn loadavg() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
         .unwrap_or_else(|_| "unknown".into())
+}
+
+/// Missed deadlines, with the real time the tick thread got and its wake-up p99 and max.
+fn missed_text(st: &haptic_loop::pacing::TickStats) -> String {
+    format!(
+        "{} ({}; wake-up p99 {:.0} µs, max {:.0} µs)",
+        st.missed,
+        st.realtime.describe(),
+        st.wakeup.p99_ns as f64 * 1e-3,
+        st.wakeup.max_ns as f64 * 1e-3
+    )
 }
 
 fn main() {
