@@ -41,47 +41,66 @@ ALLOWED = {
     "chart": {"picture"},
     "render": {"haptic-types", "picture", "world-form"},
     "nanohaptics-recording": {"haptic-types", "world-form"},
-    "haptic-devices": {"haptic-types", "world-form"},
+    # The engine knows no world, no file format, no renderer and no server (NEVER below).
+    "haptic-engine": {"haptic-types", "world-form"},
+    "haptic-devices": {"haptic-engine", "haptic-types", "world-form"},
     "haptic-loop": {
-        "brickworld", "haptic-devices", "haptic-types", "nanohaptics-recording", "nanoworld",
-        "ot-envelope", "ot-physics", "render", "webguard", "world-form",
+        "brickworld", "haptic-devices", "haptic-engine", "haptic-types", "nanohaptics-recording",
+        "nanoworld", "ot-envelope", "ot-physics", "render", "webguard", "world-form",
     },
     "nanohaptics-lesson": {
         "brickworld", "chart", "haptic-devices", "haptic-loop", "nanohaptics-recording",
         "nanoworld", "world-form",
     },
     "nanohaptics-play": {
-        "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-recording", "render",
+        "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-recording", "render",
         "webguard", "world-form",
     },
     "nanohaptics-cli": {
-        "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-lesson",
+        "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-lesson",
         "nanohaptics-play", "nanohaptics-recording", "render", "world-form",
     },
     # The wheel sits on top: besides its bindings it carries the whole program (the
     # `nanohaptics` command of `pip install nanohaptics`, docs/python.md), so it depends on the
     # cli crate and nothing depends on it.
     "ot-py": {
-        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-cli",
+        "brickworld", "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-cli",
         "nanohaptics-recording", "nanoworld", "ot-envelope", "ot-physics", "world-form",
     },
     "nanohaptics-fuzz": {
-        "brickworld", "haptic-devices", "haptic-loop", "haptic-types", "nanohaptics-play",
+        "brickworld", "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-play",
         "nanohaptics-recording", "nanoworld", "ot-envelope", "webguard", "world-form",
     },
     "bench-harness": {"chart", "world-form"},
 }
 
+# What a crate must never depend on, whatever ALLOWED grants it: the engine (the tick, the Scene
+# trait, the loop config, the runner, the sinks' interface, the header, the pacing) knows no
+# world, no file format, no renderer, no device protocol and no server.
+NEVER = {
+    "haptic-engine": {
+        "brickworld", "nanoworld", "ot-envelope", "ot-physics", "nanohaptics-recording",
+        "render", "picture", "chart", "webguard", "haptic-devices", "haptic-loop",
+        "nanohaptics-play", "nanohaptics-lesson", "nanohaptics-cli",
+    },
+}
+
 # Top-level modules of a crate from the bottom up (one list entry may hold several modules of
 # the same rank, written "a b"); a module may import only modules of its rank or below.
 RANKS = {
+    "haptic-engine": [
+        "check realtime",
+        "timing header scene loop_config",
+        "haptic pacing wakeup clock",
+        "sink",
+        "totals",
+        "runner",
+    ],
     "haptic-loop": [
-        "header pacing",
         "scene",
-        "haptic",
-        "encode sink totals arrays",
+        "encode arrays",
         "record_sink replay_device live",
-        "runner error",
+        "error",
         "replay closed_loop sinks",
         "builtin",
         "setup",
@@ -95,9 +114,8 @@ RANKS = {
         "edit",
     ],
     "haptic-devices": [
-        "realtime",
-        "mechanics grip plant pacing link local",
-        "script wakeup",
+        "mechanics grip plant link local",
+        "script",
         "operator modelled linked",
         "bridge",
         "source",
@@ -158,6 +176,8 @@ def crate_offences(crates):
     bad = []
     deps_of = crate_deps(crates)
     for name, (path, deps, dev) in sorted(deps_of.items()):
+        for d in sorted((deps | ALLOWED.get(name, set())) & NEVER.get(name, set())):
+            bad.append(f"{path}: `{name}` must never depend on `{d}` (NEVER, scripts/layering.py)")
         if name not in ALLOWED:
             bad.append(f"{path}: crate `{name}` has no place in ALLOWED (scripts/layering.py): "
                        "add it with the crates it depends on")

@@ -23,7 +23,7 @@
 //! sample of 1-based rank ⌈q·n⌉, clamped to 1…n. So p50 of [1, 2, 3, 4] is 2 (rank 2), p99 of
 //! 100 samples is the 99th smallest, of 1000 samples the 990th, and p100 is the maximum. Every
 //! percentile is a measured sample (no interpolation), and this is the definition
-//! `haptic_devices::pacing::Percentiles` uses for the session statistics, so a report's own
+//! `haptic_engine::timing::Percentiles` uses for the session statistics, so a report's own
 //! percentiles and the loop's agree.
 //!
 //! What this crate is not: a micro-benchmark framework (criterion does that, under

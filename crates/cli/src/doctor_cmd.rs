@@ -3,8 +3,8 @@
 //! what to change when it cannot.
 
 use crate::status;
-use haptic_devices::realtime::{self, Permissions, RtRequest};
-use haptic_devices::wakeup::{self, Measurement, RATES_HZ, Verdict};
+use haptic_engine::realtime::{self, Permissions, RtRequest};
+use haptic_engine::wakeup::{self, Measurement, RATES_HZ, Verdict};
 use haptic_types::value::ValueError;
 use std::time::Duration;
 

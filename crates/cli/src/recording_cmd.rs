@@ -77,7 +77,7 @@ pub(crate) fn info(rec: &Path, salvage: bool, json: bool) -> Result<u8, String> 
     let d = &r.description;
     let ticks = a.tick.len() as u64;
     let duration = ticks as f64 / f64::from(d.rate_hz);
-    let pct = haptic_devices::pacing::Percentiles::of(&a.compute_ns);
+    let pct = haptic_engine::timing::Percentiles::of(&a.compute_ns);
     let session = r.metadata.get("session").cloned().unwrap_or_default();
     let channels: Vec<_> = r
         .channels

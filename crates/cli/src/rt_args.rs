@@ -1,7 +1,7 @@
 //! The real-time flags every command with a tick thread shares (`run`, `play`, `classroom`):
 //! `--no-rt` and `--rt-priority`.
 
-use haptic_devices::realtime::{DEFAULT_PRIORITY, RtRequest};
+use haptic_engine::realtime::{DEFAULT_PRIORITY, RtRequest};
 
 /// `--no-rt` and `--rt-priority N`.
 #[derive(clap::Args, Debug, Clone)]

@@ -3,11 +3,11 @@
 
 use crate::status;
 use haptic_devices::source::DeviceSource;
+use haptic_engine::totals::Totals;
 use haptic_loop::live::LiveConfig;
 use haptic_loop::session::{
     OperatorChoice, SceneSource, SessionError, SessionOptions, SessionReport, run_session_until,
 };
-use haptic_loop::totals::Totals;
 use haptic_types::value::ValueError;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::BTreeMap;

@@ -66,7 +66,7 @@ fn unprivileged() -> Option<Command> {
         ]);
         return Some(c);
     }
-    let p = haptic_devices::realtime::permissions();
+    let p = haptic_engine::realtime::permissions();
     (!p.cap_sys_nice && p.rlimit_rtprio == Some(0)).then(|| Command::new(bin()))
 }
 
@@ -139,7 +139,7 @@ fn a_refused_request_is_said_once_with_its_fix_and_the_session_runs_as_before() 
 #[test]
 fn granted_where_permitted_off_with_no_rt_and_the_priority_checked() {
     let dir = scratch("granted");
-    let p = haptic_devices::realtime::permissions();
+    let p = haptic_engine::realtime::permissions();
     let permitted = p.cap_sys_nice || p.rlimit_rtprio.is_none_or(|l| l >= 50);
     let rec = dir.join("rt.mcap");
     let o = Command::new(bin())

@@ -28,16 +28,11 @@
 //!   line, the Python adapters;
 //! - [`link`]: a network link as a deterministic model (latency, jitter, loss), and
 //!   [`linked`], a modelled device held by a hand at its far end;
-//! - [`pacing`]: real-time pacing of ticks (sleeps to absolute deadlines, spins the last
-//!   stretch, measures its own wake-up latency) and the tick-time statistics (constant-memory
-//!   histograms, percentiles);
-//! - [`realtime`]: the tick thread's real-time set-up (`SCHED_FIFO`, locked memory, a core of
-//!   its own), what the system granted and how to allow what it refused; [`wakeup`], this
-//!   machine's wake-up latency and the tick rates it allows (`nanohaptics doctor`).
 //!
-//! What it is not: no haptic loop, no worlds, no recording. The device interface itself (the
+//! What it is not: no haptic loop, no worlds, no recording, no pacing of ticks (the engine's,
+//! `haptic_engine::timing` and `haptic_engine::realtime`). The device interface itself (the
 //! trait, samples, force commands, specifications) is `haptic-types`'; the engine
-//! (`haptic-loop`) drives these devices and knows them only through that interface.
+//! (`haptic-engine`) drives these devices and knows them only through that interface.
 //!
 //! ```
 //! use haptic_devices::{Grip, Mechanics, Plant, Hold};
@@ -63,12 +58,9 @@ pub mod local;
 mod mechanics;
 pub mod modelled;
 pub mod operator;
-pub mod pacing;
 mod plant;
-pub mod realtime;
 pub mod script;
 pub mod source;
-pub mod wakeup;
 
 pub use grip::{Grip, GripError};
 pub use mechanics::{Mechanics, MechanicsError, PRESETS};

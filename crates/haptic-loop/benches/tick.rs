@@ -3,8 +3,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use haptic_engine::haptic::HapticLoop;
 use haptic_loop::encode::LoopEncoder;
-use haptic_loop::haptic::HapticLoop;
 use haptic_loop::scene::load_scene;
 use haptic_types::Buttons;
 use haptic_types::DeviceSample;

@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used)]
 use haptic_devices::{Grip, Mechanics};
 use haptic_devices::{ModelledDevice, Script};
-use haptic_loop::haptic::HapticLoop;
+use haptic_engine::haptic::HapticLoop;
 use haptic_loop::scene::load_scene_for;
 use haptic_types::HapticDevice;
 use haptic_types::TickTime;

@@ -1,8 +1,8 @@
 //! Per-tick arrays of a session (struct of arrays), filled straight from the loop as a sink of
 //! the runner, or decoded from a recording.
 
-use crate::haptic::HapticLoop;
-use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_engine::haptic::HapticLoop;
+use haptic_engine::sink::{SessionInfo, Sink, SinkError, TickView};
 use recording::channels::cdr::CdrError;
 use recording::channels::messages::{
     Channel, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, TickColumns, TimingMsg,

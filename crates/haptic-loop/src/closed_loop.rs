@@ -12,19 +12,20 @@
 //! A run is [`Report::stable`] when it has no such jump, at most [`MAX_HF_FRACTION`] of its
 //! power above [`BUZZ_HZ`] and an observer that never went below minus its reserve.
 
-use crate::haptic::HapticLoop;
+use haptic_engine::haptic::HapticLoop;
 
-use crate::pacing::Pacing;
-use crate::runner::{RunError, Runner};
-use crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
-use crate::scene::{SceneError, load_scene_for};
-use crate::sink::{Sink, SinkError, TickView};
+use crate::scene::load_scene_for;
 use haptic_devices::link::{LinkError, LinkParams};
 use haptic_devices::linked::LinkedDevice;
 use haptic_devices::local::Protocol;
 use haptic_devices::modelled::specs_of;
 use haptic_devices::{Grip, Mechanics};
 use haptic_devices::{Script, ScriptError};
+use haptic_engine::check::SceneError;
+use haptic_engine::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
+use haptic_engine::pacing::Pacing;
+use haptic_engine::runner::{RunError, Runner};
+use haptic_engine::sink::{Sink, SinkError, TickView};
 use haptic_types::DeviceModel;
 use haptic_types::DeviceSample;
 use haptic_types::device::{DeviceError, DeviceSpecs, ForceCommand, HapticDevice, TickTime};

@@ -1,7 +1,7 @@
 //! The recording's tick encoder fed from a running loop: the scene's state fields and drawing
 //! are read from the loop, then encoded by `recording`'s [`TickEncoder`].
 
-use crate::haptic::HapticLoop;
+use haptic_engine::haptic::HapticLoop;
 use haptic_types::TickResult;
 use recording::{OutMsg, TickEncoder};
 

@@ -1,10 +1,10 @@
 //! The engine's one error type: what can go wrong in a session, a replay or a re-simulation.
 
 use crate::live::LiveError;
-use crate::runner::RunError;
-use crate::scene::SceneError;
-use crate::sink::SinkError;
 use haptic_devices::ScriptError;
+use haptic_engine::check::SceneError;
+use haptic_engine::runner::RunError;
+use haptic_engine::sink::SinkError;
 use haptic_types::DeviceError;
 use haptic_types::textpos::Location;
 use recording::RecordingError;

@@ -3,10 +3,10 @@
 //! [`SessionHeader`] and the file's description ([`description_of`], [`header_of`]).
 
 use crate::encode::LoopEncoder;
-use crate::haptic::HapticLoop;
-use crate::header::SessionHeader;
-use crate::pacing::TickStats;
-use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_engine::haptic::HapticLoop;
+use haptic_engine::header::SessionHeader;
+use haptic_engine::pacing::TickStats;
+use haptic_engine::sink::{SessionInfo, Sink, SinkError, TickView};
 use recording::channels::messages::DescriptionMsg;
 use recording::{Recorder, RecorderSetup, TickEncoder, TickMessages, WriteSummary};
 use std::collections::BTreeMap;

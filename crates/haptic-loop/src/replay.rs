@@ -2,18 +2,18 @@
 //!
 //! The scene is rebuilt from the description (scene text and the device's specifications), the
 //! device inputs, sample ages and deadline flags are played back through a [`ReplayDevice`] by
-//! the [runner](crate::runner), and the verifier sink recomputes every verified output message
+//! the [runner](haptic_engine::runner), and the verifier sink recomputes every verified output message
 //! (state, force, events, Foxglove channels) and compares it byte for byte with the recorded
 //! one. The first difference names its tick and channel.
 
 use crate::encode::LoopEncoder;
 use crate::error::SessionError;
-use crate::haptic::HapticLoop;
-use crate::pacing::Pacing;
 use crate::replay_device::ReplayDevice;
-use crate::runner::Runner;
 use crate::scene::load_scene_for;
-use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_engine::haptic::HapticLoop;
+use haptic_engine::pacing::Pacing;
+use haptic_engine::runner::Runner;
+use haptic_engine::sink::{SessionInfo, Sink, SinkError, TickView};
 use recording::channels::messages::{Channel, ForceMsg, StateMsg};
 use recording::{OutMsg, Recording, RecordingError};
 

@@ -11,20 +11,21 @@
 //! println!("{} ticks, peak force {peak} N", report.arrays.tick.len());
 //! ```
 
-use crate::haptic::HapticLoop;
-use crate::header::SessionHeader;
 use crate::live::LiveConfig;
-use crate::pacing::Pacing;
-use crate::pacing::TickStats;
-use crate::runner::Runner;
-use crate::scene::{SceneError, SceneFile};
+use crate::scene::SceneFile;
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::{live_summary, start_live};
-use crate::totals::Totals;
-use haptic_devices::realtime::RtRequest;
 use haptic_devices::script::{OperatorKind, Script};
 use haptic_devices::source::{DeviceSource, Driver, open_device};
 use haptic_devices::{OperatorParams, ScriptError};
+use haptic_engine::check::SceneError;
+use haptic_engine::haptic::HapticLoop;
+use haptic_engine::header::SessionHeader;
+use haptic_engine::pacing::Pacing;
+use haptic_engine::pacing::TickStats;
+use haptic_engine::realtime::RtRequest;
+use haptic_engine::runner::Runner;
+use haptic_engine::totals::Totals;
 use haptic_types::DeviceModel;
 use haptic_types::Switch;
 use haptic_types::TickTime;
@@ -75,7 +76,7 @@ pub struct SessionOptions {
     /// are the clock).
     pub realtime: bool,
     /// The real-time scheduling the tick thread asks for in a real-time session (default
-    /// `SCHED_FIFO` 50, memory locked, pinned; see `haptic_devices::realtime`); `None`: ask for
+    /// `SCHED_FIFO` 50, memory locked, pinned; see `haptic_engine::realtime`); `None`: ask for
     /// nothing (`--no-rt`). Batch sessions never ask.
     pub rt: Option<RtRequest>,
     /// Record to this MCAP file.
@@ -131,7 +132,7 @@ pub struct SessionReport {
     /// What the live view published, when serving one.
     pub live: Option<crate::live::LiveSummary>,
     /// Time each sink took per tick, ns.
-    pub sinks: Vec<crate::runner::SinkTime>,
+    pub sinks: Vec<haptic_engine::runner::SinkTime>,
 }
 
 /// The script text for a local device (the given one or the scene's default script) and
@@ -219,7 +220,7 @@ fn script_switches(
     script: &Script,
     text: &str,
     origin: &str,
-    scene: &dyn crate::scene::Scene,
+    scene: &dyn haptic_engine::scene::Scene,
     rate_hz: u32,
 ) -> Result<Vec<(u64, Switch)>, SessionError> {
     let mut out = Vec::with_capacity(script.switches.len());

@@ -4,7 +4,7 @@
 //! source every session starts from ([`SceneSource`]).
 //!
 //! Not for: choosing or opening the device (that is [`haptic_devices::source`]) or running
-//! the ticks (that is the [`Runner`](crate::runner::Runner)).
+//! the ticks (that is the [`Runner`](haptic_engine::runner::Runner)).
 //!
 //! [`run_session`]: crate::session::run_session
 //! [`Stepper`]: crate::stepper::Stepper
@@ -20,11 +20,12 @@
 
 use crate::arrays::SessionArrays;
 use crate::error::SessionError;
-use crate::haptic::HapticLoop;
-use crate::header::SessionHeader;
-use crate::scene::{SceneError, SceneFile, load_scene_for};
+use crate::scene::{SceneFile, load_scene_for};
 use crate::sinks::SessionSinks;
 use haptic_devices::source::DeviceSource;
+use haptic_engine::check::SceneError;
+use haptic_engine::haptic::HapticLoop;
+use haptic_engine::header::SessionHeader;
 use haptic_types::DeviceSpecs;
 use haptic_types::textpos::Location;
 use recording::channels::messages;

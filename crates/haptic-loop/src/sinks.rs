@@ -8,8 +8,8 @@ use crate::arrays::SessionArrays;
 use crate::error::SessionError;
 use crate::live::{LiveConfig, LiveSummary};
 use crate::record_sink::RecorderSink;
-use crate::sink::Sink;
-use crate::totals::Totals;
+use haptic_engine::sink::Sink;
+use haptic_engine::totals::Totals;
 use recording::WriteSummary;
 use std::path::PathBuf;
 

@@ -19,17 +19,19 @@
 //! ```
 
 use crate::arrays::SessionArrays;
-use crate::haptic::HapticLoop;
-use crate::header::SessionHeader;
-use crate::pacing::TickStats;
-use crate::runner::{TickEngine, TickStart};
 use crate::session::{SceneSource, SessionError};
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::SessionSinks;
+use haptic_engine::clock::Batch;
+use haptic_engine::haptic::HapticLoop;
+use haptic_engine::header::SessionHeader;
+use haptic_engine::pacing::TickStats;
+use haptic_engine::runner::TickEngine;
 use haptic_types::DeviceModel;
 use haptic_types::DeviceSample;
 use haptic_types::ForceCommand;
 use haptic_types::TickResult;
+use haptic_types::{DeviceError, DeviceSpecs, HapticDevice, TickTime};
 use recording::WriteSummary;
 use std::path::PathBuf;
 
@@ -101,7 +103,7 @@ impl Stepper {
             ..SetupOptions::new(&opts.scene, model.specs().clone(), "stepped", &opts.link)
         })?;
         let mut engine = TickEngine::new(Vec::new());
-        engine.start(&mut sinks.list(), &lp, &header, None, false)?;
+        engine.start(&mut sinks.list(), &lp, &header, None)?;
         Ok(Stepper {
             lp,
             header,
@@ -113,14 +115,16 @@ impl Stepper {
     /// Runs one tick on `sample` and hands it to the sinks (the caller renders the force:
     /// [`command`](Self::command)).
     pub fn tick(&mut self, sample: DeviceSample) -> Result<&TickResult, SessionError> {
-        self.engine.tick(
+        let mut given = Given {
+            specs: &self.header.device,
+            sample,
+        };
+        self.engine.cycle(
             &mut self.sinks.list(),
             &mut self.lp,
-            sample,
-            TickStart::now(),
+            &mut given,
+            &mut Batch,
             None,
-            &mut |_, _| false,
-            &mut |_, _| Ok(()),
         )?;
         Ok(self.lp.last_result())
     }
@@ -168,5 +172,24 @@ impl Stepper {
             stats,
             written,
         })
+    }
+}
+
+/// The caller's sample as the device of one cycle: the caller renders the force itself
+/// ([`Stepper::command`]).
+struct Given<'a> {
+    specs: &'a DeviceSpecs,
+    sample: DeviceSample,
+}
+
+impl HapticDevice for Given<'_> {
+    fn specs(&self) -> &DeviceSpecs {
+        self.specs
+    }
+    fn sample(&mut self, _time: TickTime) -> Result<DeviceSample, DeviceError> {
+        Ok(self.sample)
+    }
+    fn set_force(&mut self, _cmd: &ForceCommand) -> Result<(), DeviceError> {
+        Ok(())
     }
 }

@@ -3,8 +3,9 @@
 #![allow(unsafe_code)] // a counting GlobalAlloc is unsafe by definition
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use haptic_engine::scene::{Scene, SceneInput, SceneOutput};
+use haptic_loop::scene::SceneFile;
 use haptic_loop::scene::optical::OpticalScene;
-use haptic_loop::scene::{Scene, SceneFile, SceneInput, SceneOutput};
 use haptic_types::Buttons;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

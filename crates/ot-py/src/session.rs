@@ -292,7 +292,7 @@ pub fn resolve_scene<'py>(
 ///     timing). The GIL is released while the session runs.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments
-#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None, wait_s=120.0, overrides=None, rt_priority=Some(i64::from(haptic_devices::realtime::DEFAULT_PRIORITY))))]
+#[pyo3(signature = (scene, *, script=None, seconds=None, operator=None, device=None, out=None, wait_s=120.0, overrides=None, rt_priority=Some(i64::from(haptic_engine::realtime::DEFAULT_PRIORITY))))]
 pub fn run_scene<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -306,7 +306,7 @@ pub fn run_scene<'py>(
     rt_priority: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let rt = rt_priority
-        .map(haptic_devices::realtime::RtRequest::with_priority)
+        .map(haptic_engine::realtime::RtRequest::with_priority)
         .transpose()
         .map_err(|e| value_err(e.map_field(|_| "rt_priority".into())))?;
     if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {

@@ -165,7 +165,7 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
     Ok(Outcome {
         scene,
         pages,
-        input: s.input_latency_ms,
+        input: s.session.input_latency_ms,
         fps,
         sound: LatencyMs::of(&audio),
         sound_ts: LatencyMs::of(&audio_ts),
@@ -180,10 +180,10 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         lead_ms: lead,
         underruns,
         samples_dropped,
-        ticks: s.stats.ticks,
-        missed: missed_text(&s.stats),
-        missed_n: s.stats.missed,
-        tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
+        ticks: s.session.stats.ticks,
+        missed: missed_text(&s.session.stats),
+        missed_n: s.session.stats.missed,
+        tick_p99_us: s.session.stats.compute.p99_ns as f64 * 1e-3,
         dropped: s.messages_dropped,
     })
 }
@@ -259,7 +259,7 @@ fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
     Ok(Outcome {
         scene,
         pages: 0,
-        input: s.input_latency_ms,
+        input: s.session.input_latency_ms,
         fps: Vec::new(),
         sound: None,
         sound_ts: None,
@@ -270,10 +270,10 @@ fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
         lead_ms: None,
         underruns: 0,
         samples_dropped: 0,
-        ticks: s.stats.ticks,
-        missed: missed_text(&s.stats),
-        missed_n: s.stats.missed,
-        tick_p99_us: s.stats.compute.p99_ns as f64 * 1e-3,
+        ticks: s.session.stats.ticks,
+        missed: missed_text(&s.session.stats),
+        missed_n: s.session.stats.missed,
+        tick_p99_us: s.session.stats.compute.p99_ns as f64 * 1e-3,
         dropped: s.messages_dropped,
     })
 }
@@ -291,7 +291,7 @@ fn loadavg() -> String {
 }
 
 /// Missed deadlines, with the real time the tick thread got and its wake-up p99 and max.
-fn missed_text(st: &haptic_loop::pacing::TickStats) -> String {
+fn missed_text(st: &haptic_engine::pacing::TickStats) -> String {
     format!(
         "{} ({}; wake-up p99 {:.0} µs, max {:.0} µs)",
         st.missed,

@@ -200,17 +200,21 @@ fn one_run(n: usize, secs: f64) -> RunFigures {
         eprintln!("{l}");
     }
     fps.sort_by(f64::total_cmp);
-    let ticks: u64 = summary.students.iter().map(|s| s.stats.ticks).sum();
-    let missed: u64 = summary.students.iter().map(|s| s.stats.missed).sum();
+    let ticks: u64 = summary.students.iter().map(|s| s.session.stats.ticks).sum();
+    let missed: u64 = summary
+        .students
+        .iter()
+        .map(|s| s.session.stats.missed)
+        .sum();
     let worst_missed_pct = summary
         .students
         .iter()
-        .map(|s| 100.0 * s.stats.missed as f64 / s.stats.ticks.max(1) as f64)
+        .map(|s| 100.0 * s.session.stats.missed as f64 / s.session.stats.ticks.max(1) as f64)
         .fold(0.0, f64::max);
     let p99s: Vec<f64> = summary
         .students
         .iter()
-        .filter_map(|s| s.input_latency_ms.map(|l| l.p99))
+        .filter_map(|s| s.session.input_latency_ms.map(|l| l.p99))
         .collect();
     let mut p99_sorted = p99s.clone();
     p99_sorted.sort_by(f64::total_cmp);

@@ -198,7 +198,7 @@ mod tests {
             let ph = k as f64 * 0.731;
             let n = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
             let s = DeviceSample::new(page_to_device(n, r), Buttons(1));
-            assert_eq!(haptic_loop::HapticLoop::check_sample(&FALCON, &s), None);
+            assert_eq!(haptic_engine::HapticLoop::check_sample(&FALCON, &s), None);
         }
     }
 
@@ -244,7 +244,7 @@ mod tests {
         use haptic_loop::session::SceneSource;
         let scene = SceneSource::builtin("wall").unwrap();
         let loaded = haptic_loop::scene::load_scene_for(&scene.text, FALCON.clone()).unwrap();
-        let mut lp = haptic_loop::HapticLoop::new(loaded.config, loaded.scene);
+        let mut lp = haptic_engine::HapticLoop::new(loaded.config, loaded.scene);
         let l = LatestInput {
             position_m: [0.0, 0.0, -0.01],
             buttons: 0,

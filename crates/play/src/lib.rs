@@ -18,7 +18,7 @@
 //!   (sent as binary sound ticks), in an AudioWorklet that runs the same synthesis as
 //!   `render --audio --proximity` ([`render::audio::StreamSynth`]) at the page's sample rate.
 //! - **The live menu**: the scene's switches, set from a page and applied before the next tick
-//!   (through [`haptic_loop::runner::Runner::with_live`]), recorded as switches.
+//!   (through [`haptic_engine::runner::Runner::with_live`]), recorded as switches.
 //! - **The protocol** ([`protocol`]): one typed message enum per direction, [`protocol::ServerMsg`]
 //!   and [`protocol::PageMsg`], tabled in `docs/play.md`.
 //!
@@ -41,25 +41,17 @@ pub mod input;
 pub mod protocol;
 pub mod publish;
 pub mod server;
+pub mod session;
 
 use gate::{Limits, RefusedCounts};
-use haptic_devices::bridge::{BridgeConfig, UdpDevice};
-use haptic_devices::pacing::Percentiles;
+use haptic_devices::bridge::BridgeConfig;
 use haptic_devices::source::DeviceSource;
-use haptic_loop::HapticLoop;
-use haptic_loop::pacing::{Pacing, TickStats};
-use haptic_loop::runner::{EndReason, Runner};
+use haptic_engine::pacing::Pacing;
 use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
-use haptic_loop::setup::{Setup, SetupOptions, session_device};
-use haptic_loop::totals::Totals;
-use haptic_types::DeviceSpecs;
-use haptic_types::HapticDevice;
-use input::PageDevice;
+use haptic_loop::setup::session_device;
 pub use protocol::LatencyMs;
-use protocol::{EndReport, Hello, Mapping, ServerMsg, SwitchInfo, TickWorkMs};
-use publish::{PlaySink, PublishSummary, ToPublisher};
-use recording::WriteSummary;
-use server::{SceneLink, Server, Shared};
+use server::{Server, Shared};
+use session::{Hand, PageSession, SessionSpec, SessionSummary};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -89,8 +81,8 @@ pub struct PlayConfig {
     pub limits: Limits,
     /// The tick thread's real-time scheduling (default `SCHED_FIFO` 50, memory locked, pinned;
     /// the server's, publisher's and pages' threads stay at normal priority); `None`: ask for
-    /// nothing (`--no-rt`). What it got is in [`PlaySummary::stats`]`.realtime`.
-    pub rt: Option<haptic_devices::realtime::RtRequest>,
+    /// nothing (`--no-rt`). What it got is in the summary's `session.stats.realtime`.
+    pub rt: Option<haptic_engine::realtime::RtRequest>,
 }
 
 impl PlayConfig {
@@ -105,7 +97,7 @@ impl PlayConfig {
             seconds: None,
             keep_serving_s: None,
             limits: Limits::default(),
-            rt: Some(haptic_devices::realtime::RtRequest::default()),
+            rt: Some(haptic_engine::realtime::RtRequest::default()),
         }
     }
 }
@@ -115,22 +107,9 @@ impl PlayConfig {
 pub struct PlaySummary {
     /// The page's URL.
     pub url: String,
-    /// How it ended: `completed` (its `seconds` ran), `stopped` (the player ended it on the
-    /// page, or `stop`), `device_ended` (a bridged device said goodbye); the words of
-    /// [`EndReason::name`], as `haptic_loop::session` reports them.
-    pub end: &'static str,
-    /// Tick statistics (ticks, missed deadlines, tick work).
-    pub stats: TickStats,
-    /// The scene's state after the last tick (name, value): the score and its parts.
-    pub state: Vec<(String, f64)>,
-    /// The recording.
-    pub recording: PathBuf,
-    /// What the recorder wrote.
-    pub written: Option<WriteSummary>,
-    /// Page input to the force of the first tick that used it, ms (page device only).
-    pub input_latency_ms: Option<LatencyMs>,
-    /// What the pages were sent.
-    pub published: PublishSummary,
+    /// The session: how it ended, its ticks, state, recording, latencies and what the pages
+    /// were sent.
+    pub session: SessionSummary,
     /// Pages connected during the session.
     pub pages_served: u64,
     /// Messages not queued to a page that could not keep up.
@@ -145,20 +124,16 @@ pub struct PlaySummary {
 impl PlaySummary {
     /// One line for a person: how it ended, ticks, missed deadlines, score and recording.
     pub fn line(&self) -> String {
+        let s = &self.session;
         format!(
             "{}: {} ticks, {} missed deadlines, score {}, recording {}; real time: {}",
-            self.end,
-            self.stats.ticks,
-            self.stats.missed,
-            self.state("score").unwrap_or(0.0),
-            self.recording.display(),
-            self.stats.realtime.describe()
+            s.end,
+            s.stats.ticks,
+            s.stats.missed,
+            s.state("score").unwrap_or(0.0),
+            s.recording.display(),
+            s.stats.realtime.describe()
         )
-    }
-
-    /// The value of state field `name` after the last tick.
-    pub fn state(&self, name: &str) -> Option<f64> {
-        self.state.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
     }
 }
 
@@ -181,215 +156,10 @@ pub enum PlayError {
     /// Stopped before any page pressed Start (nothing was recorded).
     #[error("stopped before a page started the session: nothing was recorded")]
     NotStarted,
-}
-
-fn stats_ms(p: &Percentiles) -> TickWorkMs {
-    TickWorkMs {
-        p50_ms: p.p50_ns as f64 * 1e-6,
-        p99_ms: p.p99_ns as f64 * 1e-6,
-        max_ms: p.max_ns as f64 * 1e-6,
-    }
-}
-
-/// The hand of a play session: the page, or a device bridged over UDP.
-enum Hand {
-    Page(PageDevice),
-    Bridged(Box<UdpDevice>),
-}
-
-impl Hand {
-    /// Opens the hand of a session: a bridged device (`device` made for the session by
-    /// [`session_device`]: its hello is awaited here), or the page with the scene's model.
-    fn open(device: DeviceSource, shared: &Shared) -> Result<Hand, PlayError> {
-        Ok(match device {
-            DeviceSource::Udp(b) => {
-                let mut dev = UdpDevice::new(b);
-                dev.open().map_err(SessionError::Device)?;
-                Hand::Bridged(Box::new(dev))
-            }
-            DeviceSource::Model(m) => {
-                Hand::Page(PageDevice::new(m.specs().clone(), shared.input.clone()))
-            }
-        })
-    }
-
-    fn device(&mut self) -> &mut dyn HapticDevice {
-        match self {
-            Hand::Page(d) => d,
-            Hand::Bridged(d) => d.as_mut(),
-        }
-    }
-
-    fn is_page(&self) -> bool {
-        matches!(self, Hand::Page(_))
-    }
-
-    /// The link and the operator as the recording names them.
-    fn describe(&self, config: &PlayConfig) -> (String, &'static str) {
-        match &config.device {
-            Some(b) => (format!("udp:{}", b.bind), "person (bridged device)"),
-            None => ("page".to_string(), "person (browser page)"),
-        }
-    }
-}
-
-/// The page's `hello`: the scene, the device, the view's mapping, the menu of switches with
-/// their values now and the state fields.
-fn hello_message(
-    scene_name: &str,
-    lp: &HapticLoop,
-    specs: &DeviceSpecs,
-    page_is_hand: bool,
-    seconds: Option<f64>,
-) -> ServerMsg {
-    let scene = lp.scene();
-    let config = lp.config();
-    ServerMsg::Hello(Hello {
-        scene: scene_name.to_string(),
-        kind: scene.kind().to_string(),
-        rate_hz: config.rate_hz,
-        device: specs.name.to_string(),
-        workspace_radius_m: specs.workspace_radius_m,
-        max_force_n: specs.limits.max_force_n,
-        buttons: specs
-            .button_strs()
-            .into_iter()
-            .map(str::to_string)
-            .collect(),
-        page_is_hand,
-        display_scale: config.display_scale,
-        mapping: Mapping {
-            origin_m: config.mapping.origin_m,
-            workspace_scale: config.mapping.workspace_scale,
-        },
-        switches: scene
-            .switches()
-            .iter()
-            .map(|s| SwitchInfo {
-                name: s.name.to_string(),
-                min: s.min,
-                max: s.max,
-                boolean: s.boolean,
-                doc: s.doc.to_string(),
-                value: scene.switch_value(s.name),
-            })
-            .collect(),
-        state_fields: scene.state_fields(),
-        seconds,
-    })
-}
-
-/// Tells the server and every page what is played: the scene's switches and the device (for
-/// checking page messages), and the `hello` (kept for pages that connect later).
-pub(crate) fn announce(
-    shared: &Shared,
-    scene_name: &str,
-    lp: &HapticLoop,
-    specs: &DeviceSpecs,
-    page_is_hand: bool,
-    seconds: Option<f64>,
-) {
-    let scene = lp.scene();
-    if let Ok(mut s) = shared.scene.lock() {
-        *s = Some(SceneLink {
-            switches: scene.switches(),
-            kind: scene.kind(),
-            workspace_radius_m: specs.workspace_radius_m,
-            button_mask: specs.button_mask(),
-            page_is_hand,
-        });
-    }
-    let hello = hello_message(scene_name, lp, specs, page_is_hand, seconds).to_json();
-    if let Ok(mut h) = shared.hello.lock() {
-        *h = Some(hello.clone());
-    }
-    shared.broadcast(&tungstenite::Message::text(hello));
-}
-
-/// The page's `end`: the session's figures and where to download its recording (`url`, the
-/// file `out`).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn end_message(
-    url: &str,
-    out: &std::path::Path,
-    end: EndReason,
-    stats: &TickStats,
-    rate_hz: u32,
-    totals: &Totals,
-    input_latency_ms: Option<LatencyMs>,
-    written: Option<&WriteSummary>,
-) -> ServerMsg {
-    ServerMsg::End(EndReport {
-        end,
-        ticks: stats.ticks,
-        seconds: stats.ticks as f64 / f64::from(rate_hz),
-        missed_deadlines: stats.missed,
-        tick_work: stats_ms(&stats.compute),
-        state: totals
-            .state_fields
-            .iter()
-            .cloned()
-            .zip(totals.last_state.iter().copied())
-            .collect(),
-        peak_device_force_n: totals.peak_device_force_n,
-        events: totals.events,
-        input_latency_ms,
-        recording: url.to_string(),
-        recording_file: out.file_name().map(|n| n.to_string_lossy().to_string()),
-        recording_bytes: written.map(|w| w.bytes),
-    })
-}
-
-/// Offers the recording `out` for download and tells every page (and later ones) the end.
-pub(crate) fn offer_end(shared: &Shared, out: &std::path::Path, end_msg: &ServerMsg) {
-    if let Ok(mut r) = shared.recording.lock() {
-        *r = Some(out.to_path_buf());
-    }
-    let text = end_msg.to_json();
-    if let Ok(mut e) = shared.end.lock() {
-        *e = Some(text.clone());
-    }
-    shared.broadcast(&tungstenite::Message::text(text));
-}
-
-/// Applies before tick `tick` the switches pages (or a teacher) asked for: each told to the
-/// publisher as applied on `tick`, or refused with the reason (to the page that asked).
-pub(crate) fn apply_page_switches(
-    shared: &Shared,
-    tx: &std::sync::mpsc::Sender<ToPublisher>,
-    tick: u64,
-    lp: &mut HapticLoop,
-) {
-    // Never wait for a page's thread: a busy queue waits for the next tick.
-    let reqs = match shared.switches.try_lock() {
-        Ok(mut q) if !q.is_empty() => std::mem::take(&mut *q),
-        _ => return,
-    };
-    for (page, name, value) in reqs {
-        let m = match lp.switch(&name, value) {
-            Ok(()) => ToPublisher::Switched { tick, name, value },
-            Err(e) => ToPublisher::Refused {
-                page,
-                message: e.to_string(),
-            },
-        };
-        let _ = tx.send(m);
-    }
-}
-
-/// The hook run before each tick's step: raises the end on `stop`, and applies the switches
-/// pages asked for.
-fn switch_hook<'a>(
-    stop: &'a AtomicBool,
-    shared: Arc<Shared>,
-    tx: std::sync::mpsc::Sender<ToPublisher>,
-) -> impl FnMut(u64, &mut HapticLoop) + 'a {
-    move |tick: u64, lp: &mut HapticLoop| {
-        if stop.load(Ordering::Relaxed) {
-            shared.end_requested.store(true, Ordering::Relaxed);
-        }
-        apply_page_switches(&shared, &tx, tick, lp);
-    }
+    /// The session failed while it ran (its device, a sink or a scheduled switch); the
+    /// recording holds every tick before the failure.
+    #[error("the session ended early: {0}")]
+    Failed(String),
 }
 
 /// A play session running on its own thread (see [`start`]).
@@ -466,104 +236,44 @@ pub fn run(
     let url = server.url();
     on_ready(&url);
 
-    let mut hand = Hand::open(device, &shared)?;
+    let hand = Hand::open(device, &shared)?;
     let page_is_hand = hand.is_page();
-    let specs = hand.device().specs().clone();
-    let (link, operator) = hand.describe(config);
-    let Setup {
-        mut lp,
-        header,
-        mut sinks,
-    } = Setup::new(&SetupOptions {
-        operator: Some(operator.to_string()),
-        keep_arrays: false,
-        out: Some(config.out.clone()),
-        start_time_ns: Some(start_time_ns),
-        ..SetupOptions::new(scene_src, specs.clone(), "realtime", &link)
-    })?;
-    let fields = lp.scene().state_fields();
-    let kind = lp.scene().kind();
-    announce(
-        &shared,
-        &file.scene.name,
-        &lp,
-        &specs,
-        page_is_hand,
-        config.seconds,
-    );
+    let (link, operator) = match &config.device {
+        Some(b) => (format!("udp:{}", b.bind), "person (bridged device)"),
+        None => ("page".to_string(), "person (browser page)"),
+    };
+    let spec = SessionSpec {
+        scene: scene_src,
+        scene_name: &file.scene.name,
+        out: config.out.clone(),
+        recording_url: "/recording.mcap".into(),
+        start_time_ns,
+        operator: operator.into(),
+        link,
+        seconds: config.seconds,
+        ticks,
+    };
+    let mut session = PageSession::open(&spec, hand, shared.clone())?;
     if page_is_hand && !shared.input.wait_first(stop) {
         server.stop(&shared);
         return Err(PlayError::NotStarted);
     }
-
-    // The session.
-    let prox = haptic_loop::sound::proximity_on_distance_m(kind)
-        .filter(|_| fields.iter().any(|f| f == "nearest_m"));
-    let (tx, rx) = std::sync::mpsc::channel::<ToPublisher>();
-    let sh = shared.clone();
-    let publisher = std::thread::Builder::new()
-        .name("play-publish".into())
-        .spawn(move || publish::run_publisher(rx, sh, rate, fields, prox))
-        .map_err(|e| PlayError::Serve {
-            port: config.port,
-            message: e.to_string(),
-        })?;
-    let mut play_sink = PlaySink::new(tx.clone(), shared.clone());
-    let mut hook = switch_hook(stop, shared.clone(), tx);
     let pacing = if page_is_hand {
         Pacing::Realtime
     } else {
         Pacing::DeviceClock
     };
-    let result = {
-        let mut list = sinks.list();
-        list.push(&mut play_sink);
-        let mut runner = Runner::new(list)
-            .with_live(&mut hook)
-            .stop_on(&shared.end_requested)
-            .with_realtime(config.rt);
-        runner.run(
-            &mut lp,
-            hand.device(),
-            &header,
-            ticks,
-            pacing,
-            &mut |_, _| {},
-        )
-    };
-    drop(hook);
-    let latencies = std::mem::take(&mut play_sink.input_latency_ms);
-    drop(play_sink);
-    let closed = hand.device().close();
-    let published = publisher.join().unwrap_or_default();
-    let (stats, end) = result.map_err(SessionError::from)?;
-    closed.map_err(SessionError::Device)?;
-    let totals = &sinks.totals;
-    let state = totals.state();
-    let input_latency_ms = LatencyMs::of(&latencies);
-    let written = sinks.written();
-    let end_msg = end_message(
-        "/recording.mcap",
-        &config.out,
-        end,
-        &stats,
-        rate,
-        totals,
-        input_latency_ms,
-        written.as_ref(),
-    );
-    offer_end(&shared, &config.out, &end_msg);
+    session.run(pacing, config.rt.as_ref(), stop);
+    let session = session.finish();
+    if let Some(e) = &session.error {
+        server.stop(&shared);
+        return Err(PlayError::Failed(e.clone()));
+    }
     serve_end_screen(config, stop);
     server.stop(&shared);
     Ok(PlaySummary {
         url,
-        end: end.name(),
-        stats,
-        state,
-        recording: config.out.clone(),
-        written,
-        input_latency_ms,
-        published,
+        session,
         pages_served: shared.pages_served.load(Ordering::Relaxed),
         messages_dropped: shared.dropped.load(Ordering::Relaxed),
         page_messages_refused: shared.refused.load(Ordering::Relaxed),

@@ -19,7 +19,7 @@
 //! itself (`synth.js`, an AudioWorklet port of [`render::audio::StreamSynth`]). The layout is
 //! [`SoundTicks::encode`]'s.
 
-use haptic_loop::runner::EndReason;
+use haptic_engine::runner::EndReason;
 use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;

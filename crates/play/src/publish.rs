@@ -20,10 +20,10 @@ use crate::protocol::{
     EventAt, Frame, FrameView, ServerMsg, Shape, SoundAt, SoundKind, SoundOn, SoundTick, SoundTicks,
 };
 use crate::server::Shared;
-use haptic_loop::HapticLoop;
-use haptic_loop::pacing::TickStats;
+use haptic_engine::HapticLoop;
+use haptic_engine::pacing::TickStats;
+use haptic_engine::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_loop::session::{SessionArrays, now_unix_ns};
-use haptic_loop::sink::{SessionInfo, Sink, SinkError, TickView};
 use haptic_types::Primitive;
 use render::audio::Sound;
 use std::collections::VecDeque;

@@ -153,7 +153,7 @@ fn end_session(b: &mut Browser, s: Session, shot: Option<&str>) -> (PlaySummary,
         Some(std::fs::metadata(&s.out).unwrap().len()),
         "the download link serves the recording"
     );
-    assert_eq!(summary.end, "stopped");
+    assert_eq!(summary.session.end, "stopped");
     (summary, page)
 }
 
@@ -206,7 +206,7 @@ fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
     let rec = read_recording_file(out, false).unwrap();
     let report = haptic_loop::replay::verify(&rec).unwrap();
     assert!(report.ok(), "replay diverged: {:?}", report.divergence);
-    assert_eq!(report.ticks, summary.stats.ticks);
+    assert_eq!(report.ticks, summary.session.stats.ticks);
     assert!(report.messages_compared > report.ticks);
 
     // The sound events at their ticks, as `render --audio` finds them in the recording.
@@ -234,14 +234,20 @@ fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
     assert_eq!(got, want);
     // And the synthesis's input: every tick once, in order, each sound with it (the page
     // synthesises the samples; tests/browser_sound.rs compares them with `render --audio`).
-    assert_eq!(summary.published.sound_ticks, summary.stats.ticks);
+    assert_eq!(
+        summary.session.published.sound_ticks,
+        summary.session.stats.ticks
+    );
     assert_eq!(page["sound"]["firstTick"], 0);
     assert_eq!(page["sound"]["gaps"], 0);
-    assert_eq!(page["sound"]["ticks"].as_u64(), Some(summary.stats.ticks));
+    assert_eq!(
+        page["sound"]["ticks"].as_u64(),
+        Some(summary.session.stats.ticks)
+    );
     assert_eq!(page["sound"]["sounds"].as_u64(), Some(want.len() as u64));
     assert_eq!(
         page["sound"]["messages"].as_u64(),
-        Some(summary.published.sound_messages)
+        Some(summary.session.published.sound_messages)
     );
     // The page's audio ran at its context's rate, and its worklet played sounds: each one's
     // tick → output latency measured once, a positive time under the session's length.
@@ -377,16 +383,16 @@ fn a_pointer_grabs_a_brick_and_places_it_in_a_slot() {
     let out = s.out.clone();
     let (summary, page) = end_session(&mut b, s, Some("end.png"));
     assert!(
-        summary.state("slots_filled").unwrap() >= 1.0,
+        summary.session.state("slots_filled").unwrap() >= 1.0,
         "{:?}",
-        summary.state
+        summary.session.state
     );
-    assert!(summary.state("score").unwrap() >= 25.0 - 1e-9);
+    assert!(summary.session.state("score").unwrap() >= 25.0 - 1e-9);
     assert_eq!(
         page["ended"]["state"]["score"].as_f64(),
-        summary.state("score")
+        summary.session.state("score")
     );
-    assert!(summary.input_latency_ms.is_some());
+    assert!(summary.session.input_latency_ms.is_some());
     assert_eq!(summary.page_messages_refused, 1);
     let rec = read_recording_file(&out, false).unwrap();
     let sched = recording::switch_schedule(&rec, 1_000_000).unwrap();
@@ -481,7 +487,7 @@ fn a_keyboard_only_session_fills_a_slot() {
         .unwrap();
     let out = s.out.clone();
     let (summary, page) = end_session(&mut b, s, Some("end-keyboard.png"));
-    assert!(summary.state("slots_filled").unwrap() >= 1.0);
+    assert!(summary.session.state("slots_filled").unwrap() >= 1.0);
     // The log (the ARIA live region) announced the grab and the slot, in words.
     let said = said(&page);
     for want in [
@@ -525,7 +531,7 @@ fn the_nano_world_plays_in_the_page() {
     assert!(drawn > 30, "{drawn} draws");
     let out = s.out.clone();
     let (summary, page) = end_session(&mut b, s, Some("end-nano.png"));
-    assert!(summary.stats.ticks > 1500);
+    assert!(summary.session.stats.ticks > 1500);
     assert_eq!(page["hello"]["kind"], "nanoworld");
     assert_only_the_game_said(&page);
     // The tip snapped to the substrate (and, pulled across it, maybe came off): said in words.
@@ -713,7 +719,7 @@ fn a_gamepad_moves_the_hand_grips_and_rumbles_with_the_force() {
         .unwrap();
     let out = s.out.clone();
     let (summary, page) = end_session(&mut b, s, None);
-    assert!(summary.stats.ticks > 1000);
+    assert!(summary.session.stats.ticks > 1000);
 
     let polls: Vec<Poll> = pad["polls"]
         .as_array()

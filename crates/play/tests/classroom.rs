@@ -252,22 +252,23 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
     );
     assert_eq!(summary.refused.origin, 1);
     for s in &summary.students {
-        assert_eq!(s.end, "stopped", "{}", s.line());
-        assert!(s.stats.ticks > 100, "{}", s.line());
-        assert!(s.error.is_none(), "{}", s.line());
+        assert_eq!(s.session.end, "stopped", "{}", s.line());
+        assert!(s.session.stats.ticks > 100, "{}", s.line());
+        assert!(s.session.error.is_none(), "{}", s.line());
         // Each recording is the student's own, named for them, and replays bit for bit.
-        assert_eq!(s.recording.parent(), Some(c.dir.as_path()));
+        assert_eq!(s.session.recording.parent(), Some(c.dir.as_path()));
         let stem = s
+            .session
             .recording
             .file_name()
             .unwrap()
             .to_string_lossy()
             .to_string();
         assert!(stem.starts_with(&format!("{}-", play::classroom::names::file_stem(&s.name))));
-        let rec = read_recording_file(&s.recording, false).unwrap();
+        let rec = read_recording_file(&s.session.recording, false).unwrap();
         let v = haptic_loop::replay::verify(&rec).unwrap();
         assert!(v.ok(), "{}: {:?}", s.name, v);
-        assert_eq!(v.ticks, s.stats.ticks);
+        assert_eq!(v.ticks, s.session.stats.ticks);
     }
     let _ = std::fs::remove_dir_all(&c.dir);
 }
@@ -370,16 +371,17 @@ fn a_bridged_device_joins_as_a_student_and_the_teacher_sees_and_ends_it() {
         .iter()
         .find(|s| s.name == "Falcon lab 2")
         .expect("the device's session");
-    assert_eq!(s.end, "stopped", "{}", s.line());
-    assert!(s.stats.ticks > 0, "{}", s.line());
+    assert_eq!(s.session.end, "stopped", "{}", s.line());
+    assert!(s.session.stats.ticks > 0, "{}", s.line());
     assert!(
-        s.recording
+        s.session
+            .recording
             .file_name()
             .unwrap()
             .to_string_lossy()
             .starts_with("Falcon_lab_2-")
     );
-    let rec = read_recording_file(&s.recording, false).unwrap();
+    let rec = read_recording_file(&s.session.recording, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
     let _ = std::fs::remove_dir_all(&dir);
 }

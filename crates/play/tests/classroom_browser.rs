@@ -191,8 +191,8 @@ fn the_teacher_page_watches_switches_ends_and_collects_the_class() {
     let s = class.join().unwrap().unwrap();
     assert_eq!(s.students.len(), 3);
     for st in &s.students {
-        assert_eq!(st.end, "stopped", "{}", st.line());
-        let rec = read_recording_file(&st.recording, false).unwrap();
+        assert_eq!(st.session.end, "stopped", "{}", st.line());
+        let rec = read_recording_file(&st.session.recording, false).unwrap();
         assert!(
             haptic_loop::replay::verify(&rec).unwrap().ok(),
             "{}",

@@ -6,13 +6,13 @@
 
 use haptic_devices::ScriptedDevice;
 use haptic_devices::script::Script;
-use haptic_loop::HapticLoop;
-use haptic_loop::pacing::Pacing;
+use haptic_engine::HapticLoop;
+use haptic_engine::pacing::Pacing;
+use haptic_engine::runner::Runner;
+use haptic_engine::sink::Sink;
 use haptic_loop::record_sink::RecorderSink;
-use haptic_loop::runner::Runner;
 use haptic_loop::scene::load_scene_for;
 use haptic_loop::session::SceneSource;
-use haptic_loop::sink::Sink;
 use haptic_types::HapticDevice;
 use haptic_types::device::FALCON;
 use recording::{read_recording_file, switch_schedule};

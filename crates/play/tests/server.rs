@@ -208,7 +208,7 @@ fn the_watchdog_takes_the_force_down_when_the_page_goes_quiet() {
     let msgs = read_for(&mut ws, 0.5);
     assert!(msgs.iter().any(|m| m["type"] == "end"));
     let s = h.join().unwrap().unwrap();
-    assert_eq!(s.end, "stopped");
+    assert_eq!(s.session.end, "stopped");
     let a = read_arrays(&out, false).unwrap();
     let first = |name: &str| a.events.iter().find(|e| e.1 == name).map(|e| e.0);
     let (late, lost, back) = (
@@ -276,7 +276,7 @@ fn a_bridged_device_is_the_hand_and_the_page_watches() {
     dev.join().unwrap().unwrap();
     let s = h.join().unwrap().unwrap();
     msgs.extend(read_for(&mut ws, 0.2));
-    assert_eq!(s.end, "device_ended");
+    assert_eq!(s.session.end, "device_ended");
     assert!(
         msgs.iter()
             .any(|m| m["type"] == "role" && m["role"] == "view")
@@ -285,11 +285,11 @@ fn a_bridged_device_is_the_hand_and_the_page_watches() {
         && m["message"] == "a device is the hand in this session: the page only watches"));
     let frames = msgs.iter().filter(|m| m["type"] == "frame").count();
     assert!(
-        frames as u64 * 16 >= s.stats.ticks / 2,
+        frames as u64 * 16 >= s.session.stats.ticks / 2,
         "{frames} frames for {} ticks",
-        s.stats.ticks
+        s.session.stats.ticks
     );
-    assert!(s.input_latency_ms.is_none());
+    assert!(s.session.input_latency_ms.is_none());
     let rec = read_recording_file(&out, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }
@@ -495,5 +495,5 @@ fn a_page_that_stops_reading_loses_frames_never_the_loop() {
     // …while the player's page kept receiving them in the last second,
     assert!(frames_late > 10, "{frames_late} frames in the last second");
     // and the loop ran every tick of the session (none waited for the stalled page).
-    assert!(s.stats.ticks > 3000, "{}", s.line());
+    assert!(s.session.stats.ticks > 3000, "{}", s.line());
 }

@@ -15,9 +15,9 @@
 
 use super::protocol::{ForceReply, Packet, Sample};
 use crate::local::{DeviceSide, Protocol};
-use crate::pacing::{Pacer, Percentiles};
 use crate::script::Script;
 use crate::{OperatorParams, Plant, ScriptedDevice, SimulatedOperator};
+use haptic_engine::timing::{Pacer, Percentiles};
 use haptic_types::device::{
     DeviceError, DeviceModel, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };

@@ -5,7 +5,7 @@ use super::{Outcome, falcon};
 use haptic_devices::Script;
 use haptic_devices::bridge::protocol::Packet;
 use haptic_devices::local::{DeviceSide, Protocol};
-use haptic_loop::HapticLoop;
+use haptic_engine::HapticLoop;
 use haptic_loop::scene::load_scene_for;
 use haptic_types::Buttons;
 use haptic_types::DeviceSample;

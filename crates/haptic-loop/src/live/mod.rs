@@ -27,7 +27,7 @@ mod server;
 #[cfg(feature = "live")]
 pub use server::LiveSink;
 
-use crate::sink::SinkError;
+use haptic_engine::sink::SinkError;
 use std::net::SocketAddr;
 
 /// Why the live view could not start or publish.

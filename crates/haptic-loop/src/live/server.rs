@@ -2,9 +2,9 @@
 //! publisher thread.
 
 use super::{LiveConfig, LiveError, LiveSummary};
-use crate::haptic::HapticLoop;
-use crate::pacing::TickStats;
-use crate::sink::{SessionInfo, Sink, SinkError, TickView};
+use haptic_engine::haptic::HapticLoop;
+use haptic_engine::pacing::TickStats;
+use haptic_engine::sink::{SessionInfo, Sink, SinkError, TickView};
 use recording::foxglove_out;
 
 use haptic_types::Event;

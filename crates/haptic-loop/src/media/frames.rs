@@ -2,9 +2,9 @@
 
 use super::{MediaError, camera_for, draw_prims, style};
 use crate::replay::Resimulation;
-use crate::scene::Scene;
 use crate::scene::optical::RecordedPicture;
-use crate::sink::{Sink, SinkError, TickView};
+use haptic_engine::scene::Scene;
+use haptic_engine::sink::{Sink, SinkError, TickView};
 use haptic_types::Primitive;
 use haptic_types::value::ValueError;
 use recording::channels::messages::DescriptionMsg;

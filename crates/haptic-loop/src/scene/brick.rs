@@ -9,10 +9,13 @@
 //! `turn_z`.
 //! The world's `dt_s` must equal the loop's tick.
 
-use super::check::{SceneError, check_positive, out_of_range};
 use super::score::{self, DROP_HEIGHT_M, HouseScore};
-use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use super::{WorldKind, world_table};
 use brickworld::{CursorInput, Grip, Params, World};
+use haptic_engine::check::{SceneError, check_positive, out_of_range};
+use haptic_engine::scene::Scene;
+use haptic_engine::scene::SceneInput;
+use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
 use haptic_types::Primitive;
 use haptic_types::Rgba;

@@ -33,12 +33,12 @@
 //! ...
 //! ```
 
-use super::Scene;
-use super::check::SceneError;
-use super::loop_config::{DisplaySection, LoopConfig, LoopSection, MappingSection};
 use super::registry;
 use super::table;
-use crate::header::SessionHeader;
+use haptic_engine::check::SceneError;
+use haptic_engine::header::SessionHeader;
+use haptic_engine::loop_config::{DisplaySection, LoopConfig, LoopSection, MappingSection};
+use haptic_engine::scene::Scene;
 use haptic_types::DeviceModel;
 use haptic_types::DeviceSpecs;
 use serde::Deserialize;

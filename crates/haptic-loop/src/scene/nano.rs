@@ -14,9 +14,12 @@
 //! `mapping.workspace_scale`). Each tick the scene reports the adhesion `k` of the anchored
 //! contact (game mode) or `k_c` (physical).
 
-use super::check::{SceneError, check_positive, out_of_range, out_of_range_text};
 use super::score::{self, HouseScore};
-use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use super::{WorldKind, world_table};
+use haptic_engine::check::{SceneError, check_positive, out_of_range, out_of_range_text};
+use haptic_engine::scene::Scene;
+use haptic_engine::scene::SceneInput;
+use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
 use haptic_types::Primitive;
 use haptic_types::Rgba;

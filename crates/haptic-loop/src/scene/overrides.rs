@@ -21,9 +21,9 @@
 //!     "override `wall.stifness_n_per_m`: unknown field `stifness_n_per_m`, expected"));
 //! ```
 
-use super::check::SceneError;
 use super::file::SceneFile;
 use haptic_devices::script::{Script, ScriptError};
+use haptic_engine::check::SceneError;
 use haptic_types::DeviceSpecs;
 use toml::{Table, Value};
 

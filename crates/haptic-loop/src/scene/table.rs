@@ -1,7 +1,7 @@
 //! Reading one table of a scene file by its key, keeping the TOML reader's positions, so an
 //! error inside a world's table still points at its line and column.
 
-use super::check::SceneError;
+use haptic_engine::check::SceneError;
 use serde::Deserialize;
 use serde::de::{DeserializeOwned, DeserializeSeed, Deserializer, IgnoredAny, MapAccess, Visitor};
 use std::fmt;

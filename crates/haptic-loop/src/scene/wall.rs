@@ -9,8 +9,11 @@
 //! It checks the loop's stiffness cap and force clamp: pressed `d` deep, a wall of stiffness
 //! `k` gives `k·d` until the device maximum, then exactly the maximum, in the same direction.
 
-use super::check::{SceneError, check_positive, check_range, out_of_range_text};
-use super::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use super::{WorldKind, world_table};
+use haptic_engine::check::{SceneError, check_positive, check_range, out_of_range_text};
+use haptic_engine::scene::Scene;
+use haptic_engine::scene::SceneInput;
+use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
 use haptic_types::Primitive;
 use haptic_types::Rgba;

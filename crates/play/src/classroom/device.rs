@@ -4,16 +4,12 @@
 //! other. One thread for the one device; the students' sessions stay on the workers.
 
 use super::{Class, Phase, Status, Student, StudentSummary};
-use crate::protocol::LatencyMs;
-use crate::publish::{self, PlaySink, ToPublisher};
-use crate::{announce, apply_page_switches, end_message, offer_end};
-use haptic_devices::bridge::{BridgeConfig, UdpDevice};
-use haptic_loop::HapticLoop;
-use haptic_loop::pacing::Pacing;
-use haptic_loop::runner::Runner;
-use haptic_loop::session::{SessionError, now_unix_ns};
-use haptic_loop::setup::{Setup, SetupOptions, session_device};
-use haptic_types::HapticDevice;
+use crate::session::{Hand, PageSession, SessionSpec, SessionSummary};
+use haptic_devices::bridge::BridgeConfig;
+use haptic_devices::source::DeviceSource;
+use haptic_engine::pacing::Pacing;
+use haptic_loop::session::now_unix_ns;
+use haptic_loop::setup::session_device;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -48,25 +44,20 @@ pub(crate) fn run_device_student(
     if let Ok(mut s) = class.students.lock() {
         s.push(student.clone());
     }
-    let summary = session(class, &student, bridge, start_ns, stop);
-    let summary = match summary {
-        Ok(s) => s,
-        Err(e) => StudentSummary {
-            name: name.to_string(),
+    let session =
+        session(class, &student, bridge, start_ns, stop).unwrap_or_else(|e| SessionSummary {
             end: "stopped",
-            stats: Default::default(),
-            state: Vec::new(),
             recording: out,
-            written: None,
-            input_latency_ms: None,
-            published: Default::default(),
             error: Some(e),
-        },
-    };
+            ..SessionSummary::default()
+        });
     student.set_phase(Phase::Ended);
     class.ended.fetch_add(1, Ordering::Relaxed);
     if let Ok(mut f) = class.finished.lock() {
-        f.push(summary);
+        f.push(StudentSummary {
+            name: name.to_string(),
+            session,
+        });
     }
     Ok(())
 }
@@ -77,111 +68,37 @@ fn session(
     bridge: BridgeConfig,
     start_ns: u64,
     stop: &AtomicBool,
-) -> Result<StudentSummary, String> {
+) -> Result<SessionSummary, String> {
     let file = class.config.scene.parse().map_err(|e| e.to_string())?;
-    let source = haptic_devices::source::DeviceSource::Udp(bridge);
-    let haptic_devices::source::DeviceSource::Udp(b) =
-        session_device(&file, Some(&source), start_ns)
-    else {
-        return Err("the bridge's configuration was lost".into());
+    let device = session_device(&file, Some(&DeviceSource::Udp(bridge)), start_ns);
+    let link = match &device {
+        DeviceSource::Udp(b) => format!("udp:{}", b.bind),
+        DeviceSource::Model(_) => return Err("the bridge's configuration was lost".into()),
     };
-    let link = format!("udp:{}", b.bind);
-    let mut dev = UdpDevice::new(b);
     // Waits for the device's hello (its own wait limit applies).
-    dev.open().map_err(|e| e.to_string())?;
-    let specs = dev.specs().clone();
-    let Setup {
-        mut lp,
-        header,
-        mut sinks,
-    } = Setup::new(&SetupOptions {
-        operator: Some(format!(
+    let hand = Hand::open(device, &student.shared).map_err(|e| e.to_string())?;
+    let spec = SessionSpec {
+        scene: &class.config.scene,
+        scene_name: &class.scene_name,
+        out: student.out.clone(),
+        recording_url: format!("/recording.mcap?s={}", student.token),
+        start_time_ns: start_ns,
+        operator: format!(
             "person (bridged device, classroom student `{}`)",
             student.name
-        )),
-        keep_arrays: false,
-        out: Some(student.out.clone()),
-        start_time_ns: Some(start_ns),
-        ..SetupOptions::new(&class.config.scene, specs.clone(), "realtime", &link)
-    })
-    .map_err(|e| e.to_string())?;
-    announce(
-        &student.shared,
-        &class.scene_name,
-        &lp,
-        &specs,
-        false,
-        class.config.seconds,
-    );
-    student.set_phase(Phase::Playing);
-    let fields = lp.scene().state_fields();
-    let prox = haptic_loop::sound::proximity_on_distance_m(lp.scene().kind())
-        .filter(|_| fields.iter().any(|f| f == "nearest_m"));
-    let rate = lp.config().rate_hz;
-    let (tx, rx) = std::sync::mpsc::channel::<ToPublisher>();
-    let sh = student.shared.clone();
-    let publisher = std::thread::Builder::new()
-        .name("class-publish".into())
-        .spawn(move || publish::run_publisher(rx, sh, rate, fields, prox))
-        .map_err(|e| e.to_string())?;
-    let mut play_sink = PlaySink::new(tx.clone(), student.shared.clone());
-    let shared = student.shared.clone();
+        ),
+        link,
+        seconds: class.config.seconds,
+        ticks: class.ticks,
+    };
     let st = student.clone();
-    let mut hook = move |tick: u64, lp: &mut HapticLoop| {
-        if stop.load(Ordering::Relaxed) {
-            shared.end_requested.store(true, Ordering::Relaxed);
-        }
-        apply_page_switches(&shared, &tx, tick, lp);
-        if tick % super::STATUS_EVERY_TICKS == 0 {
-            st.report(tick + 1, 0, lp);
-        }
-    };
-    let result = {
-        let mut list = sinks.list();
-        list.push(&mut play_sink);
-        let mut runner = Runner::new(list)
-            .with_live(&mut hook)
-            .stop_on(&student.shared.end_requested);
-        runner.run(
-            &mut lp,
-            &mut dev,
-            &header,
-            class.ticks,
-            Pacing::DeviceClock,
-            &mut |_, _| {},
-        )
-    };
-    drop(hook);
-    let latencies = std::mem::take(&mut play_sink.input_latency_ms);
-    drop(play_sink);
-    let closed = dev.close();
-    let published = publisher.join().unwrap_or_default();
-    let (stats, end) = result.map_err(|e| SessionError::from(e).to_string())?;
-    closed.map_err(|e| e.to_string())?;
-    student.report(stats.ticks, stats.missed, &lp);
-    let written = sinks.written();
-    let input_latency_ms = LatencyMs::of(&latencies);
-    let url = format!("/recording.mcap?s={}", student.token);
-    let end_msg = end_message(
-        &url,
-        &student.out,
-        end,
-        &stats,
-        rate,
-        &sinks.totals,
-        input_latency_ms,
-        written.as_ref(),
-    );
-    offer_end(&student.shared, &student.out, &end_msg);
-    Ok(StudentSummary {
-        name: student.name.clone(),
-        end: end.name(),
-        stats,
-        state: sinks.totals.state(),
-        recording: student.out.clone(),
-        written,
-        input_latency_ms,
-        published,
-        error: None,
-    })
+    let mut session = PageSession::open(&spec, hand, student.shared.clone())
+        .map_err(|e| e.to_string())?
+        .with_reporter(
+            super::STATUS_EVERY_TICKS,
+            Box::new(move |ticks, missed, lp| st.report(ticks, missed, lp)),
+        );
+    student.set_phase(Phase::Playing);
+    session.run(Pacing::DeviceClock, class.config.rt.as_ref(), stop);
+    Ok(session.finish())
 }

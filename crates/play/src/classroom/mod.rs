@@ -30,18 +30,14 @@ mod sched;
 mod teacher;
 pub mod zip;
 
+use crate::PlayError;
 use crate::gate::{Limits, RefusedCounts};
 use crate::input::PageDevice;
-use crate::protocol::LatencyMs;
-use crate::publish::PublishSummary;
 use crate::server::{Listener, Shared};
-use crate::{PlayError, announce};
-use haptic_loop::pacing::TickStats;
+use crate::session::{Hand, PageSession, SessionSpec, SessionSummary};
 use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
-use haptic_loop::setup::{Setup, SetupOptions};
 use live::Live;
 pub use live::Phase;
-use recording::WriteSummary;
 use std::hash::{BuildHasher, Hasher};
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
@@ -86,7 +82,7 @@ pub struct ClassConfig {
     pub device_name: String,
     /// The tick workers' real-time scheduling (default `SCHED_FIFO` 50 and memory locked; the
     /// workers are not pinned, so each core can take one); `None`: ask for nothing (`--no-rt`).
-    pub rt: Option<haptic_devices::realtime::RtRequest>,
+    pub rt: Option<haptic_engine::realtime::RtRequest>,
 }
 
 impl ClassConfig {
@@ -104,7 +100,7 @@ impl ClassConfig {
             workers: None,
             device: None,
             device_name: "device".into(),
-            rt: Some(haptic_devices::realtime::RtRequest::default()),
+            rt: Some(haptic_engine::realtime::RtRequest::default()),
         }
     }
 }
@@ -173,7 +169,7 @@ impl Status {
 impl Student {
     /// Updates what the teacher sees: `ticks` run (`missed` of them late) of `lp`, and its
     /// state, force and switches after the last.
-    fn report(&self, ticks: u64, missed: u64, lp: &haptic_loop::HapticLoop) {
+    fn report(&self, ticks: u64, missed: u64, lp: &haptic_engine::HapticLoop) {
         let mut state = Vec::new();
         lp.scene().state(&mut state);
         let f = lp.last_result().device_force_n;
@@ -210,41 +206,23 @@ impl Student {
 pub struct StudentSummary {
     /// The student.
     pub name: String,
-    /// How it ended (`completed`, `stopped`).
-    pub end: &'static str,
-    /// Tick statistics (ticks, missed deadlines, tick work).
-    pub stats: TickStats,
-    /// The scene's state after the last tick.
-    pub state: Vec<(String, f64)>,
-    /// The recording.
-    pub recording: PathBuf,
-    /// What the recorder wrote.
-    pub written: Option<WriteSummary>,
-    /// Page input to force, ms.
-    pub input_latency_ms: Option<LatencyMs>,
-    /// What the pages were sent.
-    pub published: PublishSummary,
-    /// A failure that ended the session early, if any.
-    pub error: Option<String>,
+    /// Their session.
+    pub session: SessionSummary,
 }
 
 impl StudentSummary {
     /// One line for a person.
     pub fn line(&self) -> String {
-        let score = self
-            .state
-            .iter()
-            .find(|(n, _)| n == "score")
-            .map_or(0.0, |(_, v)| *v);
+        let s = &self.session;
         format!(
             "{}: {}, {} ticks, {} missed deadlines, score {}, recording {}{}",
             self.name,
-            self.end,
-            self.stats.ticks,
-            self.stats.missed,
-            score,
-            self.recording.display(),
-            self.error
+            s.end,
+            s.stats.ticks,
+            s.stats.missed,
+            s.state("score").unwrap_or(0.0),
+            s.recording.display(),
+            s.error
                 .as_deref()
                 .map(|e| format!(" (error: {e})"))
                 .unwrap_or_default()
@@ -264,7 +242,7 @@ pub struct ClassSummary {
     /// Worker threads that ticked the sessions.
     pub workers: usize,
     /// The real-time scheduling the workers got (the first worker's; they all ask alike).
-    pub realtime: haptic_devices::realtime::RtStatus,
+    pub realtime: haptic_engine::realtime::RtStatus,
 }
 
 /// Why a student could not join.
@@ -375,40 +353,33 @@ impl Class {
             .scene
             .parse()
             .map_err(|e| JoinError::Setup(e.to_string()))?;
-        let specs = file.device.model.specs().clone();
-        let Setup { lp, header, sinks } = Setup::new(&SetupOptions {
-            operator: Some(format!("person (browser page, classroom student `{name}`)")),
-            keep_arrays: false,
-            out: Some(out.clone()),
-            start_time_ns: Some(start_ns),
-            ..SetupOptions::new(&self.config.scene, specs.clone(), "realtime", "page")
-        })
-        .map_err(|e| JoinError::Setup(e.to_string()))?;
         let shared = Arc::new(Shared::default());
-        announce(
-            &shared,
-            &self.scene_name,
-            &lp,
-            &specs,
-            true,
-            self.config.seconds,
-        );
+        let token = random_code(24, b"0123456789abcdefghijklmnopqrstuvwxyz");
+        let hand = Hand::Page(PageDevice::new(
+            file.device.model.specs().clone(),
+            shared.input.clone(),
+        ));
+        let spec = SessionSpec {
+            scene: &self.config.scene,
+            scene_name: &self.scene_name,
+            out: out.clone(),
+            recording_url: format!("/recording.mcap?s={token}"),
+            start_time_ns: start_ns,
+            operator: format!("person (browser page, classroom student `{name}`)"),
+            link: "page".into(),
+            seconds: self.config.seconds,
+            ticks: self.ticks,
+        };
+        let session = PageSession::open(&spec, hand, shared.clone())
+            .map_err(|e| JoinError::Setup(e.to_string()))?;
         let student = Arc::new(Student {
             name,
-            token: random_code(24, b"0123456789abcdefghijklmnopqrstuvwxyz"),
+            token,
             out,
-            shared: shared.clone(),
+            shared,
             status: Mutex::new(Status::waiting()),
         });
-        let device = PageDevice::new(specs, shared.input.clone());
-        let live = Box::new(Live::new(
-            student.clone(),
-            lp,
-            header,
-            sinks,
-            device,
-            self.ticks,
-        ));
+        let live = Box::new(Live::new(student.clone(), session));
         let (tx, load) = self
             .workers
             .iter()
@@ -491,7 +462,7 @@ pub fn run(
         let (l, f, s) = (load.clone(), fin_tx.clone(), worker_stop.clone());
         let rt = config
             .rt
-            .map(|r| haptic_devices::realtime::RtRequest { pin: false, ..r });
+            .map(|r| haptic_engine::realtime::RtRequest { pin: false, ..r });
         let h = std::thread::Builder::new()
             .name(format!("class-tick-{i}"))
             .spawn(move || sched::worker(rx, f, period_ns, l, s, rt))
@@ -606,7 +577,7 @@ pub fn run(
         std::thread::sleep(Duration::from_millis(20));
     }
     worker_stop.store(true, Ordering::Relaxed);
-    let mut realtime = haptic_devices::realtime::RtStatus::default();
+    let mut realtime = haptic_engine::realtime::RtStatus::default();
     for (i, h) in handles.into_iter().enumerate() {
         if let Ok(st) = h.join()
             && i == 0

@@ -1,14 +1,14 @@
 //! Pacing without a thread per student: a few workers (one per core, at most four), each
 //! ticking every session it holds once per period, in turn, against one wall-clock schedule.
 //! A session's tick `n` runs in its worker's cycle `k0 + n`; its deadline is the start of the
-//! next cycle, as [`haptic_devices::pacing::Pacer`] counts it for `play` (a missed deadline
+//! next cycle, as [`haptic_engine::timing::Pacer`] counts it for `play` (a missed deadline
 //! sends zero force and is recorded, so the session still replays bit for bit). A session that
 //! ended leaves its worker for the finisher thread, which closes its recording and tells its
 //! pages, so ending never delays the others' ticks.
 
 use super::live::Live;
-use haptic_devices::pacing::Pacer;
-use haptic_devices::realtime::{self, RtRequest, RtStatus};
+use haptic_engine::realtime::{self, RtRequest, RtStatus};
+use haptic_engine::timing::Pacer;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};

@@ -21,8 +21,11 @@ mod tests;
 pub use look::RecordedPicture;
 pub use params::OtParams;
 
-use crate::scene::check::SceneError;
-use crate::scene::{Scene, SceneInput, SceneOutput, WorldKind, world_table};
+use crate::scene::{WorldKind, world_table};
+use haptic_engine::check::SceneError;
+use haptic_engine::scene::Scene;
+use haptic_engine::scene::SceneInput;
+use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
 use haptic_types::Primitive;
 use haptic_types::vec3::Vec3;

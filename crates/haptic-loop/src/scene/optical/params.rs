@@ -2,7 +2,7 @@
 //! to the world's SI parameters and tick map, every field checked with its range.
 
 use super::three_digits_down;
-use crate::scene::check::{SceneError, check_positive, check_range, out_of_range};
+use haptic_engine::check::{SceneError, check_positive, check_range, out_of_range};
 use ot_envelope::ClipMode;
 use ot_envelope::world::{Params, TickMap};
 use serde::Deserialize;

@@ -1,7 +1,7 @@
 //! The loop's configuration: the `[mapping]`, `[loop]` and `[display]` tables of a scene file,
 //! checked, and what the haptic loop makes of them ([`LoopConfig`]).
 
-use super::check::{SceneError, check_range, out_of_range};
+use crate::check::{SceneError, check_range, out_of_range};
 use haptic_types::DeviceSpecs;
 use haptic_types::vec3::{self, Vec3};
 use serde::Deserialize;

@@ -1,8 +1,12 @@
-//! The loop's guarantees, tick by tick (see the parent module's list).
+//! The loop's guarantees, tick by tick (see `haptic_engine::haptic`'s list), on the calibration
+//! wall scene.
 
-use super::*;
-use crate::scene::load_scene;
+use haptic_engine::haptic::*;
+use haptic_loop::scene::load_scene;
 use haptic_types::device::FALCON;
+use haptic_types::tick::status;
+use haptic_types::vec3;
+use haptic_types::{Buttons, DeviceSample};
 
 const WALL: &str = r#"
 [scene]
@@ -51,7 +55,7 @@ fn stiffness_is_capped_and_force_clamped_along_its_direction() {
 fn a_limit_with_subnormal_squares_still_clamps() {
     let mut specs = FALCON.clone();
     specs.limits.max_force_n = 3.7555737088373936e-159;
-    let s = crate::scene::load_scene_for(WALL, specs).unwrap();
+    let s = haptic_loop::scene::load_scene_for(WALL, specs).unwrap();
     let mut l = HapticLoop::new(s.config, s.scene);
     for k in 1..=20 {
         let r = l.tick(at(-0.0001 * f64::from(k)), false).clone();

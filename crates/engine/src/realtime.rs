@@ -14,11 +14,11 @@
 //! (`SCHED_RESET_ON_FORK`): the recorder, the publisher, the live view and the receivers
 //! never inherit real-time priority.
 //!
-//! Not for: the sleeping itself ([`Pacer`](crate::pacing::Pacer), which sleeps to absolute
+//! Not for: the sleeping itself ([`Pacer`](crate::timing::Pacer), which sleeps to absolute
 //! deadlines with `clock_nanosleep`), or choosing the rate.
 //!
 //! ```
-//! use haptic_devices::realtime::{RtRequest, enter};
+//! use crate::realtime::{RtRequest, enter};
 //! // Ask for SCHED_FIFO 50, locked memory and a core of its own; whatever the answer, the
 //! // thread goes on (restored to what it was when the guard drops).
 //! let guard = enter(&RtRequest::default());

@@ -2,11 +2,11 @@
 //! measurement behind `nanohaptics doctor`, as cyclictest makes it (a thread sleeps to absolute
 //! deadlines and records how late each wake-up came).
 //!
-//! Not for: pacing a session ([`Pacer`](crate::pacing::Pacer) measures its own wake-ups) or
+//! Not for: pacing a session ([`Pacer`](crate::timing::Pacer) measures its own wake-ups) or
 //! setting up real time ([`realtime`](crate::realtime)).
 //!
 //! ```
-//! use haptic_devices::wakeup::{measure, Verdict};
+//! use crate::wakeup::{measure, Verdict};
 //! use std::time::Duration;
 //! // 50 ms of wake-ups every 500 µs at normal priority.
 //! let m = measure(Duration::from_micros(500), Duration::from_millis(50), None).unwrap();
@@ -17,8 +17,8 @@
 //! assert!(matches!(v, Verdict::Holds | Verdict::Misses { .. }));
 //! ```
 
-use crate::pacing::{Percentiles, sleep_until};
 use crate::realtime::{self, RtRequest, RtStatus};
+use crate::timing::{Percentiles, sleep_until};
 use std::time::{Duration, Instant};
 
 /// The tick rates a session uses, Hz: the brick and nano worlds (1 kHz), a fast device servo

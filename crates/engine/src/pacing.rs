@@ -2,11 +2,11 @@
 //! the runner paces by the first and fills the second; the sinks, the summaries and the
 //! recording's `session` metadata read it.
 //!
-//! Not for: the wall-clock sleeper itself (`haptic_devices::pacing::Pacer`, shared with the
-//! fake device) or the percentile arithmetic (`haptic_devices::pacing::Percentiles`).
+//! Not for: the wall-clock sleeper itself (`crate::timing::Pacer`, shared with the
+//! fake device) or the percentile arithmetic (`crate::timing::Percentiles`).
 
-use haptic_devices::pacing::Percentiles;
-use haptic_devices::realtime::RtStatus;
+use crate::realtime::RtStatus;
+use crate::timing::Percentiles;
 
 /// How ticks are paced and where the deadline flag comes from.
 #[derive(Clone, Debug, PartialEq)]

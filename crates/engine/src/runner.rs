@@ -6,24 +6,25 @@
 //!   UDP bridge, Python)        stiffness cap, watchdog)     replay verifier, frames, live view)
 //! ```
 //!
-//! Every way a session is driven goes through [`TickEngine::tick`], the one way time advances:
-//! from a device by [`Runner::run`] (`nanohaptics run`, `replay --verify`, `render`, `demo`,
-//! `play`, the closed-loop checks), or one tick at a time by the
-//! [`Stepper`](crate::stepper::Stepper) (Python's `Session`). A sink sees each tick once, after
-//! the force was sent to the device, and must not block: the recorder and the live view hand their data to threads of
-//! their own.
+//! Every way a session is driven goes through [`TickEngine::cycle`], the one way time advances,
+//! under one of the clocks of [`crate::clock`]: from a device by [`Runner::run`] (`nanohaptics
+//! run`, `replay --verify`, `render`, `demo`, a bridged `play`, the closed-loop checks), by a
+//! live page session's own step (`play`, a classroom student, on a shared worker's clock), or
+//! one tick per call by `haptic_loop::stepper::Stepper` (Python's `Session`). A sink sees each
+//! tick once, after the force was sent to the device, and must not block: the recorder and the
+//! live view hand their data to threads of their own.
 //!
 //! Adding a sink is one new file implementing [`Sink`](crate::sink::Sink) and one line where the
-//! session builds its list of sinks (`session::run_session`).
+//! session builds its list of sinks (`haptic_loop::sinks`).
 
+use crate::clock::{self, TickClock};
 use crate::haptic::HapticLoop;
 use crate::header::SessionHeader;
 use crate::pacing::{Pacing, TickStats};
+use crate::realtime::{self, RtRequest, RtStatus};
 use crate::sink::{SessionInfo, Sink, SinkError, TickView};
-use haptic_devices::pacing::{DurationHistogram, Pacer, Percentiles};
-use haptic_devices::realtime::{self, RtRequest, RtStatus};
+use crate::timing::{DurationHistogram, Percentiles};
 use haptic_types::DeviceError;
-use haptic_types::DeviceSample;
 use haptic_types::HapticDevice;
 use haptic_types::TickTime;
 use haptic_types::switch::{Switch, SwitchError};
@@ -78,32 +79,20 @@ impl EndReason {
 /// the tick's index and the loop.
 pub type LiveHook<'a> = dyn FnMut(u64, &mut HapticLoop) + 'a;
 
-/// When a tick started, as its pacing saw it.
-#[derive(Clone, Copy, Debug)]
-pub struct TickStart {
-    /// When the tick's sample was in hand (its work is timed from here).
-    pub t0: Instant,
-    /// Start lateness against the schedule, ns (0 in batch mode; wall clock).
-    pub late_ns: i64,
-    /// The deadline flag read from a recording (replay), an input of the tick.
-    pub recorded_missed: bool,
+/// What one [`TickEngine::cycle`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cycle {
+    /// A tick ran.
+    Ticked,
+    /// The device ended the session (a bridged device said goodbye); no tick ran.
+    DeviceEnded,
 }
 
-impl TickStart {
-    /// A tick starting now, on time, with no recorded deadline flag.
-    pub fn now() -> Self {
-        TickStart {
-            t0: Instant::now(),
-            late_ns: 0,
-            recorded_missed: false,
-        }
-    }
-}
-
-/// The one way a session's time advances: tick by tick, the scheduled switches, the live hook,
-/// the loop's tick, the deadline flag, the force to the device and the hand-off to the sinks,
-/// with the run's statistics. [`Runner::run`] drives it from a device and a pacing policy; the
-/// [`Stepper`](crate::stepper::Stepper) from its caller, one tick per call.
+/// The one way a session's time advances: cycle by cycle ([`TickEngine::cycle`]), the clock's
+/// wait, the device's sample, the scheduled switches, the live hook, the loop's tick, the
+/// deadline flag, the force to the device and the hand-off to the sinks, with the run's
+/// statistics. [`Runner::run`] loops over it; a live page session steps it once per cycle of
+/// its worker.
 pub struct TickEngine {
     switches: Vec<(u64, Switch)>,
     compute: DurationHistogram,
@@ -111,7 +100,6 @@ pub struct TickEngine {
     sink_ns: Vec<DurationHistogram>,
     missed: u64,
     ticks: u64,
-    timed: bool,
     started: Instant,
     wakeup: Percentiles,
     realtime: RtStatus,
@@ -129,7 +117,6 @@ impl TickEngine {
             sink_ns: Vec::new(),
             missed: 0,
             ticks: 0,
-            timed: false,
             started: Instant::now(),
             wakeup: Percentiles::default(),
             realtime: RtStatus::default(),
@@ -137,14 +124,13 @@ impl TickEngine {
     }
 
     /// Starts a run of `ticks` ticks (`None`: open-ended) of `lp`: calls every sink's `start`
-    /// with `header` and resets the statistics; `timed` runs record the start lateness.
+    /// with `header` and resets the statistics.
     pub fn start(
         &mut self,
         sinks: &mut [&mut dyn Sink],
         lp: &HapticLoop,
         header: &SessionHeader,
         ticks: Option<u64>,
-        timed: bool,
     ) -> Result<(), RunError> {
         let info = SessionInfo {
             header,
@@ -160,7 +146,6 @@ impl TickEngine {
         self.sink_ns = vec![DurationHistogram::new(); sinks.len()];
         self.missed = 0;
         self.ticks = 0;
-        self.timed = timed;
         self.started = Instant::now();
         self.wakeup = Percentiles::default();
         self.realtime = RtStatus::default();
@@ -184,21 +169,31 @@ impl TickEngine {
         self.missed
     }
 
-    /// Runs the next tick of `lp` on `sample`: its scheduled switches, then `live`, then the
-    /// step; `deadline(t0)` says whether the force came too late (zero force is then sent);
-    /// `send` hands the command to the device; then every sink sees the tick.
-    #[allow(clippy::too_many_arguments)]
-    pub fn tick(
+    /// One whole cycle of the session: waits for tick `n`'s start under `clock`, reads the
+    /// device's sample for it, applies tick `n`'s scheduled switches and then `live`, steps the
+    /// loop, replaces the force by zero when `clock` says the deadline passed, hands the
+    /// command (with the local model, for a protocol-2 device) to `dev` and then the tick to
+    /// every sink. The one way a session's time advances, whoever drives it and whatever the
+    /// clock ([`crate::clock`]).
+    pub fn cycle(
         &mut self,
         sinks: &mut [&mut dyn Sink],
         lp: &mut HapticLoop,
-        sample: DeviceSample,
-        at: TickStart,
+        dev: &mut dyn HapticDevice,
+        clock: &mut dyn TickClock,
         live: Option<&mut LiveHook<'_>>,
-        deadline: &mut dyn FnMut(u64, Instant) -> bool,
-        send: &mut dyn FnMut(&HapticLoop, u64) -> Result<(), DeviceError>,
-    ) -> Result<(), RunError> {
+    ) -> Result<Cycle, RunError> {
         let n = self.ticks;
+        let waited = clock.wait(n);
+        let sample = match dev.sample(TickTime::new(n, lp.config().rate_hz)) {
+            Ok(s) => s,
+            Err(DeviceError::Ended) => return Ok(Cycle::DeviceEnded),
+            Err(e) => return Err(e.into()),
+        };
+        // The tick starts when its sample is in hand (for a device clock, when it arrived).
+        let t0 = Instant::now();
+        let late_ns = clock.started(n, t0, waited);
+        let recorded_missed = clock.recorded_missed(n);
         let due = self.switches.partition_point(|(t, _)| *t < n);
         for (_, sw) in self.switches[due..].iter().take_while(|(t, _)| *t == n) {
             lp.switch(&sw.name, sw.value)
@@ -207,20 +202,23 @@ impl TickEngine {
         if let Some(hook) = live {
             hook(n, lp);
         }
-        lp.tick(sample, at.recorded_missed);
-        let missed = at.recorded_missed || deadline(n, at.t0);
-        if missed && !at.recorded_missed {
+        lp.tick(sample, recorded_missed);
+        let missed = recorded_missed || clock.deadline_passed(n, t0);
+        if missed && !recorded_missed {
             lp.mark_deadline_missed();
         }
-        send(lp, sample.seq)?;
-        let compute_ns = at.t0.elapsed().as_nanos() as u64;
+        if dev.wants_local_model() {
+            dev.set_local_model(lp.local_model());
+        }
+        dev.set_force(&lp.command(sample.seq))?;
+        let compute_ns = t0.elapsed().as_nanos() as u64;
         self.missed += u64::from(missed);
         let view = TickView {
             sample,
             deadline_missed: missed,
             result: lp.last_result(),
             lp,
-            start_late_ns: at.late_ns,
+            start_late_ns: late_ns,
             compute_ns,
         };
         for (s, times) in sinks.iter_mut().zip(self.sink_ns.iter_mut()) {
@@ -229,12 +227,12 @@ impl TickEngine {
             times.record(t.elapsed().as_nanos() as u64);
         }
         // The hand-off to the sinks belongs to the tick's cost.
-        self.compute.record(at.t0.elapsed().as_nanos() as u64);
-        if self.timed && n > 0 {
-            self.jitter.record(at.late_ns.unsigned_abs());
+        self.compute.record(t0.elapsed().as_nanos() as u64);
+        if clock.timed() && n > 0 {
+            self.jitter.record(late_ns.unsigned_abs());
         }
         self.ticks += 1;
-        Ok(())
+        Ok(Cycle::Ticked)
     }
 
     /// Ends the run: the statistics, handed with the device's link counters to every sink's
@@ -348,17 +346,13 @@ impl<'s> Runner<'s> {
         progress: &mut dyn FnMut(u64, u64),
     ) -> Result<(TickStats, EndReason), RunError> {
         let timed = !matches!(pacing, Pacing::Batch | Pacing::Recorded(_));
-        self.engine
-            .start(&mut self.sinks, lp, header, ticks, timed)?;
-        let rate = lp.config().rate_hz;
+        self.engine.start(&mut self.sinks, lp, header, ticks)?;
         let period_ns = lp.config().period_ns();
         // The tick thread in real time for the run (the sinks' threads, started above, and any
         // it starts later stay at normal priority); back as it was when the guard drops.
         let rt = realtime::enter_if(self.rt.as_ref().filter(|_| timed));
         realtime::advise_once(&rt.status());
-        let mut pacer =
-            matches!(pacing, Pacing::Realtime).then(|| Pacer::for_thread(period_ns, &rt.status()));
-        let mut prev_start: Option<Instant> = None;
+        let mut clock = clock::for_pacing(pacing, period_ns, &rt.status());
         let mut end = EndReason::Completed;
         let mut n = 0u64;
         while ticks.is_none_or(|t| n < t) {
@@ -366,67 +360,24 @@ impl<'s> Runner<'s> {
                 end = EndReason::Stopped;
                 break;
             }
-            let late = match &mut pacer {
-                Some(p) => p.wait_for(n),
-                None => 0,
-            };
-            let sample = match dev.sample(TickTime::new(n, rate)) {
-                Ok(s) => s,
-                Err(DeviceError::Ended) => {
-                    end = EndReason::DeviceEnded;
-                    break;
-                }
-                Err(e) => return Err(e.into()),
-            };
-            // The tick starts when its sample is in hand (for a device clock, when it arrived).
-            let t0 = Instant::now();
-            let late = match (&pacing, prev_start) {
-                (Pacing::DeviceClock, Some(p)) => {
-                    t0.duration_since(p).as_nanos() as i64 - period_ns as i64
-                }
-                _ => late,
-            };
-            prev_start = Some(t0);
-            let recorded_missed = match &pacing {
-                Pacing::Recorded(flags) => flags.get(n as usize).copied().unwrap_or(false),
-                _ => false,
-            };
-            let mut deadline = |n: u64, t0: Instant| match &pacing {
-                Pacing::Realtime => pacer.as_ref().is_some_and(|p| p.deadline_passed(n)),
-                Pacing::DeviceClock => t0.elapsed().as_nanos() as u64 > period_ns,
-                _ => false,
-            };
-            let mut send = |lp: &HapticLoop, seq: u64| {
-                if dev.wants_local_model() {
-                    dev.set_local_model(lp.local_model());
-                }
-                dev.set_force(&lp.command(seq))
-            };
-            self.engine.tick(
+            let step = self.engine.cycle(
                 &mut self.sinks,
                 lp,
-                sample,
-                TickStart {
-                    t0,
-                    late_ns: late,
-                    recorded_missed,
-                },
+                dev,
+                clock.as_mut(),
                 self.live.as_deref_mut(),
-                &mut deadline,
-                &mut send,
             )?;
+            if step == Cycle::DeviceEnded {
+                end = EndReason::DeviceEnded;
+                break;
+            }
             n += 1;
             if n % 100 == 0 || ticks == Some(n) {
                 progress(n, ticks.unwrap_or(0));
             }
         }
         let link = dev.link_counters();
-        self.engine.set_pacing_report(
-            pacer
-                .as_ref()
-                .map_or_else(Percentiles::default, |p| p.wakeups().percentiles()),
-            rt.status(),
-        );
+        self.engine.set_pacing_report(clock.wakeups(), rt.status());
         let stats = self.engine.finish(&mut self.sinks, &link)?;
         Ok((stats, end))
     }

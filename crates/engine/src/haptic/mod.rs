@@ -34,7 +34,7 @@
 //! The world force, the sent force and the status of every tick are returned in
 //! [`TickResult`]; the sent force is always finite and of norm ≤ the device maximum.
 
-pub use crate::scene::loop_config::{LoopConfig, Mapping};
+pub use crate::loop_config::{LoopConfig, Mapping};
 use crate::scene::{Scene, SceneOutput};
 use haptic_types::Buttons;
 use haptic_types::DeviceSample;
@@ -134,7 +134,7 @@ impl HapticLoop {
             tank_j: config
                 .safety
                 .passivity_reserve_j
-                .unwrap_or(crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J),
+                .unwrap_or(crate::loop_config::DEFAULT_PASSIVITY_RESERVE_J),
             last_position_m: None,
             passivity_active: false,
             rate_limiting: false,
@@ -280,7 +280,7 @@ impl HapticLoop {
         self.config
             .safety
             .passivity_reserve_j
-            .unwrap_or(crate::scene::loop_config::DEFAULT_PASSIVITY_RESERVE_J)
+            .unwrap_or(crate::loop_config::DEFAULT_PASSIVITY_RESERVE_J)
     }
 
     /// The passivity observer's energy tank, J (device side): the reserve minus the energy the
@@ -299,6 +299,3 @@ impl HapticLoop {
         self.scene.state(out);
     }
 }
-
-#[cfg(test)]
-mod tests;
