@@ -24,7 +24,7 @@
 //!
 //! - **The classroom** ([`classroom`]): one server for a whole class, a session per student
 //!   ticked by shared workers, a teacher page, the recordings as one zip.
-//! - **Safe to reach** ([`gate`], `webguard`): `Host` and `Origin` checked on every request and
+//! - **Safe to reach** ([`webguard::gate`]): `Host` and `Origin` checked on every request and
 //!   upgrade, limits on connections, message size and rate, every refusal answered and counted.
 //!
 //! What it is not: it is no general web server (the page's fixed files
@@ -35,15 +35,15 @@
 
 pub mod background;
 pub mod classroom;
-pub mod gate;
+
 pub mod http;
 pub mod input;
 pub mod protocol;
 pub mod publish;
 pub mod server;
 pub mod session;
+pub mod wslink;
 
-use gate::{Limits, RefusedCounts};
 use haptic_devices::bridge::BridgeConfig;
 use haptic_devices::source::DeviceSource;
 use haptic_engine::pacing::Pacing;
@@ -56,6 +56,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+use webguard::gate::{Limits, RefusedCounts};
 
 /// Default port of the page.
 pub const DEFAULT_PORT: u16 = 8080;

@@ -3,10 +3,10 @@
 //! hands its data to the publisher thread ([`crate::publish`]), which queues it for each page
 //! (bounded queues; a page that cannot keep up loses frames, never the tick's time).
 
-use crate::gate::{Gate, Limits, RateLimit};
 use crate::http::{accept_upgrade, respond, respond_text};
 use crate::input::{SharedInput, page_to_device};
 use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
+use crate::wslink::{self, Incoming, LinkConfig};
 use haptic_types::SwitchSpec;
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::path::PathBuf;
@@ -15,9 +15,8 @@ use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
-use tungstenite::protocol::Role as WsRole;
-use tungstenite::protocol::WebSocketConfig;
-use tungstenite::{Message, WebSocket};
+use tungstenite::Message;
+use webguard::gate::{Gate, Limits};
 use webguard::{Guard, Head, HeadError, read_head};
 
 /// A file of the page, built into the binary.
@@ -286,7 +285,7 @@ fn accept_loop(
                 let _ = stream.set_nonblocking(false);
                 let _ = stream.set_write_timeout(Some(Duration::from_secs(WRITE_TIMEOUT_S)));
                 if let Some(b) = gate.limits.send_buffer_bytes {
-                    crate::gate::set_send_buffer(&stream, b);
+                    webguard::gate::set_send_buffer(&stream, b);
                 }
                 let ticket = match gate.admit(peer.ip()) {
                     Ok(t) => t,
@@ -564,72 +563,18 @@ pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
     if let Ok(mut pages) = shared.pages.lock() {
         pages.push(Page { id, tx });
     }
-    let _ = stream.set_read_timeout(Some(Duration::from_millis(2)));
-    let max = gate.limits.max_message_bytes;
-    let wmax = gate.limits.max_write_buffer_bytes.max(2 * max);
-    let config = WebSocketConfig::default()
-        .max_message_size(Some(max))
-        .max_frame_size(Some(max))
-        .write_buffer_size((wmax / 2).min(128 * 1024))
-        .max_write_buffer_size(wmax);
-    let mut ws = WebSocket::from_raw_socket(stream, WsRole::Server, Some(config));
-    let mut rate = RateLimit::new(gate.limits.messages_per_s);
-    let mut told_rate: Option<Instant> = None;
-    'link: while !shared.shutdown.load(Ordering::Relaxed) {
-        let mut msg = ws.read();
-        if matches!(msg, Ok(Message::Text(_) | Message::Binary(_))) && !rate.take(Instant::now()) {
-            msg = Ok(Message::Pong(Default::default()));
-            gate.refused.count("rate");
-            if told_rate.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
-                told_rate = Some(Instant::now());
-                let m = format!(
-                    "too many messages: at most {} per second (this one was dropped)",
-                    gate.limits.messages_per_s
-                );
-                shared.error_to(id, "type", &m);
-            }
-        }
-        match msg {
-            Ok(Message::Text(t)) => on_message(shared, id, t.as_str()),
-            Ok(Message::Binary(_)) => {
-                shared.error_to(id, "type", &ProtocolError::Binary.to_string());
-            }
-            Ok(Message::Close(_)) => break,
-            Ok(_) => {}
-            Err(tungstenite::Error::Io(e))
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) => {}
-            Err(tungstenite::Error::Capacity(_)) => {
-                gate.refused.count("size");
-                break;
-            }
-            Err(_) => break,
-        }
-        let mut wrote = false;
-        while let Ok(m) = rx.try_recv() {
-            match ws.write(m) {
-                Ok(()) => wrote = true,
-                Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {
-                    wrote = true;
-                }
-                // The page has not taken what was written (Limits::max_write_buffer_bytes):
-                // this message is dropped, counted, and the rest wait in the bounded queue.
-                Err(tungstenite::Error::WriteBufferFull(_)) => {
-                    shared.dropped.fetch_add(1, Ordering::Relaxed);
-                    wrote = true;
-                    break;
-                }
-                Err(_) => break 'link,
-            }
-        }
-        if wrote && ws.flush().is_err() {
-            let _ = ws.flush();
-        }
-    }
-    let _ = ws.close(None);
-    let _ = ws.flush();
+    let mut peer = PagePeer {
+        shared,
+        id,
+        rx,
+        messages_per_s: gate.limits.messages_per_s,
+        told_rate: None,
+    };
+    let link = LinkConfig {
+        read_wait: Duration::from_millis(2),
+        max_write_buffer_bytes: Some(gate.limits.max_write_buffer_bytes),
+    };
+    wslink::run(stream, gate, link, &mut peer);
     if let Ok(mut pages) = shared.pages.lock() {
         pages.retain(|p| p.id != id);
     }
@@ -637,6 +582,53 @@ pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
         && *p == Some(id)
     {
         *p = None;
+    }
+}
+
+/// A game page's end of its link: its messages go to the session, its queue to the page.
+struct PagePeer<'a> {
+    shared: &'a Arc<Shared>,
+    id: u64,
+    rx: Receiver<Message>,
+    messages_per_s: u32,
+    told_rate: Option<Instant>,
+}
+
+impl wslink::Peer for PagePeer<'_> {
+    fn stopped(&self) -> bool {
+        self.shared.shutdown.load(Ordering::Relaxed)
+    }
+
+    fn receive(&mut self, msg: Incoming<'_>) {
+        match msg {
+            Incoming::Text(t) => on_message(self.shared, self.id, t),
+            Incoming::Binary => {
+                self.shared
+                    .error_to(self.id, "type", &ProtocolError::Binary.to_string());
+            }
+            // Told at most once a second.
+            Incoming::TooFast => {
+                if self
+                    .told_rate
+                    .is_none_or(|t| t.elapsed() >= Duration::from_secs(1))
+                {
+                    self.told_rate = Some(Instant::now());
+                    let m = format!(
+                        "too many messages: at most {} per second (this one was dropped)",
+                        self.messages_per_s
+                    );
+                    self.shared.error_to(self.id, "type", &m);
+                }
+            }
+        }
+    }
+
+    fn next_out(&mut self) -> Option<Message> {
+        self.rx.try_recv().ok()
+    }
+
+    fn dropped(&mut self) {
+        self.shared.dropped.fetch_add(1, Ordering::Relaxed);
     }
 }
 

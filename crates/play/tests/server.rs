@@ -35,14 +35,14 @@ fn start(
     JoinHandle<Result<PlaySummary, PlayError>>,
     PathBuf,
 ) {
-    start_with(scene, name, device, play::gate::Limits::default())
+    start_with(scene, name, device, webguard::gate::Limits::default())
 }
 
 fn start_with(
     scene: &str,
     name: &str,
     device: Option<BridgeConfig>,
-    limits: play::gate::Limits,
+    limits: webguard::gate::Limits,
 ) -> (
     String,
     Arc<AtomicBool>,
@@ -446,10 +446,10 @@ fn a_page_that_stops_reading_loses_frames_never_the_loop() {
     use std::os::fd::AsRawFd;
     // Small buffers (8 KiB in the kernel, 32 KiB in the link) so a stalled page fills them in
     // a second instead of the system's few MiB.
-    let limits = play::gate::Limits {
+    let limits = webguard::gate::Limits {
         send_buffer_bytes: Some(8192),
         max_write_buffer_bytes: 32 * 1024,
-        ..play::gate::Limits::default()
+        ..webguard::gate::Limits::default()
     };
     let (url, stop, h, _) = start_with("brickworld", "stalled", None, limits);
     let addr = url.trim_start_matches("http://").trim_end_matches('/');

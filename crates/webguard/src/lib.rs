@@ -14,6 +14,8 @@
 //! port, and whose `Origin`, when a browser sends one, is that same `http://HOST:PORT`. A
 //! rebinding page's host name and another site's origin are refused with `403`.
 
+pub mod gate;
+
 use std::io::Read;
 use std::net::{IpAddr, TcpStream};
 use std::time::Duration;

@@ -8,25 +8,22 @@
 use std::io::{Read, Write};
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
 use std::time::Duration;
+use webguard::gate::{Gate, Limits};
 use webguard::{Guard, HeadError, read_head_bytes};
 
 /// The Foxglove web app's origin, allowed to connect (Foxglove's desktop app sends none).
 pub const FOXGLOVE_APP_ORIGIN: &str = "https://app.foxglove.dev";
-/// Connections open at once through the guard.
-pub const MAX_CONNECTIONS: u64 = 32;
-
-/// What the guard refused.
-#[derive(Debug, Default)]
-pub struct GuardCounts {
-    /// A `Host` that is not this machine's (DNS rebinding), or none.
-    pub host: AtomicU64,
-    /// An `Origin` of another site.
-    pub origin: AtomicU64,
-    /// A malformed head, or over [`MAX_CONNECTIONS`].
-    pub other: AtomicU64,
+/// What the guard accepts: connections at once (in all and per address; the Foxglove app
+/// opens one or two) — the same limits and refusal counters as the game's servers.
+pub fn limits() -> Limits {
+    Limits {
+        max_connections: 32,
+        max_per_address: 32,
+        ..Limits::default()
+    }
 }
 
 /// The running guard.
@@ -35,7 +32,7 @@ pub struct LiveGuard {
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
     /// What it refused.
-    pub counts: Arc<GuardCounts>,
+    pub gate: Arc<Gate>,
 }
 
 impl LiveGuard {
@@ -50,16 +47,16 @@ impl LiveGuard {
             other_origins: vec![FOXGLOVE_APP_ORIGIN.to_string()],
         };
         let stop = Arc::new(AtomicBool::new(false));
-        let counts = Arc::new(GuardCounts::default());
-        let (s, c) = (stop.clone(), counts.clone());
+        let gate = Arc::new(Gate::new(guard, limits()));
+        let (s, g) = (stop.clone(), gate.clone());
         let thread = std::thread::Builder::new()
             .name("live-guard".into())
-            .spawn(move || accept(listener, guard, backend, s, c))?;
+            .spawn(move || accept(listener, g, backend, s))?;
         Ok(LiveGuard {
             addr,
             stop,
             thread: Some(thread),
-            counts,
+            gate,
         })
     }
 
@@ -78,30 +75,23 @@ impl Drop for LiveGuard {
     }
 }
 
-fn accept(
-    listener: TcpListener,
-    guard: Guard,
-    backend: SocketAddr,
-    stop: Arc<AtomicBool>,
-    counts: Arc<GuardCounts>,
-) {
-    let open = Arc::new(AtomicU64::new(0));
-    let guard = Arc::new(guard);
+fn accept(listener: TcpListener, gate: Arc<Gate>, backend: SocketAddr, stop: Arc<AtomicBool>) {
     while !stop.load(Ordering::Relaxed) {
         match listener.accept() {
-            Ok((stream, _)) => {
-                if open.load(Ordering::Relaxed) >= MAX_CONNECTIONS {
-                    counts.other.fetch_add(1, Ordering::Relaxed);
-                    refuse(stream, "503 Service Unavailable", "too many connections");
-                    continue;
-                }
-                open.fetch_add(1, Ordering::Relaxed);
-                let (g, c, o, s) = (guard.clone(), counts.clone(), open.clone(), stop.clone());
+            Ok((stream, peer)) => {
+                let ticket = match gate.admit(peer.ip()) {
+                    Ok(t) => t,
+                    Err(why) => {
+                        refuse(stream, "503 Service Unavailable", &why);
+                        continue;
+                    }
+                };
+                let (g, s) = (gate.clone(), stop.clone());
                 let _ = std::thread::Builder::new()
                     .name("live-guard-conn".into())
                     .spawn(move || {
-                        connection(stream, &g, backend, &c, &s);
-                        o.fetch_sub(1, Ordering::Relaxed);
+                        connection(stream, &g, backend, &s);
+                        drop(ticket);
                     });
             }
             Err(_) => std::thread::sleep(Duration::from_millis(10)),
@@ -120,29 +110,18 @@ fn refuse(mut stream: TcpStream, status: &str, message: &str) {
     let _ = stream.write_all(body.as_bytes());
 }
 
-fn connection(
-    mut client: TcpStream,
-    guard: &Guard,
-    backend: SocketAddr,
-    counts: &GuardCounts,
-    stop: &AtomicBool,
-) {
+fn connection(mut client: TcpStream, gate: &Gate, backend: SocketAddr, stop: &AtomicBool) {
     let _ = client.set_nonblocking(false);
     let (bytes, head) = match read_head_bytes(&mut client) {
         Ok(x) => x,
         Err(HeadError::Closed) => return,
         Err(e) => {
-            counts.other.fetch_add(1, Ordering::Relaxed);
+            gate.refused.count("head");
             return refuse(client, "400 Bad Request", &e.to_string());
         }
     };
-    if let Err(r) = guard.check(&head) {
-        let c = if r.kind() == "origin" {
-            &counts.origin
-        } else {
-            &counts.host
-        };
-        c.fetch_add(1, Ordering::Relaxed);
+    if let Err(r) = gate.guard.check(&head) {
+        gate.refused.count(r.kind());
         return refuse(client, "403 Forbidden", &r.to_string());
     }
     let Ok(mut server) = TcpStream::connect(backend) else {

@@ -119,11 +119,11 @@ impl LiveSink {
             refused_host: self
                 .guard
                 .as_ref()
-                .map_or(0, |g| g.counts.host.load(Ordering::Relaxed)),
+                .map_or(0, |g| g.gate.refused.snapshot().host),
             refused_origin: self
                 .guard
                 .as_ref()
-                .map_or(0, |g| g.counts.origin.load(Ordering::Relaxed)),
+                .map_or(0, |g| g.gate.refused.snapshot().origin),
         }
     }
 

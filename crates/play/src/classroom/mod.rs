@@ -9,7 +9,7 @@
 //!
 //! - **Pacing** ([`sched`]): a few worker threads (one per core, at most four) tick every
 //!   session at the scene's rate against one schedule, not a thread per student.
-//! - **Safety**: the same gate as `play` ([`crate::gate`], [`crate::http`]): `Host` and
+//! - **Safety**: the same gate as `play` ([`webguard::gate`], [`crate::http`]): `Host` and
 //!   `Origin` checked on every request and upgrade, limits on students, connections per
 //!   address, message size and rate, names of bounded length and characters that never become
 //!   a path ([`names`]), every refusal answered and counted.
@@ -31,7 +31,6 @@ mod teacher;
 pub mod zip;
 
 use crate::PlayError;
-use crate::gate::{Limits, RefusedCounts};
 use crate::input::PageDevice;
 use crate::server::{Listener, Shared};
 use crate::session::{Hand, PageSession, SessionSpec, SessionSummary};
@@ -45,6 +44,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::Sender;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
+use webguard::gate::{Limits, RefusedCounts};
 
 /// Ticks between two updates of what the teacher page shows of a student (50 ms at 1 kHz).
 pub const STATUS_EVERY_TICKS: u64 = 50;

@@ -4,12 +4,12 @@
 //! the listener's gate and its `Host`/`Origin` check before it reaches these.
 
 use super::{Class, JoinError, teacher};
-use crate::gate::Gate;
 use crate::http::{accept_upgrade, respond, respond_text};
 use crate::server::{PAGE_FILES, Routes, page_link, serve_download, serve_page_file};
 use std::net::TcpStream;
 use std::sync::Arc;
 use webguard::Head;
+use webguard::gate::Gate;
 
 /// The classroom's files besides the play page's.
 const JOIN_CSS: &str = include_str!("page/class.css");

@@ -3,12 +3,12 @@
 //! answered (`done` or `error`). And the zip of every finished recording.
 
 use super::{Class, Phase};
-use crate::gate::{Gate, RateLimit};
+use crate::wslink::{self, Incoming, LinkConfig};
 use std::net::TcpStream;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
-use tungstenite::protocol::{Role, WebSocketConfig};
-use tungstenite::{Message, WebSocket};
+use tungstenite::Message;
+use webguard::gate::Gate;
 
 /// How often the teacher page is sent the class, ms.
 pub const CLASS_EVERY_MS: u64 = 250;
@@ -52,12 +52,6 @@ pub enum TeacherReply {
         /// Why.
         message: String,
     },
-}
-
-fn reply(ws: &mut WebSocket<TcpStream>, r: &TeacherReply) {
-    if let Ok(t) = serde_json::to_string(r) {
-        let _ = ws.send(Message::text(t));
-    }
 }
 
 /// The `class` message: the scene, its switches, the codes' use and every student's status.
@@ -198,49 +192,55 @@ pub(crate) fn command(class: &Class, text: &str) -> TeacherReply {
 /// The teacher page's WebSocket: the class every [`CLASS_EVERY_MS`], commands as they come
 /// (bounded in size and rate by the gate's limits).
 pub(crate) fn link(stream: TcpStream, class: &Class, gate: &Gate) {
-    let _ = stream.set_read_timeout(Some(Duration::from_millis(20)));
-    let max = gate.limits.max_message_bytes;
-    let config = WebSocketConfig::default()
-        .max_message_size(Some(max))
-        .max_frame_size(Some(max));
-    let mut ws = WebSocket::from_raw_socket(stream, Role::Server, Some(config));
-    let mut rate = RateLimit::new(gate.limits.messages_per_s);
-    let mut last: Option<Instant> = None;
-    loop {
-        if class.shutdown.load(Ordering::Relaxed) {
-            break;
-        }
-        if last.is_none_or(|t| t.elapsed() >= Duration::from_millis(CLASS_EVERY_MS)) {
-            last = Some(Instant::now());
-            if ws.send(Message::text(class_json(class, gate))).is_err() {
-                break;
+    let mut peer = TeacherPeer {
+        class,
+        gate,
+        replies: Vec::new(),
+        last: None,
+    };
+    let link = LinkConfig {
+        read_wait: Duration::from_millis(20),
+        max_write_buffer_bytes: None,
+    };
+    wslink::run(stream, gate, link, &mut peer);
+}
+
+/// The teacher page's end of its link: commands in, their replies and the class's status
+/// every [`CLASS_EVERY_MS`] out.
+struct TeacherPeer<'a> {
+    class: &'a Class,
+    gate: &'a Gate,
+    replies: Vec<Message>,
+    last: Option<Instant>,
+}
+
+impl wslink::Peer for TeacherPeer<'_> {
+    fn stopped(&self) -> bool {
+        self.class.shutdown.load(Ordering::Relaxed)
+    }
+
+    fn receive(&mut self, msg: Incoming<'_>) {
+        if let Incoming::Text(t) = msg {
+            let r = command(self.class, t);
+            if let Ok(t) = serde_json::to_string(&r) {
+                self.replies.push(Message::text(t));
             }
-        }
-        match ws.read() {
-            Ok(Message::Text(t)) => {
-                if !rate.take(Instant::now()) {
-                    gate.refused.count("rate");
-                    continue;
-                }
-                let r = command(class, t.as_str());
-                reply(&mut ws, &r);
-            }
-            Ok(Message::Close(_)) => break,
-            Ok(_) => {}
-            Err(tungstenite::Error::Io(e))
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) => {}
-            Err(tungstenite::Error::Capacity(_)) => {
-                gate.refused.count("size");
-                break;
-            }
-            Err(_) => break,
         }
     }
-    let _ = ws.close(None);
-    let _ = ws.flush();
+
+    fn next_out(&mut self) -> Option<Message> {
+        if !self.replies.is_empty() {
+            return Some(self.replies.remove(0));
+        }
+        if self
+            .last
+            .is_none_or(|t| t.elapsed() >= Duration::from_millis(CLASS_EVERY_MS))
+        {
+            self.last = Some(Instant::now());
+            return Some(Message::text(class_json(self.class, self.gate)));
+        }
+        None
+    }
 }
 
 /// A zip of every finished recording (the sessions still running are not in it).

@@ -2,12 +2,12 @@
 //! and rate) and the count of everything it refused, by reason. One [`Gate`] per listening
 //! server; every connection passes it before its request is read.
 
+use crate::Guard;
 use std::collections::HashMap;
 use std::net::IpAddr;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
-use webguard::Guard;
 
 /// A server's limits.
 #[derive(Clone, Debug, PartialEq)]
