@@ -18,7 +18,7 @@
 //! deadlines with `clock_nanosleep`), or choosing the rate.
 //!
 //! ```
-//! use crate::realtime::{RtRequest, enter};
+//! use haptic_engine::realtime::{RtRequest, enter};
 //! // Ask for SCHED_FIFO 50, locked memory and a core of its own; whatever the answer, the
 //! // thread goes on (restored to what it was when the guard drops).
 //! let guard = enter(&RtRequest::default());

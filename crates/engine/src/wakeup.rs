@@ -6,7 +6,7 @@
 //! setting up real time ([`realtime`](crate::realtime)).
 //!
 //! ```
-//! use crate::wakeup::{measure, Verdict};
+//! use haptic_engine::wakeup::{measure, Verdict};
 //! use std::time::Duration;
 //! // 50 ms of wake-ups every 500 µs at normal priority.
 //! let m = measure(Duration::from_micros(500), Duration::from_millis(50), None).unwrap();

@@ -1,5 +1,5 @@
 // nanohaptics play: the link to the server. One WebSocket (`/ws` and the page's own query):
-// JSON text messages tagged by `type` (docs/play.md's table; crates/play/src/protocol.rs's
+// JSON text messages tagged by `type` (docs/play.md's table; crates/play/src/protocol/'s
 // ServerMsg and PageMsg), each handled by its entry in HANDLERS, and binary sound ticks for
 // the sound module. The events' words are events.js's.
 

@@ -1,6 +1,6 @@
 // nanohaptics play: sound. The page synthesises it: the server's binary sound ticks (per tick
 // its wall time and the distance to the nearest object, and the sounds that start on it; see
-// protocol.rs's SoundTicks) go to an AudioWorklet (synth.js), which runs the same synthesis as
+// protocol/sound.rs's SoundTicks) go to an AudioWorklet (synth.js), which runs the same synthesis as
 // `nanohaptics render REC --audio OUT.wav --proximity` at the AudioContext's own sample rate.
 // The audio starts on the Start press (a user gesture); `m` mutes it. For the benches, each
 // sound's tick → output latency is measured when the worklet renders its first sample.

@@ -4,7 +4,7 @@
 // rate: impacts, snap and pull-off voices (0.5 ms attack, exponential decay, each normalised to
 // its peak amplitude), the proximity tone (220 Hz → 880 Hz below the on-distance, pitch and
 // amplitude interpolated between tick centres, phase continuous), and samples beyond the
-// ±0.98 ceiling limited to it. Its input is the server's binary sound ticks (protocol.rs's
+// ±0.98 ceiling limited to it. Its input is the server's binary sound ticks (protocol/sound.rs's
 // SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it.
 //
 // The samples go through a FIFO to the output: playback starts once `leadS` of sound is
