@@ -269,37 +269,29 @@ pub fn run_publisher(
     state_fields: Vec<String>,
     proximity_on_distance_m: Option<f64>,
 ) -> PublishSummary {
-    let dt = 1.0 / f64::from(rate_hz.max(1));
-    let mut sum = PublishSummary::default();
-    let mut scratch = SessionArrays::new(rate_hz, Vec::new());
-    let mut events: Vec<EventAt> = Vec::new();
-    let mut sounds: Vec<SoundAt> = Vec::new();
-    // The ticks not yet sent to the pages' synthesis.
-    let mut ticks = SoundTicks {
-        first_tick: 0,
-        tone_on_distance_m: proximity_on_distance_m,
-        ticks: Vec::new(),
-        sounds: Vec::new(),
-    };
-    let send_ticks = |ticks: &mut SoundTicks, sum: &mut PublishSummary| {
-        if ticks.ticks.is_empty() {
-            return;
-        }
-        shared.broadcast(&Message::binary(ticks.encode()));
-        sum.sound_messages += 1;
-        sum.sound_ticks += ticks.ticks.len() as u64;
-        ticks.first_tick += ticks.ticks.len() as u64;
-        ticks.ticks.clear();
-        ticks.sounds.clear();
-    };
     crate::background::lower_priority();
+    let mut p = Publisher {
+        shared,
+        dt: 1.0 / f64::from(rate_hz.max(1)),
+        state_fields,
+        sum: PublishSummary::default(),
+        scratch: SessionArrays::new(rate_hz, Vec::new()),
+        events: Vec::new(),
+        sounds: Vec::new(),
+        ticks: SoundTicks {
+            first_tick: 0,
+            tone_on_distance_m: proximity_on_distance_m,
+            ticks: Vec::new(),
+            sounds: Vec::new(),
+        },
+    };
     let mut queue: VecDeque<ToPublisher> = VecDeque::new();
     loop {
         let m = match queue.pop_front() {
             Some(m) => m,
             None => {
                 // All that was handed over is done: its sound goes out now.
-                send_ticks(&mut ticks, &mut sum);
+                p.send_ticks();
                 match rx.recv() {
                     Ok(m) => m,
                     Err(_) => break,
@@ -315,87 +307,140 @@ pub fn run_publisher(
             ToPublisher::Tick {
                 tick,
                 wall_ms,
-                events: evs,
+                events,
                 nearest_m,
                 frame,
             } => {
-                if ticks.ticks.is_empty() || ticks.first_tick + ticks.ticks.len() as u64 != tick {
-                    // Ticks are consecutive; a message starts at the first tick it holds.
-                    send_ticks(&mut ticks, &mut sum);
-                    ticks.first_tick = tick;
-                }
-                ticks.ticks.push(SoundTick { wall_ms, nearest_m });
-                if !evs.is_empty() {
-                    scratch.events.clear();
-                    for (name, detail) in evs {
-                        sum.events += 1;
-                        events.push(EventAt(tick, name.clone(), detail.clone()));
-                        scratch.events.push((tick, name, detail));
-                    }
-                    // The mapping of `render --audio`; an event whose detail it cannot read
-                    // makes no sound (the recording keeps it; `render --audio` names it).
-                    if let Ok(list) = haptic_loop::sound::sound_events(&scratch) {
-                        for s in list {
-                            let (kind, amplitude) = SoundKind::of(&s.sound);
-                            sounds.push(SoundAt(tick, kind.name().to_string(), amplitude));
-                            ticks.sounds.push(SoundOn {
-                                tick,
-                                index: u32::try_from(sum.sounds).unwrap_or(u32::MAX),
-                                kind,
-                                amplitude,
-                            });
-                            sum.sounds += 1;
-                        }
-                    }
-                }
+                p.tick(tick, wall_ms, nearest_m);
+                p.events(tick, events);
                 if let Some(f) = frame {
-                    // The sound first: the frame takes a while to write.
-                    send_ticks(&mut ticks, &mut sum);
-                    let msg = ServerMsg::Frame(Frame {
-                        tick,
-                        time_s: tick as f64 * dt,
-                        view: Some(FrameView {
-                            wall_ms,
-                            prims: f.prims.iter().map(Shape::from).collect(),
-                            state: state_fields.iter().cloned().zip(f.state).collect(),
-                            cursor_m: f.cursor_m,
-                            world_force_n: f.world_force_n,
-                            device_force_n: f.device_force_n,
-                            status: f.status,
-                        }),
-                        events: std::mem::take(&mut events),
-                        sounds: std::mem::take(&mut sounds),
-                    });
-                    shared.broadcast(&Message::text(msg.to_json()));
-                    sum.frames += 1;
+                    p.frame(tick, wall_ms, f);
                 }
             }
             ToPublisher::Switched { tick, name, value } => {
-                refresh_hello(&shared, &name, value);
+                refresh_hello(&p.shared, &name, value);
                 let m = ServerMsg::Switched { tick, name, value };
-                shared.broadcast(&Message::text(m.to_json()));
+                p.shared.broadcast(&Message::text(m.to_json()));
             }
             ToPublisher::Refused { page, message } => {
                 let m = ServerMsg::Error {
                     field: "switch.value".into(),
                     message,
                 };
-                shared.send_to(page, Message::text(m.to_json()));
+                p.shared.send_to(page, Message::text(m.to_json()));
             }
-            ToPublisher::Finish { ticks: n } => {
-                send_ticks(&mut ticks, &mut sum);
-                // The last events and sounds, in a last frame without drawing.
-                let msg = ServerMsg::Frame(Frame {
-                    tick: n.saturating_sub(1),
-                    time_s: n as f64 * dt,
-                    view: None,
-                    events: std::mem::take(&mut events),
-                    sounds: std::mem::take(&mut sounds),
-                });
-                shared.broadcast(&Message::text(msg.to_json()));
+            ToPublisher::Finish { ticks } => {
+                p.finish(ticks);
                 break;
             }
         }
     }
-    sum
+    p.sum
+}
+
+/// The publisher's state between messages: the ticks not yet sent to the pages' synthesis,
+/// and the events and sounds since the last frame.
+struct Publisher {
+    shared: Arc<Shared>,
+    dt: f64,
+    state_fields: Vec<String>,
+    sum: PublishSummary,
+    scratch: SessionArrays,
+    events: Vec<EventAt>,
+    sounds: Vec<SoundAt>,
+    ticks: SoundTicks,
+}
+
+impl Publisher {
+    /// Sends the ticks not yet sent to the pages' synthesis.
+    fn send_ticks(&mut self) {
+        let ticks = &mut self.ticks;
+        if ticks.ticks.is_empty() {
+            return;
+        }
+        self.shared.broadcast(&Message::binary(ticks.encode()));
+        self.sum.sound_messages += 1;
+        self.sum.sound_ticks += ticks.ticks.len() as u64;
+        ticks.first_tick += ticks.ticks.len() as u64;
+        ticks.ticks.clear();
+        ticks.sounds.clear();
+    }
+
+    /// Tick `tick`'s input to the synthesis.
+    fn tick(&mut self, tick: u64, wall_ms: f64, nearest_m: f64) {
+        let t = &self.ticks;
+        if t.ticks.is_empty() || t.first_tick + t.ticks.len() as u64 != tick {
+            // Ticks are consecutive; a message starts at the first tick it holds.
+            self.send_ticks();
+            self.ticks.first_tick = tick;
+        }
+        self.ticks.ticks.push(SoundTick { wall_ms, nearest_m });
+    }
+
+    /// Tick `tick`'s events, and the sounds they start.
+    fn events(&mut self, tick: u64, evs: Vec<(String, String)>) {
+        if evs.is_empty() {
+            return;
+        }
+        self.scratch.events.clear();
+        for (name, detail) in evs {
+            self.sum.events += 1;
+            self.events
+                .push(EventAt(tick, name.clone(), detail.clone()));
+            self.scratch.events.push((tick, name, detail));
+        }
+        // The mapping of `render --audio`; an event whose detail it cannot read makes no
+        // sound (the recording keeps it; `render --audio` names it).
+        if let Ok(list) = haptic_loop::sound::sound_events(&self.scratch) {
+            for s in list {
+                let (kind, amplitude) = SoundKind::of(&s.sound);
+                self.sounds
+                    .push(SoundAt(tick, kind.name().to_string(), amplitude));
+                self.ticks.sounds.push(SoundOn {
+                    tick,
+                    index: u32::try_from(self.sum.sounds).unwrap_or(u32::MAX),
+                    kind,
+                    amplitude,
+                });
+                self.sum.sounds += 1;
+            }
+        }
+    }
+
+    /// The world drawn at tick `tick`, with the events and sounds since the last frame.
+    fn frame(&mut self, tick: u64, wall_ms: f64, f: Box<FrameData>) {
+        // The sound first: the frame takes a while to write.
+        self.send_ticks();
+        let msg = ServerMsg::Frame(Frame {
+            tick,
+            time_s: tick as f64 * self.dt,
+            view: Some(FrameView {
+                wall_ms,
+                prims: f.prims.iter().map(Shape::from).collect(),
+                state: self.state_fields.iter().cloned().zip(f.state).collect(),
+                cursor_m: f.cursor_m,
+                world_force_n: f.world_force_n,
+                device_force_n: f.device_force_n,
+                status: f.status,
+            }),
+            events: std::mem::take(&mut self.events),
+            sounds: std::mem::take(&mut self.sounds),
+        });
+        self.shared.broadcast(&Message::text(msg.to_json()));
+        self.sum.frames += 1;
+    }
+
+    /// The session's end after `n` ticks: the last sound, and the last events and sounds in a
+    /// last frame without drawing.
+    fn finish(&mut self, n: u64) {
+        self.send_ticks();
+        let msg = ServerMsg::Frame(Frame {
+            tick: n.saturating_sub(1),
+            time_s: n as f64 * self.dt,
+            view: None,
+            events: std::mem::take(&mut self.events),
+            sounds: std::mem::take(&mut self.sounds),
+        });
+        self.shared.broadcast(&Message::text(msg.to_json()));
+    }
 }

@@ -291,6 +291,8 @@ fn random_code(n: usize, alphabet: &[u8]) -> String {
 
 /// A worker's inbox and its count of sessions.
 type WorkerLink = (Mutex<Sender<Box<Live>>>, Arc<AtomicUsize>);
+/// A worker's thread; it returns the real-time scheduling it got.
+type WorkerHandle = std::thread::JoinHandle<haptic_engine::realtime::RtStatus>;
 
 /// The class's state shared by the routes, the workers and the finisher.
 pub(crate) struct Class {
@@ -394,6 +396,54 @@ impl Class {
         Ok(student)
     }
 
+    /// The class of `config` playing `plan`, ticked by `workers`.
+    fn new(
+        config: &ClassConfig,
+        plan: Plan,
+        workers: Vec<WorkerLink>,
+        shutdown: Arc<AtomicBool>,
+    ) -> Class {
+        let loopback = config.listen.is_loopback();
+        Class {
+            config: config.clone(),
+            scene_name: plan.scene_name,
+            kind: plan.kind,
+            switches: plan.switches,
+            rate_hz: plan.rate_hz,
+            ticks: plan.ticks,
+            teacher_code: config
+                .teacher_code
+                .clone()
+                .unwrap_or_else(|| random_code(8, b"ABCDEFGHJKLMNPQRSTUVWXYZ23456789")),
+            join_code: (!loopback).then(|| {
+                config
+                    .join_code
+                    .clone()
+                    .unwrap_or_else(|| random_code(6, b"0123456789"))
+            }),
+            students: Mutex::new(Vec::new()),
+            workers,
+            finished: Mutex::new(Vec::new()),
+            ended: AtomicUsize::new(0),
+            shutdown,
+        }
+    }
+
+    /// The addresses printed at start, for a listener bound to `addr`.
+    fn addresses(&self, addr: SocketAddr) -> ClassAddresses {
+        let shown = if self.config.listen.is_unspecified() {
+            SocketAddr::new(IpAddr::from([127, 0, 0, 1]), addr.port())
+        } else {
+            addr
+        };
+        ClassAddresses {
+            student_url: format!("http://{shown}/"),
+            teacher_url: format!("http://{shown}/teacher?code={}", self.teacher_code),
+            teacher_code: self.teacher_code.clone(),
+            join_code: self.join_code.clone(),
+        }
+    }
+
     /// The student whose session token is `token`.
     pub(crate) fn student(&self, token: &str) -> Option<Arc<Student>> {
         self.students
@@ -419,159 +469,30 @@ pub fn run(
     stop: &AtomicBool,
     on_ready: &mut dyn FnMut(&ClassAddresses),
 ) -> Result<ClassSummary, PlayError> {
-    if !(1..=MAX_CLASS).contains(&config.max_students) {
-        return Err(PlayError::Session(SessionError::Option(
-            haptic_types::value::ValueError::out_of_range(
-                "--max-students",
-                config.max_students as f64,
-                "1 ≤ students ≤ 200",
-            )
-            .to_string(),
-        )));
-    }
-    let file = config.scene.parse()?;
-    // The scene is checked whole before anyone joins.
-    let loaded = haptic_loop::scene::load_scene(&config.scene.text, Some(file.device.model))
-        .map_err(|e| config.scene.locate(e))?;
-    let (switches, kind) = (loaded.scene.switches(), loaded.scene.kind());
-    drop(loaded);
-    let rate = file.loop_.rate_hz;
-    let ticks = config.seconds.map(|s| ticks_for(s, rate)).transpose()?;
-    std::fs::create_dir_all(&config.out_dir).map_err(|e| {
-        PlayError::Session(SessionError::Option(format!(
-            "cannot create the recordings' folder {}: {e}",
-            config.out_dir.display()
-        )))
-    })?;
-    let n_workers = config
-        .workers
-        .unwrap_or_else(|| {
-            std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(1)
-        })
-        .clamp(1, 4);
+    let plan = Plan::check(config)?;
+    let serve_err = |e: std::io::Error| PlayError::Serve {
+        port: config.port,
+        message: e.to_string(),
+    };
     let worker_stop = Arc::new(AtomicBool::new(false));
     let (fin_tx, fin_rx) = std::sync::mpsc::channel::<Box<Live>>();
-    let period_ns = 1_000_000_000 / u64::from(rate.max(1));
-    let mut workers = Vec::new();
-    let mut handles = Vec::new();
-    for i in 0..n_workers {
-        let (tx, rx) = std::sync::mpsc::channel();
-        let load = Arc::new(AtomicUsize::new(0));
-        let (l, f, s) = (load.clone(), fin_tx.clone(), worker_stop.clone());
-        let rt = config
-            .rt
-            .map(|r| haptic_engine::realtime::RtRequest { pin: false, ..r });
-        let h = std::thread::Builder::new()
-            .name(format!("class-tick-{i}"))
-            .spawn(move || sched::worker(rx, f, period_ns, l, s, rt))
-            .map_err(|e| PlayError::Serve {
-                port: config.port,
-                message: e.to_string(),
-            })?;
-        workers.push((Mutex::new(tx), load));
-        handles.push(h);
-    }
+    let (workers, handles) =
+        start_workers(config, &plan, &fin_tx, &worker_stop).map_err(serve_err)?;
     drop(fin_tx);
-    let loopback = config.listen.is_loopback();
     let shutdown = Arc::new(AtomicBool::new(false));
-    let class = Arc::new(Class {
-        config: config.clone(),
-        scene_name: file.scene.name.clone(),
-        kind,
-        switches,
-        rate_hz: rate,
-        ticks,
-        teacher_code: config
-            .teacher_code
-            .clone()
-            .unwrap_or_else(|| random_code(8, b"ABCDEFGHJKLMNPQRSTUVWXYZ23456789")),
-        join_code: if loopback {
-            None
-        } else {
-            Some(
-                config
-                    .join_code
-                    .clone()
-                    .unwrap_or_else(|| random_code(6, b"0123456789")),
-            )
-        },
-        students: Mutex::new(Vec::new()),
-        workers,
-        finished: Mutex::new(Vec::new()),
-        ended: AtomicUsize::new(0),
-        shutdown: shutdown.clone(),
-    });
-    let c2 = class.clone();
-    let finisher = std::thread::Builder::new()
-        .name("class-finish".into())
-        .spawn(move || {
-            while let Ok(l) = fin_rx.recv() {
-                let s = l.finish();
-                c2.ended.fetch_add(1, Ordering::Relaxed);
-                if let Ok(mut f) = c2.finished.lock() {
-                    f.push(s);
-                }
-            }
-        })
-        .map_err(|e| PlayError::Serve {
-            port: config.port,
-            message: e.to_string(),
-        })?;
-    // A connection per page file, a link per page: four per student from one address on
-    // loopback (every student of a test or a one-machine class shares 127.0.0.1).
-    let limits = Limits {
-        max_connections: 8 * config.max_students + 16,
-        max_per_address: if loopback {
-            8 * config.max_students + 16
-        } else {
-            16
-        },
-        ..Limits::default()
-    };
+    let class = Arc::new(Class::new(config, plan, workers, shutdown.clone()));
+    let finisher = start_finisher(class.clone(), fin_rx).map_err(serve_err)?;
     let mut listener = Listener::start(
         SocketAddr::new(config.listen, config.port),
-        limits,
+        class_limits(config),
         Arc::new(routes::ClassRoutes {
             class: class.clone(),
         }),
-        shutdown.clone(),
+        shutdown,
     )
-    .map_err(|e| PlayError::Serve {
-        port: config.port,
-        message: e.to_string(),
-    })?;
-    let addr = listener.addr();
-    let shown = if config.listen.is_unspecified() {
-        SocketAddr::new(IpAddr::from([127, 0, 0, 1]), addr.port())
-    } else {
-        addr
-    };
-    let addresses = ClassAddresses {
-        student_url: format!("http://{shown}/"),
-        teacher_url: format!("http://{shown}/teacher?code={}", class.teacher_code),
-        teacher_code: class.teacher_code.clone(),
-        join_code: class.join_code.clone(),
-    };
-    let device = match config.device.clone() {
-        Some(b) => {
-            let name = names::check_name(&config.device_name).map_err(|e| {
-                PlayError::Session(SessionError::Option(format!("--device-name: {e}")))
-            })?;
-            let (c, s) = (class.clone(), worker_stop.clone());
-            Some(
-                std::thread::Builder::new()
-                    .name("class-device".into())
-                    .spawn(move || device::run_device_student(&c, b, &name, &s))
-                    .map_err(|e| PlayError::Serve {
-                        port: config.port,
-                        message: e.to_string(),
-                    })?,
-            )
-        }
-        None => None,
-    };
+    .map_err(serve_err)?;
+    let addresses = class.addresses(listener.addr());
+    let device = start_device(config, &class, &worker_stop)?;
     on_ready(&addresses);
     while !stop.load(Ordering::Relaxed) {
         std::thread::sleep(Duration::from_millis(20));
@@ -611,7 +532,142 @@ pub fn run(
         addresses,
         students,
         refused: listener.gate().refused.snapshot(),
-        workers: n_workers,
+        workers: class.workers.len(),
         realtime,
     })
+}
+
+/// What a class plays, checked before anyone joins.
+struct Plan {
+    scene_name: String,
+    kind: &'static str,
+    switches: &'static [haptic_types::SwitchSpec],
+    rate_hz: u32,
+    ticks: Option<u64>,
+}
+
+impl Plan {
+    /// Checks the class's size, its scene (whole) and session length, and makes the
+    /// recordings' folder.
+    fn check(config: &ClassConfig) -> Result<Plan, PlayError> {
+        if !(1..=MAX_CLASS).contains(&config.max_students) {
+            return Err(PlayError::Session(SessionError::Option(
+                haptic_types::value::ValueError::out_of_range(
+                    "--max-students",
+                    config.max_students as f64,
+                    "1 ≤ students ≤ 200",
+                )
+                .to_string(),
+            )));
+        }
+        let file = config.scene.parse()?;
+        let loaded = haptic_loop::scene::load_scene(&config.scene.text, Some(file.device.model))
+            .map_err(|e| config.scene.locate(e))?;
+        let (switches, kind) = (loaded.scene.switches(), loaded.scene.kind());
+        let rate_hz = file.loop_.rate_hz;
+        let ticks = config.seconds.map(|s| ticks_for(s, rate_hz)).transpose()?;
+        std::fs::create_dir_all(&config.out_dir).map_err(|e| {
+            PlayError::Session(SessionError::Option(format!(
+                "cannot create the recordings' folder {}: {e}",
+                config.out_dir.display()
+            )))
+        })?;
+        Ok(Plan {
+            scene_name: file.scene.name.clone(),
+            kind,
+            switches,
+            rate_hz,
+            ticks,
+        })
+    }
+}
+
+/// The tick workers (one per core, at most four, or as configured), each with its inbox and
+/// its count of sessions; an ended session goes to `finished`.
+fn start_workers(
+    config: &ClassConfig,
+    plan: &Plan,
+    finished: &Sender<Box<Live>>,
+    stop: &Arc<AtomicBool>,
+) -> std::io::Result<(Vec<WorkerLink>, Vec<WorkerHandle>)> {
+    let n = config
+        .workers
+        .unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        })
+        .clamp(1, 4);
+    let period_ns = 1_000_000_000 / u64::from(plan.rate_hz.max(1));
+    let mut workers = Vec::new();
+    let mut handles = Vec::new();
+    for i in 0..n {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let load = Arc::new(AtomicUsize::new(0));
+        let (l, f, s) = (load.clone(), finished.clone(), stop.clone());
+        let rt = config
+            .rt
+            .map(|r| haptic_engine::realtime::RtRequest { pin: false, ..r });
+        handles.push(
+            std::thread::Builder::new()
+                .name(format!("class-tick-{i}"))
+                .spawn(move || sched::worker(rx, f, period_ns, l, s, rt))?,
+        );
+        workers.push((Mutex::new(tx), load));
+    }
+    Ok((workers, handles))
+}
+
+/// The finisher: closes each ended session off the tick threads.
+fn start_finisher(
+    class: Arc<Class>,
+    ended: std::sync::mpsc::Receiver<Box<Live>>,
+) -> std::io::Result<std::thread::JoinHandle<()>> {
+    std::thread::Builder::new()
+        .name("class-finish".into())
+        .spawn(move || {
+            while let Ok(l) = ended.recv() {
+                let s = l.finish();
+                class.ended.fetch_add(1, Ordering::Relaxed);
+                if let Ok(mut f) = class.finished.lock() {
+                    f.push(s);
+                }
+            }
+        })
+}
+
+/// A connection per page file, a link per page: four per student from one address on
+/// loopback (every student of a test or a one-machine class shares 127.0.0.1).
+fn class_limits(config: &ClassConfig) -> Limits {
+    Limits {
+        max_connections: 8 * config.max_students + 16,
+        max_per_address: if config.listen.is_loopback() {
+            8 * config.max_students + 16
+        } else {
+            16
+        },
+        ..Limits::default()
+    }
+}
+
+/// The bridged device's student on a thread of its own, when the class has one.
+fn start_device(
+    config: &ClassConfig,
+    class: &Arc<Class>,
+    stop: &Arc<AtomicBool>,
+) -> Result<Option<std::thread::JoinHandle<Result<(), String>>>, PlayError> {
+    let Some(b) = config.device.clone() else {
+        return Ok(None);
+    };
+    let name = names::check_name(&config.device_name)
+        .map_err(|e| PlayError::Session(SessionError::Option(format!("--device-name: {e}"))))?;
+    let (c, s) = (class.clone(), stop.clone());
+    std::thread::Builder::new()
+        .name("class-device".into())
+        .spawn(move || device::run_device_student(&c, b, &name, &s))
+        .map(Some)
+        .map_err(|e| PlayError::Serve {
+            port: config.port,
+            message: e.to_string(),
+        })
 }

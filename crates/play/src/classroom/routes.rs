@@ -75,75 +75,83 @@ impl ClassRoutes {
     }
 }
 
+impl ClassRoutes {
+    /// `/join?name=…&code=…`: the student's session, or the join page with the reason.
+    fn join(&self, stream: &mut TcpStream, head: &Head, gate: &Arc<Gate>) {
+        let class = &self.class;
+        let name = head.query("name").unwrap_or_default();
+        match class.join(&name, head.query("code").as_deref()) {
+            Ok(s) => respond(
+                stream,
+                "303 See Other",
+                "text/plain; charset=utf-8",
+                &format!("Location: /play?s={}\r\n", s.token),
+                b"joined\n",
+            ),
+            Err(e) => {
+                gate.refused.count(match e {
+                    JoinError::Code => "code",
+                    _ => "join",
+                });
+                let status = match e {
+                    JoinError::Code => "403 Forbidden",
+                    JoinError::Full { .. } => "503 Service Unavailable",
+                    JoinError::Taken { .. } => "409 Conflict",
+                    _ => "400 Bad Request",
+                };
+                let shown: String = name.chars().take(32).collect();
+                html(
+                    stream,
+                    status,
+                    &join_page(class, Some(&e.to_string()), &shown),
+                );
+            }
+        }
+    }
+
+    /// A student's page, link and recording, by their session's token (`?s=`).
+    fn student_route(&self, mut stream: TcpStream, head: &Head, gate: &Arc<Gate>) {
+        let Some(s) = head.query("s").and_then(|t| self.class.student(&t)) else {
+            return respond_text(
+                &mut stream,
+                "404 Not Found",
+                "no such session in this class: join again at /",
+            );
+        };
+        match head.path() {
+            "/play" => {
+                serve_page_file(&mut stream, "/index.html");
+            }
+            "/ws" if head.is_upgrade() => {
+                if accept_upgrade(&mut stream, head).is_ok() {
+                    page_link(stream, &s.shared, gate);
+                }
+            }
+            "/ws" => respond_text(
+                &mut stream,
+                "400 Bad Request",
+                "a WebSocket upgrade is expected here",
+            ),
+            _ => {
+                let file = s.shared.recording.lock().ok().and_then(|r| r.clone());
+                serve_download(
+                    &mut stream,
+                    file,
+                    "the recording is served once the session has ended",
+                );
+            }
+        }
+    }
+}
+
 impl Routes for ClassRoutes {
     fn route(&self, mut stream: TcpStream, head: Head, gate: &Arc<Gate>) {
         let class = &self.class;
         let path = head.path().to_string();
         match path.as_str() {
             "/" | "/index.html" => html(&mut stream, "200 OK", &join_page(class, None, "")),
-            "/join" => {
-                let name = head.query("name").unwrap_or_default();
-                match class.join(&name, head.query("code").as_deref()) {
-                    Ok(s) => respond(
-                        &mut stream,
-                        "303 See Other",
-                        "text/plain; charset=utf-8",
-                        &format!("Location: /play?s={}\r\n", s.token),
-                        b"joined\n",
-                    ),
-                    Err(e) => {
-                        gate.refused.count(match e {
-                            JoinError::Code => "code",
-                            _ => "join",
-                        });
-                        let status = match e {
-                            JoinError::Code => "403 Forbidden",
-                            JoinError::Full { .. } => "503 Service Unavailable",
-                            JoinError::Taken { .. } => "409 Conflict",
-                            _ => "400 Bad Request",
-                        };
-                        let shown: String = name.chars().take(32).collect();
-                        html(
-                            &mut stream,
-                            status,
-                            &join_page(class, Some(&e.to_string()), &shown),
-                        );
-                    }
-                }
-            }
-            "/play" | "/ws" | "/recording.mcap" => {
-                let student = head.query("s").and_then(|t| class.student(&t));
-                let Some(s) = student else {
-                    return respond_text(
-                        &mut stream,
-                        "404 Not Found",
-                        "no such session in this class: join again at /",
-                    );
-                };
-                match path.as_str() {
-                    "/play" => {
-                        serve_page_file(&mut stream, "/index.html");
-                    }
-                    "/ws" if head.is_upgrade() => {
-                        if accept_upgrade(&mut stream, &head).is_ok() {
-                            page_link(stream, &s.shared, gate);
-                        }
-                    }
-                    "/ws" => respond_text(
-                        &mut stream,
-                        "400 Bad Request",
-                        "a WebSocket upgrade is expected here",
-                    ),
-                    _ => {
-                        let file = s.shared.recording.lock().ok().and_then(|r| r.clone());
-                        serve_download(
-                            &mut stream,
-                            file,
-                            "the recording is served once the session has ended",
-                        );
-                    }
-                }
-            }
+            "/join" => self.join(&mut stream, &head, gate),
+            "/play" | "/ws" | "/recording.mcap" => self.student_route(stream, &head, gate),
             "/class.css" => respond(
                 &mut stream,
                 "200 OK",

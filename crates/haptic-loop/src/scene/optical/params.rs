@@ -151,6 +151,35 @@ impl OtParams {
             p.envelope_draw_scale,
             1e6,
         )?;
+        let (tol, build_evals) = self.envelope_choice()?;
+        let params = Params {
+            depth_j: p.depth_nj * 1e-9,
+            waists_m: [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
+            mass_kg: p.mass_g * 1e-3,
+            dt_s: p.dt_us * 1e-6,
+            tick_map,
+            map_speed_m_per_s: map_speed,
+            warm_start: p.warm_start,
+            particle_radius_m: 0.5 * p.particle_diameter_um * 1e-6,
+            cursor_radius_m: p.cursor_radius_nm * 1e-9,
+            stiffness_n_per_m: p.stiffness_n_per_m,
+            feedback: p.feedback,
+            clip: p.clip,
+            velocity_retain: p.velocity_retain,
+            start_m: [p.start_um[0] * 1e-6, p.start_um[1] * 1e-6],
+            envelope_tol_m: tol,
+            envelope_cell_waists: p.envelope_cell_waists,
+            envelope_margin_waists: p.envelope_margin_waists,
+            envelope_build_evals_per_tick: build_evals,
+        };
+        self.check_tick_length(&params)?;
+        Ok(params)
+    }
+
+    /// The envelope's settings, checked: its tolerance, m, and the evaluations per tick of
+    /// its spread rebuild (`None`: rebuilt whole when needed).
+    fn envelope_choice(&self) -> Result<(f64, Option<u64>), SceneError> {
+        let p = self;
         let tol = match p.envelope_tol_nm {
             Some(t) => {
                 check_positive("optical_tweezers.envelope_tol_nm", t, 1e3)?;
@@ -188,27 +217,13 @@ impl OtParams {
                 });
             }
         };
-        let params = Params {
-            depth_j: p.depth_nj * 1e-9,
-            waists_m: [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
-            mass_kg: p.mass_g * 1e-3,
-            dt_s: p.dt_us * 1e-6,
-            tick_map,
-            map_speed_m_per_s: map_speed,
-            warm_start: p.warm_start,
-            particle_radius_m: 0.5 * p.particle_diameter_um * 1e-6,
-            cursor_radius_m: p.cursor_radius_nm * 1e-9,
-            stiffness_n_per_m: p.stiffness_n_per_m,
-            feedback: p.feedback,
-            clip: p.clip,
-            velocity_retain: p.velocity_retain,
-            start_m: [p.start_um[0] * 1e-6, p.start_um[1] * 1e-6],
-            envelope_tol_m: tol,
-            envelope_cell_waists: p.envelope_cell_waists,
-            envelope_margin_waists: p.envelope_margin_waists,
-            envelope_build_evals_per_tick: build_evals,
-        };
-        // A haptic tick must be cheap: the world's bound (ot_envelope::tick_length, the one
+        Ok((tol, build_evals))
+    }
+
+    /// A haptic tick must be cheap: `dt_us` within the world's bound of a tick's length.
+    fn check_tick_length(&self, params: &Params) -> Result<(), SceneError> {
+        let p = self;
+        // The world's bound (ot_envelope::tick_length, the one
         // bound of a tick's length), said in the scene's unit.
         let max_dt_us = params.max_dt_s() * 1e6;
         if !max_dt_us.is_finite() || p.dt_us > max_dt_us {
@@ -224,7 +239,7 @@ impl OtParams {
                 ),
             ));
         }
-        Ok(params)
+        Ok(())
     }
 
     /// The tick map the table asks for: by name (`tick_map`, or the older `rk4_substeps`), or
