@@ -12,6 +12,7 @@
 //! A run is [`Report::stable`] when it has no such jump, at most [`MAX_HF_FRACTION`] of its
 //! power above [`BUZZ_HZ`] and an observer that never went below minus its reserve.
 
+use haptic_devices::bridge::rule::SampleRule;
 use haptic_engine::haptic::HapticLoop;
 
 use crate::scene::load_scene_for;
@@ -245,18 +246,17 @@ pub fn run_linked_traced(
 }
 
 /// The loop's side of a modelled link: which sample each tick uses and when it runs (the
-/// bridge's rule, in simulated time).
+/// bridge's rule, `haptic_devices::bridge::rule`, in simulated time).
 struct LoopSide {
     period_ns: u64,
     /// The simulator's clock, ns.
     now_ns: u64,
     /// The device's next sample to send.
     next_send: u64,
-    /// (arrival ns, slot) of the last on-time sample.
-    anchor: Option<(u64, u64)>,
+    /// Which sample a tick reads (the bridge's rule).
+    rule: SampleRule<DeviceSample>,
     /// Samples arrived and not yet used, by sequence number.
     queue: std::collections::BTreeMap<u64, DeviceSample>,
-    last: Option<DeviceSample>,
 }
 
 impl LoopSide {
@@ -265,9 +265,8 @@ impl LoopSide {
             period_ns,
             now_ns: 0,
             next_send: 0,
-            anchor: None,
+            rule: SampleRule::new(),
             queue: std::collections::BTreeMap::new(),
-            last: None,
         }
     }
 
@@ -287,12 +286,10 @@ impl LoopSide {
 
     /// Waits for tick `k`'s sample (or its deadline) and returns what the tick reads.
     fn wait(&mut self, k: u64, dev: &mut LinkedDevice) -> DeviceSample {
-        let deadline = self
-            .anchor
-            .map(|(t, a)| t + (k - a) * self.period_ns + self.period_ns / 2);
+        let deadline = self.rule.deadline_ns(k, self.period_ns);
         loop {
             self.device_until(self.now_ns, dev);
-            if self.queue.last_key_value().is_some_and(|(&s, _)| s >= k) {
+            if SampleRule::<DeviceSample>::ready(k, self.queue.last_key_value().map(|(&s, _)| s)) {
                 break;
             }
             let next_send = self.next_send * self.period_ns;
@@ -308,18 +305,12 @@ impl LoopSide {
         }
         // The newest sample for this slot or an earlier one.
         let keep = self.queue.split_off(&(k + 1));
-        if let Some((_, s)) = self.queue.pop_last() {
-            self.last = Some(s);
-        }
+        let newest = self.queue.pop_last().map(|(_, s)| s);
         self.queue = keep;
-        let s = self.last.unwrap_or(DeviceSample {
+        let (s, age) = self.rule.read(k, newest, self.now_ns, |k| DeviceSample {
             seq: k,
             ..DeviceSample::new([0.0; 3], Default::default())
         });
-        let age = u32::try_from(k.saturating_sub(s.seq)).unwrap_or(u32::MAX);
-        if age == 0 {
-            self.anchor = Some((self.now_ns, k));
-        }
         DeviceSample {
             age_ticks: age,
             ..s

@@ -9,6 +9,7 @@
 
 pub mod fake;
 pub mod protocol;
+pub mod rule;
 pub mod udp;
 
 pub use udp::{BridgeConfig, UdpDevice};

@@ -11,6 +11,7 @@
 //! oversized datagrams, packets from a stranger, gaps in the sequence.
 
 use super::protocol::{ForceReply, Packet, Sample};
+use super::rule::{Numbered, SampleRule};
 use haptic_types::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, FALCON, ForceCommand, HapticDevice, TickTime,
 };
@@ -107,11 +108,11 @@ pub struct UdpDevice {
     socket: Option<UdpSocket>,
     shared: Arc<Shared>,
     thread: Option<JoinHandle<()>>,
-    last: Option<Sample>,
     /// The device sequence number the next tick stands for.
     slot: Option<u64>,
-    /// When the last on-time sample arrived, and its slot.
-    anchor: Option<(Instant, u64)>,
+    /// Which sample a tick reads (the anchor's time is ns since `epoch`).
+    rule: SampleRule<Sample>,
+    epoch: Instant,
     generation: u64,
     peer: Option<SocketAddr>,
     tx: Vec<u8>,
@@ -142,9 +143,9 @@ impl UdpDevice {
                 stop: AtomicBool::new(false),
             }),
             thread: None,
-            last: None,
             slot: None,
-            anchor: None,
+            rule: SampleRule::new(),
+            epoch: Instant::now(),
             generation: 0,
             peer: None,
             tx: Vec::with_capacity(super::protocol::MAX_PACKET),
@@ -331,14 +332,16 @@ impl HapticDevice for UdpDevice {
             // A (re)started device numbers its samples afresh.
             self.generation = st.generation;
             self.slot = None;
-            self.anchor = None;
+            self.rule.reset();
         }
-        // The tick of slot k waits for the device's sample k; without it, it runs at
-        // (k − a + 0.5) periods after the arrival of the last on-time sample (slot a), so the
-        // stale ticks keep the device's clock and the sample's age is its lateness in periods.
-        let deadline = match (self.slot, self.anchor) {
-            (Some(k), Some((t, a))) => t + period.mul_f64(k.saturating_sub(a) as f64 + 0.5),
-            _ => Instant::now() + Duration::from_secs_f64(self.config.wait_s.max(0.0)),
+        // The tick of slot k waits for the device's sample k until the rule's deadline (the
+        // bridge's one rule, `rule`); before an on-time sample, as long as the link allows.
+        let deadline = match self
+            .slot
+            .and_then(|k| self.rule.deadline_ns(k, period.as_nanos() as u64))
+        {
+            Some(ns) => self.epoch + Duration::from_nanos(ns),
+            None => Instant::now() + Duration::from_secs_f64(self.config.wait_s.max(0.0)),
         };
         loop {
             if let Some(e) = st.error.take() {
@@ -346,7 +349,7 @@ impl HapticDevice for UdpDevice {
             }
             let ready = match self.slot {
                 None => !st.queue.is_empty(),
-                Some(k) => st.queue.back().is_some_and(|s| s.seq >= k),
+                Some(k) => SampleRule::<Sample>::ready(k, st.queue.back().map(|s| s.seq)),
             };
             if ready {
                 break;
@@ -389,24 +392,18 @@ impl HapticDevice for UdpDevice {
             }
             used = st.queue.pop_front();
         }
-        if let Some(s) = used {
-            self.last = Some(s);
-        }
-        let s = self.last.unwrap_or(Sample {
+        let now_ns = self.epoch.elapsed().as_nanos() as u64;
+        let (s, age) = self.rule.read(k, used, now_ns, |k| Sample {
             seq: k,
             device_time_ns: 0,
             position_m: [0.0; 3],
             buttons: 0,
             two_port_periods: None,
         });
-        let age = u32::try_from(k.saturating_sub(s.seq)).unwrap_or(u32::MAX);
         if age > 0 {
             st.c.stale_ticks += 1;
         }
         drop(st);
-        if age == 0 {
-            self.anchor = Some((Instant::now(), k));
-        }
         self.slot = Some(k + 1);
         Ok(DeviceSample {
             position_m: s.position_m,
@@ -452,7 +449,7 @@ impl HapticDevice for UdpDevice {
     fn close(&mut self) -> Result<(), DeviceError> {
         if let (Some(sock), Some(peer)) = (&self.socket, self.peer) {
             let zero = Packet::Force(ForceReply {
-                seq: self.last.map_or(0, |s| s.seq),
+                seq: self.rule.last().map_or(0, |s| s.seq),
                 tick: u64::MAX,
                 force_n: [0.0; 3],
                 stiffness_n_per_m: [0.0; 9],
@@ -496,5 +493,11 @@ impl Drop for UdpDevice {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
+    }
+}
+
+impl Numbered for Sample {
+    fn seq(&self) -> u64 {
+        self.seq
     }
 }
