@@ -3,10 +3,11 @@
 
 use crate::status;
 use haptic_devices::source::DeviceSource;
+use haptic_devices::source::OperatorChoice;
 use haptic_engine::totals::Totals;
 use haptic_loop::live::LiveConfig;
 use haptic_loop::session::{
-    OperatorChoice, SceneSource, SessionError, SessionOptions, SessionReport, run_session_until,
+    SceneSource, SessionError, SessionOptions, SessionReport, run_session_until,
 };
 use haptic_types::value::ValueError;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -59,7 +60,7 @@ pub(crate) struct RunArgs {
 
 /// `--operator`: the one operator parser, shared with the wheel.
 pub(crate) fn parse_operator(s: &str) -> Result<OperatorChoice, String> {
-    OperatorChoice::parse(s).map_err(|e| match e {
+    haptic_loop::session::parse_operator(s).map_err(|e| match e {
         // An unknown name is the flag's error; a bad `hand:k=v` names its key.
         SessionError::Option(m) => format!("--{m}"),
         e => e.to_string(),

@@ -23,7 +23,7 @@
 use crate::bridge::{BridgeConfig, UdpDevice};
 use crate::operator::SimulatedOperator;
 use crate::script::Script;
-use crate::script::{OperatorParams, ScriptedDevice};
+use crate::script::{OperatorKind, OperatorParams, ScriptedDevice};
 use haptic_types::device::{DeviceError, DeviceModel, HapticDevice};
 
 /// The forms a device name may take, as errors list them.
@@ -82,8 +82,23 @@ impl DeviceSource {
     }
 }
 
+/// How a session's script drives its device model: the one choice `nanohaptics run`
+/// (`--operator`), the wheel and the checks make; [`Driver::of_script`] resolves it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OperatorChoice {
+    /// The stylus follows the script exactly (forces do not move it).
+    Rigid,
+    /// A simulated hand follows the script and is pushed by the rendered force.
+    Hand(OperatorParams),
+    /// As the script says (`[script] operator`): a hand with its `[operator]` parameters (or
+    /// the defaults), or a rigid stylus.
+    ScriptHand,
+}
+
 /// What drives a session: a model moved by a script (rigidly or through a simulated hand), or
-/// a bridged device.
+/// a bridged device. Made from the device named ([`DeviceSource`]) and, for a model, how its
+/// script holds it ([`OperatorChoice`]); a live page session's hand is the page itself
+/// (`nanohaptics-play`'s `Hand`), which drives the same engine step.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Driver {
     /// The script played exactly by a rigid stylus of this model.
@@ -95,6 +110,26 @@ pub enum Driver {
 }
 
 impl Driver {
+    /// The driver of `model` played by `script` as `choice` says (a hand's parameters are
+    /// checked).
+    pub fn of_script(
+        model: DeviceModel,
+        choice: &OperatorChoice,
+        script: &Script,
+    ) -> Result<Driver, crate::ScriptError> {
+        Ok(match choice {
+            OperatorChoice::Rigid => Driver::Script(model),
+            OperatorChoice::Hand(p) => {
+                p.validate()?;
+                Driver::Hand(model, *p)
+            }
+            OperatorChoice::ScriptHand if script.operator_kind == OperatorKind::Rigid => {
+                Driver::Script(model)
+            }
+            OperatorChoice::ScriptHand => Driver::Hand(model, script.operator.unwrap_or_default()),
+        })
+    }
+
     /// The operator as written in the recording's description.
     pub fn describe(&self) -> String {
         match self {

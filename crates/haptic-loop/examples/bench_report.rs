@@ -10,8 +10,9 @@
 use bench_harness::chart::{Chart, Legend, PALETTE, Scale, Series, Style};
 use bench_harness::{Report, Summary, Table, span};
 use haptic_devices::OperatorParams;
+use haptic_devices::source::OperatorChoice;
 use haptic_loop::replay::verify;
-use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
+use haptic_loop::session::{SceneSource, SessionOptions, run_session};
 use recording::read_recording_file;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -2,7 +2,8 @@
 //! per-tick arrays back; read a recording into the same arrays.
 //!
 //! ```no_run
-//! use haptic_loop::session::{run_session, OperatorChoice, SceneSource, SessionOptions};
+//! use haptic_loop::session::{run_session, SceneSource, SessionOptions};
+//! use haptic_devices::source::OperatorChoice;
 //! let scene = SceneSource::from_path("scenes/wall.toml".as_ref()).unwrap();
 //! let mut opts = SessionOptions::new(scene);
 //! opts.operator = OperatorChoice::Hand(Default::default());
@@ -15,8 +16,8 @@ use crate::live::LiveConfig;
 use crate::scene::SceneFile;
 use crate::setup::{Setup, SetupOptions};
 use crate::sinks::{live_summary, start_live};
-use haptic_devices::script::{OperatorKind, Script};
-use haptic_devices::source::{DeviceSource, Driver, open_device};
+use haptic_devices::script::Script;
+use haptic_devices::source::{DeviceSource, Driver, OperatorChoice, open_device};
 use haptic_devices::{OperatorParams, ScriptError};
 use haptic_engine::check::SceneError;
 use haptic_engine::haptic::HapticLoop;
@@ -41,18 +42,6 @@ pub use crate::arrays::SessionArrays;
 pub use crate::error::SessionError;
 pub use crate::record_sink::stats_metadata;
 pub use crate::setup::{SceneSource, now_unix_ns, read_toml_text};
-
-/// How the script drives the device.
-#[derive(Clone, Debug, PartialEq)]
-pub enum OperatorChoice {
-    /// The stylus follows the script exactly (forces do not move it).
-    Rigid,
-    /// A simulated hand follows the script and is pushed by the rendered force.
-    Hand(OperatorParams),
-    /// As the script says (`[script] operator`): a hand with its `[operator]` parameters (or
-    /// the defaults), or a rigid stylus.
-    ScriptHand,
-}
 
 /// Options of a session.
 #[derive(Clone, Debug)]
@@ -297,19 +286,7 @@ pub fn run_session_until(
             DeviceSource::Udp(b) => (Driver::Udp(b), None),
             DeviceSource::Model(model) => {
                 let (script, text, origin) = load_script(opts, &file, model.specs())?;
-                let driver = match &opts.operator {
-                    OperatorChoice::Rigid => Driver::Script(model),
-                    OperatorChoice::Hand(p) => {
-                        p.validate()?;
-                        Driver::Hand(model, *p)
-                    }
-                    OperatorChoice::ScriptHand if script.operator_kind == OperatorKind::Rigid => {
-                        Driver::Script(model)
-                    }
-                    OperatorChoice::ScriptHand => {
-                        Driver::Hand(model, script.operator.unwrap_or_default())
-                    }
-                };
+                let driver = Driver::of_script(model, &opts.operator, &script)?;
                 (driver, Some((script, text, origin)))
             }
         };
@@ -440,24 +417,22 @@ pub fn read_arrays(path: &Path, salvage: bool) -> Result<SessionArrays, SessionE
     Ok(SessionArrays::from_recording(&rec)?)
 }
 
-impl OperatorChoice {
-    /// The operator by the name the command line's `--operator` and Python's `operator=` both
-    /// take: `rigid` (the stylus follows the script exactly), `hand` (as the script says: the
-    /// simulated hand with the script's `[operator]` parameters or the defaults, or a rigid
-    /// stylus for a script with `operator = "rigid"`), or `hand:key=value,...` (a simulated hand
-    /// with the default parameters changed: `mass_kg`, `stiffness_n_per_m`,
-    /// `damping_n_s_per_m`, `yield_force_n`, each checked against its range).
-    pub fn parse(name: &str) -> Result<Self, SessionError> {
-        match (name, name.strip_prefix("hand:")) {
-            ("rigid", _) => Ok(OperatorChoice::Rigid),
-            ("hand", _) => Ok(OperatorChoice::ScriptHand),
-            (_, Some(kv)) => Ok(OperatorChoice::Hand(
-                OperatorParams::default().with_overrides(kv)?,
-            )),
-            (_, None) => Err(SessionError::Option(format!(
-                "operator `{name}` is not one of: rigid, hand, hand:key=value,..."
-            ))),
-        }
+/// The operator by the name the command line's `--operator` and Python's `operator=` both
+/// take: `rigid` (the stylus follows the script exactly), `hand` (as the script says: the
+/// simulated hand with the script's `[operator]` parameters or the defaults, or a rigid
+/// stylus for a script with `operator = "rigid"`), or `hand:key=value,...` (a simulated hand
+/// with the default parameters changed: `mass_kg`, `stiffness_n_per_m`,
+/// `damping_n_s_per_m`, `yield_force_n`, each checked against its range).
+pub fn parse_operator(name: &str) -> Result<OperatorChoice, SessionError> {
+    match (name, name.strip_prefix("hand:")) {
+        ("rigid", _) => Ok(OperatorChoice::Rigid),
+        ("hand", _) => Ok(OperatorChoice::ScriptHand),
+        (_, Some(kv)) => Ok(OperatorChoice::Hand(
+            OperatorParams::default().with_overrides(kv)?,
+        )),
+        (_, None) => Err(SessionError::Option(format!(
+            "operator `{name}` is not one of: rigid, hand, hand:key=value,..."
+        ))),
     }
 }
 

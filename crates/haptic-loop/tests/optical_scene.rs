@@ -91,7 +91,7 @@ fn scene_errors_name_the_field() {
 #[test]
 fn feedback_keeps_the_cursor_near_the_particle() {
     use haptic_devices::OperatorParams;
-    use haptic_loop::session::OperatorChoice;
+    use haptic_devices::source::OperatorChoice;
     let drag = "[script]\nname = 'drag'\nduration_s = 1.2\n\
                 [[button]]\nt_s = 0.3\nname = 'centre'\ndown = true\n\
                 [[waypoint]]\nt_s = 0.5\nposition_mm = [0.0, 0.0, 0.0]\n\

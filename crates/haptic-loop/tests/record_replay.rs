@@ -2,10 +2,9 @@
 //! and the golden recordings under `recordings/`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use haptic_devices::source::OperatorChoice;
 use haptic_loop::replay::verify;
-use haptic_loop::session::{
-    OperatorChoice, SceneSource, SessionArrays, SessionOptions, read_arrays, run_session,
-};
+use haptic_loop::session::{SceneSource, SessionArrays, SessionOptions, read_arrays, run_session};
 use recording::channels::messages::{
     Channel, DescriptionMsg, DeviceInputMsg, EventsMsg, ForceMsg, StateMsg, SwitchMsg, TimingMsg,
 };

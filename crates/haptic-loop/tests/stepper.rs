@@ -2,8 +2,9 @@
 //! inputs, records, and replays bit for bit.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use haptic_devices::source::OperatorChoice;
 use haptic_loop::replay::verify;
-use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
+use haptic_loop::session::{SceneSource, SessionOptions, run_session};
 use haptic_loop::stepper::{Stepper, StepperOptions};
 use haptic_types::Buttons;
 use haptic_types::DeviceSample;

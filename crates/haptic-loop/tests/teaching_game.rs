@@ -3,10 +3,9 @@
 //! the house score.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use haptic_devices::source::OperatorChoice;
 use haptic_loop::replay::verify;
-use haptic_loop::session::{
-    OperatorChoice, SceneSource, SessionArrays, SessionOptions, run_session,
-};
+use haptic_loop::session::{SceneSource, SessionArrays, SessionOptions, run_session};
 use recording::channels::messages::Channel;
 use recording::read_recording_file;
 use std::path::{Path, PathBuf};

@@ -17,9 +17,8 @@ pub mod measure;
 pub mod report;
 pub mod scripts;
 
-use haptic_loop::session::{
-    OperatorChoice, SceneSource, SessionArrays, SessionError, SessionOptions,
-};
+use haptic_devices::source::OperatorChoice;
+use haptic_loop::session::{SceneSource, SessionArrays, SessionError, SessionOptions};
 use measure::{BrickThrow, HouseOutcome, Hysteresis};
 use serde::Serialize;
 use std::path::{Path, PathBuf};

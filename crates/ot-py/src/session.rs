@@ -1,10 +1,11 @@
 //! Sessions of the haptic loop (`haptic-loop`): run a scene with a script and
 //! get per-tick arrays back; read an MCAP recording into the same arrays.
 
+use haptic_devices::source::OperatorChoice;
 use haptic_devices::source::{DEVICE_FORMS, DeviceNameError, DeviceSource};
 use haptic_loop::scene::overrides::{is_script_field, override_scene};
 use haptic_loop::session::{
-    OperatorChoice, Resolved, SceneSource, SessionArrays, SessionError, SessionOptions,
+    Resolved, SceneSource, SessionArrays, SessionError, SessionOptions, parse_operator,
     read_arrays, read_toml_text, run_session_until,
 };
 use haptic_types::DeviceModel;
@@ -91,13 +92,13 @@ pub(crate) fn arrays_to_py<'py>(py: Python<'py>, a: SessionArrays) -> PyResult<B
 
 /// The `operator` argument: None (`hand`, the default), a name as the command line's
 /// `--operator` takes it (`rigid`, `hand`, `hand:key=value,...`: one parser,
-/// [`OperatorChoice::parse`]), or a dict of hand parameters (`hand:` with those values).
+/// [`parse_operator`]), or a dict of hand parameters (`hand:` with those values).
 fn operator_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OperatorChoice> {
     let Some(obj) = obj else {
         return Ok(OperatorChoice::ScriptHand);
     };
     if let Ok(s) = obj.cast::<PyString>() {
-        return OperatorChoice::parse(&s.to_cow()?).map_err(session_error);
+        return parse_operator(&s.to_cow()?).map_err(session_error);
     }
     Ok(OperatorChoice::Hand(from_py(obj, "operator")?))
 }
@@ -448,28 +449,23 @@ pub fn render_audio<'py>(
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use haptic_devices::OperatorParams;
-    use haptic_loop::session::{OperatorChoice, SceneSource, resolve};
+    use haptic_devices::source::OperatorChoice;
+    use haptic_loop::session::{SceneSource, parse_operator, resolve};
     use toml::Value;
 
     #[test]
     fn operator_names_are_the_command_lines() {
+        assert_eq!(parse_operator("rigid").unwrap(), OperatorChoice::Rigid);
+        assert_eq!(parse_operator("hand").unwrap(), OperatorChoice::ScriptHand);
         assert_eq!(
-            OperatorChoice::parse("rigid").unwrap(),
-            OperatorChoice::Rigid
-        );
-        assert_eq!(
-            OperatorChoice::parse("hand").unwrap(),
-            OperatorChoice::ScriptHand
-        );
-        assert_eq!(
-            OperatorChoice::parse("hand:stiffness_n_per_m=100,yield_force_n=0.5").unwrap(),
+            parse_operator("hand:stiffness_n_per_m=100,yield_force_n=0.5").unwrap(),
             OperatorChoice::Hand(OperatorParams {
                 stiffness_n_per_m: 100.0,
                 yield_force_n: 0.5,
                 ..OperatorParams::default()
             })
         );
-        let err = |s: &str| OperatorChoice::parse(s).unwrap_err().to_string();
+        let err = |s: &str| parse_operator(s).unwrap_err().to_string();
         assert_eq!(
             err("script"),
             "operator `script` is not one of: rigid, hand, hand:key=value,..."

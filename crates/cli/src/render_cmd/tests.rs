@@ -250,7 +250,8 @@ fn the_wav_has_a_sound_on_each_recorded_impact() {
 /// A brick let go from higher lands with a larger impulse, and its sound is louder.
 #[test]
 fn a_brick_dropped_from_higher_sounds_louder() {
-    use haptic_loop::session::{OperatorChoice, SceneSource, SessionOptions, run_session};
+    use haptic_devices::source::OperatorChoice;
+    use haptic_loop::session::{SceneSource, SessionOptions, run_session};
     use lesson::scripts::{BRICK_PICK_MM, ScriptText};
     let dir = std::env::temp_dir().join(format!("nh-drops-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
