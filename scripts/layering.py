@@ -4,10 +4,11 @@
 Three rules, each failing with one line per offence (exit status 1):
 
 1. **Crates.** Every crate's `[dependencies]` on workspace crates must be exactly those that
-   `ALLOWED` grants it (the arrows of `docs/extending.md` and `../shared/DESIGN.md`: types <-
-   recording, devices <- engine <- lesson, play <- cli <- the wheel (ot-py runs the program as
-   its `nanohaptics` command); world crates know nothing of devices, logging, sound or
-   Python): a dependency the map does not grant fails, and so does a grant
+   `ALLOWED` grants it (the arrows of `docs/architecture.md`: types <- engine <- devices <-
+   sessions (haptic-loop) <- lesson, play <- cli <- the wheel (ot-py runs the program as its
+   `nanohaptics` command); world crates know nothing of devices, logging, sound or Python; the
+   engine knows no world, format, renderer or server, whatever ALLOWED says (`NEVER`)): a
+   dependency the map does not grant fails, and so does a grant
    the crate does not use (the map lists only the edges in use). A crate missing from
    `ALLOWED` fails too: a new crate states its place. A dev-dependency may point anywhere
    (a test may drive a crate from above) except into a cycle: a crate A dev-depending on B

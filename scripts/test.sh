@@ -13,6 +13,9 @@ cargo fmt --all -- --check
 step "layering: crate dependencies one way, no import circles, no upward imports"
 python3 scripts/layering.py
 
+step "sizes: no source file over 700 lines, no function over 100 lines outside tests"
+python3 scripts/sizes.py
+
 step "cargo clippy (warnings are errors)"
 cargo clippy --workspace --all-targets --release -- -D warnings
 
