@@ -2,7 +2,6 @@
 //! [`play::classroom`]).
 
 use crate::status;
-use haptic_devices::source::DeviceSource;
 use haptic_loop::session::SceneSource;
 use std::net::{IpAddr, UdpSocket};
 use std::path::PathBuf;
@@ -64,18 +63,10 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
     c.seconds = a.seconds;
     c.device_name = a.device_name.clone();
     c.rt = a.rt.request()?;
-    c.device = match a.device.as_deref().map(DeviceSource::parse).transpose() {
-        Ok(None) => None,
-        Ok(Some(DeviceSource::Udp(b))) => Some(b),
-        Ok(Some(DeviceSource::Model(m))) => {
-            return Err(format!(
-                "--device `{}`: the students' hands are their pages; --device names a device in \
-                 another process (udp:HOST:PORT or udp:PORT)",
-                m.name()
-            ));
-        }
-        Err(e) => return Err(format!("--device: {e}")),
-    };
+    c.device = crate::play_cmd::bridged_device(
+        a.device.as_deref(),
+        "the students' hands are their pages",
+    )?;
     let stop = crate::run_cmd::interrupt_flag()?;
     let listen = a.listen;
     let s = play::classroom::run(&c, &stop, &mut |addr| {

@@ -29,6 +29,24 @@ pub struct PlayArgs {
     pub(crate) rt: crate::rt_args::RtArgs,
 }
 
+/// `--device` of a page front end: a device in another process over the bridge (`None`: the
+/// page is the hand); a device model is refused, saying whose hand the page is (`hand`).
+pub(crate) fn bridged_device(
+    device: Option<&str>,
+    hand: &str,
+) -> Result<Option<haptic_devices::bridge::BridgeConfig>, String> {
+    match device.map(DeviceSource::parse).transpose() {
+        Ok(None) => Ok(None),
+        Ok(Some(DeviceSource::Udp(b))) => Ok(Some(b)),
+        Ok(Some(DeviceSource::Model(m))) => Err(format!(
+            "--device `{}`: {hand}; --device names a device in another process (udp:HOST:PORT \
+             or udp:PORT)",
+            m.name()
+        )),
+        Err(e) => Err(format!("--device: {e}")),
+    }
+}
+
 /// Runs `nanohaptics play`: prints the page's address, runs the session, prints its figures.
 /// After the session the end screen and the download stay up until Ctrl-C.
 pub fn cmd(a: &PlayArgs) -> Result<u8, String> {
@@ -37,18 +55,7 @@ pub fn cmd(a: &PlayArgs) -> Result<u8, String> {
     c.port = a.port;
     c.seconds = a.seconds;
     c.rt = a.rt.request()?;
-    c.device = match a.device.as_deref().map(DeviceSource::parse).transpose() {
-        Ok(None) => None,
-        Ok(Some(DeviceSource::Udp(b))) => Some(b),
-        Ok(Some(DeviceSource::Model(m))) => {
-            return Err(format!(
-                "--device `{}`: play's own hand is the page; --device names a device in \
-                 another process (udp:HOST:PORT or udp:PORT)",
-                m.name()
-            ));
-        }
-        Err(e) => return Err(format!("--device: {e}")),
-    };
+    c.device = crate::play_cmd::bridged_device(a.device.as_deref(), "play's own hand is the page")?;
     let stop = crate::run_cmd::interrupt_flag()?;
     let s = play::run(&c, &stop, &mut |url| {
         println!("open {url} in a browser (Ctrl-C ends the session)");
