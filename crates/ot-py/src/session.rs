@@ -121,18 +121,21 @@ pub(crate) fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<
 
 type Overrides = Vec<(String, toml::Value)>;
 
+/// The error for an `overrides` argument that is not a dict: the form it takes.
+const OVERRIDES_FORM: &str = concat!(
+    "overrides: expected a dict of dotted field names to values, e.g. ",
+    r#"{"optical_tweezers.stiffness_n_per_m": 0.4, "loop.rate_hz": 2000}"#,
+);
+
 /// The `overrides` argument: a dict of dotted field name → value, in the dict's order.
 fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Overrides> {
     let mut out = Vec::new();
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(out);
     };
-    let d = obj.cast::<PyDict>().map_err(|_| {
-        PyValueError::new_err(
-            "overrides: expected a dict of dotted field names to values, e.g. \
-             {\"optical_tweezers.stiffness_n_per_m\": 0.4, \"loop.rate_hz\": 2000}",
-        )
-    })?;
+    let d = obj
+        .cast::<PyDict>()
+        .map_err(|_| PyValueError::new_err(OVERRIDES_FORM))?;
     for (k, v) in d.iter() {
         let key: String = k.extract().map_err(|_| {
             PyValueError::new_err(format!(
