@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use world_form::Limits;
 
-use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, vector};
+use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, value_error, vector};
 use crate::json::{from_py, to_py};
 
 /// The grip commands by their names in `brickworld::Grip`.
@@ -84,22 +84,14 @@ fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Limits> {
         };
     }
     let d: Limits = from_py(obj, "device")?;
-    d.validate()
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    d.validate().map_err(value_error)?;
     Ok(d)
 }
 
 fn brick_id(world: &World, obj: &Bound<'_, PyAny>) -> PyResult<BrickId> {
     let id = int_in(obj, "brick", 0, i128::from(u32::MAX))? as u32;
     let b = BrickId(id);
-    world
-        .brick(b)
-        .map(|_| b)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
-}
-
-fn err(e: impl std::fmt::Display) -> PyErr {
-    PyValueError::new_err(e.to_string())
+    world.brick(b).map(|_| b).map_err(value_error)
 }
 
 /// Per-tick record of a batch.
@@ -250,7 +242,7 @@ impl BrickWorld {
         };
         let dev = device_from_py(device)?;
         Ok(Self {
-            world: World::new(&p, &dev).map_err(err)?,
+            world: World::new(&p, &dev).map_err(value_error)?,
         })
     }
 
@@ -293,7 +285,7 @@ impl BrickWorld {
                     restitution,
                 },
             )
-            .map_err(err)?;
+            .map_err(value_error)?;
         Ok(id.0)
     }
 
@@ -317,7 +309,7 @@ impl BrickWorld {
     ) -> PyResult<Bound<'py, PyAny>> {
         let p = vector::<3>(position_m, "position_m", "m")?;
         let b = parse_buttons(buttons, "buttons")?;
-        let input = self.world.input([p.x, p.y, p.z], b).map_err(err)?;
+        let input = self.world.input([p.x, p.y, p.z], b).map_err(value_error)?;
         let r = self.world.step(&input);
         to_py(py, &r)
     }
@@ -427,7 +419,7 @@ impl BrickWorld {
                 }
                 Ok::<_, brickworld::InputError>(())
             })
-            .map_err(err)?;
+            .map_err(value_error)?;
             py.check_signals()?;
         }
         let mut left = settle_ticks;
@@ -484,7 +476,7 @@ impl BrickWorld {
     /// "half_extents_m", "velocity_m_per_s", "held", "sleeping"}.
     fn brick<'py>(&self, py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let b = brick_id(&self.world, id)?;
-        to_py(py, &self.world.brick(b).map_err(err)?)
+        to_py(py, &self.world.brick(b).map_err(value_error)?)
     }
 
     /// Proxy (god-object) centre (3,) m: never inside a brick or the ground.
@@ -564,17 +556,17 @@ impl BrickWorld {
 
     /// Gravity magnitude (m/s², 0 switches it off), validated.
     fn set_gravity(&mut self, g_m_per_s2: f64) -> PyResult<()> {
-        self.world.set_gravity(g_m_per_s2).map_err(err)
+        self.world.set_gravity(g_m_per_s2).map_err(value_error)
     }
 
     /// Restitution of every contact (0..1), validated.
     fn set_restitution(&mut self, e: f64) -> PyResult<()> {
-        self.world.set_restitution(e).map_err(err)
+        self.world.set_restitution(e).map_err(value_error)
     }
 
     /// Coulomb friction coefficient of every contact, validated.
     fn set_friction(&mut self, mu: f64) -> PyResult<()> {
-        self.world.set_friction(mu).map_err(err)
+        self.world.set_friction(mu).map_err(value_error)
     }
 
     /// How a carried brick's inertia is felt: ``"coupling"`` (a spring-damper the device can
@@ -606,7 +598,7 @@ impl BrickWorld {
 
     /// Mass of every brick (kg), validated.
     fn set_brick_mass(&mut self, kg: f64) -> PyResult<()> {
-        self.world.set_brick_mass(kg).map_err(err)
+        self.world.set_brick_mass(kg).map_err(value_error)
     }
 
     fn __repr__(&self) -> String {
