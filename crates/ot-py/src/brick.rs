@@ -5,6 +5,7 @@ use brickworld::script::WallScript;
 use brickworld::{
     BrickId, BrickPlacement, BrickProps, CursorInput, Grip, Params, StepReport, World,
 };
+use haptic_devices::source::DeviceSource;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -71,15 +72,21 @@ fn parse_buttons(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Grip> {
     ]))
 }
 
+/// The `device` argument: None (the Falcon), a device name read as every `device=` of the
+/// wheel reads it ([`crate::session::device_from_py`]: a model in this process, whose limits
+/// the world renders to; a bridged device is refused), or a dict of limits.
 fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Limits> {
     let Some(obj) = obj else {
         return Ok(Limits::FALCON);
     };
     if let Ok(s) = obj.cast::<PyString>() {
-        return match s.to_cow()?.as_ref() {
-            "falcon" => Ok(Limits::FALCON),
-            other => Err(PyValueError::new_err(format!(
-                "device = {other:?}: allowed \"falcon\" or a dict with max_force_n and max_stiffness_n_per_m"
+        return match crate::session::device_from_py(Some(obj))? {
+            Some(DeviceSource::Model(m)) => Ok(m.specs().limits),
+            _ => Err(PyValueError::new_err(format!(
+                "device = {:?}: the brick world renders to a model in this process \
+                 (\"falcon\", \"touch\") or a dict with max_force_n and max_stiffness_n_per_m, \
+                 not a bridged device",
+                s.to_cow()?
             ))),
         };
     }
@@ -218,9 +225,15 @@ fn record(world: &World, report: StepReport) -> Tick {
 ///         fields take their defaults (see :attr:`params` for the full set:
 ///         dt_s, gravity_m_per_s2, restitution, friction, inertia, brick_mass_kg,
 ///         brick_half_extents_m, loading_zone, blueprint, bricks, ...).
-///     device: "falcon" (Novint Falcon: 8 N, 3000 N/m, CHAI3D's figures) or
+///     device: a device model by the name every ``device=`` of the wheel
+///         takes: "falcon" (default; Novint Falcon: 8 N, 3000 N/m, CHAI3D's
+///         figures) or "touch" (3D Systems Touch: 3.3 N, 400 N/m; the default
+///         1000 N/m proxy is then too stiff: pass a softer
+///         ``proxy_stiffness_n_per_m``), rendering to that model's limits; or
 ///         a dict {"max_force_n": ..., "max_stiffness_n_per_m": ...} (the old
-///         key "max_stiffness_n_m" is still accepted).
+///         key "max_stiffness_n_m" is still accepted). An unknown name is
+///         refused as :func:`run_scene` refuses it; a bridged device
+///         ("udp:...") is refused.
 ///
 /// Units: m, kg, s, N; quaternions are [x, y, z, w]. Buttons (the hand's grip
 /// commands) are None, a dict with keys among hold/turn_x/turn_y/turn_z (the
