@@ -322,8 +322,11 @@ class BrickWorld:
     a cursor proxy (god-object), grab/throw/rotate, a blueprint score.
 
     params: None or a dict (scene-table layout; missing fields take defaults).
-    device: "falcon" (8 N, 3000 N/m) or {"max_force_n", "max_stiffness_n_per_m"}
-    (the old key "max_stiffness_n_m" is still accepted).
+    device: a model name as every ``device=`` takes it, "falcon" (default,
+    8 N, 3000 N/m) or "touch" (3.3 N, 400 N/m: pass a proxy_stiffness_n_per_m
+    within it), or {"max_force_n", "max_stiffness_n_per_m"} (the old key
+    "max_stiffness_n_m" is still accepted). An unknown name is refused as
+    run_scene refuses it; "udp:..." is refused.
     Buttons (the hand's grip): None, {"hold", "turn_x", "turn_y", "turn_z"}
     (the older {"center", "rotate_x", "rotate_y", "rotate_z"} still accepted)
     or 4 bools in that order.

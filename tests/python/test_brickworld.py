@@ -188,7 +188,7 @@ def test_run_equals_repeated_step():
 def test_bad_arguments_raise_value_error_naming_them():
     cases = [
         (lambda: nh.BrickWorld({"restitution": 1.5}), "parameter `restitution` = 1.5 is out of range: allowed [0, 1]"),
-        (lambda: nh.BrickWorld(device="phantom"), 'device = "phantom": allowed "falcon" or a dict with max_force_n and max_stiffness_n_per_m'),
+        (lambda: nh.BrickWorld(device="phantom"), 'device = "phantom": allowed falcon, touch, udp:HOST:PORT or udp:PORT'),
         (lambda: nh.BrickWorld().step((0, 0, 3.0)), "cursor input `position_m[2]` = 3 m is outside the workspace: allowed [-2, 2] m"),
         (lambda: nh.BrickWorld().step((0, 0)), "position_m: expected shape (3,), got (2,)"),
         (lambda: nh.BrickWorld().step((0, 0, 0.1), {"centre": True}), "buttons: unknown button \"centre\": allowed [\"hold\", \"turn_x\", \"turn_y\", \"turn_z\"] or [\"center\", \"rotate_x\", \"rotate_y\", \"rotate_z\"]"),
@@ -229,3 +229,26 @@ def test_issue12_grip_keys_old_unit_names_and_falcon_limits():
     assert nh.BrickWorld().device == {"max_force_n": 8.0, "max_stiffness_n_per_m": 3000.0}
     d = nh.BrickWorld(device={"max_force_n": 5.0, "max_stiffness_n_m": 2000.0}).device
     assert d == {"max_force_n": 5.0, "max_stiffness_n_per_m": 2000.0}
+
+
+def test_device_is_named_as_everywhere_in_the_wheel():
+    # A Touch by name: its own limits (3.3 N, 400 N/m), with a proxy within its stiffness cap.
+    w = nh.BrickWorld({"proxy_stiffness_n_per_m": 400.0}, device="touch")
+    assert w.device == {"max_force_n": 3.3, "max_stiffness_n_per_m": 400.0}
+    # Pressed 5 cm into the ground, the spring asks 20 N: the Touch renders 3.3 N.
+    r = w.run(np.linspace((0.0, 0.0, 0.05), (0.0, 0.0, -0.05), 100))
+    norms = np.linalg.norm(r["force"], axis=1)
+    assert norms.max() <= 3.3 + 1e-12 and norms.max() > 3.2
+    assert nh.BrickWorld(device="falcon").device == nh.BrickWorld().device
+    # The Falcon's default 1000 N/m proxy is too stiff for a Touch: refused naming the field.
+    with pytest.raises(ValueError, match=r"proxy_stiffness_n_per_m` = 1000 is out of range"):
+        nh.BrickWorld(device="touch")
+    # An unknown name: the same text as every other device= argument of the wheel.
+    with pytest.raises(ValueError) as brick:
+        nh.BrickWorld(device="phantom")
+    with pytest.raises(ValueError) as session:
+        nh.resolve_scene("wall", device="phantom")
+    assert str(brick.value) == str(session.value) == 'device = "phantom": allowed falcon, touch, udp:HOST:PORT or udp:PORT'
+    # A bridged device is a device in another process: not a brick world's.
+    with pytest.raises(ValueError, match=r'^device = "udp:9870": the brick world renders to a model in this process'):
+        nh.BrickWorld(device="udp:9870")

@@ -282,9 +282,7 @@ impl TraceJob {
         slice: &mut Slice,
     ) -> Result<bool> {
         let [nx, ny] = map.n;
-        let nh = (nx - 1) * ny;
-        let hid = |i: usize, j: usize| i * ny + j;
-        let vid = |i: usize, j: usize| nh + i * (ny - 1) + j;
+        let ids = EdgeIds::of(map);
         if let TraceStage::Crossings { mut next } = self.stage {
             let det = &self.det;
             let pos = |i: usize, j: usize| det[i * ny + j] >= 0.0;
@@ -305,7 +303,7 @@ impl TraceJob {
                         &map.offset(i + 1, j),
                         det[(i + 1) * ny + j],
                     )?;
-                    self.cross_of[hid(i, j)] = Some(self.pts.len());
+                    self.cross_of[ids.h(i, j)] = Some(self.pts.len());
                     self.pts.push(p);
                 }
                 if cy {
@@ -315,7 +313,7 @@ impl TraceJob {
                         &map.offset(i, j + 1),
                         det[i * ny + j + 1],
                     )?;
-                    self.cross_of[vid(i, j)] = Some(self.pts.len());
+                    self.cross_of[ids.v(i, j)] = Some(self.pts.len());
                     self.pts.push(p);
                 }
                 slice.spend(ctx.evals - before);
@@ -374,129 +372,185 @@ impl TraceJob {
     /// Marching squares: links the crossings through the cells into fold
     /// curves and appends the region edge's curve (no evaluations).
     fn link(&mut self, map: &SampledMap) {
-        let [nx, ny] = map.n;
-        let nh = (nx - 1) * ny;
-        let hid = |i: usize, j: usize| i * ny + j;
-        let vid = |i: usize, j: usize| nh + i * (ny - 1) + j;
-        let det = &self.det;
-        let pos = |i: usize, j: usize| det[i * ny + j] >= 0.0;
-        let cross_of = &self.cross_of;
-        let pts = &self.pts;
-        // Marching squares: link crossings through cells.
-        let mut links: Vec<Vec<usize>> = vec![Vec::new(); pts.len()];
-        let link = |a: Option<usize>, b: Option<usize>, links: &mut Vec<Vec<usize>>| {
-            if let (Some(a), Some(b)) = (a, b) {
-                links[a].push(b);
-                links[b].push(a);
-            }
-        };
-        for i in 0..nx - 1 {
-            for j in 0..ny - 1 {
-                let (bo, to, le, ri) = (
-                    cross_of[hid(i, j)],
-                    cross_of[hid(i, j + 1)],
-                    cross_of[vid(i, j)],
-                    cross_of[vid(i + 1, j)],
-                );
-                let es: Vec<Option<usize>> = [bo, ri, to, le]
-                    .into_iter()
-                    .filter(|e| e.is_some())
-                    .collect();
-                match es.len() {
-                    2 => link(es[0], es[1], &mut links),
-                    4 => {
-                        let centre = det[i * ny + j]
-                            + det[(i + 1) * ny + j]
-                            + det[i * ny + j + 1]
-                            + det[(i + 1) * ny + j + 1];
-                        if (centre >= 0.0) == pos(i, j) {
-                            link(bo, ri, &mut links);
-                            link(le, to, &mut links);
-                        } else {
-                            link(bo, le, &mut links);
-                            link(ri, to, &mut links);
-                        }
-                    }
-                    _ => {}
-                }
-            }
-        }
-        // Chains: open ones from their ends first, then closed loops.
-        let curves = &mut self.curves;
-        let mut used = vec![false; pts.len()];
-        let walk = |s: usize, used: &mut Vec<bool>| -> (Vec<usize>, bool) {
-            let mut chain = vec![s];
-            used[s] = true;
-            let mut cur = s;
-            loop {
-                let next = links[cur].iter().copied().find(|&x| !used[x]);
-                match next {
-                    Some(x) => {
-                        used[x] = true;
-                        chain.push(x);
-                        cur = x;
-                    }
-                    None => break,
-                }
-            }
-            let closed = chain.len() > 2 && links[cur].contains(&s);
-            (chain, closed)
-        };
-        let order: Vec<usize> = (0..pts.len())
-            .filter(|&k| links[k].len() <= 1)
-            .chain((0..pts.len()).filter(|&k| links[k].len() > 1))
-            .collect();
-        for s in order {
-            if used[s] {
-                continue;
-            }
-            let (chain, closed) = walk(s, &mut used);
-            curves.push(Curve {
-                pts: chain.iter().map(|&k| pts[k]).collect(),
+        let ids = EdgeIds::of(map);
+        let links = cell_links(ids, map.n, &self.det, &self.cross_of, self.pts.len());
+        for (chain, closed) in chains(&links) {
+            self.curves.push(Curve {
+                pts: chain.iter().map(|&k| self.pts[k]).collect(),
                 closed,
                 edge_dir: None,
             });
         }
-        self.fold_curves = curves.len();
-        // The region edge, counter-clockwise, with its fold crossings inserted.
-        let mut edge = Curve {
-            pts: Vec::new(),
-            closed: true,
-            edge_dir: Some(Vec::new()),
-        };
-        let edge_only = &mut self.edge_only;
-        {
-            let mut ring: Vec<(usize, usize)> = Vec::new();
-            ring.extend((0..nx - 1).map(|i| (i, 0)));
-            ring.extend((0..ny - 1).map(|j| (nx - 1, j)));
-            ring.extend((1..nx).rev().map(|i| (i, ny - 1)));
-            ring.extend((1..ny).rev().map(|j| (0, j)));
-            let m = ring.len();
-            let dirs = edge.edge_dir.as_mut().expect("edge curve has directions");
-            for k in 0..m {
-                let (i, j) = ring[k];
-                let (i2, j2) = ring[(k + 1) % m];
-                let dir = V2::new(i2 as f64 - i as f64, j2 as f64 - j as f64);
-                let d = map.disp[map.idx(i, j)];
-                edge.pts.push(CurvePoint {
-                    o: map.offset(i, j),
-                    d,
-                    j: map.jac[map.idx(i, j)],
-                });
-                dirs.push(dir);
-                edge_only.insert((d.x.to_bits(), d.y.to_bits()));
-                let e = if j2 == j {
-                    hid(i.min(i2), j)
-                } else {
-                    vid(i, j.min(j2))
-                };
-                if let Some(c) = cross_of[e] {
-                    edge.pts.push(pts[c]);
-                    dirs.push(dir);
+        self.fold_curves = self.curves.len();
+        let edge = edge_curve(ids, map, &self.cross_of, &self.pts, &mut self.edge_only);
+        self.curves.push(edge);
+    }
+}
+
+/// Where the grid edges stand in `cross_of`: first the edges `(i, j) → (i + 1, j)`, then the
+/// edges `(i, j) → (i, j + 1)`.
+#[derive(Clone, Copy)]
+struct EdgeIds {
+    /// Grid vertices along the second axis.
+    ny: usize,
+    /// Number of edges along the first axis.
+    nh: usize,
+}
+
+impl EdgeIds {
+    fn of(map: &SampledMap) -> Self {
+        let [nx, ny] = map.n;
+        Self {
+            ny,
+            nh: (nx - 1) * ny,
+        }
+    }
+
+    /// The edge `(i, j) → (i + 1, j)`.
+    fn h(self, i: usize, j: usize) -> usize {
+        i * self.ny + j
+    }
+
+    /// The edge `(i, j) → (i, j + 1)`.
+    fn v(self, i: usize, j: usize) -> usize {
+        self.nh + i * (self.ny - 1) + j
+    }
+}
+
+/// Marching squares on the signs of `det` over the `n` grid: for each crossing (of `n_pts`),
+/// the crossings it is linked to through the cells it bounds. A cell with four crossings (a
+/// saddle) is split by the sign of its centre (the mean of its corners).
+fn cell_links(
+    ids: EdgeIds,
+    n: [usize; 2],
+    det: &[f64],
+    cross_of: &[Option<usize>],
+    n_pts: usize,
+) -> Vec<Vec<usize>> {
+    let [nx, ny] = n;
+    let pos = |i: usize, j: usize| det[i * ny + j] >= 0.0;
+    let mut links: Vec<Vec<usize>> = vec![Vec::new(); n_pts];
+    let link = |a: Option<usize>, b: Option<usize>, links: &mut Vec<Vec<usize>>| {
+        if let (Some(a), Some(b)) = (a, b) {
+            links[a].push(b);
+            links[b].push(a);
+        }
+    };
+    for i in 0..nx - 1 {
+        for j in 0..ny - 1 {
+            let (bo, to, le, ri) = (
+                cross_of[ids.h(i, j)],
+                cross_of[ids.h(i, j + 1)],
+                cross_of[ids.v(i, j)],
+                cross_of[ids.v(i + 1, j)],
+            );
+            let es: Vec<Option<usize>> = [bo, ri, to, le]
+                .into_iter()
+                .filter(|e| e.is_some())
+                .collect();
+            match es.len() {
+                2 => link(es[0], es[1], &mut links),
+                4 => {
+                    let centre = det[i * ny + j]
+                        + det[(i + 1) * ny + j]
+                        + det[i * ny + j + 1]
+                        + det[(i + 1) * ny + j + 1];
+                    if (centre >= 0.0) == pos(i, j) {
+                        link(bo, ri, &mut links);
+                        link(le, to, &mut links);
+                    } else {
+                        link(bo, le, &mut links);
+                        link(ri, to, &mut links);
+                    }
                 }
+                _ => {}
             }
         }
-        curves.push(edge);
+    }
+    links
+}
+
+/// The chains of linked crossings, each with whether it closes on itself: open ones walked
+/// from their ends first, then the closed loops.
+fn chains(links: &[Vec<usize>]) -> Vec<(Vec<usize>, bool)> {
+    let n = links.len();
+    let mut used = vec![false; n];
+    let walk = |s: usize, used: &mut Vec<bool>| -> (Vec<usize>, bool) {
+        let mut chain = vec![s];
+        used[s] = true;
+        let mut cur = s;
+        loop {
+            let next = links[cur].iter().copied().find(|&x| !used[x]);
+            match next {
+                Some(x) => {
+                    used[x] = true;
+                    chain.push(x);
+                    cur = x;
+                }
+                None => break,
+            }
+        }
+        let closed = chain.len() > 2 && links[cur].contains(&s);
+        (chain, closed)
+    };
+    let order: Vec<usize> = (0..n)
+        .filter(|&k| links[k].len() <= 1)
+        .chain((0..n).filter(|&k| links[k].len() > 1))
+        .collect();
+    let mut out = Vec::new();
+    for s in order {
+        if used[s] {
+            continue;
+        }
+        out.push(walk(s, &mut used));
+    }
+    out
+}
+
+/// The region edge, counter-clockwise, with its fold crossings (`pts` by `cross_of`)
+/// inserted; its grid points are added to `edge_only`.
+fn edge_curve(
+    ids: EdgeIds,
+    map: &SampledMap,
+    cross_of: &[Option<usize>],
+    pts: &[CurvePoint],
+    edge_only: &mut BTreeSet<Key>,
+) -> Curve {
+    let [nx, ny] = map.n;
+    let mut ring: Vec<(usize, usize)> = Vec::new();
+    ring.extend((0..nx - 1).map(|i| (i, 0)));
+    ring.extend((0..ny - 1).map(|j| (nx - 1, j)));
+    ring.extend((1..nx).rev().map(|i| (i, ny - 1)));
+    ring.extend((1..ny).rev().map(|j| (0, j)));
+    let m = ring.len();
+    let mut points = Vec::new();
+    let mut dirs = Vec::new();
+    for k in 0..m {
+        let (i, j) = ring[k];
+        let (i2, j2) = ring[(k + 1) % m];
+        let dir = V2::new(i2 as f64 - i as f64, j2 as f64 - j as f64);
+        let d = map.disp[map.idx(i, j)];
+        points.push(CurvePoint {
+            o: map.offset(i, j),
+            d,
+            j: map.jac[map.idx(i, j)],
+        });
+        dirs.push(dir);
+        edge_only.insert((d.x.to_bits(), d.y.to_bits()));
+        let e = if j2 == j {
+            ids.h(i.min(i2), j)
+        } else {
+            ids.v(i, j.min(j2))
+        };
+        if let Some(c) = cross_of[e] {
+            points.push(pts[c]);
+            dirs.push(dir);
+        }
+    }
+    Curve {
+        pts: points,
+        closed: true,
+        edge_dir: Some(dirs),
     }
 }
 

@@ -485,18 +485,7 @@ impl TickController {
         finite_vec("cursor [m]", cursor.as_slice())?;
         self.stats.ticks += 1;
         let v0 = particle.velocity;
-        let mut rebuilt = false;
-        let slice_evals = if self.params.warm_start {
-            self.advance_pending(prop)?
-        } else {
-            0
-        };
-        if self.warm(prop, &v0)? {
-            self.maybe_start(prop, &v0)?;
-        } else {
-            self.rebuild(prop, &v0)?;
-            rebuilt = true;
-        }
+        let (slice_evals, mut rebuilt) = self.serve(prop, &v0)?;
         let tol = self.params.steer.tol;
         let free = free_drift(prop.model(), &v0, prop.dt());
         let command = cursor - particle.position;
@@ -520,47 +509,22 @@ impl TickController {
         } else {
             V2::zeros()
         };
-        let mut target = clipped.allowed;
-        let mut found = self.quick_solve(&nw, &target, prev.as_ref(), &shift)?;
-        if found.is_none() && back != V2::zeros() {
-            target = clipped.allowed - back;
-            found = self.quick_solve(&nw, &target, prev.as_ref(), &shift)?;
+        let mut solved = solve_pulled_back(clipped.allowed, back, |t| {
+            self.quick_solve(&nw, t, prev.as_ref(), &shift)
+        })?;
+        if solved.is_none() {
+            solved = self.full_solve(
+                prop,
+                &v0,
+                clipped.allowed,
+                back,
+                prev.as_ref(),
+                &mut rebuilt,
+            )?;
         }
-        if found.is_none() {
-            // the full solve on a grid for this velocity (the build in
-            // service when it is for this very velocity)
-            let fresh = self.base_valid
-                && self.map.as_ref().is_some_and(|m| {
-                    m.v0.x.to_bits() == v0.x.to_bits() && m.v0.y.to_bits() == v0.y.to_bits()
-                });
-            if !rebuilt && !fresh {
-                self.rebuild(prop, &v0)?;
-                rebuilt = true;
-            }
-            self.stats.full_solves += 1;
-            if let Some(map) = self.map.take() {
-                let solver = TrapSolver::from_map(prop, map);
-                target = clipped.allowed;
-                found = solver.steer(&target, prev.as_ref())?;
-                if found.is_none() && back != V2::zeros() {
-                    target = clipped.allowed - back;
-                    found = solver.steer(&target, prev.as_ref())?;
-                }
-                self.map = Some(solver.map);
-            }
-        }
-        let (offset, choice) = match found {
-            Some(x) => x,
-            None => {
-                // Unreachable even after the pull-back (a boundary sliver
-                // thinner than the tolerance): park the trap at the region's
-                // corner, where the particle drifts almost freely, and report
-                // the displacement that really happens.
-                self.stats.parked += 1;
-                let o = region.hi;
-                target = prop.flow(&o, &v0)?.0;
-                (o, Choice::SmallestMove)
-            }
+        let (target, (offset, choice)) = match solved {
+            Some(s) => s,
+            None => self.park(prop, &region, &v0)?,
         };
         match choice {
             Choice::Continued => self.stats.continued += 1,
@@ -580,4 +544,85 @@ impl TickController {
             slice_evals,
         })
     }
+
+    /// Puts an envelope for `v0` in service: the pending build advanced (with warm start),
+    /// then the base envelope translated when its checks pass, else a rebuild. Returns the
+    /// force evaluations the pending build spent and whether this tick rebuilt.
+    fn serve(&mut self, prop: &Propagator<2>, v0: &V2) -> Result<(u64, bool)> {
+        let slice_evals = if self.params.warm_start {
+            self.advance_pending(prop)?
+        } else {
+            0
+        };
+        if self.warm(prop, v0)? {
+            self.maybe_start(prop, v0)?;
+            Ok((slice_evals, false))
+        } else {
+            self.rebuild(prop, v0)?;
+            Ok((slice_evals, true))
+        }
+    }
+
+    /// The full solve on a grid for velocity `v0` (the build in service when it is for this
+    /// very velocity, else a rebuild unless this tick has `rebuilt` already), for `allowed`
+    /// then `allowed − back` (m): the target reached and its offset, or `None`.
+    fn full_solve(
+        &mut self,
+        prop: &Propagator<2>,
+        v0: &V2,
+        allowed: V2,
+        back: V2,
+        prev: Option<&V2>,
+        rebuilt: &mut bool,
+    ) -> Result<Option<(V2, (V2, Choice))>> {
+        let fresh = self.base_valid
+            && self.map.as_ref().is_some_and(|m| {
+                m.v0.x.to_bits() == v0.x.to_bits() && m.v0.y.to_bits() == v0.y.to_bits()
+            });
+        if !*rebuilt && !fresh {
+            self.rebuild(prop, v0)?;
+            *rebuilt = true;
+        }
+        self.stats.full_solves += 1;
+        let Some(map) = self.map.take() else {
+            return Ok(None);
+        };
+        let solver = TrapSolver::from_map(prop, map);
+        let solved = solve_pulled_back(allowed, back, |t| solver.steer(t, prev))?;
+        self.map = Some(solver.map);
+        Ok(solved)
+    }
+
+    /// Unreachable even after the pull-back (a boundary sliver thinner than
+    /// the tolerance): parks the trap at the region's corner, where the
+    /// particle drifts almost freely. Returns the displacement that really
+    /// happens (m) and the offset (m).
+    fn park(
+        &mut self,
+        prop: &Propagator<2>,
+        region: &OffsetRegion,
+        v0: &V2,
+    ) -> Result<(V2, (V2, Choice))> {
+        self.stats.parked += 1;
+        let o = region.hi;
+        let target = prop.flow(&o, v0)?.0;
+        Ok((target, (o, Choice::SmallestMove)))
+    }
+}
+
+/// `solve` for the clipped point `allowed` (m), then, when that fails and the clip pulled it
+/// back by `back` (m, nonzero), for `allowed − back`: the target reached and its solution.
+fn solve_pulled_back(
+    allowed: V2,
+    back: V2,
+    mut solve: impl FnMut(&V2) -> Result<Option<(V2, Choice)>>,
+) -> Result<Option<(V2, (V2, Choice))>> {
+    if let Some(found) = solve(&allowed)? {
+        return Ok(Some((allowed, found)));
+    }
+    if back != V2::zeros() {
+        let target = allowed - back;
+        return Ok(solve(&target)?.map(|found| (target, found)));
+    }
+    Ok(None)
 }

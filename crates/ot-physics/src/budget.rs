@@ -97,6 +97,19 @@ fn candidates() -> Vec<(u64, Method)> {
     c
 }
 
+/// Checks the largest start speed `v_max` (m/s) of the probes: finite and ≥ 0.
+fn start_speed(v_max: f64) -> Result<f64> {
+    if v_max.is_finite() && v_max >= 0.0 {
+        Ok(v_max)
+    } else {
+        Err(PhysicsError::Value(ValueError::out_of_range(
+            "v_max [m/s]",
+            v_max,
+            "finite and >= 0",
+        )))
+    }
+}
+
 /// The probe set: for each start velocity (0, `v_max` along x, along y and
 /// along the anti-diagonal), a lattice of offsets over the region within 3
 /// waists of the free drift path.
@@ -133,13 +146,7 @@ fn probes(model: &TrapModel<2>, dt: f64, v_max: f64) -> Vec<(Vector2<f64>, Vecto
 /// speeds up to `v_max`, m/s), and report it as a [`MapChoice`] with
 /// `tol_m` = the measured error (a map fixed by hand has no budget).
 pub fn measure(model: TrapModel<2>, method: Method, dt: f64, v_max: f64) -> Result<MapChoice> {
-    if !(v_max.is_finite() && v_max >= 0.0) {
-        return Err(PhysicsError::Value(ValueError::out_of_range(
-            "v_max [m/s]",
-            v_max,
-            "finite and >= 0",
-        )));
-    }
+    let v_max = start_speed(v_max)?;
     let reference = converged(model, dt)?;
     let p = Propagator::new(model, method, dt)?;
     let probes = probes(&model, dt, v_max);
@@ -174,13 +181,7 @@ pub fn choose_tick_map(
     v_max: f64,
 ) -> Result<(Propagator<2>, MapChoice)> {
     let tol_m = positive("tick map tolerance [m]", tol_m)?;
-    if !(v_max.is_finite() && v_max >= 0.0) {
-        return Err(PhysicsError::Value(ValueError::out_of_range(
-            "v_max [m/s]",
-            v_max,
-            "finite and >= 0",
-        )));
-    }
+    let v_max = start_speed(v_max)?;
     let reference = converged(model, dt)?;
     let probes = probes(&model, dt, v_max);
     let mut exact = Vec::with_capacity(probes.len());

@@ -5,13 +5,14 @@ use brickworld::script::WallScript;
 use brickworld::{
     BrickId, BrickPlacement, BrickProps, CursorInput, Grip, Params, StepReport, World,
 };
+use haptic_devices::source::DeviceSource;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use world_form::Limits;
 
-use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, vector};
+use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, value_error, vector};
 use crate::json::{from_py, to_py};
 
 /// The grip commands by their names in `brickworld::Grip`.
@@ -71,35 +72,33 @@ fn parse_buttons(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Grip> {
     ]))
 }
 
+/// The `device` argument: None (the Falcon), a device name read as every `device=` of the
+/// wheel reads it ([`crate::session::device_from_py`]: a model in this process, whose limits
+/// the world renders to; a bridged device is refused), or a dict of limits.
 fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Limits> {
     let Some(obj) = obj else {
         return Ok(Limits::FALCON);
     };
     if let Ok(s) = obj.cast::<PyString>() {
-        return match s.to_cow()?.as_ref() {
-            "falcon" => Ok(Limits::FALCON),
-            other => Err(PyValueError::new_err(format!(
-                "device = {other:?}: allowed \"falcon\" or a dict with max_force_n and max_stiffness_n_per_m"
+        return match crate::session::device_from_py(Some(obj))? {
+            Some(DeviceSource::Model(m)) => Ok(m.specs().limits),
+            _ => Err(PyValueError::new_err(format!(
+                "device = {:?}: the brick world renders to a model in this process \
+                 (\"falcon\", \"touch\") or a dict with max_force_n and max_stiffness_n_per_m, \
+                 not a bridged device",
+                s.to_cow()?
             ))),
         };
     }
     let d: Limits = from_py(obj, "device")?;
-    d.validate()
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    d.validate().map_err(value_error)?;
     Ok(d)
 }
 
 fn brick_id(world: &World, obj: &Bound<'_, PyAny>) -> PyResult<BrickId> {
     let id = int_in(obj, "brick", 0, i128::from(u32::MAX))? as u32;
     let b = BrickId(id);
-    world
-        .brick(b)
-        .map(|_| b)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
-}
-
-fn err(e: impl std::fmt::Display) -> PyErr {
-    PyValueError::new_err(e.to_string())
+    world.brick(b).map(|_| b).map_err(value_error)
 }
 
 /// Per-tick record of a batch.
@@ -226,9 +225,15 @@ fn record(world: &World, report: StepReport) -> Tick {
 ///         fields take their defaults (see :attr:`params` for the full set:
 ///         dt_s, gravity_m_per_s2, restitution, friction, inertia, brick_mass_kg,
 ///         brick_half_extents_m, loading_zone, blueprint, bricks, ...).
-///     device: "falcon" (Novint Falcon: 8 N, 3000 N/m, CHAI3D's figures) or
+///     device: a device model by the name every ``device=`` of the wheel
+///         takes: "falcon" (default; Novint Falcon: 8 N, 3000 N/m, CHAI3D's
+///         figures) or "touch" (3D Systems Touch: 3.3 N, 400 N/m; the default
+///         1000 N/m proxy is then too stiff: pass a softer
+///         ``proxy_stiffness_n_per_m``), rendering to that model's limits; or
 ///         a dict {"max_force_n": ..., "max_stiffness_n_per_m": ...} (the old
-///         key "max_stiffness_n_m" is still accepted).
+///         key "max_stiffness_n_m" is still accepted). An unknown name is
+///         refused as :func:`run_scene` refuses it; a bridged device
+///         ("udp:...") is refused.
 ///
 /// Units: m, kg, s, N; quaternions are [x, y, z, w]. Buttons (the hand's grip
 /// commands) are None, a dict with keys among hold/turn_x/turn_y/turn_z (the
@@ -250,7 +255,7 @@ impl BrickWorld {
         };
         let dev = device_from_py(device)?;
         Ok(Self {
-            world: World::new(&p, &dev).map_err(err)?,
+            world: World::new(&p, &dev).map_err(value_error)?,
         })
     }
 
@@ -293,7 +298,7 @@ impl BrickWorld {
                     restitution,
                 },
             )
-            .map_err(err)?;
+            .map_err(value_error)?;
         Ok(id.0)
     }
 
@@ -317,7 +322,7 @@ impl BrickWorld {
     ) -> PyResult<Bound<'py, PyAny>> {
         let p = vector::<3>(position_m, "position_m", "m")?;
         let b = parse_buttons(buttons, "buttons")?;
-        let input = self.world.input([p.x, p.y, p.z], b).map_err(err)?;
+        let input = self.world.input([p.x, p.y, p.z], b).map_err(value_error)?;
         let r = self.world.step(&input);
         to_py(py, &r)
     }
@@ -427,7 +432,7 @@ impl BrickWorld {
                 }
                 Ok::<_, brickworld::InputError>(())
             })
-            .map_err(err)?;
+            .map_err(value_error)?;
             py.check_signals()?;
         }
         let mut left = settle_ticks;
@@ -484,7 +489,7 @@ impl BrickWorld {
     /// "half_extents_m", "velocity_m_per_s", "held", "sleeping"}.
     fn brick<'py>(&self, py: Python<'py>, id: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let b = brick_id(&self.world, id)?;
-        to_py(py, &self.world.brick(b).map_err(err)?)
+        to_py(py, &self.world.brick(b).map_err(value_error)?)
     }
 
     /// Proxy (god-object) centre (3,) m: never inside a brick or the ground.
@@ -564,17 +569,17 @@ impl BrickWorld {
 
     /// Gravity magnitude (m/s², 0 switches it off), validated.
     fn set_gravity(&mut self, g_m_per_s2: f64) -> PyResult<()> {
-        self.world.set_gravity(g_m_per_s2).map_err(err)
+        self.world.set_gravity(g_m_per_s2).map_err(value_error)
     }
 
     /// Restitution of every contact (0..1), validated.
     fn set_restitution(&mut self, e: f64) -> PyResult<()> {
-        self.world.set_restitution(e).map_err(err)
+        self.world.set_restitution(e).map_err(value_error)
     }
 
     /// Coulomb friction coefficient of every contact, validated.
     fn set_friction(&mut self, mu: f64) -> PyResult<()> {
-        self.world.set_friction(mu).map_err(err)
+        self.world.set_friction(mu).map_err(value_error)
     }
 
     /// How a carried brick's inertia is felt: ``"coupling"`` (a spring-damper the device can
@@ -606,7 +611,7 @@ impl BrickWorld {
 
     /// Mass of every brick (kg), validated.
     fn set_brick_mass(&mut self, kg: f64) -> PyResult<()> {
-        self.world.set_brick_mass(kg).map_err(err)
+        self.world.set_brick_mass(kg).map_err(value_error)
     }
 
     fn __repr__(&self) -> String {

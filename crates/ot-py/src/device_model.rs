@@ -4,25 +4,22 @@
 use haptic_devices::{Grip, Hold, Mechanics, Plant};
 use haptic_types::value::{ValueError, finite3};
 use numpy::{PyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-fn value_err(e: impl std::fmt::Display) -> PyErr {
-    PyValueError::new_err(e.to_string())
-}
+use crate::convert::value_error;
 
 /// A 3-vector argument: exactly three finite numbers, or a ValueError naming the argument.
 fn vec3_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 3]> {
     let v: Vec<f64> = obj
         .extract()
-        .map_err(|_| value_err(format!("{name}: expected 3 numbers")))?;
+        .map_err(|_| value_error(format!("{name}: expected 3 numbers")))?;
     match v.as_slice() {
         [x, y, z] => {
-            finite3(name, [*x, *y, *z]).map_err(value_err)?;
+            finite3(name, [*x, *y, *z]).map_err(value_error)?;
             Ok([*x, *y, *z])
         }
-        _ => Err(value_err(format!(
+        _ => Err(value_error(format!(
             "{name}: expected 3 numbers, got {}",
             v.len()
         ))),
@@ -30,12 +27,12 @@ fn vec3_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<[f64; 3]> {
 }
 
 fn mechanics(model: &str, counts: bool) -> PyResult<Mechanics> {
-    let m = Mechanics::preset(model).map_err(|e| value_err(format!("model: {e}")))?;
+    let m = Mechanics::preset(model).map_err(|e| value_error(format!("model: {e}")))?;
     Ok(if counts { m } else { m.without_quantization() })
 }
 
 fn grip_arg(grip: &str) -> PyResult<Grip> {
-    Grip::parse(grip).map_err(|e| value_err(format!("grip: {e}")))
+    Grip::parse(grip).map_err(|e| value_error(format!("grip: {e}")))
 }
 
 /// A haptic device held by a hand: moving mass, viscous friction, encoder counts, force
@@ -94,7 +91,7 @@ impl DeviceModel {
         stiffness: Option<PyReadonlyArray2<'_, f64>>,
     ) -> PyResult<()> {
         if !(dt_s.is_finite() && dt_s > 0.0 && dt_s <= 1.0) {
-            return Err(value_err(ValueError::out_of_range(
+            return Err(value_error(ValueError::out_of_range(
                 "dt_s",
                 dt_s,
                 "0 < dt_s ≤ 1 s",
@@ -110,7 +107,7 @@ impl DeviceModel {
         if let Some(s) = stiffness {
             let a = s.as_array();
             if a.shape() != [3, 3] || a.iter().any(|v| !v.is_finite()) {
-                return Err(value_err(format!(
+                return Err(value_error(format!(
                     "stiffness: expected a (3, 3) array of finite N/m, got shape {:?}",
                     a.shape()
                 )));
@@ -225,7 +222,7 @@ pub fn check_closed_loop<'py>(
     if let Some(s) = seconds
         && !(s.is_finite() && s > 0.0 && s <= 3600.0)
     {
-        return Err(value_err(ValueError::out_of_range(
+        return Err(value_error(ValueError::out_of_range(
             "seconds",
             s,
             "0 < seconds ≤ 3600 s",
@@ -235,7 +232,7 @@ pub fn check_closed_loop<'py>(
     let (text, script) = (r.source.text.clone(), r.script.clone());
     let rep = py
         .detach(|| haptic_loop::closed_loop::run(&text, &script, mech, grip, seconds))
-        .map_err(value_err)?;
+        .map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("stable", rep.stable())?;
     d.update(crate::json::to_py(py, &rep)?.cast::<pyo3::types::PyMapping>()?)?;

@@ -18,7 +18,7 @@ use recording::RecordingError;
 use recording::channels::declare::ColumnData;
 use std::path::PathBuf;
 
-use crate::convert::array2_flat;
+use crate::convert::{array2_flat, value_error};
 use crate::json::{from_py, py_to_toml, to_py};
 
 /// File errors as `OSError`, everything else (bad scene, script, options,
@@ -122,18 +122,21 @@ pub(crate) fn device_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<
 
 type Overrides = Vec<(String, toml::Value)>;
 
+/// The error for an `overrides` argument that is not a dict: the form it takes.
+const OVERRIDES_FORM: &str = concat!(
+    "overrides: expected a dict of dotted field names to values, e.g. ",
+    r#"{"optical_tweezers.stiffness_n_per_m": 0.4, "loop.rate_hz": 2000}"#,
+);
+
 /// The `overrides` argument: a dict of dotted field name → value, in the dict's order.
 fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Overrides> {
     let mut out = Vec::new();
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(out);
     };
-    let d = obj.cast::<PyDict>().map_err(|_| {
-        PyValueError::new_err(
-            "overrides: expected a dict of dotted field names to values, e.g. \
-             {\"optical_tweezers.stiffness_n_per_m\": 0.4, \"loop.rate_hz\": 2000}",
-        )
-    })?;
+    let d = obj
+        .cast::<PyDict>()
+        .map_err(|_| PyValueError::new_err(OVERRIDES_FORM))?;
     for (k, v) in d.iter() {
         let key: String = k.extract().map_err(|_| {
             PyValueError::new_err(format!(
@@ -144,10 +147,6 @@ fn overrides_from_py(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Overrides> {
         out.push((key, value));
     }
     Ok(out)
-}
-
-fn value_err(e: impl std::fmt::Display) -> PyErr {
-    PyValueError::new_err(e.to_string())
 }
 
 /// The scene argument: a path or built-in name, or a dict of `resolve_scene` (its scene and
@@ -309,9 +308,9 @@ pub fn run_scene<'py>(
     let rt = rt_priority
         .map(haptic_engine::realtime::RtRequest::with_priority)
         .transpose()
-        .map_err(|e| value_err(e.map_field(|_| "rt_priority".into())))?;
+        .map_err(|e| value_error(e.map_field(|_| "rt_priority".into())))?;
     if !(wait_s.is_finite() && (0.0..=86400.0).contains(&wait_s)) {
-        return Err(value_err(ValueError::out_of_range(
+        return Err(value_error(ValueError::out_of_range(
             "wait_s",
             wait_s,
             "0–86400 s",
@@ -327,7 +326,7 @@ pub fn run_scene<'py>(
                 )));
             }
             let (mut source, _) = scene_source(scene)?;
-            source.text = override_scene(&source.text, &ov).map_err(value_err)?;
+            source.text = override_scene(&source.text, &ov).map_err(value_error)?;
             b.wait_s = wait_s;
             let mut opts = SessionOptions::new(source);
             opts.device = Some(DeviceSource::Udp(b));
@@ -435,7 +434,7 @@ pub fn render_audio<'py>(
             proximity,
             rate,
         )
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        .map_err(value_error)?;
         if let Some(o) = &out {
             s.write_wav(o)
                 .map_err(|e| PyOSError::new_err(e.to_string()))?;

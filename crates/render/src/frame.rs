@@ -403,21 +403,7 @@ impl Frame {
                 ..
             } => {
                 let ax = axes(normq(*rotation));
-                let rect = rect_of(
-                    box_corners(*center_m, ax, *half_extents_m)
-                        .iter()
-                        .map(|c| cam.project(*c)),
-                );
-                Some(Item {
-                    shape: Shape::Obb {
-                        c: *center_m,
-                        axes: ax,
-                        half: *half_extents_m,
-                    },
-                    depth: cam.project(*center_m).depth_m,
-                    flat: false,
-                    rect,
-                })
+                Some(obb_item(cam, *center_m, ax, *half_extents_m, false))
             }
             Primitive::Ellipse {
                 center_m,
@@ -426,24 +412,22 @@ impl Frame {
             } => {
                 let ax = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
                 let half = [semi_axes_m[0], semi_axes_m[1], 0.0];
-                let rect = rect_of(
-                    box_corners(*center_m, ax, half)
-                        .iter()
-                        .map(|c| cam.project(*c)),
-                );
-                Some(Item {
-                    shape: Shape::Obb {
-                        c: *center_m,
-                        axes: ax,
-                        half,
-                    },
-                    depth: cam.project(*center_m).depth_m,
-                    flat: true,
-                    rect,
-                })
+                Some(obb_item(cam, *center_m, ax, half, true))
             }
             _ => None,
         }
+    }
+}
+
+/// The item of an oriented box centred at `c` (m) with unit axes `ax` and half extents `half`
+/// (m): its depth that of its centre, its screen rectangle that of its eight corners.
+fn obb_item(cam: &Camera, c: Vec3, ax: [Vec3; 3], half: Vec3, flat: bool) -> Item {
+    let rect = rect_of(box_corners(c, ax, half).iter().map(|p| cam.project(*p)));
+    Item {
+        shape: Shape::Obb { c, axes: ax, half },
+        depth: cam.project(c).depth_m,
+        flat,
+        rect,
     }
 }
 

@@ -19,6 +19,7 @@ mod dopri5;
 mod driver;
 mod rk4;
 mod symplectic;
+mod tableau;
 
 pub use dop853::{dop853, rk8};
 pub use dopri5::dopri5;
