@@ -214,7 +214,7 @@ impl Scene for BrickScene {
     }
 
     fn state_fields(&self) -> Vec<String> {
-        [
+        score::with_score_fields(&[
             "proxy_x_m",
             "proxy_y_m",
             "proxy_z_m",
@@ -224,11 +224,7 @@ impl Scene for BrickScene {
             "slots_filled",
             "proxy_penetration_m",
             "nearest_m",
-        ]
-        .iter()
-        .chain(score::FIELDS.iter())
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
 
     fn switches(&self) -> &'static [SwitchSpec] {
@@ -360,22 +356,25 @@ impl Scene for BrickScene {
             rotation: [0.0, 0.0, 0.0, 1.0],
             color: Rgba([0.3, 0.6, 0.25, 1.0]),
         });
+        let boxed = |center_m, half_extents_m, rotation, color| Primitive::Box {
+            center_m,
+            half_extents_m,
+            rotation,
+            color,
+        };
         for o in self.world.obstacles() {
-            out.push(Primitive::Box {
-                center_m: o.position_m,
-                half_extents_m: o.half_extents_m,
-                rotation: o.orientation_xyzw,
-                color: Rgba([0.5, 0.5, 0.5, 1.0]),
-            });
+            let grey = Rgba([0.5, 0.5, 0.5, 1.0]);
+            out.push(boxed(
+                o.position_m,
+                o.half_extents_m,
+                o.orientation_xyzw,
+                grey,
+            ));
         }
         let h = self.world.params().brick_half_extents_m;
         for s in self.world.slots().filter(|s| s.filled_by.is_none()) {
-            out.push(Primitive::Box {
-                center_m: s.position_m,
-                half_extents_m: h,
-                rotation: s.orientation_xyzw,
-                color: Rgba([0.4, 0.6, 1.0, 0.3]),
-            });
+            let ghost = Rgba([0.4, 0.6, 1.0, 0.3]);
+            out.push(boxed(s.position_m, h, s.orientation_xyzw, ghost));
         }
         for b in self.world.bricks() {
             out.push(Primitive::Box {

@@ -232,7 +232,7 @@ impl Scene for NanoScene {
     }
 
     fn state_fields(&self) -> Vec<String> {
-        [
+        score::with_score_fields(&[
             "tip_x_m",
             "tip_y_m",
             "tip_z_m",
@@ -241,11 +241,7 @@ impl Scene for NanoScene {
             "movable_atoms",
             "house_score",
             "nearest_m",
-        ]
-        .iter()
-        .chain(score::FIELDS.iter())
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
 
     fn switches(&self) -> &'static [SwitchSpec] {

@@ -30,6 +30,15 @@ pub const COMFORT_FRACTION: f64 = 0.5;
 /// The state field names of the score, in the order [`HouseScore::state`] writes them.
 pub const FIELDS: [&str; 4] = ["score", "dropped", "comfort_exceeded_s", "complete_s"];
 
+/// A house world's state fields: its own `world` fields, then the score's ([`FIELDS`]).
+pub fn with_score_fields(world: &[&str]) -> Vec<String> {
+    world
+        .iter()
+        .chain(FIELDS.iter())
+        .map(|s| s.to_string())
+        .collect()
+}
+
 /// Running score of a house task.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HouseScore {

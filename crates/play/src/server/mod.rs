@@ -45,70 +45,31 @@ const CSS: &str = "text/css; charset=utf-8";
 const JS: &str = "text/javascript; charset=utf-8";
 const INDEX_HTML: &str = include_str!("../page/index.html");
 
+/// A page file at `path` of `content_type` holding `body`.
+const fn file(path: &'static str, content_type: &'static str, body: &'static str) -> PageFile {
+    PageFile {
+        path,
+        content_type,
+        body,
+    }
+}
+
 /// Every file of the page: the HTML, the style sheet and the JavaScript modules (`main.js`
 /// imports the others). These paths, `/ws`, `/favicon.ico` and `/recording.mcap` are all the
 /// server answers; anything else is 404.
 pub const PAGE_FILES: &[PageFile] = &[
-    PageFile {
-        path: "/",
-        content_type: HTML,
-        body: INDEX_HTML,
-    },
-    PageFile {
-        path: "/index.html",
-        content_type: HTML,
-        body: INDEX_HTML,
-    },
-    PageFile {
-        path: "/play.css",
-        content_type: CSS,
-        body: include_str!("../page/play.css"),
-    },
-    PageFile {
-        path: "/main.js",
-        content_type: JS,
-        body: include_str!("../page/main.js"),
-    },
-    PageFile {
-        path: "/page.js",
-        content_type: JS,
-        body: include_str!("../page/page.js"),
-    },
-    PageFile {
-        path: "/camera.js",
-        content_type: JS,
-        body: include_str!("../page/camera.js"),
-    },
-    PageFile {
-        path: "/draw.js",
-        content_type: JS,
-        body: include_str!("../page/draw.js"),
-    },
-    PageFile {
-        path: "/input.js",
-        content_type: JS,
-        body: include_str!("../page/input.js"),
-    },
-    PageFile {
-        path: "/sound.js",
-        content_type: JS,
-        body: include_str!("../page/sound.js"),
-    },
-    PageFile {
-        path: "/synth.js",
-        content_type: JS,
-        body: include_str!("../page/synth.js"),
-    },
-    PageFile {
-        path: "/messages.js",
-        content_type: JS,
-        body: include_str!("../page/messages.js"),
-    },
-    PageFile {
-        path: "/events.js",
-        content_type: JS,
-        body: include_str!("../page/events.js"),
-    },
+    file("/", HTML, INDEX_HTML),
+    file("/index.html", HTML, INDEX_HTML),
+    file("/play.css", CSS, include_str!("../page/play.css")),
+    file("/main.js", JS, include_str!("../page/main.js")),
+    file("/page.js", JS, include_str!("../page/page.js")),
+    file("/camera.js", JS, include_str!("../page/camera.js")),
+    file("/draw.js", JS, include_str!("../page/draw.js")),
+    file("/input.js", JS, include_str!("../page/input.js")),
+    file("/sound.js", JS, include_str!("../page/sound.js")),
+    file("/synth.js", JS, include_str!("../page/synth.js")),
+    file("/messages.js", JS, include_str!("../page/messages.js")),
+    file("/events.js", JS, include_str!("../page/events.js")),
 ];
 
 /// What a listening server does with a request that passed its [`Gate`] and its
