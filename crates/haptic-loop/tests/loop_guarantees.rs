@@ -1,6 +1,8 @@
 //! The loop's guarantees, tick by tick (see `haptic_engine::haptic`'s list), on the calibration
 //! wall scene.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use haptic_engine::haptic::*;
 use haptic_loop::scene::load_scene;
 use haptic_types::device::FALCON;

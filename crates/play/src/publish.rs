@@ -314,7 +314,7 @@ pub fn run_publisher(
                 p.tick(tick, wall_ms, nearest_m);
                 p.events(tick, events);
                 if let Some(f) = frame {
-                    p.frame(tick, wall_ms, f);
+                    p.frame(tick, wall_ms, *f);
                 }
             }
             ToPublisher::Switched { tick, name, value } => {
@@ -408,7 +408,7 @@ impl Publisher {
     }
 
     /// The world drawn at tick `tick`, with the events and sounds since the last frame.
-    fn frame(&mut self, tick: u64, wall_ms: f64, f: Box<FrameData>) {
+    fn frame(&mut self, tick: u64, wall_ms: f64, f: FrameData) {
         // The sound first: the frame takes a while to write.
         self.send_ticks();
         let msg = ServerMsg::Frame(Frame {
