@@ -127,26 +127,8 @@ impl WallScript {
                     self.set(Phase::WaitBrick);
                 }
             }
-            Phase::WaitBrick => {
-                let s = self.spawn;
-                let found = world.bricks().find(|b| {
-                    !b.held
-                        && (b.position_m[0] - s.x).abs() < h[0]
-                        && (b.position_m[1] - s.y).abs() < h[1]
-                        && b.position_m[2] < 2.0 * h[2]
-                });
-                if let Some(b) = found {
-                    self.set(Phase::Touch(b.id));
-                }
-            }
-            Phase::Touch(id) => {
-                let top = world.brick(id).map(|b| b.position_m).unwrap_or([0.0; 3]);
-                // Aim 1 mm below the top: the proxy rests on it, the spring presses lightly.
-                let target = Vector::new(top[0], top[1], top[2] + h[2] + r - 1e-3);
-                if self.go(target, dt) {
-                    self.set(Phase::Grab(id));
-                }
-            }
+            Phase::WaitBrick => self.wait_brick(world, h),
+            Phase::Touch(id) => self.touch(world, id, dt, h, r),
             Phase::Grab(_) => {
                 self.grip.hold = true;
                 if self.ticks_in_phase > 2 {
@@ -166,43 +148,8 @@ impl WallScript {
                     self.set(Phase::Turn(0));
                 }
             }
-            Phase::Turn(n) => {
-                // Turn about z until the held brick matches the slot's orientation (≤ 3 turns).
-                let held = world.held_brick().and_then(|id| world.brick(id).ok());
-                let target = self.slots[self.next_slot].rotation();
-                let aligned = held.is_none_or(|b| {
-                    let q = b.orientation_xyzw;
-                    let q = Rotation::from_xyzw(q[0], q[1], q[2], q[3]);
-                    cuboid_orientation_error_rad(target, q) < 0.1
-                });
-                if self.grip.turn_z {
-                    self.grip.turn_z = false;
-                } else if aligned || n >= 3 {
-                    self.set(Phase::Lower);
-                } else {
-                    self.grip.turn_z = true;
-                    self.phase = Phase::Turn(n + 1);
-                }
-            }
-            Phase::Lower => {
-                let t = *self.lower_target.get_or_insert_with(|| {
-                    let slot = Vector::from_array(self.slots[self.next_slot].center_m);
-                    // Grip point above the brick centre as the brick hangs now (h_z + r + skin
-                    // when grabbed on top, plus the coupling's sag).
-                    let held = world.held_brick().and_then(|id| world.brick(id).ok());
-                    let offset = held
-                        .map(|b| {
-                            Vector::from_array(world.proxy_position_m())
-                                - Vector::from_array(b.position_m)
-                        })
-                        .unwrap_or(Vector::new(0.0, 0.0, h[2] + r));
-                    slot + offset + Vector::new(0.0, 0.0, 1e-3)
-                });
-                if self.go(t, dt) {
-                    self.lower_target = None;
-                    self.set(Phase::Release(0));
-                }
-            }
+            Phase::Turn(n) => self.turn(world, n),
+            Phase::Lower => self.lower(world, dt, h, r),
             Phase::Release(_) => {
                 self.grip.hold = false;
                 if self.ticks_in_phase > 300 {
@@ -219,5 +166,72 @@ impl WallScript {
             Phase::Done => {}
         }
         world.input(self.cursor.to_array(), self.grip)
+    }
+
+    /// [`Phase::WaitBrick`]: a free brick lying at the spawn spot (within its half extents
+    /// `h`, m) is the one to touch next.
+    fn wait_brick(&mut self, world: &World, h: [f64; 3]) {
+        let s = self.spawn;
+        let found = world.bricks().find(|b| {
+            !b.held
+                && (b.position_m[0] - s.x).abs() < h[0]
+                && (b.position_m[1] - s.y).abs() < h[1]
+                && b.position_m[2] < 2.0 * h[2]
+        });
+        if let Some(b) = found {
+            self.set(Phase::Touch(b.id));
+        }
+    }
+
+    /// [`Phase::Touch`]: down onto brick `id`'s top (half extents `h`, proxy radius `r`, m).
+    fn touch(&mut self, world: &World, id: BrickId, dt: f64, h: [f64; 3], r: f64) {
+        let top = world.brick(id).map(|b| b.position_m).unwrap_or([0.0; 3]);
+        // Aim 1 mm below the top: the proxy rests on it, the spring presses lightly.
+        let target = Vector::new(top[0], top[1], top[2] + h[2] + r - 1e-3);
+        if self.go(target, dt) {
+            self.set(Phase::Grab(id));
+        }
+    }
+
+    /// [`Phase::Turn`] after `n` turns: press turn-z for one tick at a time until the carried
+    /// brick lines up with its slot.
+    fn turn(&mut self, world: &World, n: u8) {
+        // Turn about z until the held brick matches the slot's orientation (≤ 3 turns).
+        let held = world.held_brick().and_then(|id| world.brick(id).ok());
+        let target = self.slots[self.next_slot].rotation();
+        let aligned = held.is_none_or(|b| {
+            let q = b.orientation_xyzw;
+            let q = Rotation::from_xyzw(q[0], q[1], q[2], q[3]);
+            cuboid_orientation_error_rad(target, q) < 0.1
+        });
+        if self.grip.turn_z {
+            self.grip.turn_z = false;
+        } else if aligned || n >= 3 {
+            self.set(Phase::Lower);
+        } else {
+            self.grip.turn_z = true;
+            self.phase = Phase::Turn(n + 1);
+        }
+    }
+
+    /// [`Phase::Lower`]: down to 1 mm above the slot, the target fixed on the first tick
+    /// (half extents `h`, proxy radius `r`, m).
+    fn lower(&mut self, world: &World, dt: f64, h: [f64; 3], r: f64) {
+        let t = *self.lower_target.get_or_insert_with(|| {
+            let slot = Vector::from_array(self.slots[self.next_slot].center_m);
+            // Grip point above the brick centre as the brick hangs now (h_z + r + skin
+            // when grabbed on top, plus the coupling's sag).
+            let held = world.held_brick().and_then(|id| world.brick(id).ok());
+            let offset = held
+                .map(|b| {
+                    Vector::from_array(world.proxy_position_m()) - Vector::from_array(b.position_m)
+                })
+                .unwrap_or(Vector::new(0.0, 0.0, h[2] + r));
+            slot + offset + Vector::new(0.0, 0.0, 1e-3)
+        });
+        if self.go(t, dt) {
+            self.lower_target = None;
+            self.set(Phase::Release(0));
+        }
     }
 }

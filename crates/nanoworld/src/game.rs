@@ -4,8 +4,8 @@
 use nalgebra::Vector3;
 
 use crate::contact::{Candidate, pair_of};
-use crate::law::PairKind;
-use crate::world::{Event, Member, Target, World};
+use crate::law::{PairKind, PairLaw};
+use crate::world::{Event, Member, MovableAtom, Target, World};
 
 /// The tip–substrate force at one tip position computed three ways (N), for the error report.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +50,30 @@ impl World {
         }
     }
 
+    /// The pair type and law of member `m` and target `t` if `m` may snap to `t`: the law on
+    /// and the contact not disarmed.
+    fn armed_law(&self, m: Member, t: Target) -> Option<(PairKind, &PairLaw)> {
+        let pair = pair_of(m, t);
+        let law = self.laws.get(pair);
+        (law.is_on() && !self.is_disarmed(m, t)).then_some((pair, law))
+    }
+
+    /// The movable atoms member `m` may snap to (not carried, [`World::armed_law`]), in
+    /// ascending index, with their target, pair type and law.
+    fn armed_atoms(
+        &self,
+        m: Member,
+    ) -> impl Iterator<Item = (&MovableAtom, Target, PairKind, &PairLaw)> + '_ {
+        self.atoms.iter().enumerate().filter_map(move |(i, a)| {
+            if a.is_carried() {
+                return None;
+            }
+            let t = Target::Atom(i);
+            let (pair, law) = self.armed_law(m, t)?;
+            Some((a, t, pair, law))
+        })
+    }
+
     /// The first point of the straight move `from` → `to` of the tip centre (m) at which a
     /// member of the tip assembly enters the snap gap of an armed target it was outside of:
     /// the fraction t ∈ [0, 1] of the move and the contact. `None` if the move enters none.
@@ -71,25 +95,14 @@ impl World {
         for m in self.members() {
             let (pm, rm) = self.member_pos_radius(m);
             let p0 = pm + (from - self.tip);
-            for (i, a) in self.atoms.iter().enumerate() {
-                if a.is_carried() {
-                    continue;
-                }
-                let t = Target::Atom(i);
-                let pair = pair_of(m, t);
-                let law = self.laws.get(pair);
-                if !law.is_on() || self.is_disarmed(m, t) {
-                    continue;
-                }
+            for (a, t, pair, law) in self.armed_atoms(m) {
                 if let Some(s) = ray_sphere(p0, d, a.position, rm + ra + law.snap_gap_m) {
                     offer(s, sweep_candidate(m, t, pair, law.snap_gap_m));
                 }
             }
-            let pair = pair_of(m, Target::SubstratePlane);
-            let law = self.laws.get(pair);
-            if !law.is_on() || self.is_disarmed(m, Target::SubstratePlane) {
+            let Some((pair, law)) = self.armed_law(m, Target::SubstratePlane) else {
                 continue;
-            }
+            };
             let r = rm + rs + law.snap_gap_m;
             if let Some((s, j)) = self.sweep_substrate(p0, d, r) {
                 offer(
@@ -208,16 +221,7 @@ impl World {
         let rs = self.substrate.radius_m();
         for m in self.members() {
             let (pm, rm) = self.member_pos_radius(m);
-            for (i, a) in self.atoms.iter().enumerate() {
-                if a.is_carried() {
-                    continue;
-                }
-                let t = Target::Atom(i);
-                let pair = pair_of(m, t);
-                let law = self.laws.get(pair);
-                if !law.is_on() || self.is_disarmed(m, t) {
-                    continue;
-                }
+            for (a, t, pair, law) in self.armed_atoms(m) {
                 let gap = (pm - a.position).norm() - rm - self.params.atoms.radius_m;
                 if gap < law.snap_gap_m {
                     offer(Candidate {
@@ -229,11 +233,9 @@ impl World {
                     });
                 }
             }
-            let pair = pair_of(m, Target::SubstratePlane);
-            let law = self.laws.get(pair);
-            if !law.is_on() || self.is_disarmed(m, Target::SubstratePlane) {
+            let Some((pair, law)) = self.armed_law(m, Target::SubstratePlane) else {
                 continue;
-            }
+            };
             self.substrate
                 .for_each_within(&pm, rm + rs + law.snap_gap_m, |j, q| {
                     let gap = (pm - q).norm() - rm - rs;

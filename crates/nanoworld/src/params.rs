@@ -355,9 +355,62 @@ impl GamePair {
     }
 }
 
+impl<T> Pairs<T> {
+    /// The four pair types with their field names, in declaration order.
+    pub(crate) fn named(&self) -> [(&'static str, &T); 4] {
+        [
+            ("tip_substrate", &self.tip_substrate),
+            ("tip_atom", &self.tip_atom),
+            ("atom_atom", &self.atom_atom),
+            ("atom_substrate", &self.atom_substrate),
+        ]
+    }
+}
+
+/// The part of the plane a coordinate must lie in: over the substrate's atoms, `0..=x_max_m`
+/// and `0..=y_max_m` (m).
+#[derive(Clone, Copy)]
+struct SubstrateExtent {
+    /// Largest x of a substrate atom, m.
+    x_max_m: f64,
+    /// Largest y of a substrate atom, m.
+    y_max_m: f64,
+}
+
+impl SubstrateExtent {
+    /// Whether coordinate `k` (0: x, 1: y) of value `v` (m) is over the substrate. One axis at
+    /// a time, so that the error names the component that is out of range.
+    fn over_axis(self, v: f64, k: usize) -> bool {
+        v >= 0.0 && v <= if k == 0 { self.x_max_m } else { self.y_max_m }
+    }
+
+    /// The allowed range, as an error message says it.
+    fn range(self) -> String {
+        format!(
+            "inside the substrate, 0..={} x 0..={} m",
+            fmt_num(self.x_max_m),
+            fmt_num(self.y_max_m)
+        )
+    }
+}
+
 impl Params {
     /// Check every field; the first violation is returned, naming the field and its range.
     pub fn validate(&self) -> Result<(), ParamError> {
+        self.validate_bodies()?;
+        self.validate_interaction()?;
+        let s = &self.substrate;
+        let ext = SubstrateExtent {
+            x_max_m: (s.nx - 1) as f64 * s.spacing_m,
+            y_max_m: (s.ny - 1) as f64 * s.spacing_m,
+        };
+        self.validate_loading_zone(ext)?;
+        self.validate_initial_atoms(ext)?;
+        self.validate_house()
+    }
+
+    /// The substrate, the tip, the movable atoms and gravity.
+    fn validate_bodies(&self) -> Result<(), ParamError> {
         let s = &self.substrate;
         check("substrate.nx", s.nx as f64, s.nx >= 1, || {
             format!("1 <= nx, nx*ny <= {MAX_SUBSTRATE_ATOMS}")
@@ -383,7 +436,12 @@ impl Params {
             self.atoms.max_count <= MAX_MOVABLE_ATOMS,
             || format!("0 <= value <= {MAX_MOVABLE_ATOMS}"),
         )?;
-        nonneg_up_to("gravity_m_per_s2", self.gravity_m_per_s2, 1000.0)?;
+        nonneg_up_to("gravity_m_per_s2", self.gravity_m_per_s2, 1000.0)
+    }
+
+    /// The interaction: game mode's pull-off ratio and pair laws, or physical mode's Hamaker
+    /// constants, contact gap and cantilever.
+    fn validate_interaction(&self) -> Result<(), ParamError> {
         match &self.interaction {
             Interaction::Game(g) => {
                 check(
@@ -392,26 +450,15 @@ impl Params {
                     (1.0..=1000.0).contains(&g.pull_off_ratio),
                     || "1 <= value <= 1000".to_string(),
                 )?;
-                g.pairs
-                    .tip_substrate
-                    .validate("interaction.game.pairs.tip_substrate", g.pull_off_ratio)?;
-                g.pairs
-                    .tip_atom
-                    .validate("interaction.game.pairs.tip_atom", g.pull_off_ratio)?;
-                g.pairs
-                    .atom_atom
-                    .validate("interaction.game.pairs.atom_atom", g.pull_off_ratio)?;
-                g.pairs
-                    .atom_substrate
-                    .validate("interaction.game.pairs.atom_substrate", g.pull_off_ratio)?;
+                for (name, pair) in g.pairs.named() {
+                    pair.validate(&format!("interaction.game.pairs.{name}"), g.pull_off_ratio)?;
+                }
             }
             Interaction::Physical(p) => {
-                let h = &p.hamaker_j;
                 let pre = "interaction.physical.hamaker_j";
-                nonneg_up_to(&format!("{pre}.tip_substrate"), h.tip_substrate, 1e-17)?;
-                nonneg_up_to(&format!("{pre}.tip_atom"), h.tip_atom, 1e-17)?;
-                nonneg_up_to(&format!("{pre}.atom_atom"), h.atom_atom, 1e-17)?;
-                nonneg_up_to(&format!("{pre}.atom_substrate"), h.atom_substrate, 1e-17)?;
+                for (name, &a) in p.hamaker_j.named() {
+                    nonneg_up_to(&format!("{pre}.{name}"), a, 1e-17)?;
+                }
                 positive_up_to("interaction.physical.contact_gap_m", p.contact_gap_m, 1e-8)?;
                 positive_up_to(
                     "interaction.physical.cantilever_stiffness_n_per_m",
@@ -420,45 +467,43 @@ impl Params {
                 )?;
             }
         }
-        let (x_max, y_max) = (
-            (s.nx - 1) as f64 * s.spacing_m,
-            (s.ny - 1) as f64 * s.spacing_m,
-        );
-        // One axis at a time, so that the error names the component that is out of range.
-        let over_axis = |v: f64, k: usize| v >= 0.0 && v <= if k == 0 { x_max } else { y_max };
-        let sub_range = || {
-            format!(
-                "inside the substrate, 0..={} x 0..={} m",
-                fmt_num(x_max),
-                fmt_num(y_max)
-            )
+        Ok(())
+    }
+
+    /// The loading zone: a box per axis, its spawn point inside it and over the substrate.
+    fn validate_loading_zone(&self, ext: SubstrateExtent) -> Result<(), ParamError> {
+        let Some(z) = &self.loading_zone else {
+            return Ok(());
         };
-        if let Some(z) = &self.loading_zone {
-            for k in 0..2 {
-                finite(&format!("loading_zone.min_xy_m[{k}]"), z.min_xy_m[k])?;
-                let lo = z.min_xy_m[k];
-                check(
-                    &format!("loading_zone.max_xy_m[{k}]"),
-                    z.max_xy_m[k],
-                    z.max_xy_m[k] > lo,
-                    || format!("value > min_xy_m[{k}] = {}", fmt_num(lo)),
-                )?;
-                let hi = z.max_xy_m[k];
-                check(
-                    &format!("loading_zone.spawn_xy_m[{k}]"),
-                    z.spawn_xy_m[k],
-                    z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && over_axis(z.spawn_xy_m[k], k),
-                    || {
-                        format!(
-                            "inside the zone [{}, {}] and {}",
-                            fmt_num(lo),
-                            fmt_num(hi),
-                            sub_range()
-                        )
-                    },
-                )?;
-            }
+        for k in 0..2 {
+            finite(&format!("loading_zone.min_xy_m[{k}]"), z.min_xy_m[k])?;
+            let lo = z.min_xy_m[k];
+            check(
+                &format!("loading_zone.max_xy_m[{k}]"),
+                z.max_xy_m[k],
+                z.max_xy_m[k] > lo,
+                || format!("value > min_xy_m[{k}] = {}", fmt_num(lo)),
+            )?;
+            let hi = z.max_xy_m[k];
+            check(
+                &format!("loading_zone.spawn_xy_m[{k}]"),
+                z.spawn_xy_m[k],
+                z.spawn_xy_m[k] >= lo && z.spawn_xy_m[k] <= hi && ext.over_axis(z.spawn_xy_m[k], k),
+                || {
+                    format!(
+                        "inside the zone [{}, {}] and {}",
+                        fmt_num(lo),
+                        fmt_num(hi),
+                        ext.range()
+                    )
+                },
+            )?;
         }
+        Ok(())
+    }
+
+    /// The initial movable atoms: how many, over the substrate, and not overlapping.
+    fn validate_initial_atoms(&self, ext: SubstrateExtent) -> Result<(), ParamError> {
         check(
             "initial_atoms_xy_m.len()",
             self.initial_atoms_xy_m.len() as f64,
@@ -471,8 +516,8 @@ impl Params {
                 check(
                     &format!("initial_atoms_xy_m[{i}][{k}]"),
                     c,
-                    over_axis(c, k),
-                    sub_range,
+                    ext.over_axis(c, k),
+                    || ext.range(),
                 )?;
             }
             for (j, b) in self.initial_atoms_xy_m[..i].iter().enumerate() {
@@ -485,6 +530,11 @@ impl Params {
                 })?;
             }
         }
+        Ok(())
+    }
+
+    /// The house: its tolerance and finite slots.
+    fn validate_house(&self) -> Result<(), ParamError> {
         if let Some(h) = &self.house {
             positive_up_to("house.tolerance_m", h.tolerance_m, 1e-6)?;
             for (i, s) in h.slots_m.iter().enumerate() {
@@ -502,12 +552,7 @@ impl Params {
     pub fn max_render_stiffness(&self) -> (String, f64) {
         match &self.interaction {
             Interaction::Game(g) => {
-                let pairs = [
-                    ("tip_substrate", g.pairs.tip_substrate.stiffness_n_per_m),
-                    ("tip_atom", g.pairs.tip_atom.stiffness_n_per_m),
-                    ("atom_atom", g.pairs.atom_atom.stiffness_n_per_m),
-                    ("atom_substrate", g.pairs.atom_substrate.stiffness_n_per_m),
-                ];
+                let pairs = g.pairs.named().map(|(name, p)| (name, p.stiffness_n_per_m));
                 let (name, k) =
                     pairs.iter().fold(
                         ("tip_substrate", 0.0),

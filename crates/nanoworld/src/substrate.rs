@@ -112,15 +112,11 @@ impl Substrate {
         radius_m: f64,
         mut f: impl FnMut(usize, &Vector3<f64>),
     ) {
-        let r2 = radius_m * radius_m;
         if radius_m > self.cell_m {
-            for (i, q) in self.positions.iter().enumerate() {
-                if (q - p).norm_squared() < r2 {
-                    f(i, q);
-                }
-            }
+            self.for_each_within_brute_force(p, radius_m, f);
             return;
         }
+        let r2 = radius_m * radius_m;
         if p.z.abs() >= radius_m {
             return;
         }

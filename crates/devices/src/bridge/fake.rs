@@ -151,27 +151,14 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     let seconds = cfg.seconds.unwrap_or(cfg.script.duration_s);
     let ticks = (seconds * f64::from(rate_hz)).round().max(0.0) as u64;
     let mut pacer = Pacer::new(1_000_000_000 / u64::from(rate_hz));
-    let mut servo = Servo {
+    let mut servo = Servo::new(
         cfg,
-        socket: &socket,
-        max_force_n: specs.limits.max_force_n,
-        rng: ChaCha8Rng::seed_from_u64(cfg.seed),
-        start: pacer.start(),
-        pending: BTreeMap::new(),
-        sent_at: BTreeMap::new(),
-        rtt: Vec::with_capacity(ticks as usize),
-        rep: FakeReport {
-            protocol: welcome.version,
-            welcome,
-            forces_within_limits: true,
-            ..Default::default()
-        },
-        last_sent: None,
-        outage_begun: false,
-        force: [0.0; 3],
-        felt: [0.0; 3],
-        period_s: 1.0 / f64::from(rate_hz),
-    };
+        &socket,
+        specs.limits.max_force_n,
+        welcome,
+        ticks,
+        pacer.start(),
+    );
     let dt = 1.0 / f64::from(rate_hz);
     for k in 0..ticks {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) || receiver.done.load(Ordering::Relaxed)
@@ -187,33 +174,8 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         servo.rep.ticks += 1;
         let t = TickTime::new(k, rate_hz);
         let (position_m, buttons, two_port) = match modelled.as_mut() {
-            Some(m) => {
-                // The device and hand over the last period, rendered by the device side.
-                if k > 0 {
-                    let t0 = t.time_s - dt;
-                    let script = &cfg.script;
-                    let side = &mut m.side;
-                    m.plant.advance_with(
-                        dt,
-                        |s| (script.position(t0 + s), script.velocity(t0 + s)),
-                        &mut |p, servo_s| side.render(p, servo_s),
-                    );
-                    servo.felt(m.plant.last_force_n());
-                }
-                let reading = m.plant.reading_m();
-                m.side.record_reading(k, reading);
-                let count = (protocol == Protocol::V2)
-                    .then(|| u32::try_from(m.side.interventions()).unwrap_or(u32::MAX));
-                (reading, cfg.script.buttons(t.time_s).0, count)
-            }
-            None => {
-                other.set_force(&ForceCommand {
-                    force_n: servo.force,
-                    ..Default::default()
-                })?;
-                let s = other.sample(t)?;
-                (s.position_m, s.buttons.0, None)
-            }
+            Some(m) => m.read(k, t.time_s, dt, protocol, &cfg.script, &mut servo),
+            None => read_rigid(other.as_mut(), &servo, t)?,
         };
         servo.queue(k, t.time_s, position_m, buttons, two_port);
         servo.send_due();
@@ -227,17 +189,10 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
         for r in receiver.take() {
             servo.reply(&r, modelled.is_none());
             if let Some(m) = modelled.as_mut() {
-                let f = &r.force;
-                m.side.receive(&f.command(), f.local.as_deref().cloned());
+                m.receive(&r.force);
             }
         }
-        // Forget sends never answered (lost replies) after a second.
-        if servo.sent_at.len() > 4 * rate_hz as usize {
-            let keep = servo
-                .sent_at
-                .split_off(&k.saturating_sub(u64::from(rate_hz)));
-            servo.sent_at = keep;
-        }
+        servo.forget_unanswered(k, rate_hz);
     }
     if cfg.bye {
         let _ = socket.send_to(&Packet::Bye { reason: 0 }.encode(), cfg.target);
@@ -252,10 +207,62 @@ pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeRepor
     Ok(rep)
 }
 
+/// A rigid stylus or a simulated hand: it renders the force received last, then is read at
+/// tick time `t`; its position (m), its buttons and no two-port count.
+fn read_rigid(
+    other: &mut dyn HapticDevice,
+    servo: &Servo,
+    t: TickTime,
+) -> Result<([f64; 3], u32, Option<u32>), DeviceError> {
+    other.set_force(&ForceCommand {
+        force_n: servo.force,
+        ..Default::default()
+    })?;
+    let s = other.sample(t)?;
+    Ok((s.position_m, s.buttons.0, None))
+}
+
 /// A modelled device: the device and hand, and what its servo thread renders.
 struct Modelled {
     plant: Plant,
     side: DeviceSide,
+}
+
+impl Modelled {
+    /// Period `k` at `time_s` (s; periods of `dt` s): the device and hand over the last period,
+    /// rendered by the device side (the force its motors rendered goes to `servo`), then its
+    /// encoder reading (m), the script's buttons and, in protocol 2, the two-port layer's count.
+    fn read(
+        &mut self,
+        k: u64,
+        time_s: f64,
+        dt: f64,
+        protocol: Protocol,
+        script: &Script,
+        servo: &mut Servo,
+    ) -> ([f64; 3], u32, Option<u32>) {
+        // The device and hand over the last period, rendered by the device side.
+        if k > 0 {
+            let t0 = time_s - dt;
+            let side = &mut self.side;
+            self.plant.advance_with(
+                dt,
+                |s| (script.position(t0 + s), script.velocity(t0 + s)),
+                &mut |p, servo_s| side.render(p, servo_s),
+            );
+            servo.felt(self.plant.last_force_n());
+        }
+        let reading = self.plant.reading_m();
+        self.side.record_reading(k, reading);
+        let count = (protocol == Protocol::V2)
+            .then(|| u32::try_from(self.side.interventions()).unwrap_or(u32::MAX));
+        (reading, script.buttons(time_s).0, count)
+    }
+
+    /// An answer, handed to the device side as it arrives.
+    fn receive(&mut self, f: &ForceReply) {
+        self.side.receive(&f.command(), f.local.as_deref().cloned());
+    }
 }
 
 fn link(what: &str, e: std::io::Error) -> DeviceError {
@@ -435,7 +442,52 @@ struct Servo<'a> {
     period_s: f64,
 }
 
-impl Servo<'_> {
+impl<'a> Servo<'a> {
+    /// The sending side of a session the simulator welcomed with `welcome`, for a device of
+    /// largest force `max_force_n` (N) playing `ticks` periods from `start`.
+    fn new(
+        cfg: &'a FakeConfig,
+        socket: &'a UdpSocket,
+        max_force_n: f64,
+        welcome: WelcomeInfo,
+        ticks: u64,
+        start: Instant,
+    ) -> Servo<'a> {
+        let rate_hz = welcome.rate_hz;
+        Servo {
+            cfg,
+            socket,
+            max_force_n,
+            rng: ChaCha8Rng::seed_from_u64(cfg.seed),
+            start,
+            pending: BTreeMap::new(),
+            sent_at: BTreeMap::new(),
+            rtt: Vec::with_capacity(ticks as usize),
+            rep: FakeReport {
+                protocol: welcome.version,
+                welcome,
+                forces_within_limits: true,
+                ..Default::default()
+            },
+            last_sent: None,
+            outage_begun: false,
+            force: [0.0; 3],
+            felt: [0.0; 3],
+            period_s: 1.0 / f64::from(rate_hz),
+        }
+    }
+
+    /// Forgets sends never answered (lost replies) after a second, at period `k` of a session
+    /// at `rate_hz` (Hz).
+    fn forget_unanswered(&mut self, k: u64, rate_hz: u32) {
+        if self.sent_at.len() > 4 * rate_hz as usize {
+            let keep = self
+                .sent_at
+                .split_off(&k.saturating_sub(u64::from(rate_hz)));
+            self.sent_at = keep;
+        }
+    }
+
     /// Period `k`'s sample at `time_s`: silent in the outage, dropped with the loss's
     /// probability, or else queued after the latency and a jitter draw.
     fn queue(

@@ -1,0 +1,174 @@
+//! Decoding a datagram: the header checked, then one decoder per packet type; every malformed
+//! input is an error, never a panic.
+
+use super::reader::Reader;
+use super::{
+    BYE_LEN, FORCE_LEN, HEADER_LEN, LOCAL_FIXED_LEN, MAGIC, MAX_PACKET, SAMPLE_LEN, SAMPLE_V2_LEN,
+    VERSION, VERSION_2,
+};
+use super::{ForceReply, Packet, ProtocolError, Sample};
+use haptic_types::device::DeviceSpecs;
+use std::borrow::Cow;
+
+impl Packet {
+    /// Decodes a datagram; every malformed input is an error, never a panic.
+    pub fn decode(b: &[u8]) -> Result<Packet, ProtocolError> {
+        if b.len() > MAX_PACKET {
+            return Err(ProtocolError::Oversized(b.len()));
+        }
+        if b.len() < HEADER_LEN {
+            return Err(ProtocolError::TooShort {
+                kind: "header",
+                got: b.len(),
+                need: HEADER_LEN,
+            });
+        }
+        let magic = [b[0], b[1], b[2], b[3]];
+        if magic != MAGIC {
+            return Err(ProtocolError::Magic(magic));
+        }
+        let version = b[4];
+        if version != VERSION && version != VERSION_2 {
+            return Err(ProtocolError::Version(version));
+        }
+        let mut r = Reader::new(b, HEADER_LEN);
+        match b[5] {
+            1 => hello(version, &mut r),
+            2 => welcome(version, &mut r),
+            3 => sample(version, b, &mut r),
+            4 => force(version, b, &mut r),
+            5 => bye(b, &mut r),
+            t => Err(ProtocolError::Type(t)),
+        }
+    }
+}
+
+/// A packet of a fixed size: `b` must be exactly `len` bytes long (`kind` names it).
+fn fixed(b: &[u8], kind: &'static str, len: usize) -> Result<(), ProtocolError> {
+    if b.len() < len {
+        Err(ProtocolError::TooShort {
+            kind,
+            got: b.len(),
+            need: len,
+        })
+    } else if b.len() > len {
+        Err(ProtocolError::TooLong {
+            kind,
+            got: b.len(),
+            expected: len,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// Type 1, a hello: the device's specifications, checked.
+fn hello(version: u8, r: &mut Reader) -> Result<Packet, ProtocolError> {
+    let rate_hz = r.u32("hello")?;
+    let max_force_n = r.f64("hello")?;
+    let max_stiffness_n_per_m = r.f64("hello")?;
+    let workspace_radius_m = r.f64("hello")?;
+    let name = r.string("hello name")?;
+    let n = r.u8("hello")?;
+    let mut buttons = Vec::with_capacity(usize::from(n));
+    for _ in 0..n {
+        buttons.push(Cow::Owned(r.string("hello button name")?));
+    }
+    r.end("hello")?;
+    let specs = DeviceSpecs {
+        name: Cow::Owned(name),
+        limits: world_form::Limits {
+            max_force_n,
+            max_stiffness_n_per_m,
+        },
+        workspace_radius_m,
+        button_names: Cow::Owned(buttons),
+    };
+    specs
+        .validate()
+        .map_err(|e| ProtocolError::Spec(e.to_string()))?;
+    Ok(Packet::Hello {
+        version,
+        rate_hz,
+        specs,
+    })
+}
+
+/// Type 2, a welcome.
+fn welcome(version: u8, r: &mut Reader) -> Result<Packet, ProtocolError> {
+    let rate_hz = r.u32("welcome")?;
+    let start_time_ns = r.u64("welcome")?;
+    let scene = r.string("welcome scene")?;
+    r.end("welcome")?;
+    Ok(Packet::Welcome {
+        version,
+        rate_hz,
+        start_time_ns,
+        scene,
+    })
+}
+
+/// Type 3, a sample of the size its version gives (`b`: the whole datagram).
+fn sample(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError> {
+    if version == VERSION {
+        fixed(b, "sample", SAMPLE_LEN)?;
+    } else {
+        fixed(b, "sample (version 2)", SAMPLE_V2_LEN)?;
+    }
+    Ok(Packet::Sample(Sample {
+        seq: r.u64("sample")?,
+        device_time_ns: r.u64("sample")?,
+        position_m: [r.f64("sample")?, r.f64("sample")?, r.f64("sample")?],
+        buttons: r.u32("sample")?,
+        two_port_periods: if version == VERSION_2 {
+            Some(r.u32("sample")?)
+        } else {
+            None
+        },
+    }))
+}
+
+/// Type 4, a force: the version-1 fields, then in version 2 the local model (`b`: the whole
+/// datagram).
+fn force(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError> {
+    if version == VERSION {
+        fixed(b, "force", FORCE_LEN)?;
+    } else if b.len() < FORCE_LEN + LOCAL_FIXED_LEN + 3 {
+        return Err(ProtocolError::TooShort {
+            kind: "force (version 2)",
+            got: b.len(),
+            need: FORCE_LEN + LOCAL_FIXED_LEN + 3,
+        });
+    }
+    let seq = r.u64("force")?;
+    let tick = r.u64("force")?;
+    let force_n = [r.f64("force")?, r.f64("force")?, r.f64("force")?];
+    let mut k = [0.0; 9];
+    for x in &mut k {
+        *x = r.f64("force")?;
+    }
+    let status = r.u8("force")?;
+    let local = if version == VERSION_2 {
+        let m = r.local()?;
+        r.end("force (version 2)")?;
+        Some(Box::new(m))
+    } else {
+        None
+    };
+    Ok(Packet::Force(ForceReply {
+        seq,
+        tick,
+        force_n,
+        stiffness_n_per_m: k,
+        status,
+        local,
+    }))
+}
+
+/// Type 5, a bye (`b`: the whole datagram).
+fn bye(b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError> {
+    fixed(b, "bye", BYE_LEN)?;
+    Ok(Packet::Bye {
+        reason: r.u8("bye")?,
+    })
+}

@@ -1,0 +1,345 @@
+//! The device bridge's wire format, versions 1 and 2 (documented byte for byte in
+//! `docs/device-bridge.md`).
+//!
+//! Every packet is one UDP datagram, little-endian, byte-packed, starting with an 8-byte header:
+//! the magic `NHDB`, the version (1 or 2), the packet type and two reserved zero bytes.
+//!
+//! Version 2 (issue 31) adds the local model a device renders between answers
+//! (`haptic_types::local`): a device that says hello with version 2 is welcomed with version 2
+//! and every force packet it receives carries the local model after the version-1 fields.
+//! A version-2 sample also carries the device side's count of servo periods its two-port
+//! layer acted on (the simulator reports the largest in its link counters, which the recording
+//! keeps). Byes are the same in both versions (sent with version 1, read with either).
+//!
+//! | type | name    | direction     | body after the header                                              |
+//! |------|---------|---------------|--------------------------------------------------------------------|
+//! | 1    | hello   | device → sim  | rate u32, max force f64 (N), max stiffness f64 (N/m), workspace radius f64 (m), name (u8 length + UTF-8), button count u8, button names (u8 length + UTF-8 each) |
+//! | 2    | welcome | sim → device  | tick rate u32 (Hz), session start u64 (ns since the Unix epoch), scene name (u8 length + UTF-8) |
+//! | 3    | sample  | device → sim  | seq u64, device time u64 (ns), position 3 × f64 (m), buttons u32   |
+//! | 4    | force   | sim → device  | seq answered u64, tick u64, force 3 × f64 (N), stiffness 9 × f64 (N/m, row-major), status u8 |
+//! | 5    | bye     | either        | reason u8 (0: end of session, 1: error)                             |
+//!
+//! The module holds the packets as types (`packets`: [`Packet`], [`Sample`], [`ForceReply`],
+//! [`ProtocolError`]) apart from their codec: `encode` ([`Packet::encode`]) and `decode`
+//! ([`Packet::decode`], one decoder per packet type, over the bounds-checked byte reader of
+//! `reader`).
+
+mod decode;
+mod encode;
+mod packets;
+mod reader;
+
+pub use packets::{ForceReply, Packet, ProtocolError, Sample};
+
+/// The magic bytes every packet starts with.
+pub const MAGIC: [u8; 4] = *b"NHDB";
+/// The protocol version of samples and byes (the same in both versions).
+pub const VERSION: u8 = 1;
+/// The newest protocol version this build speaks: 2, the local model.
+pub const VERSION_2: u8 = 2;
+/// Size of the local model's fixed part after a version-1 force packet, bytes (residual
+/// force and stiffness, world energy).
+const LOCAL_FIXED_LEN: usize = 12 * 8 + 8;
+/// Size of one plane on the wire: normal, offset, stiffness.
+const PLANE_LEN: usize = 5 * 8;
+/// Size of the body on the wire: position, velocity, mass, three coupling constants, damper
+/// share, external force, substeps (u32), restitution.
+const BODY_LEN: usize = 16 * 8 + 4 + 8;
+/// Largest datagram accepted, bytes (a hello with 32 buttons of 32 characters fits).
+pub const MAX_PACKET: usize = 1200;
+/// Size of a sample packet, bytes.
+pub const SAMPLE_LEN: usize = 52;
+/// Size of a version-2 sample packet, bytes: a version-1 sample and the device side's u32
+/// count of servo periods its two-port layer acted on.
+pub const SAMPLE_V2_LEN: usize = 56;
+/// Size of a force packet, bytes.
+pub const FORCE_LEN: usize = 121;
+/// Size of a bye packet, bytes.
+pub const BYE_LEN: usize = 9;
+/// Size of the header, bytes.
+const HEADER_LEN: usize = 8;
+
+/// Size of a version-2 force packet with `planes` contact planes, a body or none and
+/// `body_planes` body planes, bytes.
+pub fn force_v2_len(planes: usize, body: bool, body_planes: usize) -> usize {
+    FORCE_LEN
+        + LOCAL_FIXED_LEN
+        + 1
+        + planes * PLANE_LEN
+        + 1
+        + if body { BODY_LEN } else { 0 }
+        + 1
+        + body_planes * PLANE_LEN
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic_types::device::{FALCON, TOUCH};
+    use haptic_types::local::{Body, LocalModel, MAX_PLANES, Plane};
+    use proptest::prelude::*;
+
+    #[test]
+    fn every_packet_round_trips_with_its_documented_size() {
+        let s = Packet::Sample(Sample {
+            seq: 7,
+            device_time_ns: 99,
+            position_m: [0.01, -0.02, f64::NAN],
+            buttons: 5,
+            two_port_periods: None,
+        });
+        let b = s.encode();
+        assert_eq!(b.len(), SAMPLE_LEN);
+        assert_eq!(&b[..8], b"NHDB\x01\x03\x00\x00");
+        match Packet::decode(&b) {
+            Ok(Packet::Sample(x)) => {
+                assert_eq!((x.seq, x.device_time_ns, x.buttons), (7, 99, 5));
+                assert!(x.position_m[2].is_nan());
+            }
+            other => panic!("{other:?}"),
+        }
+        let f = Packet::Force(ForceReply {
+            seq: 7,
+            tick: 3,
+            force_n: [1.0, 2.0, 3.0],
+            stiffness_n_per_m: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            status: 32,
+            local: None,
+        });
+        assert_eq!(f.encode().len(), FORCE_LEN);
+        assert_eq!(Packet::decode(&f.encode()), Ok(f));
+        for (specs, version) in [(FALCON, 1), (TOUCH, 2)] {
+            let h = Packet::Hello {
+                version,
+                rate_hz: 1000,
+                specs,
+            };
+            assert_eq!(h.encode()[4], version);
+            assert_eq!(Packet::decode(&h.encode()), Ok(h));
+        }
+        let w = Packet::Welcome {
+            version: 2,
+            rate_hz: 1000,
+            start_time_ns: 1_700_000_000_000_000_000,
+            scene: "wall".into(),
+        };
+        assert_eq!(Packet::decode(&w.encode()), Ok(w));
+        assert_eq!(Packet::Bye { reason: 0 }.encode().len(), BYE_LEN);
+        // A version-2 sample: the version-1 fields, then the two-port count.
+        let s2 = Packet::Sample(Sample {
+            seq: 8,
+            device_time_ns: 1,
+            position_m: [0.0; 3],
+            buttons: 0,
+            two_port_periods: Some(41),
+        });
+        let b = s2.encode();
+        assert_eq!(b.len(), SAMPLE_V2_LEN);
+        assert_eq!(&b[..8], b"NHDB\x02\x03\x00\x00");
+        assert_eq!(&b[52..], &41u32.to_le_bytes());
+        assert_eq!(Packet::decode(&b), Ok(s2));
+        assert_eq!(
+            Packet::decode(&b[..52]).unwrap_err().to_string(),
+            "sample (version 2) packet of 52 bytes is too short (needs 56)"
+        );
+    }
+
+    #[test]
+    fn malformed_packets_name_what_is_wrong() {
+        let good = Packet::Sample(Sample {
+            seq: 1,
+            device_time_ns: 0,
+            position_m: [0.0; 3],
+            buttons: 0,
+            two_port_periods: None,
+        })
+        .encode();
+        let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
+        assert_eq!(
+            e(&good[..51]),
+            "sample packet of 51 bytes is too short (needs 52)"
+        );
+        let mut long = good.clone();
+        long.push(0);
+        assert_eq!(
+            e(&long),
+            "sample packet of 53 bytes is too long (expected 52)"
+        );
+        assert_eq!(
+            e(&vec![0; MAX_PACKET + 1]),
+            "datagram of 1201 bytes is over the 1200-byte limit"
+        );
+        let mut v = good.clone();
+        v[4] = 3;
+        assert_eq!(e(&v), "protocol version 3 (this build speaks 1 and 2)");
+        v[4] = 1;
+        v[5] = 9;
+        assert_eq!(e(&v), "unknown packet type 9");
+        assert_eq!(e(b"GET / HT"), "bad magic [47, 45, 54, 20] (expected NHDB)");
+        let mut bad = FALCON;
+        bad.limits.max_force_n = f64::INFINITY;
+        assert_eq!(
+            e(&Packet::Hello {
+                version: 1,
+                rate_hz: 1000,
+                specs: bad.clone()
+            }
+            .encode()),
+            "device specs: `max_force_n` = inf is out of range: allowed 0.001 ≤ max_force_n ≤ 1000"
+        );
+        // A force limit of 4e-159 N (found by the libFuzzer bridge target: its squares are
+        // subnormal, and clamping to it took 12 s for 20 ticks) is no haptic device.
+        bad.limits.max_force_n = 3.7555737088373936e-159;
+        assert_eq!(
+            e(&Packet::Hello {
+                version: 1,
+                rate_hz: 1000,
+                specs: bad
+            }
+            .encode()),
+            "device specs: `max_force_n` = 3.7555737088373936e-159 is out of range: allowed \
+             0.001 ≤ max_force_n ≤ 1000"
+        );
+    }
+
+    /// A local model with every part: two planes, a body, one body plane.
+    fn full_model() -> LocalModel {
+        LocalModel {
+            residual_force_n: [0.1, -0.2, 0.3],
+            residual_stiffness_n_per_m: [5.0, 0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0, 5.0],
+            planes: vec![
+                Plane {
+                    normal: [0.0, 0.0, 1.0],
+                    offset_m: -0.01,
+                    stiffness_n_per_m: 2500.0,
+                },
+                Plane {
+                    normal: [1.0, 0.0, 0.0],
+                    offset_m: 0.02,
+                    stiffness_n_per_m: 2500.0,
+                },
+            ],
+            body: Some(Body {
+                position_m: [0.001, 0.002, -0.003],
+                velocity_m_per_s: [0.01, 0.0, -0.02],
+                mass_kg: 1.25,
+                stiffness_n_per_m: 900.0,
+                series_stiffness_n_per_m: 900.0,
+                damping_n_s_per_m: 60.0,
+                damper_m: [0.0, 0.0, -1e-4],
+                external_force_n: [0.0, 0.0, -0.6],
+                substeps: 4,
+                restitution: 0.2,
+            }),
+            body_planes: vec![Plane {
+                normal: [0.0, 0.0, 1.0],
+                offset_m: -0.02,
+                stiffness_n_per_m: 0.0,
+            }],
+            world_energy_j: -0.125,
+        }
+    }
+
+    #[test]
+    fn a_version_2_force_packet_carries_the_local_model_in_its_documented_size() {
+        let f = Packet::Force(ForceReply {
+            seq: 9,
+            tick: 8,
+            force_n: [0.5, 0.0, -1.0],
+            stiffness_n_per_m: [0.0; 9],
+            status: 1,
+            local: Some(Box::new(full_model())),
+        });
+        let b = f.encode();
+        assert_eq!(b.len(), force_v2_len(2, true, 1));
+        assert_eq!(b.len(), 121 + 104 + 1 + 80 + 1 + 140 + 1 + 40);
+        assert_eq!(&b[..8], b"NHDB\x02\x04\x00\x00");
+        // The version-1 fields are where version 1 has them.
+        assert_eq!(&b[8..16], &9u64.to_le_bytes());
+        assert_eq!(Packet::decode(&b), Ok(f));
+        // The largest: four planes, a body, four body planes: within one datagram.
+        assert!(force_v2_len(MAX_PLANES, true, MAX_PLANES) <= MAX_PACKET);
+        // Without a body.
+        let mut m = full_model();
+        m.body = None;
+        let g = Packet::Force(ForceReply {
+            seq: 1,
+            tick: 1,
+            force_n: [0.0; 3],
+            stiffness_n_per_m: [0.0; 9],
+            status: 0,
+            local: Some(Box::new(m)),
+        });
+        assert_eq!(g.encode().len(), force_v2_len(2, false, 1));
+        assert_eq!(Packet::decode(&g.encode()), Ok(g));
+    }
+
+    #[test]
+    fn a_bad_local_model_is_refused_by_name() {
+        let mut m = full_model();
+        m.planes[1].normal = [2.0, 0.0, 0.0];
+        let f = |m: LocalModel| {
+            Packet::decode(
+                &Packet::Force(ForceReply {
+                    seq: 1,
+                    tick: 1,
+                    force_n: [0.0; 3],
+                    stiffness_n_per_m: [0.0; 9],
+                    status: 0,
+                    local: Some(Box::new(m)),
+                })
+                .encode(),
+            )
+            .unwrap_err()
+            .to_string()
+        };
+        assert_eq!(
+            f(m),
+            "force packet's local model: plane 1: the normal must be a finite unit vector"
+        );
+        let mut m = full_model();
+        if let Some(b) = m.body.as_mut() {
+            b.mass_kg = -1.0;
+        }
+        assert_eq!(
+            f(m),
+            "force packet's local model: body.mass_kg = -1 is out of range: allowed 0 < m ≤ 10000 kg"
+        );
+        let mut b = Packet::Force(ForceReply {
+            seq: 1,
+            tick: 1,
+            force_n: [0.0; 3],
+            stiffness_n_per_m: [0.0; 9],
+            status: 0,
+            local: Some(Box::new(full_model())),
+        })
+        .encode();
+        // Five planes announced.
+        b[121 + 104] = 5;
+        assert_eq!(
+            Packet::decode(&b).unwrap_err().to_string(),
+            "force packet's local model: force (version 2): 5 planes, allowed at most 4"
+        );
+        // Cut short.
+        assert_eq!(
+            Packet::decode(&b[..200]).unwrap_err().to_string(),
+            "force (version 2) packet of 200 bytes is too short (needs 228)"
+        );
+    }
+
+    proptest! {
+        /// Any bytes decode to a packet or an error; never a panic.
+        #[test]
+        fn arbitrary_bytes_never_panic(b in proptest::collection::vec(any::<u8>(), 0..300)) {
+            let _ = Packet::decode(&b);
+            for v in [b"NHDB\x01", b"NHDB\x02"] {
+                let mut h = v.to_vec();
+                h.extend_from_slice(&b);
+                let r = Packet::decode(&h);
+                if let Ok(Packet::Sample(_)) = r {
+                    prop_assert_eq!(h.len(), if v[4] == 1 { SAMPLE_LEN } else { SAMPLE_V2_LEN });
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,133 @@
+//! The packets of the bridge protocol as Rust types, and the reasons a datagram is refused.
+
+use super::MAX_PACKET;
+use haptic_types::device::DeviceSpecs;
+use haptic_types::local::LocalModel;
+use haptic_types::vec3::Vec3;
+
+/// A decoded packet.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Packet {
+    /// A device announces itself and its specifications.
+    Hello {
+        /// The protocol version the device speaks (1, or 2: it renders the local model).
+        version: u8,
+        /// The device's own servo rate, Hz (information: the session's tick rate rules).
+        rate_hz: u32,
+        /// The device's specifications.
+        specs: DeviceSpecs,
+    },
+    /// The simulator accepts a device.
+    Welcome {
+        /// The protocol version of the session (the device's, at most [`VERSION_2`](super::VERSION_2)).
+        version: u8,
+        /// The session's tick rate, Hz: send one sample per tick.
+        rate_hz: u32,
+        /// Session start, ns since the Unix epoch.
+        start_time_ns: u64,
+        /// Scene name.
+        scene: String,
+    },
+    /// One device reading.
+    Sample(Sample),
+    /// The simulator's answer to a sample.
+    Force(ForceReply),
+    /// End of the session.
+    Bye {
+        /// 0: end of session, 1: error.
+        reason: u8,
+    },
+}
+
+/// A device reading on the wire.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// The device's sequence number (increasing by one per sample).
+    pub seq: u64,
+    /// The device's clock when it read the sample, ns (information only).
+    pub device_time_ns: u64,
+    /// Stylus position, m, device frame.
+    pub position_m: Vec3,
+    /// Button bits.
+    pub buttons: u32,
+    /// Version 2 only: the servo periods the device side's two-port passivity layer has
+    /// acted on since the hello (`None`: a version-1 sample).
+    pub two_port_periods: Option<u32>,
+}
+
+/// The simulator's answer to a sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ForceReply {
+    /// Sequence number of the sample this answers.
+    pub seq: u64,
+    /// The tick that computed it.
+    pub tick: u64,
+    /// Force to render, N, device frame.
+    pub force_n: Vec3,
+    /// Local stiffness, N/m, device frame, row-major 3×3.
+    pub stiffness_n_per_m: [f64; 9],
+    /// Status bits of the tick (1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over
+    /// cap, 16 force invalid, 32 watchdog, 64 passivity controller, 128 force-rate limit).
+    pub status: u8,
+    /// The local model (version 2 only; `None`: a version-1 packet).
+    pub local: Option<Box<LocalModel>>,
+}
+
+impl ForceReply {
+    /// The answer as the device interface's command (its local model apart).
+    pub fn command(&self) -> haptic_types::device::ForceCommand {
+        haptic_types::device::ForceCommand {
+            tick: self.tick,
+            seq: self.seq,
+            force_n: self.force_n,
+            stiffness_n_per_m: self.stiffness_n_per_m,
+            status: self.status,
+        }
+    }
+}
+
+/// Why a datagram was refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ProtocolError {
+    /// Shorter than a header or than its type needs.
+    #[error("{kind} packet of {got} bytes is too short (needs {need})")]
+    TooShort {
+        /// Packet type name.
+        kind: &'static str,
+        /// Bytes received.
+        got: usize,
+        /// Bytes needed.
+        need: usize,
+    },
+    /// Longer than its type allows.
+    #[error("{kind} packet of {got} bytes is too long (expected {expected})")]
+    TooLong {
+        /// Packet type name.
+        kind: &'static str,
+        /// Bytes received.
+        got: usize,
+        /// Bytes expected.
+        expected: usize,
+    },
+    /// Larger than [`MAX_PACKET`].
+    #[error("datagram of {0} bytes is over the {MAX_PACKET}-byte limit")]
+    Oversized(usize),
+    /// Does not start with `NHDB`.
+    #[error("bad magic {0:02x?} (expected NHDB)")]
+    Magic([u8; 4]),
+    /// Another protocol version.
+    #[error("protocol version {0} (this build speaks 1 and 2)")]
+    Version(u8),
+    /// A local model out of range.
+    #[error("force packet's local model: {0}")]
+    Local(String),
+    /// Unknown packet type.
+    #[error("unknown packet type {0}")]
+    Type(u8),
+    /// A string that is not UTF-8 or runs past the end.
+    #[error("{0}: bad string")]
+    Text(&'static str),
+    /// Announced specifications out of range.
+    #[error("{0}")]
+    Spec(String),
+}
