@@ -34,7 +34,8 @@ ALLOWED = {
     "world-form": set(),
     "ot-physics": {"world-form"},
     "ot-envelope": {"ot-physics", "world-form"},
-    "brickworld": {"world-form"},
+    # The brick world fills the one local-model type (haptic_types::local) itself.
+    "brickworld": {"haptic-types", "world-form"},
     "nanoworld": {"world-form"},
     "haptic-types": {"world-form"},
     "picture": set(),

@@ -60,7 +60,6 @@ pub use estimator::{AdaptiveWindow, MotionEstimator};
 pub use event::{Axis, Body, BrickId, Event, Touch};
 pub use hand::NEAREST_MAX_M;
 pub use input::{CursorInput, Grip};
-pub use local::{CarriedBody, ContactPlane, LocalPrimitives};
 pub use params::{
     AccelEstimator, Blueprint, BrickPlacement, BrickProps, Coupling, Inertia, LoadingZone,
     Obstacle, Params, ParamsFromTomlError,

@@ -283,7 +283,7 @@ impl World {
     }
 
     /// The brick carried through the coupling, in the state the next step starts from.
-    pub(crate) fn carried_body(&self) -> Option<crate::local::CarriedBody> {
+    pub(crate) fn carried_body(&self) -> Option<haptic_types::local::Body> {
         self.hand
             .carried_body(&self.params, &self.limits, &self.bricks)
     }
@@ -293,7 +293,7 @@ impl World {
         &self,
         grip_m: [f64; 3],
         margin_m: f64,
-    ) -> Vec<crate::local::ContactPlane> {
+    ) -> Vec<haptic_types::local::Plane> {
         self.hand
             .carried_contacts(&self.params, &self.bricks, grip_m, margin_m)
     }
@@ -364,11 +364,11 @@ impl World {
     /// The primitives the device may render until the next tick: a plane for each surface the
     /// god-object touches (deduplicated by normal) and for the nearest surface within
     /// [`crate::local::NEAR_SURFACE_M`], each `n·c ≥ n·proxy` at the proxy stiffness; and the carried brick.
-    pub fn local_primitives(&self) -> crate::local::LocalPrimitives {
+    pub fn local_primitives(&self) -> haptic_types::local::WorldPrimitives {
         let p = self.params();
         let proxy = Vector::from_array(self.proxy_position_m());
         let k = p.proxy_stiffness_n_per_m;
-        let mut planes: Vec<crate::local::ContactPlane> =
+        let mut planes: Vec<haptic_types::local::Plane> =
             Vec::with_capacity(crate::local::MAX_PLANES);
         let mut push = |n: Vector, offset: f64| {
             let dup = planes
@@ -379,7 +379,7 @@ impl World {
                 && n.is_finite()
                 && offset.is_finite()
             {
-                planes.push(crate::local::ContactPlane {
+                planes.push(haptic_types::local::Plane {
                     normal: n.to_array(),
                     offset_m: offset,
                     stiffness_n_per_m: k,
@@ -403,7 +403,7 @@ impl World {
             }
             None => Vec::new(),
         };
-        crate::local::LocalPrimitives {
+        haptic_types::local::WorldPrimitives {
             planes,
             body,
             body_planes,

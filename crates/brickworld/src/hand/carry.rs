@@ -22,7 +22,7 @@ impl Hand {
         params: &Params,
         limits: &Limits,
         bricks: &BrickSet,
-    ) -> Option<crate::local::CarriedBody> {
+    ) -> Option<haptic_types::local::Body> {
         let h = self.held.filter(|h| h.coupled)?;
         let rb = bricks.phys.bodies.get(bricks.body(h.brick))?;
         let m = rb.mass();
@@ -33,7 +33,7 @@ impl Hand {
         let c = &params.coupling;
         let k = Self::coupling_stiffness(params, limits);
         let k_series = (c.max_fraction - c.stiffness_fraction) * limits.max_stiffness_n_per_m;
-        Some(crate::local::CarriedBody {
+        Some(haptic_types::local::Body {
             position_m: (rb.translation() - h.offset).to_array(),
             velocity_m_per_s: rb.linvel().to_array(),
             mass_kg: m,
@@ -58,8 +58,8 @@ impl Hand {
         bricks: &BrickSet,
         grip_m: [f64; 3],
         margin_m: f64,
-    ) -> Vec<crate::local::ContactPlane> {
-        let mut out: Vec<crate::local::ContactPlane> = Vec::new();
+    ) -> Vec<haptic_types::local::Plane> {
+        let mut out: Vec<haptic_types::local::Plane> = Vec::new();
         let Some(h) = self.held.filter(|h| h.coupled) else {
             return out;
         };
@@ -98,7 +98,7 @@ impl Hand {
             if dup || out.len() == crate::local::MAX_PLANES {
                 continue;
             }
-            out.push(crate::local::ContactPlane {
+            out.push(haptic_types::local::Plane {
                 normal: n.to_array(),
                 offset_m: n.dot(x) - dist.max(0.0),
                 stiffness_n_per_m: 0.0,

@@ -264,30 +264,8 @@ impl Scene for BrickScene {
     }
 
     fn local_primitives(&self, out: &mut haptic_types::local::WorldPrimitives) {
-        use haptic_types::local::{Body, Plane};
-        let l = self.world.local_primitives();
-        out.planes.extend(l.planes.iter().map(|p| Plane {
-            normal: p.normal,
-            offset_m: p.offset_m,
-            stiffness_n_per_m: p.stiffness_n_per_m,
-        }));
-        out.body = l.body.map(|b| Body {
-            position_m: b.position_m,
-            velocity_m_per_s: b.velocity_m_per_s,
-            mass_kg: b.mass_kg,
-            stiffness_n_per_m: b.stiffness_n_per_m,
-            series_stiffness_n_per_m: b.series_stiffness_n_per_m,
-            damping_n_s_per_m: b.damping_n_s_per_m,
-            damper_m: b.damper_m,
-            external_force_n: b.external_force_n,
-            substeps: b.substeps,
-            restitution: b.restitution,
-        });
-        out.body_planes.extend(l.body_planes.iter().map(|p| Plane {
-            normal: p.normal,
-            offset_m: p.offset_m,
-            stiffness_n_per_m: 0.0,
-        }));
+        // The world fills the one local-model type itself (world frame).
+        *out = self.world.local_primitives();
     }
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
