@@ -87,17 +87,7 @@ fn advice(p: &Permissions, normal: &Measurement, rt: &Measurement) -> Vec<String
 
 /// Runs `nanohaptics doctor`.
 pub(crate) fn cmd(a: &DoctorArgs) -> Result<u8, String> {
-    if !(a.seconds.is_finite() && (0.1..=3600.0).contains(&a.seconds)) {
-        return Err(ValueError::out_of_range("--seconds", a.seconds, "0.1–3600 s").to_string());
-    }
-    if !(10..=100_000).contains(&a.interval_us) {
-        return Err(ValueError::out_of_range(
-            "--interval-us",
-            a.interval_us as f64,
-            "10–100000 µs",
-        )
-        .to_string());
-    }
+    check_args(a)?;
     let req = RtRequest {
         pin: true,
         ..RtRequest::with_priority(a.rt_priority).map_err(|e| format!("--{e}"))?
@@ -115,6 +105,47 @@ pub(crate) fn cmd(a: &DoctorArgs) -> Result<u8, String> {
     let normal = wakeup::measure(interval, half, None).map_err(|e| e.to_string())?;
     let rt = wakeup::measure(interval, half, Some(req)).map_err(|e| e.to_string())?;
     let tips = advice(&p, &normal, &rt);
+    if a.json {
+        print_json(&p, &normal, &rt, &tips)?;
+        return Ok(status::SUCCESS);
+    }
+    print_permissions(&p);
+    println!();
+    print_latency(&normal, &rt);
+    println!();
+    print_rates(&normal, &rt);
+    if !tips.is_empty() {
+        println!();
+        for t in &tips {
+            println!("  - {t}");
+        }
+    }
+    Ok(status::SUCCESS)
+}
+
+/// The measuring time and the wake-up interval within their ranges.
+fn check_args(a: &DoctorArgs) -> Result<(), String> {
+    if !(a.seconds.is_finite() && (0.1..=3600.0).contains(&a.seconds)) {
+        return Err(ValueError::out_of_range("--seconds", a.seconds, "0.1–3600 s").to_string());
+    }
+    if !(10..=100_000).contains(&a.interval_us) {
+        return Err(ValueError::out_of_range(
+            "--interval-us",
+            a.interval_us as f64,
+            "10–100000 µs",
+        )
+        .to_string());
+    }
+    Ok(())
+}
+
+/// The report as JSON: permissions, both measurements, the verdict per rate and the advice.
+fn print_json(
+    p: &Permissions,
+    normal: &Measurement,
+    rt: &Measurement,
+    tips: &[String],
+) -> Result<(), String> {
     let rates: Vec<serde_json::Value> = RATES_HZ
         .iter()
         .map(|&hz| {
@@ -125,20 +156,22 @@ pub(crate) fn cmd(a: &DoctorArgs) -> Result<u8, String> {
             })
         })
         .collect();
-    if a.json {
-        let j = serde_json::json!({
-            "permissions": p,
-            "normal": normal,
-            "realtime": rt,
-            "rates": rates,
-            "advice": tips,
-        });
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&j).map_err(|e| e.to_string())?
-        );
-        return Ok(status::SUCCESS);
-    }
+    let j = serde_json::json!({
+        "permissions": p,
+        "normal": normal,
+        "realtime": rt,
+        "rates": rates,
+        "advice": tips,
+    });
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&j).map_err(|e| e.to_string())?
+    );
+    Ok(())
+}
+
+/// The kernel and the real-time permissions.
+fn print_permissions(p: &Permissions) {
     let opt = |v: Option<u64>| v.map_or("unlimited".to_string(), |x| x.to_string());
     println!(
         "  kernel {}, {} cores, real-time throttling {} µs of each second",
@@ -153,12 +186,15 @@ pub(crate) fn cmd(a: &DoctorArgs) -> Result<u8, String> {
         if p.cap_ipc_lock { "yes" } else { "no" },
         opt(p.rlimit_memlock_bytes)
     );
-    println!();
+}
+
+/// The wake-up latency table, at normal priority and in real time.
+fn print_latency(normal: &Measurement, rt: &Measurement) {
     println!(
         "  {:<44} {:>8} {:>10} {:>10} {:>10} {:>10}",
         "scheduling", "wake-ups", "p50", "p99", "p99.9", "max"
     );
-    for m in [&normal, &rt] {
+    for m in [normal, rt] {
         let l = &m.latency;
         println!(
             "  {:<44} {:>8} {:>10} {:>10} {:>10} {:>10}",
@@ -170,7 +206,10 @@ pub(crate) fn cmd(a: &DoctorArgs) -> Result<u8, String> {
             us(l.max_ns)
         );
     }
-    println!();
+}
+
+/// Which tick rates hold, at normal priority and in real time.
+fn print_rates(normal: &Measurement, rt: &Measurement) {
     println!(
         "  {:<8} {:<10} {:<40} real time",
         "rate", "period", "normal priority"
@@ -188,11 +227,4 @@ pub(crate) fn cmd(a: &DoctorArgs) -> Result<u8, String> {
         "  (a rate holds when no wake-up took more than half its period; the other half is the \
          tick's work)"
     );
-    if !tips.is_empty() {
-        println!();
-        for t in &tips {
-            println!("  - {t}");
-        }
-    }
-    Ok(status::SUCCESS)
 }

@@ -3,7 +3,7 @@
 
 use super::{Outcome, falcon};
 use haptic_devices::Script;
-use haptic_devices::bridge::protocol::Packet;
+use haptic_devices::bridge::protocol::{ForceReply, Packet, Sample};
 use haptic_devices::local::{DeviceSide, Protocol};
 use haptic_engine::HapticLoop;
 use haptic_loop::scene::load_scene_for;
@@ -107,19 +107,8 @@ pub fn run_bridge(input: &[u8]) -> Outcome {
     let Ok(p) = Packet::decode(input) else {
         return Outcome::Refused;
     };
-    // Encoding what was decoded and decoding it again gives the same packet.
-    let once = p.encode();
-    match Packet::decode(&once).map(|q| q.encode()) {
-        Ok(twice) if twice == once => {}
-        Ok(_) => {
-            return Outcome::Finding("round-trip", "re-encoding changes the packet".into());
-        }
-        Err(e) => {
-            return Outcome::Finding(
-                "round-trip",
-                format!("an accepted packet, re-encoded, is refused: {e}"),
-            );
-        }
+    if let Some(finding) = round_trip(&p) {
+        return finding;
     }
     let wall = haptic_loop::builtin::SCENES
         .iter()
@@ -127,72 +116,8 @@ pub fn run_bridge(input: &[u8]) -> Outcome {
         .map(|b| b.scene)
         .unwrap_or_default();
     match p {
-        Packet::Sample(s) => {
-            // A device sample straight into the loop: the force stays finite and bounded.
-            let Ok(l) = load_scene_for(wall, falcon().clone()) else {
-                return Outcome::Finding("seed", "the wall scene does not load".into());
-            };
-            let mut lp = HapticLoop::new(l.config, l.scene);
-            for k in 0..3 {
-                let t = lp.tick(
-                    DeviceSample {
-                        position_m: s.position_m,
-                        buttons: Buttons(s.buttons),
-                        seq: s.seq,
-                        age_ticks: k,
-                    },
-                    false,
-                );
-                if !finite3(t.device_force_n)
-                    || norm(t.device_force_n) > falcon().limits.max_force_n
-                {
-                    return Outcome::Finding(
-                        "non-finite",
-                        format!(
-                            "sample at ({}, {}, {}) m gives device force ({}, {}, {}) N",
-                            s.position_m[0],
-                            s.position_m[1],
-                            s.position_m[2],
-                            t.device_force_n[0],
-                            t.device_force_n[1],
-                            t.device_force_n[2]
-                        ),
-                    );
-                }
-            }
-            Outcome::Accepted
-        }
-        Packet::Force(f) => {
-            // A force packet rendered by the device side (a Falcon's servo thread, both
-            // protocols): the force its motors are asked for stays finite and within the limit.
-            let max = falcon().limits.max_force_n;
-            for protocol in [Protocol::V1, Protocol::V2] {
-                let mut side = DeviceSide::new(protocol, max, 1e-3);
-                side.record_reading(f.seq, [0.0; 3]);
-                side.record_reading(f.seq.saturating_add(1), [0.001, 0.0, -0.002]);
-                side.receive(&f.command(), f.local.as_deref().cloned());
-                for p in [[0.0; 3], [0.001, 0.0, -0.002], [0.03, -0.03, 0.03]] {
-                    let g = side.render(p, 2.5e-4);
-                    // Within the limit to rounding (the motors clamp exactly).
-                    if !finite3(g) || norm(g) > max * (1.0 + 1e-12) {
-                        return Outcome::Finding(
-                            "non-finite",
-                            format!(
-                                "protocol {} device side renders ({}, {}, {}) N at ({}, {}, {}) m",
-                                protocol.version(),
-                                g[0],
-                                g[1],
-                                g[2],
-                                p[0],
-                                p[1],
-                                p[2]
-                            ),
-                        );
-                    }
-                }
-            }
-            Outcome::Accepted
-        }
+        Packet::Sample(s) => bridge_sample(wall, &s),
+        Packet::Force(f) => bridge_force(&f),
         Packet::Hello { specs, .. } => {
             // Announced specifications drive a session: its forces respect them.
             match load_scene_for(wall, specs.clone()) {
@@ -205,4 +130,87 @@ pub fn run_bridge(input: &[u8]) -> Outcome {
         }
         _ => Outcome::Accepted,
     }
+}
+
+/// Encoding what was decoded and decoding it again gives the same packet; a finding if not.
+fn round_trip(p: &Packet) -> Option<Outcome> {
+    let once = p.encode();
+    match Packet::decode(&once).map(|q| q.encode()) {
+        Ok(twice) if twice == once => None,
+        Ok(_) => Some(Outcome::Finding(
+            "round-trip",
+            "re-encoding changes the packet".into(),
+        )),
+        Err(e) => Some(Outcome::Finding(
+            "round-trip",
+            format!("an accepted packet, re-encoded, is refused: {e}"),
+        )),
+    }
+}
+
+/// A device sample straight into the loop of the `wall` scene: the force stays finite and
+/// bounded.
+fn bridge_sample(wall: &str, s: &Sample) -> Outcome {
+    let Ok(l) = load_scene_for(wall, falcon().clone()) else {
+        return Outcome::Finding("seed", "the wall scene does not load".into());
+    };
+    let mut lp = HapticLoop::new(l.config, l.scene);
+    for k in 0..3 {
+        let t = lp.tick(
+            DeviceSample {
+                position_m: s.position_m,
+                buttons: Buttons(s.buttons),
+                seq: s.seq,
+                age_ticks: k,
+            },
+            false,
+        );
+        if !finite3(t.device_force_n) || norm(t.device_force_n) > falcon().limits.max_force_n {
+            return Outcome::Finding(
+                "non-finite",
+                format!(
+                    "sample at ({}, {}, {}) m gives device force ({}, {}, {}) N",
+                    s.position_m[0],
+                    s.position_m[1],
+                    s.position_m[2],
+                    t.device_force_n[0],
+                    t.device_force_n[1],
+                    t.device_force_n[2]
+                ),
+            );
+        }
+    }
+    Outcome::Accepted
+}
+
+/// A force packet rendered by the device side (a Falcon's servo thread, both protocols): the
+/// force its motors are asked for stays finite and within the limit.
+fn bridge_force(f: &ForceReply) -> Outcome {
+    let max = falcon().limits.max_force_n;
+    for protocol in [Protocol::V1, Protocol::V2] {
+        let mut side = DeviceSide::new(protocol, max, 1e-3);
+        side.record_reading(f.seq, [0.0; 3]);
+        side.record_reading(f.seq.saturating_add(1), [0.001, 0.0, -0.002]);
+        side.receive(&f.command(), f.local.as_deref().cloned());
+        for p in [[0.0; 3], [0.001, 0.0, -0.002], [0.03, -0.03, 0.03]] {
+            let g = side.render(p, 2.5e-4);
+            // Within the limit to rounding (the motors clamp exactly).
+            if !finite3(g) || norm(g) > max * (1.0 + 1e-12) {
+                return Outcome::Finding(
+                    "non-finite",
+                    format!(
+                        "protocol {} device side renders ({}, {}, {}) N at ({}, {}, {}) m",
+                        protocol.version(),
+                        g[0],
+                        g[1],
+                        g[2],
+                        p[0],
+                        p[1],
+                        p[2]
+                    ),
+                );
+            }
+        }
+    }
+    Outcome::Accepted
 }
