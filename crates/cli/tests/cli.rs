@@ -399,9 +399,14 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
         .port();
     let rec = tmp("modelled.mcap");
     // Real time over UDP on a shared 2-core machine: a reply later than the watchdog's grace
-    // (2.5 ms) makes the watchdog ramp the force, which is a jump the hand feels but not the
-    // rendering's buzz. Such a run is tried again (at most three runs); a jump over 1 N with
-    // every reply on time is the buzz, and fails at once.
+    // (2.5 ms), or a sample the simulator saw late (its `watchdog_ticks`), makes the watchdog
+    // ramp the force down and the soft engagement ramp it up again. That is a jump the hand
+    // feels and energy the re-engagement gives it, but neither is the rendering's buzz nor
+    // its passivity. A run whose claims fail while the machine disturbed it is tried again
+    // (at most five runs); a jump over 1 N or energy into the hand in a run with every reply
+    // on time is the rendering's fault, and fails at once. Measured under three CPU hogs on
+    // 2 cores: disturbed runs gave 0.0002-0.014 J into the hand and up to 16 jumps; the
+    // undisturbed runs of this test give none.
     let mut attempt = 0;
     let d = loop {
         attempt += 1;
@@ -422,11 +427,17 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
         let d = json(&dev);
         let s = json(&sim.wait_with_output().unwrap());
         assert_eq!(s["end"], "device_ended");
-        let late = d["round_trip"]["max_ns"].as_u64().unwrap() > 2_500_000;
-        if d["jumps_over_1n"] == 0 || !late || attempt == 3 {
+        let late = d["round_trip"]["max_ns"].as_u64().unwrap() > 2_500_000
+            || s["watchdog_ticks"].as_u64().unwrap() > 0;
+        let held = d["jumps_over_1n"] == 0 && d["energy_to_hand_j"].as_f64().unwrap() < 0.0;
+        if held || !late || attempt == 5 {
             break d;
         }
-        eprintln!("run {attempt}: a reply later than the watchdog's grace, tried again: {d}");
+        eprintln!(
+            "run {attempt}: the machine made a reply or sample later than the watchdog's \
+             grace ({} watchdog ticks), tried again: {d}",
+            s["watchdog_ticks"]
+        );
     };
     assert_eq!(d["jumps_over_1n"], 0, "{d}");
     assert!(d["max_jump_n"].as_f64().unwrap() < 1.0);
