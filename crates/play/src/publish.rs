@@ -17,7 +17,7 @@
 //! carry each sound with its tick, for captions and checks.
 
 use crate::protocol::{
-    EventAt, Frame, FrameView, ServerMsg, Shape, SoundAt, SoundKind, SoundOn, SoundTick, SoundTicks,
+    EventAt, Frame, FrameView, ServerMsg, SoundAt, SoundKind, SoundOn, SoundTick, SoundTicks,
 };
 use crate::server::Shared;
 use haptic_engine::HapticLoop;
@@ -416,7 +416,7 @@ impl Publisher {
             time_s: tick as f64 * self.dt,
             view: Some(FrameView {
                 wall_ms,
-                prims: f.prims.iter().map(Shape::from).collect(),
+                prims: f.prims,
                 state: self.state_fields.iter().cloned().zip(f.state).collect(),
                 cursor_m: f.cursor_m,
                 world_force_n: f.world_force_n,

@@ -5,7 +5,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use play::protocol::{PageMsg, ServerMsg, Shape};
+use haptic_types::primitive::{Primitive as Shape, Rgba};
+use play::protocol::{PageMsg, ServerMsg};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -162,44 +163,44 @@ fn every_shape_key_is_documented() {
         Shape::Sphere {
             center_m: [0.0; 3],
             radius_m: 1.0,
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
         Shape::Cursor {
             center_m: [0.0; 3],
             radius_m: 1.0,
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
         Shape::Box {
             center_m: [0.0; 3],
             half_extents_m: [1.0; 3],
             rotation: [0.0, 0.0, 0.0, 1.0],
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
         Shape::Slot {
             center_m: [0.0; 3],
             half_extents_m: [1.0; 3],
             rotation: [0.0, 0.0, 0.0, 1.0],
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
         Shape::Ellipse {
             center_m: [0.0; 3],
             semi_axes_m: [1.0; 2],
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
-        Shape::Line {
+        Shape::Polyline {
             points_m: vec![[0.0; 3]],
             closed: false,
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
         Shape::Arrow {
             from_m: [0.0; 3],
             to_m: [1.0; 3],
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
         Shape::Label {
             position_m: [0.0; 3],
             text: "a".into(),
-            color: [1.0; 4],
+            color: Rgba([1.0; 4]),
         },
     ];
     // A new shape stops this match from compiling: add it above and to docs/play.md.
@@ -210,7 +211,7 @@ fn every_shape_key_is_documented() {
             | Shape::Box { .. }
             | Shape::Slot { .. }
             | Shape::Ellipse { .. }
-            | Shape::Line { .. }
+            | Shape::Polyline { .. }
             | Shape::Arrow { .. }
             | Shape::Label { .. } => {}
         }

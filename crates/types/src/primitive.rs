@@ -3,12 +3,18 @@
 //! Every scene draws with these (`[f64; 3]` points, `[x, y, z, w]` quaternions, RGBA in 0–1);
 //! the renderer, the recording's Foxglove scene messages and the live views take them as they
 //! are. [`Primitive::Cursor`] and [`Primitive::Slot`] are the haptic cursor and blueprint slots.
+//!
+//! A primitive serialises (serde) in the compact form a page's frame carries
+//! (`docs/play.md`): an object tagged by `k` (`sphere`, `cursor`, `box`, `slot`, `ellipse`,
+//! `line`, `arrow`, `label`) with short keys (`c`, `r`, `h`, `q`, `ax`, `p`, `a`, `b`, `col`),
+//! a colour as its four channels.
 
 use crate::value::{ValueError, finite, finite3};
 use crate::vec3::Vec3;
 
 /// An RGBA colour, each channel in 0–1 (straight, not premultiplied alpha).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(transparent)]
 pub struct Rgba(pub [f64; 4]);
 
 impl Rgba {
@@ -62,85 +68,111 @@ impl Rgba {
 }
 
 /// A drawable primitive, world frame, metres.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "k", rename_all = "snake_case")]
 pub enum Primitive {
     /// A shaded sphere.
     Sphere {
         /// Centre, m.
+        #[serde(rename = "c")]
         center_m: Vec3,
         /// Radius, m (> 0).
+        #[serde(rename = "r")]
         radius_m: f64,
         /// Colour.
+        #[serde(rename = "col")]
         color: Rgba,
     },
     /// A shaded box rotated by a unit quaternion `[x, y, z, w]`.
     Box {
         /// Centre, m.
+        #[serde(rename = "c")]
         center_m: Vec3,
         /// Half extents along the box axes, m (each ≥ 0).
+        #[serde(rename = "h")]
         half_extents_m: Vec3,
         /// Orientation as a unit quaternion `[x, y, z, w]` (normalised when drawn).
+        #[serde(rename = "q")]
         rotation: [f64; 4],
         /// Colour.
+        #[serde(rename = "col")]
         color: Rgba,
     },
     /// A filled, outlined ellipse in a plane of constant z (e.g. the beam's cross-section).
     Ellipse {
         /// Centre, m.
+        #[serde(rename = "c")]
         center_m: Vec3,
         /// Semi-axes along x and y, m (each ≥ 0).
+        #[serde(rename = "ax")]
         semi_axes_m: [f64; 2],
         /// Colour (the fill uses a third of its alpha, the outline all of it).
+        #[serde(rename = "col")]
         color: Rgba,
     },
     /// A polyline, closed into a loop when `closed`; drawn over the solids.
+    #[serde(rename = "line")]
     Polyline {
         /// Vertices, m.
+        #[serde(rename = "p")]
         points_m: Vec<Vec3>,
         /// Join the last vertex to the first.
         closed: bool,
         /// Colour.
+        #[serde(rename = "col")]
         color: Rgba,
     },
     /// An arrow from `from_m` to `to_m` (e.g. a force drawn at some m/N scale); drawn over the
     /// solids.
     Arrow {
         /// Tail, m.
+        #[serde(rename = "a")]
         from_m: Vec3,
         /// Head, m.
+        #[serde(rename = "b")]
         to_m: Vec3,
         /// Colour.
+        #[serde(rename = "col")]
         color: Rgba,
     },
     /// A text label whose baseline starts a few pixels right of and above its anchor; drawn
     /// last.
     Label {
         /// Anchor, m.
+        #[serde(rename = "c")]
         position_m: Vec3,
         /// Text.
         text: String,
         /// Colour.
+        #[serde(rename = "col")]
         color: Rgba,
     },
     /// The haptic cursor: a see-through sphere with an outline and a cross-hair at its centre.
     Cursor {
         /// Centre, m.
+        #[serde(rename = "c")]
         center_m: Vec3,
         /// Radius, m (> 0).
+        #[serde(rename = "r")]
         radius_m: f64,
         /// Colour (the body uses its alpha, the outline and cross-hair are opaque).
+        #[serde(rename = "col")]
         color: Rgba,
     },
     /// A blueprint slot: the dashed edges of a box where a brick should go; drawn over the
     /// solids.
     Slot {
         /// Centre, m.
+        #[serde(rename = "c")]
         center_m: Vec3,
         /// Half extents along the box axes, m (each ≥ 0).
+        #[serde(rename = "h")]
         half_extents_m: Vec3,
         /// Orientation as a unit quaternion `[x, y, z, w]`.
+        #[serde(rename = "q")]
         rotation: [f64; 4],
         /// Colour.
+        #[serde(rename = "col")]
         color: Rgba,
     },
 }

@@ -21,7 +21,6 @@
 
 mod page;
 mod server;
-mod shape;
 mod sound;
 #[cfg(test)]
 mod tests;
@@ -31,7 +30,6 @@ pub use server::{
     EndReport, EventAt, Frame, FrameView, Hello, LatencyMs, Mapping, Role, ServerMsg, SoundAt,
     SwitchInfo, TickWorkMs,
 };
-pub use shape::Shape;
 pub use sound::{
     SOUND_ON_BYTES, SOUND_TICK_BYTES, SOUND_TICKS_HEADER_BYTES, SoundKind, SoundOn, SoundTick,
     SoundTicks, SoundTicksError,

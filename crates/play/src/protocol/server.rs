@@ -1,7 +1,7 @@
 //! Server → page: the JSON messages ([`ServerMsg`]) and their parts.
 
-use super::Shape;
 use haptic_engine::runner::EndReason;
+use haptic_types::primitive::{Primitive, Rgba};
 use serde::{Deserialize, Deserializer, Serialize};
 use std::collections::BTreeMap;
 
@@ -108,10 +108,10 @@ impl ServerMsg {
                 time_s: 0.032,
                 view: Some(FrameView {
                     wall_ms: 1_764_000_000_000.5,
-                    prims: vec![Shape::Sphere {
+                    prims: vec![Primitive::Sphere {
                         center_m: [0.0, 0.0, 0.1],
                         radius_m: 0.01,
-                        color: [1.0, 0.5, 0.0, 1.0],
+                        color: Rgba([1.0, 0.5, 0.0, 1.0]),
                     }],
                     state: [("score".to_string(), 25.0)].into_iter().collect(),
                     cursor_m: [0.0, 0.0, 0.1],
@@ -270,7 +270,7 @@ pub struct FrameView {
     /// When the tick's force was sent, by the server's clock, ms since the Unix epoch.
     pub wall_ms: f64,
     /// The shapes to draw, world frame, in the scene's order (the first is the ground).
-    pub prims: Vec<Shape>,
+    pub prims: Vec<Primitive>,
     /// The scene's state after the tick: each of the hello's `state_fields` with its value
     /// (units in the field's name; a non-finite value is `null`).
     #[serde(deserialize_with = "null_as_nan")]
