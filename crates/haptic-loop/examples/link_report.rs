@@ -23,7 +23,7 @@ use bench_harness::{Report, Table};
 use haptic_devices::link::LinkParams;
 use haptic_devices::local::Protocol;
 use haptic_devices::{Grip, Mechanics, PRESETS};
-use haptic_loop::closed_loop::{Linked, run_linked, run_linked_traced};
+use haptic_loop::closed_loop::{Linked, run_linked};
 
 const LATENCIES_MS: [f64; 8] = [0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0];
 const KS: usize = 13;
@@ -91,7 +91,7 @@ fn largest_stable(mech: Mechanics, l: &Linked) -> f64 {
     let mut best = 0.0;
     for i in 0..KS {
         let k = k_of(i);
-        let r = run_linked(&wall(k), PRESS, dev, Grip::LOOSE, l, None).unwrap();
+        let (r, _) = run_linked(&wall(k), PRESS, dev, Grip::LOOSE, l, None).unwrap();
         if !r.stable() {
             break;
         }
@@ -204,7 +204,7 @@ fn main() {
             let mut at10 = 0.0;
             for (pi, protocol) in [Protocol::V1, Protocol::V2].into_iter().enumerate() {
                 for ms in LATENCIES_MS {
-                    let r = run_linked(
+                    let (r, _) = run_linked(
                         &text,
                         &stext,
                         mech,
@@ -248,7 +248,7 @@ fn main() {
         let k = 0.5 * mech.limits.max_stiffness_n_per_m;
         for ms in [0.0, 0.5, 1.0, 2.0, 5.0, 10.0] {
             let felt = |protocol| {
-                let (_, t) = run_linked_traced(
+                let (_, t) = run_linked(
                     &wall(k),
                     PRESS,
                     mech,
@@ -273,7 +273,7 @@ fn main() {
                 });
                 sxy / sxx / k
             };
-            let (_, g) = run_linked_traced(
+            let (_, g) = run_linked(
                 &wall(k),
                 GLIDE,
                 mech,

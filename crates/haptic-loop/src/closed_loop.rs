@@ -122,7 +122,7 @@ pub fn run(
     grip: Grip,
     seconds: Option<f64>,
 ) -> Result<Report, ClosedLoopError> {
-    run_linked(scene_text, script_text, mech, grip, &Linked::IDEAL, seconds)
+    run_linked(scene_text, script_text, mech, grip, &Linked::IDEAL, seconds).map(|(r, _)| r)
 }
 
 /// The link of a closed-loop run and the protocol the device side speaks.
@@ -142,25 +142,6 @@ impl Linked {
     };
 }
 
-/// As [`run`], with the device at the far end of `linked.link`: its samples reach the loop
-/// and the loop's answers reach it after the link's latency and jitter, or never (loss).
-///
-/// The loop's side follows the bridge's rule (`UdpDevice`): tick `k` waits for the device's
-/// sample `k`; without it, it runs `k − a + ½` periods after the last on-time sample (slot
-/// `a`) on the newest sample it has, with its age. The device renders each answer from its
-/// arrival with [`haptic_devices::local::DeviceSide`]. Time is simulated in whole
-/// nanoseconds and every draw is seeded: a run repeats to the bit.
-pub fn run_linked(
-    scene_text: &str,
-    script_text: &str,
-    mech: Mechanics,
-    grip: Grip,
-    linked: &Linked,
-    seconds: Option<f64>,
-) -> Result<Report, ClosedLoopError> {
-    run_linked_traced(scene_text, script_text, mech, grip, linked, seconds).map(|(r, _)| r)
-}
-
 /// What the hand met, sample by sample: each encoder reading (m) and the force the motors
 /// rendered when it was read (N), device frame.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -171,8 +152,15 @@ pub struct Trace {
     pub felt: Vec<[f64; 3]>,
 }
 
-/// As [`run_linked`], with the trace of what the hand met.
-pub fn run_linked_traced(
+/// As [`run`], with the device at the far end of `linked.link`: its samples reach the loop
+/// and the loop's answers reach it after the link's latency and jitter, or never (loss).
+///
+/// The loop's side follows the bridge's rule (`UdpDevice`): tick `k` waits for the device's
+/// sample `k`; without it, it runs `k − a + ½` periods after the last on-time sample (slot
+/// `a`) on the newest sample it has, with its age. The device renders each answer from its
+/// arrival with [`haptic_devices::local::DeviceSide`]. Time is simulated in whole
+/// nanoseconds and every draw is seeded: a run repeats to the bit, its [`Trace`] included.
+pub fn run_linked(
     scene_text: &str,
     script_text: &str,
     mech: Mechanics,

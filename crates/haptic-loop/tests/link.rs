@@ -88,7 +88,7 @@ fn every_scene_on_every_device_is_stable_behind_a_link_of_up_to_10_ms() {
                         link: link(ms, bad),
                         protocol: Protocol::V2,
                     };
-                    let r = run_linked(&read(scene), &read(script), mech, grip, &l, None)
+                    let (r, _) = run_linked(&read(scene), &read(script), mech, grip, &l, None)
                         .unwrap_or_else(|e| panic!("{scene} on {}: {e}", mech.name));
                     let label =
                         format!("{scene} {} {} {}", mech.name, grip.label(), l.link.label());
@@ -135,7 +135,9 @@ fn the_carried_brick_buzzes_behind_2_ms_with_protocol_1_and_not_with_protocol_2(
             link: LinkParams::latency_ms(2.0),
             protocol,
         };
-        run_linked(&scene, &script, Mechanics::FALCON, Grip::LOOSE, &l, None).unwrap()
+        run_linked(&scene, &script, Mechanics::FALCON, Grip::LOOSE, &l, None)
+            .unwrap()
+            .0
     };
     let (v1, v2) = (run(Protocol::V1), run(Protocol::V2));
     println!("{}", line("protocol 1, 2 ms", &v1));
@@ -146,7 +148,8 @@ fn the_carried_brick_buzzes_behind_2_ms_with_protocol_1_and_not_with_protocol_2(
     assert!(v2.house_complete_s.is_some_and(|t| t > 0.0));
 }
 
-/// A linked run is simulated in whole nanoseconds with seeded draws: it repeats to the bit.
+/// A linked run is simulated in whole nanoseconds with seeded draws: it repeats to the bit,
+/// every reading and every force the hand felt as well as the summary.
 #[test]
 fn a_run_behind_a_lossy_jittery_link_repeats_to_the_bit() {
     let (scene, script) = (read("wall.toml"), read("wall.script.toml"));
@@ -156,7 +159,15 @@ fn a_run_behind_a_lossy_jittery_link_repeats_to_the_bit() {
     };
     let a = run_linked(&scene, &script, Mechanics::TOUCH, Grip::LOOSE, &l, None).unwrap();
     let b = run_linked(&scene, &script, Mechanics::TOUCH, Grip::LOOSE, &l, None).unwrap();
-    assert_eq!(a, b);
+    assert_eq!(a.0, b.0);
+    assert!(!a.1.felt.is_empty() && a.1.felt.len() == a.1.readings.len());
+    let bits = |t: &haptic_loop::closed_loop::Trace| -> Vec<u64> {
+        (t.readings.iter().chain(&t.felt))
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect()
+    };
+    assert_eq!(bits(&a.1), bits(&b.1));
     // And an ideal link with protocol 1 is the closed loop of issue 22.
     let ideal = run_linked(
         &scene,
@@ -166,7 +177,8 @@ fn a_run_behind_a_lossy_jittery_link_repeats_to_the_bit() {
         &Linked::IDEAL,
         None,
     )
-    .unwrap();
+    .unwrap()
+    .0;
     assert!(ideal.stable());
 }
 
