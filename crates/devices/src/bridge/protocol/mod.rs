@@ -79,6 +79,18 @@ mod tests {
     use haptic_types::local::{Body, LocalModel, MAX_PLANES, Plane};
     use proptest::prelude::*;
 
+    /// A force reply at tick 1 with no force and no stiffness, carrying the local model `m`.
+    fn at_rest(m: LocalModel) -> Packet {
+        Packet::Force(ForceReply {
+            seq: 1,
+            tick: 1,
+            force_n: [0.0; 3],
+            stiffness_n_per_m: [0.0; 9],
+            status: 0,
+            local: Some(Box::new(m)),
+        })
+    }
+
     #[test]
     fn every_packet_round_trips_with_its_documented_size() {
         let s = Packet::Sample(Sample {
@@ -262,14 +274,7 @@ mod tests {
         // Without a body.
         let mut m = full_model();
         m.body = None;
-        let g = Packet::Force(ForceReply {
-            seq: 1,
-            tick: 1,
-            force_n: [0.0; 3],
-            stiffness_n_per_m: [0.0; 9],
-            status: 0,
-            local: Some(Box::new(m)),
-        });
+        let g = at_rest(m);
         assert_eq!(g.encode().len(), force_v2_len(2, false, 1));
         assert_eq!(Packet::decode(&g.encode()), Ok(g));
     }
@@ -279,19 +284,9 @@ mod tests {
         let mut m = full_model();
         m.planes[1].normal = [2.0, 0.0, 0.0];
         let f = |m: LocalModel| {
-            Packet::decode(
-                &Packet::Force(ForceReply {
-                    seq: 1,
-                    tick: 1,
-                    force_n: [0.0; 3],
-                    stiffness_n_per_m: [0.0; 9],
-                    status: 0,
-                    local: Some(Box::new(m)),
-                })
-                .encode(),
-            )
-            .unwrap_err()
-            .to_string()
+            Packet::decode(&at_rest(m).encode())
+                .unwrap_err()
+                .to_string()
         };
         assert_eq!(
             f(m),
@@ -305,15 +300,7 @@ mod tests {
             f(m),
             "force packet's local model: body.mass_kg = -1 is out of range: allowed 0 < m ≤ 10000 kg"
         );
-        let mut b = Packet::Force(ForceReply {
-            seq: 1,
-            tick: 1,
-            force_n: [0.0; 3],
-            stiffness_n_per_m: [0.0; 9],
-            status: 0,
-            local: Some(Box::new(full_model())),
-        })
-        .encode();
+        let mut b = at_rest(full_model()).encode();
         // Five planes announced.
         b[121 + 104] = 5;
         assert_eq!(
