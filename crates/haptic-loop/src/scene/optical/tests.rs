@@ -87,30 +87,61 @@ fn the_tick_map_choice_is_reported_once() {
     );
 }
 
+/// The tick map is chosen by name, and each bad field of the scene's `[optical_tweezers]`
+/// table is refused with its exact message: the field, the value, the allowed range or forms.
 #[test]
-fn the_tick_map_is_chosen_by_name_with_clear_errors() {
-    assert_eq!(
-        build_error("tick_map = \"euler\""),
-        "scene: optical_tweezers: `tick_map` = \"euler\" is not a tick map (allowed: \"budget\", \
+fn bad_fields_are_refused_with_their_exact_message() {
+    for (extra, want) in [
+        (
+            "tick_map = \"euler\"",
+            "scene: optical_tweezers: `tick_map` = \"euler\" is not a tick map (allowed: \"budget\", \
          \"paper-rk4\", \"rk4\", \"rk8\", \"dopri5\", \"adaptive\", \"symplectic\", \
-         \"yoshida4\", \"yoshida6\")"
-    );
-    assert_eq!(
-        build_error("rk4_substeps = 4\ntick_map = \"rk8\""),
-        "scene: optical_tweezers: `rk4_substeps` is the older form of \
-         `tick_map = \"rk4\"` with `tick_map_substeps`: give one of them, not both"
-    );
-    assert_eq!(
-        build_error("tick_map = \"rk8\"\ntick_map_tol_nm = 0.1"),
-        "scene: optical_tweezers: `tick_map_tol_nm` is the budget of \
+         \"yoshida4\", \"yoshida6\")",
+        ),
+        (
+            "rk4_substeps = 4\ntick_map = \"rk8\"",
+            "scene: optical_tweezers: `rk4_substeps` is the older form of \
+         `tick_map = \"rk4\"` with `tick_map_substeps`: give one of them, not both",
+        ),
+        (
+            "tick_map = \"rk8\"\ntick_map_tol_nm = 0.1",
+            "scene: optical_tweezers: `tick_map_tol_nm` is the budget of \
          `tick_map = \"budget\"`; the named map `rk8` is set by `tick_map_substeps` or \
-         `tick_map_rtol`"
-    );
-    assert_eq!(
-        build_error("tick_map = \"rk4\"\ntick_map_substeps = 0"),
-        "scene: `optical_tweezers.tick_map_substeps` = 0 is out of range: allowed 1 ≤ \
-         optical_tweezers.tick_map_substeps ≤ 1000"
-    );
+         `tick_map_rtol`",
+        ),
+        (
+            "tick_map = \"rk4\"\ntick_map_substeps = 0",
+            "scene: `optical_tweezers.tick_map_substeps` = 0 is out of range: allowed 1 ≤ \
+         optical_tweezers.tick_map_substeps ≤ 1000",
+        ),
+        (
+            "envelope_build_evals_per_tick = 0",
+            "scene: `optical_tweezers.envelope_build_evals_per_tick` = 0 is out of range: \
+         allowed 1 ≤ optical_tweezers.envelope_build_evals_per_tick ≤ 1e6",
+        ),
+        (
+            "spread_build = false\nenvelope_build_evals_per_tick = 64",
+            "scene: optical_tweezers: `envelope_build_evals_per_tick` sets the spread rebuild \
+         that `spread_build = false` switches off: give one of them, not both",
+        ),
+        (
+            "tick_map_tol_nm = 0.0",
+            "scene: `optical_tweezers.tick_map_tol_nm` = 0 is out of range: allowed 1e-4 ≤ \
+         optical_tweezers.tick_map_tol_nm ≤ 100",
+        ),
+        (
+            "tick_map_speed_m_per_s = -1.0",
+            "scene: `optical_tweezers.tick_map_speed_m_per_s` = -1 is out of range: allowed 0 ≤ \
+         optical_tweezers.tick_map_speed_m_per_s ≤ 1000",
+        ),
+        (
+            "rk4_substeps = 0",
+            "scene: `optical_tweezers.rk4_substeps` = 0 is out of range: allowed 1 ≤ \
+         optical_tweezers.rk4_substeps ≤ 1000",
+        ),
+    ] {
+        assert_eq!(build_error(extra), want, "{extra}");
+    }
 }
 
 #[test]
@@ -127,17 +158,7 @@ fn the_10_khz_scene_loads_with_an_exact_period() {
 }
 
 #[test]
-fn the_spread_build_fields_are_checked_and_reach_the_world() {
-    assert_eq!(
-        build_error("envelope_build_evals_per_tick = 0"),
-        "scene: `optical_tweezers.envelope_build_evals_per_tick` = 0 is out of range: \
-         allowed 1 ≤ optical_tweezers.envelope_build_evals_per_tick ≤ 1e6"
-    );
-    assert_eq!(
-        build_error("spread_build = false\nenvelope_build_evals_per_tick = 64"),
-        "scene: optical_tweezers: `envelope_build_evals_per_tick` sets the spread rebuild \
-         that `spread_build = false` switches off: give one of them, not both"
-    );
+fn the_spread_build_fields_reach_the_world() {
     let l = limits();
     let world = |extra: &str| params(extra).world_params(&l).unwrap();
     assert_eq!(
@@ -155,26 +176,6 @@ fn the_spread_build_fields_are_checked_and_reach_the_world() {
     // the first envelope is built when the scene loads
     let s = OpticalScene::new(params("tick_map_tol_nm = 0.01"), &l).unwrap();
     assert_eq!((s.tick_stats().rebuilds, s.tick_stats().ticks), (1, 0));
-}
-
-#[test]
-fn budget_fields_are_validated_with_their_range() {
-    let err = build_error;
-    assert_eq!(
-        err("tick_map_tol_nm = 0.0"),
-        "scene: `optical_tweezers.tick_map_tol_nm` = 0 is out of range: allowed 1e-4 ≤ \
-         optical_tweezers.tick_map_tol_nm ≤ 100"
-    );
-    assert_eq!(
-        err("tick_map_speed_m_per_s = -1.0"),
-        "scene: `optical_tweezers.tick_map_speed_m_per_s` = -1 is out of range: allowed 0 ≤ \
-         optical_tweezers.tick_map_speed_m_per_s ≤ 1000"
-    );
-    assert_eq!(
-        err("rk4_substeps = 0"),
-        "scene: `optical_tweezers.rk4_substeps` = 0 is out of range: allowed 1 ≤ \
-         optical_tweezers.rk4_substeps ≤ 1000"
-    );
 }
 
 #[test]
