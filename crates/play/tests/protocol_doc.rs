@@ -5,7 +5,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_types::primitive::{Primitive as Shape, Rgba};
+use haptic_types::primitive::Primitive as Shape;
 use play::protocol::{PageMsg, ServerMsg};
 use serde_json::Value;
 use std::collections::BTreeSet;
@@ -159,51 +159,9 @@ fn each_row_names_every_field_of_its_message() {
 #[test]
 fn every_shape_key_is_documented() {
     let doc = crate_file("../../docs/play.md");
-    let shapes = [
-        Shape::Sphere {
-            center_m: [0.0; 3],
-            radius_m: 1.0,
-            color: Rgba([1.0; 4]),
-        },
-        Shape::Cursor {
-            center_m: [0.0; 3],
-            radius_m: 1.0,
-            color: Rgba([1.0; 4]),
-        },
-        Shape::Box {
-            center_m: [0.0; 3],
-            half_extents_m: [1.0; 3],
-            rotation: [0.0, 0.0, 0.0, 1.0],
-            color: Rgba([1.0; 4]),
-        },
-        Shape::Slot {
-            center_m: [0.0; 3],
-            half_extents_m: [1.0; 3],
-            rotation: [0.0, 0.0, 0.0, 1.0],
-            color: Rgba([1.0; 4]),
-        },
-        Shape::Ellipse {
-            center_m: [0.0; 3],
-            semi_axes_m: [1.0; 2],
-            color: Rgba([1.0; 4]),
-        },
-        Shape::Polyline {
-            points_m: vec![[0.0; 3]],
-            closed: false,
-            color: Rgba([1.0; 4]),
-        },
-        Shape::Arrow {
-            from_m: [0.0; 3],
-            to_m: [1.0; 3],
-            color: Rgba([1.0; 4]),
-        },
-        Shape::Label {
-            position_m: [0.0; 3],
-            text: "a".into(),
-            color: Rgba([1.0; 4]),
-        },
-    ];
-    // A new shape stops this match from compiling: add it above and to docs/play.md.
+    let shapes = Shape::examples();
+    // A new shape stops this match from compiling: add it to `Primitive::examples` and to
+    // docs/play.md.
     for s in &shapes {
         match s {
             Shape::Sphere { .. }

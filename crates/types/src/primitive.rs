@@ -209,6 +209,58 @@ fn quaternion(field: &str, q: [f64; 4]) -> Result<(), ValueError> {
 }
 
 impl Primitive {
+    /// One primitive of each kind, in the order the page's protocol documents them (for
+    /// docs and tests of the serialised form).
+    pub fn examples() -> Vec<Primitive> {
+        let color = Rgba([0.5, 0.25, 1.0, 1.0]);
+        let c = [0.25, -0.5, 1.0];
+        let (half_extents_m, rotation) = ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0, 1.0]);
+        vec![
+            Primitive::Sphere {
+                center_m: c,
+                radius_m: 0.5,
+                color,
+            },
+            Primitive::Cursor {
+                center_m: c,
+                radius_m: 0.5,
+                color,
+            },
+            Primitive::Box {
+                center_m: c,
+                half_extents_m,
+                rotation,
+                color,
+            },
+            Primitive::Slot {
+                center_m: c,
+                half_extents_m,
+                rotation,
+                color,
+            },
+            Primitive::Ellipse {
+                center_m: c,
+                semi_axes_m: [0.5, 0.25],
+                color,
+            },
+            Primitive::Polyline {
+                points_m: vec![c, [0.0; 3]],
+                closed: true,
+                color,
+            },
+            Primitive::Arrow {
+                from_m: c,
+                to_m: [0.0; 3],
+                color,
+            },
+            Primitive::Label {
+                position_m: c,
+                text: "blueprint 1/4".into(),
+                color,
+            },
+        ]
+    }
+
     /// Short name of the variant, used in error field names (`sphere`, `box`, …).
     pub fn kind(&self) -> &'static str {
         match self {
@@ -303,6 +355,26 @@ impl Primitive {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_primitive_serialises_with_its_short_keys_and_reads_back() {
+        let want = [
+            r#"{"k":"sphere","c":[0.25,-0.5,1.0],"r":0.5,"col":[0.5,0.25,1.0,1.0]}"#,
+            r#"{"k":"cursor","c":[0.25,-0.5,1.0],"r":0.5,"col":[0.5,0.25,1.0,1.0]}"#,
+            r#"{"k":"box","c":[0.25,-0.5,1.0],"h":[1.0,2.0,3.0],"q":[0.0,0.0,0.0,1.0],"col":[0.5,0.25,1.0,1.0]}"#,
+            r#"{"k":"slot","c":[0.25,-0.5,1.0],"h":[1.0,2.0,3.0],"q":[0.0,0.0,0.0,1.0],"col":[0.5,0.25,1.0,1.0]}"#,
+            r#"{"k":"ellipse","c":[0.25,-0.5,1.0],"ax":[0.5,0.25],"col":[0.5,0.25,1.0,1.0]}"#,
+            r#"{"k":"line","p":[[0.25,-0.5,1.0],[0.0,0.0,0.0]],"closed":true,"col":[0.5,0.25,1.0,1.0]}"#,
+            r#"{"k":"arrow","a":[0.25,-0.5,1.0],"b":[0.0,0.0,0.0],"col":[0.5,0.25,1.0,1.0]}"#,
+            r#"{"k":"label","c":[0.25,-0.5,1.0],"text":"blueprint 1/4","col":[0.5,0.25,1.0,1.0]}"#,
+        ];
+        let examples = Primitive::examples();
+        assert_eq!(examples.len(), want.len());
+        for (p, want) in examples.iter().zip(want) {
+            assert_eq!(serde_json::to_string(p).unwrap(), want);
+            assert_eq!(&serde_json::from_str::<Primitive>(want).unwrap(), p);
+        }
+    }
 
     #[test]
     fn validation_names_field_and_range() {
