@@ -29,23 +29,8 @@ const LATENCIES_MS: [f64; 8] = [0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0];
 const KS: usize = 13;
 const COLORS: [[u8; 3]; 3] = [[210, 50, 40], [40, 150, 60], [120, 120, 120]];
 
-const PRESS: &str = r#"
-[script]
-name = "press and hold"
-duration_s = 3.0
-[[waypoint]]
-t_s = 0.0
-position_mm = [0.0, 0.0, 6.0]
-[[waypoint]]
-t_s = 0.5
-position_mm = [0.0, 0.0, -2.0]
-[[waypoint]]
-t_s = 2.0
-position_mm = [0.0, 0.0, -2.0]
-[[waypoint]]
-t_s = 2.5
-position_mm = [0.0, 0.0, 6.0]
-"#;
+/// Down 8 mm into the wall in 0.5 s, held 1.5 s, back up by 2.5 s.
+const PRESS: &str = include_str!("press_and_hold.script.toml");
 
 /// 0.1 m/s along x, 20 mm above the wall (free space), after a 0.2 s start.
 const GLIDE: &str = r#"

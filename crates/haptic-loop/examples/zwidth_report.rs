@@ -25,23 +25,8 @@ const GREEN: [u8; 3] = [40, 150, 60];
 const RED: [u8; 3] = [210, 50, 40];
 const BLUE: [u8; 3] = [40, 80, 200];
 
-const SCRIPT: &str = r#"
-[script]
-name = "z-width: press and hold"
-duration_s = 3.0
-[[waypoint]]
-t_s = 0.0
-position_mm = [0.0, 0.0, 6.0]
-[[waypoint]]
-t_s = 0.5
-position_mm = [0.0, 0.0, -2.0]
-[[waypoint]]
-t_s = 2.0
-position_mm = [0.0, 0.0, -2.0]
-[[waypoint]]
-t_s = 2.5
-position_mm = [0.0, 0.0, 6.0]
-"#;
+/// Down 8 mm into the wall in 0.5 s, held 1.5 s, back up by 2.5 s.
+const SCRIPT: &str = include_str!("press_and_hold.script.toml");
 
 fn wall(k: f64, b: f64) -> String {
     format!(
