@@ -91,6 +91,15 @@ pub trait Scene: Send {
         None
     }
 
+    /// Every switch of [`Scene::switches`] that has a value, with its value now, in the
+    /// menu's order (what a menu or a teacher's status shows).
+    fn switch_values(&self) -> Vec<(String, f64)> {
+        self.switches()
+            .iter()
+            .filter_map(|s| Some((s.name.to_string(), self.switch_value(s.name)?)))
+            .collect()
+    }
+
     /// Writes what the device may render on its own until the next tick (after the last
     /// step; world frame and units): the contact planes at and near the cursor and a carried
     /// body (bridge protocol 2, `haptic_types::local`). None by default: the device then

@@ -254,11 +254,7 @@ impl Sink for LiveSink {
         let start_ns = info.header.start_time_ns;
         let (period, rate, scale) = (c.period_ns(), c.rate_hz, c.display_scale);
         let scene = lp.scene();
-        let values = scene
-            .switches()
-            .iter()
-            .filter_map(|s| Some((s.name.to_string(), scene.switch_value(s.name)?)))
-            .collect();
+        let values = scene.switch_values().into_iter().collect();
         if let Ok(mut m) = self.menu.lock() {
             m.offer(scene.kind(), scene.switches(), values);
         }

@@ -29,4 +29,31 @@ mod tests {
             ["wall", "nanoworld", "brickworld", "optical_tweezers"]
         );
     }
+
+    /// A menu reads every switch with its value now, a switch set through the scene
+    /// included; a scene without switches lists none.
+    #[test]
+    fn a_menu_reads_each_switch_with_its_value_now() {
+        let scene_file = |name: &str| {
+            let p = format!("{}/../../scenes/{name}", env!("CARGO_MANIFEST_DIR"));
+            std::fs::read_to_string(p).unwrap()
+        };
+        let mut bricks = crate::scene::load_scene(&scene_file("brickworld.toml"), None)
+            .unwrap()
+            .scene;
+        bricks.set_switch("gravity_m_per_s2", 0.0).unwrap();
+        bricks.set_switch("inertia", 0.0).unwrap();
+        let values = bricks.switch_values();
+        let names: Vec<&str> = values.iter().map(|(n, _)| n.as_str()).collect();
+        let menu: Vec<&str> = bricks.switches().iter().map(|s| s.name).collect();
+        assert_eq!(names, menu);
+        let value = |n: &str| values.iter().find(|(m, _)| m == n).map(|(_, v)| *v);
+        assert_eq!(value("gravity_m_per_s2"), Some(0.0));
+        assert_eq!(value("inertia"), Some(0.0));
+        assert_eq!(value("friction"), bricks.switch_value("friction"));
+        let wall = crate::scene::load_scene(&scene_file("wall.toml"), None)
+            .unwrap()
+            .scene;
+        assert!(wall.switch_values().is_empty());
+    }
 }

@@ -174,11 +174,7 @@ impl Student {
         lp.scene().state(&mut state);
         let f = lp.last_result().device_force_n;
         let scene = lp.scene();
-        let switches = scene
-            .switches()
-            .iter()
-            .filter_map(|s| Some((s.name.to_string(), scene.switch_value(s.name)?)))
-            .collect();
+        let switches = scene.switch_values();
         if let Ok(mut st) = self.status.lock() {
             st.ticks = ticks;
             st.time_s = ticks as f64 / f64::from(lp.config().rate_hz);
