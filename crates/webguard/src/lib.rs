@@ -15,6 +15,7 @@
 //! rebinding page's host name and another site's origin are refused with `403`.
 
 pub mod gate;
+pub mod serve;
 
 use std::io::Read;
 use std::net::{IpAddr, TcpStream};

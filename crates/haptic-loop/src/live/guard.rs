@@ -12,6 +12,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
 use std::time::Duration;
 use webguard::gate::{Gate, Limits};
+use webguard::serve::{accept_until, respond_text};
 use webguard::{Guard, HeadError, read_head_bytes};
 
 /// The Foxglove web app's origin, allowed to connect (Foxglove's desktop app sends none).
@@ -51,7 +52,12 @@ impl LiveGuard {
         let (s, g) = (stop.clone(), gate.clone());
         let thread = std::thread::Builder::new()
             .name("live-guard".into())
-            .spawn(move || accept(listener, g, backend, s))?;
+            .spawn(move || {
+                let (g2, s2) = (g.clone(), s.clone());
+                accept_until(listener, g, s, "live-guard-conn", move |stream| {
+                    connection(stream, &g2, backend, &s2)
+                })
+            })?;
         Ok(LiveGuard {
             addr,
             stop,
@@ -75,41 +81,6 @@ impl Drop for LiveGuard {
     }
 }
 
-fn accept(listener: TcpListener, gate: Arc<Gate>, backend: SocketAddr, stop: Arc<AtomicBool>) {
-    while !stop.load(Ordering::Relaxed) {
-        match listener.accept() {
-            Ok((stream, peer)) => {
-                let ticket = match gate.admit(peer.ip()) {
-                    Ok(t) => t,
-                    Err(why) => {
-                        refuse(stream, "503 Service Unavailable", &why);
-                        continue;
-                    }
-                };
-                let (g, s) = (gate.clone(), stop.clone());
-                let _ = std::thread::Builder::new()
-                    .name("live-guard-conn".into())
-                    .spawn(move || {
-                        connection(stream, &g, backend, &s);
-                        drop(ticket);
-                    });
-            }
-            Err(_) => std::thread::sleep(Duration::from_millis(10)),
-        }
-    }
-}
-
-fn refuse(mut stream: TcpStream, status: &str, message: &str) {
-    let _ = stream.set_nonblocking(false);
-    let body = format!("{message}\n");
-    let head = format!(
-        "HTTP/1.1 {status}\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: {}\r\nConnection: close\r\n\r\n",
-        body.len()
-    );
-    let _ = stream.write_all(head.as_bytes());
-    let _ = stream.write_all(body.as_bytes());
-}
-
 fn connection(mut client: TcpStream, gate: &Gate, backend: SocketAddr, stop: &AtomicBool) {
     let _ = client.set_nonblocking(false);
     let (bytes, head) = match read_head_bytes(&mut client) {
@@ -117,15 +88,19 @@ fn connection(mut client: TcpStream, gate: &Gate, backend: SocketAddr, stop: &At
         Err(HeadError::Closed) => return,
         Err(e) => {
             gate.refused.count("head");
-            return refuse(client, "400 Bad Request", &e.to_string());
+            return respond_text(&mut client, "400 Bad Request", &e.to_string());
         }
     };
     if let Err(r) = gate.guard.check(&head) {
         gate.refused.count(r.kind());
-        return refuse(client, "403 Forbidden", &r.to_string());
+        return respond_text(&mut client, "403 Forbidden", &r.to_string());
     }
     let Ok(mut server) = TcpStream::connect(backend) else {
-        return refuse(client, "502 Bad Gateway", "the live view is not serving");
+        return respond_text(
+            &mut client,
+            "502 Bad Gateway",
+            "the live view is not serving",
+        );
     };
     let _ = server.set_nodelay(true);
     let _ = client.set_nodelay(true);

@@ -108,10 +108,15 @@ impl Listener {
             },
             limits,
         ));
-        let (g, sd) = (gate.clone(), shutdown.clone());
+        let (g, g2, sd) = (gate.clone(), gate.clone(), shutdown.clone());
         let accept = std::thread::Builder::new()
             .name("page-accept".into())
-            .spawn(move || accept_loop(listener, g, routes, sd))?;
+            .spawn(move || {
+                webguard::serve::accept_until(listener, g, sd, "page-conn", move |stream| {
+                    let _ = stream.set_write_timeout(Some(Duration::from_secs(WRITE_TIMEOUT_S)));
+                    connection(stream, &g2, routes.as_ref())
+                })
+            })?;
         Ok(Listener {
             addr,
             gate,
@@ -142,52 +147,6 @@ impl Listener {
 impl Drop for Listener {
     fn drop(&mut self) {
         self.stop();
-    }
-}
-
-fn accept_loop(
-    listener: TcpListener,
-    gate: Arc<Gate>,
-    routes: Arc<dyn Routes>,
-    shutdown: Arc<AtomicBool>,
-) {
-    let mut conns: Vec<JoinHandle<()>> = Vec::new();
-    while !shutdown.load(Ordering::Relaxed) {
-        match listener.accept() {
-            Ok((mut stream, peer)) => {
-                let _ = stream.set_nonblocking(false);
-                let _ = stream.set_write_timeout(Some(Duration::from_secs(WRITE_TIMEOUT_S)));
-                if let Some(b) = gate.limits.send_buffer_bytes {
-                    webguard::gate::set_send_buffer(&stream, b);
-                }
-                let ticket = match gate.admit(peer.ip()) {
-                    Ok(t) => t,
-                    Err(message) => {
-                        respond_text(&mut stream, "503 Service Unavailable", &message);
-                        continue;
-                    }
-                };
-                let (g, r) = (gate.clone(), routes.clone());
-                if let Ok(h) =
-                    std::thread::Builder::new()
-                        .name("page-conn".into())
-                        .spawn(move || {
-                            connection(stream, &g, r.as_ref());
-                            drop(ticket);
-                        })
-                {
-                    conns.push(h);
-                }
-                conns.retain(|h| !h.is_finished());
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
-                std::thread::sleep(Duration::from_millis(5));
-            }
-            Err(_) => std::thread::sleep(Duration::from_millis(5)),
-        }
-    }
-    for h in conns {
-        let _ = h.join();
     }
 }
 

@@ -1,0 +1,155 @@
+//! The accept loop of every server of the project (the page servers and the live view's
+//! guard), and its plain answers: each connection admitted by the [`Gate`] or refused with
+//! `503` and the gate's reason, then handled on its own thread while it holds its ticket.
+
+use crate::gate::{Gate, set_send_buffer};
+use std::io::Write;
+use std::net::{TcpListener, TcpStream};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// How long the loop sleeps when no connection is waiting, ms.
+const IDLE_MS: u64 = 5;
+
+/// Writes a complete response (`Connection: close`, never cached); `extra` is more header
+/// lines, each ending in `\r\n`.
+pub fn respond(stream: &mut TcpStream, status: &str, ctype: &str, extra: &str, body: &[u8]) {
+    let head = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n{extra}Connection: close\r\n\r\n",
+        body.len()
+    );
+    let _ = stream.write_all(head.as_bytes());
+    let _ = stream.write_all(body);
+    let _ = stream.flush();
+}
+
+/// Answers with a plain-text message (status line such as `403 Forbidden`).
+pub fn respond_text(stream: &mut TcpStream, status: &str, message: &str) {
+    respond(
+        stream,
+        status,
+        "text/plain; charset=utf-8",
+        "",
+        format!("{message}\n").as_bytes(),
+    );
+}
+
+/// Accepts connections on `listener` (non-blocking) until `stop` is raised. Each accepted
+/// stream is made blocking and given the gate's send buffer; a connection the gate does not
+/// admit is answered `503 Service Unavailable` with the reason; an admitted one is handed to
+/// `handle` on a thread named `thread_name`, its ticket held until `handle` returns. On
+/// `stop`, the connections' threads are joined (a handler should watch `stop` or its own
+/// time-outs).
+pub fn accept_until<H>(
+    listener: TcpListener,
+    gate: Arc<Gate>,
+    stop: Arc<AtomicBool>,
+    thread_name: &str,
+    handle: H,
+) where
+    H: Fn(TcpStream) + Send + Sync + 'static,
+{
+    let handle = Arc::new(handle);
+    let mut conns: Vec<JoinHandle<()>> = Vec::new();
+    while !stop.load(Ordering::Relaxed) {
+        let Ok((mut stream, peer)) = listener.accept() else {
+            std::thread::sleep(Duration::from_millis(IDLE_MS));
+            continue;
+        };
+        let _ = stream.set_nonblocking(false);
+        if let Some(b) = gate.limits.send_buffer_bytes {
+            set_send_buffer(&stream, b);
+        }
+        let ticket = match gate.admit(peer.ip()) {
+            Ok(t) => t,
+            Err(message) => {
+                respond_text(&mut stream, "503 Service Unavailable", &message);
+                continue;
+            }
+        };
+        let h = handle.clone();
+        if let Ok(t) = std::thread::Builder::new()
+            .name(thread_name.to_string())
+            .spawn(move || {
+                h(stream);
+                drop(ticket);
+            })
+        {
+            conns.push(t);
+        }
+        conns.retain(|t| !t.is_finished());
+    }
+    for t in conns {
+        let _ = t.join();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::Guard;
+    use crate::gate::Limits;
+    use std::io::Read;
+    use std::sync::mpsc;
+
+    /// One connection is admitted and held by its handler; a second from the same address is
+    /// answered 503 with the gate's reason and counted; on stop the loop joins the handler.
+    #[test]
+    fn a_connection_over_the_limit_is_told_why_and_stop_joins_the_handlers() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        listener.set_nonblocking(true).unwrap();
+        let addr = listener.local_addr().unwrap();
+        let limits = Limits {
+            max_connections: 8,
+            max_per_address: 1,
+            ..Limits::default()
+        };
+        let guard = Guard {
+            port: addr.port(),
+            loopback_only: true,
+            other_origins: Vec::new(),
+        };
+        let gate = Arc::new(Gate::new(guard, limits));
+        let stop = Arc::new(AtomicBool::new(false));
+        let (held_tx, held_rx) = mpsc::channel();
+        let (g, s, s2) = (gate.clone(), stop.clone(), stop.clone());
+        let held_tx = std::sync::Mutex::new(held_tx);
+        let server = std::thread::spawn(move || {
+            accept_until(listener, g, s, "test-conn", move |mut stream| {
+                held_tx.lock().unwrap().send(()).unwrap();
+                while !s2.load(Ordering::Relaxed) {
+                    std::thread::sleep(Duration::from_millis(2));
+                }
+                respond_text(&mut stream, "200 OK", "bye");
+            })
+        });
+        let mut first = TcpStream::connect(addr).unwrap();
+        held_rx.recv_timeout(Duration::from_secs(5)).unwrap();
+        let mut second = TcpStream::connect(addr).unwrap();
+        let mut refused = String::new();
+        second.read_to_string(&mut refused).unwrap();
+        assert!(
+            refused.starts_with("HTTP/1.1 503 Service Unavailable\r\n"),
+            "{refused}"
+        );
+        assert!(
+            refused.ends_with(
+                "\r\n\r\n127.0.0.1 has 1 connections open, the limit per address: close a tab \
+                 or try again shortly\n"
+            ),
+            "{refused}"
+        );
+        assert_eq!(gate.refused.snapshot().total(), 1);
+        stop.store(true, Ordering::Relaxed);
+        server.join().unwrap();
+        let mut bye = String::new();
+        first.read_to_string(&mut bye).unwrap();
+        assert!(
+            bye.starts_with("HTTP/1.1 200 OK\r\n") && bye.ends_with("bye\n"),
+            "{bye}"
+        );
+    }
+}
