@@ -3,6 +3,7 @@
 //! `503` and the gate's reason, then handled on its own thread while it holds its ticket.
 
 use crate::gate::{Gate, set_send_buffer};
+use crate::{Head, HeadError, read_head_bytes};
 use std::io::Write;
 use std::net::{TcpListener, TcpStream};
 use std::sync::Arc;
@@ -34,6 +35,31 @@ pub fn respond_text(stream: &mut TcpStream, status: &str, message: &str) {
         "",
         format!("{message}\n").as_bytes(),
     );
+}
+
+/// Reads a connection's request head within bounds and checks its `Host` and `Origin`: the
+/// head's bytes (to pass on unchanged) and the head, or `None` when it was refused. A head
+/// that never came or broke a bound is counted as `head` and answered `400 Bad Request`
+/// (a connection closed before its head gets no answer); a refused `Host` or `Origin` is
+/// counted by its kind and answered `403 Forbidden`, each with the reason.
+pub fn checked_head(stream: &mut TcpStream, gate: &Gate) -> Option<(Vec<u8>, Head)> {
+    match read_head_bytes(stream) {
+        Ok((bytes, head)) => match gate.guard.check(&head) {
+            Ok(()) => Some((bytes, head)),
+            Err(r) => {
+                gate.refused.count(r.kind());
+                respond_text(stream, "403 Forbidden", &r.to_string());
+                None
+            }
+        },
+        Err(e) => {
+            gate.refused.count("head");
+            if !matches!(e, HeadError::Closed) {
+                respond_text(stream, "400 Bad Request", &e.to_string());
+            }
+            None
+        }
+    }
 }
 
 /// Accepts connections on `listener` (non-blocking) until `stop` is raised. Each accepted
@@ -151,5 +177,47 @@ mod tests {
             bye.starts_with("HTTP/1.1 200 OK\r\n") && bye.ends_with("bye\n"),
             "{bye}"
         );
+    }
+
+    /// What a client sends and what `checked_head` answered it (`None`: let through).
+    fn exchange(request: &str) -> (Option<String>, crate::gate::RefusedCounts) {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let port = listener.local_addr().unwrap().port();
+        let guard = Guard {
+            port,
+            loopback_only: true,
+            other_origins: Vec::new(),
+        };
+        let gate = Gate::new(guard, Limits::default());
+        let mut client = TcpStream::connect(("127.0.0.1", port)).unwrap();
+        client
+            .write_all(request.replace("PORT", &port.to_string()).as_bytes())
+            .unwrap();
+        let (mut server, _) = listener.accept().unwrap();
+        let passed = checked_head(&mut server, &gate);
+        drop(server);
+        let answer = passed.is_none().then(|| {
+            let mut a = String::new();
+            client.read_to_string(&mut a).unwrap();
+            a.split("\r\n\r\n").nth(1).unwrap_or_default().to_string()
+        });
+        (answer, gate.refused.snapshot())
+    }
+
+    #[test]
+    fn a_head_is_let_through_or_answered_with_its_refusal() {
+        let (ok, counts) = exchange("GET / HTTP/1.1\r\nHost: 127.0.0.1:PORT\r\n\r\n");
+        assert_eq!((ok, counts.total()), (None, 0));
+        let (answer, counts) = exchange(
+            "GET /ws HTTP/1.1\r\nHost: localhost:PORT\r\nOrigin: https://evil.example\r\n\r\n",
+        );
+        assert!(answer.unwrap().contains("https://evil.example"));
+        assert_eq!((counts.origin, counts.total()), (1, 1));
+        let (answer, counts) = exchange("NONSENSE\r\n\r\n");
+        assert_eq!(
+            answer.unwrap(),
+            "the request line is not `METHOD TARGET HTTP/1.1`\n"
+        );
+        assert_eq!((counts.head, counts.total()), (1, 1));
     }
 }

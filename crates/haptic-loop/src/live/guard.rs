@@ -11,9 +11,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
 use std::time::Duration;
+use webguard::Guard;
 use webguard::gate::{Gate, Limits};
-use webguard::serve::{accept_until, respond_text};
-use webguard::{Guard, HeadError, read_head_bytes};
+use webguard::serve::{accept_until, checked_head, respond_text};
 
 /// The Foxglove web app's origin, allowed to connect (Foxglove's desktop app sends none).
 pub const FOXGLOVE_APP_ORIGIN: &str = "https://app.foxglove.dev";
@@ -83,18 +83,9 @@ impl Drop for LiveGuard {
 
 fn connection(mut client: TcpStream, gate: &Gate, backend: SocketAddr, stop: &AtomicBool) {
     let _ = client.set_nonblocking(false);
-    let (bytes, head) = match read_head_bytes(&mut client) {
-        Ok(x) => x,
-        Err(HeadError::Closed) => return,
-        Err(e) => {
-            gate.refused.count("head");
-            return respond_text(&mut client, "400 Bad Request", &e.to_string());
-        }
+    let Some((bytes, _)) = checked_head(&mut client, gate) else {
+        return;
     };
-    if let Err(r) = gate.guard.check(&head) {
-        gate.refused.count(r.kind());
-        return respond_text(&mut client, "403 Forbidden", &r.to_string());
-    }
     let Ok(mut server) = TcpStream::connect(backend) else {
         return respond_text(
             &mut client,

@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
 use std::time::Duration;
 use webguard::gate::{Gate, Limits};
-use webguard::{Guard, Head, HeadError, read_head};
+use webguard::{Guard, Head};
 
 /// A file of the page, built into the binary.
 #[derive(Clone, Copy, Debug)]
@@ -153,18 +153,9 @@ impl Drop for Listener {
 /// Reads and checks one request, then routes it.
 fn connection(mut stream: TcpStream, gate: &Arc<Gate>, routes: &dyn Routes) {
     let _ = stream.set_nodelay(true);
-    let head = match read_head(&mut stream) {
-        Ok(h) => h,
-        Err(HeadError::Closed) => return gate.refused.count("head"),
-        Err(e) => {
-            gate.refused.count("head");
-            return respond_text(&mut stream, "400 Bad Request", &e.to_string());
-        }
+    let Some((_, head)) = webguard::serve::checked_head(&mut stream, gate) else {
+        return;
     };
-    if let Err(r) = gate.guard.check(&head) {
-        gate.refused.count(r.kind());
-        return respond_text(&mut stream, "403 Forbidden", &r.to_string());
-    }
     if head.method != "GET" {
         return respond_text(&mut stream, "405 Method Not Allowed", "GET only");
     }
