@@ -29,7 +29,7 @@ fi
 step "cargo test (release profile)"
 cargo test --workspace --release
 
-step "fuzz: the program as a process (the in-tree driver's cli target, a fixed input set; libFuzzer runs in .ci/run, docs/fuzzing.md)"
+step "fuzz: every target of the in-tree driver, a fixed input set each (about 20 s; libFuzzer runs in .ci/run, docs/fuzzing.md)"
 cargo build --release -q -p nanohaptics-cli --bin nanohaptics
 cargo run --release -q -p nanohaptics-fuzz -- --ci
 
