@@ -7,6 +7,22 @@ cd "$(dirname "$0")/.."
 
 step() { printf '\n==> %s\n' "$*"; }
 
+# The tracked tree before the run: each path `git status` lists, with a hash of its content, so
+# the run's own changes are told from edits the developer had already made (docs/testing.md).
+tree_state() {
+  git status --porcelain --untracked-files=all | while IFS= read -r line; do
+    p=${line:3}
+    p=${p##* -> }
+    if [ -f "$p" ]; then h=$(git hash-object -- "$p"); else h=-; fi
+    printf '%s %s\n' "$line" "$h"
+  done
+}
+in_git=0
+if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+  in_git=1
+  tree_before=$(tree_state)
+fi
+
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
@@ -60,5 +76,17 @@ if [ -d crates/ot-py ]; then
   fi
   step "pytest (includes the docs examples and the sdist contents check)"
   .venv/bin/python -m pytest -q tests/python
+fi
+step "the tracked tree: nothing changed by this run (tests write under target/)"
+if [ "$in_git" = 1 ]; then
+  tree_after=$(tree_state)
+  if [ "$tree_before" != "$tree_after" ]; then
+    echo "the run changed these paths (git status --porcelain, then a hash of the content):" >&2
+    diff <(printf '%s\n' "$tree_before") <(printf '%s\n' "$tree_after") | grep '^[<>]' >&2 || true
+    exit 1
+  fi
+  echo "unchanged"
+else
+  echo "not a git work tree: not checked"
 fi
 step "all tests passed"
