@@ -75,7 +75,8 @@ if [ -d crates/ot-py ]; then
     target/venv-sdist/bin/python -c "import nanohaptics as nh; print('sdist install:', nh.__version__, nh.__file__)"
   fi
   step "pytest (includes the docs examples and the sdist contents check)"
-  .venv/bin/python -m pytest -q tests/python
+  # -rs: every skipped test with its reason (NANOHAPTICS_SKIP_REALTIME, docs/testing.md).
+  .venv/bin/python -m pytest -q -rs tests/python
 fi
 step "the tracked tree: nothing changed by this run (tests write under target/)"
 if [ "$in_git" = 1 ]; then
