@@ -7,6 +7,22 @@ cd "$(dirname "$0")/.."
 
 step() { printf '\n==> %s\n' "$*"; }
 
+# The tracked tree before the run: each path `git status` lists, with a hash of its content, so
+# the run's own changes are told from edits the developer had already made (docs/testing.md).
+tree_state() {
+  git status --porcelain --untracked-files=all | while IFS= read -r line; do
+    p=${line:3}
+    p=${p##* -> }
+    if [ -f "$p" ]; then h=$(git hash-object -- "$p"); else h=-; fi
+    printf '%s %s\n' "$line" "$h"
+  done
+}
+in_git=0
+if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+  in_git=1
+  tree_before=$(tree_state)
+fi
+
 step "cargo fmt --check"
 cargo fmt --all -- --check
 
@@ -29,7 +45,7 @@ fi
 step "cargo test (release profile)"
 cargo test --workspace --release
 
-step "fuzz: the program as a process (the in-tree driver's cli target, a fixed input set; libFuzzer runs in .ci/run, docs/fuzzing.md)"
+step "fuzz: every target of the in-tree driver, a fixed input set each (about 20 s; libFuzzer runs in .ci/run, docs/fuzzing.md)"
 cargo build --release -q -p nanohaptics-cli --bin nanohaptics
 cargo run --release -q -p nanohaptics-fuzz -- --ci
 
@@ -59,6 +75,19 @@ if [ -d crates/ot-py ]; then
     target/venv-sdist/bin/python -c "import nanohaptics as nh; print('sdist install:', nh.__version__, nh.__file__)"
   fi
   step "pytest (includes the docs examples and the sdist contents check)"
-  .venv/bin/python -m pytest -q tests/python
+  # -rs: every skipped test with its reason (NANOHAPTICS_SKIP_REALTIME, docs/testing.md).
+  .venv/bin/python -m pytest -q -rs tests/python
+fi
+step "the tracked tree: nothing changed by this run (tests write under target/)"
+if [ "$in_git" = 1 ]; then
+  tree_after=$(tree_state)
+  if [ "$tree_before" != "$tree_after" ]; then
+    echo "the run changed these paths (git status --porcelain, then a hash of the content):" >&2
+    diff <(printf '%s\n' "$tree_before") <(printf '%s\n' "$tree_after") | grep '^[<>]' >&2 || true
+    exit 1
+  fi
+  echo "unchanged"
+else
+  echo "not a git work tree: not checked"
 fi
 step "all tests passed"

@@ -5,7 +5,7 @@
 //! region) speaks of the game only; the menu shows each switch's value as it changes; a
 //! scripted gamepad (injected through the DevTools Protocol: headless Chromium has none) moves
 //! the hand, grips and rumbles with the force; page errors fail the tests; screenshots go to
-//! docs/figures/play/.
+//! the target folder's `tmp/figures/play/` (`scripts/figures.sh` writes them to docs/figures/play/).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -56,8 +56,14 @@ fn start(scene: &str, name: &str) -> Session {
     }
 }
 
+/// Where the screenshots go: under the target folder, so a test run leaves the tracked tree as
+/// it was; `scripts/figures.sh` names `docs/figures/play` in `NANOHAPTICS_FIGURES_DIR` to
+/// regenerate the docs' figures.
 fn figures() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/figures/play")
+    match std::env::var_os("NANOHAPTICS_FIGURES_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("figures/play"),
+    }
 }
 
 fn browser() -> Browser {

@@ -1,7 +1,8 @@
 //! The classroom in a real browser (Debian's headless `chromium`, through the DevTools
 //! Protocol): a student joins on the join page and starts playing; two more play through page
 //! links; the teacher page shows all three, sets a switch for everyone, ends every session and
-//! downloads the zip. Screenshots of the join and teacher pages go to docs/figures/play/.
+//! downloads the zip. Screenshots of the join and teacher pages go to the target folder's
+//! `tmp/figures/play/` (`scripts/figures.sh` writes them to docs/figures/play/).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -23,8 +24,14 @@ use tungstenite::{Message, WebSocket};
 
 type Ws = WebSocket<MaybeTlsStream<TcpStream>>;
 
+/// Where the screenshots go: under the target folder, so a test run leaves the tracked tree as
+/// it was; `scripts/figures.sh` names `docs/figures/play` in `NANOHAPTICS_FIGURES_DIR` to
+/// regenerate the docs' figures.
 fn figures() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/figures/play")
+    match std::env::var_os("NANOHAPTICS_FIGURES_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("figures/play"),
+    }
 }
 
 /// A student playing through a page link (no browser): joins, starts, and moves the hand
