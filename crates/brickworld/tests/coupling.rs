@@ -199,9 +199,9 @@ fn a_coupled_throw_leaves_with_the_hands_velocity() {
             _ => None,
         })
         .expect("a throw");
-    let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    // Each component within 0.012 m/s, 1 % of the 1.2 m/s throw (measured: 1e-14).
     for k in 0..3 {
-        assert!((v0[k] - v[k]).abs() < 0.02 * speed, "{v0:?} vs hand {v:?}");
+        assert!((v0[k] - v[k]).abs() < 0.01 * 1.2, "{v0:?} vs hand {v:?}");
     }
     // Nothing held. The brick was taken from above with the cursor on its top face and stays
     // there in the hand (its coupling starts at rest under its weight, issue 31), so at the
