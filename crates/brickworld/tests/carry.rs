@@ -270,7 +270,7 @@ fn a_thrown_brick_leaves_with_the_hands_velocity_and_lands_where_it_should() {
                 tau / DT,
             );
             assert!(
-                tau >= 0.0 && tau < 3.0 * DT,
+                (0.0..3.0 * DT).contains(&tau),
                 "{name}: stopped {tau} s above the ground"
             );
             assert!(v_err <= 0.02, "{name}: velocity {v_err}");
