@@ -188,7 +188,9 @@ fn a_coupled_throw_leaves_with_the_hands_velocity() {
         }
         hold(&mut w, c, true);
     }
+    let before = w.brick(BrickId(0)).unwrap().velocity_m_per_s;
     let rel = hold(&mut w, c, false);
+    let after = w.brick(BrickId(0)).unwrap().velocity_m_per_s;
     let v0 = rel
         .events
         .iter()
@@ -199,15 +201,31 @@ fn a_coupled_throw_leaves_with_the_hands_velocity() {
             _ => None,
         })
         .expect("a throw");
-    let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    // Each component within 0.012 m/s, 1 % of the 1.2 m/s throw (measured: 1e-14).
+    let g = w.params().gravity_m_per_s2;
     for k in 0..3 {
-        assert!((v0[k] - v[k]).abs() < 0.02 * speed, "{v0:?} vs hand {v:?}");
+        assert!((v0[k] - v[k]).abs() < 0.01 * 1.2, "{v0:?} vs hand {v:?}");
+        // The brick's own velocity just before the release was the hand's but for the
+        // coupling's swing: the release changes it by less than 0.05 m/s (measured 2.5 mm/s).
+        assert!(
+            (v0[k] - before[k]).abs() < 0.05,
+            "{v0:?} vs brick {before:?}"
+        );
+        // And the body leaves with it: after the release tick it moves at the released
+        // velocity less that tick's gravity (measured: within 1e-14 m/s).
+        let fall = if k == 2 { g * dt } else { 0.0 };
+        assert!(
+            (after[k] - (v0[k] - fall)).abs() < 1e-9,
+            "body {after:?} vs released {v0:?}"
+        );
     }
-    // Nothing held. The brick was taken from above with the cursor on its top face and stays
-    // there in the hand (its coupling starts at rest under its weight, issue 31), so at the
-    // release the cursor may still touch it: a light push, not the weight.
-    let f = (rel.force_n[0].powi(2) + rel.force_n[1].powi(2) + rel.force_n[2].powi(2)).sqrt();
-    assert!(f < 1.0, "{:?}", rel.force_n);
+    // Nothing held, nothing touched: no force. The cursor still sits on the brick's top face
+    // (taken from above, issue 31), but the hand passes through a brick it let go of until it
+    // has left it, so the release tick renders exactly nothing.
+    assert_eq!(
+        rel.force_n, [0.0; 3],
+        "nothing held, nothing touched: no force"
+    );
     // Flight: gravity only (no contact within 0.1 s).
     let b0 = w.brick(BrickId(0)).unwrap();
     for _ in 0..100 {

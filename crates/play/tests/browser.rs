@@ -910,8 +910,9 @@ fn a_gamepad_moves_the_hand_grips_and_rumbles_with_the_force() {
 }
 
 /// The page's words for every game event of the golden recordings (recordings/*.mcap: the
-/// brick and nano worlds, the wall, the optical tweezers): a short sentence, never JSON, and
-/// nothing for the loop's reports and the events the player hears or feels.
+/// brick world under both solver settings, the nano world, the wall, the optical tweezers): a
+/// short sentence, never JSON, and nothing for the loop's reports and the events the player
+/// hears or feels.
 #[test]
 fn every_game_event_of_the_golden_recordings_reads_as_a_short_sentence() {
     let _one = serial();
@@ -923,6 +924,7 @@ fn every_game_event_of_the_golden_recordings_reads_as_a_short_sentence() {
     let mut said_names = std::collections::BTreeSet::new();
     for file in [
         "brickworld.mcap",
+        "brickworld_shipped.mcap",
         "nanoworld.mcap",
         "wall.mcap",
         "optical_tweezers.mcap",
