@@ -122,6 +122,9 @@ pub fn write(
     Ok(files)
 }
 
+/// The events a house chart marks: event name, its label on the chart, its colour (RGB).
+type EventMarks<'a> = &'a [(&'a str, &'a str, [u8; 3])];
+
 /// The house tasks: force over time with their events.
 fn house_figures(
     dir: &Path,
@@ -129,30 +132,41 @@ fn house_figures(
     runs: &Runs,
     files: &mut Vec<String>,
 ) -> Result<(), LessonError> {
-    let macro_chart = house_chart(
-        "Macro world: building the wall (force on the hand, world frame)",
-        "force (N)",
-        &runs.macro_house,
-        1.0,
-        &[
-            ("brick.grabbed", "grab", GREEN),
-            ("brick.released", "release", RED),
-            ("brick.slot_filled", "slot", PURPLE),
-        ],
-    );
-    save(dir, "macro_forces.png", w, &macro_chart, files)?;
-    let nano_chart = house_chart(
-        "Nano world: building the house (force on the tip, world frame)",
-        "force (nN)",
-        &runs.nano_house,
-        1e9,
-        &[
-            ("nano.snap", "snap", GREEN),
-            ("nano.pull_off", "pull-off", RED),
-            ("nano.slot_filled", "slot", PURPLE),
-        ],
-    );
-    save(dir, "nano_forces.png", w, &nano_chart, files)?;
+    let worlds: [(&str, &str, &Run, f64, EventMarks, &str); 2] = [
+        (
+            "Macro world: building the wall (force on the hand, world frame)",
+            "force (N)",
+            &runs.macro_house,
+            1.0,
+            &[
+                ("brick.grabbed", "grab", GREEN),
+                ("brick.released", "release", RED),
+                ("brick.slot_filled", "slot", PURPLE),
+            ],
+            "macro_forces.png",
+        ),
+        (
+            "Nano world: building the house (force on the tip, world frame)",
+            "force (nN)",
+            &runs.nano_house,
+            1e9,
+            &[
+                ("nano.snap", "snap", GREEN),
+                ("nano.pull_off", "pull-off", RED),
+                ("nano.slot_filled", "slot", PURPLE),
+            ],
+            "nano_forces.png",
+        ),
+    ];
+    for (title, y_label, run, scale, events, file) in worlds {
+        save(
+            dir,
+            file,
+            w,
+            &house_chart(title, y_label, run, scale, events),
+            files,
+        )?;
+    }
     Ok(())
 }
 
@@ -165,32 +179,30 @@ fn lift_figures(
 ) -> Result<(), LessonError> {
     let labels = ["normal", "gravity off", "inertia off"];
     let colors = [BLUE, GREEN, ORANGE];
-    let mut c = Chart::new(
-        "Lift and carry a brick: vertical force (weight)",
-        "time (s)",
-        "Fz (N)",
-    );
-    c.series = runs
-        .lifts
-        .iter()
-        .zip(labels.iter().zip(colors))
-        .map(|(r, (l, col))| series(l, force_curve(r, 2, 1.0), col, Style::Line))
-        .collect();
-    c.markers = lift_markers();
-    save(dir, "lift_weight.png", w, &c, files)?;
-    let mut c = Chart::new(
-        "Lift and carry a brick: sideways force (inertia −M a)",
-        "time (s)",
-        "Fx (N)",
-    );
-    c.series = runs
-        .lifts
-        .iter()
-        .zip(labels.iter().zip(colors))
-        .map(|(r, (l, col))| series(l, force_curve(r, 0, 1.0), col, Style::Line))
-        .collect();
-    c.markers = lift_markers();
-    save(dir, "lift_inertia.png", w, &c, files)?;
+    for (title, y_label, axis, file) in [
+        (
+            "Lift and carry a brick: vertical force (weight)",
+            "Fz (N)",
+            2,
+            "lift_weight.png",
+        ),
+        (
+            "Lift and carry a brick: sideways force (inertia −M a)",
+            "Fx (N)",
+            0,
+            "lift_inertia.png",
+        ),
+    ] {
+        let mut c = Chart::new(title, "time (s)", y_label);
+        c.series = runs
+            .lifts
+            .iter()
+            .zip(labels.iter().zip(colors))
+            .map(|(r, (l, col))| series(l, force_curve(r, axis, 1.0), col, Style::Line))
+            .collect();
+        c.markers = lift_markers();
+        save(dir, file, w, &c, files)?;
+    }
     Ok(())
 }
 
@@ -333,13 +345,7 @@ fn scale_figures(
 }
 
 /// Force over time of a house task (vertical and magnitude, × `unit`) with its events marked.
-fn house_chart(
-    title: &str,
-    y_label: &str,
-    r: &Run,
-    unit: f64,
-    events: &[(&str, &str, [u8; 3])],
-) -> Chart {
+fn house_chart(title: &str, y_label: &str, r: &Run, unit: f64, events: EventMarks) -> Chart {
     let mut c = Chart::new(title, "time (s)", y_label);
     c.series = vec![
         series(
