@@ -40,17 +40,9 @@ pub enum EnvelopeError {
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, EnvelopeError>;
 
-/// Check that `value` is finite and strictly positive.
+/// Check that `value` is finite and strictly positive ([`ot_physics::error::positive_value`]).
 pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(EnvelopeError::Value(ValueError::out_of_range(
-            field,
-            value,
-            "finite and > 0",
-        )))
-    }
+    Ok(ot_physics::error::positive_value(field, value)?)
 }
 
 /// Check that every component is finite.

@@ -56,17 +56,19 @@ pub enum PhysicsError {
 /// Result alias used across the crate.
 pub type Result<T> = std::result::Result<T, PhysicsError>;
 
-/// Check that `value` is finite and strictly positive.
-pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {
+/// Check that `value` is finite and strictly positive; the error names `field` and the range
+/// (the check of every crate built on this one).
+pub fn positive_value(field: &'static str, value: f64) -> std::result::Result<f64, ValueError> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(PhysicsError::Value(ValueError::out_of_range(
-            field,
-            value,
-            "finite and > 0",
-        )))
+        Err(ValueError::out_of_range(field, value, "finite and > 0"))
     }
+}
+
+/// Check that `value` is finite and strictly positive ([`positive_value`]).
+pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {
+    Ok(positive_value(field, value)?)
 }
 
 /// Check that `value` is finite (any sign).

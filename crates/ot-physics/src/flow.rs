@@ -48,6 +48,16 @@ fn check<const D: usize>(field: &'static str, x: &SVector<f64, D>) -> Result<()>
     Ok(())
 }
 
+/// The start phase of one flow, the particle at `-offset` from the trap centre moving at `v0`,
+/// once the call is not cancelled and both vectors are finite.
+#[inline]
+fn start<const D: usize>(offset: &SVector<f64, D>, v0: &SVector<f64, D>) -> Result<Phase<D>> {
+    crate::cancel::check()?;
+    check("offset [m]", offset)?;
+    check("velocity [m/s]", v0)?;
+    Ok(Phase { r: -offset, v: *v0 })
+}
+
 impl<const D: usize> Propagator<D> {
     /// Displacement (m) and end velocity (m/s) after Δt of a particle with
     /// initial velocity `v0` (m/s) when the trap centre sits at `offset` (m)
@@ -57,20 +67,14 @@ impl<const D: usize> Propagator<D> {
         offset: &SVector<f64, D>,
         v0: &SVector<f64, D>,
     ) -> Result<(SVector<f64, D>, SVector<f64, D>, u64)> {
-        crate::cancel::check()?;
-        check("offset [m]", offset)?;
-        check("velocity [m/s]", v0)?;
-        let y0 = Phase { r: -offset, v: *v0 };
+        let y0 = start(offset, v0)?;
         let p = self.phase(&y0)?;
         Ok((p.end.r - y0.r, p.end.v, p.evals))
     }
 
     /// [`Propagator::flow`] plus the Jacobians from the variational equations.
     pub fn flow_jacobian(&self, offset: &SVector<f64, D>, v0: &SVector<f64, D>) -> Result<Flow<D>> {
-        crate::cancel::check()?;
-        check("offset [m]", offset)?;
-        check("velocity [m/s]", v0)?;
-        let y0 = Phase { r: -offset, v: *v0 };
+        let y0 = start(offset, v0)?;
         let p = self.phase_var(&y0)?;
         let e = p.end;
         // r(Δt) depends on r0 = −offset: d(r − r0)/d offset = I − ∂r/∂r0.
@@ -93,10 +97,7 @@ impl<const D: usize> Propagator<D> {
         offset: &SVector<f64, D>,
         v0: &SVector<f64, D>,
     ) -> Result<OffsetFlow<D>> {
-        crate::cancel::check()?;
-        check("offset [m]", offset)?;
-        check("velocity [m/s]", v0)?;
-        let y0 = Phase { r: -offset, v: *v0 };
+        let y0 = start(offset, v0)?;
         let p = self.phase_sens(&y0)?;
         let e = p.end;
         Ok(OffsetFlow {

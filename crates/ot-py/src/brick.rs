@@ -9,11 +9,11 @@ use haptic_devices::source::DeviceSource;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyString};
 use world_form::Limits;
 
 use crate::convert::{SIGNAL_CHUNK_TICKS, array2_flat, int_in, numbers, value_error, vector};
-use crate::json::{from_py, to_py};
+use crate::json::{from_py, tick_events, to_py};
 
 /// The grip commands by their names in `brickworld::Grip`.
 const GRIP_KEYS: [&str; 4] = ["hold", "turn_x", "turn_y", "turn_z"];
@@ -167,13 +167,8 @@ fn ticks_to_py<'py>(
     d.set_item("held", PyArray1::from_vec(py, held))?;
     let filled: Vec<i64> = ticks.iter().map(|t| t.filled as i64).collect();
     d.set_item("filled", PyArray1::from_vec(py, filled))?;
-    let ev = PyList::empty(py);
-    for (i, t) in ticks.iter().enumerate() {
-        for e in &t.report.events {
-            ev.append((i, to_py(py, e)?))?;
-        }
-    }
-    d.set_item("events", ev)?;
+    let events = ticks.iter().map(|t| t.report.events.as_slice());
+    d.set_item("events", tick_events(py, events)?)?;
     // Brick poses: (T, B, 3) and (T, B, 4) with B the brick count after the last tick; a
     // brick that did not exist yet at a tick has position 0 and orientation [0, 0, 0, 1]
     // there ("brick_count" (T,) says how many existed).

@@ -78,20 +78,35 @@ fn to_vectors<const D: usize>(data: &[f64]) -> Vec<SVector<f64, D>> {
         .collect()
 }
 
+/// An array-like of finite numbers whose shape `fits`: otherwise a ValueError
+/// `"{name}: expected shape {expected}, got (...)"`, then one naming the first non-finite value.
+fn shaped(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    unit: &str,
+    fits: impl FnOnce(&[usize]) -> bool,
+    expected: impl FnOnce() -> String,
+) -> PyResult<Numbers> {
+    let n = numbers(obj, name)?;
+    if !fits(&n.shape) {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected shape {}, got {}",
+            expected(),
+            shape_text(&n.shape)
+        )));
+    }
+    all_finite(&n, name, unit)?;
+    Ok(n)
+}
+
 /// An `(N, D)` array of finite numbers as N vectors.
 pub(crate) fn rows<const D: usize>(
     obj: &Bound<'_, PyAny>,
     name: &str,
     unit: &str,
 ) -> PyResult<Vec<SVector<f64, D>>> {
-    let n = numbers(obj, name)?;
-    if n.shape.len() != 2 || n.shape[1] != D {
-        return Err(PyValueError::new_err(format!(
-            "{name}: expected shape (N, {D}), got {}",
-            shape_text(&n.shape)
-        )));
-    }
-    all_finite(&n, name, unit)?;
+    let fits = |s: &[usize]| s.len() == 2 && s[1] == D;
+    let n = shaped(obj, name, unit, fits, || format!("(N, {D})"))?;
     Ok(to_vectors(&n.data))
 }
 
@@ -101,14 +116,7 @@ pub(crate) fn vector<const D: usize>(
     name: &str,
     unit: &str,
 ) -> PyResult<SVector<f64, D>> {
-    let n = numbers(obj, name)?;
-    if n.shape != [D] {
-        return Err(PyValueError::new_err(format!(
-            "{name}: expected shape ({D},), got {}",
-            shape_text(&n.shape)
-        )));
-    }
-    all_finite(&n, name, unit)?;
+    let n = shaped(obj, name, unit, |s| s == [D], || format!("({D},)"))?;
     Ok(SVector::<f64, D>::from_column_slice(&n.data))
 }
 
@@ -119,15 +127,10 @@ pub(crate) fn one_or_rows<const D: usize>(
     unit: &str,
     n_rows: usize,
 ) -> PyResult<Vec<SVector<f64, D>>> {
-    let n = numbers(obj, name)?;
-    let ok = n.shape == [D] || n.shape == [n_rows, D];
-    if !ok {
-        return Err(PyValueError::new_err(format!(
-            "{name}: expected shape ({D},) or ({n_rows}, {D}), got {}",
-            shape_text(&n.shape)
-        )));
-    }
-    all_finite(&n, name, unit)?;
+    let fits = |s: &[usize]| s == [D] || s == [n_rows, D];
+    let n = shaped(obj, name, unit, fits, || {
+        format!("({D},) or ({n_rows}, {D})")
+    })?;
     Ok(to_vectors(&n.data))
 }
 
@@ -138,16 +141,9 @@ pub(crate) fn point_or_rows<const D: usize>(
     name: &str,
     unit: &str,
 ) -> PyResult<(Vec<SVector<f64, D>>, bool)> {
-    let n = numbers(obj, name)?;
-    let single = n.shape == [D];
-    if !(single || (n.shape.len() == 2 && n.shape[1] == D)) {
-        return Err(PyValueError::new_err(format!(
-            "{name}: expected shape ({D},) or (N, {D}), got {}",
-            shape_text(&n.shape)
-        )));
-    }
-    all_finite(&n, name, unit)?;
-    Ok((to_vectors(&n.data), single))
+    let fits = |s: &[usize]| s == [D] || (s.len() == 2 && s[1] == D);
+    let n = shaped(obj, name, unit, fits, || format!("({D},) or (N, {D})"))?;
+    Ok((to_vectors(&n.data), n.shape == [D]))
 }
 
 /// A Python integer in `lo ..= hi`: TypeError naming `name` for a non-integer (a bool is

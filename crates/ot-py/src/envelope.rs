@@ -60,19 +60,24 @@ fn tick<const D: usize>(
     Propagator::new(model, m, dt).map_err(value_error)
 }
 
-fn planar(trap: &GaussianTrap, call: &str) -> PyResult<TrapModel<2>> {
-    match trap.deterministic() {
-        Model::D2(m) => Ok(m),
-        Model::D3(_) => Err(PyValueError::new_err(format!(
-            "trap: {call} needs a 2D trap (axial_waist=None); use working_envelope_3d for 3D"
-        ))),
-    }
-}
-
-fn velocity2(model: &TrapModel<2>, velocity: &Bound<'_, PyAny>) -> PyResult<SVector<f64, 2>> {
+/// The deterministic model of a 2D `trap` for the function `call`, and the particle's
+/// initial `velocity` (2,) (m/s) checked against it.
+fn planar(
+    trap: &GaussianTrap,
+    call: &str,
+    velocity: &Bound<'_, PyAny>,
+) -> PyResult<(TrapModel<2>, SVector<f64, 2>)> {
+    let model = match trap.deterministic() {
+        Model::D2(m) => m,
+        Model::D3(_) => {
+            return Err(PyValueError::new_err(format!(
+                "trap: {call} needs a 2D trap (axial_waist=None); use working_envelope_3d for 3D"
+            )));
+        }
+    };
     let v = vector::<2>(velocity, "velocity", "m/s")?;
-    check_overdamped_velocity(model, &[v])?;
-    Ok(v)
+    check_overdamped_velocity(&model, &[v])?;
+    Ok((model, v))
 }
 
 /// Every trap offset (trap centre relative to the particle, m) that moves a
@@ -108,8 +113,7 @@ pub fn solve_trap<'py>(
     rtol: Option<f64>,
     substeps: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let model = planar(trap, "solve_trap")?;
-    let v0 = velocity2(&model, velocity)?;
+    let (model, v0) = planar(trap, "solve_trap", velocity)?;
     let target = vector::<2>(target, "target", "m")?;
     let prop = tick(py, model, dt, method, rtol, substeps)?;
     let s = interruptible_flows(py, || solve(&prop, &v0, &target))?.map_err(value_error)?;
@@ -140,8 +144,7 @@ pub fn working_envelope<'py>(
     rtol: Option<f64>,
     substeps: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let model = planar(trap, "working_envelope")?;
-    let v0 = velocity2(&model, velocity)?;
+    let (model, v0) = planar(trap, "working_envelope", velocity)?;
     let prop = tick(py, model, dt, method, rtol, substeps)?;
     let e = interruptible_flows(py, || we(&prop, &v0, tol))?.map_err(value_error)?;
     array2(py, &e.polygon)
@@ -176,8 +179,7 @@ pub fn clip_command<'py>(
     rtol: Option<f64>,
     substeps: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let model = planar(trap, "clip_command")?;
-    let v0 = velocity2(&model, velocity)?;
+    let (model, v0) = planar(trap, "clip_command", velocity)?;
     let command = vector::<2>(command, "command", "m")?;
     let mode = match mode {
         "radial" | "nearest" => ClipMode::from_name(mode).map_err(value_error)?,

@@ -51,6 +51,21 @@ pub(crate) fn to_py<'py, T: Serialize>(py: Python<'py>, t: &T) -> PyResult<Bound
     value_to_py(py, &v)
 }
 
+/// The events of a batch as a list of `(tick, event dict)`, `tick` the row index of the tick
+/// that raised it.
+pub(crate) fn tick_events<'a, 'py, E: Serialize + 'a>(
+    py: Python<'py>,
+    per_tick: impl Iterator<Item = &'a [E]>,
+) -> PyResult<Bound<'py, PyList>> {
+    let ev = PyList::empty(py);
+    for (k, events) in per_tick.enumerate() {
+        for e in events {
+            ev.append((k, to_py(py, e)?))?;
+        }
+    }
+    Ok(ev)
+}
+
 /// A Python value (dicts, lists, tuples, numpy arrays, floats, ints, bools,
 /// strings) as a TOML value, keeping every float as it is — NaN and ±inf
 /// included, so that they reach the wrapped crate's validation, which names

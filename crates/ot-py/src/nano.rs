@@ -12,7 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::convert::{SIGNAL_CHUNK_TICKS, array1, array2, int_in, rows, value_error, vector};
-use crate::json::to_py;
+use crate::json::{tick_events, to_py};
 use crate::params_dict::{limits_from_py, params_from_py};
 
 /// What one tick of a batch left behind.
@@ -168,13 +168,8 @@ impl NanoWorld {
         d.set_item("carried", PyArray1::from_vec(py, carried))?;
         let score: Vec<i64> = records.iter().map(|r| r.score as i64).collect();
         d.set_item("score", PyArray1::from_vec(py, score))?;
-        let ev = PyList::empty(py);
-        for (k, r) in records.iter().enumerate() {
-            for e in &r.events {
-                ev.append((k, to_py(py, e)?))?;
-            }
-        }
-        d.set_item("events", ev)?;
+        let events = records.iter().map(|r| r.events.as_slice());
+        d.set_item("events", tick_events(py, events)?)?;
         Ok(d)
     }
 

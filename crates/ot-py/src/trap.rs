@@ -60,8 +60,14 @@ macro_rules! with_model {
 #[derive(Debug, Clone)]
 pub struct GaussianTrap {
     pub(crate) model: Model,
+    /// Particle radius (m), or None.
+    #[pyo3(get)]
     radius: Option<f64>,
+    /// Fluid viscosity (Pa·s), or None.
+    #[pyo3(get)]
     viscosity: Option<f64>,
+    /// Temperature (K), or None (no thermal noise).
+    #[pyo3(get)]
     temperature: Option<f64>,
 }
 
@@ -79,15 +85,13 @@ impl GaussianTrap {
     /// The model without thermal noise: the deterministic dynamics the flow
     /// map and trajectories integrate.
     pub(crate) fn deterministic(&self) -> Model {
+        fn without_noise<const D: usize>(mut m: TrapModel<D>) -> TrapModel<D> {
+            m.kt = None;
+            m
+        }
         match self.model {
-            Model::D2(mut m) => {
-                m.kt = None;
-                Model::D2(m)
-            }
-            Model::D3(mut m) => {
-                m.kt = None;
-                Model::D3(m)
-            }
+            Model::D2(m) => Model::D2(without_noise(m)),
+            Model::D3(m) => Model::D3(without_noise(m)),
         }
     }
 
@@ -155,22 +159,41 @@ fn positive(value: f64, name: &str, unit: &str) -> PyResult<f64> {
     }
 }
 
-fn displacement_d<const D: usize>(
-    py: Python<'_>,
-    model: TrapModel<D>,
-    offsets: &Bound<'_, PyAny>,
-    velocity: &Bound<'_, PyAny>,
-    dt: f64,
-    method: Method,
-) -> PyResult<Py<PyArray2<f64>>> {
-    let offsets = rows::<D>(offsets, "offsets", "m")?;
-    let velocities = one_or_rows::<D>(velocity, "velocity", "m/s", offsets.len())?;
-    check_overdamped_velocity(&model, &velocities)?;
-    let prop = Propagator::new(model, method, dt).map_err(value_error)?;
+/// A batch of flows: the offsets (N, D) (m), their initial velocities (one (D,) for all or
+/// (N, D)) (m/s) and the model bound to a method over Δt.
+struct FlowBatch<const D: usize> {
+    offsets: Vec<SVector<f64, D>>,
+    velocities: Vec<SVector<f64, D>>,
+    prop: Propagator<D>,
+}
+
+impl<const D: usize> FlowBatch<D> {
+    /// Read and check `offsets` and `velocity`, then bind `model` to `method` over `dt` (s).
+    fn new(
+        model: TrapModel<D>,
+        offsets: &Bound<'_, PyAny>,
+        velocity: &Bound<'_, PyAny>,
+        dt: f64,
+        method: Method,
+    ) -> PyResult<Self> {
+        let offsets = rows::<D>(offsets, "offsets", "m")?;
+        let velocities = one_or_rows::<D>(velocity, "velocity", "m/s", offsets.len())?;
+        check_overdamped_velocity(&model, &velocities)?;
+        let prop = Propagator::new(model, method, dt).map_err(value_error)?;
+        Ok(Self {
+            offsets,
+            velocities,
+            prop,
+        })
+    }
+}
+
+fn displacement_d<const D: usize>(py: Python<'_>, b: FlowBatch<D>) -> PyResult<Py<PyArray2<f64>>> {
     let out = py
         .detach(|| {
-            let mut out = vec![SVector::<f64, D>::zeros(); offsets.len()];
-            prop.flow_batch(&offsets, &velocities, &mut out)
+            let mut out = vec![SVector::<f64, D>::zeros(); b.offsets.len()];
+            b.prop
+                .flow_batch(&b.offsets, &b.velocities, &mut out)
                 .map(|_| out)
         })
         .map_err(value_error)?;
@@ -178,7 +201,7 @@ fn displacement_d<const D: usize>(
         return Err(PyValueError::new_err(format!(
             "displacement[{i}] is not finite: dt = {} s is beyond what the integrator \
              can follow for this model (use a shorter dt)",
-            world_form::numbers::fmt_num(dt)
+            world_form::numbers::fmt_num(b.prop.dt())
         )));
     }
     Ok(array2(py, &out)?.unbind())
@@ -193,28 +216,20 @@ fn flat_matrices<const D: usize>(m: &[nalgebra::SMatrix<f64, D, D>]) -> Vec<f64>
 
 fn flow_jacobian_d<'py, const D: usize>(
     py: Python<'py>,
-    model: TrapModel<D>,
-    offsets: &Bound<'py, PyAny>,
-    velocity: &Bound<'py, PyAny>,
-    dt: f64,
-    method: Method,
+    b: FlowBatch<D>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let offsets = rows::<D>(offsets, "offsets", "m")?;
-    let velocities = one_or_rows::<D>(velocity, "velocity", "m/s", offsets.len())?;
-    check_overdamped_velocity(&model, &velocities)?;
-    let prop = Propagator::new(model, method, dt).map_err(value_error)?;
     let flows = py
         .detach(|| {
-            offsets
+            b.offsets
                 .iter()
                 .enumerate()
                 .map(|(i, o)| {
-                    let v = if velocities.len() == 1 {
-                        &velocities[0]
+                    let v = if b.velocities.len() == 1 {
+                        &b.velocities[0]
                     } else {
-                        &velocities[i]
+                        &b.velocities[i]
                     };
-                    prop.flow_jacobian(o, v)
+                    b.prop.flow_jacobian(o, v)
                 })
                 .collect::<Result<Vec<_>, _>>()
         })
@@ -343,6 +358,36 @@ fn potential_d<const D: usize>(
     })
 }
 
+/// The particle and its fluid, the same options in either dimension.
+struct Particle {
+    mass: Option<f64>,
+    radius: Option<f64>,
+    viscosity: Option<f64>,
+    temperature: Option<f64>,
+}
+
+/// The validated model of `D` dimensions with these waists (m); `external_force` (N), one
+/// entry per axis, defaults to zero.
+fn build<const D: usize>(
+    depth: f64,
+    waists: [f64; D],
+    p: Particle,
+    external_force: Option<&Bound<'_, PyAny>>,
+) -> PyResult<TrapModel<D>> {
+    let f = match external_force {
+        Some(f) => vector::<D>(f, "external_force", "N")?.into(),
+        None => [0.0; D],
+    };
+    TrapModel::builder(depth, waists)
+        .maybe_mass(p.mass)
+        .radius(p.radius)
+        .viscosity(p.viscosity)
+        .temperature(p.temperature)
+        .external_force(f)
+        .build()
+        .map_err(value_error)
+}
+
 fn tuple_of<'py>(py: Python<'py>, v: &[f64]) -> PyResult<Bound<'py, PyTuple>> {
     PyTuple::new(py, v.iter().copied())
 }
@@ -369,39 +414,15 @@ impl GaussianTrap {
             )));
         }
         let (a, b) = (numbers.data[0], numbers.data[1]);
+        let particle = Particle {
+            mass,
+            radius,
+            viscosity,
+            temperature,
+        };
         let model = match axial_waist {
-            None => {
-                let f = match external_force {
-                    Some(f) => vector::<2>(f, "external_force", "N")?.into(),
-                    None => [0.0; 2],
-                };
-                Model::D2(
-                    TrapModel::builder(depth, [a, b])
-                        .maybe_mass(mass)
-                        .radius(radius)
-                        .viscosity(viscosity)
-                        .temperature(temperature)
-                        .external_force(f)
-                        .build()
-                        .map_err(value_error)?,
-                )
-            }
-            Some(c) => {
-                let f = match external_force {
-                    Some(f) => vector::<3>(f, "external_force", "N")?.into(),
-                    None => [0.0; 3],
-                };
-                Model::D3(
-                    TrapModel::builder(depth, [a, b, c])
-                        .maybe_mass(mass)
-                        .radius(radius)
-                        .viscosity(viscosity)
-                        .temperature(temperature)
-                        .external_force(f)
-                        .build()
-                        .map_err(value_error)?,
-                )
-            }
+            None => Model::D2(build(depth, [a, b], particle, external_force)?),
+            Some(c) => Model::D3(build(depth, [a, b, c], particle, external_force)?),
         };
         // ot-physics accepts any positive waist; one so small that the stiffness
         // 2·ln2·P0/w² overflows would integrate to NaN. Refuse it here, by name, until the
@@ -456,7 +477,7 @@ impl GaussianTrap {
         substeps: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Py<PyArray2<f64>>> {
         let method = parse_method(method, rtol, substeps, MAX_FLOW_SUBSTEPS)?;
-        with_model!(self.deterministic(), m => displacement_d(py, m, offsets, velocity, dt, method))
+        with_model!(self.deterministic(), m => displacement_d(py, FlowBatch::new(m, offsets, velocity, dt, method)?))
     }
 
     /// The flow map with its derivatives (variational equations), per offset.
@@ -479,7 +500,7 @@ impl GaussianTrap {
         substeps: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let method = parse_method(method, rtol, substeps, MAX_FLOW_SUBSTEPS)?;
-        with_model!(self.deterministic(), m => flow_jacobian_d(py, m, offsets, velocity, dt, method))
+        with_model!(self.deterministic(), m => flow_jacobian_d(py, FlowBatch::new(m, offsets, velocity, dt, method)?))
     }
 
     /// Positions and velocities at ``samples`` evenly spaced times over
@@ -610,24 +631,6 @@ impl GaussianTrap {
     #[getter]
     fn mass(&self) -> Option<f64> {
         with_model!(&self.model, m => m.mass)
-    }
-
-    /// Particle radius (m), or None.
-    #[getter]
-    fn radius(&self) -> Option<f64> {
-        self.radius
-    }
-
-    /// Fluid viscosity (Pa·s), or None.
-    #[getter]
-    fn viscosity(&self) -> Option<f64> {
-        self.viscosity
-    }
-
-    /// Temperature (K), or None (no thermal noise).
-    #[getter]
-    fn temperature(&self) -> Option<f64> {
-        self.temperature
     }
 
     /// Stokes drag coefficient γ = 6πηr (kg/s), or None (no drag).

@@ -16,7 +16,7 @@
 
 use std::path::Path;
 
-use crate::error::RenderError;
+use crate::error::{RenderError, out_of_range};
 
 /// Largest peak amplitude of one sound.
 pub const A_MAX: f64 = 0.8;
@@ -198,18 +198,14 @@ pub fn synthesize(
     sample_rate_hz: u32,
 ) -> Result<Vec<f32>, RenderError> {
     if !(8_000..=192_000).contains(&sample_rate_hz) {
-        return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+        return Err(out_of_range(
             "sample_rate_hz",
             f64::from(sample_rate_hz),
             "8000–192000 Hz",
-        )));
+        ));
     }
     if !(duration_s.is_finite() && (0.0..=3600.0).contains(&duration_s)) {
-        return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
-            "duration_s",
-            duration_s,
-            "0–3600 s",
-        )));
+        return Err(out_of_range("duration_s", duration_s, "0–3600 s"));
     }
     let sr = f64::from(sample_rate_hz);
     let n = (duration_s * sr).round() as usize;
@@ -333,18 +329,14 @@ impl StreamSynth {
         proximity_on_distance_m: Option<f64>,
     ) -> Result<Self, RenderError> {
         if !(8_000..=192_000).contains(&sample_rate_hz) {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+            return Err(out_of_range(
                 "sample_rate_hz",
                 f64::from(sample_rate_hz),
                 "8000–192000 Hz",
-            )));
+            ));
         }
         if !(dt_s.is_finite() && dt_s > 0.0 && dt_s <= 1.0) {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
-                "dt_s",
-                dt_s,
-                "0 < dt_s ≤ 1 s",
-            )));
+            return Err(out_of_range("dt_s", dt_s, "0 < dt_s ≤ 1 s"));
         }
         Ok(StreamSynth {
             sr: f64::from(sample_rate_hz),

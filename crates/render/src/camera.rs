@@ -6,9 +6,9 @@
 //! metre in any plane facing the camera is `pixels_per_m` pixels everywhere on the image and a
 //! scale bar is exact.
 
-use crate::error::{RenderError, finite, finite3};
+use crate::error::{RenderError, finite, finite3, out_of_range};
 use haptic_types::Primitive;
-use haptic_types::vec3::{Vec3, add, axes, cross, dot, normalize, scale, sub};
+use haptic_types::vec3::{Vec3, add, axes, box_corners, cross, dot, normalize, normq, sub};
 
 /// Largest image side the renderer makes, px (`picture`'s).
 pub use picture::MAX_SIDE_PX;
@@ -69,11 +69,11 @@ impl View {
             finite(|| "view.elevation_rad".into(), elevation_rad)?;
             let lim = std::f64::consts::FRAC_PI_2;
             if elevation_rad.abs() >= lim {
-                return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                return Err(out_of_range(
                     "view.elevation_rad",
                     elevation_rad,
                     "(-pi/2, pi/2) rad; use View::Top for straight down",
-                )));
+                ));
             }
         }
         Ok(())
@@ -134,14 +134,8 @@ pub fn bounds(prims: &[Primitive]) -> Option<(Vec3, Vec3)> {
                 rotation,
                 ..
             } => {
-                let n = rotation.iter().map(|v| v * v).sum::<f64>().sqrt();
-                let ax = axes(rotation.map(|v| v / n));
-                for k in 0..8 {
-                    let mut c = *center_m;
-                    for (i, a) in ax.iter().enumerate() {
-                        let sgn = if k & (1 << i) == 0 { -1.0 } else { 1.0 };
-                        c = add(c, scale(*a, sgn * half_extents_m[i]));
-                    }
+                let ax = axes(normq(*rotation));
+                for c in box_corners(*center_m, ax, *half_extents_m) {
                     grow(c);
                 }
             }
@@ -231,11 +225,11 @@ impl Camera {
         finite3("camera.center_m", center_m)?;
         finite(|| "camera.pixels_per_m".into(), pixels_per_m)?;
         if pixels_per_m <= 0.0 {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+            return Err(out_of_range(
                 "camera.pixels_per_m",
                 pixels_per_m,
                 "(0, inf) px/m",
-            )));
+            ));
         }
         check_size(width_px, height_px)?;
         let (right, up, forward) = view.basis();
@@ -266,19 +260,19 @@ impl Camera {
         finite3("fit.max_m", max_m)?;
         finite(|| "fit.margin".into(), margin)?;
         if !(0.0..=0.45).contains(&margin) {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+            return Err(out_of_range(
                 "fit.margin",
                 margin,
                 "[0, 0.45] (fraction of each side)",
-            )));
+            ));
         }
         for i in 0..3 {
             if max_m[i] < min_m[i] {
-                return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+                return Err(out_of_range(
                     format!("fit.max_m[{i}]"),
                     max_m[i],
                     "[fit.min_m, inf) m",
-                )));
+                ));
             }
         }
         check_size(width_px, height_px)?;
@@ -313,11 +307,11 @@ impl Camera {
         };
         let s = sx.min(sy);
         if !s.is_finite() {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+            return Err(out_of_range(
                 "fit.max_m - fit.min_m",
                 0.0,
                 "a box with non-zero extent on the image plane",
-            )));
+            ));
         }
         Camera::new(view, center, s, width_px, height_px)
     }
@@ -332,12 +326,11 @@ impl Camera {
         height_px: u32,
         margin: f64,
     ) -> Result<Camera, RenderError> {
-        let (lo, hi) =
-            bounds(prims).ok_or(RenderError::Value(haptic_types::ValueError::out_of_range(
-                "fit.primitives",
-                0.0,
-                "at least one primitive with a position",
-            )))?;
+        let (lo, hi) = bounds(prims).ok_or(out_of_range(
+            "fit.primitives",
+            0.0,
+            "at least one primitive with a position",
+        ))?;
         Camera::fit(view, lo, hi, width_px, height_px, margin)
     }
 

@@ -124,6 +124,15 @@ impl Frame {
         }
     }
 
+    /// The image points (px) of the 8 corners of a box with centre `c` (m), unit axes `ax` and
+    /// half extents `half` (m), in [`box_corners`]' order.
+    fn corner_pixels(&self, c: Vec3, ax: [Vec3; 3], half: Vec3) -> [(f32, f32); 8] {
+        box_corners(c, ax, half).map(|p| {
+            let q = self.camera.project(p);
+            (q.x_px as f32, q.y_px as f32)
+        })
+    }
+
     pub(crate) fn draw_box(
         &self,
         pm: &mut Pixmap,
@@ -133,14 +142,7 @@ impl Frame {
         color: Rgba,
     ) {
         let ax = axes(normq(rot));
-        let corners = box_corners(c, ax, half);
-        let pts: Vec<(f32, f32)> = corners
-            .iter()
-            .map(|p| {
-                let q = self.camera.project(*p);
-                (q.x_px as f32, q.y_px as f32)
-            })
-            .collect();
+        let pts = self.corner_pixels(c, ax, half);
         let fwd = self.camera.forward();
         let light = self.light();
         let amb = self.style.ambient;
@@ -290,15 +292,13 @@ impl Frame {
         rot: [f64; 4],
         color: Rgba,
     ) {
-        let corners = box_corners(c, axes(normq(rot)), half);
+        let pts = self.corner_pixels(c, axes(normq(rot)), half);
         let mut pb = PathBuilder::new();
         for a in 0..8usize {
             for bit in [1usize, 2, 4] {
                 if a & bit == 0 {
-                    let p = self.camera.project(corners[a]);
-                    let q = self.camera.project(corners[a | bit]);
-                    pb.move_to(p.x_px as f32, p.y_px as f32);
-                    pb.line_to(q.x_px as f32, q.y_px as f32);
+                    pb.move_to(pts[a].0, pts[a].1);
+                    pb.line_to(pts[a | bit].0, pts[a | bit].1);
                 }
             }
         }

@@ -77,3 +77,14 @@ pub(crate) fn finite(field: impl FnOnce() -> String, value: f64) -> Result<f64, 
 pub(crate) fn finite3(field: &str, p: [f64; 3]) -> Result<(), RenderError> {
     Ok(haptic_types::value::finite3(field, p)?)
 }
+
+/// The error of a number outside its allowed range, naming the field and the range.
+pub(crate) fn out_of_range(
+    field: impl Into<std::borrow::Cow<'static, str>>,
+    value: f64,
+    allowed: impl Into<std::borrow::Cow<'static, str>>,
+) -> RenderError {
+    RenderError::Value(haptic_types::ValueError::out_of_range(
+        field, value, allowed,
+    ))
+}

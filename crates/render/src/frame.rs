@@ -3,7 +3,7 @@
 
 use crate::ToSkia;
 use crate::camera::Camera;
-use crate::error::{RenderError, finite, finite3};
+use crate::error::{RenderError, finite, finite3, out_of_range};
 use crate::image::Image;
 use crate::order::{Item, Shape, back_to_front};
 use haptic_types::Primitive;
@@ -46,11 +46,7 @@ impl Style {
         let pos = |field: &str, v: f32, max: f32| -> Result<(), RenderError> {
             finite(|| field.to_string(), f64::from(v))?;
             if !(v > 0.0 && v <= max) {
-                return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
-                    field.to_string(),
-                    f64::from(v),
-                    "(0, 200] px",
-                )));
+                return Err(out_of_range(field.to_string(), f64::from(v), "(0, 200] px"));
             }
             Ok(())
         };
@@ -59,11 +55,7 @@ impl Style {
         pos("style.arrow_head_px", self.arrow_head_px, 200.0)?;
         finite(|| "style.ambient".into(), self.ambient)?;
         if !(0.0..=1.0).contains(&self.ambient) {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
-                "style.ambient",
-                self.ambient,
-                "[0, 1]",
-            )));
+            return Err(out_of_range("style.ambient", self.ambient, "[0, 1]"));
         }
         Ok(())
     }
@@ -164,11 +156,7 @@ impl Frame {
         finite3("scaled_loop.about_m", about_m)?;
         finite(|| "scaled_loop.factor".into(), factor)?;
         if factor <= 0.0 {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
-                "scaled_loop.factor",
-                factor,
-                "(0, inf)",
-            )));
+            return Err(out_of_range("scaled_loop.factor", factor, "(0, inf)"));
         }
         let points_m = points_m
             .iter()
@@ -190,11 +178,7 @@ impl Frame {
             Some(l) => {
                 finite(|| "scale_bar.length_m".into(), l)?;
                 if l <= 0.0 {
-                    return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
-                        "scale_bar.length_m",
-                        l,
-                        "(0, inf) m",
-                    )));
+                    return Err(out_of_range("scale_bar.length_m", l, "(0, inf) m"));
                 }
                 l
             }

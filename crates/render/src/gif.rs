@@ -11,7 +11,7 @@
 
 use std::io::Write;
 
-use crate::error::{RenderError, finite};
+use crate::error::{RenderError, finite, out_of_range};
 use crate::image::Image;
 
 const BINS: usize = 1 << 15;
@@ -44,11 +44,11 @@ impl Palette {
     /// Deterministic: same images, same palette.
     pub fn from_images(images: &[&Image], max_colors: usize) -> Result<Palette, RenderError> {
         if !(1..=255).contains(&max_colors) {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
+            return Err(out_of_range(
                 "palette.max_colors",
                 max_colors as f64,
                 "1..=255",
-            )));
+            ));
         }
         let mut hist = vec![Bin::default(); BINS];
         let mut any = false;
@@ -236,11 +236,7 @@ impl<W: Write> GifWriter<W> {
     ) -> Result<GifWriter<W>, RenderError> {
         finite(|| "gif.fps".into(), fps)?;
         if !(fps > 0.0 && fps <= 50.0) {
-            return Err(RenderError::Value(haptic_types::ValueError::out_of_range(
-                "gif.fps",
-                fps,
-                "(0, 50] frames/s",
-            )));
+            return Err(out_of_range("gif.fps", fps, "(0, 50] frames/s"));
         }
         let (Ok(w16), Ok(h16)) = (u16::try_from(width), u16::try_from(height)) else {
             return Err(RenderError::ImageSize {

@@ -2,7 +2,7 @@
 //! crossings found through a bucket grid, segments split at them) walked with the right-hand
 //! rule around its unbounded face.
 
-use super::{V2, bbox, cross, grid_shape, signed_area};
+use super::{Buckets, V2, bbox, cross, signed_area};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Union–find over vertex ids.
@@ -117,13 +117,7 @@ fn vertices_and_segments(polylines: &[(Vec<V2>, bool)]) -> (Vec<V2>, Vec<(usize,
 }
 
 /// A bucket grid over the arrangement: each cell lists the segments whose box meets it.
-struct Grid {
-    lo: V2,
-    cell: f64,
-    nbx: usize,
-    nby: usize,
-    cells: Vec<Vec<usize>>,
-}
+struct Grid(Buckets);
 
 impl Grid {
     /// Cells of about twice the mean segment length (at most 1024 × 1024).
@@ -134,32 +128,8 @@ impl Grid {
             .map(|&(a, b)| (pts[b] - pts[a]).norm())
             .sum::<f64>()
             / segs.len() as f64;
-        let (cell, nbx, nby) = grid_shape(lo, hi, mean_len, 512.0, 1024);
-        let mut grid = Grid {
-            lo,
-            cell,
-            nbx,
-            nby,
-            cells: vec![Vec::new(); nbx * nby],
-        };
-        for (k, &(a, b)) in segs.iter().enumerate() {
-            let (i0, j0) = grid.bucket(&pts[a].inf(&pts[b]));
-            let (i1, j1) = grid.bucket(&pts[a].sup(&pts[b]));
-            for i in i0..=i1 {
-                for j in j0..=j1 {
-                    grid.cells[i * nby + j].push(k);
-                }
-            }
-        }
-        grid
-    }
-
-    /// The cell holding `p`.
-    fn bucket(&self, p: &V2) -> (usize, usize) {
-        (
-            (((p.x - self.lo.x) / self.cell) as usize).min(self.nbx - 1),
-            (((p.y - self.lo.y) / self.cell) as usize).min(self.nby - 1),
-        )
+        let ends = segs.iter().map(|&(a, b)| (pts[a], pts[b]));
+        Grid(Buckets::new(lo, hi, mean_len, 512.0, 1024, ends))
     }
 
     /// The crossing search tests every pair of segments sharing a bucket: bound it before
@@ -167,6 +137,7 @@ impl Grid {
     /// can use).
     fn check_pairs(&self, max_pairs: u64) -> Result<(), ot_physics::PhysicsError> {
         let pairs: u64 = self
+            .0
             .cells
             .iter()
             .map(|l| (l.len() as u64) * (l.len() as u64).saturating_sub(1) / 2)
@@ -197,8 +168,8 @@ impl Grid {
     ) -> Result<(Dsu, Vec<(usize, f64, usize)>), ot_physics::PhysicsError> {
         let mut dsu = Dsu((0..pts.len()).collect());
         let mut inserts: Vec<(usize, f64, usize)> = Vec::new();
-        for (cell_idx, list) in self.cells.iter().enumerate() {
-            let (ci, cj) = (cell_idx / self.nby, cell_idx % self.nby);
+        for (cell_idx, list) in self.0.cells.iter().enumerate() {
+            let (ci, cj) = (cell_idx / self.0.ny, cell_idx % self.0.ny);
             for x in 0..list.len() {
                 ot_physics::cancel::check()?;
                 for y in x + 1..list.len() {
@@ -213,7 +184,7 @@ impl Grid {
                     // process the pair only in the bucket holding the low corner of
                     // the overlap of their boxes (each pair once).
                     let olo = p.inf(&pts[b]).sup(&q.inf(&pts[d]));
-                    if self.bucket(&olo) != (ci, cj) {
+                    if self.0.bucket(&olo) != (ci, cj) {
                         continue;
                     }
                     let den = cross(&r, &s);

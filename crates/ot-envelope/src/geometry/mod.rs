@@ -34,6 +34,62 @@ fn grid_shape(
     (cell, nx, ny)
 }
 
+/// Segments bucketed in a grid of square cells over a box: each cell lists, in ascending
+/// order, the segments whose bounding box meets it.
+struct Buckets {
+    lo: V2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    /// Segment indices per cell, cell `(x, y)` at `x * ny + y`.
+    cells: Vec<Vec<usize>>,
+}
+
+impl Buckets {
+    /// The grid of [`grid_shape`] over the box `(lo, hi)`, holding `segments` (end points),
+    /// numbered in their order.
+    fn new(
+        lo: V2,
+        hi: V2,
+        mean_len: f64,
+        min_div: f64,
+        max_cells: usize,
+        segments: impl Iterator<Item = (V2, V2)>,
+    ) -> Self {
+        let (cell, nx, ny) = grid_shape(lo, hi, mean_len, min_div, max_cells);
+        let mut g = Buckets {
+            lo,
+            cell,
+            nx,
+            ny,
+            cells: vec![Vec::new(); nx * ny],
+        };
+        for (k, (p, q)) in segments.enumerate() {
+            let (x0, y0) = g.bucket(&p.inf(&q));
+            let (x1, y1) = g.bucket(&p.sup(&q));
+            for x in x0..=x1 {
+                for y in y0..=y1 {
+                    g.cells[x * ny + y].push(k);
+                }
+            }
+        }
+        g
+    }
+
+    /// The cell holding `p`, clamped to the grid (a NaN coordinate reads as cell 0).
+    fn bucket(&self, p: &V2) -> (usize, usize) {
+        (
+            (((p.x - self.lo.x) / self.cell) as usize).min(self.nx - 1),
+            (((p.y - self.lo.y) / self.cell) as usize).min(self.ny - 1),
+        )
+    }
+
+    /// The segments listed in cell `(x, y)`.
+    fn at(&self, x: usize, y: usize) -> &[usize] {
+        &self.cells[x * self.ny + y]
+    }
+}
+
 /// Bounding box `(lo, hi)` of a point set (m); `(+∞, −∞)` when empty.
 pub fn bbox(points: &[V2]) -> (V2, V2) {
     let mut lo = V2::repeat(f64::INFINITY);
@@ -191,12 +247,8 @@ pub fn directed_hausdorff(a: &[V2], b: &[V2], step: f64) -> f64 {
 /// to its boundary.
 struct EdgeGrid<'a> {
     poly: &'a [V2],
-    lo: V2,
-    cell: f64,
-    nx: usize,
-    ny: usize,
-    /// Edge indices per cell, row-major.
-    cells: Vec<Vec<usize>>,
+    /// Edge `i` (from vertex `i` to the next) as segment `i`.
+    grid: Buckets,
 }
 
 impl<'a> EdgeGrid<'a> {
@@ -214,38 +266,11 @@ impl<'a> EdgeGrid<'a> {
             .map(|i| (poly[(i + 1) % n] - poly[i]).norm())
             .sum::<f64>()
             / n.max(1) as f64;
-        let (cell, nx, ny) = grid_shape(lo, hi, mean, 256.0, 256);
-        let mut g = EdgeGrid {
+        let edges = (0..n).map(|i| (poly[i], poly[(i + 1) % n]));
+        EdgeGrid {
             poly,
-            lo,
-            cell,
-            nx,
-            ny,
-            cells: vec![Vec::new(); nx * ny],
-        };
-        for i in 0..n {
-            let (p, q) = (poly[i], poly[(i + 1) % n]);
-            let (x0, y0) = g.bucket(&p.inf(&q));
-            let (x1, y1) = g.bucket(&p.sup(&q));
-            for y in y0..=y1 {
-                for x in x0..=x1 {
-                    g.cells[y * nx + x].push(i);
-                }
-            }
+            grid: Buckets::new(lo, hi, mean, 256.0, 256, edges),
         }
-        g
-    }
-
-    fn bucket(&self, p: &V2) -> (usize, usize) {
-        let c = |v: f64, lo: f64, n: usize| {
-            let k = ((v - lo) / self.cell).floor();
-            if k.is_nan() || k < 0.0 {
-                0
-            } else {
-                (k as usize).min(n - 1)
-            }
-        };
-        (c(p.x, self.lo.x, self.nx), c(p.y, self.lo.y, self.ny))
     }
 
     /// Distance from `p` to the boundary (∞ for an empty polygon), exactly
@@ -257,25 +282,26 @@ impl<'a> EdgeGrid<'a> {
         }
         // Cells are clamped to the grid, so a point outside it searches from the nearest cell;
         // the rings' distance bound counts from the point itself.
-        let (cx, cy) = self.bucket(p);
+        let g = &self.grid;
+        let (cx, cy) = g.bucket(p);
         let outside = {
-            let hi = self.lo + V2::new(self.nx as f64, self.ny as f64) * self.cell;
-            let dx = (self.lo.x - p.x).max(p.x - hi.x).max(0.0);
-            let dy = (self.lo.y - p.y).max(p.y - hi.y).max(0.0);
+            let hi = g.lo + V2::new(g.nx as f64, g.ny as f64) * g.cell;
+            let dx = (g.lo.x - p.x).max(p.x - hi.x).max(0.0);
+            let dy = (g.lo.y - p.y).max(p.y - hi.y).max(0.0);
             dx.max(dy)
         };
         let mut best = f64::INFINITY;
-        let max_ring = self.nx.max(self.ny);
+        let max_ring = g.nx.max(g.ny);
         for r in 0..=max_ring {
-            let (x0, x1) = (cx.saturating_sub(r), (cx + r).min(self.nx - 1));
-            let (y0, y1) = (cy.saturating_sub(r), (cy + r).min(self.ny - 1));
+            let (x0, x1) = (cx.saturating_sub(r), (cx + r).min(g.nx - 1));
+            let (y0, y1) = (cy.saturating_sub(r), (cy + r).min(g.ny - 1));
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     // Only the ring's own cells (the inside was searched before).
                     if x.abs_diff(cx) != r && y.abs_diff(cy) != r {
                         continue;
                     }
-                    for &i in &self.cells[y * self.nx + x] {
+                    for &i in g.at(x, y) {
                         let q = closest_on_segment(&self.poly[i], &self.poly[(i + 1) % n], p);
                         best = best.min((q - p).norm());
                     }
@@ -283,7 +309,7 @@ impl<'a> EdgeGrid<'a> {
             }
             // Every edge not yet seen lies in cells of ring r + 1 or beyond: at least r cells
             // away along one axis, and never nearer than the grid itself.
-            if best <= outside.max(r as f64 * self.cell) {
+            if best <= outside.max(r as f64 * g.cell) {
                 break;
             }
         }
