@@ -9,6 +9,7 @@ The run ends with a table and exits non-zero if any mutation was missed.
 
     python3 scripts/mutations.py            # every mutation (about 20 min on 2 cores)
     python3 scripts/mutations.py --list     # what each one breaks and which test catches it
+    python3 scripts/mutations.py --check    # every mutation still applies (./scripts/test.sh)
     python3 scripts/mutations.py two-port-halves release-at-rest
 
 Builds in release into the usual target folder (`CARGO_TARGET_DIR` if set), so the mutated crate
@@ -96,17 +97,24 @@ def target_dir() -> pathlib.Path:
     return pathlib.Path(t) if t else ROOT / "target"
 
 
-def run_one(m: Mutation, logs: pathlib.Path) -> tuple[str, str]:
-    """Applies `m`, runs its tests, restores the file. Returns (verdict, detail)."""
-    path = ROOT / m.path
-    original = path.read_bytes()
-    text = original.decode()
+def anchored(m: Mutation) -> str:
+    """The text of `m`'s file; exits naming the mutation when its piece is not there as often
+    as expected (the code moved: the mutation must be updated, not skipped)."""
+    text = (ROOT / m.path).read_text()
     found = text.count(m.old)
     if found != m.count:
         raise SystemExit(
             f"mutation `{m.name}`: `{m.old}` occurs {found} times in {m.path}, expected {m.count}"
             " (the code moved: update scripts/mutations.py)"
         )
+    return text
+
+
+def run_one(m: Mutation, logs: pathlib.Path) -> tuple[str, str]:
+    """Applies `m`, runs its tests, restores the file. Returns (verdict, detail)."""
+    path = ROOT / m.path
+    original = path.read_bytes()
+    text = anchored(m)
     log = logs / f"{m.name}.log"
     restore = lambda *_: path.write_bytes(original)  # noqa: E731
     old_int = signal.signal(signal.SIGINT, lambda *_: (restore(), sys.exit(130)))
@@ -146,8 +154,18 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("names", nargs="*", help="mutations to run (all when none)")
     ap.add_argument("--list", action="store_true", help="list the mutations and exit")
+    ap.add_argument(
+        "--check",
+        action="store_true",
+        help="only check that every mutation's piece of source is where it expects (no build)",
+    )
     a = ap.parse_args()
     known = {m.name: m for m in MUTATIONS}
+    if a.check:
+        for m in MUTATIONS:
+            anchored(m)
+        print(f"all {len(MUTATIONS)} mutations apply to today's source")
+        return 0
     if a.list:
         for m in MUTATIONS:
             tests = " | ".join(" ".join(t) for t in m.tests)

@@ -32,6 +32,9 @@ python3 scripts/layering.py
 step "sizes: no source file over 700 lines, no function over 100 lines outside tests"
 python3 scripts/sizes.py
 
+step "the mutation check still applies to today's source (docs/testing.md)"
+python3 scripts/mutations.py --check
+
 step "cargo clippy (warnings are errors)"
 cargo clippy --workspace --all-targets --release -- -D warnings
 
