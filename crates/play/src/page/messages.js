@@ -5,7 +5,7 @@
 
 import { $, P, log, say } from './page.js';
 import { aimAtWorkspace } from './camera.js';
-import { onSoundTicks } from './sound.js';
+import { finishAudio, onSoundTicks } from './sound.js';
 import { eventClass, sentence } from './events.js';
 
 let ws = null;
@@ -118,6 +118,7 @@ function onFrame(f) {
 // `end`: the session's figures and the recording's download.
 function onEnd(m) {
   announceEvents([], true);
+  finishAudio(P.sound.nextTick);
   P.ended = m;
   const rows = [['how it ended', m.end], ['time', `${m.seconds.toFixed(2)} s`], ['score', (m.state.score ?? 0).toFixed(1)]];
   for (const k of ['slots_filled', 'house_score', 'dropped', 'comfort_exceeded_s', 'complete_s']) {

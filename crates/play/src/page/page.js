@@ -12,6 +12,7 @@ export const P = (window.__play = {
     messages: 0, ticks: 0, sounds: 0, firstTick: -1, nextTick: 0, gaps: 0, sampleRate: null,
     underruns: 0, dropped: 0, limited: 0, leadMs: null, outputLatencyS: null, baseLatencyS: null,
     latencyMs: [], latencyTsMs: [], parts: [],
+    sent: [], played: [], lost: [], live: null,
   },
   inputsSent: 0,
   said: [], menu: {},

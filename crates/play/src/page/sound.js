@@ -3,7 +3,9 @@
 // protocol/sound.rs's SoundTicks) go to an AudioWorklet (synth.js), which runs the same synthesis as
 // `nanohaptics render REC --audio OUT.wav --proximity` at the AudioContext's own sample rate.
 // The audio starts on the Start press (a user gesture); `m` mutes it. For the benches, each
-// sound's tick → output latency is measured when the worklet renders its first sample.
+// sound's tick → output latency is measured when the worklet renders its first sample. For the
+// tests, the page keeps the sounds it was sent and those the worklet played (or lost to a
+// drop), and at the session's end the worklet's hash of every sample it played (`P.sound.live`).
 
 import { P, say } from './page.js';
 
@@ -27,9 +29,9 @@ export function startAudio() {
         numberOfInputs: 0, numberOfOutputs: 1, outputChannelCount: [1],
         processorOptions: { rateHz: P.hello ? P.hello.rate_hz : 1000, leadS: LEAD_S },
       });
-      node.port.onmessage = (e) => onRendered(e.data);
+      node.port.onmessage = (e) => onWorklet(e.data);
       node.connect(gain);
-      for (const b of waiting) node.port.postMessage(b, [b]);
+      for (const b of waiting) node.port.postMessage(b, b instanceof ArrayBuffer ? [b] : []);
       waiting = [];
     }).catch(() => { node = null; say('sound is not available in this browser'); });
   } catch (err) { actx = null; say('sound is not available in this browser'); }
@@ -50,13 +52,36 @@ export function onSoundTicks(buf) {
     const first = Number(dv.getBigUint64(0, true));
     if (s.firstTick < 0) s.firstTick = first;
     else if (first !== s.nextTick) s.gaps++;
-    const nt = dv.getUint32(16, true);
-    s.nextTick = first + nt; s.ticks += nt; s.sounds += dv.getUint32(20, true);
+    const nt = dv.getUint32(16, true), ns = dv.getUint32(20, true);
+    s.nextTick = first + nt; s.ticks += nt; s.sounds += ns;
+    // Each sound: its tick (u64) and its index in the session's list (u32).
+    for (let j = 0, at = 24 + 16 * nt; j < ns && at + 24 <= buf.byteLength && s.sent.length < 100000; j++, at += 24) {
+      s.sent.push([Number(dv.getBigUint64(at, true)), dv.getUint32(at + 8, true)]);
+    }
   }
   s.messages++;
   if (!actx) return;
   if (node) node.port.postMessage(buf, [buf]);
   else if (waiting.length < 2000) waiting.push(buf);
+}
+
+// The session ended after `ticks` ticks: the worklet plays its last samples, then reports.
+export function finishAudio(ticks) {
+  if (!actx) return;
+  if (node) node.port.postMessage({ finish: ticks });
+  else waiting.push({ finish: ticks });
+}
+
+// The worklet's reports: the end of the stream (what it heard), a sound lost to a drop, or a
+// sound's first sample rendered.
+function onWorklet(m) {
+  const s = P.sound;
+  if (m.kind === 'done') {
+    s.live = m;
+    s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs;
+  }
+  else if (m.kind === 'lost') s.lost.push([m.tick, m.index]);
+  else { if (s.played.length < 100000) s.played.push([m.tick, m.index]); onRendered(m); }
 }
 
 // The worklet rendered a sound's first sample: tick → output, two ways. `latencyMs`: the

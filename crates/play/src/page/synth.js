@@ -12,8 +12,15 @@
 // it again, and each second without one shortens it by 1 ms (down to `leadS`); a FIFO that
 // stays fuller than the lead for 0.1 s drops the excess (counted). For each sound's first sample the processor reports
 // when it was rendered (Date.now() at the render quantum, the frame within it, the context
-// time) so the page can measure tick → output. With `offline` options (a test's
-// OfflineAudioContext) it takes all its ticks at construction and plays from sample 0.
+// time) so the page can measure tick → output, or that it was dropped (`lost`). It hashes
+// every sample it plays from the FIFO (FNV-1a over the Float32 bytes, in the order played;
+// the silence of a wait or an underrun is not the session's and is not hashed) and keeps where
+// it dropped samples, so the test can compare what was heard with `render --audio`. A
+// `{ finish: ticks }` message (the session ended after `ticks` ticks) ends the stream as
+// StreamSynth::finish does: the last samples are queued and played, the FIFO running empty then
+// is the end rather than an underrun, and the processor reports `done` with the hash. With
+// `offline` options (a test's OfflineAudioContext) it takes all its ticks at construction and
+// plays from sample 0.
 
 const A_MAX = 0.8, CEILING = 0.98, ATTACK_S = 5e-4, TONE_AMPLITUDE = 0.12;
 const TAU = 2 * Math.PI; // std::f64::consts::TAU
@@ -212,12 +219,44 @@ class Synth extends AudioWorkletProcessor {
     this.underruns = 0; this.dropped = 0;
     this.minLevel = Infinity; this.quanta = 0;
     this.offline = !!o.offline;
+    // What was heard: the FNV-1a hash of the samples played, their count, the first one's
+    // session index, a checkpoint of the hash every second played, the [index, count] of each
+    // drop, the restarts after a long gap; `ending`: the stream was finished.
+    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], restarts: 0 };
+    this.ending = false; this.done = false;
     if (o.offline) {
       for (const b of o.offline.blocks) this.take(b, 0);
       if (this.synth) this.synth.finish(o.offline.ticks * this.dt);
       this.primed = true;
     }
-    this.port.onmessage = (e) => this.take(e.data, Date.now());
+    this.port.onmessage = (e) => {
+      if (e.data instanceof ArrayBuffer) this.take(e.data, Date.now());
+      else if (e.data && Number.isFinite(e.data.finish)) this.finish(e.data.finish);
+    };
+  }
+
+  // The session ended after `ticks` ticks: the stream's last samples, then the end.
+  finish(ticks) {
+    if (this.ending) return;
+    const s = this.synth;
+    if (s !== null) {
+      while (s.ticks < ticks) s.tick(NaN);
+      s.finish(ticks * this.dt);
+    }
+    this.ending = true; this.primed = true;
+  }
+
+  // Hashes the `n` samples just played from `out` (session indices from `from`).
+  hear(out, n, from) {
+    const h = this.heard;
+    if (n === 0) return;
+    if (h.first < 0) h.first = from;
+    const bytes = new Uint8Array(out.buffer, out.byteOffset, n * 4);
+    let x = h.hash;
+    for (let i = 0; i < bytes.length; i++) x = Math.imul(x ^ bytes[i], 0x01000193) >>> 0;
+    const second = Math.round(sampleRate);
+    if (Math.floor((h.played + n) / second) > Math.floor(h.played / second)) h.checkpoints.push([h.played + n, x]);
+    h.hash = x; h.played += n;
   }
 
   // One binary sound-ticks message.
@@ -231,7 +270,8 @@ class Synth extends AudioWorkletProcessor {
     if (buf.byteLength !== HEADER + TICK * nt + SOUND * ns) return;
     let s = this.synth;
     // A gap (messages the server dropped for this page): silent ticks; a long one, a restart.
-    if (s !== null && first > s.ticks && first - s.ticks > 5000) s = null;
+    if (s !== null && first > s.ticks && first - s.ticks > 5000) { s = null; this.heard.restarts++; }
+    if (this.ending) return;
     if (s === null) {
       s = this.synth = new StreamSynth(sampleRate, this.dt, on, first, (v) => this.fifo.push(v));
       this.fifo.clear(s.nextSample); this.primed = this.offline; this.onsets = [];
@@ -250,7 +290,8 @@ class Synth extends AudioWorkletProcessor {
         const tS = st * this.dt;
         s.push(tS, dv.getUint32(at + 12, true), dv.getFloat64(at + 16, true), dv.getUint32(at + 8, true));
         const k = Math.round(tS * sampleRate);
-        if (!this.offline && k >= s.nextSample && this.onsets.length < 1000) this.onsets.push([k, st, wallMs, gotMs]);
+        const index = dv.getUint32(at + 8, true);
+        if (!this.offline && k >= s.nextSample && this.onsets.length < 1000) this.onsets.push([k, st, wallMs, gotMs, index]);
       }
       if (tick < s.ticks) continue; // already had
       s.tick(dv.getFloat64(HEADER + TICK * i + 8, true));
@@ -266,17 +307,22 @@ class Synth extends AudioWorkletProcessor {
     // Too much queued for a while: come back to the lead (over ~0.1 s of quanta).
     this.minLevel = Math.min(this.minLevel, fifo.length);
     if (++this.quanta >= Math.ceil(0.1 * sampleRate / out.length)) {
-      if (!this.offline && this.minLevel > this.lead + out.length) {
+      if (!this.offline && !this.ending && this.minLevel > this.lead + out.length) {
         const n = this.minLevel - this.lead;
+        if (this.heard.drops.length < 10000) this.heard.drops.push([fifo.first, n]);
         fifo.drop(n); this.dropped += n;
       }
       this.minLevel = Infinity; this.quanta = 0;
     }
     const from = fifo.first;
     const n = fifo.take(out, 0);
+    if (!this.offline) this.hear(out, n, from);
     if (n < out.length) {
       out.fill(0, n);
-      if (!this.offline) {
+      if (this.ending) {
+        // The end of the stream, not an underrun.
+        if (!this.done) { this.done = true; this.port.postMessage(this.report('done')); }
+      } else if (!this.offline) {
         // An underrun: wait for the lead again, a millisecond longer (up to 50 ms).
         this.underruns++; this.primed = false;
         this.lead = Math.min(this.lead + Math.round(0.001 * sampleRate), Math.round(0.05 * sampleRate));
@@ -291,11 +337,11 @@ class Synth extends AudioWorkletProcessor {
     if (this.onsets.length && this.onsets[0][0] < from + n) {
       const renderMs = Date.now();
       while (this.onsets.length && this.onsets[0][0] < from + n) {
-        const [k, tick, wallMs, gotMs] = this.onsets.shift();
-        if (k < from) continue;
+        const [k, tick, wallMs, gotMs, index] = this.onsets.shift();
+        if (k < from) { this.port.postMessage({ kind: 'lost', tick, index }); continue; }
         const frame = k - from;
         this.port.postMessage({
-          tick, wallMs, gotMs, renderMs, frame, sampleRate,
+          kind: 'onset', tick, index, wallMs, gotMs, renderMs, frame, sampleRate,
           contextTime: currentTime + frame / sampleRate,
           underruns: this.underruns, dropped: this.dropped, limited: this.synth ? this.synth.limited : 0,
           level: fifo.length, leadMs: this.lead / sampleRate * 1000,
@@ -303,6 +349,15 @@ class Synth extends AudioWorkletProcessor {
       }
     }
     return true;
+  }
+
+  // The counts and what was heard (`kind`: 'done' at the end of the stream).
+  report(kind) {
+    return {
+      kind, sampleRate, underruns: this.underruns, dropped: this.dropped,
+      limited: this.synth ? this.synth.limited : 0, emitted: this.synth ? this.synth.nextSample : 0,
+      leadMs: this.lead / sampleRate * 1000, ...this.heard,
+    };
   }
 }
 
