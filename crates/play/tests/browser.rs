@@ -1,7 +1,9 @@
 //! The game in a real browser: Debian's headless `chromium`, driven through the DevTools
 //! Protocol. A pointer session and a keyboard-only session each fill a blueprint slot of the
 //! brick world; their recordings replay bit for bit; the page received every sound event at its
-//! tick and every tick's input of its sound synthesis; the Events list (the live
+//! tick and every tick's input of its sound synthesis, and played the samples of `render
+//! --audio --proximity` for the recording bit for bit (its drops aside), each sound it was sent
+//! played once or lost in a listed drop (common/live.rs); the Events list (the live
 //! region) speaks of the game only; the menu shows each switch's value as it changes; a
 //! scripted gamepad (injected through the DevTools Protocol: headless Chromium has none) moves
 //! the hand, grips and rumbles with the force; page errors fail the tests; screenshots go to
@@ -12,6 +14,7 @@
 mod common;
 
 use common::cdp::Browser;
+use common::live;
 use haptic_loop::session::{SceneSource, read_arrays};
 use play::{PlayConfig, PlayError, PlaySummary};
 use recording::read_recording_file;
@@ -137,6 +140,9 @@ fn end_session(b: &mut Browser, s: Session, shot: Option<&str>) -> (PlaySummary,
     b.key("e", true, false).unwrap();
     b.key("e", false, false).unwrap();
     b.wait_for("window.__play.ended !== null", 10.0).unwrap();
+    // The worklet played the stream's last samples and reported what it heard.
+    b.wait_for("window.__play.sound.live !== null", 10.0)
+        .unwrap();
     // The end screen's link serves the recording.
     let bytes = b
         .eval("fetch(document.getElementById('download').href).then(r => r.arrayBuffer()).then(a => a.byteLength)")
@@ -255,24 +261,37 @@ fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
         page["sound"]["messages"].as_u64(),
         Some(summary.session.published.sound_messages)
     );
-    // The page's audio ran at its context's rate, and its worklet played sounds: each one's
-    // tick → output latency measured once, a positive time under the session's length.
+    // The page's audio ran at its context's rate, and played the session's samples.
     assert!(page["sound"]["sampleRate"].as_f64().unwrap() >= 8000.0);
-    let played: Vec<f64> = page["sound"]["latencyMs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
-    assert!(
-        !played.is_empty() && played.len() <= want.len(),
-        "{} sounds played of {}",
-        played.len(),
-        want.len()
-    );
-    for ms in played {
+    check_live_sound(out, page);
+}
+
+/// The page's live sound: the samples its worklet played are `render --audio --proximity`'s
+/// of the recording, bit for bit, and the sounds it played are those it was sent
+/// (common/live.rs).
+fn check_live_sound(out: &std::path::Path, page: &Value) -> live::Heard {
+    let arrays = read_arrays(out, false).unwrap();
+    let kind = page["hello"]["kind"].as_str().unwrap();
+    let h = live::check(&arrays, kind, &page["sound"]["live"], &page["sound"]);
+    // Each sound played had its tick → output latency measured (once: common/live.rs), a
+    // positive time under the session's length.
+    for ms in page["sound"]["latencyMs"].as_array().unwrap() {
+        let ms = ms.as_f64().unwrap();
         assert!(ms > 0.0 && ms < 60_000.0, "{ms} ms");
     }
+    println!(
+        "live sound ({kind}, {} Hz): {} of {} samples played, as render --audio's; \
+         {} underruns, {} samples dropped; sounds sent {}, played {}, lost in a drop {}",
+        h.sample_rate_hz,
+        h.played_samples,
+        h.track_samples,
+        h.underruns,
+        h.dropped,
+        h.sent,
+        h.played,
+        h.lost
+    );
+    h
 }
 
 /// The gravity switch's line in the menu (its value now and its range) and its input's value.
@@ -513,6 +532,7 @@ fn a_keyboard_only_session_fills_a_slot() {
     let rec = read_recording_file(&out, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
     assert!(page["inputsSent"].as_u64().unwrap() > 10);
+    check_live_sound(&out, &page);
 }
 
 #[test]
@@ -558,6 +578,7 @@ fn the_nano_world_plays_in_the_page() {
     }
     let rec = read_recording_file(&out, false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
+    check_live_sound(&out, &page);
 }
 
 #[test]

@@ -1,2 +1,3 @@
 //! Helpers shared by the browser tests and the play bench.
 pub mod cdp;
+pub mod live;

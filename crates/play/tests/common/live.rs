@@ -1,0 +1,180 @@
+//! The page's live sound against `render --audio --proximity`: what the worklet heard (its
+//! `done` report, `P.sound.live`) and the sounds it was sent, played and lost, checked against
+//! the recording's track at the page's sample rate.
+//!
+//! What the worklet hashes: every sample it played from its FIFO, in the order played (FNV-1a
+//! over the Float32 little-endian bytes), from the first one (`first`, a session sample index)
+//! on; the silence of its wait for the lead and of an underrun is not the session's and is not
+//! hashed; samples it dropped are listed (`drops`, [session index, count]). So the samples it
+//! played are exactly the track from `first` on without the dropped ranges, whatever the
+//! machine's load, and the test asks for them bit for bit (the standard of the offline test,
+//! `browser_sound.rs`: 0 ulp). The start offset: `first` is 0, the page being there from the
+//! session's first tick (docs/play.md); the output's own start (the lead, the context's time
+//! before the first ticks) is the output's and not in the comparison.
+#![allow(dead_code)]
+
+use super::cdp::fnv1a;
+use haptic_loop::session::SessionArrays;
+use serde_json::Value;
+use std::collections::BTreeSet;
+
+/// What the live check measured.
+#[derive(Debug)]
+pub struct Heard {
+    /// The page's sample rate, Hz.
+    pub sample_rate_hz: u32,
+    /// Samples of the track, and the samples the worklet played (the same bits).
+    pub track_samples: usize,
+    pub played_samples: usize,
+    /// Underruns, samples dropped.
+    pub underruns: u64,
+    pub dropped: u64,
+    /// Sounds sent to the page, played (first sample rendered), lost in a drop.
+    pub sent: usize,
+    pub played: usize,
+    pub lost: usize,
+}
+
+fn u64s(v: &Value) -> Vec<u64> {
+    v.as_array()
+        .unwrap_or_else(|| panic!("not an array: {v}"))
+        .iter()
+        .map(|x| x.as_u64().unwrap_or_else(|| panic!("not a count: {x}")))
+        .collect()
+}
+
+fn pairs(v: &Value) -> Vec<(u64, u64)> {
+    v.as_array()
+        .unwrap_or_else(|| panic!("not an array: {v}"))
+        .iter()
+        .map(|p| {
+            let p = u64s(p);
+            (p[0], p[1])
+        })
+        .collect()
+}
+
+/// The samples the worklet should have played: `track` from `first` on without the dropped
+/// ranges ([session index, count]).
+pub fn expected_played(track: &[f32], first: usize, drops: &[(u64, u64)]) -> Vec<f32> {
+    let mut out = Vec::with_capacity(track.len());
+    let mut at = first;
+    for &(d, n) in drops {
+        let (d, n) = (d as usize, n as usize);
+        assert!(
+            d >= at && d + n <= track.len(),
+            "drop [{d}, +{n}) from {at}"
+        );
+        out.extend_from_slice(&track[at..d]);
+        at = d + n;
+    }
+    out.extend_from_slice(&track[at.min(track.len())..]);
+    out
+}
+
+/// FNV-1a of samples' Float32 little-endian bytes (the worklet's hash).
+pub fn hash(samples: &[f32]) -> u32 {
+    fnv1a(samples.iter().flat_map(|s| s.to_le_bytes()))
+}
+
+/// Checks the worklet's `done` report `live` and the sounds `sent`/`played`/`lost` (arrays of
+/// [tick, index]) against the recording `a` of scene kind `kind`.
+pub fn check(a: &SessionArrays, kind: &str, live: &Value, sound: &Value) -> Heard {
+    assert_eq!(live["kind"], "done", "the worklet ended its stream: {live}");
+    let sr = live["sampleRate"].as_f64().unwrap();
+    assert!(sr >= 8000.0 && sr.fract() == 0.0, "{sr}");
+    let sr = sr as u32;
+    let track = haptic_loop::sound::session_sound(a, kind, true, sr)
+        .unwrap()
+        .samples;
+    // The offline track is scaled down as a whole only past the ceiling; live, samples past
+    // it are limited: neither happened, so the two are comparable sample for sample.
+    let peak = track.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    assert!(f64::from(peak) <= render::audio::CEILING, "{peak}");
+    assert_eq!(live["limited"], 0);
+    assert_eq!(live["restarts"], 0, "no gap restarted the synthesis");
+    assert_eq!(
+        live["emitted"].as_u64(),
+        Some(track.len() as u64),
+        "the stream ends where the track does"
+    );
+    // The start offset: none in session samples.
+    assert_eq!(
+        live["first"], 0,
+        "the first sample played is the track's first"
+    );
+    let drops = pairs(&live["drops"]);
+    let dropped = live["dropped"].as_u64().unwrap();
+    assert_eq!(
+        drops.iter().map(|d| d.1).sum::<u64>(),
+        dropped,
+        "every drop listed"
+    );
+    let want = expected_played(&track, 0, &drops);
+    let played = live["played"].as_u64().unwrap() as usize;
+    assert_eq!(
+        played,
+        want.len(),
+        "samples played: every sample of the track once, but those dropped"
+    );
+    if live["hash"].as_u64() != Some(u64::from(hash(&want))) {
+        // Where it first differs: the worklet's hash after each second played.
+        let mut at = "after the last checkpoint".to_string();
+        for c in live["checkpoints"].as_array().unwrap() {
+            let (n, h) = (c[0].as_u64().unwrap() as usize, c[1].as_u64().unwrap());
+            if u64::from(hash(&want[..n])) != h {
+                at = format!("within the {n} first samples played");
+                break;
+            }
+        }
+        panic!("the samples the page played differ from render --audio's ({at})");
+    }
+    // The sounds: the page was sent the recording's, each once; each was played (its first
+    // sample rendered) or lost in a drop (its first sample in a dropped range), once.
+    let rate = f64::from(a.rate_hz);
+    let events = haptic_loop::sound::sound_events(a).unwrap();
+    let recorded: Vec<(u64, u64)> = events
+        .iter()
+        .enumerate()
+        .map(|(i, e)| ((e.t_s * rate).round() as u64, i as u64))
+        .collect();
+    let sent = pairs(&sound["sent"]);
+    assert_eq!(sent, recorded, "the sounds sent are the recording's");
+    let in_drop = |tick: u64| {
+        let k = (tick as f64 / rate * f64::from(sr)).round() as u64;
+        drops.iter().any(|&(d, n)| (d..d + n).contains(&k))
+    };
+    let played_sounds = pairs(&sound["played"]);
+    let lost = pairs(&sound["lost"]);
+    let once = |v: &[(u64, u64)]| v.iter().copied().collect::<BTreeSet<_>>();
+    assert_eq!(
+        once(&played_sounds).len(),
+        played_sounds.len(),
+        "played twice"
+    );
+    let want_played: Vec<(u64, u64)> = recorded.iter().copied().filter(|s| !in_drop(s.0)).collect();
+    let want_lost: Vec<(u64, u64)> = recorded.iter().copied().filter(|s| in_drop(s.0)).collect();
+    assert_eq!(
+        once(&played_sounds),
+        once(&want_played),
+        "the sounds played"
+    );
+    assert_eq!(once(&lost), once(&want_lost), "the sounds lost in a drop");
+    assert_eq!(lost.len(), want_lost.len());
+    // Each sound played had its tick → output latency measured once.
+    assert_eq!(
+        sound["latencyMs"].as_array().unwrap().len(),
+        played_sounds.len(),
+        "one latency per sound played"
+    );
+    Heard {
+        sample_rate_hz: sr,
+        track_samples: track.len(),
+        played_samples: played,
+        underruns: live["underruns"].as_u64().unwrap(),
+        dropped,
+        sent: sent.len(),
+        played: played_sounds.len(),
+        lost: lost.len(),
+    }
+}
