@@ -4,6 +4,17 @@
 //! sounds on their ticks), sample by sample against the Rust synthesis of the same recording at
 //! the same sample rate.
 //!
+//! The live path (the FIFO, the lead, the underrun and drop logic, which the offline path
+//! skips): the same processor, not offline, driven one 128-sample render quantum at a time by
+//! an audio clock in the page, its sound ticks delivered by a schedule of arrival times (the
+//! publisher's 5-tick blocks, each sent when its last tick ends). Real time in headless
+//! Chromium on two shared cores cannot promise an underrun-free run (the browser tests'
+//! sessions play live and are held to the same samples whatever their underruns and drops,
+//! common/live.rs); the schedule can: an idle page (each block arriving 2 ms after its last
+//! tick, plus up to 3 ms of jitter) must play with 0 underruns and 0 drops, every sample of the
+//! track and every sound sent; a link that stalls for 50 ms must underrun, lengthen its lead,
+//! drop the backlog, and still play only the track's samples, each sound played or lost once.
+//!
 //! Tolerance: none. The worklet computes in f64 as the Rust code does, with the same formulas
 //! in the same order, and writes Float32 (the same round-to-nearest as Rust's `as f32`); only
 //! the transcendental functions could differ (V8's `Math.sin`/`exp`/`pow` against glibc's,
@@ -18,6 +29,7 @@
 mod common;
 
 use common::cdp::{Browser, base64_decode};
+use common::live;
 use haptic_loop::session::{SceneSource, SessionArrays, read_arrays};
 use play::PlayConfig;
 use play::protocol::{SoundKind, SoundOn, SoundTick, SoundTicks};
@@ -199,4 +211,166 @@ fn the_pages_worklet_makes_the_samples_of_render_audio() {
     stop.store(true, Ordering::Relaxed);
     let _ = handle.join();
     assert_eq!(report.len(), 4);
+}
+
+/// How the live test's sound ticks reach the worklet: each 5-tick block `delay_ms` after its
+/// last tick ends, plus a jitter in [0, `jitter_ms`) (a fixed sequence; blocks keep their
+/// order), and the blocks sent during `stall` (from, to, ms) held until its end.
+struct Link {
+    delay_ms: f64,
+    jitter_ms: f64,
+    stall: Option<(f64, f64)>,
+}
+
+/// The arrival time, ms, of each block (`ends`: when each block's last tick ends, ms).
+fn arrivals(ends: &[f64], link: &Link) -> Vec<f64> {
+    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut last = 0.0f64;
+    ends.iter()
+        .map(|&end| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let j = (x >> 11) as f64 / (1u64 << 53) as f64 * link.jitter_ms;
+            let mut t = end + link.delay_ms + j;
+            if let Some((from, to)) = link.stall {
+                if (from..to).contains(&end) {
+                    t = t.max(to);
+                }
+            }
+            last = last.max(t);
+            last
+        })
+        .collect()
+}
+
+/// Plays the recording's sound ticks through the worklet's live path at `sr` Hz over `link`,
+/// checks what it heard against `render --audio --proximity` (common/live.rs) and returns it.
+fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> live::Heard {
+    let a = read_arrays(rec, false).unwrap();
+    let on = haptic_loop::sound::proximity_on_distance_m(kind).unwrap();
+    let msgs = sound_ticks(&a, on);
+    let dt_ms = 1000.0 / f64::from(a.rate_hz);
+    let ends: Vec<f64> = msgs
+        .iter()
+        .map(|m| (m.first_tick + m.ticks.len() as u64) as f64 * dt_ms)
+        .collect();
+    let at = arrivals(&ends, link);
+    let blocks: Vec<String> = msgs.iter().map(|m| base64(&m.encode())).collect();
+    let sent: Vec<[u64; 2]> = msgs
+        .iter()
+        .flat_map(|m| m.sounds.iter().map(|s| [s.tick, u64::from(s.index)]))
+        .collect();
+    let js = format!(
+        r#"(async () => {{
+  const ab = (s) => Uint8Array.from(atob(s), (c) => c.charCodeAt(0)).buffer;
+  const blocks = {blocks}.map(ab), at = {at}, sr = {sr};
+  const src = await (await fetch('/synth.js')).text();
+  // The AudioWorkletGlobalScope the processor sees: its base class and port, the context's
+  // sample rate and time, registerProcessor.
+  const reports = [];
+  let Proc = null;
+  globalThis.sampleRate = sr; globalThis.currentTime = 0;
+  globalThis.AudioWorkletProcessor = class {{
+    constructor() {{ this.port = {{ postMessage: (m) => reports.push(m), onmessage: null }}; }}
+  }};
+  globalThis.registerProcessor = (name, cls) => {{ Proc = cls; }};
+  new Function(src)();
+  const p = new Proc({{ processorOptions: {{ rateHz: {rate}, leadS: {lead} }} }});
+  const out = new Float32Array(128);
+  let m = 0, finished = false;
+  for (let q = 0; q < 1e7 && !p.done; q++) {{
+    const ms = q * 128 / sr * 1000;
+    for (; m < blocks.length && at[m] <= ms; m++) p.port.onmessage({{ data: blocks[m] }});
+    // The page's `end` follows the last sound ticks.
+    if (m === blocks.length && !finished) {{ p.port.onmessage({{ data: {{ finish: {ticks} }} }}); finished = true; }}
+    globalThis.currentTime = q * 128 / sr;
+    p.process([], [[out]]);
+  }}
+  const onsets = reports.filter((r) => r.kind === 'onset');
+  return {{
+    live: reports.find((r) => r.kind === 'done') || null,
+    sound: {{
+      sent: {sent},
+      played: onsets.map((r) => [r.tick, r.index]),
+      lost: reports.filter((r) => r.kind === 'lost').map((r) => [r.tick, r.index]),
+      latencyMs: onsets.map(() => 0),
+    }},
+  }};
+}})()"#,
+        blocks = json!(blocks),
+        at = json!(at),
+        rate = a.rate_hz,
+        lead = LEAD_S,
+        ticks = a.tick.len(),
+        sent = json!(sent),
+    );
+    let v = b.eval(&js).unwrap();
+    live::check(&a, kind, &v["live"], &v["sound"])
+}
+
+/// The page's lead, s (sound.js's LEAD_S).
+const LEAD_S: f64 = 0.006;
+
+#[test]
+fn the_worklets_live_path_plays_the_samples_of_render_audio() {
+    let sound_js = include_str!("../src/page/sound.js");
+    assert!(
+        sound_js.contains(&format!("const LEAD_S = {LEAD_S};")),
+        "the page's lead is the test's"
+    );
+    let out = std::env::temp_dir().join(format!("nh-sound-live-{}.mcap", std::process::id()));
+    let mut c = PlayConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), out);
+    c.port = 0;
+    let stop = Arc::new(AtomicBool::new(false));
+    let play::Running { url, handle } = play::start(c, stop.clone()).unwrap();
+    let mut b = Browser::launch(800, 600).unwrap();
+    b.open(&url).unwrap();
+    let idle = Link {
+        delay_ms: 2.0,
+        jitter_ms: 3.0,
+        stall: None,
+    };
+    let stalled = || Link {
+        delay_ms: 2.0,
+        jitter_ms: 3.0,
+        stall: Some((1000.0, 1050.0)),
+    };
+    for (rec, kind, sr) in [
+        ("brickworld", "brickworld", 48_000),
+        ("nanoworld", "nanoworld", 44_100),
+    ] {
+        let path = workspace().join(format!("recordings/{rec}.mcap"));
+        let h = live_path(&mut b, &path, kind, sr, &idle);
+        println!("{rec}, idle page, {sr} Hz: {h:?}");
+        // An idle page: every sample of the track, every sound, no underrun, no drop.
+        assert_eq!((h.underruns, h.dropped), (0, 0), "{rec}: {h:?}");
+        assert_eq!(h.played_samples, h.track_samples);
+        assert_eq!((h.played, h.lost), (h.sent, 0));
+        assert!(h.sent > 0);
+        let h = live_path(&mut b, &path, kind, sr, &stalled());
+        println!("{rec}, a 50 ms stall, {sr} Hz: {h:?}");
+        // A stall: the worklet ran dry, then dropped the backlog; what it played is still
+        // the track's (checked in live_path).
+        assert!(h.underruns >= 1 && h.dropped > 0, "{rec}: {h:?}");
+        assert_eq!(h.played_samples as u64 + h.dropped, h.track_samples as u64);
+        assert_eq!(h.played + h.lost, h.sent);
+        // A 300 ms stall from 240 ms before the first sound: the backlog (about 300 ms) is
+        // dropped at the end of the first whole 0.1 s window after it arrives, from a playhead
+        // at most two windows (203 ms) past the stall's start, so the drop covers the sound's
+        // first sample.
+        let a = read_arrays(&path, false).unwrap();
+        let first_ms = haptic_loop::sound::sound_events(&a).unwrap()[0].t_s * 1000.0;
+        let over = Link {
+            stall: Some((first_ms - 240.0, first_ms + 60.0)),
+            ..stalled()
+        };
+        let h = live_path(&mut b, &path, kind, sr, &over);
+        println!("{rec}, a 300 ms stall over its first sound (at {first_ms} ms), {sr} Hz: {h:?}");
+        assert!(h.lost >= 1, "{rec}: {h:?}");
+        assert_eq!(h.played + h.lost, h.sent);
+    }
+    b.check().unwrap();
+    stop.store(true, Ordering::Relaxed);
+    let _ = handle.join();
 }
