@@ -55,6 +55,15 @@ MUTATIONS = (
         tests=(("-p", "brickworld", "--test", "carry"), ("-p", "brickworld", "--test", "coupling")),
     ),
     Mutation(
+        name="synthesis-skips-a-sound",
+        what="the page's live sound synthesis skips the first sound it is sent (the offline path plays it)",
+        path="crates/play/src/page/synth.js",
+        old="const tS = st * this.dt;",
+        new="if (!this.offline && !this.skipped) { this.skipped = true; continue; }\n        const tS = st * this.dt;",
+        count=1,
+        tests=(("-p", "nanohaptics-play", "--test", "browser_sound"),),
+    ),
+    Mutation(
         name="welcome-at-1khz",
         what="the bridge welcomes every scene at 1 kHz (a 10 kHz scene's device sends 1000 samples/s)",
         path="crates/devices/src/bridge/udp.rs",
