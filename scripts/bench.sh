@@ -23,7 +23,7 @@ if [ "$assemble_only" = 0 ] && [ ! -x .venv-bench/bin/python ]; then
 fi
 export NANOHAPTICS_PYTHON="$PWD/.venv-bench/bin/python"
 
-order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live soak determinism zwidth link adapters brickworld nanoworld teaching-game play render sweeps fuzz)
+order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live bridge-10khz soak determinism zwidth link adapters brickworld nanoworld teaching-game play render sweeps fuzz)
 for crate in "${order[@]}"; do
   if [ "$assemble_only" = 0 ] && [ -f "crates/$crate/examples/bench_report.rs" ]; then
     echo "==> $crate-report"

@@ -377,21 +377,42 @@ fn the_welcome_carries_the_scenes_rate_name_and_start_time() {
     assert!(dev.welcome.scene.starts_with("optical tweezers at 10 kHz"));
     assert_eq!(dev.welcome.start_time_ns, 1_700_000_000_123_456_789);
     assert_eq!(r.header.start_time_ns, 1_700_000_000_123_456_789);
-    // 0.5 s at 10 kHz: the device sent 5000 samples and every one arrived (it was welcomed
-    // with 1000 Hz and sent 500).
+    // 0.5 s at 10 kHz: the device sent 5000 samples, counted at the rate it was welcomed
+    // with (not timed), and every one arrived (welcomed with 1000 Hz, it sent 500).
     assert_eq!((dev.ticks, dev.sent), (5000, 5000));
     assert_eq!(counter(&r, "received"), 5000);
-    // On a quiet machine every sample has its tick and none is stale; on 2 shared cores with
-    // the device spinning beside the loop (and other builds running) many are late (not timed
-    // here), never the 99.98 % of a session paced at 1 kHz against a 10 kHz loop.
+    // How many ticks the loop runs in the device's 0.5 s is the machine's, not the code's: the
+    // device starts sending at its welcome, the loop ticks once the session is set up (the
+    // scene, the recording), and its first tick takes up the device's numbering where it is
+    // then (measured on 2 loaded cores: at sample 974–2122, so 2878–4566 ticks). From there it
+    // keeps one tick per device period to the device's last sample. The figure is in
+    // BENCHMARKS.md ("The 10 kHz scene over the bridge"), printed here, never asserted.
+    let a = &r.arrays;
+    assert_eq!(a.device_seq.len() as u64, r.stats.ticks);
+    let slots: Vec<u64> = (a.device_seq.iter().zip(&a.device_age_ticks))
+        .map(|(s, g)| s + u64::from(*g))
+        .collect();
+    let (first, last) = (slots[0], slots[slots.len() - 1]);
     let stale = counter(&r, "stale_ticks");
     println!(
-        "10 kHz over the bridge: {} ticks, {stale} stale, {} superseded",
+        "10 kHz over the bridge: {} ticks, from the device's sample {first} to {last}, {stale} \
+         stale, {} superseded, {} resyncs",
         r.stats.ticks,
-        counter(&r, "superseded")
+        counter(&r, "superseded"),
+        counter(&r, "resync")
     );
-    // Paced at 1 kHz (the bug) the loop would run about 500 ticks in 0.5 s.
-    assert!(r.stats.ticks >= 2500, "{} ticks", r.stats.ticks);
+    // What the recording says, whatever the clock: each tick is one period of the device (the
+    // slot its sample and age name, `seq + age`, is the last one's plus 1), from the first
+    // tick to the device's last sample. A loop that drops every other tick steps by 2.
+    assert_eq!(counter(&r, "resync"), 0);
+    assert!(
+        slots.windows(2).all(|w| w[1] == w[0] + 1),
+        "slots {:?}…",
+        &slots[..slots.len().min(20)]
+    );
+    assert!(last >= dev.sent - 1, "the last tick's slot {last}");
+    // A loop paced at 1 kHz against the 10 kHz device reads a fresh sample on 0.02 % of its
+    // ticks; a 10 kHz loop under load most of the time (measured: 3–56 % stale).
     assert!(
         stale * 10 < r.stats.ticks * 9,
         "{stale} stale ticks of {}",

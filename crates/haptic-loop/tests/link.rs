@@ -15,7 +15,7 @@
 use haptic_devices::link::LinkParams;
 use haptic_devices::local::Protocol;
 use haptic_devices::{Grip, Mechanics, PRESETS};
-use haptic_loop::closed_loop::{Linked, Report, run_linked};
+use haptic_loop::closed_loop::{Linked, Report, Trace, run_linked};
 
 fn read(name: &str) -> String {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
@@ -58,22 +58,54 @@ fn line(label: &str, r: &Report) -> String {
     )
 }
 
-#[test]
-fn every_scene_on_every_device_is_stable_behind_a_link_of_up_to_10_ms() {
-    // Every (scene, device, grip, latency, link) case, run on two threads.
-    let mut cases = Vec::new();
-    for (scene, script) in SCENES {
-        for mech in PRESETS {
-            for grip in [Grip::LOOSE, Grip::FIRM] {
-                for ms in LATENCIES_MS {
-                    for bad in [false, true] {
-                        cases.push((scene, script, mech, grip, ms, bad));
-                    }
-                }
-            }
-        }
-    }
-    assert_eq!(cases.len(), 5 * 4 * 2 * 8 * 2);
+/// One run of the grid: `ms` `None` is the ideal link (no delay, no loss, protocol 1: the
+/// closed loop of issue 22), the reference the linked runs are held to.
+#[derive(Clone, Copy)]
+struct Case {
+    scene: &'static str,
+    script: &'static str,
+    mech: Mechanics,
+    grip: Grip,
+    ms: Option<f64>,
+    bad: bool,
+}
+
+/// What the grid keeps of a run: its report and, for the wall, the felt stiffness.
+struct Run {
+    case: Case,
+    label: String,
+    r: Report,
+    wall_n_per_m: Option<f64>,
+}
+
+/// Least-squares slope of `y` against `x`.
+fn slope(pts: &[(f64, f64)]) -> f64 {
+    let n = pts.len() as f64;
+    let (sx, sy) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |a, p| {
+        (a.0 + (p.0 - mx) * (p.1 - my), a.1 + (p.0 - mx).powi(2))
+    });
+    sxy / sxx
+}
+
+/// The stiffness the hand feels pressing into `wall.toml`'s plane (z = −5 mm): the slope of
+/// the felt F_z against the depth, over the readings 0.5–2.5 mm deep on the way down (before
+/// the deepest reading; below the force clamp of every preset), N/m.
+fn wall_stiffness(t: &Trace) -> f64 {
+    let deepest = (0..t.readings.len())
+        .min_by(|&a, &b| t.readings[a][2].total_cmp(&t.readings[b][2]))
+        .unwrap_or(0);
+    let pts: Vec<(f64, f64)> = (t.readings[..deepest].iter().zip(&t.felt))
+        .map(|(p, f)| (-0.005 - p[2], f[2]))
+        .filter(|(d, _)| (0.0005..0.0025).contains(d))
+        .collect();
+    assert!(pts.len() > 50, "{} readings in the wall", pts.len());
+    slope(&pts)
+}
+
+/// Runs every case on two threads, in the order of `cases`.
+fn run_all(cases: &[Case]) -> Vec<Run> {
     let next = std::sync::atomic::AtomicUsize::new(0);
     let results = std::sync::Mutex::new(Vec::new());
     std::thread::scope(|s| {
@@ -81,46 +113,165 @@ fn every_scene_on_every_device_is_stable_behind_a_link_of_up_to_10_ms() {
             s.spawn(|| {
                 loop {
                     let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    let Some(&(scene, script, mech, grip, ms, bad)) = cases.get(i) else {
+                    let Some(&c) = cases.get(i) else {
                         break;
                     };
-                    let l = Linked {
-                        link: link(ms, bad),
-                        protocol: Protocol::V2,
+                    let l = match c.ms {
+                        None => Linked::IDEAL,
+                        Some(ms) => Linked {
+                            link: link(ms, c.bad),
+                            protocol: Protocol::V2,
+                        },
                     };
-                    let (r, _) = run_linked(&read(scene), &read(script), mech, grip, &l, None)
-                        .unwrap_or_else(|e| panic!("{scene} on {}: {e}", mech.name));
-                    let label =
-                        format!("{scene} {} {} {}", mech.name, grip.label(), l.link.label());
-                    results.lock().unwrap().push((i, ms, label, r));
+                    let (r, t) =
+                        run_linked(&read(c.scene), &read(c.script), c.mech, c.grip, &l, None)
+                            .unwrap_or_else(|e| panic!("{} on {}: {e}", c.scene, c.mech.name));
+                    let wall_n_per_m = (c.scene == "wall.toml").then(|| wall_stiffness(&t));
+                    let link = if c.ms.is_some() {
+                        l.link.label()
+                    } else {
+                        "ideal link".into()
+                    };
+                    let label = format!("{} {} {} {link}", c.scene, c.mech.name, c.grip.label());
+                    results.lock().unwrap().push((
+                        i,
+                        Run {
+                            case: c,
+                            label,
+                            r,
+                            wall_n_per_m,
+                        },
+                    ));
                 }
             });
         }
     });
     let mut results = results.into_inner().unwrap();
     results.sort_by_key(|r| r.0);
-    let mut unstable = Vec::new();
-    let mut goal_unstable = 0;
-    let mut worst_goal_energy: f64 = f64::NEG_INFINITY;
-    for (_, ms, label, r) in &results {
-        println!("{}", line(label, r));
-        if *ms <= 10.0 && !r.stable() {
-            unstable.push(label.clone());
+    results.into_iter().map(|r| r.1).collect()
+}
+
+#[test]
+fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_10_ms() {
+    // Every (scene, device, grip) on the ideal link, then behind every (latency, link).
+    let mut cases = Vec::new();
+    for (scene, script) in SCENES {
+        for mech in PRESETS {
+            for grip in [Grip::LOOSE, Grip::FIRM] {
+                let case = Case {
+                    scene,
+                    script,
+                    mech,
+                    grip,
+                    ms: None,
+                    bad: false,
+                };
+                cases.push(case);
+                for ms in LATENCIES_MS {
+                    for bad in [false, true] {
+                        cases.push(Case {
+                            ms: Some(ms),
+                            bad,
+                            ..case
+                        });
+                    }
+                }
+            }
         }
-        if *ms > 10.0 {
+    }
+    assert_eq!(cases.len(), 5 * 4 * 2 * (1 + 8 * 2));
+    let runs = run_all(&cases);
+    let mut unstable = Vec::new();
+    let mut untransparent = Vec::new();
+    let mut unbuilt = Vec::new();
+    let mut over_peak = Vec::new();
+    let (mut goal_unstable, mut goal_runs) = (0, 0);
+    let mut worst_goal_energy: f64 = f64::NEG_INFINITY;
+    let mut worst_target_energy: f64 = f64::NEG_INFINITY;
+    let (mut peak_lo, mut peak_hi, mut wall_lo, mut wall_hi) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    let mut ideal = None;
+    for Run {
+        case,
+        label,
+        r,
+        wall_n_per_m,
+    } in &runs
+    {
+        println!("{}", line(label, r));
+        let Some(ms) = case.ms else {
+            // The reference: stable, and both houses built on the ideal link.
+            assert!(r.stable(), "{label}");
+            assert!(
+                r.house_complete_s.is_none_or(|t| t > 0.0),
+                "{label}: house not built"
+            );
+            ideal = Some((r.peak_force_n, *wall_n_per_m));
+            continue;
+        };
+        let (ideal_peak, ideal_wall) = ideal.unwrap();
+        if ms > 10.0 {
+            goal_runs += 1;
             goal_unstable += u32::from(!r.stable());
             worst_goal_energy = worst_goal_energy.max(r.energy_to_hand_j);
+            continue;
+        }
+        // The target, 0–10 ms: stable, the energy into the hand within 0.01 J, the house
+        // built in both worlds, and transparent: the peak force the hand feels within 20 % of
+        // the ideal link's, the wall's felt stiffness within 10 % of it.
+        if !r.stable() {
+            unstable.push(label.clone());
+        }
+        worst_target_energy = worst_target_energy.max(r.energy_to_hand_j);
+        if r.house_complete_s.is_some_and(|t| t <= 0.0) {
+            unbuilt.push(label.clone());
+        }
+        let peak = r.peak_force_n / ideal_peak;
+        (peak_lo, peak_hi) = (peak_lo.min(peak), peak_hi.max(peak));
+        if peak > 1.2 {
+            over_peak.push(format!("{label}: {peak:.3}"));
+        }
+        if peak < 0.8 || (ms <= 2.0 && peak > 1.2) {
+            untransparent.push(format!("{label}: peak {peak:.3} of the ideal link's"));
+        }
+        if let (Some(k), Some(k0)) = (wall_n_per_m, ideal_wall) {
+            let q = k / k0;
+            (wall_lo, wall_hi) = (wall_lo.min(q), wall_hi.max(q));
+            if (q - 1.0).abs() > 0.1 {
+                untransparent.push(format!("{label}: wall felt {q:.3} of the ideal link's"));
+            }
         }
     }
     println!(
-        "{goal_unstable} of {} runs unstable at 20 and 50 ms (the goal); the most energy the \
-         motors put into a hand there: {worst_goal_energy:+.4} J",
-        5 * 4 * 2 * 2 * 2
+        "{goal_unstable} of {goal_runs} runs unstable at 20 and 50 ms (the goal); the most energy \
+         the motors put into a hand there: {worst_goal_energy:+.4} J; at 0–10 ms: \
+         {worst_target_energy:+.4} J; peak felt force {peak_lo:.3}–{peak_hi:.3} of the ideal \
+         link's; the wall's felt stiffness {wall_lo:.4}–{wall_hi:.4} of the ideal link's"
     );
-    // Beyond the target the two-port layer still bounds the energy the motors can put into
-    // the hand (protocol 1 pumps joules into it from 2 ms on).
-    assert!(worst_goal_energy < 0.1, "{worst_goal_energy} J");
+    println!("peak above 1.2 × the ideal link's (5 and 10 ms): {over_peak:#?}");
     assert!(unstable.is_empty(), "unstable up to 10 ms: {unstable:#?}");
+    assert!(worst_target_energy <= 0.01, "{worst_target_energy} J");
+    assert!(
+        untransparent.is_empty(),
+        "not transparent: {untransparent:#?}"
+    );
+    // docs/devices.md: "at 20 and 50 ms, 148 of 160 are [stable], and the most the motors put
+    // into a hand there is 0.07 J". The link is simulated and seeded: the count is exact.
+    assert_eq!((goal_runs - goal_unstable, goal_runs), (148, 160));
+    assert!(
+        (0.065..0.075).contains(&worst_goal_energy),
+        "{worst_goal_energy} J"
+    );
+    // Measured, not yet met (issue 40's target is 20 % at every latency to 10 ms): the peak
+    // force grows with the delay where the hand drags a spring (the atoms' adhesion, the
+    // 10 kHz trap, the carried brick on a Delta.3), up to +50 %. 31 of the 320 runs at 0–10 ms
+    // exceed +20 %: 3 at 5 ms (the 10 kHz trap), 28 at 10 ms; none at 0–2 ms.
+    assert_eq!(over_peak.len(), 31, "{over_peak:#?}");
+    // Measured, not yet met: one brick house is not built at 1 ms with jitter and loss.
+    assert_eq!(
+        unbuilt,
+        ["brickworld.toml falcon firm 1 ms + 1 ms jitter, 5 % loss"],
+        "houses not built at 0–10 ms"
+    );
 }
 
 /// Why protocol 2: the carried brick on a loosely held Falcon behind 2 ms each way. With
@@ -142,36 +293,47 @@ fn the_carried_brick_buzzes_behind_2_ms_with_protocol_1_and_not_with_protocol_2(
     let (v1, v2) = (run(Protocol::V1), run(Protocol::V2));
     println!("{}", line("protocol 1, 2 ms", &v1));
     println!("{}", line("protocol 2, 2 ms", &v2));
-    assert!(!v1.stable() && v1.undeclared_jumps > 100 && v1.energy_to_hand_j > 1.0);
+    assert!(!v1.stable() && v2.stable());
+    // docs/devices.md: "buzzes with protocol 1 (2174 changes, +4.05 J)" (simulated: exact).
+    assert_eq!(v1.undeclared_jumps, 2174);
+    assert!(
+        (4.045..4.055).contains(&v1.energy_to_hand_j),
+        "{} J",
+        v1.energy_to_hand_j
+    );
     assert!(v2.stable() && v2.energy_to_hand_j < 0.0);
     // The house still gets built through the link.
     assert!(v2.house_complete_s.is_some_and(|t| t > 0.0));
 }
 
-/// A linked run is simulated in whole nanoseconds with seeded draws: it repeats to the bit,
-/// every reading and every force the hand felt as well as the summary.
+/// A linked run is simulated in whole nanoseconds with seeded draws: every scene repeats to
+/// the bit behind a lossy, jittery link, every reading and every force the hand felt as well
+/// as the summary.
 #[test]
 fn a_run_behind_a_lossy_jittery_link_repeats_to_the_bit() {
-    let (scene, script) = (read("wall.toml"), read("wall.script.toml"));
     let l = Linked {
         link: link(5.0, true),
         protocol: Protocol::V2,
     };
-    let a = run_linked(&scene, &script, Mechanics::TOUCH, Grip::LOOSE, &l, None).unwrap();
-    let b = run_linked(&scene, &script, Mechanics::TOUCH, Grip::LOOSE, &l, None).unwrap();
-    assert_eq!(a.0, b.0);
-    assert!(!a.1.felt.is_empty() && a.1.felt.len() == a.1.readings.len());
-    let bits = |t: &haptic_loop::closed_loop::Trace| -> Vec<u64> {
+    let bits = |t: &Trace| -> Vec<u64> {
         (t.readings.iter().chain(&t.felt))
             .flatten()
             .map(|v| v.to_bits())
             .collect()
     };
-    assert_eq!(bits(&a.1), bits(&b.1));
+    for (scene, script) in SCENES {
+        let (scene, script) = (read(scene), read(script));
+        let run = || run_linked(&scene, &script, Mechanics::TOUCH, Grip::LOOSE, &l, None).unwrap();
+        let (a, b) = (run(), run());
+        assert_eq!(a.0, b.0);
+        assert!(!a.1.felt.is_empty() && a.1.felt.len() == a.1.readings.len());
+        assert_eq!(a.1.felt.len() as u64, a.0.ticks);
+        assert_eq!(bits(&a.1), bits(&b.1));
+    }
     // And an ideal link with protocol 1 is the closed loop of issue 22.
     let ideal = run_linked(
-        &scene,
-        &script,
+        &read("wall.toml"),
+        &read("wall.script.toml"),
         Mechanics::TOUCH,
         Grip::LOOSE,
         &Linked::IDEAL,
@@ -180,6 +342,59 @@ fn a_run_behind_a_lossy_jittery_link_repeats_to_the_bit() {
     .unwrap()
     .0;
     assert!(ideal.stable());
+}
+
+/// docs/devices.md and BENCHMARKS.md ("Transparency"): with protocol 2 the hand feels
+/// 0.94–1.00 of the wall's stiffness at every latency to 10 ms on every preset, and 0 N of
+/// drag gliding at 0.1 m/s in free space. The link report's probe
+/// (`examples/link_report.rs`): the wall at half the preset's rated stiffness, B = 0, the
+/// safety layer off, pressed 2 mm by a firm hand; the slope of F_z against the reading over
+/// the samples 0.5–2 mm deep.
+#[test]
+fn the_hand_feels_0_94_to_1_00_of_the_walls_stiffness_and_no_drag_to_10_ms() {
+    let wall = |k: f64| {
+        format!(
+            "[scene]\nname = \"link wall\"\nkind = \"wall\"\n[device]\nmodel = \"falcon\"\n\
+             [mapping]\nfit_device = false\n\
+             [loop]\nengage_s = 0.0\npassivity = false\nforce_rate_limit = false\n\
+             [wall]\nnormal = [0.0, 0.0, 1.0]\npoint_m = [0.0, 0.0, 0.0]\n\
+             stiffness_n_per_m = {k:?}\ndamping_n_s_per_m = 0.0\ncursor_radius_m = 0.001\n"
+        )
+    };
+    let press = include_str!("../examples/press_and_hold.script.toml");
+    let glide = "[script]\nname = \"glide\"\nduration_s = 0.8\n\
+                 [[waypoint]]\nt_s = 0.0\nposition_mm = [-30.0, 0.0, 20.0]\n\
+                 [[waypoint]]\nt_s = 0.2\nposition_mm = [-30.0, 0.0, 20.0]\n\
+                 [[waypoint]]\nt_s = 0.8\nposition_mm = [30.0, 0.0, 20.0]\n";
+    let (mut lo, mut hi, mut drag) = (f64::MAX, 0.0f64, 0.0f64);
+    for mech in PRESETS {
+        let k = 0.5 * mech.limits.max_stiffness_n_per_m;
+        for ms in [0.0, 0.5, 1.0, 2.0, 5.0, 10.0] {
+            let l = Linked {
+                link: LinkParams::latency_ms(ms),
+                protocol: Protocol::V2,
+            };
+            let (_, t) = run_linked(&wall(k), press, mech, Grip::FIRM, &l, None).unwrap();
+            let pts: Vec<(f64, f64)> = (t.readings.iter().zip(&t.felt))
+                .map(|(p, f)| (-p[2], f[2]))
+                .filter(|(d, _)| (0.0005..0.002).contains(d))
+                .collect();
+            let q = slope(&pts) / k;
+            println!("{} {ms} ms: felt / wall stiffness {q:.3}", mech.name);
+            (lo, hi) = (lo.min(q), hi.max(q));
+            let (_, g) = run_linked(&wall(k), glide, mech, Grip::FIRM, &l, None).unwrap();
+            let f = &g.felt[300..700];
+            let mean = f
+                .iter()
+                .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt());
+            drag = drag.max(mean.sum::<f64>() / f.len() as f64);
+        }
+    }
+    println!("felt / wall stiffness {lo:.3}–{hi:.3}, drag at most {drag:.4} N");
+    // Two-sided, to the quoted figures' rounding: the softest 0.94 (a Falcon), the stiffest 1.00.
+    assert!((0.935..0.945).contains(&lo), "{lo}");
+    assert!((0.995..1.005).contains(&hi), "{hi}");
+    assert!(drag < 5e-5, "{drag} N");
 }
 
 #[test]
