@@ -71,8 +71,17 @@ def mock_haply(monkeypatch):
     return state
 
 
-def test_an_inverse3_is_centred_announces_its_limits_and_ends_at_zero_force(tmp_path, mock_haply):
-    port, out = free_port(), tmp_path / "inverse3.mcap"
+# The status bit the simulator sets on a tick whose sample was late beyond the watchdog's grace.
+WATCHDOG = 32
+
+
+def _inverse3_session(out, mock_haply):
+    """One bridged session of the wall with the mocked Inverse3: the device, its specs, the
+    adapter's stats and the simulator's result."""
+    for key in ("forces", "positions", "ports"):
+        mock_haply[key].clear()
+    mock_haply["woken"] = False
+    port = free_port()
     t, sim = bridged_session(port, out)
     dev = bridge.HaplyInverse3Device(handle_port="auto", workspace_centre_m=CENTRE,
                                      max_force_n=2.5, max_stiffness_n_per_m=1500.0)
@@ -83,6 +92,10 @@ def test_an_inverse3_is_centred_announces_its_limits_and_ends_at_zero_force(tmp_
     mock_haply["t0"] = time.perf_counter()
     stats = bridge.run(dev, ("127.0.0.1", port), seconds=1.0)
     t.join()
+    return stats, sim
+
+
+def _check_inverse3_session(out, stats, sim, mock_haply):
     assert stats["sent"] >= 500 and stats["answered"] >= 0.9 * stats["sent"]
     assert sim["stats"]["end"] == "device_ended"
     assert sim["stats"]["link"]["received"] == stats["sent"]
@@ -118,6 +131,31 @@ def test_an_inverse3_is_centred_announces_its_limits_and_ends_at_zero_force(tmp_
     assert len(mock_haply["forces"]) == n
     back = nh.read_recording(out)
     assert np.array_equal(back["device_position_m"], seen)
+
+
+def test_an_inverse3_is_centred_announces_its_limits_and_ends_at_zero_force(tmp_path, mock_haply):
+    # On 2 shared cores a late sample can make the simulator's watchdog fade the force, and
+    # the soft engagement then ramps the stiffness back in mid-press (a peak of 1250 N/m
+    # instead of 1500 was seen under load): that is the watchdog doing its job, not the
+    # adapter. So a run whose checks fail *while the machine disturbed it* (a tick with the
+    # watchdog bit, or a round-trip p99 beyond the watchdog's 2.5 ms grace) is tried again,
+    # waiting 1 s, 2 s, ... (at most eight runs); an undisturbed run that fails fails at once.
+    # The same rule as the bridged Falcon carry in crates/cli/tests/cli.rs.
+    for k in range(8):
+        out = tmp_path / f"inverse3-{k}.mcap"
+        stats, sim = _inverse3_session(out, mock_haply)
+        watchdog_ticks = int(np.count_nonzero(sim["status"] & WATCHDOG))
+        disturbed = watchdog_ticks > 0 or stats["round_trip_p99_s"] > 0.0025
+        try:
+            _check_inverse3_session(out, stats, sim, mock_haply)
+            return
+        except AssertionError:
+            if not disturbed:
+                raise
+            print(f"run {k + 1} disturbed ({watchdog_ticks} watchdog ticks, round-trip p99 "
+                  f"{stats['round_trip_p99_s'] * 1e3:.2f} ms) and failed: trying again")
+            time.sleep(k + 1)
+    pytest.fail("eight runs in a row disturbed by the machine: the checks could not be made")
 
 
 def wait_until(predicate, timeout_s=2.0):
