@@ -74,7 +74,7 @@ pub struct Report {
     pub safety_ticks: u64,
     /// Work the device's motors did on the hand, J.
     pub energy_to_hand_j: f64,
-    /// Largest force sent, N.
+    /// Largest force the device rendered on the hand (the felt force, at each sample), N.
     pub peak_force_n: f64,
     /// Largest local stiffness sent with the force (a diagonal entry), N/m: the stiffest
     /// spring the world rendered at the device.
