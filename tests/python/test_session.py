@@ -130,3 +130,13 @@ def test_session_errors(tmp_path):
     shutil.copy(SCENES / "wall.toml", not_mcap)
     with pytest.raises(ValueError):
         nh.read_recording(not_mcap)
+
+
+def test_readme_wall_example_feels_3_newtons():
+    """README.md's example: 300 ticks 1 mm into scenes/wall.toml's plane (z = -5 mm) ->
+    [0, 0, 3.0] N: the wall's 5000 N/m capped to the Falcon's 3000 N/m, fully engaged."""
+    with nh.Session(SCENES / "wall.toml") as s:
+        for _ in range(300):
+            f = s.tick([0.0, 0.0, -0.006])
+    assert f[0] == 0.0 and f[1] == 0.0
+    assert abs(f[2] - 3.0) < 0.05, f

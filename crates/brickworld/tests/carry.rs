@@ -97,6 +97,11 @@ fn the_weight_of_a_brick_held_still_is_its_weight() {
             -f[1999][2]
         );
         assert!(err <= 1e-3, "{}: {err}", inertia.name());
+        // docs/brickworld.md ("A faithful carry") quotes the coupling's 1.7·10⁻⁵: held to
+        // that printed precision (the run is deterministic).
+        if inertia == Inertia::Coupling {
+            assert!((err - 1.7e-5).abs() <= 0.05e-5, "coupling: {err:.3e}");
+        }
     }
 }
 
@@ -153,6 +158,15 @@ fn a_switch_while_holding_and_a_grab_do_not_ring() {
         );
         for s in [mass_s, gravity_s] {
             assert!(s <= 0.1, "{}: {s} s", inertia.name());
+        }
+        // docs/brickworld.md ("A faithful carry") quotes the coupling's settling: 0 s after the
+        // mass is doubled, 0.058 s after gravity is switched off (to the printed ms).
+        if inertia == Inertia::Coupling {
+            assert_eq!(mass_s, 0.0, "coupling: mass doubled");
+            assert!(
+                (gravity_s - 0.058).abs() < 0.0005,
+                "coupling: {gravity_s} s"
+            );
         }
     }
 }
@@ -275,6 +289,24 @@ fn a_thrown_brick_leaves_with_the_hands_velocity_and_lands_where_it_should() {
             );
             assert!(v_err <= 0.02, "{name}: velocity {v_err}");
             assert!(land_err <= 0.02, "{name}: landing {land_err}");
+            // docs/brickworld.md ("A faithful carry") quotes these: the body at the hand's
+            // velocity within 10⁻¹⁵ of |v|, landing 0.05 % and 0.12 % of the 0.35 m and 0.10 m
+            // throws off the ballistic point (to the printed precision; deterministic run).
+            let (doc_pct, doc_m) = if v[2] > 0.0 {
+                (0.05, 0.35)
+            } else {
+                (0.12, 0.10)
+            };
+            assert!(v_err < 1e-15, "{name}: velocity {v_err:e}");
+            assert!(
+                (100.0 * land_err - doc_pct).abs() < 0.005,
+                "{name}: landing {:.3} %",
+                100.0 * land_err
+            );
+            assert!(
+                (distance - doc_m).abs() < 0.005,
+                "{name}: throw {distance} m"
+            );
         }
     }
 }
@@ -354,6 +386,16 @@ fn a_2_hz_carry_is_felt_as_its_inertia_within_the_couplings_bound() {
             assert!(
                 ratio > locked && ratio < free,
                 "{ratio}: [{locked}, {free}]"
+            );
+            // docs/brickworld.md ("A faithful carry") quotes: 15.88 % above M A Ω², |H| = 1.1586,
+            // the felt ratio within 0.02 % of it (each to its printed precision).
+            assert!((100.0 * (ratio - 1.0) - 15.88).abs() < 0.005, "{ratio}");
+            assert!((h - 1.1586).abs() < 0.00005, "{h}");
+            // ... and the damper's two limits this doc comment and the doc quote (28 % undamped).
+            assert!((locked - 1.123).abs() < 0.0005 && (free - 1.281).abs() < 0.0005);
+            assert!(
+                (100.0 * (ratio / h - 1.0) - 0.02).abs() < 0.005,
+                "{ratio} / {h}"
             );
         } else {
             println!(

@@ -80,6 +80,17 @@ fn slow_slide_is_not_frozen_by_sleep() {
                 (d - expected).abs() < 0.03 * expected,
                 "{solver}: mu {mu}, θ {theta_deg}°: slid {d} m, analytic {expected} m"
             );
+            // docs/brickworld.md quotes both solvers' slides to 0.1 mm (deterministic runs):
+            // default 0.3995 / 0.3425 m, the scene's 0.4001 / 0.3426 m, against 0.3993 / 0.3424.
+            let doc = match (base.solver_iterations == 1, mu == 0.0) {
+                (false, false) => 0.3995,
+                (false, true) => 0.3425,
+                (true, false) => 0.4001,
+                (true, true) => 0.3426,
+            };
+            let doc_expected = if mu == 0.0 { 0.3424 } else { 0.3993 };
+            assert!((d - doc).abs() < 0.00005, "{solver}: mu {mu}: slid {d} m");
+            assert!((expected - doc_expected).abs() < 0.00005, "{expected}");
         }
     }
 }
@@ -125,6 +136,13 @@ fn resting_brick_and_brick_below_friction_angle_fall_asleep() {
             w.awake_brick_count()
         );
         assert!(crept < 1e-3, "{solver}: crept {crept} m");
+        // docs/brickworld.md: the shipped solver's ramp brick creeps 6.1 µm (to 0.1 µm).
+        if base.solver_iterations == 1 {
+            assert!(
+                (crept - 6.1e-6).abs() < 0.05e-6,
+                "{solver}: crept {crept} m"
+            );
+        }
         assert_eq!(
             w.awake_brick_count(),
             0,
@@ -169,6 +187,16 @@ fn pressing_down_on_the_centre_does_not_walk_the_brick() {
         );
         assert!(rep.saturated, "{solver}");
         assert!((fz - max_f).abs() < 1e-9, "{solver}: device force {fz}");
+        // docs/brickworld.md quotes the walk: 0.018 µm (default), 0.5 µm (the scene's).
+        let (doc, half_ulp) = if base.solver_iterations == 1 {
+            (0.5e-6, 0.05e-6)
+        } else {
+            (0.018e-6, 0.0005e-6)
+        };
+        assert!(
+            (worst_lateral - doc).abs() < half_ulp,
+            "{solver}: walked {worst_lateral} m"
+        );
         assert!(
             worst_lateral < 1e-4,
             "{solver}: brick walked {worst_lateral} m sideways"
@@ -221,6 +249,33 @@ fn centred_flat_drop_onto_a_brick_stays_centred() {
                 worst_v < kick_max,
                 "{solver}: drop {drop}: lateral kick {worst_v} m/s"
             );
+            // docs/brickworld.md quotes each kick (mm/s, to the printed digits) and rest (mm):
+            // the scene's 9.06 / 7.69 / 12.37 mm/s, 0.040 / 0.032 / 0.193 mm; the default's
+            // 1.33 / 0.71 / 3.97 mm/s, 0.2 / 0.7 / 5.2 µm.
+            let k = [0.5, 1.0, 1.5].iter().position(|d| *d == drop).unwrap();
+            let (kick_mm_s, kick_ulp, rest_mm, rest_ulp) = if base.solver_iterations == 1 {
+                (
+                    [9.06, 7.69, 12.37][k],
+                    0.005,
+                    [0.040, 0.032, 0.193][k],
+                    0.0005,
+                )
+            } else {
+                (
+                    [1.33, 0.71, 3.97][k],
+                    0.005,
+                    [0.0002, 0.0007, 0.0052][k],
+                    0.00005,
+                )
+            };
+            assert!(
+                (1e3 * worst_v - kick_mm_s).abs() < kick_ulp,
+                "{solver}: drop {drop}: {worst_v} m/s"
+            );
+            assert!(
+                (1e3 * off - rest_mm).abs() < rest_ulp,
+                "{solver}: drop {drop}: rests {off} m off centre"
+            );
             assert!(
                 off < off_max,
                 "{solver}: drop {drop}: rests {off} m off centre"
@@ -260,6 +315,17 @@ fn brick_with_initial_velocity_and_own_friction_slides_v2_over_2_mu_g() {
         );
         assert!(
             (b.position_m[0] - expected).abs() < 0.02 * expected,
+            "{solver}: slid {} m",
+            b.position_m[0]
+        );
+        // docs/brickworld.md: 0.1698 m (default) and 0.1694 m (the scene's), to 0.1 mm.
+        let doc = if base.solver_iterations == 1 {
+            0.1694
+        } else {
+            0.1698
+        };
+        assert!(
+            (b.position_m[0] - doc).abs() < 0.00005,
             "{solver}: slid {} m",
             b.position_m[0]
         );

@@ -45,7 +45,9 @@ fn default_script_builds_the_wall_and_replays_bit_exactly() {
         .collect();
     assert!(level.len() > 1000, "{} level ticks", level.len());
     let mean = level.iter().map(|&i| a.device_force_n[i][2]).sum::<f64>() / level.len() as f64;
-    let weight = 0.5 * 9.81 * 0.125;
+    let weight: f64 = 0.5 * 9.81 * 0.125;
+    // docs/haptic-loop.md quotes it: −0.613 N.
+    assert!((weight - 0.613).abs() < 0.0005);
     assert!((mean + weight).abs() < 0.01 * weight, "mean Fz {mean} N");
     for i in 0..a.tick.len() {
         let f = a.device_force_n[i];

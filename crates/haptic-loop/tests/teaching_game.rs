@@ -168,26 +168,41 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
         .filter(|e| e.1 == "brick.impact")
         .map(|e| json(&e.2))
         .collect();
-    // The script presses each brick down and lets go 1 mm above its place: it lands at
-    // 0.757 m/s and the ground's impulse is M v (1 + e) for the 0.5 kg brick.
+    // The bricks' landings on the ground: the ground's impulse is M v (1 + e) plus the
+    // weight's impulse over the tick, M g dt (e = 0.2, M = 0.5 kg), within 0.2 %. (This loop
+    // used to look only at landings above 0.5 m/s, of which today's script has none: it
+    // checked nothing.) docs/brickworld.md quotes the six landings' range to the printed
+    // digits: 0.065–0.119 N·s at 0.101–0.190 m/s.
     let ground: Vec<_> = impacts
         .iter()
         .filter(|i| i["b"] == "ground" || i["a"] == "ground")
         .collect();
-    assert!(!ground.is_empty());
-    // M v (1 + e) plus the weight's impulse over the tick, M g dt (e = 0.2, M = 0.5 kg).
-    for i in ground
+    let f = |i: &serde_json::Value, k: &str| i[k].as_f64().unwrap();
+    let seen: Vec<(f64, f64)> = ground
         .iter()
-        .filter(|i| i["speed_m_per_s"].as_f64().unwrap() > 0.5)
-    {
-        let v = i["speed_m_per_s"].as_f64().unwrap();
+        .map(|i| (f(i, "speed_m_per_s"), f(i, "impulse_n_s")))
+        .collect();
+    assert_eq!(seen.len(), 6, "{ground:?}");
+    for (v, got) in &seen {
         let want = 0.5 * v * 1.2 + 0.5 * 9.81 * 1e-3;
-        let got = i["impulse_n_s"].as_f64().unwrap();
         assert!(
             (got / want - 1.0).abs() < 2e-3,
             "impulse {got} N s, M v (1+e) + M g dt = {want}"
         );
     }
+    let range = |k: usize| {
+        let x = seen.iter().map(|s| if k == 0 { s.0 } else { s.1 });
+        (x.clone().fold(f64::MAX, f64::min), x.fold(0.0, f64::max))
+    };
+    let ((v_lo, v_hi), (j_lo, j_hi)) = (range(0), range(1));
+    assert!(
+        (v_lo - 0.101).abs() < 0.0005 && (v_hi - 0.190).abs() < 0.0005,
+        "{seen:?}"
+    );
+    assert!(
+        (j_lo - 0.065).abs() < 0.0005 && (j_hi - 0.119).abs() < 0.0005,
+        "{seen:?}"
+    );
     for i in &impacts {
         assert_eq!(i["type"], "impact");
         assert!(i["impulse_n_s"].as_f64().unwrap() > 0.0);

@@ -141,6 +141,14 @@ fn physical_jump_to_contact_and_dmt_pull_off_match_analytic() {
         1.5 * z_jtc
     );
     let f_jtc = a * r / (6.0 * z_jtc * z_jtc);
+    // docs/nanoworld.md quotes these for A = 1e-19 J, R = 20 nm, z0 = 0.165 nm: k_c = 4.69 N/m,
+    // z_jtc = 0.522 nm, jump force 1.22 nN and pull-off 12.2 nN (to the printed digits).
+    assert!(a == 1e-19 && (r - 20e-9).abs() < 1e-15 && (z0 - 0.165e-9).abs() < 1e-18);
+    assert!((kc - 4.69).abs() < 0.005, "{kc}");
+    assert!((z_jtc - 0.522e-9).abs() < 0.0005e-9, "{z_jtc:e}");
+    assert!((f_jtc - 1.22e-9).abs() < 0.005e-9, "{f_jtc:e}");
+    let dmt = a * r / (6.0 * z0 * z0);
+    assert!((dmt - 12.2e-9).abs() < 0.05e-9, "{dmt:e}");
     let f_before = -c.approach_force_n[i - 1];
     // Near the fold D − z_jtc = sqrt(2/3·δh·z_jtc), so the last force felt lies below
     // F_jtc by at most 2·sqrt(2h/(3·z_jtc)).

@@ -25,6 +25,19 @@ fn scripted_session_builds_the_house() {
     assert_eq!(w.house().score(), 0);
     let reports = run(&mut w, 2e-12);
     let events: Vec<Event> = reports.iter().flat_map(|r| r.events.clone()).collect();
+    // docs/nanoworld.md: at a 2 pm step the script is 130 k ticks long and completes the
+    // default house at tick 126 k (each to the printed thousand).
+    let done = reports
+        .iter()
+        .position(|r| r.events.contains(&Event::HouseComplete))
+        .expect("complete");
+    println!("house complete at tick {done} of {}", reports.len());
+    assert!(
+        (129_500..130_500).contains(&reports.len()),
+        "{}",
+        reports.len()
+    );
+    assert!((125_500..126_500).contains(&done), "{done} ticks");
     let count = |f: &dyn Fn(&Event) -> bool| events.iter().filter(|e| f(e)).count();
     let slots = w.params().house.as_ref().map_or(0, |h| h.slots_m.len());
     assert_eq!(

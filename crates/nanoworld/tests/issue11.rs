@@ -77,6 +77,9 @@ fn sideways_pull_releases_at_pull_off_over_k() {
         (dx - expected).abs() <= step,
         "released at {dx:e} m, expected {expected:e} m"
     );
+    // docs/nanoworld.md: "the default tip lets go 1.5 nm (= 3 nN / 2 N/m) from its anchor".
+    assert!((law.pull_off_n - 3e-9).abs() < 0.5e-9 && law.stiffness_n_per_m == 2.0);
+    assert!((dx - 1.5e-9).abs() < 0.05e-9, "{dx:e} m");
 }
 
 /// Item 4: pushing into the contact (compression) is not a pull and never releases it.

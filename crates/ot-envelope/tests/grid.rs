@@ -56,6 +56,15 @@ fn the_chosen_grid_meets_the_budget_against_converged_dynamics_and_no_coarser_on
     let g = choose_grid(&prop, tol, 0.1).unwrap();
     eprintln!("{g}");
     assert!(g.grid_error_m <= tol / 2.0, "{g}");
+    // docs/ot-envelope.md quotes the scene's choice: region 3.75 waists (cut ≤ 4.05e-11 m),
+    // cell 0.6 waists (5.98e-11 m), 196 vertices at rest.
+    assert_eq!(
+        (g.margin_waists, g.cell_waists, g.vertices),
+        (3.75, 0.6, 196),
+        "{g}"
+    );
+    assert!((g.region_bound_m - 4.05e-11).abs() < 0.005e-11, "{g}");
+    assert!((g.grid_error_m - 5.98e-11).abs() < 0.005e-11, "{g}");
     let truth = converged(*prop.model(), prop.dt()).unwrap();
     let k = CELL_LADDER
         .iter()
@@ -101,6 +110,10 @@ fn the_chosen_grid_meets_the_budget_against_converged_dynamics_and_no_coarser_on
         "chosen cell {}: {:.3e} m; next coarser: {:.3e} m",
         g.cell_waists, worst[0], worst[1]
     );
+    // docs/ot-envelope.md: the chosen grid within 0.061 nm of converged dynamics, the next
+    // coarser spacing (0.8 waist) 0.50 nm off (each to the printed digits).
+    assert!((worst[0] - 0.061e-9).abs() < 0.0005e-9, "{worst:?}");
+    assert!((worst[1] - 0.50e-9).abs() < 0.005e-9 && CELL_LADDER[k - 1] == 0.8);
     // the budget: the grid's share, the region's cut, the tick map (1e-11 m)
     // and the reference's own tolerance
     assert!(

@@ -127,6 +127,14 @@ fn default_method_is_within_its_metre_tolerance_on_every_hard_case() {
             "{}: default flow off by {e:e} m > {DEFAULT_TOL_M:e} m at {at}",
             f.name
         );
+        // docs/ot-physics.md's table quotes each family's worst error at rtol 3e-9, to two
+        // digits: 1.5e-12, 1.1e-14 and 9.8e-16 m.
+        let (doc, half_ulp) = match f.name {
+            "paper constants, dt 0.2..20 us" => (1.5e-12, 0.05e-12),
+            "line trap b/a = 1/100" => (1.1e-14, 0.05e-14),
+            _ => (9.8e-16, 0.05e-16),
+        };
+        assert!((e - doc).abs() < half_ulp, "{}: {e:e}", f.name);
     }
 }
 
@@ -138,6 +146,11 @@ fn the_old_default_missed_the_promise() {
     let (e, at) = worst(f, Method::Adaptive { rtol: 1e-6 });
     eprintln!("old default: {e:e} m at {at}");
     assert!(e > 1e-11, "{e:e}");
+    // docs/ot-physics.md's table: 3.6e-10 m (Δt = 20 µs).
+    assert!(
+        (e - 3.6e-10).abs() < 0.05e-10 && at.starts_with("dt 2e-5 s"),
+        "{e:e} {at}"
+    );
 }
 
 #[test]
@@ -148,6 +161,15 @@ fn error_budget_chooses_the_cheapest_map_within_tolerance_and_it_holds_off_the_p
         let (p, c) = choose_tick_map(paper_model(), dt, 1e-11, v_max).unwrap();
         eprintln!("dt {dt:e}: {c}");
         assert!(c.error_m * 2.0 <= 1e-11 && c.probes == 4 * 81);
+        // docs/ot-physics.md's table: rk4 × 2, 4.2e-12 m, 8 evals (0.2 µs); rk8 × 4,
+        // 2.5e-12 m, 48 evals (1 µs), each to the printed digits.
+        let (method, doc_err, evals) = if dt < 0.5e-6 {
+            (ot_physics::Method::Rk4 { substeps: 2 }, 4.2e-12, 8)
+        } else {
+            (ot_physics::Method::Rk8 { substeps: 4 }, 2.5e-12, 48)
+        };
+        assert_eq!((c.method, c.evals_per_flow), (method, evals), "{c}");
+        assert!((c.error_m - doc_err).abs() < 0.05e-12, "{c}");
         // off-probe check: a denser, shifted lattice against the reference
         let r = converged(paper_model(), dt).unwrap();
         let mut worst: f64 = 0.0;
