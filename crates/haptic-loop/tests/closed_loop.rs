@@ -93,6 +93,11 @@ fn every_scene_is_stable_through_every_device_and_grip() {
                     if !r.stable() {
                         failures.push(label.clone());
                     }
+                    // docs/haptic-loop.md: the safety layer acts on no tick of any run (the
+                    // renderings are stable on their own).
+                    if r.safety_ticks != 0 {
+                        failures.push(format!("{label}: {} safety ticks", r.safety_ticks));
+                    }
                     // Both house tasks still complete with a hand in the loop.
                     if r.house_complete_s.is_some_and(|t| t < 0.0) {
                         unbuilt.push(label);
