@@ -15,7 +15,7 @@ use serde::Serialize;
 use crate::error::WorldError;
 use crate::event::{Body, BrickId, Touch};
 use crate::impact::hook::ImpactHook;
-use crate::params::{BrickPlacement, BrickProps, Lo, Params, range};
+use crate::params::{BrickPlacement, BrickProps, Lo, Params, finite3, placement, range};
 
 /// Half-extent of the ground slab in x and y, m (the ground is a 100 m × 100 m slab whose top
 /// face is the plane z = 0).
@@ -221,22 +221,9 @@ impl BrickSet {
     pub(crate) fn check_placement(
         &self,
         params: &Params,
-        placement: &BrickPlacement,
+        p: &BrickPlacement,
     ) -> Result<(), WorldError> {
-        for i in 0..3 {
-            range(
-                &format!("brick.center_m[{i}]"),
-                placement.center_m[i],
-                Lo::Closed(-100.0),
-                100.0,
-            )?;
-            range(
-                &format!("brick.rotation_deg[{i}]"),
-                placement.rotation_deg[i],
-                Lo::Closed(-3600.0),
-                3600.0,
-            )?;
-        }
+        placement("brick", p)?;
         if self.bricks.len() >= params.max_bricks {
             return Err(WorldError::TooManyBricks {
                 max: params.max_bricks,
@@ -247,14 +234,7 @@ impl BrickSet {
 
     /// Checks one brick's own properties against the ranges of the world's.
     pub(crate) fn check_props(props: &BrickProps) -> Result<(), WorldError> {
-        for i in 0..3 {
-            range(
-                &format!("brick.velocity_m_per_s[{i}]"),
-                props.velocity_m_per_s[i],
-                Lo::Closed(-100.0),
-                100.0,
-            )?;
-        }
+        finite3("brick.velocity_m_per_s", &props.velocity_m_per_s, 100.0)?;
         if let Some(m) = props.mass_kg {
             range("brick.mass_kg", m, Lo::Closed(1e-3), 100.0)?;
         }

@@ -359,14 +359,21 @@ fn count(field: &str, value: usize, lo: usize, hi: usize) -> Result<(), ParamErr
     }
 }
 
-fn finite3(field: &str, v: &[f64; 3], limit: f64) -> Result<(), ParamError> {
+/// Checks `value` lies in `[-limit, limit]`; NaN always fails.
+fn plus_minus(field: &str, value: f64, limit: f64) -> Result<(), ParamError> {
+    range(field, value, Lo::Closed(-limit), limit)
+}
+
+/// Checks every component `field[i]` of `v` lies in `[-limit, limit]`.
+pub(crate) fn finite3(field: &str, v: &[f64; 3], limit: f64) -> Result<(), ParamError> {
     for (i, x) in v.iter().enumerate() {
-        range(&format!("{field}[{i}]"), *x, Lo::Closed(-limit), limit)?;
+        plus_minus(&format!("{field}[{i}]"), *x, limit)?;
     }
     Ok(())
 }
 
-fn placement(field: &str, p: &BrickPlacement) -> Result<(), ParamError> {
+/// Checks a placement `field`: its centre in ±100 m, its rotation in ±3600°.
+pub(crate) fn placement(field: &str, p: &BrickPlacement) -> Result<(), ParamError> {
     finite3(&format!("{field}.center_m"), &p.center_m, 100.0)?;
     finite3(&format!("{field}.rotation_deg"), &p.rotation_deg, 3600.0)
 }
@@ -538,30 +545,15 @@ impl Params {
 /// The loading zone: its corners ordered and within ±100 m, its spawn point, its height.
 fn validate_loading_zone(z: &LoadingZone) -> Result<(), ParamError> {
     for i in 0..2 {
-        range(
-            &format!("loading_zone.min_m[{i}]"),
-            z.min_m[i],
-            Lo::Closed(-100.0),
-            100.0,
-        )?;
-        range(
-            &format!("loading_zone.max_m[{i}]"),
-            z.max_m[i],
-            Lo::Closed(-100.0),
-            100.0,
-        )?;
+        plus_minus(&format!("loading_zone.min_m[{i}]"), z.min_m[i], 100.0)?;
+        plus_minus(&format!("loading_zone.max_m[{i}]"), z.max_m[i], 100.0)?;
         if z.min_m[i] >= z.max_m[i] {
             return Err(ParamError::Inconsistent {
                 field: format!("loading_zone.max_m[{i}]"),
                 reason: format!("must exceed loading_zone.min_m[{i}] = {}", z.min_m[i]),
             });
         }
-        range(
-            &format!("loading_zone.spawn_m[{i}]"),
-            z.spawn_m[i],
-            Lo::Closed(-100.0),
-            100.0,
-        )?;
+        plus_minus(&format!("loading_zone.spawn_m[{i}]"), z.spawn_m[i], 100.0)?;
     }
     range("loading_zone.height_m", z.height_m, Lo::Open(0.0), 10.0)?;
     Ok(())

@@ -40,31 +40,23 @@ impl Chart {
         if !pts().any(|p| p[0].is_finite() && p[1].is_finite()) {
             return Err(ChartError::NoData { field: "series" });
         }
-        let xr = match self.x_range {
-            Some(r) => r,
-            None => auto_range(
-                pts()
-                    .filter(|p| p[1].is_finite())
-                    .map(|p| p[0])
-                    .chain(self.markers.iter().map(|m| m.x)),
-                self.x_scale,
-                false,
-                "x",
-            )?,
-        };
-        let yr = match self.y_range {
-            Some(r) => r,
-            None => auto_range(
-                pts()
-                    .filter(|p| p[0].is_finite())
-                    .map(|p| p[1])
-                    .chain(self.levels.iter().map(|l| l.y))
-                    .chain(self.bands.iter().flat_map(|b| [b.y_min, b.y_max])),
-                self.y_scale,
-                true,
-                "y",
-            )?,
-        };
+        // an axis without a fixed range spans its data: the points whose other coordinate is
+        // finite, and the markers (x) or the levels and bands (y)
+        let xs = pts()
+            .filter(|p| p[1].is_finite())
+            .map(|p| p[0])
+            .chain(self.markers.iter().map(|m| m.x));
+        let xr = self
+            .x_range
+            .map_or_else(|| auto_range(xs, self.x_scale, false, "x"), Ok)?;
+        let ys = pts()
+            .filter(|p| p[0].is_finite())
+            .map(|p| p[1])
+            .chain(self.levels.iter().map(|l| l.y))
+            .chain(self.bands.iter().flat_map(|b| [b.y_min, b.y_max]));
+        let yr = self
+            .y_range
+            .map_or_else(|| auto_range(ys, self.y_scale, true, "y"), Ok)?;
         check_range(xr, self.x_scale, "x_range")?;
         check_range(yr, self.y_scale, "y_range")?;
         let (l, t, r, b) = plot_area(width_px, height_px);

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 use world_form::ValueError;
+use world_form::value::in_range;
 
 /// How firmly a hand holds the stylus: the impedance of the arm around its intended path
 /// (`F = k (x_intent − x) + b (v_intent − v)`), plus the part of the hand's mass that moves with
@@ -49,16 +50,8 @@ impl Grip {
 
     /// Checks every field's range.
     pub fn validate(&self) -> Result<(), GripError> {
-        let check = |field, value: f64, ok: bool, allowed| {
-            if ok && value.is_finite() {
-                Ok(())
-            } else {
-                Err(GripError::OutOfRange(ValueError::out_of_range(
-                    format!("`{field}`"),
-                    value,
-                    allowed,
-                )))
-            }
+        let check = |field: &str, value: f64, ok: bool, allowed: &'static str| {
+            in_range(format!("`{field}`"), value, ok, allowed).map_err(GripError::OutOfRange)
         };
         let k = self.stiffness_n_per_m;
         check("k", k, k > 0.0 && k <= 1e4, "0 < k ≤ 10000 N/m")?;

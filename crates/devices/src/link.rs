@@ -52,15 +52,7 @@ impl LinkParams {
     /// Checks every field against its range; the error names the field and the range.
     pub fn validate(&self) -> Result<(), LinkError> {
         let check = |field: &'static str, v: f64, ok: bool, allowed: &'static str| {
-            if ok && v.is_finite() {
-                Ok(())
-            } else {
-                Err(LinkError(world_form::ValueError::out_of_range(
-                    format!("`{field}`"),
-                    v,
-                    allowed,
-                )))
-            }
+            world_form::value::in_range(format!("`{field}`"), v, ok, allowed).map_err(LinkError)
         };
         check(
             "latency_s",

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 use world_form::Limits;
 use world_form::ValueError;
+use world_form::value::in_range;
 
 /// The mechanics of a haptic device at its end effector, one translational axis model applied
 /// to each of x, y and z (a 3-DOF device linearised about the centre of its workspace).
@@ -137,16 +138,8 @@ impl Mechanics {
 
     /// Checks every field's range.
     pub fn validate(&self) -> Result<(), MechanicsError> {
-        let check = |field, value: f64, ok: bool, allowed| {
-            if ok && value.is_finite() {
-                Ok(())
-            } else {
-                Err(MechanicsError::OutOfRange(ValueError::out_of_range(
-                    format!("`{field}`"),
-                    value,
-                    allowed,
-                )))
-            }
+        let check = |field: &str, value: f64, ok: bool, allowed: &'static str| {
+            in_range(format!("`{field}`"), value, ok, allowed).map_err(MechanicsError::OutOfRange)
         };
         let m = self.moving_mass_kg;
         check(

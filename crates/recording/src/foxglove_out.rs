@@ -87,10 +87,10 @@ fn quat_x_to(d: Vec3) -> Quaternion {
 /// the same bodies in the same order.
 fn entity_id(p: &Primitive, counts: &mut [u32; 8]) -> String {
     let (k, name) = match p {
-        Primitive::Sphere { .. } => (0, "sphere"),
-        Primitive::Cursor { .. } => (1, "cursor"),
-        Primitive::Box { .. } => (2, "box"),
-        Primitive::Slot { .. } => (3, "slot"),
+        Primitive::Sphere(_) => (0, "sphere"),
+        Primitive::Cursor(_) => (1, "cursor"),
+        Primitive::Box(_) => (2, "box"),
+        Primitive::Slot(_) => (3, "slot"),
         Primitive::Ellipse { .. } => (4, "ellipse"),
         Primitive::Polyline { .. } => (5, "polyline"),
         Primitive::Arrow { .. } => (6, "arrow"),
@@ -127,45 +127,19 @@ fn add_primitive(e: &mut SceneEntity, p: &Primitive, scale: f64) {
     match p {
         // Foxglove has no cursor or dashed-slot primitive: a cursor is
         // drawn as its sphere, a blueprint slot as its box.
-        Primitive::Sphere {
-            center_m,
-            radius_m,
-            color: c,
-        }
-        | Primitive::Cursor {
-            center_m,
-            radius_m,
-            color: c,
-        } => e.spheres.push(SpherePrimitive {
-            pose: pose(*center_m, scale, identity()),
-            size: Some(v3([2.0 * radius_m; 3], scale)),
-            color: Some(color(*c)),
+        Primitive::Sphere(ball) | Primitive::Cursor(ball) => e.spheres.push(SpherePrimitive {
+            pose: pose(ball.center_m, scale, identity()),
+            size: Some(v3([2.0 * ball.radius_m; 3], scale)),
+            color: Some(color(ball.color)),
         }),
-        Primitive::Box {
-            center_m,
-            half_extents_m,
-            rotation,
-            color: c,
+        Primitive::Box(block) | Primitive::Slot(block) => {
+            let [x, y, z, w] = block.rotation;
+            e.cubes.push(CubePrimitive {
+                pose: pose(block.center_m, scale, Quaternion { x, y, z, w }),
+                size: Some(v3(vec3::scale(block.half_extents_m, 2.0), scale)),
+                color: Some(color(block.color)),
+            })
         }
-        | Primitive::Slot {
-            center_m,
-            half_extents_m,
-            rotation,
-            color: c,
-        } => e.cubes.push(CubePrimitive {
-            pose: pose(
-                *center_m,
-                scale,
-                Quaternion {
-                    x: rotation[0],
-                    y: rotation[1],
-                    z: rotation[2],
-                    w: rotation[3],
-                },
-            ),
-            size: Some(v3(vec3::scale(*half_extents_m, 2.0), scale)),
-            color: Some(color(*c)),
-        }),
         Primitive::Ellipse {
             center_m,
             semi_axes_m,
@@ -325,6 +299,7 @@ pub fn polyline_points(data: &[u8], id: &str) -> Result<Vec<[f64; 3]>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use haptic_types::Ball;
 
     #[test]
     fn arrow_orientation_points_along_the_force() {
@@ -359,11 +334,11 @@ mod tests {
         assert_eq!(schema::<FrameTransform>().0, "foxglove.FrameTransform");
         assert_eq!(schema::<Log>().0, "foxglove.Log");
         let u = scene_update(
-            &[Primitive::Sphere {
+            &[Primitive::Sphere(Ball {
                 center_m: [1e-6, 0.0, 0.0],
                 radius_m: 5e-7,
                 color: Rgba([1.0, 0.0, 0.0, 1.0]),
-            }],
+            })],
             1e6,
             1_500_000_000,
         );

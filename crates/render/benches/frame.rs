@@ -2,8 +2,8 @@
 //! and adding one frame to a GIF.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use haptic_types::Primitive;
 use haptic_types::Rgba;
+use haptic_types::{Ball, OrientedBox, Primitive};
 use render::{Camera, Frame, GifWriter, Palette, Style, View};
 use std::hint::black_box;
 
@@ -17,11 +17,11 @@ fn tweezers(t: f64) -> Frame {
         color: Rgba([0.2, 0.6, 0.2, 0.8]),
     })
     .expect("beam");
-    f.push(Primitive::Sphere {
+    f.push(Primitive::Sphere(Ball {
         center_m: p,
         radius_m: 0.5e-6,
         color: Rgba::from_u8(200, 80, 40),
-    })
+    }))
     .expect("particle");
     let loop_m: Vec<[f64; 3]> = (0..200)
         .map(|k| {
@@ -31,11 +31,11 @@ fn tweezers(t: f64) -> Frame {
         .collect();
     f.scaled_loop(&loop_m, p, 100.0, Rgba::from_u8(20, 20, 160))
         .expect("loop");
-    f.push(Primitive::Cursor {
+    f.push(Primitive::Cursor(Ball {
         center_m: [p[0] + 0.4e-6, p[1], 0.0],
         radius_m: 0.15e-6,
         color: Rgba([0.1, 0.3, 0.9, 0.4]),
-    })
+    }))
     .expect("cursor");
     f.push(Primitive::Arrow {
         from_m: p,
@@ -61,7 +61,7 @@ fn house() -> Frame {
     for i in 0..10 {
         for j in 0..4 {
             for k in 0..6 {
-                f.push(Primitive::Box {
+                f.push(Primitive::Box(OrientedBox {
                     center_m: [
                         -0.2 + 0.045 * i as f64,
                         -0.1 + 0.06 * j as f64,
@@ -70,7 +70,7 @@ fn house() -> Frame {
                     half_extents_m: [0.02, 0.01, 0.012],
                     rotation: [0.0, 0.0, 0.0, 1.0],
                     color: Rgba::from_u8(180, 70, 50),
-                })
+                }))
                 .expect("brick");
             }
         }

@@ -7,8 +7,8 @@
 //! scale bar is exact.
 
 use crate::error::{RenderError, finite, finite3, out_of_range};
-use haptic_types::Primitive;
-use haptic_types::vec3::{Vec3, add, axes, box_corners, cross, dot, normalize, normq, sub};
+use haptic_types::vec3::{Vec3, add, box_corners, cross, dot, normalize, sub};
+use haptic_types::{OrientedBox, Primitive};
 
 /// Largest image side the renderer makes, px (`picture`'s).
 pub use picture::MAX_SIDE_PX;
@@ -113,29 +113,12 @@ pub fn bounds(prims: &[Primitive]) -> Option<(Vec3, Vec3)> {
     };
     for p in prims {
         match p {
-            Primitive::Sphere {
-                center_m, radius_m, ..
+            Primitive::Sphere(ball) | Primitive::Cursor(ball) => {
+                grow(sub(ball.center_m, [ball.radius_m; 3]));
+                grow(add(ball.center_m, [ball.radius_m; 3]));
             }
-            | Primitive::Cursor {
-                center_m, radius_m, ..
-            } => {
-                grow(sub(*center_m, [*radius_m; 3]));
-                grow(add(*center_m, [*radius_m; 3]));
-            }
-            Primitive::Box {
-                center_m,
-                half_extents_m,
-                rotation,
-                ..
-            }
-            | Primitive::Slot {
-                center_m,
-                half_extents_m,
-                rotation,
-                ..
-            } => {
-                let ax = axes(normq(*rotation));
-                for c in box_corners(*center_m, ax, *half_extents_m) {
+            Primitive::Box(block) | Primitive::Slot(block) => {
+                for c in box_corners(block.center_m, block.axes(), block.half_extents_m) {
                     grow(c);
                 }
             }
@@ -164,7 +147,7 @@ pub fn bounds(prims: &[Primitive]) -> Option<(Vec3, Vec3)> {
 /// framing of a picture, and labels may lie over them.
 pub fn is_backdrop(p: &Primitive) -> bool {
     match p {
-        Primitive::Box { half_extents_m, .. } => {
+        Primitive::Box(OrientedBox { half_extents_m, .. }) => {
             let lo = half_extents_m.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = half_extents_m.iter().copied().fold(0.0, f64::max);
             lo < 0.1 * hi
@@ -392,6 +375,7 @@ fn check_size(width_px: u32, height_px: u32) -> Result<(), RenderError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use haptic_types::Ball;
 
     #[test]
     fn oblique_basis_is_orthonormal_and_right_handed() {
@@ -452,17 +436,17 @@ mod tests {
         let c = Rgba([1.0, 0.0, 0.0, 1.0]);
         let h = std::f64::consts::FRAC_1_SQRT_2;
         let prims = vec![
-            Primitive::Sphere {
+            Primitive::Sphere(Ball {
                 center_m: [1.0, 2.0, 0.5],
                 radius_m: 0.5,
                 color: c,
-            },
-            Primitive::Box {
+            }),
+            Primitive::Box(OrientedBox {
                 center_m: [-1.0, 0.0, 0.0],
                 half_extents_m: [1.0, 0.1, 0.1],
                 rotation: [0.0, 0.0, h, h], // long axis turned onto y
                 color: c,
-            },
+            }),
         ];
         let (lo, hi) = bounds(&prims).expect("bounds");
         assert!((lo[0] + 1.1).abs() < 1e-12 && (hi[0] - 1.5).abs() < 1e-12);

@@ -9,9 +9,9 @@ use tiny_skia::{
 use crate::ToSkia;
 use crate::error::RenderError;
 use crate::frame::{Frame, ScaleBar, format_length};
-use haptic_types::Primitive;
 use haptic_types::Rgba;
-use haptic_types::vec3::{Vec3, add, axes, box_corners, dot, normalize, normq, scale};
+use haptic_types::vec3::{Vec3, add, box_corners, dot, normalize, scale};
+use haptic_types::{Ball, OrientedBox, Primitive};
 use picture::text;
 
 impl Frame {
@@ -26,22 +26,9 @@ impl Frame {
 
     pub(crate) fn draw_solid(&self, pm: &mut Pixmap, p: &Primitive) {
         match p {
-            Primitive::Sphere {
-                center_m,
-                radius_m,
-                color,
-            } => self.draw_sphere(pm, *center_m, *radius_m, *color, false),
-            Primitive::Cursor {
-                center_m,
-                radius_m,
-                color,
-            } => self.draw_sphere(pm, *center_m, *radius_m, *color, true),
-            Primitive::Box {
-                center_m,
-                half_extents_m,
-                rotation,
-                color,
-            } => self.draw_box(pm, *center_m, *half_extents_m, *rotation, *color),
+            Primitive::Sphere(ball) => self.draw_sphere(pm, ball, false),
+            Primitive::Cursor(ball) => self.draw_sphere(pm, ball, true),
+            Primitive::Box(block) => self.draw_box(pm, block),
             Primitive::Ellipse {
                 center_m,
                 semi_axes_m,
@@ -51,16 +38,15 @@ impl Frame {
         }
     }
 
-    pub(crate) fn draw_sphere(
-        &self,
-        pm: &mut Pixmap,
-        c: Vec3,
-        r_m: f64,
-        color: Rgba,
-        cursor: bool,
-    ) {
-        let q = self.camera.project(c);
-        let r = (r_m * self.camera.pixels_per_m()) as f32;
+    /// A shaded ball; with `cursor`, see-through with an opaque outline and cross-hair.
+    pub(crate) fn draw_sphere(&self, pm: &mut Pixmap, ball: &Ball, cursor: bool) {
+        let Ball {
+            center_m,
+            radius_m,
+            color,
+        } = *ball;
+        let q = self.camera.project(center_m);
+        let r = (radius_m * self.camera.pixels_per_m()) as f32;
         let (cx, cy) = (q.x_px as f32, q.y_px as f32);
         let Some(circle) = PathBuilder::from_circle(cx, cy, r.max(0.5)) else {
             return;
@@ -133,16 +119,11 @@ impl Frame {
         })
     }
 
-    pub(crate) fn draw_box(
-        &self,
-        pm: &mut Pixmap,
-        c: Vec3,
-        half: Vec3,
-        rot: [f64; 4],
-        color: Rgba,
-    ) {
-        let ax = axes(normq(rot));
-        let pts = self.corner_pixels(c, ax, half);
+    /// A shaded box: its faces toward the camera, lit, with their edges.
+    pub(crate) fn draw_box(&self, pm: &mut Pixmap, block: &OrientedBox) {
+        let color = block.color;
+        let ax = block.axes();
+        let pts = self.corner_pixels(block.center_m, ax, block.half_extents_m);
         let fwd = self.camera.forward();
         let light = self.light();
         let amb = self.style.ambient;
@@ -284,15 +265,10 @@ impl Frame {
         }
     }
 
-    pub(crate) fn draw_slot(
-        &self,
-        pm: &mut Pixmap,
-        c: Vec3,
-        half: Vec3,
-        rot: [f64; 4],
-        color: Rgba,
-    ) {
-        let pts = self.corner_pixels(c, axes(normq(rot)), half);
+    /// A blueprint slot: the box's twelve edges, dashed.
+    pub(crate) fn draw_slot(&self, pm: &mut Pixmap, slot: &OrientedBox) {
+        let ax = slot.axes();
+        let pts = self.corner_pixels(slot.center_m, ax, slot.half_extents_m);
         let mut pb = PathBuilder::new();
         for a in 0..8usize {
             for bit in [1usize, 2, 4] {
@@ -310,7 +286,8 @@ impl Frame {
             dash: StrokeDash::new(vec![3.0 * w, 2.0 * w], 0.0),
             ..Stroke::default()
         };
-        pm.stroke_path(&path, &solid(color), &stroke, Transform::identity(), None);
+        let paint = solid(slot.color);
+        pm.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
     }
 
     pub(crate) fn draw_text(

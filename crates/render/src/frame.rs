@@ -8,8 +8,7 @@ use crate::image::Image;
 use crate::order::{Item, Shape, back_to_front};
 use haptic_types::Primitive;
 use haptic_types::Rgba;
-use haptic_types::vec3::{Vec3, add, axes, scale, sub};
-use haptic_types::vec3::{box_corners, normq};
+use haptic_types::vec3::{Vec3, add, box_corners, scale, sub};
 use picture::text;
 use world_form::numbers::{SiStyle, fmt_si};
 
@@ -246,12 +245,7 @@ impl Frame {
                     to_m,
                     color,
                 } => self.draw_arrow(pm, *from_m, *to_m, *color),
-                Primitive::Slot {
-                    center_m,
-                    half_extents_m,
-                    rotation,
-                    color,
-                } => self.draw_slot(pm, *center_m, *half_extents_m, *rotation, *color),
+                Primitive::Slot(slot) => self.draw_slot(pm, slot),
                 _ => {}
             }
         }
@@ -362,33 +356,26 @@ impl Frame {
         let cam = &self.camera;
         let s = cam.pixels_per_m();
         match p {
-            Primitive::Sphere {
-                center_m, radius_m, ..
-            }
-            | Primitive::Cursor {
-                center_m, radius_m, ..
-            } => {
-                let q = cam.project(*center_m);
-                let r = radius_m * s;
+            Primitive::Sphere(ball) | Primitive::Cursor(ball) => {
+                let q = cam.project(ball.center_m);
+                let r = ball.radius_m * s;
                 Some(Item {
                     shape: Shape::Sphere {
-                        c: *center_m,
-                        r: *radius_m,
+                        c: ball.center_m,
+                        r: ball.radius_m,
                     },
                     depth: q.depth_m,
                     flat: false,
                     rect: [q.x_px - r, q.y_px - r, q.x_px + r, q.y_px + r],
                 })
             }
-            Primitive::Box {
-                center_m,
-                half_extents_m,
-                rotation,
-                ..
-            } => {
-                let ax = axes(normq(*rotation));
-                Some(obb_item(cam, *center_m, ax, *half_extents_m, false))
-            }
+            Primitive::Box(block) => Some(obb_item(
+                cam,
+                block.center_m,
+                block.axes(),
+                block.half_extents_m,
+                false,
+            )),
             Primitive::Ellipse {
                 center_m,
                 semi_axes_m,

@@ -24,15 +24,15 @@
 //! ambient, no interpenetrating solids (they are ordered by centre depth).
 //!
 //! ```
-//! use haptic_types::{Primitive, Rgba};
+//! use haptic_types::{Ball, Primitive, Rgba};
 //! use render::{Camera, Frame, Style, View};
 //! let cam = Camera::new(View::Top, [0.0; 3], 1e8, 320, 240)?; // 1 px = 10 nm
 //! let mut f = Frame::new(cam, Style::default())?;
-//! f.push(Primitive::Sphere {
+//! f.push(Primitive::Sphere(Ball {
 //!     center_m: [0.0; 3],
 //!     radius_m: 0.5e-6,
 //!     color: Rgba::from_u8(200, 60, 40),
-//! })?;
+//! }))?;
 //! f.scale_bar(None, Rgba::from_u8(0, 0, 0))?;
 //! let img = f.finish()?;
 //! let [r, g, b, _] = img.pixel(160, 120).expect("inside");

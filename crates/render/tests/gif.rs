@@ -2,7 +2,7 @@
 
 use render::{Camera, Frame, GifWriter, Image, Palette, Style, View, frame_delays_cs};
 
-use haptic_types::Primitive;
+use haptic_types::{Ball, Primitive};
 
 use haptic_types::Rgba;
 
@@ -13,11 +13,11 @@ const H: u32 = 120;
 fn frame(i: u32) -> Image {
     let cam = Camera::new(View::Top, [0.0; 3], 1e8, W, H).expect("camera");
     let mut f = Frame::new(cam, Style::default()).expect("frame");
-    f.push(Primitive::Sphere {
+    f.push(Primitive::Sphere(Ball {
         center_m: [(-50.0 + 4.0 * f64::from(i)) * 1e-8, 0.0, 0.0],
         radius_m: 1e-7,
         color: Rgba([0.85, 0.15, 0.1, 1.0]),
-    })
+    }))
     .expect("sphere");
     f.finish().expect("image")
 }
@@ -185,18 +185,18 @@ fn a_colour_missing_from_the_palette_switches_to_a_frame_palette() {
     let cam = Camera::new(View::Top, [0.0; 3], 1e8, W, H).expect("camera");
     let draw = |green: bool| {
         let mut f = Frame::new(cam, Style::default()).expect("frame");
-        f.push(Primitive::Sphere {
+        f.push(Primitive::Sphere(Ball {
             center_m: [-3e-7, 0.0, 0.0],
             radius_m: 1e-7,
             color: Rgba([0.85, 0.15, 0.1, 1.0]),
-        })
+        }))
         .expect("red");
         if green {
-            f.push(Primitive::Sphere {
+            f.push(Primitive::Sphere(Ball {
                 center_m: [3e-7, 0.0, 0.0],
                 radius_m: 2e-7,
                 color: Rgba([0.1, 0.8, 0.2, 1.0]),
-            })
+            }))
             .expect("green");
         }
         f.finish().expect("image")

@@ -1,8 +1,8 @@
 //! Pixel checks at known positions: things are drawn where the camera says, in the right
 //! colour, pointing the right way, in the right depth order, at the right size.
 
-use haptic_types::Primitive;
 use haptic_types::Rgba;
+use haptic_types::{Ball, OrientedBox, Primitive};
 use proptest::prelude::*;
 use render::{Camera, Frame, Image, Style, View};
 
@@ -35,11 +35,11 @@ fn top(scale: f64) -> Camera {
 fn particle_where_it_is_background_elsewhere() {
     // 1 µm particle at (+1 µm, −0.5 µm), 1e8 px/m: centre at pixel (300, 200), radius 50 px.
     let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
-    f.push(Primitive::Sphere {
+    f.push(Primitive::Sphere(Ball {
         center_m: [1e-6, -0.5e-6, 0.0],
         radius_m: 0.5e-6,
         color: RED,
-    })
+    }))
     .expect("sphere");
     let img = f.finish().expect("image");
     assert!(reddish(px(&img, 300.0, 200.0)));
@@ -116,16 +116,16 @@ fn nearer_sphere_wins_where_two_overlap() {
     // top view: the sphere with larger z is nearer the viewer
     for order in [false, true] {
         let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
-        let low = Primitive::Sphere {
+        let low = Primitive::Sphere(Ball {
             center_m: [-0.3e-6, 0.0, 0.0],
             radius_m: 0.5e-6,
             color: RED,
-        };
-        let high = Primitive::Sphere {
+        });
+        let high = Primitive::Sphere(Ball {
             center_m: [0.3e-6, 0.0, 1.2e-6],
             radius_m: 0.5e-6,
             color: BLUE,
-        };
+        });
         let (a, b) = if order { (low, high) } else { (high, low) };
         f.push(a).expect("a");
         f.push(b).expect("b");
@@ -147,18 +147,18 @@ fn brick_on_a_long_slab_is_in_front_from_an_oblique_view() {
     };
     let cam =
         Camera::fit(view, [-5.0, -1.0, -0.2], [5.0, 1.0, 1.2], 500, 300, 0.05).expect("camera");
-    let slab = Primitive::Box {
+    let slab = Primitive::Box(OrientedBox {
         center_m: [0.0, 0.0, 0.0],
         half_extents_m: [5.0, 0.5, 0.1],
         rotation: [0.0, 0.0, 0.0, 1.0],
         color: RED,
-    };
-    let cube = Primitive::Box {
+    });
+    let cube = Primitive::Box(OrientedBox {
         center_m: [4.5, 0.0, 0.6],
         half_extents_m: [0.5, 0.5, 0.5],
         rotation: [0.0, 0.0, 0.0, 1.0],
         color: BLUE,
-    };
+    });
     for order in [false, true] {
         let mut f = Frame::new(cam, Style::default()).expect("frame");
         let (a, b) = if order {
@@ -189,11 +189,11 @@ fn envelope_times_100_is_drawn_at_the_right_radius() {
         })
         .collect();
     let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
-    f.push(Primitive::Sphere {
+    f.push(Primitive::Sphere(Ball {
         center_m: about,
         radius_m: 0.1e-6,
         color: RED,
-    })
+    }))
     .expect("sphere");
     f.scaled_loop(&pts, about, 100.0, INK).expect("loop");
     let img = f.finish().expect("image");
@@ -265,12 +265,12 @@ fn same_frame_same_bytes() {
         let mut f = Frame::new(cam, Style::default()).expect("frame");
         for i in 0..20 {
             let x = f64::from(i) * 0.05 - 0.5;
-            f.push(Primitive::Box {
+            f.push(Primitive::Box(OrientedBox {
                 center_m: [x, 0.0, 0.02 * f64::from(i % 3)],
                 half_extents_m: [0.02, 0.03, 0.01],
                 rotation: [0.0, 0.0, 0.38268343236508984, 0.9238795325112867],
                 color: RED,
-            })
+            }))
             .expect("box");
         }
         f.finish().expect("image")
@@ -346,8 +346,8 @@ proptest! {
             a[i] + along * fwd[i] + side * (phi.cos() * right[i] + phi.sin() * up[i])
         });
         let cam = Camera::new(view, [0.0; 3], 200.0, 400, 400).expect("camera");
-        let sa = Primitive::Sphere { center_m: a, radius_m: ra, color: RED };
-        let sb = Primitive::Sphere { center_m: b, radius_m: rb, color: BLUE };
+        let sa = Primitive::Sphere(Ball { center_m: a, radius_m: ra, color: RED });
+        let sb = Primitive::Sphere(Ball { center_m: b, radius_m: rb, color: BLUE });
         let mut f = Frame::new(cam, Style::default()).expect("frame");
         if red_first { f.push(sa).expect("a"); f.push(sb).expect("b"); }
         else { f.push(sb).expect("b"); f.push(sa).expect("a"); }
@@ -378,7 +378,7 @@ proptest! {
     fn sphere_centre_pixel_has_its_colour(x in -1.8e-6f64..1.8e-6, y in -1.3e-6f64..1.3e-6,
                                           r in 0.05e-6f64..0.5e-6) {
         let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
-        f.push(Primitive::Sphere { center_m: [x, y, 0.0], radius_m: r, color: BLUE }).expect("s");
+        f.push(Primitive::Sphere(Ball { center_m: [x, y, 0.0], radius_m: r, color: BLUE })).expect("s");
         let img = f.finish().expect("image");
         let q = f.camera().project([x, y, 0.0]);
         prop_assert!(bluish(px(&img, q.x_px, q.y_px)));
@@ -469,18 +469,18 @@ fn check_boxes(
         a[i] + along * fwd[i] + side * (phi.cos() * right[i] + phi.sin() * up[i])
     });
     let cam = Camera::new(view, [0.0; 3], 150.0, 400, 400).expect("camera");
-    let ba = Primitive::Box {
+    let ba = Primitive::Box(OrientedBox {
         center_m: a,
         half_extents_m: ha,
         rotation: qa,
         color: RED,
-    };
-    let bb = Primitive::Box {
+    });
+    let bb = Primitive::Box(OrientedBox {
         center_m: b,
         half_extents_m: hb,
         rotation: qb,
         color: BLUE,
-    };
+    });
     let mut f = Frame::new(cam, Style::default()).expect("frame");
     if red_first {
         f.push(ba).expect("a");
@@ -637,11 +637,11 @@ fn beam_ellipse_fill_outline_and_side_view() {
 fn side_view_puts_plus_z_up() {
     let cam = Camera::new(View::Side, [0.0; 3], 1e8, 400, 300).expect("camera");
     let mut f = Frame::new(cam, Style::default()).expect("frame");
-    f.push(Primitive::Sphere {
+    f.push(Primitive::Sphere(Ball {
         center_m: [0.0, 0.0, 1e-6],
         radius_m: 0.2e-6,
         color: BLUE,
-    })
+    }))
     .expect("sphere");
     let img = f.finish().expect("image");
     assert!(bluish(px(&img, 200.5, 50.5)));
@@ -652,12 +652,12 @@ fn side_view_puts_plus_z_up() {
 fn slot_is_dashed_and_cursor_shows_what_is_behind() {
     // a 2 µm × 1 µm slot seen from above: its top edge y = 100 px from x = 100 to 300
     let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
-    f.push(Primitive::Slot {
+    f.push(Primitive::Slot(OrientedBox {
         center_m: [0.0; 3],
         half_extents_m: [1e-6, 0.5e-6, 0.2e-6],
         rotation: [0.0, 0.0, 0.0, 1.0],
         color: INK,
-    })
+    }))
     .expect("slot");
     let img = f.finish().expect("image");
     let ink: Vec<bool> = (110..290)
@@ -670,17 +670,17 @@ fn slot_is_dashed_and_cursor_shows_what_is_behind() {
     assert!(switches >= 30, "{switches} dash ends");
     // a see-through cursor over a red particle: the particle still shows through it
     let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
-    f.push(Primitive::Sphere {
+    f.push(Primitive::Sphere(Ball {
         center_m: [0.0; 3],
         radius_m: 0.5e-6,
         color: RED,
-    })
+    }))
     .expect("particle");
-    f.push(Primitive::Cursor {
+    f.push(Primitive::Cursor(Ball {
         center_m: [0.2e-6, 0.0, 0.0],
         radius_m: 0.2e-6,
         color: Rgba([0.1, 0.2, 0.85, 0.4]),
-    })
+    }))
     .expect("cursor");
     let img = f.finish().expect("image");
     let p = px(&img, 228.5, 158.5); // inside the cursor, off its cross-hair
@@ -691,11 +691,11 @@ fn slot_is_dashed_and_cursor_shows_what_is_behind() {
 fn things_far_outside_the_image_leave_it_blank() {
     let mut f = Frame::new(top(1e8), Style::default()).expect("frame");
     for far in [1e-3, 1e6, 1e30] {
-        f.push(Primitive::Sphere {
+        f.push(Primitive::Sphere(Ball {
             center_m: [far, 0.0, 0.0],
             radius_m: 1e-6,
             color: RED,
-        })
+        }))
         .expect("sphere");
         f.push(Primitive::Polyline {
             points_m: vec![[far, far, 0.0], [2.0 * far, far, 0.0]],
@@ -703,12 +703,12 @@ fn things_far_outside_the_image_leave_it_blank() {
             color: RED,
         })
         .expect("line");
-        f.push(Primitive::Box {
+        f.push(Primitive::Box(OrientedBox {
             center_m: [-far, 0.0, 0.0],
             half_extents_m: [1e-6; 3],
             rotation: [0.0, 0.0, 0.0, 1.0],
             color: RED,
-        })
+        }))
         .expect("box");
         f.push(Primitive::Arrow {
             from_m: [0.0, far, 0.0],

@@ -42,7 +42,7 @@ pub use device::{
     TickTime,
 };
 pub use event::Event;
-pub use primitive::{Primitive, Rgba};
+pub use primitive::{Ball, OrientedBox, Primitive, Rgba};
 pub use switch::{Switch, SwitchError, SwitchSpec};
 pub use tick::TickResult;
 pub use value::ValueError;

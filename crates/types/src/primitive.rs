@@ -2,7 +2,8 @@
 //!
 //! Every scene draws with these (`[f64; 3]` points, `[x, y, z, w]` quaternions, RGBA in 0–1);
 //! the renderer, the recording's Foxglove scene messages and the live views take them as they
-//! are. [`Primitive::Cursor`] and [`Primitive::Slot`] are the haptic cursor and blueprint slots.
+//! are. [`Primitive::Cursor`] and [`Primitive::Slot`] are the haptic cursor and blueprint slots,
+//! drawn from the same [`Ball`] and [`OrientedBox`] as a sphere and a box.
 //!
 //! A primitive serialises (serde) in the compact form a page's frame carries
 //! (`docs/play.md`): an object tagged by `k` (`sphere`, `cursor`, `box`, `slot`, `ellipse`,
@@ -10,7 +11,7 @@
 //! a colour as its four channels.
 
 use crate::value::{ValueError, finite, finite3};
-use crate::vec3::Vec3;
+use crate::vec3::{self, Vec3};
 
 /// An RGBA colour, each channel in 0–1 (straight, not premultiplied alpha).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -67,37 +68,75 @@ impl Rgba {
     }
 }
 
+/// A ball, world frame, metres: what a [`Primitive::Sphere`] and the [`Primitive::Cursor`] are
+/// drawn from.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Ball {
+    /// Centre, m.
+    #[serde(rename = "c")]
+    pub center_m: Vec3,
+    /// Radius, m (> 0).
+    #[serde(rename = "r")]
+    pub radius_m: f64,
+    /// Colour.
+    #[serde(rename = "col")]
+    pub color: Rgba,
+}
+
+impl Ball {
+    /// Checks a finite centre, a positive radius and a colour in 0–1 (`kind` names the
+    /// primitive in the error: `sphere.radius_m`, …).
+    fn validate(&self, kind: &str) -> Result<(), ValueError> {
+        finite3(&format!("{kind}.center_m"), self.center_m)?;
+        positive(&format!("{kind}.radius_m"), self.radius_m, false)?;
+        self.color.validate(&format!("{kind}.color"))
+    }
+}
+
+/// A box rotated by a unit quaternion `[x, y, z, w]`, world frame, metres: what a
+/// [`Primitive::Box`] and a blueprint [`Primitive::Slot`] are drawn from.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct OrientedBox {
+    /// Centre, m.
+    #[serde(rename = "c")]
+    pub center_m: Vec3,
+    /// Half extents along the box axes, m (each ≥ 0).
+    #[serde(rename = "h")]
+    pub half_extents_m: Vec3,
+    /// Orientation as a unit quaternion `[x, y, z, w]` (normalised when drawn).
+    #[serde(rename = "q")]
+    pub rotation: [f64; 4],
+    /// Colour.
+    #[serde(rename = "col")]
+    pub color: Rgba,
+}
+
+impl OrientedBox {
+    /// The box's unit axes in the world frame (its rotation normalised first).
+    pub fn axes(&self) -> [Vec3; 3] {
+        vec3::axes(vec3::normq(self.rotation))
+    }
+
+    /// Checks a finite centre, half extents ≥ 0, a quaternion near unit length and a colour
+    /// in 0–1 (`kind` names the primitive in the error: `box.rotation`, …).
+    fn validate(&self, kind: &str) -> Result<(), ValueError> {
+        finite3(&format!("{kind}.center_m"), self.center_m)?;
+        for (i, h) in self.half_extents_m.iter().enumerate() {
+            positive(&format!("{kind}.half_extents_m[{i}]"), *h, true)?;
+        }
+        quaternion(&format!("{kind}.rotation"), self.rotation)?;
+        self.color.validate(&format!("{kind}.color"))
+    }
+}
+
 /// A drawable primitive, world frame, metres.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "k", rename_all = "snake_case")]
 pub enum Primitive {
     /// A shaded sphere.
-    Sphere {
-        /// Centre, m.
-        #[serde(rename = "c")]
-        center_m: Vec3,
-        /// Radius, m (> 0).
-        #[serde(rename = "r")]
-        radius_m: f64,
-        /// Colour.
-        #[serde(rename = "col")]
-        color: Rgba,
-    },
-    /// A shaded box rotated by a unit quaternion `[x, y, z, w]`.
-    Box {
-        /// Centre, m.
-        #[serde(rename = "c")]
-        center_m: Vec3,
-        /// Half extents along the box axes, m (each ≥ 0).
-        #[serde(rename = "h")]
-        half_extents_m: Vec3,
-        /// Orientation as a unit quaternion `[x, y, z, w]` (normalised when drawn).
-        #[serde(rename = "q")]
-        rotation: [f64; 4],
-        /// Colour.
-        #[serde(rename = "col")]
-        color: Rgba,
-    },
+    Sphere(Ball),
+    /// A shaded box.
+    Box(OrientedBox),
     /// A filled, outlined ellipse in a plane of constant z (e.g. the beam's cross-section).
     Ellipse {
         /// Centre, m.
@@ -147,34 +186,12 @@ pub enum Primitive {
         #[serde(rename = "col")]
         color: Rgba,
     },
-    /// The haptic cursor: a see-through sphere with an outline and a cross-hair at its centre.
-    Cursor {
-        /// Centre, m.
-        #[serde(rename = "c")]
-        center_m: Vec3,
-        /// Radius, m (> 0).
-        #[serde(rename = "r")]
-        radius_m: f64,
-        /// Colour (the body uses its alpha, the outline and cross-hair are opaque).
-        #[serde(rename = "col")]
-        color: Rgba,
-    },
+    /// The haptic cursor: a see-through sphere with an outline and a cross-hair at its centre
+    /// (the body uses the colour's alpha, the outline and cross-hair are opaque).
+    Cursor(Ball),
     /// A blueprint slot: the dashed edges of a box where a brick should go; drawn over the
     /// solids.
-    Slot {
-        /// Centre, m.
-        #[serde(rename = "c")]
-        center_m: Vec3,
-        /// Half extents along the box axes, m (each ≥ 0).
-        #[serde(rename = "h")]
-        half_extents_m: Vec3,
-        /// Orientation as a unit quaternion `[x, y, z, w]`.
-        #[serde(rename = "q")]
-        rotation: [f64; 4],
-        /// Colour.
-        #[serde(rename = "col")]
-        color: Rgba,
-    },
+    Slot(OrientedBox),
 }
 
 fn positive(field: &str, v: f64, allow_zero: bool) -> Result<(), ValueError> {
@@ -214,30 +231,22 @@ impl Primitive {
     pub fn examples() -> Vec<Primitive> {
         let color = Rgba([0.5, 0.25, 1.0, 1.0]);
         let c = [0.25, -0.5, 1.0];
-        let (half_extents_m, rotation) = ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0, 1.0]);
+        let ball = Ball {
+            center_m: c,
+            radius_m: 0.5,
+            color,
+        };
+        let block = OrientedBox {
+            center_m: c,
+            half_extents_m: [1.0, 2.0, 3.0],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            color,
+        };
         vec![
-            Primitive::Sphere {
-                center_m: c,
-                radius_m: 0.5,
-                color,
-            },
-            Primitive::Cursor {
-                center_m: c,
-                radius_m: 0.5,
-                color,
-            },
-            Primitive::Box {
-                center_m: c,
-                half_extents_m,
-                rotation,
-                color,
-            },
-            Primitive::Slot {
-                center_m: c,
-                half_extents_m,
-                rotation,
-                color,
-            },
+            Primitive::Sphere(ball),
+            Primitive::Cursor(ball),
+            Primitive::Box(block),
+            Primitive::Slot(block),
             Primitive::Ellipse {
                 center_m: c,
                 semi_axes_m: [0.5, 0.25],
@@ -264,14 +273,14 @@ impl Primitive {
     /// Short name of the variant, used in error field names (`sphere`, `box`, …).
     pub fn kind(&self) -> &'static str {
         match self {
-            Primitive::Sphere { .. } => "sphere",
-            Primitive::Box { .. } => "box",
+            Primitive::Sphere(_) => "sphere",
+            Primitive::Box(_) => "box",
             Primitive::Ellipse { .. } => "ellipse",
             Primitive::Polyline { .. } => "polyline",
             Primitive::Arrow { .. } => "arrow",
             Primitive::Label { .. } => "label",
-            Primitive::Cursor { .. } => "cursor",
-            Primitive::Slot { .. } => "slot",
+            Primitive::Cursor(_) => "cursor",
+            Primitive::Slot(_) => "slot",
         }
     }
 
@@ -281,39 +290,8 @@ impl Primitive {
         let k = self.kind();
         let f = |name: &str| format!("{k}.{name}");
         match self {
-            Primitive::Sphere {
-                center_m,
-                radius_m,
-                color,
-            }
-            | Primitive::Cursor {
-                center_m,
-                radius_m,
-                color,
-            } => {
-                finite3(&f("center_m"), *center_m)?;
-                positive(&f("radius_m"), *radius_m, false)?;
-                color.validate(&f("color"))
-            }
-            Primitive::Box {
-                center_m,
-                half_extents_m,
-                rotation,
-                color,
-            }
-            | Primitive::Slot {
-                center_m,
-                half_extents_m,
-                rotation,
-                color,
-            } => {
-                finite3(&f("center_m"), *center_m)?;
-                for (i, h) in half_extents_m.iter().enumerate() {
-                    positive(&format!("{k}.half_extents_m[{i}]"), *h, true)?;
-                }
-                quaternion(&f("rotation"), *rotation)?;
-                color.validate(&f("color"))
-            }
+            Primitive::Sphere(ball) | Primitive::Cursor(ball) => ball.validate(k),
+            Primitive::Box(block) | Primitive::Slot(block) => block.validate(k),
             Primitive::Ellipse {
                 center_m,
                 semi_axes_m,
@@ -378,11 +356,11 @@ mod tests {
 
     #[test]
     fn validation_names_field_and_range() {
-        let p = Primitive::Sphere {
+        let p = Primitive::Sphere(Ball {
             center_m: [0.0, 0.0, 0.0],
             radius_m: 0.0,
             color: Rgba([1.0, 0.0, 0.0, 1.0]),
-        };
+        });
         assert_eq!(
             p.validate().unwrap_err().to_string(),
             "sphere.radius_m = 0 is out of range: allowed (0, inf) m"
@@ -396,22 +374,21 @@ mod tests {
             p.validate().unwrap_err().to_string(),
             "arrow.to_m[1] must be finite, got inf"
         );
-        let p = Primitive::Box {
+        let block = OrientedBox {
             center_m: [0.0; 3],
             half_extents_m: [1.0; 3],
             rotation: [0.0, 0.0, 0.0, 1.0],
             color: Rgba([1.5, 0.0, 0.0, 1.0]),
         };
         assert_eq!(
-            p.validate().unwrap_err().to_string(),
+            Primitive::Box(block).validate().unwrap_err().to_string(),
             "box.color[0] = 1.5 is out of range: allowed [0, 1]"
         );
-        let p = Primitive::Slot {
-            center_m: [0.0; 3],
-            half_extents_m: [1.0; 3],
+        let p = Primitive::Slot(OrientedBox {
             rotation: [0.0; 4],
             color: Rgba([1.0, 0.0, 0.0, 1.0]),
-        };
+            ..block
+        });
         assert!(
             p.validate()
                 .unwrap_err()

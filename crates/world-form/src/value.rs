@@ -109,6 +109,21 @@ pub fn finite(field: impl FnOnce() -> String, value: f64) -> Result<f64, ValueEr
     }
 }
 
+/// Checks that `value` is finite and passes its range test `ok`; else a
+/// [`ValueError::OutOfRange`] naming `field` and the range `allowed`, written out with its unit.
+pub fn in_range(
+    field: impl Into<Cow<'static, str>>,
+    value: f64,
+    ok: bool,
+    allowed: impl Into<Cow<'static, str>>,
+) -> Result<(), ValueError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ValueError::out_of_range(field, value, allowed))
+    }
+}
+
 /// Checks that every component of `p` is finite (`field[i]` names a bad one).
 pub fn finite3(field: &str, p: [f64; 3]) -> Result<(), ValueError> {
     for (i, v) in p.iter().enumerate() {

@@ -17,10 +17,10 @@ use haptic_engine::scene::Scene;
 use haptic_engine::scene::SceneInput;
 use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
-use haptic_types::Primitive;
 use haptic_types::Rgba;
 use haptic_types::SwitchSpec;
 use haptic_types::vec3::Vec3;
+use haptic_types::{Ball, OrientedBox, Primitive};
 use serde::Deserialize;
 use world_form::Limits;
 use world_form::fmt_num;
@@ -328,17 +328,19 @@ impl Scene for BrickScene {
 
     fn draw(&self, out: &mut Vec<Primitive>) {
         let g = self.ground_half_m;
-        out.push(Primitive::Box {
+        out.push(Primitive::Box(OrientedBox {
             center_m: [0.0, 0.0, -0.01],
             half_extents_m: [g, g, 0.01],
             rotation: [0.0, 0.0, 0.0, 1.0],
             color: Rgba([0.3, 0.6, 0.25, 1.0]),
-        });
-        let boxed = |center_m, half_extents_m, rotation, color| Primitive::Box {
-            center_m,
-            half_extents_m,
-            rotation,
-            color,
+        }));
+        let boxed = |center_m, half_extents_m, rotation, color| {
+            Primitive::Box(OrientedBox {
+                center_m,
+                half_extents_m,
+                rotation,
+                color,
+            })
         };
         for o in self.world.obstacles() {
             let grey = Rgba([0.5, 0.5, 0.5, 1.0]);
@@ -355,7 +357,7 @@ impl Scene for BrickScene {
             out.push(boxed(s.position_m, h, s.orientation_xyzw, ghost));
         }
         for b in self.world.bricks() {
-            out.push(Primitive::Box {
+            out.push(Primitive::Box(OrientedBox {
                 center_m: b.position_m,
                 half_extents_m: b.half_extents_m,
                 rotation: b.orientation_xyzw,
@@ -364,7 +366,7 @@ impl Scene for BrickScene {
                 } else {
                     Rgba([0.7, 0.25, 0.15, 1.0])
                 },
-            });
+            }));
         }
         if let Some(z) = &self.world.params().loading_zone {
             let (a, b) = (z.min_m, z.max_m);
@@ -380,11 +382,11 @@ impl Scene for BrickScene {
             });
         }
         let p = self.world.proxy_position_m();
-        out.push(Primitive::Sphere {
+        out.push(Primitive::Sphere(Ball {
             center_m: p,
             radius_m: self.world.params().proxy_radius_m.max(0.01),
             color: Rgba([0.2, 0.5, 0.95, 1.0]),
-        });
+        }));
         let f = self.force_n;
         if f.iter().any(|c| *c != 0.0) {
             // Arrow length: 1 cm per newton of world force (drawing only).

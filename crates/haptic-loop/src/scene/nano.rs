@@ -21,10 +21,10 @@ use haptic_engine::scene::Scene;
 use haptic_engine::scene::SceneInput;
 use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
-use haptic_types::Primitive;
 use haptic_types::Rgba;
 use haptic_types::SwitchSpec;
 use haptic_types::vec3::Vec3;
+use haptic_types::{Ball, OrientedBox, Primitive};
 use nalgebra::Vector3;
 use nanoworld::{BodyKind, Interaction, Params, TipContact, TipInput, World};
 use serde::Deserialize;
@@ -381,7 +381,7 @@ impl Scene for NanoScene {
         // The substrate as a slab, and its atoms near the tip.
         let s = &self.params.substrate;
         let (lx, ly) = (s.nx as f64 * s.spacing_m, s.ny as f64 * s.spacing_m);
-        out.push(Primitive::Box {
+        out.push(Primitive::Box(OrientedBox {
             center_m: [
                 0.5 * (lx - s.spacing_m),
                 0.5 * (ly - s.spacing_m),
@@ -390,36 +390,36 @@ impl Scene for NanoScene {
             half_extents_m: [0.5 * lx, 0.5 * ly, 0.5 * s.atom_radius_m],
             rotation: [0.0, 0.0, 0.0, 1.0],
             color: Rgba([0.0, 0.35, 0.35, 0.6]),
-        });
+        }));
         let near = Vector3::new(tip.x, tip.y, 0.0);
         w.substrate()
             .for_each_within(&near, self.draw_radius_m, |_, q| {
-                out.push(Primitive::Sphere {
+                out.push(Primitive::Sphere(Ball {
                     center_m: v(*q),
                     radius_m: s.atom_radius_m,
                     color: teal,
-                });
+                }));
             });
         for b in w.bodies().filter(|b| b.kind != BodyKind::Substrate) {
             let color = match b.kind {
                 BodyKind::Tip => Rgba([0.75, 0.75, 0.8, 1.0]),
                 _ => orange,
             };
-            out.push(Primitive::Sphere {
+            out.push(Primitive::Sphere(Ball {
                 center_m: v(b.position_m),
                 radius_m: b.radius_m,
                 color,
-            });
+            }));
         }
         if let Some(h) = &self.params.house {
             for (k, slot) in h.slots_m.iter().enumerate() {
                 let filled = w.house().filled().get(k).is_some_and(Option::is_some);
                 if !filled {
-                    out.push(Primitive::Sphere {
+                    out.push(Primitive::Sphere(Ball {
                         center_m: *slot,
                         radius_m: self.params.atoms.radius_m,
                         color: Rgba([1.0, 1.0, 1.0, 0.25]),
-                    });
+                    }));
                 }
             }
         }

@@ -15,9 +15,9 @@ use haptic_engine::scene::Scene;
 use haptic_engine::scene::SceneInput;
 use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
-use haptic_types::Primitive;
 use haptic_types::Rgba;
 use haptic_types::vec3::{self, Vec3};
+use haptic_types::{Ball, OrientedBox, Primitive};
 use serde::{Deserialize, Serialize};
 use world_form::Limits;
 use world_form::fmt_num;
@@ -257,22 +257,22 @@ impl Scene for WallScene {
 
     fn draw(&self, out: &mut Vec<Primitive>) {
         let thickness = self.half_size * 0.05;
-        out.push(Primitive::Box {
+        out.push(Primitive::Box(OrientedBox {
             center_m: vec3::sub(self.point_m, vec3::scale(self.normal, thickness)),
             half_extents_m: [self.half_size, self.half_size, thickness],
             rotation: quat_z_to(self.normal),
             color: Rgba([0.55, 0.6, 0.7, 0.8]),
-        });
+        }));
         let color = if self.in_contact {
             Rgba([0.9, 0.3, 0.2, 1.0])
         } else {
             Rgba([0.2, 0.6, 0.9, 1.0])
         };
-        out.push(Primitive::Sphere {
+        out.push(Primitive::Sphere(Ball {
             center_m: self.cursor_m,
             radius_m: self.cursor_radius,
             color,
-        });
+        }));
         if vec3::norm(self.force_n) > 0.0 {
             // Arrow length: 1 cm per newton of world force (drawing only).
             let tip = vec3::add(self.cursor_m, vec3::scale(self.force_n, 0.01));

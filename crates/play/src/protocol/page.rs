@@ -235,17 +235,33 @@ fn parse_input(v: &Value, button_mask: u32) -> Result<PageMsg, ProtocolError> {
 
 /// `input.seq`: an integer a page's JavaScript number holds exactly.
 fn input_seq(v: &Value) -> Result<u64, ProtocolError> {
-    match v.get("seq") {
-        Some(Value::Number(n)) if n.as_u64().is_some_and(|s| s <= MAX_SAFE_INTEGER) => {
-            Ok(n.as_u64().unwrap_or(0))
-        }
-        Some(Value::Number(n)) => Err(ProtocolError::OutOfRange {
-            field: "input.seq".into(),
-            value: n.to_string(),
-            allowed: format!("an integer 0 ≤ seq ≤ {MAX_SAFE_INTEGER}"),
-        }),
+    input_integer(
+        v,
+        "seq",
+        |s| s <= MAX_SAFE_INTEGER,
+        || format!("an integer 0 ≤ seq ≤ {MAX_SAFE_INTEGER}"),
+    )
+}
+
+/// The integer `input.{key}`, refused as out of range (`allowed` says what is) when it is
+/// negative, fractional or fails `ok`.
+fn input_integer(
+    v: &Value,
+    key: &str,
+    ok: impl FnOnce(u64) -> bool,
+    allowed: impl FnOnce() -> String,
+) -> Result<u64, ProtocolError> {
+    match v.get(key) {
+        Some(Value::Number(n)) => match n.as_u64() {
+            Some(i) if ok(i) => Ok(i),
+            _ => Err(ProtocolError::OutOfRange {
+                field: format!("input.{key}"),
+                value: n.to_string(),
+                allowed: allowed(),
+            }),
+        },
         other => Err(ProtocolError::Field {
-            field: "input.seq".into(),
+            field: format!("input.{key}"),
             got: kind(other),
             expected: "an integer",
         }),
@@ -294,19 +310,12 @@ fn input_pos(v: &Value) -> Result<[f64; 3], ProtocolError> {
 
 /// `input.buttons`: an integer whose bits are among the device's buttons (`button_mask`).
 fn input_buttons(v: &Value, button_mask: u32) -> Result<u32, ProtocolError> {
-    match v.get("buttons") {
-        Some(Value::Number(n)) if n.as_u64().is_some_and(|b| b & !u64::from(button_mask) == 0) => {
-            Ok(n.as_u64().unwrap_or(0) as u32)
-        }
-        Some(Value::Number(n)) => Err(ProtocolError::OutOfRange {
-            field: "input.buttons".into(),
-            value: n.to_string(),
-            allowed: format!("an integer whose bits are the device's buttons, 0–{button_mask}"),
-        }),
-        other => Err(ProtocolError::Field {
-            field: "input.buttons".into(),
-            got: kind(other),
-            expected: "an integer",
-        }),
-    }
+    let b = input_integer(
+        v,
+        "buttons",
+        |b| b & !u64::from(button_mask) == 0,
+        || format!("an integer whose bits are the device's buttons, 0–{button_mask}"),
+    )?;
+    // every bit is one of the mask's: it fits in a u32
+    Ok(b as u32)
 }

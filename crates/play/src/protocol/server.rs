@@ -1,7 +1,7 @@
 //! Server → page: the JSON messages ([`ServerMsg`]) and their parts.
 
 use haptic_engine::runner::EndReason;
-use haptic_types::primitive::{Primitive, Rgba};
+use haptic_types::primitive::{Ball, Primitive, Rgba};
 use serde::{Deserialize, Deserializer, Serialize};
 use std::collections::BTreeMap;
 
@@ -108,11 +108,11 @@ impl ServerMsg {
                 time_s: 0.032,
                 view: Some(FrameView {
                     wall_ms: 1_764_000_000_000.5,
-                    prims: vec![Primitive::Sphere {
+                    prims: vec![Primitive::Sphere(Ball {
                         center_m: [0.0, 0.0, 0.1],
                         radius_m: 0.01,
                         color: Rgba([1.0, 0.5, 0.0, 1.0]),
-                    }],
+                    })],
                     state: [("score".to_string(), 25.0)].into_iter().collect(),
                     cursor_m: [0.0, 0.0, 0.1],
                     world_force_n: [0.0, 0.0, 1.5],

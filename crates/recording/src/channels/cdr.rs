@@ -229,29 +229,27 @@ impl<'a> CdrReader<'a> {
         String::from_utf8(b[..n - 1].to_vec()).map_err(|_| CdrError::BadString(at))
     }
 
+    /// Reads a sequence's length, refusing one the rest of the message cannot hold when each
+    /// element takes at least `min_bytes` (`what` names the sequence in the error).
+    fn seq_len(&mut self, min_bytes: usize, what: &'static str) -> Result<usize, CdrError> {
+        let n = self.u32()? as usize;
+        if n > (self.buf.len() - self.pos) / min_bytes {
+            return Err(CdrError::Eof { at: self.pos, what });
+        }
+        Ok(n)
+    }
+
     /// Reads a `float64[]` (unbounded sequence).
     pub fn f64_seq(&mut self) -> Result<Vec<f64>, CdrError> {
-        let n = self.u32()? as usize;
-        // Each element takes 8 bytes: refuse counts the message cannot hold.
-        if n > (self.buf.len() - self.pos) / 8 {
-            return Err(CdrError::Eof {
-                at: self.pos,
-                what: "float64[]",
-            });
-        }
+        // each element takes 8 bytes
+        let n = self.seq_len(8, "float64[]")?;
         (0..n).map(|_| self.f64()).collect()
     }
 
     /// Reads a `string[]`.
     pub fn strings(&mut self) -> Result<Vec<String>, CdrError> {
-        let n = self.u32()? as usize;
-        // Each string takes at least 5 bytes: refuse counts the message cannot hold.
-        if n > (self.buf.len() - self.pos) / 5 {
-            return Err(CdrError::Eof {
-                at: self.pos,
-                what: "string[]",
-            });
-        }
+        // each string takes at least 5 bytes: its length and its terminating NUL
+        let n = self.seq_len(5, "string[]")?;
         (0..n).map(|_| self.string()).collect()
     }
 

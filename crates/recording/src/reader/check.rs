@@ -121,30 +121,10 @@ fn statistics(w: &Walk, at: usize, st: &Stats) -> Result<(), RecordingError> {
 
 /// Every schema and channel of the data section, the same in the summary, and no other.
 fn definitions(w: &Walk, s: &Summary, footer_at: usize) -> Result<(), RecordingError> {
-    for (id, x) in &w.schemas {
-        if s.schemas.get(id) != Some(x) {
-            return Err(corrupt(
-                footer_at,
-                "summary",
-                format!(
-                    "schema {id} (`{}`) is missing from the summary or differs",
-                    x.name
-                ),
-            ));
-        }
-    }
-    for (id, x) in &w.channel_recs {
-        if s.channels.get(id) != Some(x) {
-            return Err(corrupt(
-                footer_at,
-                "summary",
-                format!(
-                    "channel {id} (`{}`) is missing from the summary or differs",
-                    x.topic
-                ),
-            ));
-        }
-    }
+    in_summary(&w.schemas, &s.schemas, footer_at, "schema", |x| &x.name)?;
+    in_summary(&w.channel_recs, &s.channels, footer_at, "channel", |x| {
+        &x.topic
+    })?;
     if s.schemas.len() != w.schemas.len() || s.channels.len() != w.channel_recs.len() {
         return Err(corrupt(
             footer_at,
@@ -161,20 +141,61 @@ fn definitions(w: &Walk, s: &Summary, footer_at: usize) -> Result<(), RecordingE
     Ok(())
 }
 
+/// Every `kind` record of the data section (`name` says what it is called), the same in the
+/// summary.
+fn in_summary<T: PartialEq>(
+    data: &BTreeMap<u16, T>,
+    summary: &BTreeMap<u16, T>,
+    footer_at: usize,
+    kind: &str,
+    name: impl Fn(&T) -> &str,
+) -> Result<(), RecordingError> {
+    match data.iter().find(|(id, x)| summary.get(id) != Some(x)) {
+        None => Ok(()),
+        Some((id, x)) => Err(corrupt(
+            footer_at,
+            "summary",
+            format!(
+                "{kind} {id} (`{}`) is missing from the summary or differs",
+                name(x)
+            ),
+        )),
+    }
+}
+
+/// The summary's `kind` indexes (each at its byte) number the `held` records of the data
+/// section (`records` names them in the error); the error is at the first index, or at the
+/// footer when there is none.
+fn one_index_each<T>(
+    indexes: &[(usize, T)],
+    held: usize,
+    footer_at: usize,
+    kind: &str,
+    records: &str,
+) -> Result<(), RecordingError> {
+    if indexes.len() == held {
+        return Ok(());
+    }
+    let at = indexes.first().map_or(footer_at, |c| c.0);
+    Err(corrupt(
+        at,
+        format!("{kind} indexes"),
+        format!(
+            "the summary indexes {} {records}, the data section holds {held}",
+            indexes.len()
+        ),
+    ))
+}
+
 /// One chunk index per chunk, in order, each equal to its chunk.
 fn chunk_indexes(w: &Walk, s: &Summary, footer_at: usize) -> Result<(), RecordingError> {
-    if s.chunk_indexes.len() != w.chunks.len() {
-        let at = s.chunk_indexes.first().map_or(footer_at, |c| c.0);
-        return Err(corrupt(
-            at,
-            "chunk indexes",
-            format!(
-                "the summary indexes {} chunks, the data section holds {}",
-                s.chunk_indexes.len(),
-                w.chunks.len()
-            ),
-        ));
-    }
+    one_index_each(
+        &s.chunk_indexes,
+        w.chunks.len(),
+        footer_at,
+        "chunk",
+        "chunks",
+    )?;
     for (i, ((at, ci), c)) in s.chunk_indexes.iter().zip(&w.chunks).enumerate() {
         chunk_index(i, *at, ci, c)?;
     }
@@ -245,18 +266,13 @@ fn chunk_index(
 
 /// One metadata index per metadata record, in order, each naming its record's place.
 fn metadata_indexes(w: &Walk, s: &Summary, footer_at: usize) -> Result<(), RecordingError> {
-    if s.metadata_indexes.len() != w.metadata_recs.len() {
-        let at = s.metadata_indexes.first().map_or(footer_at, |c| c.0);
-        return Err(corrupt(
-            at,
-            "metadata indexes",
-            format!(
-                "the summary indexes {} metadata records, the data section holds {}",
-                s.metadata_indexes.len(),
-                w.metadata_recs.len()
-            ),
-        ));
-    }
+    one_index_each(
+        &s.metadata_indexes,
+        w.metadata_recs.len(),
+        footer_at,
+        "metadata",
+        "metadata records",
+    )?;
     for ((at, (off, len, name)), (a_off, a_len, a_name)) in
         s.metadata_indexes.iter().zip(&w.metadata_recs)
     {

@@ -6,7 +6,7 @@
 
 use render::{Camera, Frame, RenderError, Style, View};
 
-use haptic_types::Primitive;
+use haptic_types::{Ball, OrientedBox, Primitive};
 
 use haptic_types::Rgba;
 
@@ -267,16 +267,16 @@ pub fn draw_tweezers(f: &mut Frame, s: &Tweezers, labels: bool) -> Result<(), Re
             color: beam_color(),
         })?;
     }
-    f.push(Primitive::Sphere {
+    f.push(Primitive::Sphere(Ball {
         center_m: s.particle_m,
         radius_m: 0.5e-6,
         color: particle_color(),
-    })?;
-    f.push(Primitive::Cursor {
+    }))?;
+    f.push(Primitive::Cursor(Ball {
         center_m: s.cursor_m,
         radius_m: 0.15e-6,
         color: cursor_color(),
-    })?;
+    }))?;
     let env: Vec<Vec3> = s
         .envelope_m
         .iter()
@@ -435,41 +435,41 @@ pub fn draw_bricks(f: &mut Frame, t: f64, labels: bool) -> Result<(), RenderErro
         std::f64::consts::FRAC_1_SQRT_2,
     ];
     let q_id = [0.0, 0.0, 0.0, 1.0];
-    f.push(Primitive::Box {
+    f.push(Primitive::Box(OrientedBox {
         center_m: [0.0, 0.0, -0.01],
         half_extents_m: [0.45, 0.35, 0.01],
         rotation: q_id,
         color: Rgba::from_u8(110, 160, 80),
-    })?;
+    }))?;
     // loading zone
-    f.push(Primitive::Box {
+    f.push(Primitive::Box(OrientedBox {
         center_m: [0.33, -0.25, 0.001],
         half_extents_m: [0.09, 0.07, 0.001],
         rotation: q_id,
         color: Rgba::from_u8(200, 200, 150),
-    })?;
+    }))?;
     for (k, (c, turned)) in slots.iter().enumerate() {
         let rot = if *turned { q_turn } else { q_id };
         let shade = 0.85 + 0.15 * (((k * 37) % 11) as f64 / 10.0);
         if k < laid {
-            f.push(Primitive::Box {
+            f.push(Primitive::Box(OrientedBox {
                 center_m: *c,
                 half_extents_m: BRICK_HALF,
                 rotation: rot,
                 color: Rgba([0.72 * shade, 0.3 * shade, 0.2 * shade, 1.0]),
-            })?;
+            }))?;
         } else {
-            f.push(Primitive::Slot {
+            f.push(Primitive::Slot(OrientedBox {
                 center_m: *c,
                 half_extents_m: BRICK_HALF,
                 rotation: rot,
                 color: Rgba([0.2, 0.35, 0.8, 0.55]),
-            })?;
+            }))?;
         }
     }
     // spare bricks in the loading zone
     for i in 0..4 {
-        f.push(Primitive::Box {
+        f.push(Primitive::Box(OrientedBox {
             center_m: [
                 0.29 + 0.0 * f64::from(i),
                 -0.3 + 0.045 * f64::from(i),
@@ -478,7 +478,7 @@ pub fn draw_bricks(f: &mut Frame, t: f64, labels: bool) -> Result<(), RenderErro
             half_extents_m: BRICK_HALF,
             rotation: q_id,
             color: Rgba::from_u8(180, 80, 50),
-        })?;
+        }))?;
     }
     if laid < slots.len() {
         // the carried brick travels from the loading zone to its slot
@@ -492,18 +492,18 @@ pub fn draw_bricks(f: &mut Frame, t: f64, labels: bool) -> Result<(), RenderErro
             start[2] + frac * (target[2] - start[2]) + hop,
         ];
         let rot = if turned && frac > 0.5 { q_turn } else { q_id };
-        f.push(Primitive::Box {
+        f.push(Primitive::Box(OrientedBox {
             center_m: p,
             half_extents_m: BRICK_HALF,
             rotation: rot,
             color: Rgba::from_u8(220, 110, 60),
-        })?;
+        }))?;
         let cursor = [p[0], p[1], p[2] + BRICK_HALF[2] + 0.02];
-        f.push(Primitive::Cursor {
+        f.push(Primitive::Cursor(Ball {
             center_m: cursor,
             radius_m: 0.02,
             color: cursor_color(),
-        })?;
+        }))?;
         // weight of the held brick (0.1 kg, 0.98 N) drawn at 0.1 m/N
         f.push(Primitive::Arrow {
             from_m: cursor,
@@ -549,11 +549,11 @@ pub fn draw_nano(f: &mut Frame, t: f64, labels: bool) -> Result<(), RenderError>
         for j in 0..n {
             let x = (f64::from(i) - 5.5) * pitch;
             let y = (f64::from(j) - 5.5) * pitch;
-            f.push(Primitive::Sphere {
+            f.push(Primitive::Sphere(Ball {
                 center_m: [x, y, -r],
                 radius_m: r,
                 color: Rgba::from_u8(40, 160, 160),
-            })?;
+            }))?;
         }
     }
     // house footprint: a 4×3 ring, three layers, then a ridge
@@ -575,19 +575,19 @@ pub fn draw_nano(f: &mut Frame, t: f64, labels: bool) -> Result<(), RenderError>
     let per = 60.0 / sites.len() as f64;
     let placed = ((t / per) as usize).min(sites.len());
     for s in &sites[..placed] {
-        f.push(Primitive::Sphere {
+        f.push(Primitive::Sphere(Ball {
             center_m: *s,
             radius_m: r,
             color: Rgba::from_u8(235, 130, 40),
-        })?;
+        }))?;
     }
     // loading zone atoms
     for k in 0..5 {
-        f.push(Primitive::Sphere {
+        f.push(Primitive::Sphere(Ball {
             center_m: [1.3e-9, -1.3e-9 + 0.3e-9 * f64::from(k), r],
             radius_m: r,
             color: Rgba::from_u8(235, 130, 40),
-        })?;
+        }))?;
     }
     let frac = (t / per).fract();
     let target = sites.get(placed).copied().unwrap_or([0.0, 0.0, 1.5e-9]);
@@ -599,24 +599,24 @@ pub fn draw_nano(f: &mut Frame, t: f64, labels: bool) -> Result<(), RenderError>
         start[2] + frac * (target[2] - start[2]) + hop,
     ];
     if placed < sites.len() {
-        f.push(Primitive::Sphere {
+        f.push(Primitive::Sphere(Ball {
             center_m: atom,
             radius_m: r,
             color: Rgba::from_u8(245, 150, 60),
-        })?;
+        }))?;
     }
     let tip = [atom[0], atom[1], atom[2] + 2.0 * r];
-    f.push(Primitive::Cursor {
+    f.push(Primitive::Cursor(Ball {
         center_m: tip,
         radius_m: 0.6 * r,
         color: Rgba([0.55, 0.55, 0.6, 0.9]),
-    })?;
-    f.push(Primitive::Box {
+    }))?;
+    f.push(Primitive::Box(OrientedBox {
         center_m: [tip[0] + 0.7e-9, tip[1], tip[2] + 0.5e-9],
         half_extents_m: [0.7e-9, 0.12e-9, 0.03e-9],
         rotation: [0.0, 0.0, 0.0, 1.0],
         color: Rgba::from_u8(150, 150, 160),
-    })?;
+    }))?;
     // adhesion on the tip, about 1 nN, drawn at 0.4 nm/nN
     f.push(Primitive::Arrow {
         from_m: tip,

@@ -2,9 +2,9 @@
 //! without the physics.
 
 use super::{OtParams, STATE_FIELDS, V2};
-use haptic_types::Primitive;
 use haptic_types::Rgba;
 use haptic_types::vec3::Vec3;
+use haptic_types::{Ball, Primitive};
 
 /// The parts of the picture that never change during a session: sizes, the envelope's drawing
 /// scale, the label.
@@ -45,7 +45,7 @@ impl Look {
             semi_axes_m: self.waists_m,
             color: Rgba([0.3, 0.8, 0.3, 0.4]),
         });
-        out.push(Primitive::Sphere {
+        out.push(Primitive::Sphere(Ball {
             center_m: p,
             radius_m: self.particle_r_m,
             color: if t.grabbed {
@@ -53,12 +53,12 @@ impl Look {
             } else {
                 Rgba([0.8, 0.8, 0.85, 1.0])
             },
-        });
-        out.push(Primitive::Sphere {
+        }));
+        out.push(Primitive::Sphere(Ball {
             center_m: [t.cursor.x, t.cursor.y, 0.0],
             radius_m: self.cursor_r_m,
             color: Rgba([0.2, 0.5, 0.95, 1.0]),
-        });
+        }));
         if !envelope.is_empty() {
             out.push(Primitive::Polyline {
                 points_m: envelope,
