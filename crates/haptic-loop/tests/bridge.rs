@@ -384,7 +384,7 @@ fn the_welcome_carries_the_scenes_rate_name_and_start_time() {
     // How many ticks the loop runs in the device's 0.5 s is the machine's, not the code's: the
     // device starts sending at its welcome, the loop ticks once the session is set up (the
     // scene, the recording), and its first tick takes up the device's numbering where it is
-    // then (measured on 2 loaded cores: at sample 974–2122, so 2878–4566 ticks). From there it
+    // then (measured on 2 loaded cores: at sample 674–2122, so 2878–4566 ticks). From there it
     // keeps one tick per device period to the device's last sample. The figure is in
     // BENCHMARKS.md ("The 10 kHz scene over the bridge"), printed here, never asserted.
     let a = &r.arrays;
