@@ -25,38 +25,12 @@ use haptic_devices::local::Protocol;
 use haptic_devices::{Grip, Mechanics, PRESETS};
 use haptic_loop::closed_loop::{Linked, run_linked};
 
+mod probe;
+use probe::{PRESS, wall};
+
 const LATENCIES_MS: [f64; 8] = [0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0];
 const KS: usize = 13;
 const COLORS: [[u8; 3]; 3] = [[210, 50, 40], [40, 150, 60], [120, 120, 120]];
-
-/// Down 8 mm into the wall in 0.5 s, held 1.5 s, back up by 2.5 s.
-const PRESS: &str = include_str!("press_and_hold.script.toml");
-
-/// 0.1 m/s along x, 20 mm above the wall (free space), after a 0.2 s start.
-const GLIDE: &str = r#"
-[script]
-name = "glide at 0.1 m/s"
-duration_s = 0.8
-[[waypoint]]
-t_s = 0.0
-position_mm = [-30.0, 0.0, 20.0]
-[[waypoint]]
-t_s = 0.2
-position_mm = [-30.0, 0.0, 20.0]
-[[waypoint]]
-t_s = 0.8
-position_mm = [30.0, 0.0, 20.0]
-"#;
-
-fn wall(k: f64) -> String {
-    format!(
-        "[scene]\nname = \"link wall\"\nkind = \"wall\"\n[device]\nmodel = \"falcon\"\n\
-         [mapping]\nfit_device = false\n\
-         [loop]\nengage_s = 0.0\npassivity = false\nforce_rate_limit = false\n\
-         [wall]\nnormal = [0.0, 0.0, 1.0]\npoint_m = [0.0, 0.0, 0.0]\n\
-         stiffness_n_per_m = {k:?}\ndamping_n_s_per_m = 0.0\ncursor_radius_m = 0.001\n"
-    )
-}
 
 fn k_of(i: usize) -> f64 {
     100.0 * 10f64.powf(i as f64 / 4.0)
@@ -232,49 +206,8 @@ fn main() {
     for mech in PRESETS {
         let k = 0.5 * mech.limits.max_stiffness_n_per_m;
         for ms in [0.0, 0.5, 1.0, 2.0, 5.0, 10.0] {
-            let felt = |protocol| {
-                let (_, t) = run_linked(
-                    &wall(k),
-                    PRESS,
-                    mech,
-                    Grip::FIRM,
-                    &linked(ms, protocol),
-                    None,
-                )
-                .unwrap();
-                // Least squares of F_z against penetration over the samples 0.5–2 mm deep.
-                let pts: Vec<(f64, f64)> = t
-                    .readings
-                    .iter()
-                    .zip(&t.felt)
-                    .map(|(p, f)| (-p[2], f[2]))
-                    .filter(|(d, _)| (0.0005..0.002).contains(d))
-                    .collect();
-                let n = pts.len() as f64;
-                let (sx, sy) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
-                let (mx, my) = (sx / n, sy / n);
-                let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |a, p| {
-                    (a.0 + (p.0 - mx) * (p.1 - my), a.1 + (p.0 - mx).powi(2))
-                });
-                sxy / sxx / k
-            };
-            let (_, g) = run_linked(
-                &wall(k),
-                GLIDE,
-                mech,
-                Grip::FIRM,
-                &linked(ms, Protocol::V2),
-                None,
-            )
-            .unwrap();
-            let glide: Vec<f64> = g
-                .felt
-                .iter()
-                .skip(300)
-                .take(400)
-                .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
-                .collect();
-            let drag = glide.iter().sum::<f64>() / glide.len().max(1) as f64;
+            let felt = |protocol| probe::felt_over_wall(mech, k, &linked(ms, protocol));
+            let drag = probe::drag_n(mech, k, &linked(ms, Protocol::V2));
             tt.row([
                 mech.name.to_string(),
                 format!("{ms}"),

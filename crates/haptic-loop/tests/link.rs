@@ -17,6 +17,9 @@ use haptic_devices::local::Protocol;
 use haptic_devices::{Grip, Mechanics, PRESETS};
 use haptic_loop::closed_loop::{Linked, Report, Trace, run_linked};
 
+#[path = "../examples/probe/mod.rs"]
+mod probe;
+
 fn read(name: &str) -> String {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     std::fs::read_to_string(root.join(name)).unwrap()
@@ -78,17 +81,6 @@ struct Run {
     wall_n_per_m: Option<f64>,
 }
 
-/// Least-squares slope of `y` against `x`.
-fn slope(pts: &[(f64, f64)]) -> f64 {
-    let n = pts.len() as f64;
-    let (sx, sy) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
-    let (mx, my) = (sx / n, sy / n);
-    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |a, p| {
-        (a.0 + (p.0 - mx) * (p.1 - my), a.1 + (p.0 - mx).powi(2))
-    });
-    sxy / sxx
-}
-
 /// The stiffness the hand feels pressing into `wall.toml`'s plane (z = −5 mm): the slope of
 /// the felt F_z against the depth, over the readings 0.5–2.5 mm deep on the way down (before
 /// the deepest reading; below the force clamp of every preset), N/m.
@@ -101,7 +93,7 @@ fn wall_stiffness(t: &Trace) -> f64 {
         .filter(|(d, _)| (0.0005..0.0025).contains(d))
         .collect();
     assert!(pts.len() > 50, "{} readings in the wall", pts.len());
-    slope(&pts)
+    probe::slope(&pts)
 }
 
 /// Runs every case on two threads, in the order of `cases`.
@@ -352,20 +344,6 @@ fn a_run_behind_a_lossy_jittery_link_repeats_to_the_bit() {
 /// the samples 0.5–2 mm deep.
 #[test]
 fn the_hand_feels_0_94_to_1_00_of_the_walls_stiffness_and_no_drag_to_10_ms() {
-    let wall = |k: f64| {
-        format!(
-            "[scene]\nname = \"link wall\"\nkind = \"wall\"\n[device]\nmodel = \"falcon\"\n\
-             [mapping]\nfit_device = false\n\
-             [loop]\nengage_s = 0.0\npassivity = false\nforce_rate_limit = false\n\
-             [wall]\nnormal = [0.0, 0.0, 1.0]\npoint_m = [0.0, 0.0, 0.0]\n\
-             stiffness_n_per_m = {k:?}\ndamping_n_s_per_m = 0.0\ncursor_radius_m = 0.001\n"
-        )
-    };
-    let press = include_str!("../examples/press_and_hold.script.toml");
-    let glide = "[script]\nname = \"glide\"\nduration_s = 0.8\n\
-                 [[waypoint]]\nt_s = 0.0\nposition_mm = [-30.0, 0.0, 20.0]\n\
-                 [[waypoint]]\nt_s = 0.2\nposition_mm = [-30.0, 0.0, 20.0]\n\
-                 [[waypoint]]\nt_s = 0.8\nposition_mm = [30.0, 0.0, 20.0]\n";
     let (mut lo, mut hi, mut drag) = (f64::MAX, 0.0f64, 0.0f64);
     for mech in PRESETS {
         let k = 0.5 * mech.limits.max_stiffness_n_per_m;
@@ -374,20 +352,10 @@ fn the_hand_feels_0_94_to_1_00_of_the_walls_stiffness_and_no_drag_to_10_ms() {
                 link: LinkParams::latency_ms(ms),
                 protocol: Protocol::V2,
             };
-            let (_, t) = run_linked(&wall(k), press, mech, Grip::FIRM, &l, None).unwrap();
-            let pts: Vec<(f64, f64)> = (t.readings.iter().zip(&t.felt))
-                .map(|(p, f)| (-p[2], f[2]))
-                .filter(|(d, _)| (0.0005..0.002).contains(d))
-                .collect();
-            let q = slope(&pts) / k;
+            let q = probe::felt_over_wall(mech, k, &l);
             println!("{} {ms} ms: felt / wall stiffness {q:.3}", mech.name);
             (lo, hi) = (lo.min(q), hi.max(q));
-            let (_, g) = run_linked(&wall(k), glide, mech, Grip::FIRM, &l, None).unwrap();
-            let f = &g.felt[300..700];
-            let mean = f
-                .iter()
-                .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt());
-            drag = drag.max(mean.sum::<f64>() / f.len() as f64);
+            drag = drag.max(probe::drag_n(mech, k, &l));
         }
     }
     println!("felt / wall stiffness {lo:.3}–{hi:.3}, drag at most {drag:.4} N");
