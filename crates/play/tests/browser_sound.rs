@@ -182,16 +182,34 @@ fn compare(b: &mut Browser, rec: &Path, kind: &str, sr: u32) -> (usize, usize, u
     (want.len(), differ, max_ulps, max_abs)
 }
 
+/// A play server for the page's files (its session waits for a Start that never comes), its
+/// recording `name` under the target folder, and a browser on its page.
+struct PageServer {
+    stop: Arc<AtomicBool>,
+    handle: std::thread::JoinHandle<Result<play::PlaySummary, play::PlayError>>,
+}
+
+impl PageServer {
+    fn open(name: &str) -> (Browser, PageServer) {
+        let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+        let mut c = PlayConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), out);
+        c.port = 0;
+        let stop = Arc::new(AtomicBool::new(false));
+        let play::Running { url, handle } = play::start(c, stop.clone()).unwrap();
+        let mut b = Browser::launch(800, 600).unwrap();
+        b.open(&url).unwrap();
+        (b, PageServer { stop, handle })
+    }
+
+    fn close(self) {
+        self.stop.store(true, Ordering::Relaxed);
+        let _ = self.handle.join();
+    }
+}
+
 #[test]
 fn the_pages_worklet_makes_the_samples_of_render_audio() {
-    // A server for the page's files (the session waits for a Start that never comes).
-    let out = std::env::temp_dir().join(format!("nh-sound-{}.mcap", std::process::id()));
-    let mut c = PlayConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), out);
-    c.port = 0;
-    let stop = Arc::new(AtomicBool::new(false));
-    let play::Running { url, handle } = play::start(c, stop.clone()).unwrap();
-    let mut b = Browser::launch(800, 600).unwrap();
-    b.open(&url).unwrap();
+    let (mut b, server) = PageServer::open("nh-sound.mcap");
     let mut report = Vec::new();
     for (rec, kind) in [("brickworld", "brickworld"), ("nanoworld", "nanoworld")] {
         let path = workspace().join(format!("recordings/{rec}.mcap"));
@@ -208,8 +226,7 @@ fn the_pages_worklet_makes_the_samples_of_render_audio() {
         }
     }
     b.check().unwrap();
-    stop.store(true, Ordering::Relaxed);
-    let _ = handle.join();
+    server.close();
     assert_eq!(report.len(), 4);
 }
 
@@ -319,13 +336,7 @@ fn the_worklets_live_path_plays_the_samples_of_render_audio() {
         sound_js.contains(&format!("const LEAD_S = {LEAD_S};")),
         "the page's lead is the test's"
     );
-    let out = std::env::temp_dir().join(format!("nh-sound-live-{}.mcap", std::process::id()));
-    let mut c = PlayConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), out);
-    c.port = 0;
-    let stop = Arc::new(AtomicBool::new(false));
-    let play::Running { url, handle } = play::start(c, stop.clone()).unwrap();
-    let mut b = Browser::launch(800, 600).unwrap();
-    b.open(&url).unwrap();
+    let (mut b, server) = PageServer::open("nh-sound-live.mcap");
     let idle = Link {
         delay_ms: 2.0,
         jitter_ms: 3.0,
@@ -371,6 +382,5 @@ fn the_worklets_live_path_plays_the_samples_of_render_audio() {
         assert_eq!(h.played + h.lost, h.sent);
     }
     b.check().unwrap();
-    stop.store(true, Ordering::Relaxed);
-    let _ = handle.join();
+    server.close();
 }
