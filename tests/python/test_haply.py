@@ -21,7 +21,7 @@ from nanohaptics import bridge
 
 # pytest's default (prepend) import mode puts this folder on sys.path: the session helpers are
 # shared with test_live.py rather than copied.
-from test_live import bridged_session, free_port, press_path
+from test_live import bridged_session, free_port, press_path, retry_while_disturbed
 
 # A made-up centre of reach in the Inverse3's base frame (not the adapter's default), and the
 # cursor's x, y in the centred frame: the simulator must see the mock's positions minus CENTRE.
@@ -69,10 +69,6 @@ def mock_haply(monkeypatch):
     api.SerialStream, api.Inverse3, api.Handle = SerialStream, Inverse3, Handle
     monkeypatch.setitem(sys.modules, "HaplyHardwareAPI", api)
     return state
-
-
-# The status bit the simulator sets on a tick whose sample was late beyond the watchdog's grace.
-WATCHDOG = 32
 
 
 def _inverse3_session(out, mock_haply):
@@ -134,28 +130,16 @@ def _check_inverse3_session(out, stats, sim, mock_haply):
 
 
 def test_an_inverse3_is_centred_announces_its_limits_and_ends_at_zero_force(tmp_path, mock_haply):
-    # On 2 shared cores a late sample can make the simulator's watchdog fade the force, and
-    # the soft engagement then ramps the stiffness back in mid-press (a peak of 1250 N/m
-    # instead of 1500 was seen under load): that is the watchdog doing its job, not the
-    # adapter. So a run whose checks fail *while the machine disturbed it* (a tick with the
-    # watchdog bit, or a round-trip p99 beyond the watchdog's 2.5 ms grace) is tried again,
-    # waiting 1 s, 2 s, ... (at most eight runs); an undisturbed run that fails fails at once.
-    # The same rule as the bridged Falcon carry in crates/cli/tests/cli.rs.
-    for k in range(8):
-        out = tmp_path / f"inverse3-{k}.mcap"
-        stats, sim = _inverse3_session(out, mock_haply)
-        watchdog_ticks = int(np.count_nonzero(sim["status"] & WATCHDOG))
-        disturbed = watchdog_ticks > 0 or stats["round_trip_p99_s"] > 0.0025
-        try:
-            _check_inverse3_session(out, stats, sim, mock_haply)
-            return
-        except AssertionError:
-            if not disturbed:
-                raise
-            print(f"run {k + 1} disturbed ({watchdog_ticks} watchdog ticks, round-trip p99 "
-                  f"{stats['round_trip_p99_s'] * 1e3:.2f} ms) and failed: trying again")
-            time.sleep(k + 1)
-    pytest.fail("eight runs in a row disturbed by the machine: the checks could not be made")
+    # A peak of 1250 N/m instead of 1500 was seen under load: the watchdog faded the force and
+    # the soft engagement ramped the stiffness back in mid-press (retry_while_disturbed).
+    outs = []
+
+    def session(k):
+        outs.append(tmp_path / f"inverse3-{k}.mcap")
+        return _inverse3_session(outs[-1], mock_haply)
+
+    retry_while_disturbed(
+        session, lambda stats, sim: _check_inverse3_session(outs[-1], stats, sim, mock_haply))
 
 
 def wait_until(predicate, timeout_s=2.0):

@@ -85,6 +85,34 @@ def test_protocol_encodings_have_the_documented_sizes():
     assert bridge.local_force(r, (0, 0, -0.006), (0, 0, -0.007), 5.0)[2] == pytest.approx(5.0)
 
 
+# The status bit the simulator sets on a tick whose sample was late beyond the watchdog's grace.
+WATCHDOG = 32
+
+
+def retry_while_disturbed(session, check, runs=8):
+    """Runs ``session(k)`` -> (adapter stats, simulator result) and ``check`` on it. On 2 shared
+    cores a late sample makes the simulator's watchdog fade the force (and the soft engagement
+    ramp it back), which is the watchdog doing its job, not the adapter: so a run whose checks
+    fail *while the machine disturbed it* (a tick with the watchdog bit, or a round-trip p99
+    beyond the watchdog's 2.5 ms grace) is tried again, waiting 1 s, 2 s, ... (at most
+    ``runs``); an undisturbed run that fails fails at once. The rule of the bridged Falcon
+    carry in crates/cli/tests/cli.rs."""
+    for k in range(runs):
+        stats, sim = session(k)
+        watchdog_ticks = int(np.count_nonzero(sim["status"] & WATCHDOG))
+        disturbed = watchdog_ticks > 0 or stats["round_trip_p99_s"] > 0.0025
+        try:
+            check(stats, sim)
+            return
+        except AssertionError:
+            if not disturbed:
+                raise
+            print(f"run {k + 1} disturbed ({watchdog_ticks} watchdog ticks, round-trip p99 "
+                  f"{stats['round_trip_p99_s'] * 1e3:.2f} ms) and failed: trying again")
+            time.sleep(k + 1)
+    pytest.fail(f"{runs} runs in a row disturbed by the machine: the checks could not be made")
+
+
 def bridged_session(port, out, seconds=None):
     result = {}
 
@@ -147,31 +175,42 @@ def mock_openhaptics(monkeypatch):
 
 
 def test_a_touch_through_pyopenhaptics_feels_the_wall_and_the_session_replays(tmp_path, mock_openhaptics):
-    port, out = free_port(), tmp_path / "touch.mcap"
-    t, sim = bridged_session(port, out)
-    dev = bridge.TouchDevice()
-    mock_openhaptics["t0"] = time.perf_counter()
-    stats = bridge.run(dev, ("127.0.0.1", port), seconds=1.0)
-    t.join()
-    assert mock_openhaptics["closed"]
-    assert stats["sent"] >= 500 and stats["answered"] >= 0.9 * stats["sent"]
-    assert sim["stats"]["end"] == "device_ended"
-    assert sim["stats"]["link"]["received"] == stats["sent"]
-    # The Touch's limits came from its hello: 3.3 N, 400 N/m (the wall is capped at 400 N/m).
-    k = sim["device_stiffness_n_per_m"][:, 2, 2]
-    assert k.max() == pytest.approx(400.0)
-    z = sim["device_position_m"][:, 2]
-    assert z.min() == pytest.approx(-0.007, abs=2e-4) and z.max() <= 0.0100001
-    assert np.all(np.linalg.norm(sim["device_force_n"], axis=1) <= 3.3)
-    # The hand felt an upward force at the bottom (2 mm deep at 400 N/m = 0.8 N) ...
-    felt = np.array(mock_openhaptics["forces"])
-    assert felt[:, 2].max() == pytest.approx(0.8, rel=0.1)
-    assert np.all(np.linalg.norm(felt, axis=1) <= 3.3 + 1e-12)
-    # ... and zero once the session ended.
-    assert tuple(felt[-1]) == (0.0, 0.0, 0.0)
-    back = nh.read_recording(out)
-    assert np.array_equal(back["device_force_n"], sim["device_force_n"])
-    assert np.array_equal(back["device_age_ticks"], sim["device_age_ticks"])
+    outs = []
+
+    def session(k):
+        mock_openhaptics["forces"].clear()
+        mock_openhaptics["closed"] = False
+        port = free_port()
+        outs.append(tmp_path / f"touch-{k}.mcap")
+        t, sim = bridged_session(port, outs[-1])
+        dev = bridge.TouchDevice()
+        mock_openhaptics["t0"] = time.perf_counter()
+        stats = bridge.run(dev, ("127.0.0.1", port), seconds=1.0)
+        t.join()
+        return stats, sim
+
+    def check(stats, sim):
+        assert mock_openhaptics["closed"]
+        assert stats["sent"] >= 500 and stats["answered"] >= 0.9 * stats["sent"]
+        assert sim["stats"]["end"] == "device_ended"
+        assert sim["stats"]["link"]["received"] == stats["sent"]
+        # The Touch's limits came from its hello: 3.3 N, 400 N/m (the wall is capped at 400 N/m).
+        k = sim["device_stiffness_n_per_m"][:, 2, 2]
+        assert k.max() == pytest.approx(400.0)
+        z = sim["device_position_m"][:, 2]
+        assert z.min() == pytest.approx(-0.007, abs=2e-4) and z.max() <= 0.0100001
+        assert np.all(np.linalg.norm(sim["device_force_n"], axis=1) <= 3.3)
+        # The hand felt an upward force at the bottom (2 mm deep at 400 N/m = 0.8 N) ...
+        felt = np.array(mock_openhaptics["forces"])
+        assert felt[:, 2].max() == pytest.approx(0.8, rel=0.1)
+        assert np.all(np.linalg.norm(felt, axis=1) <= 3.3 + 1e-12)
+        # ... and zero once the session ended.
+        assert tuple(felt[-1]) == (0.0, 0.0, 0.0)
+        back = nh.read_recording(outs[-1])
+        assert np.array_equal(back["device_force_n"], sim["device_force_n"])
+        assert np.array_equal(back["device_age_ticks"], sim["device_age_ticks"])
+
+    retry_while_disturbed(session, check)
 
 
 # ---------------------------------------------------------------- Force Dimension through a mock SDK
@@ -204,19 +243,29 @@ def mock_dhd(monkeypatch):
 
 
 def test_a_force_dimension_device_announces_its_limits(tmp_path, mock_dhd):
-    port, out = free_port(), tmp_path / "fd.mcap"
-    t, sim = bridged_session(port, out)
     dev = bridge.ForceDimensionDevice()
     assert dev.specs().name == "delta.3" and dev.specs().max_force_n == 12.0
-    mock_dhd["t0"] = time.perf_counter()
-    stats = bridge.run(dev, ("127.0.0.1", port), seconds=0.8)
-    t.join()
-    assert mock_dhd["closed"] and mock_dhd["forces"][-1] == (0.0, 0.0, 0.0)
-    # 2 mm deep at the 3000 N/m it announced: 6 N up, within its own 12 N (not the Falcon's 8 N)
-    felt = np.array(mock_dhd["forces"])
-    assert felt[:, 2].max() == pytest.approx(6.0, rel=0.1)
-    assert np.all(np.linalg.norm(sim["device_force_n"], axis=1) <= 12.0)
-    assert sim["stats"]["link"]["received"] == stats["sent"]
+
+    def session(k):
+        mock_dhd["forces"].clear()
+        mock_dhd["closed"] = False
+        port, out = free_port(), tmp_path / f"fd-{k}.mcap"
+        t, sim = bridged_session(port, out)
+        mock_dhd["t0"] = time.perf_counter()
+        stats = bridge.run(bridge.ForceDimensionDevice(), ("127.0.0.1", port), seconds=0.8)
+        t.join()
+        return stats, sim
+
+    def check(stats, sim):
+        assert mock_dhd["closed"] and mock_dhd["forces"][-1] == (0.0, 0.0, 0.0)
+        # 2 mm deep at the 3000 N/m it announced: 6 N up, within its own 12 N (not the
+        # Falcon's 8 N)
+        felt = np.array(mock_dhd["forces"])
+        assert felt[:, 2].max() == pytest.approx(6.0, rel=0.1)
+        assert np.all(np.linalg.norm(sim["device_force_n"], axis=1) <= 12.0)
+        assert sim["stats"]["link"]["received"] == stats["sent"]
+
+    retry_while_disturbed(session, check)
 
 
 def test_no_device_is_a_clear_error():
