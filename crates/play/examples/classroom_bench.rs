@@ -43,8 +43,16 @@ fn unix_ms() -> f64 {
 /// One student: joins, plays for `secs`, returns the frames it received per second of play.
 fn student(host: &str, name: &str, secs: f64) -> Result<f64, String> {
     let mut s = TcpStream::connect(host).map_err(|e| e.to_string())?;
-    s.write_all(format!("GET /join?name={name} HTTP/1.1\r\nHost: {host}\r\n\r\n").as_bytes())
-        .map_err(|e| e.to_string())?;
+    s.write_all(
+        format!(
+            "POST /join HTTP/1.1\r\nHost: {host}\r\nOrigin: http://{host}\r\n\
+             Content-Type: application/x-www-form-urlencoded\r\n\
+             Content-Length: {}\r\n\r\nname={name}",
+            name.len() + 5
+        )
+        .as_bytes(),
+    )
+    .map_err(|e| e.to_string())?;
     let mut r = String::new();
     s.read_to_string(&mut r).map_err(|e| e.to_string())?;
     let token = r

@@ -31,7 +31,8 @@ struct Running {
 }
 
 fn start(name: &str, max: usize) -> Running {
-    let dir = std::env::temp_dir().join(format!("nh-class-{}-{name}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-class-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let mut c = ClassConfig::new(
         SceneSource::resolve("brickworld".as_ref()).unwrap(),
@@ -78,9 +79,25 @@ fn get(host: &str, path: &str) -> String {
     )
 }
 
-/// Joins as `name`; the session token from the redirect.
+/// A form `POST` to `/join` from the join page (`name` URL-encoded), with `headers` (each
+/// ending in `\r\n`) in place of the page's own `Origin` and `Sec-Fetch-Site`.
+fn post_join(host: &str, name: &str, headers: Option<&str>) -> String {
+    let body = format!("name={name}");
+    let own = format!("Origin: http://{host}\r\nSec-Fetch-Site: same-origin\r\n");
+    http(
+        host,
+        &format!(
+            "POST /join HTTP/1.1\r\nHost: {host}\r\n{}Content-Type: \
+             application/x-www-form-urlencoded\r\nContent-Length: {}\r\n\r\n{body}",
+            headers.unwrap_or(&own),
+            body.len()
+        ),
+    )
+}
+
+/// Joins as `name` through the join page's form; the session token from the redirect.
 fn join(host: &str, name: &str) -> String {
-    let r = get(host, &format!("/join?name={name}"));
+    let r = post_join(host, name, None);
     assert!(r.starts_with("HTTP/1.1 303 See Other"), "{r}");
     let loc = r
         .lines()
@@ -121,8 +138,43 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
     // The join page, and a student's page with its modules.
     let j = get(&host, "/");
     assert!(j.starts_with("HTTP/1.1 200 OK"), "{j}");
-    assert!(j.contains(r#"<form method="get" action="/join">"#));
+    assert!(j.contains(r#"<form method="post" action="/join">"#));
     assert!(!j.contains(r#"name="code""#));
+    // Joining is no link another site can follow, and no form another site can send: each
+    // forged join is refused with its reason and opens no session (the class of 3 still has
+    // room for all three below).
+    let link = http(
+        &host,
+        &format!(
+            "GET /join?name=Eve HTTP/1.1\r\nHost: {host}\r\nSec-Fetch-Site: cross-site\r\n\r\n"
+        ),
+    );
+    assert!(
+        link.starts_with("HTTP/1.1 405 Method Not Allowed"),
+        "{link}"
+    );
+    assert!(link.contains("Allow: POST\r\n"), "{link}");
+    assert!(
+        link.contains("GET /join changes state: send it as POST from this server&#39;s own page")
+    );
+    let cross = post_join(
+        &host,
+        "Eve",
+        Some(&format!(
+            "Origin: http://{host}\r\nSec-Fetch-Site: cross-site\r\n"
+        )),
+    );
+    assert!(cross.starts_with("HTTP/1.1 403 Forbidden"), "{cross}");
+    assert!(cross.contains("Sec-Fetch-Site `cross-site` is refused: allowed `same-origin`"));
+    let other = post_join(&host, "Eve", Some("Origin: https://evil.example\r\n"));
+    assert!(other.starts_with("HTTP/1.1 403 Forbidden"), "{other}");
+    assert!(
+        other.contains("Origin `https://evil.example` is not this page's own origin"),
+        "{other}"
+    );
+    let bare = post_join(&host, "Eve", Some(""));
+    assert!(bare.starts_with("HTTP/1.1 403 Forbidden"), "{bare}");
+    assert!(bare.contains("a POST without an Origin header is refused"));
     let names = ["Ada", "Grace", "Zo%C3%AB"];
     let tokens: Vec<String> = names.iter().map(|n| join(&host, n)).collect();
     let page = get(&host, &format!("/play?s={}", tokens[0]));
@@ -132,12 +184,12 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
     );
     assert!(get(&host, "/main.js").starts_with("HTTP/1.1 200 OK"));
     // Refusals: the class is full, a taken name, a name that would be a path, no session.
-    let full = get(&host, "/join?name=Dan");
+    let full = post_join(&host, "Dan", None);
     assert!(full.starts_with("HTTP/1.1 503"), "{full}");
     assert!(full.contains("the class is full (3 students playing)"));
-    let taken = get(&host, "/join?name=Ada");
+    let taken = post_join(&host, "Ada", None);
     assert!(taken.starts_with("HTTP/1.1 409"), "{taken}");
-    let bad = get(&host, "/join?name=..%2Fetc%2Fpasswd");
+    let bad = post_join(&host, "..%2Fetc%2Fpasswd", None);
     assert!(bad.starts_with("HTTP/1.1 400"), "{bad}");
     assert!(bad.contains("name contains `/`: allowed letters, digits, spaces and - _ . &#39;"));
     assert!(get(&host, "/play?s=nope").starts_with("HTTP/1.1 404"));
@@ -250,7 +302,9 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
         "{:?}",
         summary.refused
     );
-    assert_eq!(summary.refused.origin, 1);
+    // The forged teacher link, the cross-site form, the other site's and the bare POST.
+    assert_eq!(summary.refused.origin, 4);
+    assert_eq!(summary.refused.head, 1, "the GET link to /join");
     for s in &summary.students {
         assert_eq!(s.session.end, "stopped", "{}", s.line());
         assert!(s.session.stats.ticks > 100, "{}", s.line());
@@ -285,7 +339,8 @@ fn a_bridged_device_joins_as_a_student_and_the_teacher_sees_and_ends_it() {
         .local_addr()
         .unwrap()
         .port();
-    let dir = std::env::temp_dir().join(format!("nh-class-{}-device", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-class-{}-device", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let mut c = ClassConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), dir.clone());
     c.port = 0;

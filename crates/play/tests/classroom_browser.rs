@@ -44,8 +44,16 @@ fn link_student(
     std::thread::spawn(move || {
         let mut s = TcpStream::connect(&host).unwrap();
         use std::io::{Read, Write};
-        s.write_all(format!("GET /join?name={name} HTTP/1.1\r\nHost: {host}\r\n\r\n").as_bytes())
-            .unwrap();
+        s.write_all(
+            format!(
+                "POST /join HTTP/1.1\r\nHost: {host}\r\nOrigin: http://{host}\r\n\
+                 Content-Type: application/x-www-form-urlencoded\r\n\
+                 Content-Length: {}\r\n\r\nname={name}",
+                name.len() + 5
+            )
+            .as_bytes(),
+        )
+        .unwrap();
         let mut r = String::new();
         s.read_to_string(&mut r).unwrap();
         let token = r
@@ -90,7 +98,8 @@ fn link_student(
 
 #[test]
 fn the_teacher_page_watches_switches_ends_and_collects_the_class() {
-    let dir = std::env::temp_dir().join(format!("nh-class-browser-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-class-browser-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let mut c = ClassConfig::new(
         SceneSource::resolve("brickworld".as_ref()).unwrap(),

@@ -3,8 +3,8 @@
 //! The request head of an HTTP request read within bounds, and the two checks every request
 //! and WebSocket upgrade of the project's servers passes (`Host` and `Origin`): the page
 //! servers (`play`, `classroom`) and the live view (`run --live`). It is for small servers on
-//! plain threads; it is no HTTP implementation (no bodies, no chunking, no keep-alive) and no
-//! authentication.
+//! plain threads; it is no HTTP implementation (no bodies but a small form ([`form`]), no
+//! chunking, no keep-alive) and no authentication.
 //!
 //! **Why the checks.** Loopback is no boundary against other pages in the same browser. A page
 //! from any site can open `ws://127.0.0.1:8080/ws` (the browser sends its own `Origin`), and a
@@ -14,6 +14,7 @@
 //! port, and whose `Origin`, when a browser sends one, is that same `http://HOST:PORT`. A
 //! rebinding page's host name and another site's origin are refused with `403`.
 
+pub mod form;
 pub mod gate;
 pub mod serve;
 

@@ -37,6 +37,32 @@ pub fn respond_text(stream: &mut TcpStream, status: &str, message: &str) {
     );
 }
 
+/// Discards up to `limit` bytes of a refused request's body (waiting at most 100 ms for
+/// them) after its answer was written: a connection closed with unread bytes is reset, and
+/// the client would lose the answer that says why.
+pub fn drain_body(stream: &mut TcpStream, head: &Head, limit: usize) {
+    let n = head
+        .header("content-length")
+        .and_then(|v| v.parse::<usize>().ok())
+        .unwrap_or(0)
+        .min(limit);
+    if n == 0
+        || stream
+            .set_read_timeout(Some(Duration::from_millis(100)))
+            .is_err()
+    {
+        return;
+    }
+    let mut left = n;
+    let mut buf = [0u8; 512];
+    while left > 0 {
+        match std::io::Read::read(stream, &mut buf[..left.min(512)]) {
+            Ok(0) | Err(_) => break,
+            Ok(k) => left -= k,
+        }
+    }
+}
+
 /// Reads a connection's request head within bounds and checks its `Host` and `Origin`: the
 /// head's bytes (to pass on unchanged) and the head, or `None` when it was refused. A head
 /// that never came or broke a bound is counted as `head` and answered `400 Bad Request`
@@ -49,6 +75,7 @@ pub fn checked_head(stream: &mut TcpStream, gate: &Gate) -> Option<(Vec<u8>, Hea
             Err(r) => {
                 gate.refused.count(r.kind());
                 respond_text(stream, "403 Forbidden", &r.to_string());
+                drain_body(stream, &head, crate::form::MAX_FORM_BYTES);
                 None
             }
         },

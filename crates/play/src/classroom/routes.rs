@@ -1,7 +1,9 @@
-//! The classroom's paths: the join page and `/join`, each student's page (`/play?s=TOKEN`,
+//! The classroom's paths: the join page and `POST /join`, each student's page (`/play?s=TOKEN`,
 //! the page's modules, `/ws?s=TOKEN`, `/recording.mcap?s=TOKEN`), and the teacher's
 //! (`/teacher?code=…`, `/teacher/ws?code=…`, `/recordings.zip?code=…`). Every request passed
-//! the listener's gate and its `Host`/`Origin` check before it reaches these.
+//! the listener's gate and its `Host`/`Origin` check before it reaches these. Joining changes
+//! the class (a session, a name taken), so it is a form `POST` from the join page itself
+//! ([`webguard::form`]): a link or a page from another site cannot fill the class with names.
 
 use super::{Class, JoinError, teacher};
 use crate::http::{accept_upgrade, respond, respond_text};
@@ -46,7 +48,7 @@ fn join_page(class: &Class, error: Option<&str>, name: &str) -> String {
 <title>nanohaptics classroom: join</title><link rel="stylesheet" href="/class.css"></head>
 <body><main class="join"><h1>Join the class</h1>
 <p>Scene: <b>{scene}</b>. Enter your name: you get your own world and your own recording.</p>
-{error}<form method="get" action="/join">
+{error}<form method="post" action="/join">
 <label>Your name <input name="name" value="{name}" required maxlength="32" autocomplete="off" autofocus></label>
 {code}<button type="submit">Join</button></form></main></body></html>
 "#,
@@ -76,11 +78,32 @@ impl ClassRoutes {
 }
 
 impl ClassRoutes {
-    /// `/join?name=…&code=…`: the student's session, or the join page with the reason.
+    /// `POST /join` with the form's `name` and `code`: the student's session, or the join page
+    /// with the reason. A request that is not a form `POST` from this server's page is refused
+    /// with its reason (and counted), and opens nothing.
     fn join(&self, stream: &mut TcpStream, head: &Head, gate: &Arc<Gate>) {
         let class = &self.class;
-        let name = head.query("name").unwrap_or_default();
-        match class.join(&name, head.query("code").as_deref()) {
+        let form = match webguard::form::read_own_form(stream, head) {
+            Ok(f) => f,
+            Err(e) => {
+                gate.refused.count(e.kind());
+                let allow = if matches!(e, webguard::form::FormError::Method { .. }) {
+                    "Allow: POST\r\n"
+                } else {
+                    ""
+                };
+                respond(
+                    stream,
+                    e.status(),
+                    "text/html; charset=utf-8",
+                    allow,
+                    join_page(class, Some(&e.to_string()), "").as_bytes(),
+                );
+                return webguard::serve::drain_body(stream, head, webguard::form::MAX_FORM_BYTES);
+            }
+        };
+        let name = form.get("name").unwrap_or_default().to_string();
+        match class.join(&name, form.get("code")) {
             Ok(s) => respond(
                 stream,
                 "303 See Other",
@@ -145,6 +168,10 @@ impl ClassRoutes {
 }
 
 impl Routes for ClassRoutes {
+    fn post_paths(&self) -> &'static [&'static str] {
+        &["/join"]
+    }
+
     fn route(&self, mut stream: TcpStream, head: Head, gate: &Arc<Gate>) {
         let class = &self.class;
         let path = head.path().to_string();

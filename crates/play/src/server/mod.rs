@@ -77,6 +77,12 @@ pub const PAGE_FILES: &[PageFile] = &[
 pub trait Routes: Send + Sync + 'static {
     /// Answers `head` on `stream` (a WebSocket upgrade keeps the stream until it closes).
     fn route(&self, stream: TcpStream, head: Head, gate: &Arc<Gate>);
+
+    /// The paths that take a form `POST` (a state change from the server's own page, checked
+    /// by the route with `webguard::form`); every other path is `GET` only.
+    fn post_paths(&self) -> &'static [&'static str] {
+        &[]
+    }
 }
 
 /// A listening page server: one thread accepting, one per connection, each connection
@@ -156,8 +162,10 @@ fn connection(mut stream: TcpStream, gate: &Arc<Gate>, routes: &dyn Routes) {
     let Some((_, head)) = webguard::serve::checked_head(&mut stream, gate) else {
         return;
     };
-    if head.method != "GET" {
-        return respond_text(&mut stream, "405 Method Not Allowed", "GET only");
+    let post = head.method == "POST" && routes.post_paths().contains(&head.path());
+    if head.method != "GET" && !post {
+        respond_text(&mut stream, "405 Method Not Allowed", "GET only");
+        return webguard::serve::drain_body(&mut stream, &head, webguard::form::MAX_FORM_BYTES);
     }
     routes.route(stream, head, gate);
 }
