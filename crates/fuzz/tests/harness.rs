@@ -10,7 +10,10 @@ fn panics_aborts_hangs_and_non_finite_results_are_named_by_input() {
     let out = Command::new(env!("CARGO_BIN_EXE_nanohaptics-fuzz"))
         .args(["--target", "selftest", "--inputs", "200", "--batch", "50"])
         .args(["--timeout-ms", "300", "--json", "--findings"])
-        .arg(std::env::temp_dir().join(format!("fuzz-selftest-{}", std::process::id())))
+        .arg(
+            std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+                .join(format!("fuzz-selftest-{}", std::process::id())),
+        )
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1), "findings give status 1");

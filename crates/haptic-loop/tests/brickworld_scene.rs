@@ -15,7 +15,8 @@ fn root() -> PathBuf {
 
 #[test]
 fn default_script_builds_the_wall_and_replays_bit_exactly() {
-    let dir = std::env::temp_dir().join(format!("haptic-loop-brick-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("haptic-loop-brick-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let rec = dir.join("brick.mcap");
     let mut o = SessionOptions::new(

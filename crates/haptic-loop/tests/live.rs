@@ -167,7 +167,8 @@ fn foxglove_parameters_set_a_switch_that_is_recorded() {
         .local_addr()
         .unwrap()
         .port();
-    let out = std::env::temp_dir().join(format!("nh-live-menu-{}.mcap", std::process::id()));
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-live-menu-{}.mcap", std::process::id()));
     let mut o = SessionOptions::new(SceneSource::resolve(Path::new("brickworld")).unwrap());
     o.realtime = true;
     o.seconds = Some(2.0);

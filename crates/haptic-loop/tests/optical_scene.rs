@@ -15,7 +15,8 @@ fn root() -> PathBuf {
 
 #[test]
 fn steering_inside_the_envelope_is_exact_and_outside_is_felt() {
-    let dir = std::env::temp_dir().join(format!("haptic-loop-ot-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("haptic-loop-ot-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let rec = dir.join("ot.mcap");
     let mut o = SessionOptions::new(

@@ -19,7 +19,8 @@ fn stepping_the_scripted_inputs_reproduces_the_scripted_session_and_replays() {
     o.operator = OperatorChoice::Rigid;
     let scripted = run_session(&o, &mut |_, _| {}).unwrap().arrays;
 
-    let out = std::env::temp_dir().join(format!("stepped-{}.mcap", std::process::id()));
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("stepped-{}.mcap", std::process::id()));
     let mut so = StepperOptions::new(scene);
     so.out = Some(out.clone());
     let mut s = Stepper::new(so).unwrap();

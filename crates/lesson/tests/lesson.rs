@@ -5,7 +5,8 @@ use lesson::{LessonOptions, run_lesson};
 
 #[test]
 fn the_lesson_measures_what_it_says() {
-    let out = std::env::temp_dir().join(format!("nh-lesson-{}", std::process::id()));
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-lesson-{}", std::process::id()));
     let mut calls = Vec::new();
     let s = run_lesson(
         &LessonOptions {

@@ -26,7 +26,8 @@ fn live_switches_are_recorded_on_their_tick_and_replay_bit_for_bit() {
     let header = loaded.header(&scene.text, "batch", "page", 1_000_000_000);
     let mut lp = HapticLoop::new(loaded.config, loaded.scene);
     let mut dev = ScriptedDevice::new(script, FALCON.clone());
-    let out = std::env::temp_dir().join(format!("nh-live-switch-{}.mcap", std::process::id()));
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-live-switch-{}.mcap", std::process::id()));
     let mut rec = RecorderSink::new(out.clone());
     let mut refused = Vec::new();
     let mut hook = |tick: u64, lp: &mut HapticLoop| {

@@ -49,7 +49,8 @@ fn start_with(
     JoinHandle<Result<PlaySummary, PlayError>>,
     PathBuf,
 ) {
-    let out = std::env::temp_dir().join(format!("nh-play-srv-{}-{name}.mcap", std::process::id()));
+    let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-play-srv-{}-{name}.mcap", std::process::id()));
     let mut c = PlayConfig::new(SceneSource::resolve(scene.as_ref()).unwrap(), out.clone());
     c.port = 0;
     c.device = device;
@@ -300,7 +301,7 @@ fn a_busy_port_and_a_bad_length_are_named() {
     let port = busy.local_addr().unwrap().port();
     let mut c = PlayConfig::new(
         SceneSource::resolve("brickworld".as_ref()).unwrap(),
-        std::env::temp_dir().join("nh-play-busy.mcap"),
+        std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("nh-play-busy.mcap"),
     );
     c.port = port;
     let stop = AtomicBool::new(false);
