@@ -137,7 +137,8 @@ impl MotionEstimator {
 /// `q / dt` (1.27 m/s for the Falcon's 0.0635 mm count at the brick world's ×20 mapping); a
 /// fixed long window lags on fast motion. The adaptive window takes the longest window `n`
 /// (up to `max_window` ticks) over which the straight line through the newest and the `n`-th
-/// previous sample stays within `band_m` of every sample in between, and returns its slope.
+/// previous sample stays within `band_m` of every sample in between (up to the positions'
+/// rounding: a sample exactly `band_m` off is within), and returns its slope.
 /// On slow motion the window grows and the count noise falls as `band / (n dt)`; on fast or
 /// accelerating motion it shrinks to one tick and the lag vanishes. With `band_m = 0` it is the
 /// one-tick difference (exact positions need no smoothing).
@@ -194,7 +195,10 @@ impl AdaptiveWindow {
             for i in 1..n {
                 let mid = self.samples[len - 1 - i][axis];
                 let line = newest - (newest - old) * (i as f64 / n as f64);
-                if (mid - line).abs() > self.band_m {
+                // Within the band up to the rounding of the positions it is computed from: a
+                // sample exactly one band off must not be rejected by its last bit.
+                let rounding = 8.0 * f64::EPSILON * newest.abs().max(old.abs()).max(mid.abs());
+                if (mid - line).abs() > self.band_m + rounding {
                     break 'grow;
                 }
             }
@@ -313,5 +317,35 @@ mod tests {
             w.push([0.5 * k as f64 * dt, 0.0, 0.0]);
         }
         assert!((w.velocity()[0] - 0.5).abs() < 1e-9);
+    }
+
+    /// A hand at rest whose reading flickers one count for two ticks (a linked Falcon, held
+    /// firmly, 1 ms away: the brick house's last placement). The samples are the world's
+    /// cursor as recorded, bit for bit: one count (1.27 mm at ×20) is
+    /// 0.0012700000000000003 m between them, one rounding above the band. A sample one
+    /// count off the line through two others is within the band (the documented rule), so
+    /// the window runs past the flicker and the hand is at rest: before, the comparison
+    /// rejected it on that rounding, the window stopped at 3 ticks, and the released brick
+    /// was thrown sideways at 0.42 m/s and missed its slot.
+    #[test]
+    fn a_one_count_flicker_at_rest_is_no_throw() {
+        let (up, down) = (-0.000_470_000_000_000_005_14, -0.001_740_000_000_000_005_4);
+        let mut w = AdaptiveWindow::new(1e-3, 0.001_27, 25);
+        w.reset([0.0, up, 0.0]);
+        for _ in 0..25 {
+            w.push([0.0, up, 0.0]);
+        }
+        for y in [down, down, up, up, up] {
+            w.push([0.0, y, 0.0]);
+        }
+        assert_eq!(w.window(1), 25);
+        assert_eq!(w.velocity(), [0.0; 3]);
+        // And a sample a rounding beyond a count is still rejected (the band is not widened).
+        let mut w = AdaptiveWindow::new(1e-3, 0.001_27, 25);
+        w.reset([0.0; 3]);
+        for y in [0.0, 0.0, -0.001_271, 0.0, 0.0] {
+            w.push([0.0, y, 0.0]);
+        }
+        assert_eq!(w.window(1), 2);
     }
 }
