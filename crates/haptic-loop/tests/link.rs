@@ -258,12 +258,9 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
     // 10 kHz trap, the carried brick on a Delta.3), up to +50 %. 31 of the 320 runs at 0–10 ms
     // exceed +20 %: 3 at 5 ms (the 10 kHz trap), 28 at 10 ms; none at 0–2 ms.
     assert_eq!(over_peak.len(), 31, "{over_peak:#?}");
-    // Measured, not yet met: one brick house is not built at 1 ms with jitter and loss.
-    assert_eq!(
-        unbuilt,
-        ["brickworld.toml falcon firm 1 ms + 1 ms jitter, 5 % loss"],
-        "houses not built at 0–10 ms"
-    );
+    // Every house is built in both worlds at 0–10 ms (the last exception, a Falcon at 1 ms
+    // with jitter and loss, was a one-count flicker thrown as a release velocity).
+    assert!(unbuilt.is_empty(), "houses not built at 0–10 ms: {unbuilt:#?}");
 }
 
 /// Why protocol 2: the carried brick on a loosely held Falcon behind 2 ms each way. With
@@ -286,10 +283,10 @@ fn the_carried_brick_buzzes_behind_2_ms_with_protocol_1_and_not_with_protocol_2(
     println!("{}", line("protocol 1, 2 ms", &v1));
     println!("{}", line("protocol 2, 2 ms", &v2));
     assert!(!v1.stable() && v2.stable());
-    // docs/devices.md: "buzzes with protocol 1 (2174 changes, +4.05 J)" (simulated: exact).
-    assert_eq!(v1.undeclared_jumps, 2174);
+    // docs/devices.md: "buzzes with protocol 1 (2167 changes, +4.04 J)" (simulated: exact).
+    assert_eq!(v1.undeclared_jumps, 2167);
     assert!(
-        (4.045..4.055).contains(&v1.energy_to_hand_j),
+        (4.035..4.045).contains(&v1.energy_to_hand_j),
         "{} J",
         v1.energy_to_hand_j
     );
