@@ -144,7 +144,7 @@ fn the_papers_inertia_buzzes_where_the_coupling_does_not() {
             0.996,
             0.15,
         ),
-        ("paper, safety on", &paper, false, 5233, 0.834, 0.07),
+        ("paper, safety on", &paper, false, 5269, 0.834, 0.07),
         ("coupling, safety off", &no_safety, true, 0, 0.006, -0.02),
         ("coupling, safety on", &|t| t, true, 0, 0.006, -0.02),
     ];
