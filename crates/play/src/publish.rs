@@ -38,10 +38,12 @@ pub const FRAME_EVERY_TICKS: u64 = 16;
 /// Ticks the tick thread hands over at once when nothing sounds (5 ms at 1 kHz): the most a
 /// [`SoundTicks`] message holds, short of a frame's.
 pub const SOUND_BLOCK_TICKS: u64 = 5;
-/// The same for `play` (one page or a few): every tick at once. The page's worklet plays a
-/// lead behind its clock that must cover the lateness of a block's first tick, so a block of 5
-/// ticks would add 4 ms to every sound's latency (BENCHMARKS.md, play).
-pub const PLAY_SOUND_BLOCK_TICKS: u64 = 1;
+/// The same for `play` (one page or a few): 2 ticks. The page's worklet plays a lead behind
+/// its clock that must cover the lateness of a block's first tick, so a block of 5 ticks adds
+/// 3 ms to every sound's latency over 2; a block of 1 (1000 messages a second) let the page's
+/// main thread fall behind by a quarter of a second and more on this 2-core machine under load
+/// (BENCHMARKS.md, play).
+pub const PLAY_SOUND_BLOCK_TICKS: u64 = 2;
 
 /// The events that make a sound (those [`haptic_loop::sound::sound_events`] reads): a tick
 /// with one is handed to the publisher at once.

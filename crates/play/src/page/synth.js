@@ -19,7 +19,7 @@
 // least `leadS` past it. Playback starts, and restarts after an underrun, once the clock is a
 // lead past the next sample (and a quantum of it is queued): an underrun plays silence and
 // waits, but does not lengthen the lead. Every 0.1 s of quanta, when the output plays more
-// than 3 ms behind the lead (a backlog after a stall, or jitter that has passed), the excess is
+// than 5 ms behind the lead (a backlog after a stall, or jitter that has passed), the excess is
 // dropped (counted and listed), never below one quantum queued at the window's lowest. For each sound's first
 // sample the processor reports
 // when it was rendered (Date.now() at the render quantum, the frame within it, the context
@@ -39,7 +39,7 @@ const SILENT = [0, 0];
 const HEADER = 24, TICK = 16, SOUND = 24;
 // The lead's window (LATE_BUCKETS buckets of LATE_BUCKET_S of the processor's clock), the margin
 // on top of the largest lateness, and the excess over the lead that is dropped, s.
-const LATE_BUCKETS = 8, LATE_BUCKET_S = 0.5, MARGIN_S = 0.001, TRIM_S = 0.003;
+const LATE_BUCKETS = 8, LATE_BUCKET_S = 0.5, MARGIN_S = 0.001, TRIM_S = 0.005;
 
 // 64-bit unsigned arithmetic on [hi, lo] 32-bit halves (the noise is xorshift64*).
 function mul64(ah, al, bh, bl) {
