@@ -12,8 +12,9 @@ import { P, say } from './page.js';
 let actx = null, gain = null, node = null, muted = false;
 let waiting = []; // sound ticks received while the worklet loads
 // The lead (how far the worklet plays behind its own clock), s: the worklet sizes it from the
-// ticks' measured arrival jitter (synth.js); LEAD_S until it has measured 4 s, LEAD_MAX_S at
-// most (a stall longer than that underruns and its backlog is dropped).
+// ticks' measured arrival jitter (synth.js), past the earliest arrival at least LEAD_S until
+// it has measured 4 s and at most LEAD_MAX_S (a stall longer than that underruns and its
+// backlog is dropped).
 const LEAD_S = 0.008;
 const LEAD_MAX_S = 0.03;
 // The output's buffer, s: the smallest the device offers (the browser clamps the hint to its

@@ -20,10 +20,10 @@
 // lead past the next sample (and a quantum of it is queued): an underrun plays silence and
 // waits, but does not lengthen the lead. Every 0.1 s of quanta, when the output plays more
 // than 5 ms behind the lead (a backlog after a stall, or jitter that has passed), the excess is
-// dropped (counted and listed), never below one quantum queued at the window's lowest. For each sound's first
-// sample the processor reports
-// when it was rendered (Date.now() at the render quantum, the frame within it, the context
-// time) so the page can measure tick → output, or that it was dropped (`lost`). It hashes
+// dropped (counted and listed), never below one quantum queued at the window's lowest. For
+// each sound's first sample the processor reports when it was rendered (Date.now() at the
+// render quantum, the frame within it, the context time) so the page can measure tick →
+// output, or that it was dropped (`lost`). It hashes
 // every sample it plays from the FIFO (FNV-1a over the Float32 bytes, in the order played;
 // the silence of a wait or an underrun is not the session's and is not hashed) and keeps where
 // it dropped samples, so the test can compare what was heard with `render --audio`. A
