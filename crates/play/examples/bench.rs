@@ -42,11 +42,15 @@ struct Outcome {
     fps: Vec<f64>,
     sound: Option<LatencyMs>,
     sound_ts: Option<LatencyMs>,
-    sound_parts: [Option<LatencyMs>; 3],
+    /// Per sound: tick → the worklet has it, queued in the worklet, the output's latency, and
+    /// the page's own part (the first two added).
+    sound_parts: [Option<LatencyMs>; 4],
     output_latency_s: Option<f64>,
     base_latency_s: Option<f64>,
     sample_rate: Option<f64>,
     lead_ms: Option<f64>,
+    /// The worklet's arrival jitter over its last 4 s at the end, ms.
+    late_ms: Option<f64>,
     underruns: u64,
     samples_dropped: u64,
     ticks: u64,
@@ -120,18 +124,21 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
     let mut fps = Vec::new();
     let mut audio = Vec::new();
     let mut audio_ts = Vec::new();
-    let mut parts: [Vec<f64>; 3] = Default::default();
-    let (mut out_lat, mut base_lat, mut rate, mut lead) = (None, None, None, None);
+    let mut parts: [Vec<f64>; 4] = Default::default();
+    let (mut out_lat, mut base_lat, mut rate, mut lead, mut late) = (None, None, None, None, None);
     let (mut underruns, mut samples_dropped) = (0, 0);
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
-        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks]; })()")?;
+        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs]; })()")?;
         for p in v[5].as_array().into_iter().flatten() {
-            for (k, part) in parts.iter_mut().enumerate() {
+            for (k, part) in parts.iter_mut().take(3).enumerate() {
                 if let Some(x) = p[k].as_f64() {
                     part.push(x);
                 }
+            }
+            if let (Some(a), Some(q)) = (p[0].as_f64(), p[1].as_f64()) {
+                parts[3].push(a + q);
             }
         }
         fps.push(v[0].as_f64().unwrap_or(0.0) / (v[1].as_f64().unwrap_or(1.0) * 1e-3));
@@ -147,10 +154,16 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         underruns += v[4].as_u64().unwrap_or(0);
         samples_dropped += v[9].as_u64().unwrap_or(0);
         lead = v[10].as_f64().or(lead);
+        late = v[13].as_f64().or(late);
+        let page_ms: Vec<f64> = v[14]
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_f64).collect())
+            .unwrap_or_default();
         eprintln!(
-            "{scene}: a page got {} sounds in {} ticks",
+            "{scene}: a page got {} sounds in {} ticks; tick → the page's main thread {}",
             v[11].as_u64().unwrap_or(0),
-            v[12].as_u64().unwrap_or(0)
+            v[12].as_u64().unwrap_or(0),
+            fmt(LatencyMs::of(&page_ms))
         );
         b.check()?;
     }
@@ -173,11 +186,13 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
             LatencyMs::of(&parts[0]),
             LatencyMs::of(&parts[1]),
             LatencyMs::of(&parts[2]),
+            LatencyMs::of(&parts[3]),
         ],
         output_latency_s: out_lat,
         base_latency_s: base_lat,
         sample_rate: rate,
         lead_ms: lead,
+        late_ms: late,
         underruns,
         samples_dropped,
         ticks: s.session.stats.ticks,
@@ -263,11 +278,12 @@ fn no_browser(scene: &'static str, seconds: f64) -> Result<Outcome, String> {
         fps: Vec::new(),
         sound: None,
         sound_ts: None,
-        sound_parts: [None, None, None],
+        sound_parts: [None, None, None, None],
         output_latency_s: None,
         base_latency_s: None,
         sample_rate: None,
         lead_ms: None,
+        late_ms: None,
         underruns: 0,
         samples_dropped: 0,
         ticks: s.session.stats.ticks,
@@ -354,7 +370,7 @@ fn main() {
                     parts.push((o.scene, label.clone(), o.sound_parts));
                 }
                 rows.push(format!(
-                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} / {} | {} | {} | {:.0} | {} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} / {} ({}) | {} | {} | {:.0} | {} |",
                     o.scene,
                     label,
                     fmt(o.input),
@@ -377,7 +393,8 @@ fn main() {
                     o.sample_rate.map_or("–".into(), |r| format!("{r:.0}")),
                     o.underruns,
                     o.samples_dropped,
-                    o.lead_ms.map_or("–".into(), |l| format!("{l:.0}")),
+                    o.lead_ms.map_or("–".into(), |l| format!("{l:.1}")),
+                    o.late_ms.map_or("–".into(), |l| format!("{l:.1}")),
                     o.ticks,
                     o.missed,
                     o.tick_p99_us,
@@ -418,7 +435,7 @@ fn main() {
         "- **sound tick → output**: for every sound (the hand's taps, impacts, snaps, pull-offs), the wall time its first \
          sample leaves the page's audio output minus the wall time of its tick at the server: the AudioWorklet's render time \
          of that sample (`Date.now()` on the audio thread at its render quantum, plus the sample's place in the quantum) plus \
-         the AudioContext's `outputLatency` and `baseLatency` (`latencyHint: \"interactive\"`, the context's own sample rate). \
+         the AudioContext's `outputLatency` and `baseLatency` (`latencyHint: 0.001`, the smallest buffer the device offers; the context's own sample rate). \
          The next column maps the sample's context time through `AudioContext.getOutputTimestamp()` instead, as a \
          cross-check. Headless Chromium plays into a fake output device.".into(),
     );
@@ -427,7 +444,7 @@ fn main() {
          recorded, so replay reproduces them).".into(),
     );
     line(String::new());
-    line("| scene | pages | input → force p50 / p99 / max (ms) | frames/s drawn (per page) | sound tick → output p50 / p99 / max (ms) | by output timestamp p50 / p99 (ms) | outputLatency + baseLatency (ms) | sample rate (Hz) | underruns / samples dropped / lead at the end (ms) | ticks | missed deadlines | tick work p99 (µs) | frames dropped |".into());
+    line("| scene | pages | input → force p50 / p99 / max (ms) | frames/s drawn (per page) | sound tick → output p50 / p99 / max (ms) | by output timestamp p50 / p99 (ms) | outputLatency + baseLatency (ms) | sample rate (Hz) | underruns / samples dropped / lead at the end (the arrivals' jitter over its last 4 s) (ms) | ticks | missed deadlines | tick work p99 (µs) | frames dropped |".into());
     line("|---|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|".into());
     for r in rows {
         line(r);
@@ -435,16 +452,18 @@ fn main() {
     line(String::new());
     line("Where the sound's latency goes (per sound):".into());
     line(String::new());
-    line("| scene | pages | tick → the worklet has it p50 / p99 (ms) | queued in the worklet until rendered p50 / p99 (ms) | outputLatency + baseLatency p50 / p99 (ms) |".into());
-    line("|---|---|---|---|---|".into());
+    line("| scene | pages | tick → the worklet has it p50 / p99 (ms) | queued in the worklet until rendered p50 / p99 (ms) | the page's own part (the two added) p50 / p99 / max (ms) | outputLatency + baseLatency p50 / p99 (ms) |".into());
+    line("|---|---|---|---|---|---|".into());
     for (scene, pages, p) in parts {
         let f = |l: Option<LatencyMs>| {
             l.map_or("–".into(), |l| format!("{:.1} / {:.1}", l.p50, l.p99))
         };
         line(format!(
-            "| {scene} | {pages} | {} | {} | {} |",
+            "| {scene} | {pages} | {} | {} | {} / {:.1} | {} |",
             f(p[0]),
             f(p[1]),
+            f(p[3]),
+            p[3].map_or(f64::NAN, |l| l.max),
             f(p[2])
         ));
     }
@@ -498,8 +517,8 @@ fn main() {
     line(String::new());
     line(
         "Notes. The sound is synthesised on the page (an AudioWorklet running `render --audio`'s synthesis) from \
-         the ticks' sound input, which the server sends at once for a tick with a sound; the worklet keeps a 6 ms lead of \
-         samples. The sound's own path is the first two columns of the second table; the rest is the browser's output \
+         the ticks' sound input, which the server sends at once for a tick with a sound; the worklet plays a lead behind its own clock, \
+         sized from the ticks' measured arrival jitter. The sound's own path is the first two columns of the second table; the rest is the browser's output \
          latency, here headless Chromium's fake output device; a real sound card's latency takes its place. Missed \
          deadlines: the real-time loop waits for each period by sleeping and then spinning on one core; on this shared \
          2-core machine the browsers (software rendering, no GPU), the DevTools driver of this bench and other jobs take \

@@ -254,7 +254,8 @@ pub fn run(
         seconds: config.seconds,
         ticks,
     };
-    let mut session = PageSession::open(&spec, hand, shared.clone())?;
+    let mut session = PageSession::open(&spec, hand, shared.clone())?
+        .with_sound_block(publish::PLAY_SOUND_BLOCK_TICKS);
     if page_is_hand && !shared.input.wait_first(stop) {
         server.stop(&shared);
         return Err(PlayError::NotStarted);

@@ -9,8 +9,10 @@
 //! [`haptic_loop::sound::sound_events`], the mapping `render --audio` uses, each with its index
 //! in the session's list of sounds) and its `nearest_m` (the proximity tone), with the tick's
 //! wall time, in a binary [`SoundTicks`] message. The tick thread hands its ticks over every
-//! [`SOUND_BLOCK_TICKS`] ticks, and at once for a tick with a sound ([`SOUND_EVENTS`]) and the
-//! tick after it (whose distance the tone needs to finish the sound's tick). The page's
+//! [`SOUND_BLOCK_TICKS`] ticks (every [`PLAY_SOUND_BLOCK_TICKS`] in `play`, whose page's lead
+//! is sized from the ticks' lateness, a block's length included), and at once for a tick with
+//! a sound ([`SOUND_EVENTS`]) and the tick after it (whose distance the tone needs to finish
+//! the sound's tick). The page's
 //! samples are therefore those of `nanohaptics render REC --audio OUT.wav --proximity` at the
 //! page's sample rate (the browser test compares them), except where that track needed its
 //! anti-clipping scale (live, samples beyond the ceiling are limited instead). The frames also
@@ -36,6 +38,12 @@ pub const FRAME_EVERY_TICKS: u64 = 16;
 /// Ticks the tick thread hands over at once when nothing sounds (5 ms at 1 kHz): the most a
 /// [`SoundTicks`] message holds, short of a frame's.
 pub const SOUND_BLOCK_TICKS: u64 = 5;
+/// The same for `play` (one page or a few): 2 ticks. The page's worklet plays a lead behind
+/// its clock that must cover the lateness of a block's first tick, so a block of 5 ticks adds
+/// 3 ms to every sound's latency over 2; a block of 1 (1000 messages a second) let the page's
+/// main thread fall behind by a quarter of a second and more on this 2-core machine under load
+/// (BENCHMARKS.md, play).
+pub const PLAY_SOUND_BLOCK_TICKS: u64 = 2;
 
 /// The events that make a sound (those [`haptic_loop::sound::sound_events`] reads): a tick
 /// with one is handed to the publisher at once.
@@ -103,6 +111,8 @@ pub struct PlaySink {
     pending: Vec<ToPublisher>,
     /// The last tick had a sound: hand this one over at once too.
     flush_next: bool,
+    /// Ticks handed over at once when nothing sounds.
+    block_ticks: u64,
     /// Input-to-force latencies, ms (page event to the force of the first tick that used it).
     pub input_latency_ms: Vec<f64>,
 }
@@ -118,8 +128,15 @@ impl PlaySink {
             last_seq: 0,
             pending: Vec::with_capacity(SOUND_BLOCK_TICKS as usize),
             flush_next: false,
+            block_ticks: SOUND_BLOCK_TICKS,
             input_latency_ms: Vec::new(),
         }
+    }
+
+    /// Hands the ticks over every `ticks` ticks when nothing sounds (at least 1).
+    pub fn with_block_ticks(mut self, ticks: u64) -> Self {
+        self.block_ticks = ticks.max(1);
+        self
     }
 }
 
@@ -184,7 +201,7 @@ impl Sink for PlaySink {
         let flush = frame.is_some()
             || sounds
             || self.flush_next
-            || r.tick % SOUND_BLOCK_TICKS == SOUND_BLOCK_TICKS - 1;
+            || r.tick % self.block_ticks == self.block_ticks - 1;
         self.flush_next = sounds;
         self.pending.push(ToPublisher::Tick {
             tick: r.tick,

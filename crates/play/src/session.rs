@@ -165,6 +165,7 @@ pub struct PageSession {
     end: Option<EndReason>,
     error: Option<String>,
     reporter: Option<(u64, Reporter)>,
+    sound_block_ticks: u64,
 }
 
 impl PageSession {
@@ -208,12 +209,20 @@ impl PageSession {
             end: None,
             error: None,
             reporter: None,
+            sound_block_ticks: publish::SOUND_BLOCK_TICKS,
         })
     }
 
     /// Calls `reporter` after every `every` ticks, and once more at the end.
     pub fn with_reporter(mut self, every: u64, reporter: Reporter) -> Self {
         self.reporter = Some((every.max(1), reporter));
+        self
+    }
+
+    /// Hands the pages' sound ticks over every `ticks` ticks when nothing sounds (default
+    /// [`publish::SOUND_BLOCK_TICKS`]).
+    pub fn with_sound_block(mut self, ticks: u64) -> Self {
+        self.sound_block_ticks = ticks.max(1);
         self
     }
 
@@ -247,7 +256,9 @@ impl PageSession {
             Ok(h) => self.publisher = Some(h),
             Err(e) => self.fail(format!("cannot start the pages' publisher: {e}")),
         }
-        self.play_sink = Some(PlaySink::new(tx.clone(), self.shared.clone()));
+        self.play_sink = Some(
+            PlaySink::new(tx.clone(), self.shared.clone()).with_block_ticks(self.sound_block_ticks),
+        );
         self.tx = Some(tx);
         self.started = true;
         let mut list = self.sinks.list();

@@ -4,8 +4,15 @@
 //! [`Limits::messages_per_s`](webguard::gate::Limits) is refused — both counted), hands each to
 //! the [`Peer`], and writes what the peer has to send, within a bounded write buffer (a
 //! message that does not fit is dropped and the peer told).
+//!
+//! A link with a [`WakeRx`] (a game page's, on unix) waits for the page's socket and for its
+//! peer's queue at once (`poll`), so a queued message (a tick's sound input) goes out as soon
+//! as it is queued; without one, the loop reads with a `read_wait` timeout and writes after
+//! each read, so a message can wait up to `read_wait` (2 ms) for its turn.
 
 use std::net::TcpStream;
+#[cfg(unix)]
+use std::os::unix::net::UnixStream;
 use std::time::{Duration, Instant};
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::{Message, WebSocket};
@@ -43,10 +50,109 @@ pub struct LinkConfig {
     pub max_write_buffer_bytes: Option<usize>,
 }
 
+/// The queue's end of a link's wake-up: [`Wake::wake`] after queueing a message for the link.
+pub struct Wake {
+    #[cfg(unix)]
+    tx: UnixStream,
+}
+
+/// The link's end of its wake-up.
+pub struct WakeRx {
+    #[cfg(unix)]
+    rx: UnixStream,
+}
+
+/// A wake-up for one link (`None` where the platform has none, or the sockets could not be
+/// made: the link then reads with its `read_wait` timeout).
+pub fn wake_pair() -> Option<(Wake, WakeRx)> {
+    #[cfg(unix)]
+    {
+        let (tx, rx) = UnixStream::pair().ok()?;
+        tx.set_nonblocking(true).ok()?;
+        rx.set_nonblocking(true).ok()?;
+        Some((Wake { tx }, WakeRx { rx }))
+    }
+    #[cfg(not(unix))]
+    {
+        None
+    }
+}
+
+impl Wake {
+    /// Wakes the link (a full socket means it is awake already).
+    pub fn wake(&self) {
+        #[cfg(unix)]
+        {
+            use std::io::Write;
+            let _ = (&self.tx).write(&[1]);
+        }
+    }
+}
+
+impl WakeRx {
+    /// Takes the wake-ups sent so far.
+    fn drain(&self) {
+        #[cfg(unix)]
+        {
+            use std::io::Read;
+            let mut b = [0u8; 64];
+            while matches!((&self.rx).read(&mut b), Ok(n) if n > 0) {}
+        }
+    }
+}
+
+/// How long a read waits once `poll` said the page's socket is readable (the rest of a frame).
+const READ_SLICE: Duration = Duration::from_micros(200);
+
+/// Waits up to `timeout` for the socket `fd` or the wake-up to be readable: (socket, wake-up).
+#[cfg(unix)]
+#[allow(unsafe_code)] // one libc::poll on two descriptors this link owns
+fn wait(fd: std::os::fd::RawFd, wake: &WakeRx, timeout: Duration) -> (bool, bool) {
+    use std::os::fd::AsRawFd;
+    let mut fds = [
+        libc::pollfd {
+            fd,
+            events: libc::POLLIN,
+            revents: 0,
+        },
+        libc::pollfd {
+            fd: wake.rx.as_raw_fd(),
+            events: libc::POLLIN,
+            revents: 0,
+        },
+    ];
+    let ms = i32::try_from(timeout.as_millis())
+        .unwrap_or(i32::MAX)
+        .max(1);
+    // SAFETY: `fds` is an array of two initialised pollfd, valid for the call's duration.
+    let n = unsafe { libc::poll(fds.as_mut_ptr(), 2, ms) };
+    if n < 0 {
+        // Interrupted or failed: read (within READ_SLICE) as if the socket were ready.
+        return (true, false);
+    }
+    let ready = |f: &libc::pollfd| f.revents & (libc::POLLIN | libc::POLLHUP | libc::POLLERR) != 0;
+    (ready(&fds[0]), ready(&fds[1]))
+}
+
 /// Runs the link on `stream` until the page closes it, the peer stops, or a limit of `gate`
-/// closes it; then closes the WebSocket.
-pub fn run(stream: TcpStream, gate: &Gate, link: LinkConfig, peer: &mut dyn Peer) {
-    let _ = stream.set_read_timeout(Some(link.read_wait));
+/// closes it; then closes the WebSocket. With `wake`, it also writes as soon as woken.
+pub fn run(
+    stream: TcpStream,
+    gate: &Gate,
+    link: LinkConfig,
+    peer: &mut dyn Peer,
+    wake: Option<&WakeRx>,
+) {
+    #[cfg(unix)]
+    let fd = std::os::fd::AsRawFd::as_raw_fd(&stream);
+    #[cfg(not(unix))]
+    let wake: Option<&WakeRx> = wake.and(None);
+    let read_timeout = if wake.is_some() {
+        READ_SLICE
+    } else {
+        link.read_wait
+    };
+    let _ = stream.set_read_timeout(Some(read_timeout));
     let max = gate.limits.max_message_bytes;
     let mut config = WebSocketConfig::default()
         .max_message_size(Some(max))
@@ -59,8 +165,28 @@ pub fn run(stream: TcpStream, gate: &Gate, link: LinkConfig, peer: &mut dyn Peer
     }
     let mut ws = WebSocket::from_raw_socket(stream, Role::Server, Some(config));
     let mut rate = RateLimit::new(gate.limits.messages_per_s);
+    // The last read returned a message: more may wait in the WebSocket's buffer, unseen by poll.
+    let mut again = false;
     'link: while !peer.stopped() {
-        let mut msg = ws.read();
+        let readable = match wake {
+            #[cfg(unix)]
+            Some(w) if !again => {
+                let (readable, woken) = wait(fd, w, link.read_wait);
+                if woken {
+                    w.drain();
+                }
+                readable
+            }
+            _ => true,
+        };
+        let mut msg = if readable {
+            ws.read()
+        } else {
+            Err(tungstenite::Error::Io(
+                std::io::ErrorKind::WouldBlock.into(),
+            ))
+        };
+        again = msg.is_ok();
         if matches!(msg, Ok(Message::Text(_) | Message::Binary(_))) && !rate.take(Instant::now()) {
             gate.refused.count("rate");
             peer.receive(Incoming::TooFast);

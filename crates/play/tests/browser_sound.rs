@@ -4,16 +4,20 @@
 //! sounds on their ticks), sample by sample against the Rust synthesis of the same recording at
 //! the same sample rate.
 //!
-//! The live path (the FIFO, the lead, the underrun and drop logic, which the offline path
-//! skips): the same processor, not offline, driven one 128-sample render quantum at a time by
-//! an audio clock in the page, its sound ticks delivered by a schedule of arrival times (the
-//! publisher's 5-tick blocks, each sent when its last tick ends). Real time in headless
-//! Chromium on two shared cores cannot promise an underrun-free run (the browser tests'
-//! sessions play live and are held to the same samples whatever their underruns and drops,
-//! common/live.rs); the schedule can: an idle page (each block arriving 2 ms after its last
-//! tick, plus up to 3 ms of jitter) must play with 0 underruns and 0 drops, every sample of the
-//! track and every sound sent; a link that stalls for 50 ms must underrun, lengthen its lead,
-//! drop the backlog, and still play only the track's samples, each sound played or lost once.
+//! The live path (the FIFO, the lead sized from the arrivals' jitter, the underrun and drop
+//! logic, which the offline path skips): the same processor, not offline, driven one
+//! 128-sample render quantum at a time by an audio clock in the page (one quantum per device
+//! callback, as on the page's smallest output buffer), its sound ticks delivered by a schedule
+//! of arrival times (the `play` publisher's blocks of `PLAY_SOUND_BLOCK_TICKS` ticks, each sent
+//! when its last tick ends). No wall clock is involved, so the schedule can promise what real
+//! time in headless Chromium on two shared cores cannot: an idle page (each block arriving 2 ms
+//! after its last tick, plus up to 3 ms of jitter) must play with 0 underruns and 0 drops,
+//! every sample of the track and every sound sent, its lead a few ms past the earliest
+//! arrival; when the jitter rises to 12 ms the lead follows it, and when it falls back the lead
+//! comes back and the excess is dropped (counted, every sample played or dropped); eight 50 ms
+//! stalls underrun eight times, never lengthen the lead past its cap, and drop each backlog; a
+//! 50 ms stall and a 300 ms stall over the first sound underrun, drop the backlog and still
+//! play only the track's samples, each sound played or lost once.
 //!
 //! Tolerance: none. The worklet computes in f64 as the Rust code does, with the same formulas
 //! in the same order, and writes Float32 (the same round-to-nearest as Rust's `as f32`); only
@@ -61,9 +65,10 @@ fn base64(b: &[u8]) -> String {
     s
 }
 
-/// The recording's sound ticks as the publisher sends them: blocks of 5 ticks, each tick's
-/// distance, the sounds on their ticks with their index in the session's list.
-fn sound_ticks(a: &SessionArrays, on_m: f64) -> Vec<SoundTicks> {
+/// The recording's sound ticks as the `play` publisher sends them: blocks of
+/// `PLAY_SOUND_BLOCK_TICKS` ticks (the offline test: 5), each tick's distance, the sounds on
+/// their ticks with their index in the session's list.
+fn sound_ticks(a: &SessionArrays, on_m: f64, block: u64) -> Vec<SoundTicks> {
     let dt = 1.0 / f64::from(a.rate_hz);
     let sounds = haptic_loop::sound::sound_events(a).unwrap();
     let nearest = a.state_column("nearest_m").unwrap();
@@ -71,7 +76,7 @@ fn sound_ticks(a: &SessionArrays, on_m: f64) -> Vec<SoundTicks> {
     let mut out = Vec::new();
     let mut first = 0;
     while first < ticks {
-        let end = (first + 5).min(ticks);
+        let end = (first + block).min(ticks);
         out.push(SoundTicks {
             first_tick: first,
             tone_on_distance_m: Some(on_m),
@@ -138,7 +143,7 @@ fn compare(b: &mut Browser, rec: &Path, kind: &str, sr: u32) -> (usize, usize, u
     for n in expected {
         assert!(names.contains(n), "{kind}: {names:?}");
     }
-    let blocks: Vec<String> = sound_ticks(&a, on)
+    let blocks: Vec<String> = sound_ticks(&a, on, 5)
         .iter()
         .map(|m| base64(&m.encode()))
         .collect();
@@ -230,13 +235,26 @@ fn the_pages_worklet_makes_the_samples_of_render_audio() {
     assert_eq!(report.len(), 4);
 }
 
-/// How the live test's sound ticks reach the worklet: each 5-tick block `delay_ms` after its
-/// last tick ends, plus a jitter in [0, `jitter_ms`) (a fixed sequence; blocks keep their
-/// order), and the blocks sent during `stall` (from, to, ms) held until its end.
+/// How the live test's sound ticks reach the worklet: each block `delay_ms` after its last
+/// tick ends, plus a jitter in [0, `jitter_ms`) (a fixed sequence; blocks keep their order;
+/// from `from_ms` on, while a `phases` entry (from, to, jitter ms) covers it, that jitter
+/// instead), and the blocks sent during a stall (from, to, ms) held until its end.
 struct Link {
     delay_ms: f64,
     jitter_ms: f64,
-    stall: Option<(f64, f64)>,
+    phases: Vec<(f64, f64, f64)>,
+    stalls: Vec<(f64, f64)>,
+}
+
+impl Link {
+    fn idle() -> Link {
+        Link {
+            delay_ms: 2.0,
+            jitter_ms: 3.0,
+            phases: Vec::new(),
+            stalls: Vec::new(),
+        }
+    }
 }
 
 /// The arrival time, ms, of each block (`ends`: when each block's last tick ends, ms).
@@ -248,9 +266,14 @@ fn arrivals(ends: &[f64], link: &Link) -> Vec<f64> {
             x ^= x << 13;
             x ^= x >> 7;
             x ^= x << 17;
-            let j = (x >> 11) as f64 / (1u64 << 53) as f64 * link.jitter_ms;
+            let jitter = link
+                .phases
+                .iter()
+                .find(|p| (p.0..p.1).contains(&end))
+                .map_or(link.jitter_ms, |p| p.2);
+            let j = (x >> 11) as f64 / (1u64 << 53) as f64 * jitter;
             let mut t = end + link.delay_ms + j;
-            if let Some((from, to)) = link.stall {
+            for &(from, to) in &link.stalls {
                 if (from..to).contains(&end) {
                     t = t.max(to);
                 }
@@ -261,12 +284,20 @@ fn arrivals(ends: &[f64], link: &Link) -> Vec<f64> {
         .collect()
 }
 
+/// What the live path heard, and its lead and jitter (ms) every 0.5 s of its clock: [clock
+/// ms, lead past the earliest arrival ms, jitter ms].
+struct LivePath {
+    heard: live::Heard,
+    leads: Vec<[f64; 3]>,
+    lead_ms: f64,
+}
+
 /// Plays the recording's sound ticks through the worklet's live path at `sr` Hz over `link`,
 /// checks what it heard against `render --audio --proximity` (common/live.rs) and returns it.
-fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> live::Heard {
+fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> LivePath {
     let a = read_arrays(rec, false).unwrap();
     let on = haptic_loop::sound::proximity_on_distance_m(kind).unwrap();
-    let msgs = sound_ticks(&a, on);
+    let msgs = sound_ticks(&a, on, play::publish::PLAY_SOUND_BLOCK_TICKS);
     let dt_ms = 1000.0 / f64::from(a.rate_hz);
     let ends: Vec<f64> = msgs
         .iter()
@@ -293,9 +324,10 @@ fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> l
   }};
   globalThis.registerProcessor = (name, cls) => {{ Proc = cls; }};
   new Function(src)();
-  const p = new Proc({{ processorOptions: {{ rateHz: {rate}, leadS: {lead} }} }});
+  const p = new Proc({{ processorOptions: {{ rateHz: {rate}, leadS: {lead}, leadMaxS: {lead_max} }} }});
   const out = new Float32Array(128);
   let m = 0, finished = false;
+  const leads = [], every = Math.round(sr / 2 / 128);
   for (let q = 0; q < 1e7 && !p.done; q++) {{
     const ms = q * 128 / sr * 1000;
     for (; m < blocks.length && at[m] <= ms; m++) p.port.onmessage({{ data: blocks[m] }});
@@ -303,9 +335,11 @@ fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> l
     if (m === blocks.length && !finished) {{ p.port.onmessage({{ data: {{ finish: {ticks} }} }}); finished = true; }}
     globalThis.currentTime = q * 128 / sr;
     p.process([], [[out]]);
+    if (q % every === 0) {{ const r = p.leadReport(); if (r.leadMs !== null) leads.push([ms, r.leadMs, r.jitterMs]); }}
   }}
   const onsets = reports.filter((r) => r.kind === 'onset');
   return {{
+    leads,
     live: reports.find((r) => r.kind === 'done') || null,
     sound: {{
       sent: {sent},
@@ -319,68 +353,202 @@ fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> l
         at = json!(at),
         rate = a.rate_hz,
         lead = LEAD_S,
+        lead_max = LEAD_MAX_S,
         ticks = a.tick.len(),
         sent = json!(sent),
     );
     let v = b.eval(&js).unwrap();
-    live::check(&a, kind, &v["live"], &v["sound"])
+    let heard = live::check(&a, kind, &v["live"], &v["sound"]);
+    let leads = v["leads"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| [0, 1, 2].map(|k| r[k].as_f64().unwrap()))
+        .collect();
+    LivePath {
+        heard,
+        leads,
+        lead_ms: v["live"]["leadMs"].as_f64().unwrap(),
+    }
 }
 
-/// The page's lead, s (sound.js's LEAD_S).
-const LEAD_S: f64 = 0.006;
+/// The page's lead before the jitter is measured and its cap past the earliest arrival, s
+/// (sound.js's LEAD_S and LEAD_MAX_S).
+const LEAD_S: f64 = 0.008;
+const LEAD_MAX_S: f64 = 0.03;
+/// The worklet's margin over the largest lateness, ms (synth.js's MARGIN_S).
+const MARGIN_MS: f64 = 1.0;
+
+/// The lead past the earliest arrival the schedule's jitter calls for, ms: the jitter, the
+/// arrival's wait for the next quantum (up to one, 128 samples), the margin.
+fn lead_for(jitter_ms: f64, sr: u32) -> (f64, f64) {
+    let quantum_ms = 128.0 / f64::from(sr) * 1000.0;
+    (
+        0.8 * jitter_ms + MARGIN_MS,
+        jitter_ms + quantum_ms + MARGIN_MS + 0.01,
+    )
+}
+
+/// The least and the most lead sampled with the clock in [from, to) ms.
+fn lead_in(p: &LivePath, from: f64, to: f64) -> (f64, f64) {
+    let v: Vec<f64> = p
+        .leads
+        .iter()
+        .filter(|r| (from..to).contains(&r[0]))
+        .map(|r| r[1])
+        .collect();
+    assert!(!v.is_empty(), "no lead sampled in {from}..{to} ms");
+    (
+        v.iter().copied().fold(f64::INFINITY, f64::min),
+        v.iter().copied().fold(0.0, f64::max),
+    )
+}
+
+/// Every lead sampled is at most the cap.
+fn capped(p: &LivePath) {
+    for &[ms, lead, _] in &p.leads {
+        assert!(lead <= LEAD_MAX_S * 1000.0 + 1e-9, "{lead} ms at {ms} ms");
+    }
+}
 
 #[test]
 fn the_worklets_live_path_plays_the_samples_of_render_audio() {
     let sound_js = include_str!("../src/page/sound.js");
+    for (name, v) in [("LEAD_S", LEAD_S), ("LEAD_MAX_S", LEAD_MAX_S)] {
+        assert!(
+            sound_js.contains(&format!("const {name} = {v};")),
+            "the page's {name} is the test's"
+        );
+    }
     assert!(
-        sound_js.contains(&format!("const LEAD_S = {LEAD_S};")),
-        "the page's lead is the test's"
+        include_str!("../src/page/synth.js")
+            .contains(&format!("MARGIN_S = {}", MARGIN_MS / 1000.0))
     );
     let (mut b, server) = PageServer::open("nh-sound-live.mcap");
-    let idle = Link {
-        delay_ms: 2.0,
-        jitter_ms: 3.0,
-        stall: None,
-    };
     let stalled = || Link {
-        delay_ms: 2.0,
-        jitter_ms: 3.0,
-        stall: Some((1000.0, 1050.0)),
+        stalls: vec![(1000.0, 1050.0)],
+        ..Link::idle()
     };
     for (rec, kind, sr) in [
         ("brickworld", "brickworld", 48_000),
         ("nanoworld", "nanoworld", 44_100),
     ] {
         let path = workspace().join(format!("recordings/{rec}.mcap"));
-        let h = live_path(&mut b, &path, kind, sr, &idle);
-        println!("{rec}, idle page, {sr} Hz: {h:?}");
+        let p = live_path(&mut b, &path, kind, sr, &Link::idle());
+        let h = &p.heard;
+        println!("{rec}, idle page, {sr} Hz: {h:?}, lead {} ms", p.lead_ms);
         // An idle page: every sample of the track, every sound, no underrun, no drop.
         assert_eq!((h.underruns, h.dropped), (0, 0), "{rec}: {h:?}");
         assert_eq!(h.played_samples, h.track_samples);
         assert_eq!((h.played, h.lost), (h.sent, 0));
         assert!(h.sent > 0);
-        let h = live_path(&mut b, &path, kind, sr, &stalled());
+        // Its lead: the 3 ms jitter's once 4 s are measured (the brick world's 22 s), the
+        // first lead before (the nano world's 3 s).
+        let (lo, hi) = if h.track_samples as f64 / f64::from(sr) > 5.0 {
+            lead_for(3.0, sr)
+        } else {
+            let first = (LEAD_S * f64::from(sr)).round() / f64::from(sr) * 1000.0;
+            (first - 1e-9, first + 1e-9)
+        };
+        assert!((lo..=hi).contains(&p.lead_ms), "{rec}: {} ms", p.lead_ms);
+        capped(&p);
+        let p = live_path(&mut b, &path, kind, sr, &stalled());
+        let h = &p.heard;
         println!("{rec}, a 50 ms stall, {sr} Hz: {h:?}");
         // A stall: the worklet ran dry, then dropped the backlog; what it played is still
         // the track's (checked in live_path).
         assert!(h.underruns >= 1 && h.dropped > 0, "{rec}: {h:?}");
         assert_eq!(h.played_samples as u64 + h.dropped, h.track_samples as u64);
         assert_eq!(h.played + h.lost, h.sent);
-        // A 300 ms stall from 240 ms before the first sound: the backlog (about 300 ms) is
-        // dropped at the end of the first whole 0.1 s window after it arrives, from a playhead
-        // at most two windows (203 ms) past the stall's start, so the drop covers the sound's
-        // first sample.
+        capped(&p);
+        // A 300 ms stall from 240 ms before the first sound: the backlog (about 300 ms, less
+        // the lead's cap) is dropped at the end of the first whole 0.1 s window after it
+        // arrives, from a playhead at most two windows (203 ms) past the stall's start, so
+        // the drop covers the sound's first sample.
         let a = read_arrays(&path, false).unwrap();
         let first_ms = haptic_loop::sound::sound_events(&a).unwrap()[0].t_s * 1000.0;
         let over = Link {
-            stall: Some((first_ms - 240.0, first_ms + 60.0)),
-            ..stalled()
+            stalls: vec![(first_ms - 240.0, first_ms + 60.0)],
+            ..Link::idle()
         };
-        let h = live_path(&mut b, &path, kind, sr, &over);
+        let p = live_path(&mut b, &path, kind, sr, &over);
+        let h = &p.heard;
         println!("{rec}, a 300 ms stall over its first sound (at {first_ms} ms), {sr} Hz: {h:?}");
         assert!(h.lost >= 1, "{rec}: {h:?}");
         assert_eq!(h.played + h.lost, h.sent);
+        capped(&p);
     }
+    b.check().unwrap();
+    server.close();
+}
+
+#[test]
+fn the_worklets_lead_follows_the_arrivals_jitter_and_no_underrun_lengthens_it() {
+    let (mut b, server) = PageServer::open("nh-sound-lead.mcap");
+    let (rec, kind, sr) = ("brickworld", "brickworld", 44_100);
+    let path = workspace().join(format!("recordings/{rec}.mcap"));
+    let (idle_lo, idle_hi) = lead_for(3.0, sr);
+    let (high_lo, high_hi) = lead_for(12.0, sr);
+    // The jitter rises from 3 ms to 12 ms for 6 s, then falls back: the lead follows it up
+    // within the 6 s and comes back 4 s after (the window), the excess then dropped.
+    let jumpy = Link {
+        phases: vec![(6000.0, 12_000.0, 12.0)],
+        ..Link::idle()
+    };
+    let p = live_path(&mut b, &path, kind, sr, &jumpy);
+    let h = &p.heard;
+    let before = lead_in(&p, 4500.0, 6000.0);
+    let high = lead_in(&p, 9000.0, 12_000.0);
+    let after = lead_in(&p, 17_000.0, 21_000.0);
+    println!(
+        "jitter 3 → 12 → 3 ms: {h:?}; lead (least, most) {before:?} ms before, {high:?} ms at 12 ms, {after:?} ms after"
+    );
+    assert!(
+        before.0 >= idle_lo && before.1 <= idle_hi,
+        "{before:?} vs {idle_lo}..{idle_hi}"
+    );
+    assert!(
+        high.0 >= high_lo && high.1 <= high_hi,
+        "{high:?} vs {high_lo}..{high_hi}"
+    );
+    assert!(
+        after.0 >= idle_lo && after.1 <= idle_hi,
+        "{after:?} vs {idle_lo}..{idle_hi}"
+    );
+    // The rise underruns while the window learns it (each arrival later than all before it
+    // can), a few times; the fall drops the excess; every sample is played or dropped.
+    assert!((1..=6).contains(&h.underruns), "{h:?}");
+    assert!(h.dropped > 0, "{h:?}");
+    assert_eq!(h.played_samples as u64 + h.dropped, h.track_samples as u64);
+    assert_eq!(h.played + h.lost, h.sent);
+    capped(&p);
+
+    // Eight 50 ms stalls, 2 s apart: each underruns once (no more: the lead does not grow
+    // after one, and the stall's backlog is dropped down to the cap, then to the jitter's
+    // lead), and 4 s after the last the lead is the idle page's again.
+    let stalls: Vec<(f64, f64)> = (1..=8)
+        .map(|k| (2000.0 * f64::from(k), 2000.0 * f64::from(k) + 50.0))
+        .collect();
+    let stalled = Link {
+        stalls,
+        ..Link::idle()
+    };
+    let p = live_path(&mut b, &path, kind, sr, &stalled);
+    let h = &p.heard;
+    let after = lead_in(&p, 20_600.0, 21_900.0);
+    println!(
+        "eight 50 ms stalls: {h:?}; lead {:?} ms after the last",
+        after
+    );
+    assert_eq!(h.underruns, 8, "{h:?}");
+    assert!(h.dropped > 0, "{h:?}");
+    assert_eq!(h.played_samples as u64 + h.dropped, h.track_samples as u64);
+    assert_eq!(h.played + h.lost, h.sent);
+    assert!(
+        after.0 >= idle_lo && after.1 <= idle_hi,
+        "{after:?} vs {idle_lo}..{idle_hi}"
+    );
+    capped(&p);
     b.check().unwrap();
     server.close();
 }

@@ -202,7 +202,7 @@ pub(crate) fn link(stream: TcpStream, class: &Class, gate: &Gate) {
         read_wait: Duration::from_millis(20),
         max_write_buffer_bytes: None,
     };
-    wslink::run(stream, gate, link, &mut peer);
+    wslink::run(stream, gate, link, &mut peer, None);
 }
 
 /// The teacher page's end of its link: commands in, their replies and the class's status

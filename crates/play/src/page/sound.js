@@ -11,15 +11,22 @@ import { P, say } from './page.js';
 
 let actx = null, gain = null, node = null, muted = false;
 let waiting = []; // sound ticks received while the worklet loads
-// Sound queued before playback starts (and kept at most), s: covers the ticks' arrival
-// jitter and the audio thread's bursts; the worklet lengthens it after an underrun.
-const LEAD_S = 0.006;
+// The lead (how far the worklet plays behind its own clock), s: the worklet sizes it from the
+// ticks' measured arrival jitter (synth.js), past the earliest arrival at least LEAD_S until
+// it has measured 4 s and at most LEAD_MAX_S (a stall longer than that underruns and its
+// backlog is dropped).
+const LEAD_S = 0.008;
+const LEAD_MAX_S = 0.03;
+// The output's buffer, s: the smallest the device offers (the browser clamps the hint to its
+// device's minimum: 128 frames on headless Chromium's fake output, against 10 ms rendered in
+// bursts of 3 to 4 quanta at 'interactive').
+const LATENCY_HINT_S = 0.001;
 const SYNTH_URL = new URL('./synth.js', import.meta.url);
 
 // Opens the audio output (on the Start press: a user gesture) and loads the synthesis.
 export function startAudio() {
   try {
-    actx = new AudioContext({ latencyHint: 'interactive' });
+    actx = new AudioContext({ latencyHint: LATENCY_HINT_S });
     gain = actx.createGain(); gain.gain.value = muted ? 0 : 1; gain.connect(actx.destination);
     actx.resume();
     P.sound.sampleRate = actx.sampleRate;
@@ -27,7 +34,7 @@ export function startAudio() {
     actx.audioWorklet.addModule(SYNTH_URL).then(() => {
       node = new AudioWorkletNode(actx, 'nh-synth', {
         numberOfInputs: 0, numberOfOutputs: 1, outputChannelCount: [1],
-        processorOptions: { rateHz: P.hello ? P.hello.rate_hz : 1000, leadS: LEAD_S },
+        processorOptions: { rateHz: P.hello ? P.hello.rate_hz : 1000, leadS: LEAD_S, leadMaxS: LEAD_MAX_S },
       });
       node.port.onmessage = (e) => onWorklet(e.data);
       node.connect(gain);
@@ -56,7 +63,11 @@ export function onSoundTicks(buf) {
     s.nextTick = first + nt; s.ticks += nt; s.sounds += ns;
     // Each sound: its tick (u64) and its index in the session's list (u32).
     for (let j = 0, at = 24 + 16 * nt; j < ns && at + 24 <= buf.byteLength && s.sent.length < 100000; j++, at += 24) {
-      s.sent.push([Number(dv.getBigUint64(at, true)), dv.getUint32(at + 8, true)]);
+      const tick = Number(dv.getBigUint64(at, true));
+      s.sent.push([tick, dv.getUint32(at + 8, true)]);
+      // Tick → the page has it (before the worklet), ms.
+      const i = tick - first;
+      if (j === 0 && i >= 0 && i < nt && s.pageMs.length < 100000) s.pageMs.push(Date.now() - dv.getFloat64(24 + 16 * i, true));
     }
   }
   s.messages++;
@@ -78,7 +89,7 @@ function onWorklet(m) {
   const s = P.sound;
   if (m.kind === 'done') {
     s.live = m;
-    s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs;
+    s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs;
   }
   else if (m.kind === 'lost') s.lost.push([m.tick, m.index]);
   else { if (s.played.length < 100000) s.played.push([m.tick, m.index]); onRendered(m); }
@@ -91,7 +102,7 @@ function onWorklet(m) {
 // getOutputTimestamp() (the output's own estimate of when it plays), minus the same.
 function onRendered(m) {
   const s = P.sound;
-  s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs;
+  s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs;
   if (s.latencyMs.length >= 100000) return;
   const outS = actx.outputLatency || 0, baseS = actx.baseLatency || 0;
   s.outputLatencyS = outS; s.baseLatencyS = baseS;

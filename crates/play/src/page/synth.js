@@ -7,12 +7,23 @@
 // ±0.98 ceiling limited to it. Its input is the server's binary sound ticks (protocol/sound.rs's
 // SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it.
 //
-// The samples go through a FIFO to the output: playback starts once `leadS` of sound is
-// queued; an underrun plays silence, lengthens the lead by 1 ms (up to 50 ms) and waits for
-// it again, and each second without one shortens it by 1 ms (down to `leadS`); a FIFO that
-// stays fuller than the lead for 0.1 s drops the excess (counted). For each sound's first sample the processor reports
-// when it was rendered (Date.now() at the render quantum, the frame within it, the context
-// time) so the page can measure tick → output, or that it was dropped (`lost`). It hashes
+// The samples go through a FIFO to the output, which plays a lead behind the processor's
+// clock sized from the ticks' measured arrival jitter. The processor counts the samples it
+// has output (`clock`, silence included); for each message that brings new samples, its
+// lateness is the clock at its arrival (the next render quantum's) minus the session index of
+// its first new sample (the two origins differ by a constant: only differences of lateness
+// mean something). The output plays sample `clock − lead` at each clock, the lead being the
+// largest lateness of the last 4 s (eight 0.5 s buckets) plus a 1 ms margin: every message no
+// later than that arrives before the quantum that plays its first sample. The lead is at most
+// `leadMaxS` past the window's earliest arrival, and while less than 4 s has been measured at
+// least `leadS` past it. Playback starts, and restarts after an underrun, once the clock is a
+// lead past the next sample (and a quantum of it is queued): an underrun plays silence and
+// waits, but does not lengthen the lead. Every 0.1 s of quanta, when the output plays more
+// than 5 ms behind the lead (a backlog after a stall, or jitter that has passed), the excess is
+// dropped (counted and listed), never below one quantum queued at the window's lowest. For
+// each sound's first sample the processor reports when it was rendered (Date.now() at the
+// render quantum, the frame within it, the context time) so the page can measure tick →
+// output, or that it was dropped (`lost`). It hashes
 // every sample it plays from the FIFO (FNV-1a over the Float32 bytes, in the order played;
 // the silence of a wait or an underrun is not the session's and is not hashed) and keeps where
 // it dropped samples, so the test can compare what was heard with `render --audio`. A
@@ -26,6 +37,9 @@ const A_MAX = 0.8, CEILING = 0.98, ATTACK_S = 5e-4, TONE_AMPLITUDE = 0.12;
 const TAU = 2 * Math.PI; // std::f64::consts::TAU
 const SILENT = [0, 0];
 const HEADER = 24, TICK = 16, SOUND = 24;
+// The lead's window (LATE_BUCKETS buckets of LATE_BUCKET_S of the processor's clock), the margin
+// on top of the largest lateness, and the excess over the lead that is dropped, s.
+const LATE_BUCKETS = 8, LATE_BUCKET_S = 0.5, MARGIN_S = 0.001, TRIM_S = 0.005;
 
 // 64-bit unsigned arithmetic on [hi, lo] 32-bit halves (the noise is xorshift64*).
 function mul64(ah, al, bh, bl) {
@@ -213,8 +227,21 @@ class Synth extends AudioWorkletProcessor {
     this.fifo = new Fifo();
     this.synth = null;
     this.onsets = []; // [sample index, tick, tick wall ms, arrival ms]
-    this.lead = this.lead0 = Math.round((o.leadS || 0) * sampleRate);
-    this.calm = 0; // samples played since the last underrun or lead change
+    // The lead, samples (see above): past the earliest arrival, at least `lead0` before the
+    // jitter is measured, at most `leadMax`.
+    this.lead0 = Math.round((o.leadS || 0) * sampleRate);
+    this.leadMax = Math.round((o.leadMaxS || 0.03) * sampleRate);
+    this.lead = this.lead0;
+    this.margin = Math.round(MARGIN_S * sampleRate);
+    this.trim = Math.round(TRIM_S * sampleRate);
+    // The processor's clock (samples output, silence included), the lateness of the arrivals
+    // (the largest and the smallest per bucket of the clock), and the clock when the
+    // measuring began.
+    this.clock = 0;
+    this.bucketLen = Math.round(LATE_BUCKET_S * sampleRate);
+    this.late = new Float64Array(LATE_BUCKETS).fill(-Infinity);
+    this.early = new Float64Array(LATE_BUCKETS).fill(Infinity);
+    this.bucket = -1; this.since = -1;
     this.primed = false;
     this.underruns = 0; this.dropped = 0;
     this.minLevel = Infinity; this.quanta = 0;
@@ -246,12 +273,12 @@ class Synth extends AudioWorkletProcessor {
     this.ending = true; this.primed = true;
   }
 
-  // Hashes the `n` samples just played from `out` (session indices from `from`).
-  hear(out, n, from) {
+  // Hashes the `n` samples just played from `out` at `at` (session indices from `from`).
+  hear(out, at, n, from) {
     const h = this.heard;
     if (n === 0) return;
     if (h.first < 0) h.first = from;
-    const bytes = new Uint8Array(out.buffer, out.byteOffset, n * 4);
+    const bytes = new Uint8Array(out.buffer, out.byteOffset + at * 4, n * 4);
     let x = h.hash;
     for (let i = 0; i < bytes.length; i++) x = Math.imul(x ^ bytes[i], 0x01000193) >>> 0;
     const second = Math.round(sampleRate);
@@ -275,8 +302,10 @@ class Synth extends AudioWorkletProcessor {
     if (s === null) {
       s = this.synth = new StreamSynth(sampleRate, this.dt, on, first, (v) => this.fifo.push(v));
       this.fifo.clear(s.nextSample); this.primed = this.offline; this.onsets = [];
+      this.late.fill(-Infinity); this.early.fill(Infinity); this.since = -1;
     }
     while (s.ticks < first) s.tick(NaN);
+    const from = s.nextSample;
     let j = 0;
     const soundAt = HEADER + TICK * nt;
     for (let i = 0; i < nt; i++) {
@@ -296,42 +325,97 @@ class Synth extends AudioWorkletProcessor {
       if (tick < s.ticks) continue; // already had
       s.tick(dv.getFloat64(HEADER + TICK * i + 8, true));
     }
+    if (!this.offline && s.nextSample > from) this.arrived(this.clock - from);
+  }
+
+  // A message brought new samples `late` samples after the clock passed its first one (the
+  // clock then is the next quantum's): the lead is the window's largest lateness plus the
+  // margin. A quantum at clock c plays from c − lead, and clocks are multiples of the quantum,
+  // so a message no later than the lead arrives before the quantum that plays its first sample.
+  arrived(late) {
+    if (this.since < 0) { this.since = this.clock; this.bucket = Math.floor(this.clock / this.bucketLen); }
+    this.rotate();
+    const k = this.bucket % LATE_BUCKETS;
+    if (late > this.late[k]) this.late[k] = late;
+    if (late < this.early[k]) this.early[k] = late;
+    this.sizeLead();
+  }
+
+  // The window moves on with the clock: the buckets it left are emptied.
+  rotate() {
+    const b = Math.floor(this.clock / this.bucketLen);
+    if (this.since < 0 || b <= this.bucket) return;
+    if (b - this.bucket >= LATE_BUCKETS) { this.late.fill(-Infinity); this.early.fill(Infinity); }
+    else for (let i = this.bucket + 1; i <= b; i++) { this.late[i % LATE_BUCKETS] = -Infinity; this.early[i % LATE_BUCKETS] = Infinity; }
+    this.bucket = b;
+  }
+
+  // The lead from the window's lateness: its largest plus the margin, between lead0 (while
+  // the window is not full) and leadMax past its smallest.
+  sizeLead() {
+    this.rotate();
+    const [early, late] = this.window();
+    if (!Number.isFinite(late)) return;
+    let lead = late + this.margin;
+    if (this.clock - this.since < LATE_BUCKETS * this.bucketLen) lead = Math.max(lead, early + this.lead0);
+    this.lead = Math.min(lead, early + this.leadMax);
+  }
+
+  // The window's smallest and largest lateness, samples.
+  window() {
+    let early = Infinity, late = -Infinity;
+    for (let i = 0; i < LATE_BUCKETS; i++) { early = Math.min(early, this.early[i]); late = Math.max(late, this.late[i]); }
+    return [early, late];
   }
 
   process(inputs, outputs) {
     const out = outputs[0][0];
     if (!out) return true;
+    const r = this.render(out);
+    this.clock += out.length;
+    return r;
+  }
+
+  // One render quantum into `out`.
+  render(out) {
     const fifo = this.fifo;
-    if (!this.primed && fifo.length >= Math.max(this.lead, 1)) this.primed = true;
-    if (!this.primed) { out.fill(0); return true; }
-    // Too much queued for a while: come back to the lead (over ~0.1 s of quanta).
+    if (!this.offline && !this.ending) this.sizeLead();
+    // Play once the clock is a lead past the next sample (and a quantum of it is queued):
+    // from the frame of this quantum where it is.
+    let at = 0;
+    if (!this.primed) {
+      const wait = this.synth === null ? Infinity : fifo.first + this.lead - this.clock;
+      if (wait >= out.length || fifo.length < out.length) { out.fill(0); return true; }
+      at = Math.max(0, wait);
+      out.fill(0, 0, at);
+      this.primed = true;
+    }
+    // Playing more than TRIM_S behind the lead: drop the excess (keeping a quantum queued at
+    // the lowest of the last ~0.1 s of quanta).
     this.minLevel = Math.min(this.minLevel, fifo.length);
     if (++this.quanta >= Math.ceil(0.1 * sampleRate / out.length)) {
-      if (!this.offline && !this.ending && this.minLevel > this.lead + out.length) {
-        const n = this.minLevel - this.lead;
-        if (this.heard.drops.length < 10000) this.heard.drops.push([fifo.first, n]);
-        fifo.drop(n); this.dropped += n;
+      const excess = this.clock - fifo.first - this.lead;
+      if (!this.offline && !this.ending && excess > this.trim) {
+        const n = Math.min(excess, this.minLevel - out.length);
+        if (n > 0) {
+          if (this.heard.drops.length < 10000) this.heard.drops.push([fifo.first, n]);
+          fifo.drop(n); this.dropped += n;
+        }
       }
       this.minLevel = Infinity; this.quanta = 0;
     }
     const from = fifo.first;
-    const n = fifo.take(out, 0);
-    if (!this.offline) this.hear(out, n, from);
-    if (n < out.length) {
-      out.fill(0, n);
+    const n = fifo.take(out, at);
+    if (!this.offline) this.hear(out, at, n, from);
+    if (at + n < out.length) {
+      out.fill(0, at + n);
       if (this.ending) {
         // The end of the stream, not an underrun.
         if (!this.done) { this.done = true; this.port.postMessage(this.report('done')); }
       } else if (!this.offline) {
-        // An underrun: wait for the lead again, a millisecond longer (up to 50 ms).
+        // An underrun: silence, then play again a lead behind the clock (the lead unchanged).
         this.underruns++; this.primed = false;
-        this.lead = Math.min(this.lead + Math.round(0.001 * sampleRate), Math.round(0.05 * sampleRate));
-        this.calm = 0;
       }
-    } else if (!this.offline && (this.calm += n) >= sampleRate && this.lead > this.lead0) {
-      // A second without an underrun: a millisecond shorter, down to the first lead.
-      this.lead = Math.max(this.lead0, this.lead - Math.round(0.001 * sampleRate));
-      this.calm = 0;
     }
     // Report the sounds whose first sample is in this quantum (or was dropped).
     if (this.onsets.length && this.onsets[0][0] < from + n) {
@@ -339,16 +423,24 @@ class Synth extends AudioWorkletProcessor {
       while (this.onsets.length && this.onsets[0][0] < from + n) {
         const [k, tick, wallMs, gotMs, index] = this.onsets.shift();
         if (k < from) { this.port.postMessage({ kind: 'lost', tick, index }); continue; }
-        const frame = k - from;
+        const frame = at + k - from;
         this.port.postMessage({
           kind: 'onset', tick, index, wallMs, gotMs, renderMs, frame, sampleRate,
           contextTime: currentTime + frame / sampleRate,
           underruns: this.underruns, dropped: this.dropped, limited: this.synth ? this.synth.limited : 0,
-          level: fifo.length, leadMs: this.lead / sampleRate * 1000,
+          level: fifo.length, ...this.leadReport(),
         });
       }
     }
     return true;
+  }
+
+  // The lead past the window's earliest arrival and the window's jitter (its largest minus
+  // its smallest lateness), ms (null: nothing measured).
+  leadReport() {
+    const [early, late] = this.window();
+    const ms = (x) => (Number.isFinite(x) ? x / sampleRate * 1000 : null);
+    return { leadMs: ms(this.lead - early), jitterMs: ms(late - early) };
   }
 
   // The counts and what was heard (`kind`: 'done' at the end of the stream).
@@ -356,7 +448,7 @@ class Synth extends AudioWorkletProcessor {
     return {
       kind, sampleRate, underruns: this.underruns, dropped: this.dropped,
       limited: this.synth ? this.synth.limited : 0, emitted: this.synth ? this.synth.nextSample : 0,
-      leadMs: this.lead / sampleRate * 1000, ...this.heard,
+      ...this.leadReport(), ...this.heard,
     };
   }
 }

@@ -117,8 +117,9 @@ pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
     if let Some(end) = shared.end.lock().ok().and_then(|e| e.clone()) {
         let _ = tx.try_send(Message::text(end));
     }
+    let (wake, wake_rx) = wslink::wake_pair().unzip();
     if let Ok(mut pages) = shared.pages.lock() {
-        pages.push(Page { id, tx });
+        pages.push(Page { id, tx, wake });
     }
     let mut peer = PagePeer {
         shared,
@@ -131,7 +132,7 @@ pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
         read_wait: Duration::from_millis(2),
         max_write_buffer_bytes: Some(gate.limits.max_write_buffer_bytes),
     };
-    wslink::run(stream, gate, link, &mut peer);
+    wslink::run(stream, gate, link, &mut peer, wake_rx.as_ref());
     if let Ok(mut pages) = shared.pages.lock() {
         pages.retain(|p| p.id != id);
     }

@@ -71,6 +71,8 @@ pub struct Page {
     /// Its id.
     pub id: u64,
     pub(crate) tx: SyncSender<Message>,
+    /// Wakes its link when a message is queued (`None`: the link polls every 2 ms).
+    pub(crate) wake: Option<crate::wslink::Wake>,
 }
 
 impl Shared {
@@ -93,8 +95,16 @@ impl Shared {
     }
 
     fn queue(&self, p: &Page, m: Message) {
-        if let Err(TrySendError::Full(_)) = p.tx.try_send(m) {
-            self.dropped.fetch_add(1, Ordering::Relaxed);
+        match p.tx.try_send(m) {
+            Err(TrySendError::Full(_)) => {
+                self.dropped.fetch_add(1, Ordering::Relaxed);
+            }
+            Ok(()) => {
+                if let Some(w) = &p.wake {
+                    w.wake();
+                }
+            }
+            Err(TrySendError::Disconnected(_)) => {}
         }
     }
 

@@ -19,8 +19,16 @@ fn shared(page_is_hand: bool) -> (Arc<Shared>, Receiver<Message>, Receiver<Messa
     });
     let (t1, r1) = sync_channel(16);
     let (t2, r2) = sync_channel(16);
-    sh.pages.lock().unwrap().push(Page { id: 1, tx: t1 });
-    sh.pages.lock().unwrap().push(Page { id: 2, tx: t2 });
+    sh.pages.lock().unwrap().push(Page {
+        id: 1,
+        tx: t1,
+        wake: None,
+    });
+    sh.pages.lock().unwrap().push(Page {
+        id: 2,
+        tx: t2,
+        wake: None,
+    });
     (sh, r1, r2)
 }
 
