@@ -679,3 +679,54 @@ fn pressing_the_overhanging_end_tips_the_brick_pressing_inside_does_not() {
         "pressed on the overhang (5 N x 8 cm > M g x 1 cm), it tips: {outside}"
     );
 }
+
+/// BENCHMARKS.md's "Inertial-force acceleration estimators" table (its report's computation):
+/// a 2 Hz, 3 cm sinusoid at 1 kHz quantized to 50 µm; delay, noise gain and RMS error against
+/// the true acceleration at the estimator's delay, to the printed digits.
+#[test]
+fn acceleration_estimators_hold_the_benchmarks_table() {
+    use brickworld::{AccelEstimator, MotionEstimator};
+    let (dt, amp, q) = (1e-3, 0.03, 50e-6);
+    let w = 2.0 * std::f64::consts::PI * 2.0;
+    for (k, delay_ms, gain, rms) in [
+        (AccelEstimator::Paper, 2.0, 6.124e5, 8.516),
+        (
+            AccelEstimator::SavitzkyGolay { window: 11 },
+            5.0,
+            6.828e4,
+            0.974,
+        ),
+        (
+            AccelEstimator::SavitzkyGolay { window: 21 },
+            10.0,
+            1.335e4,
+            0.172,
+        ),
+        (
+            AccelEstimator::SavitzkyGolay { window: 41 },
+            20.0,
+            2.497e3,
+            0.032,
+        ),
+    ] {
+        let mut m = MotionEstimator::new(dt, k);
+        m.reset([0.0; 3]);
+        let lag = m.accel_lag_s();
+        let (mut se, mut n) = (0.0, 0);
+        for i in 0..3000 {
+            let t = i as f64 * dt;
+            m.push([((amp * (w * t).sin()) / q).round() * q, 0.0, 0.0]);
+            if i >= 1000 {
+                let truth = -amp * w * w * (w * (t - lag)).sin();
+                se += (m.acceleration()[0] - truth).powi(2);
+                n += 1;
+            }
+        }
+        let e = (se / f64::from(n)).sqrt();
+        assert!((lag * 1e3 - delay_ms).abs() < 0.05, "{k:?}: {lag} s");
+        // the gain to 4 significant digits, the error to 3 decimals; 0.5 kg times it: the force
+        let g = m.accel_noise_gain();
+        assert!((g / gain - 1.0).abs() <= 0.5e-3 * 1.01, "{k:?}: {g:e}");
+        assert!((e - rms).abs() <= 5e-4, "{k:?}: {e} m/s²");
+    }
+}
