@@ -93,6 +93,29 @@ fn run_info_and_verify() {
     assert!(v["report"]["divergence"].is_null());
 }
 
+/// The figures docs/recording-format.md quotes from the golden recordings.
+#[test]
+fn the_golden_recordings_hold_the_figures_the_format_doc_quotes() {
+    let _shared = beside_others();
+    // docs/recording-format.md: "`brickworld.mcap`, which now holds the whole 21.9 s house script"
+    let info = json(&nh(&["info", "recordings/brickworld.mcap", "--json"]));
+    let s = info["duration_s"].as_f64().expect("duration");
+    assert!((21.85..21.95).contains(&s), "{info}"); // 21 932 ticks at 1 kHz
+    // docs/recording-format.md: "`replay` prints what was checked: `checked: 5 chunk CRCs, the
+    // data-section CRC, the summary CRC and the summary against the records, ticks 0–3999 in
+    // sequence and as many as the session record says`"
+    let o = nh(&["replay", "recordings/wall.mcap", "--verify"]);
+    assert!(o.status.success(), "{o:?}");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.lines().any(|l| l.trim()
+            == "checked: 5 chunk CRCs, the data-section CRC, the summary CRC and the summary \
+                against the records, ticks 0–3999 in sequence and as many as the session \
+                record says"),
+        "{out}"
+    );
+}
+
 #[test]
 fn replay_of_a_recording_of_another_scene_version_exits_2_naming_tick_and_channel() {
     let _shared = beside_others();

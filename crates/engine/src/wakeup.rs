@@ -164,6 +164,32 @@ mod tests {
         assert_eq!(with(vec![50_000]).verdict(10_000), Verdict::Holds);
     }
 
+    /// docs/realtime.md's `doctor` example on 4000 wake-ups of 500 µs: real time (max 287.1 µs,
+    /// 3 wake-ups over 50 µs, all 3 over 125 µs) "1 kHz holds", "4 kHz no: ~180.0 late ticks a
+    /// minute", "10 kHz no: ~450.0"; normal priority (139 over 500 µs, 155 over 125 µs, 3988
+    /// over 50 µs) "~2085.0", "~9300.0", "~598200.0": the rule gives the printed rows.
+    #[test]
+    fn the_verdicts_of_the_realtime_doc_example_follow_from_its_wakeups() {
+        let per_minute = |m: &Measurement, hz| match m.verdict(hz) {
+            Verdict::Holds => None,
+            Verdict::Misses { per_minute } => Some((per_minute * 10.0).round() / 10.0),
+        };
+        let mut rt = vec![10_400; 3997];
+        rt.extend([130_000, 200_000, 287_100]);
+        let rt = with(rt);
+        assert_eq!(per_minute(&rt, 1000), None);
+        assert_eq!(per_minute(&rt, 4000), Some(180.0));
+        assert_eq!(per_minute(&rt, 10_000), Some(450.0));
+        let mut normal = vec![40_000; 12];
+        normal.extend(vec![61_800; 3988 - 155]);
+        normal.extend(vec![200_000; 155 - 139]);
+        normal.extend(vec![4_385_200; 139]);
+        let normal = with(normal);
+        assert_eq!(per_minute(&normal, 1000), Some(2085.0));
+        assert_eq!(per_minute(&normal, 4000), Some(9300.0));
+        assert_eq!(per_minute(&normal, 10_000), Some(598_200.0));
+    }
+
     #[test]
     fn bad_interval_and_duration_are_refused_by_name() {
         let e = measure(Duration::from_micros(1), Duration::from_secs(1), None).unwrap_err();

@@ -576,3 +576,34 @@ fn main() -> ExitCode {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// docs/fuzzing.md's table of `--ci` inputs per target is `ci_inputs`, for every target.
+    #[test]
+    fn the_ci_input_counts_are_the_ones_docs_fuzzing_md_lists() {
+        let doc = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../docs/fuzzing.md"
+        ))
+        .expect("docs/fuzzing.md");
+        let mut listed = Vec::new();
+        for line in doc.lines().filter(|l| l.starts_with("| `")) {
+            let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+            for pair in [(1, 2), (4, 5)] {
+                if let (Some(t), Some(n)) = (cells.get(pair.0), cells.get(pair.1)) {
+                    if let Ok(n) = n.replace(' ', "").parse::<u64>() {
+                        listed.push((t.trim_matches('`').to_string(), n));
+                    }
+                }
+            }
+        }
+        let mut want: Vec<(String, u64)> = super::TARGETS
+            .iter()
+            .map(|t| (t.to_string(), super::ci_inputs(t)))
+            .collect();
+        listed.sort();
+        want.sort();
+        assert_eq!(listed, want);
+    }
+}

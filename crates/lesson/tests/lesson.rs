@@ -107,6 +107,54 @@ fn the_lesson_measures_what_it_says() {
             "docs/lesson/lesson.json `{key}` is stale"
         );
     }
+    // BENCHMARKS.md (docs/bench/teaching-game.md), the teaching report's accuracy table, to
+    // its printed digits: "weight of the held brick | 4.930856 N | M g = 4.905000 N | 5.3e-3",
+    // "peak inertial force of the carry | 1.88009 N | M·5.7735·D/T² = 1.60375 N | +17.231 %",
+    // "weight with gravity off ... 2.6e-2 N", "stays ≤ 5.99, thrown ≥ 7.70 m/s² |
+    // hold/(m·scale) = 6.67 m/s²", "brick throw: distance / (speed × flight time) | 0.9716 |
+    // ... | -2.84 %"
+    let near = |x: f64, printed: f64, half_digit: f64| (x - printed).abs() <= half_digit;
+    assert!(
+        near(-s.lift_weight_n[0], 4.930856, 5e-7),
+        "{}",
+        s.lift_weight_n[0]
+    );
+    assert!(near(mg, 4.905, 5e-7));
+    assert!(near((-s.lift_weight_n[0] - mg).abs() / mg, 5.3e-3, 0.5e-4));
+    assert!(near(s.lift_inertia_n[0], 1.88009, 5e-6));
+    assert!(near(s.lift_inertia_predicted_n, 1.60375, 5e-6));
+    assert!(near(100.0 * rel, 17.231, 5e-4), "{rel}");
+    assert!(near(s.lift_weight_n[1].abs(), 2.6e-2, 0.05e-2));
+    assert!(near(sw.kept_below_m_per_s2, 5.99, 0.005));
+    assert!(near(sw.thrown_from_m_per_s2, 7.70, 0.005));
+    assert!(near(sw.predicted_hand_m_per_s2, 6.67, 0.005));
+    let ratio = t.distance_m / (t.release_speed_m_per_s * t.flight_s);
+    assert!(near(ratio, 0.9716, 5e-5), "{ratio}");
+    assert!(near(100.0 * (ratio - 1.0), -2.84, 0.005));
+    // BENCHMARKS.md: "16 sessions (two house tasks, three lifts, two approach–retract cycles,
+    // two throws, seven heavy-atom throws), 8 figures ..., 2 recordings, 2 WAV files" (the
+    // progress counts each session and then the report; the report said 17 sessions)
+    assert_eq!(calls.len(), 16 + 1, "{calls:?}");
+    let runs = |prefix: &str| calls.iter().filter(|c| c.2.starts_with(prefix)).count();
+    assert_eq!(
+        [
+            runs("macro_house") + runs("nano_house"),
+            runs("lift"),
+            runs("approach_retract"),
+            runs("brick_throw") + runs("atom_throw"),
+            runs("heavy_atom_throw"),
+        ],
+        [2, 3, 2, 2, 7]
+    );
+    assert_eq!(sw.runs.len(), 7);
+    assert_eq!(s.files.iter().filter(|f| f.ends_with(".png")).count(), 8);
+    let count = |ext: &str| {
+        std::fs::read_dir(&out)
+            .unwrap()
+            .filter(|e| e.as_ref().unwrap().path().extension() == Some(ext.as_ref()))
+            .count()
+    };
+    assert_eq!((count("mcap"), count("wav")), (2, 2));
     // The house sessions replay bit for bit.
     let rec = recording::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());

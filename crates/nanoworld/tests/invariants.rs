@@ -153,3 +153,33 @@ proptest! {
         }
     }
 }
+
+/// BENCHMARKS.md's nanoworld table (its report's 50 probes on the hover circle: radius 1 nm,
+/// 0.25 nm gap, over the substrate centre): atoms in range 24 / 24 / 22 / 24 and the activation
+/// cutoff's largest difference from the untruncated 1/z² sum 0.643 / 0.656 / 0.659 / 0.660 at
+/// 1024 / 10000 / 100489 / 1000000 substrate atoms; the cell list's error 0.
+#[test]
+fn the_benchmarks_substrate_table_at_four_sizes() {
+    for (n, in_range, cutoff) in [
+        (32, 24, 0.643),
+        (100, 24, 0.656),
+        (317, 22, 0.659),
+        (1000, 24, 0.660),
+    ] {
+        let p = bare(Params::game_default(), n);
+        let c = n as f64 * p.substrate.spacing_m / 2.0;
+        let z = p.substrate.atom_radius_m + p.tip.radius_m + 0.25e-9;
+        let w = World::new(&p, &p.default_limits(), Vector3::new(c + 1e-9, c, z)).expect("valid");
+        let (mut most, mut worst) = (0, 0.0f64);
+        for k in (0..20_000).step_by(400) {
+            let t = k as f64 / 997.0 * std::f64::consts::TAU;
+            let tip = Vector3::new(c + 1e-9 * t.cos(), c + 1e-9 * t.sin(), z);
+            let f = w.substrate_force_check(tip).expect("game mode");
+            assert_eq!(f.cell_list_n, f.brute_force_n, "{n}² atoms");
+            most = most.max(f.atoms_in_range);
+            worst = worst.max((f.cell_list_n - f.untruncated_n).norm() / f.untruncated_n.norm());
+        }
+        assert_eq!(most, in_range, "{n}² atoms");
+        assert!((worst - cutoff).abs() <= 5e-4, "{n}² atoms: {worst}");
+    }
+}

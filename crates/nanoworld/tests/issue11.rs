@@ -314,6 +314,27 @@ fn an_atom_is_thrown_off_exactly_above_the_pull_off_load() {
         assert_eq!(thrown, leaves, "factor {factor}");
         assert_eq!(w.carried().is_empty(), leaves);
     }
+    // docs/lesson.md: "For the built-in atom (10⁻²⁵ kg, held with 3 nN) the threshold is
+    // 3·10¹⁶ m/s² in the world, 2·10²³ m/s² of hand acceleration at the scene's 1 mm =
+    // 0.15 nm" (the hold above is the one the throw-off was just tested at).
+    let (hold, m) = (10.0 * 0.3e-9, Params::game_default().atoms.mass_kg);
+    assert_eq!(m, 1e-25);
+    let scene = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/nanoworld.toml"
+    ))
+    .expect("scenes/nanoworld.toml");
+    assert!(
+        scene
+            .lines()
+            .any(|l| l.trim() == "workspace_scale = 1.5e-7")
+    );
+    let world = hold / m;
+    assert!((world / 3e16 - 1.0).abs() < 1e-12, "{world:e} m/s²");
+    assert!(
+        (world / 1.5e-7 / 2e23 - 1.0).abs() < 1e-12,
+        "{world:e} m/s²"
+    );
 }
 
 /// Item 15: the force at a position can be queried without stepping; it equals what a free

@@ -197,3 +197,92 @@ fn damped_particle_with_external_force_matches_brute_force() {
         "outside {outside} nm, overreach {over} nm"
     );
 }
+
+/// BENCHMARKS.md (docs/bench/ot-envelope.md), the paper's 961-envelope cache: "All 961
+/// envelopes (RK4 × 4 at Δt = 0.2 µs: ωh ≈ 0.2): ... 81284 polygon vertices in total (1.3 MB
+/// as f64 pairs) ... Error of the v0 = (80, −80) nm/µs envelope vs converged: 0.078 nm" (the
+/// report's computation; its time is the benchmark's).
+#[test]
+fn the_paper_cache_of_961_envelopes_has_the_benchmarks_vertices_and_error() {
+    let m = paper_model([600e-9, 300e-9]);
+    let p02 = ot_physics::Propagator::new(m, ot_physics::Method::Rk4 { substeps: 4 }, 0.2e-6)
+        .expect("tick map");
+    let (mut verts, mut corner) = (0usize, None);
+    for i in 0..31 {
+        for j in 0..31 {
+            let v0 = v(
+                -0.08 + 0.16 * i as f64 / 30.0,
+                -0.08 + 0.16 * j as f64 / 30.0,
+            );
+            let we = working_envelope(&p02, &v0, None).expect("envelope");
+            verts += we.polygon.len();
+            if (i, j) == (30, 0) {
+                corner = Some(we);
+            }
+        }
+    }
+    assert_eq!(verts, 81_284);
+    assert!((1.25..1.35).contains(&(verts as f64 * 16.0 / 1e6)));
+    let we = corner.expect("the (80, −80) nm/µs envelope");
+    let conv = ot_physics::Propagator::new(m, ot_physics::Method::Adaptive { rtol: 1e-10 }, 0.2e-6)
+        .expect("converged");
+    let r = Reference::sample(&conv, &we.v0, &we.region, 700).expect("sampling");
+    let e = r
+        .errors(&conv, &we.polygon, 1.0 * NM)
+        .expect("errors")
+        .hausdorff();
+    eprintln!(
+        "961 envelopes, {verts} vertices; (80, −80) nm/µs: {:.4} nm",
+        e / NM
+    );
+    assert!((0.0775..0.0785).contains(&(e / NM)), "{} nm", e / NM);
+}
+
+/// BENCHMARKS.md (docs/bench/ot-envelope.md), paper constants at Δt = 1 µs against DOP853 at
+/// rtol 1e-10: "Tick-map accuracy (max displacement error over 41×41 offsets within ±3
+/// waists)": paper-rk4 337.361, rk4 × 4 5.538, rk4 × 8 0.205, rk4 × 16 0.012 nm; "Working
+/// envelope": (0, 0) 336 vertices, 11440 force evaluations, outside 0.266, overreach 0.000 nm;
+/// (100, 100) 335, 12864, 0.314, 0.002 nm (a 900×900 sampling, as the report).
+#[test]
+fn the_benchmarks_tick_map_and_envelope_table() {
+    use ot_physics::{Method, Propagator};
+    let m = paper_model([600e-9, 300e-9]);
+    let conv = Propagator::new(m, Method::Adaptive { rtol: 1e-10 }, 1e-6).unwrap();
+    for (meth, doc) in [
+        (Method::PaperRk4, 337.361),
+        (Method::Rk4 { substeps: 4 }, 5.538),
+        (Method::Rk4 { substeps: 8 }, 0.205),
+        (Method::Rk4 { substeps: 16 }, 0.012),
+    ] {
+        let p = Propagator::new(m, meth, 1e-6).unwrap();
+        let mut err: f64 = 0.0;
+        for i in -20..=20 {
+            for j in -20..=20 {
+                let o = v(i as f64 * 90e-9, j as f64 * 45e-9);
+                let (a, b) = (
+                    p.flow(&o, &v(0.0, 0.0)).unwrap(),
+                    conv.flow(&o, &v(0.0, 0.0)).unwrap(),
+                );
+                err = err.max((a.0 - b.0).norm());
+            }
+        }
+        assert!((err / NM - doc).abs() <= 5e-4, "{meth:?}: {} nm", err / NM);
+    }
+    let fast = paper();
+    for (v0, doc) in [
+        (v(0.0, 0.0), (336, 11440, 0.266, 0.000)),
+        (v(0.1, 0.1), (335, 12864, 0.314, 0.002)),
+    ] {
+        let we = working_envelope(&fast, &v0, None).unwrap();
+        assert_eq!((we.polygon.len(), we.evals), (doc.0, doc.1), "{v0:?}");
+        let r = Reference::sample(&conv, &v0, &we.region, 900).unwrap();
+        let e = r.errors(&conv, &we.polygon, 2.0 * NM).unwrap();
+        eprintln!(
+            "{v0:?}: outside {:.4} nm, overreach {:.4} nm",
+            e.outside / NM,
+            e.overreach / NM
+        );
+        assert!((e.outside / NM - doc.2).abs() <= 5e-4, "{v0:?}: {e:?}");
+        assert!((e.overreach / NM - doc.3).abs() <= 5e-4, "{v0:?}: {e:?}");
+    }
+}

@@ -312,3 +312,38 @@ fn solve_trap_answers_reproduce_the_target_under_converged_dynamics() {
     assert!(worst_old > 1e-11, "{worst_old:e}");
     assert!(worst_new <= 1e-11, "{worst_new:e}");
 }
+
+/// BENCHMARKS.md (docs/bench/ot-envelope.md), "Inverse solve (paper constants, v0 = (100, 100)
+/// nm/µs)": "900 targets on a 30×30 grid over the envelope's bounding box ... Solution counts
+/// 0/1/2/3/4+: 203/0/697/0/0. Solvable ⇔ inside the envelope for all 893 targets farther than
+/// 2 nm from its boundary: 0 mismatches" (the report's grid; its times are the benchmark's).
+#[test]
+fn the_benchmarks_inverse_solve_grid_counts() {
+    let fast = prop([600e-9, 300e-9], 8, 1e-6);
+    let v0 = v(0.1, 0.1);
+    let we = working_envelope(&fast, &v0, None).unwrap();
+    let solver = TrapSolver::new(&fast, &v0, Some(we.region), None).unwrap();
+    let (mut lo, mut hi) = (we.polygon[0], we.polygon[0]);
+    for q in &we.polygon {
+        lo = lo.inf(q);
+        hi = hi.sup(q);
+    }
+    let (mut n_sol, mut checked, mut mismatch) = ([0usize; 5], 0, 0);
+    let k = 30;
+    for a in 0..k {
+        for b in 0..k {
+            let t = lo
+                + (hi - lo).component_mul(&Vector2::new(
+                    (a as f64 + 0.5) / k as f64,
+                    (b as f64 + 0.5) / k as f64,
+                ));
+            let (sol, _) = solver.solve(&t).unwrap();
+            n_sol[sol.offsets().len().min(4)] += 1;
+            if nearest_on_boundary(&we.polygon, &t).1 > 2.0 * NM {
+                checked += 1;
+                mismatch += usize::from(we.contains(&t) == sol.offsets().is_empty());
+            }
+        }
+    }
+    assert_eq!((n_sol, checked, mismatch), ([203, 0, 697, 0, 0], 893, 0));
+}

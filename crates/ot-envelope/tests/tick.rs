@@ -92,6 +92,11 @@ fn warm_envelope_stays_within_a_tenth_of_a_nanometre_of_converged_dynamics() {
     assert!(checked >= 10);
     // issue 13's target: ≤ 0.1 nm from converged dynamics at every tick
     assert!(worst <= 0.1e-9, "{worst:e} m");
+    // BENCHMARKS.md (docs/bench/ot-tick.md): "Tests: warm envelopes within 0.081 nm of
+    // converged dynamics over two drags (`ot-envelope/tests/tick.rs`)" (measured 0.0808 nm at
+    // 20 ticks)
+    assert_eq!(checked, 20);
+    assert!((0.0805e-9..0.0815e-9).contains(&worst), "{worst:e} m");
     assert!(st.rebuilds * 4 < st.ticks, "{st:?}");
 }
 
@@ -215,6 +220,7 @@ fn a_velocity_jump_fails_the_fold_check_and_rebuilds() {
         )
         .unwrap();
         let h = hausdorff(c.envelope(), &reference.polygon, 0.05e-9);
+        eprintln!("dv {dv} m/s: {:.4} nm", h * 1e9);
         assert!(h <= 0.1e-9, "dv {dv}: {h:e} m");
     }
 }

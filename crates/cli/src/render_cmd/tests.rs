@@ -110,6 +110,32 @@ fn golden_recording_becomes_frames_and_a_gif() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// docs/render.md's example of what `render` says it wrote: "`wrote GIF animation wall.gif
+/// (122 frames, 350967 bytes)`" (`nanohaptics render recordings/wall.mcap --out wall.gif`,
+/// the defaults: every 33 ticks at 1 kHz, 640 px).
+#[test]
+fn the_wall_gif_is_the_one_the_render_doc_quotes() {
+    let dir = std::env::temp_dir().join(format!("nanohaptics-render-doc-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let gif = dir.join("wall.gif");
+    let s = run(&RenderArgs {
+        out: Some(gif.clone()),
+        audio: None,
+        ..audio_args("recordings/wall.mcap", &gif, false)
+    })
+    .expect("gif");
+    eprintln!("{:?}", s.written);
+    assert_eq!(
+        s.written,
+        [format!(
+            "GIF animation {} (122 frames, 350967 bytes)",
+            gif.display()
+        )]
+    );
+    assert_eq!(std::fs::metadata(&gif).expect("gif").len(), 350_967);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn optical_tweezers_frames_from_the_recorded_state_equal_the_recomputed_ones() {
     let dir = std::env::temp_dir().join(format!("nanohaptics-render-ot-{}", std::process::id()));
@@ -226,7 +252,7 @@ fn the_wav_has_a_sound_on_each_recorded_impact() {
         .tick
         .len();
     assert_eq!(x.len(), (ticks as f64 / 1000.0 * sr).round() as usize);
-    let mut checked = 0;
+    let (mut checked, mut worst, mut worst_report) = (0, 0.0f64, 0.0f64);
     for (t, _) in &hits {
         // Impacts with nothing sounding in the 150 ms before (a thud rings ~100 ms).
         if hits.iter().any(|(u, _)| u < t && t - u < 0.15) {
@@ -237,12 +263,42 @@ fn the_wav_has_a_sound_on_each_recorded_impact() {
             (onset - t).abs() <= 1e-3,
             "onset {onset} s for an impact at {t} s"
         );
+        worst = worst.max((onset - t).abs());
+        // the teaching report's measure (BENCHMARKS.md): its window starts 44 samples (1 ms)
+        // before the tick's sample, and the onset is the window's first sample at 10 % of its
+        // peak
+        let k = (t * sr).round() as usize;
+        let lo = k - (0.001 * sr) as usize;
+        let win = &x[lo..(k + (0.025 * sr) as usize).min(x.len())];
+        let top = win.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let first = win
+            .iter()
+            .position(|v| v.abs() >= 0.1 * top)
+            .expect("onset");
+        worst_report = worst_report.max(((lo + first) as f64 / sr - t).abs());
         // Audible: the gentlest isolated impact of the golden session (the first brick set
         // down in its slot) sounds at 0.089 of full scale.
         assert!(peak > 0.05, "impact at {t} s: peak {peak}");
         checked += 1;
     }
     assert!(checked >= 4, "{checked} isolated impacts");
+    eprintln!(
+        "{checked} isolated impacts, worst onset {:.4} ms (the report's measure {:.4} ms)",
+        worst * 1e3,
+        worst_report * 1e3
+    );
+    // BENCHMARKS.md: "on the golden brick recording, the 5 impacts with silence before them
+    // start within **0.283 ms** of their tick"; docs/render.md: "measured there: the first
+    // sample at 10 % of each sound's peak within 0.3 ms of its tick (0.27 ms)"
+    assert_eq!(checked, 5, "isolated impacts");
+    assert!(
+        (0.2695e-3..0.2705e-3).contains(&worst),
+        "worst onset {worst} s"
+    );
+    assert!(
+        (0.2825e-3..0.2835e-3).contains(&worst_report),
+        "worst onset {worst_report} s"
+    );
     assert!(x.iter().all(|v| v.abs() <= 0.98 + 1e-4));
     std::fs::remove_file(&wav).ok();
 }
@@ -289,6 +345,14 @@ fn a_brick_dropped_from_higher_sounds_louder() {
         let (onset, peak) = onset_and_peak(&x, sr, t);
         assert!((onset - t).abs() <= 1e-3);
         level.push((j, peak));
+    }
+    eprintln!("(impulse N·s, peak) for drops from 0, 6, 15 mm: {level:?}");
+    // docs/render.md: "bricks let go from 0, 6 and 15 mm of stylus height (0.12 m apart in the
+    // world) land with impulses 0.97, 1.34 and 1.75 N·s, and their sounds peak at 0.50, 0.59
+    // and 0.66 in the WAV" (to the printed digits)
+    for ((j, p), (jd, pd)) in level.iter().zip([(0.97, 0.50), (1.34, 0.59), (1.75, 0.66)]) {
+        assert!((j - jd).abs() <= 0.005, "impulse {j} N·s, doc {jd}");
+        assert!((p - pd).abs() <= 0.005, "peak {p}, doc {pd}");
     }
     for w in level.windows(2) {
         assert!(w[1].0 > w[0].0 * 1.2, "impulses {level:?}");
