@@ -32,6 +32,11 @@ pub(crate) struct RunArgs {
     /// its hello; always real time; see docs/device-bridge.md).
     #[arg(long)]
     device: Option<String>,
+    /// Which button plays which role, overriding the device's preset or the default by index:
+    /// `grip=a,turn_z=b` (roles: grip, turn_x, turn_y, turn_z; docs/devices.md). Recorded as
+    /// the scene's `[device] buttons`, so a replay maps them the same.
+    #[arg(long)]
+    buttons: Option<String>,
     /// Serve a live Foxglove view at `ws:HOST:PORT` while the session runs (open
     /// ws://HOST:PORT in Foxglove; layout in docs/foxglove/).
     #[arg(long)]
@@ -56,6 +61,14 @@ pub(crate) struct RunArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
+}
+
+/// The scene `text` with `--buttons ROLE=BUTTON,...` set as its `[device] buttons` (each role
+/// name checked; each button is checked against the device when the session starts).
+pub(crate) fn with_buttons(text: &str, buttons: &str) -> Result<String, String> {
+    let pairs = haptic_types::buttons::parse_overrides(buttons).map_err(|e| e.to_string())?;
+    haptic_loop::scene::overrides::override_buttons(text, &pairs)
+        .map_err(|e| format!("--buttons: {e}"))
 }
 
 /// `--operator`: the one operator parser, shared with the wheel.
@@ -206,6 +219,7 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
         script,
         operator,
         device,
+        buttons,
         live,
         live_hz,
         wait_s,
@@ -215,7 +229,11 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
         rt,
         json,
     } = args;
-    let mut opts = SessionOptions::new(SceneSource::resolve(&scene).map_err(|e| e.to_string())?);
+    let mut source = SceneSource::resolve(&scene).map_err(|e| e.to_string())?;
+    if let Some(b) = buttons.as_deref() {
+        source.text = with_buttons(&source.text, b)?;
+    }
+    let mut opts = SessionOptions::new(source);
     opts.operator = parse_operator(&operator)?;
     if let Some(d) = device.as_deref() {
         let mut d = DeviceSource::parse(d).map_err(|e| format!("--device: {e}"))?;
