@@ -123,7 +123,18 @@ pub(crate) fn summary_json(r: &SessionReport) -> serde_json::Value {
         "live": r.live,
         "sinks": r.sinks,
         "house_score": house_score(t),
+        "buttons": buttons_in_force(r),
     })
+}
+
+/// The button roles the session ran with, as people read them (`grip = centre, turn_x = plus,
+/// … (the falcon preset)`): the recorded device's buttons and the recorded scene's overrides.
+fn buttons_in_force(r: &SessionReport) -> String {
+    let d = &r.header.device;
+    match haptic_loop::scene::device::roles_in(&r.header.scene_toml, d) {
+        Ok(roles) => roles.describe(&d.button_strs()),
+        Err(e) => e.to_string(),
+    }
 }
 
 pub(crate) fn print_summary(r: &SessionReport) {
@@ -133,6 +144,7 @@ pub(crate) fn print_summary(r: &SessionReport) {
         "{} ({}, {} device, {} operator)",
         r.header.scene_name, r.header.mode, r.header.device.name, r.header.operator
     );
+    println!("  buttons: {}", buttons_in_force(r));
     println!(
         "  {} ticks ({:.3} s), peak force {:.3} N, {} clamped ticks, {} events",
         s.ticks,
