@@ -73,6 +73,31 @@ fn every_builtin_script_runs_on_every_preset_locally() {
     }
 }
 
+/// Each built-in script, by role, on each preset's own buttons over the bridge: `fake-device`
+/// as the modelled preset (protocol 2, a firm hand), 1 s of each scene, welcomed with the
+/// preset's roles; the session runs to the device's bye.
+#[test]
+fn every_builtin_script_runs_on_every_preset_over_the_bridge() {
+    let _serial = serial();
+    for (scene, script) in BUILTIN {
+        for mech in PRESETS {
+            let addr = free_port();
+            let mut dev = brick_device(addr, Some(mech), None);
+            let specs = fake_specs(&dev, None);
+            dev.script = Script::from_toml(&read(script), &specs).unwrap();
+            dev.seconds = Some(1.0);
+            let roles = haptic_types::ButtonRoles::resolve(&specs, &[]).unwrap();
+            let mut o = bridged(read(scene), addr, &out("every.mcap"));
+            o.out = None;
+            let (r, f) = session_with(o, move || run_fake_as(&dev, None, None).unwrap());
+            let who = format!("{scene} on {}", mech.name);
+            assert_eq!(f.welcome.roles, Some(roles.wire()), "{who}");
+            assert_eq!(r.end, "device_ended", "{who}");
+            assert!(f.replies > 500, "{who}: {} replies", f.replies);
+        }
+    }
+}
+
 /// The brick world's script on a local Touch: button1 grips, the first brick is carried to its
 /// slot (before issue 41 the script was refused by button name).
 #[test]
