@@ -198,8 +198,19 @@ fn haply_touch_and_delta3_hellos_build_in_the_brick_world_over_the_bridge() {
         );
         assert_eq!(f.welcome.roles, Some(roles), "{who}");
         assert_placed(&r, who);
-        let v = verify(&read_recording_file(&rec, false).unwrap()).unwrap();
+        let rec = read_recording_file(&rec, false).unwrap();
+        let v = verify(&rec).unwrap();
         assert!(v.ok(), "{who}: {:?}", v.divergence);
+        // The recording states the mapping in force (its metadata record `buttons`).
+        let grip = if who == "haply" {
+            "a"
+        } else if who == "touch" {
+            "button1"
+        } else {
+            "button0"
+        };
+        assert_eq!(rec.metadata["buttons"]["grip"], grip, "{who}");
+        assert!(rec.metadata["buttons"]["mapping"].starts_with(&format!("grip = {grip},")));
     }
 }
 
