@@ -134,7 +134,7 @@ def test_a_version_2_force_packet_has_its_documented_layout():
     assert bridge.encode_hello(specs)[4] == 1 and bridge.encode_hello(specs, version=2)[4] == 2
     kind, welcome = bridge.decode(bridge.encode_welcome(1000, 17, "wall", version=2))
     assert kind == "welcome" and welcome == {"version": 2, "rate_hz": 1000, "start_time_ns": 17,
-                                             "scene": "wall"}
+                                             "scene": "wall", "roles": None}
     kind, hello = bridge.decode(bridge.encode_hello(specs, version=2))
     assert kind == "hello" and hello["version"] == 2 and hello["specs"] == specs
     assert bridge.encode_sample(0, 0, (0.0, 0.0, 0.0), 0)[4] == 1 and bridge.encode_bye()[4] == 1

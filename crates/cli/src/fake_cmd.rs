@@ -3,13 +3,13 @@
 
 use crate::run_cmd::parse_operator;
 use crate::status;
-use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
+use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake_as};
 use haptic_devices::local::Protocol;
 use haptic_devices::source::DeviceSource;
 use haptic_devices::source::OperatorChoice;
 use haptic_devices::{Grip, Mechanics, Script};
-use haptic_types::DeviceModel;
 use haptic_types::value::{ValueError, out_of_range};
+use haptic_types::{DeviceModel, DeviceSpecs};
 use std::path::PathBuf;
 use world_form::fmt_num;
 
@@ -62,6 +62,10 @@ pub(crate) struct FakeArgs {
     /// How long to wait for the simulator's welcome, s.
     #[arg(long, default_value_t = 30.0)]
     wait_s: f64,
+    /// Announce these button names in the hello instead of the model's, comma-separated
+    /// (`--button-names a,b,c`: a device the simulator maps by index; docs/devices.md).
+    #[arg(long)]
+    button_names: Option<String>,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -71,11 +75,11 @@ pub(crate) struct FakeArgs {
 const FAKE_SCRIPT: &str = include_str!("../../../scenes/wall.script.toml");
 
 pub(crate) fn cmd(a: FakeArgs) -> Result<u8, String> {
-    let (cfg, physical) = config(&a)?;
+    let (cfg, physical, names) = config(&a)?;
     if !a.json {
         eprintln!("fake-device: saying hello to {} ...", cfg.target);
     }
-    let r = run_fake(&cfg, None).map_err(|e| e.to_string())?;
+    let r = run_fake_as(&cfg, names.as_deref(), None).map_err(|e| e.to_string())?;
     if a.json {
         println!("{}", serde_json::json!(r));
     } else {
@@ -133,8 +137,9 @@ fn physical(a: &FakeArgs) -> Result<Option<(Mechanics, Grip)>, String> {
     }))
 }
 
-/// The script the stylus plays (`--script`, or the built-in wall press), errors located.
-fn script(a: &FakeArgs, model: DeviceModel) -> Result<Script, String> {
+/// The script the stylus plays (`--script`, or the built-in wall press) on a device with
+/// `specs` (its button events by role or by that device's button names), errors located.
+fn script(a: &FakeArgs, specs: &DeviceSpecs) -> Result<Script, String> {
     let (text, origin) = match &a.script {
         Some(p) => (
             haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?,
@@ -145,7 +150,7 @@ fn script(a: &FakeArgs, model: DeviceModel) -> Result<Script, String> {
             "built-in fake-device script".into(),
         ),
     };
-    Script::from_toml(&text, model.specs()).map_err(|e| {
+    Script::from_toml(&text, specs).map_err(|e| {
         let at = haptic_types::textpos::Location {
             file: origin,
             at: e.position(&text),
@@ -154,8 +159,37 @@ fn script(a: &FakeArgs, model: DeviceModel) -> Result<Script, String> {
     })
 }
 
+/// The button names of `--button-names`, each checked as a hello checks them.
+fn button_names(a: &FakeArgs) -> Result<Option<Vec<String>>, String> {
+    let Some(list) = &a.button_names else {
+        return Ok(None);
+    };
+    let names: Vec<String> = list
+        .split(',')
+        .map(|b| b.trim().to_string())
+        .filter(|b| !b.is_empty())
+        .collect();
+    let specs = DeviceSpecs {
+        button_names: names
+            .iter()
+            .cloned()
+            .map(std::borrow::Cow::Owned)
+            .collect::<Vec<_>>()
+            .into(),
+        ..haptic_types::device::FALCON
+    };
+    specs
+        .validate()
+        .map_err(|e| format!("--button-names: {e}"))?;
+    Ok(Some(names))
+}
+
+/// The fake device's configuration from its flags, every value checked, with the button names
+/// it announces instead of its model's (`--button-names`).
+type Config = (FakeConfig, Option<(Mechanics, Grip)>, Option<Vec<String>>);
+
 /// The fake device's configuration from its flags, every value checked.
-fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), String> {
+fn config(a: &FakeArgs) -> Result<Config, String> {
     let target = match DeviceSource::parse(&a.target) {
         Ok(DeviceSource::Udp(b)) => b.bind,
         Ok(DeviceSource::Model(m)) => {
@@ -174,18 +208,27 @@ fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), Strin
         p => return Err(out_of_range("--protocol", p, "1 or 2")),
     };
     let physical = physical(a)?;
-    // Scripts name the buttons of the device they were written for: a Falcon's, or a Touch's.
-    // A modelled device plays a script written for the other with that device's buttons (a
-    // Touch's mechanics, a Falcon's four buttons), as the closed-loop tests do: every built-in
-    // scene's script is written for a Falcon.
-    let mut model = DeviceModel::from_name(&a.model).unwrap_or(DeviceModel::Falcon);
-    let script = match script(a, model) {
-        Err(e) if physical.is_some() && e.contains("has no button") => {
-            model = DeviceModel::Falcon;
-            script(a, model).map_err(|_| e)?
-        }
-        other => other?,
+    // Every device announces its own buttons (a modelled preset its preset's); the built-in
+    // scripts bind their events by role, so each plays on every preset.
+    let model = DeviceModel::from_name(&a.model).unwrap_or(DeviceModel::Falcon);
+    let names = button_names(a)?;
+    let base = match &physical {
+        Some((mech, _)) => haptic_devices::modelled::preset_specs(mech),
+        None => model.specs().clone(),
     };
+    let specs = match &names {
+        Some(n) => DeviceSpecs {
+            button_names: n
+                .iter()
+                .cloned()
+                .map(std::borrow::Cow::Owned)
+                .collect::<Vec<_>>()
+                .into(),
+            ..base
+        },
+        None => base,
+    };
+    let script = script(a, &specs)?;
     let hand = match parse_operator(&a.operator)? {
         OperatorChoice::Rigid => None,
         OperatorChoice::Hand(p) => Some(p),
@@ -215,7 +258,7 @@ fn config(a: &FakeArgs) -> Result<(FakeConfig, Option<(Mechanics, Grip)>), Strin
         bye: true,
         protocol,
     };
-    Ok((cfg, physical))
+    Ok((cfg, physical, names))
 }
 
 /// The report as text: periods, samples, round trips, forces and the work done on the hand.

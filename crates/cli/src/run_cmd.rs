@@ -32,6 +32,11 @@ pub(crate) struct RunArgs {
     /// its hello; always real time; see docs/device-bridge.md).
     #[arg(long)]
     device: Option<String>,
+    /// Which button plays which role, overriding the device's preset or the default by index:
+    /// `grip=a,turn_z=b` (roles: grip, turn_x, turn_y, turn_z; docs/devices.md). Recorded as
+    /// the scene's `[device] buttons`, so a replay maps them the same.
+    #[arg(long)]
+    buttons: Option<String>,
     /// Serve a live Foxglove view at `ws:HOST:PORT` while the session runs (open
     /// ws://HOST:PORT in Foxglove; layout in docs/foxglove/).
     #[arg(long)]
@@ -56,6 +61,14 @@ pub(crate) struct RunArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
+}
+
+/// The scene `text` with `--buttons ROLE=BUTTON,...` set as its `[device] buttons` (each role
+/// name checked; each button is checked against the device when the session starts).
+pub(crate) fn with_buttons(text: &str, buttons: &str) -> Result<String, String> {
+    let pairs = haptic_types::buttons::parse_overrides(buttons).map_err(|e| e.to_string())?;
+    haptic_loop::scene::overrides::override_buttons(text, &pairs)
+        .map_err(|e| format!("--buttons: {e}"))
 }
 
 /// `--operator`: the one operator parser, shared with the wheel.
@@ -110,7 +123,18 @@ pub(crate) fn summary_json(r: &SessionReport) -> serde_json::Value {
         "live": r.live,
         "sinks": r.sinks,
         "house_score": house_score(t),
+        "buttons": buttons_in_force(r),
     })
+}
+
+/// The button roles the session ran with, as people read them (`grip = centre, turn_x = plus,
+/// … (the falcon preset)`): the recorded device's buttons and the recorded scene's overrides.
+fn buttons_in_force(r: &SessionReport) -> String {
+    let d = &r.header.device;
+    match haptic_loop::scene::device::roles_in(&r.header.scene_toml, d) {
+        Ok(roles) => roles.describe(&d.button_strs()),
+        Err(e) => e.to_string(),
+    }
 }
 
 pub(crate) fn print_summary(r: &SessionReport) {
@@ -120,6 +144,7 @@ pub(crate) fn print_summary(r: &SessionReport) {
         "{} ({}, {} device, {} operator)",
         r.header.scene_name, r.header.mode, r.header.device.name, r.header.operator
     );
+    println!("  buttons: {}", buttons_in_force(r));
     println!(
         "  {} ticks ({:.3} s), peak force {:.3} N, {} clamped ticks, {} events",
         s.ticks,
@@ -206,6 +231,7 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
         script,
         operator,
         device,
+        buttons,
         live,
         live_hz,
         wait_s,
@@ -215,7 +241,11 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
         rt,
         json,
     } = args;
-    let mut opts = SessionOptions::new(SceneSource::resolve(&scene).map_err(|e| e.to_string())?);
+    let mut source = SceneSource::resolve(&scene).map_err(|e| e.to_string())?;
+    if let Some(b) = buttons.as_deref() {
+        source.text = with_buttons(&source.text, b)?;
+    }
+    let mut opts = SessionOptions::new(source);
     opts.operator = parse_operator(&operator)?;
     if let Some(d) = device.as_deref() {
         let mut d = DeviceSource::parse(d).map_err(|e| format!("--device: {e}"))?;

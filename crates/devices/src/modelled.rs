@@ -49,6 +49,20 @@ impl ModelledDevice {
     }
 }
 
+/// Device specifications for a modelled preset: its name, limits and workspace, and its own
+/// buttons (`haptic_types::buttons::BUTTON_PRESETS`; none for a device that is not a preset).
+pub fn preset_specs(mech: &Mechanics) -> DeviceSpecs {
+    let buttons: Vec<Cow<'static, str>> = haptic_types::buttons::button_preset(mech.name)
+        .map(|p| p.buttons.iter().map(|b| Cow::Borrowed(b.0)).collect())
+        .unwrap_or_default();
+    DeviceSpecs {
+        name: Cow::Borrowed(mech.name),
+        limits: mech.limits,
+        workspace_radius_m: mech.workspace_radius_m,
+        button_names: Cow::Owned(buttons),
+    }
+}
+
 /// Device specifications for a modelled device: its name, limits and workspace, and the
 /// buttons of `buttons_of`.
 pub fn specs_of(mech: &Mechanics, buttons_of: &DeviceSpecs) -> DeviceSpecs {

@@ -21,8 +21,9 @@
 //!
 //! [[button]]
 //! t_s = 1.0
-//! name = "centre"
-//! down = true
+//! role = "grip"               # a role (grip, turn_x, turn_y, turn_z), played by whichever
+//! down = true                 # button the device maps to it; or `name = "centre"`, a button
+//!                             # of the device by its own name
 //!
 //! [[switch]]                  # optional: the teaching game's menu, at a time
 //! t_s = 2.0
@@ -34,6 +35,7 @@ use haptic_types::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice, TickTime,
 };
 use haptic_types::vec3::{self, Vec3};
+use haptic_types::{ButtonRoles, Role};
 use serde::{Deserialize, Serialize};
 use world_form::{ValueError, fmt_num};
 
@@ -66,6 +68,10 @@ pub enum ScriptError {
         /// What the scene allows.
         source: haptic_types::switch::SwitchError,
     },
+    /// A button event's role out of range, or an event with both or neither of `name` and
+    /// `role` (the error names the field).
+    #[error("script: {0}")]
+    Role(DeviceError),
     /// A button the device does not have.
     #[error("script: `{field}`: {source}")]
     Button {
@@ -88,6 +94,8 @@ impl ScriptError {
                 field_position(text, field)
             }
             ScriptError::NoWaypoints => field_position(text, "script"),
+            ScriptError::Role(DeviceError::Buttons { field, .. }) => field_position(text, field),
+            ScriptError::Role(_) => None,
             ScriptError::Parse(_) => None,
         }
     }
@@ -140,7 +148,10 @@ struct WaypointFile {
 #[serde(deny_unknown_fields)]
 struct ButtonFile {
     t_s: f64,
-    name: String,
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    role: Option<String>,
     down: bool,
 }
 
@@ -273,17 +284,44 @@ fn waypoints(file: &[WaypointFile], specs: &DeviceSpecs) -> Result<Vec<Waypoint>
     Ok(waypoints)
 }
 
-/// The `[[button]]` events, by time: each a button the device has.
-fn buttons(file: &[ButtonFile], specs: &DeviceSpecs) -> Result<Vec<ButtonEvent>, ScriptError> {
+/// The `[[button]]` events, by time: each a button the device has, by its name or by the role
+/// it plays in `roles`. An event for a role no button of the device plays is left out (the
+/// device cannot press it; the script still runs).
+fn buttons(
+    file: &[ButtonFile],
+    specs: &DeviceSpecs,
+    roles: &ButtonRoles,
+) -> Result<Vec<ButtonEvent>, ScriptError> {
     let mut buttons = Vec::with_capacity(file.len());
     for (i, b) in file.iter().enumerate() {
         check_time(format!("button[{i}].t_s"), b.t_s)?;
-        let index = specs
-            .button_index(&b.name)
-            .map_err(|source| ScriptError::Button {
-                field: format!("button[{i}].name"),
-                source,
-            })?;
+        let index = match (&b.name, &b.role) {
+            (Some(name), None) => {
+                specs
+                    .button_index(name)
+                    .map_err(|source| ScriptError::Button {
+                        field: format!("button[{i}].name"),
+                        source,
+                    })?
+            }
+            (None, Some(role)) => {
+                let field = format!("button[{i}].role");
+                let role = Role::from_name(&field, role).map_err(ScriptError::Role)?;
+                match roles.bit(role) {
+                    Some(bit) => bit,
+                    None => continue,
+                }
+            }
+            _ => {
+                return Err(ScriptError::Role(DeviceError::Buttons {
+                    field: format!("button[{i}]"),
+                    value: "both or neither of `name` and `role`".into(),
+                    allowed: "exactly one: `role` (grip, turn_x, turn_y, turn_z) or `name` \
+                              (a button of the device)"
+                        .into(),
+                }));
+            }
+        };
         buttons.push(ButtonEvent {
             t_s: b.t_s,
             index,
@@ -324,8 +362,20 @@ fn switches(file: &[SwitchFile]) -> Result<Vec<SwitchEvent>, ScriptError> {
 pub const MAX_SCRIPT_S: f64 = 3600.0;
 
 impl Script {
-    /// Parses and validates a script for a device with specs `specs`.
+    /// Parses and validates a script for a device with specs `specs`, its buttons by their
+    /// preset's roles or the default by index (no overrides).
     pub fn from_toml(text: &str, specs: &DeviceSpecs) -> Result<Script, ScriptError> {
+        let roles = ButtonRoles::resolve(specs, &[]).map_err(ScriptError::Role)?;
+        Script::from_toml_with(text, specs, &roles)
+    }
+
+    /// Parses and validates a script for a device with specs `specs` whose buttons play the
+    /// roles `roles` (the mapping in force, overrides included).
+    pub fn from_toml_with(
+        text: &str,
+        specs: &DeviceSpecs,
+        roles: &ButtonRoles,
+    ) -> Result<Script, ScriptError> {
         let file: ScriptFile =
             toml::from_str(text).map_err(|e: toml::de::Error| ScriptError::Syntax {
                 message: e.message().trim().to_string(),
@@ -335,7 +385,7 @@ impl Script {
             return Err(ScriptError::NoWaypoints);
         }
         let waypoints = waypoints(&file.waypoint, specs)?;
-        let buttons = buttons(&file.button, specs)?;
+        let buttons = buttons(&file.button, specs, roles)?;
         let switches = switches(&file.switch)?;
         let natural = buttons
             .iter()

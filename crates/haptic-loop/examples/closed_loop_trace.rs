@@ -29,15 +29,14 @@ fn main() {
         // Scale the device-side impedance by `scale` (as the Z-width report's margins do).
         (text, mech) = haptic_loop::closed_loop::scale_impedance(&text, mech, scale);
     }
-    let falcon = haptic_types::DeviceModel::Falcon.specs().clone();
-    let specs = haptic_devices::modelled::specs_of(&mech, &falcon);
+    let specs = haptic_devices::modelled::preset_specs(&mech);
     let l = load_scene_for(&text, specs.clone()).unwrap();
     let stext = std::fs::read_to_string(root.join(format!("{scene}.script.toml"))).unwrap();
     let script = Script::from_toml(&stext, &specs).unwrap();
     let ticks = (script.duration_s * f64::from(l.config.rate_hz)).round() as u64;
     let rate = l.config.rate_hz;
     let mut lp = HapticLoop::new(l.config, l.scene);
-    let mut dev = ModelledDevice::new(script, mech, grip, &falcon);
+    let mut dev = ModelledDevice::new(script, mech, grip, &specs);
     println!("tick,x,y,z,fx,fy,fz,status,tank,events");
     for i in 0..ticks {
         let s = dev.sample(TickTime::new(i, rate)).unwrap();

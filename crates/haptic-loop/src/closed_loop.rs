@@ -19,7 +19,7 @@ use crate::scene::load_scene_for;
 use haptic_devices::link::{LinkError, LinkParams};
 use haptic_devices::linked::LinkedDevice;
 use haptic_devices::local::Protocol;
-use haptic_devices::modelled::specs_of;
+use haptic_devices::modelled::preset_specs;
 use haptic_devices::{Grip, Mechanics};
 use haptic_devices::{Script, ScriptError};
 use haptic_engine::check::SceneError;
@@ -27,7 +27,6 @@ use haptic_engine::loop_config::DEFAULT_PASSIVITY_RESERVE_J;
 use haptic_engine::pacing::Pacing;
 use haptic_engine::runner::{RunError, Runner};
 use haptic_engine::sink::{Sink, SinkError, TickView};
-use haptic_types::DeviceModel;
 use haptic_types::DeviceSample;
 use haptic_types::device::{DeviceError, DeviceSpecs, ForceCommand, HapticDevice, TickTime};
 use haptic_types::tick::status;
@@ -113,7 +112,7 @@ pub enum ClosedLoopError {
     Run(#[from] RunError),
 }
 
-/// Plays `scene_text` with `script_text` (its buttons named for a Falcon) through the device
+/// Plays `scene_text` with `script_text` (its buttons by role, or named for the device) through the device
 /// `mech` held with `grip`, for the script's duration (or `seconds`), on an ideal link.
 pub fn run(
     scene_text: &str,
@@ -169,8 +168,8 @@ pub fn run_linked(
     seconds: Option<f64>,
 ) -> Result<(Report, Trace), ClosedLoopError> {
     linked.link.validate()?;
-    let falcon = DeviceModel::Falcon.specs().clone();
-    let specs = specs_of(&mech, &falcon);
+    // The preset's own buttons; the script binds its events by role.
+    let specs = preset_specs(&mech);
     let loaded = load_scene_for(scene_text, specs.clone())?;
     let script = Script::from_toml(script_text, &specs)?;
     let rate = loaded.config.rate_hz;
@@ -189,7 +188,7 @@ pub fn run_linked(
         script,
         mech,
         grip,
-        &falcon,
+        &specs,
         &linked.link,
         rate,
         linked.protocol,

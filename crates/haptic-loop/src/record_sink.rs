@@ -18,6 +18,8 @@ pub struct RecorderSink {
     recorder: Option<Recorder>,
     enc: Option<LoopEncoder>,
     mode: String,
+    /// Metadata record `buttons`: the roles in force (issue 41).
+    buttons: BTreeMap<String, String>,
     summary: Option<WriteSummary>,
 }
 
@@ -29,6 +31,7 @@ impl RecorderSink {
             recorder: None,
             enc: None,
             mode: String::new(),
+            buttons: BTreeMap::new(),
             summary: None,
         }
     }
@@ -81,6 +84,29 @@ pub fn header_of(d: &DescriptionMsg) -> SessionHeader {
     }
 }
 
+/// Metadata record `buttons` of a recording: the button that plays each role (`grip`, `turn_x`,
+/// `turn_y`, `turn_z`; empty for none) and `mapping`, the whole mapping in words, as the
+/// recorded device's buttons and the recorded scene's `[device] buttons` give it (what a replay
+/// uses: the record states it, it does not drive it).
+pub fn buttons_metadata(h: &SessionHeader) -> BTreeMap<String, String> {
+    let names = h.device.button_strs();
+    let Ok(roles) = crate::scene::device::roles_in(&h.scene_toml, &h.device) else {
+        return BTreeMap::new();
+    };
+    let mut m: BTreeMap<String, String> = haptic_types::Role::ALL
+        .into_iter()
+        .map(|r| {
+            let b = roles
+                .bit(r)
+                .and_then(|b| names.get(b as usize).copied())
+                .unwrap_or("");
+            (r.name().to_string(), b.to_string())
+        })
+        .collect();
+    m.insert("mapping".into(), roles.describe(&names));
+    m
+}
+
 /// Metadata record `session` of a recording: the tick statistics and the mode.
 pub fn stats_metadata(stats: &TickStats, mode: &str) -> BTreeMap<String, String> {
     let mut m = BTreeMap::new();
@@ -121,6 +147,7 @@ impl Sink for RecorderSink {
         );
         self.enc = Some(LoopEncoder::new(lp, info.header.start_time_ns));
         self.mode = info.header.mode.clone();
+        self.buttons = buttons_metadata(info.header);
         Ok(())
     }
 
@@ -147,6 +174,10 @@ impl Sink for RecorderSink {
         if let Some(mut rec) = self.recorder.take() {
             rec.metadata("session", stats_metadata(stats, &self.mode))
                 .map_err(SinkError::new)?;
+            if !self.buttons.is_empty() {
+                rec.metadata("buttons", std::mem::take(&mut self.buttons))
+                    .map_err(SinkError::new)?;
+            }
             if !link.is_empty() {
                 rec.metadata(
                     "device_link",

@@ -180,13 +180,18 @@ fn load_script(
     specs: &haptic_types::DeviceSpecs,
 ) -> Result<(Script, String, String), SessionError> {
     let (text, origin) = script_source(opts, file)?;
-    let script = Script::from_toml(&text, specs).map_err(|error| SessionError::ScriptFile {
-        at: Location {
-            at: error.position(&text),
-            file: origin.clone(),
-        },
-        error: Box::new(error),
-    })?;
+    let roles = file
+        .device
+        .roles_for(specs)
+        .map_err(|e| opts.scene.locate(e))?;
+    let script =
+        Script::from_toml_with(&text, specs, &roles).map_err(|error| SessionError::ScriptFile {
+            at: Location {
+                at: error.position(&text),
+                file: origin.clone(),
+            },
+            error: Box::new(error),
+        })?;
     Ok((script, text, origin))
 }
 

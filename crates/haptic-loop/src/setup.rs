@@ -234,7 +234,7 @@ impl Setup {
 
 /// The device a session of `file` that starts at `start_time_ns` (ns since the Unix epoch)
 /// is played on: the one named (`None`: the scene's model). A bridged device is welcomed with
-/// the scene's tick rate, name and start time, so every way of running a bridged session
+/// the scene's tick rate, name, start time and button roles, so every way of running a bridged session
 /// (`run`, `play`, the wheel) tells the device the same.
 pub fn session_device(
     file: &SceneFile,
@@ -242,11 +242,13 @@ pub fn session_device(
     start_time_ns: u64,
 ) -> DeviceSource {
     match device {
-        Some(DeviceSource::Udp(b)) => DeviceSource::Udp(b.clone().for_session(
-            file.loop_.rate_hz,
-            &file.scene.name,
-            start_time_ns,
-        )),
+        Some(DeviceSource::Udp(b)) => DeviceSource::Udp(
+            b.clone()
+                .for_session(file.loop_.rate_hz, &file.scene.name, start_time_ns)
+                // The scene's role names were checked when it was read (`SceneFile::parse`
+                // keeps them; `load_scene` refuses a bad one); a bad one here maps nothing.
+                .with_buttons(file.device.button_overrides().unwrap_or_default()),
+        ),
         Some(DeviceSource::Model(m)) => DeviceSource::Model(*m),
         None => DeviceSource::Model(file.device.model),
     }

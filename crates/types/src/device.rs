@@ -301,6 +301,17 @@ pub enum DeviceError {
         /// The allowed range.
         allowed: String,
     },
+    /// A button role or a role's button out of range (a scene's `[device] buttons`, the
+    /// command line's `--buttons`, a script's `role`).
+    #[error("{}", out_of_range(&format!("`{field}`"), value, allowed))]
+    Buttons {
+        /// Where it was written, e.g. `buttons.grip` or `--buttons`.
+        field: String,
+        /// The value given.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
     /// The device ended the session (a bridged device said goodbye): not an error of the run.
     #[error("the device ended the session")]
     Ended,

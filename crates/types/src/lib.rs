@@ -27,6 +27,7 @@
 //! assert_eq!(status::names(r.status), ["clamped", "watchdog"]);
 //! ```
 
+pub mod buttons;
 pub mod device;
 pub mod event;
 pub mod local;
@@ -37,6 +38,7 @@ pub mod tick;
 pub mod value;
 pub mod vec3;
 
+pub use buttons::{ButtonRoles, Role};
 pub use device::{
     Buttons, DeviceError, DeviceModel, DeviceSample, DeviceSpecs, ForceCommand, HapticDevice,
     TickTime,

@@ -75,6 +75,9 @@ pub struct WelcomeInfo {
     pub start_time_ns: u64,
     /// The scene's name.
     pub scene: String,
+    /// The button roles in force: the button index of grip, turn_x, turn_y, turn_z (255:
+    /// none); `None` from a simulator that does not send them.
+    pub roles: Option<[u8; 4]>,
 }
 
 /// What the fake device measured.
@@ -124,10 +127,38 @@ struct Reply {
 
 /// Runs the fake device to the end; `stop` ends it early.
 pub fn run_fake(cfg: &FakeConfig, stop: Option<&AtomicBool>) -> Result<FakeReport, DeviceError> {
+    run_fake_as(cfg, None, stop)
+}
+
+/// The fake device's specifications: the model's (a modelled preset's own buttons), with
+/// `buttons` announced instead of the model's when given.
+pub fn fake_specs(cfg: &FakeConfig, buttons: Option<&[String]>) -> DeviceSpecs {
     let specs = match &cfg.physical {
-        Some((mech, _)) => crate::modelled::specs_of(mech, cfg.model.specs()),
+        Some((mech, _)) => crate::modelled::preset_specs(mech),
         None => cfg.model.specs().clone(),
     };
+    match buttons {
+        Some(names) => DeviceSpecs {
+            button_names: names
+                .iter()
+                .cloned()
+                .map(std::borrow::Cow::Owned)
+                .collect::<Vec<_>>()
+                .into(),
+            ..specs
+        },
+        None => specs,
+    }
+}
+
+/// As [`run_fake`], the hello announcing `buttons` instead of the model's (`None`: the
+/// model's own); the script must have been read for a device with those buttons.
+pub fn run_fake_as(
+    cfg: &FakeConfig,
+    buttons: Option<&[String]>,
+    stop: Option<&AtomicBool>,
+) -> Result<FakeReport, DeviceError> {
+    let specs = fake_specs(cfg, buttons);
     let socket = open_socket(cfg.target)?;
     // 1. Hello until welcome.
     let welcome = handshake(&socket, cfg, &specs, stop)?;
@@ -317,19 +348,30 @@ fn handshake(
         let _ = socket.send_to(&hello, cfg.target);
         if let Ok((n, from)) = socket.recv_from(&mut buf) {
             if from == cfg.target {
-                if let Ok(Packet::Welcome {
-                    version,
-                    rate_hz,
-                    start_time_ns,
-                    scene,
-                }) = Packet::decode(&buf[..n])
-                {
-                    break WelcomeInfo {
+                match Packet::decode(&buf[..n]) {
+                    Ok(Packet::Welcome {
                         version,
                         rate_hz,
                         start_time_ns,
                         scene,
-                    };
+                        roles,
+                    }) => {
+                        break WelcomeInfo {
+                            version,
+                            rate_hz,
+                            start_time_ns,
+                            scene,
+                            roles,
+                        };
+                    }
+                    // The same hello would be refused again: say why and stop.
+                    Ok(Packet::Refusal(r)) => {
+                        return Err(DeviceError::Link(format!(
+                            "the simulator at {} refused the hello: {}",
+                            cfg.target, r.message
+                        )));
+                    }
+                    _ => {}
                 }
             }
         }

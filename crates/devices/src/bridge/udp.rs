@@ -10,11 +10,12 @@
 //! one tick per device period, whatever the network does. Every fault is counted, never fatal: duplicates, reordered and malformed packets,
 //! oversized datagrams, packets from a stranger, gaps in the sequence.
 
-use super::protocol::{ForceReply, Packet, Sample};
+use super::protocol::{ForceReply, Packet, ProtocolError, Refusal, Sample};
 use super::rule::{Numbered, SampleRule};
 use haptic_types::device::{
     Buttons, DeviceError, DeviceSample, DeviceSpecs, FALCON, ForceCommand, HapticDevice, TickTime,
 };
+use haptic_types::{ButtonRoles, Role};
 use std::collections::VecDeque;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -35,6 +36,9 @@ pub struct BridgeConfig {
     pub scene: String,
     /// Session start, ns since the Unix epoch (sent in the welcome).
     pub start_time_ns: u64,
+    /// The scene's overrides of the button roles (role, button name): a device lacking a
+    /// named button is refused; the welcome states the roles in force.
+    pub buttons: Vec<(Role, String)>,
 }
 
 impl BridgeConfig {
@@ -48,7 +52,14 @@ impl BridgeConfig {
             rate_hz: 1000,
             scene: String::new(),
             start_time_ns: 0,
+            buttons: Vec::new(),
         })
+    }
+
+    /// This configuration with the scene's overrides of the button roles.
+    pub fn with_buttons(mut self, buttons: Vec<(Role, String)>) -> Self {
+        self.buttons = buttons;
+        self
     }
 
     /// This configuration for a session of `scene` at `rate_hz` that starts at
@@ -77,6 +88,9 @@ struct Counters {
     send_errors: u64,
     stale_ticks: u64,
     resync: u64,
+    /// Hellos refused (each answered with a refusal, at most one per
+    /// [`REFUSAL_INTERVAL_S`](super::protocol::REFUSAL_INTERVAL_S)).
+    refused: u64,
     /// The largest count of two-port servo periods a version-2 device reported.
     device_two_port: u64,
 }
@@ -93,6 +107,10 @@ struct State {
     c: Counters,
     /// The protocol version of the session: the device's hello's, at most version 2.
     version: u8,
+    /// The last refusal, for the simulator's own message when no device is welcomed.
+    last_refusal: Option<String>,
+    /// When the last refusal was sent.
+    refusal_sent: Option<Instant>,
 }
 
 struct Shared {
@@ -165,22 +183,66 @@ impl UdpDevice {
             .lock()
             .map_err(|_| DeviceError::Link("bridge state lock poisoned".into()))
     }
+}
 
-    /// The welcome in each version, [version 1, version 2].
-    fn welcomes(&self) -> [Vec<u8>; 2] {
-        [super::protocol::VERSION, super::protocol::VERSION_2].map(|version| {
-            Packet::Welcome {
-                version,
-                rate_hz: self.config.rate_hz,
-                start_time_ns: self.config.start_time_ns,
-                scene: self.config.scene.clone(),
-            }
-            .encode()
-        })
+/// Answers a hello: the welcome with the session's version and the device's button roles, or
+/// a refusal (rate-limited) when the device lacks a button the scene maps.
+fn answer_hello(
+    socket: &UdpSocket,
+    from: SocketAddr,
+    st: &mut State,
+    config: &BridgeConfig,
+    specs: DeviceSpecs,
+    version: u8,
+) {
+    let roles = match ButtonRoles::resolve(&specs, &config.buttons) {
+        Ok(r) => r,
+        Err(e) => {
+            refuse(socket, from, st, Refusal::of_spec(&e));
+            return;
+        }
+    };
+    st.c.hellos += 1;
+    st.specs = Some(specs);
+    if st.peer != Some(from) || st.last_seq.is_some() {
+        // A device that restarted: its old samples and numbering are gone.
+        st.generation += 1;
+        st.queue.clear();
+    }
+    st.peer = Some(from);
+    st.last_seq = None;
+    // Negotiate down: a hello above version 2 is welcomed with 2.
+    st.version = version.min(super::protocol::VERSION_2);
+    let welcome = Packet::Welcome {
+        version: st.version,
+        rate_hz: config.rate_hz,
+        start_time_ns: config.start_time_ns,
+        scene: config.scene.clone(),
+        roles: Some(roles.wire()),
+    };
+    if socket.send_to(&welcome.encode(), from).is_err() {
+        st.c.send_errors += 1;
     }
 }
 
-fn receive(socket: UdpSocket, shared: Arc<Shared>, welcomes: [Vec<u8>; 2]) {
+/// Counts a refused hello, keeps its message, and answers it unless a refusal went out less
+/// than [`REFUSAL_INTERVAL_S`](super::protocol::REFUSAL_INTERVAL_S) ago.
+fn refuse(socket: &UdpSocket, from: SocketAddr, st: &mut State, r: Refusal) {
+    st.c.refused += 1;
+    let now = Instant::now();
+    let due = st.refusal_sent.is_none_or(|t| {
+        now.duration_since(t) >= Duration::from_secs_f64(super::protocol::REFUSAL_INTERVAL_S)
+    });
+    st.last_refusal = Some(r.message.clone());
+    if due {
+        st.refusal_sent = Some(now);
+        if socket.send_to(&Packet::Refusal(r).encode(), from).is_err() {
+            st.c.send_errors += 1;
+        }
+    }
+}
+
+fn receive(socket: UdpSocket, shared: Arc<Shared>, config: BridgeConfig) {
     let mut buf = vec![0u8; 2048];
     while !shared.stop.load(Ordering::Relaxed) {
         let (n, from) = match socket.recv_from(&mut buf) {
@@ -210,26 +272,28 @@ fn receive(socket: UdpSocket, shared: Arc<Shared>, welcomes: [Vec<u8>; 2]) {
             return;
         };
         match packet {
-            Err(super::protocol::ProtocolError::Oversized(_)) => st.c.oversized += 1,
+            Err(ProtocolError::Oversized(_)) => st.c.oversized += 1,
+            Err(ProtocolError::Hello(r)) => refuse(&socket, from, &mut st, r),
             Err(_) => st.c.malformed += 1,
             Ok(Packet::Hello { specs, version, .. }) => {
                 // A first hello, a repeated one, or a device that restarted: welcome it and
                 // accept its new numbering. Its limits cannot change during a session.
                 if st.specs.as_ref().is_some_and(|s| *s != specs) {
                     st.c.stranger += 1;
+                    refuse(
+                        &socket,
+                        from,
+                        &mut st,
+                        Refusal::new(
+                            "specs",
+                            "the specifications of the session's first hello",
+                            "hello refused: `specs` differ from the session's first hello \
+                             (name, limits and buttons cannot change during a session)"
+                                .into(),
+                        ),
+                    );
                 } else {
-                    st.c.hellos += 1;
-                    st.specs = Some(specs);
-                    if st.peer != Some(from) || st.last_seq.is_some() {
-                        // A device that restarted: its old samples and numbering are gone.
-                        st.generation += 1;
-                        st.queue.clear();
-                    }
-                    st.peer = Some(from);
-                    st.last_seq = None;
-                    st.version = version.min(super::protocol::VERSION_2);
-                    let welcome = &welcomes[usize::from(st.version == super::protocol::VERSION_2)];
-                    let _ = socket.send_to(welcome, from);
+                    answer_hello(&socket, from, &mut st, &config, specs, version);
                     drop(st);
                     shared.arrived.notify_all();
                     continue;
@@ -267,9 +331,42 @@ fn receive(socket: UdpSocket, shared: Arc<Shared>, welcomes: [Vec<u8>; 2]) {
             }
             Ok(Packet::Sample(_) | Packet::Bye { .. }) => st.c.stranger += 1,
             // Packets only the simulator sends.
-            Ok(Packet::Welcome { .. } | Packet::Force(_)) => st.c.malformed += 1,
+            Ok(Packet::Welcome { .. } | Packet::Force(_) | Packet::Refusal(_)) => {
+                st.c.malformed += 1
+            }
         }
     }
+}
+
+/// The simulator's message when no device was welcomed: what it received instead.
+fn no_hello(config: &BridgeConfig, st: &State) -> String {
+    let mut m = format!(
+        "no device said hello on udp:{} within {} s",
+        config.bind, config.wait_s
+    );
+    let c = &st.c;
+    if c.refused > 0 {
+        m.push_str(&format!(
+            "; {} hello{} refused, the last: {}",
+            c.refused,
+            if c.refused == 1 { "" } else { "s" },
+            st.last_refusal.as_deref().unwrap_or("")
+        ));
+    }
+    let other = [
+        ("malformed", c.malformed),
+        ("oversized", c.oversized),
+        ("from a stranger", c.stranger),
+    ];
+    for (what, n) in other {
+        if n > 0 {
+            m.push_str(&format!(
+                "; {n} datagram{} {what}",
+                if n == 1 { "" } else { "s" }
+            ));
+        }
+    }
+    m
 }
 
 impl HapticDevice for UdpDevice {
@@ -288,11 +385,11 @@ impl HapticDevice for UdpDevice {
             .map_err(|e| link("cannot configure", e))?;
         let rx = socket.try_clone().map_err(|e| link("cannot clone", e))?;
         let shared = self.shared.clone();
-        let welcome = self.welcomes();
+        let config = self.config.clone();
         self.thread = Some(
             std::thread::Builder::new()
                 .name("bridge-rx".into())
-                .spawn(move || receive(rx, shared, welcome))
+                .spawn(move || receive(rx, shared, config))
                 .map_err(|e| link("cannot start the receiver for", e))?,
         );
         self.socket = Some(socket);
@@ -301,10 +398,7 @@ impl HapticDevice for UdpDevice {
         while st.specs.is_none() {
             let now = Instant::now();
             if now >= deadline {
-                return Err(DeviceError::Link(format!(
-                    "no device said hello on udp:{} within {} s",
-                    self.config.bind, self.config.wait_s
-                )));
+                return Err(DeviceError::Link(no_hello(&self.config, &st)));
             }
             st = self
                 .shared
@@ -482,6 +576,7 @@ impl HapticDevice for UdpDevice {
             ("send_errors", c.send_errors),
             ("stale_ticks", c.stale_ticks),
             ("resync", c.resync),
+            ("refused", c.refused),
             ("device_two_port_periods", c.device_two_port),
         ]
     }

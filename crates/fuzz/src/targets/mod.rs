@@ -127,13 +127,7 @@ impl Target {
                         local: Some(Box::new(seed_local_model())),
                     })
                     .encode(),
-                    Packet::Welcome {
-                        version: 2,
-                        rate_hz: 1000,
-                        start_time_ns: 1_795_000_000_000_000_000,
-                        scene: "wall".into(),
-                    }
-                    .encode(),
+                    seed_welcome(),
                     Packet::Sample(sample).encode(),
                     Packet::Bye { reason: 0 }.encode(),
                 ];
@@ -257,4 +251,16 @@ fn seed_local_model() -> haptic_types::local::LocalModel {
         body_planes: vec![floor(-0.02, 0.0)],
         world_energy_j: 0.0,
     }
+}
+
+/// A seed of the bridge target: a version-2 welcome with the Falcon's button roles.
+fn seed_welcome() -> Vec<u8> {
+    Packet::Welcome {
+        version: 2,
+        rate_hz: 1000,
+        start_time_ns: 1_795_000_000_000_000_000,
+        scene: "wall".into(),
+        roles: Some([0, 1, 2, 3]),
+    }
+    .encode()
 }

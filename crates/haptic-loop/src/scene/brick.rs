@@ -4,9 +4,11 @@
 //! A thin adapter. `[brickworld.params]` is the world's own [`brickworld::Params`] table
 //! (every field has a default). The world is built with the device's limits mapped to the world
 //! ([`super::LoopConfig::world_limits`]), so its proxy stiffness is checked against the real
-//! device. The device's buttons become the hand's [`Grip`] commands: Falcon centre → `hold`,
-//! plus / minus / forward → `turn_x` / `turn_y` / `turn_z`; Touch button1 → `hold`, button2 →
-//! `turn_z`.
+//! device. The device's buttons become the hand's [`Grip`] commands by their roles
+//! (`haptic_types::buttons`): the button playing `grip` holds, those playing `turn_x` /
+//! `turn_y` / `turn_z` turn (a Falcon: centre, plus / minus / forward; a Touch: button1, and
+//! button2 turns about z; any other device by index unless the scene or the command line maps
+//! them).
 //! The world's `dt_s` must equal the loop's tick.
 
 use super::score::{self, DROP_HEIGHT_M, HouseScore};
@@ -21,6 +23,7 @@ use haptic_types::Rgba;
 use haptic_types::SwitchSpec;
 use haptic_types::vec3::Vec3;
 use haptic_types::{Ball, OrientedBox, Primitive};
+use haptic_types::{ButtonRoles, Role};
 use serde::Deserialize;
 use world_form::Limits;
 use world_form::fmt_num;
@@ -35,7 +38,7 @@ pub const WORLD: WorldKind = WorldKind {
             p,
             &config.world_limits(),
             config.dt_s(),
-            &config.specs.button_strs(),
+            super::device::roles_in(text, &config.specs)?,
         )?;
         Ok(Box::new(scene))
     },
@@ -60,9 +63,8 @@ fn default_ground() -> f64 {
 /// The brick-world scene.
 pub struct BrickScene {
     world: World,
-    /// Bit of the device button for `hold`, `turn_x`, `turn_y`, `turn_z` (`None`: the device
-    /// has none).
-    bits: [Option<u32>; 4],
+    /// Which button plays each role.
+    roles: ButtonRoles,
     last_input: Option<CursorInput>,
     rejected: bool,
     force_n: Vec3,
@@ -96,12 +98,12 @@ pub const BRICK_SWITCHES: [SwitchSpec; 5] = [
 
 impl BrickScene {
     /// Builds the scene: `limits` are the device's limits mapped to the world, `dt_s` the
-    /// tick, `buttons` the device's button names.
+    /// tick, `roles` the device's buttons by role.
     pub fn new(
         s: BrickSection,
         limits: &Limits,
         dt_s: f64,
-        buttons: &[&str],
+        roles: ButtonRoles,
     ) -> Result<Self, SceneError> {
         if s.params.dt_s != dt_s {
             return Err(out_of_range(
@@ -121,19 +123,9 @@ impl BrickScene {
             field: Some(e.field().to_string()),
             message: e.to_string(),
         })?;
-        let find = |names: &[&str]| {
-            names
-                .iter()
-                .find_map(|n| buttons.iter().position(|b| b == n).map(|i| i as u32))
-        };
         Ok(BrickScene {
             world,
-            bits: [
-                find(&["centre", "button1"]),
-                find(&["plus"]),
-                find(&["minus"]),
-                find(&["forward", "button2"]),
-            ],
+            roles,
             last_input: None,
             rejected: false,
             force_n: [0.0; 3],
@@ -269,12 +261,12 @@ impl Scene for BrickScene {
     }
 
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
-        let pressed = |bit: Option<u32>| bit.is_some_and(|b| input.buttons.pressed(b));
+        let pressed = |role: Role| self.roles.pressed(role, input.buttons);
         let grip = Grip {
-            hold: pressed(self.bits[0]),
-            turn_x: pressed(self.bits[1]),
-            turn_y: pressed(self.bits[2]),
-            turn_z: pressed(self.bits[3]),
+            hold: pressed(Role::Grip),
+            turn_x: pressed(Role::TurnX),
+            turn_y: pressed(Role::TurnY),
+            turn_z: pressed(Role::TurnZ),
         };
         let cursor_input = match self.world.input(input.cursor_m, grip) {
             Ok(i) => {

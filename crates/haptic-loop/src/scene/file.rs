@@ -13,6 +13,8 @@
 //!
 //! [device]
 //! model = "falcon"                     # "falcon" | "touch"
+//! buttons = { grip = "plus" }          # optional: a role's button, overriding the device's
+//!                                      # preset or the default by index (docs/devices.md)
 //!
 //! [mapping]
 //! workspace_scale = 1.0                # world metres per device metre
@@ -33,6 +35,7 @@
 //! ...
 //! ```
 
+pub use super::device::DeviceSection;
 use super::registry;
 use super::table;
 use haptic_engine::check::SceneError;
@@ -58,22 +61,6 @@ pub struct SceneHeader {
     /// Free text.
     #[serde(default)]
     pub description: Option<String>,
-}
-
-/// `[device]`.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct DeviceSection {
-    /// Device model the scene is tuned for.
-    pub model: DeviceModel,
-}
-
-impl Default for DeviceSection {
-    fn default() -> Self {
-        DeviceSection {
-            model: DeviceModel::Falcon,
-        }
-    }
 }
 
 /// The tables every scene file shares (the world's own table is read by its adapter).
@@ -193,6 +180,7 @@ pub fn load_scene_for(text: &str, specs: DeviceSpecs) -> Result<LoadedScene, Sce
 }
 
 fn build(file: SceneFile, specs: DeviceSpecs) -> Result<LoadedScene, SceneError> {
+    file.device.roles_for(&specs)?;
     let config = file.loop_config_for(specs)?;
     let kind = file.scene.kind.as_str();
     let world = registry::find(kind).ok_or_else(|| SceneError::Kind {

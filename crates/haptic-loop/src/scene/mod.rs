@@ -3,6 +3,7 @@
 //! worlds, the house-task score, and the stiff-wall calibration scene.
 
 pub mod brick;
+pub mod device;
 pub mod file;
 pub mod nano;
 pub mod optical;

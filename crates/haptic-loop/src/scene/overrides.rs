@@ -82,6 +82,25 @@ fn segments<'a>(path: &'a str) -> Result<Vec<Segment<'a>>, String> {
     Ok(out)
 }
 
+/// The scene `text` with each (role, button name) of `pairs` set in its `[device] buttons`
+/// (the command line's `--buttons`); the buttons are checked against the device when the
+/// session starts.
+pub fn override_buttons(
+    text: &str,
+    pairs: &[(haptic_types::Role, String)],
+) -> Result<String, OverrideError> {
+    let overrides: Vec<(String, Value)> = pairs
+        .iter()
+        .map(|(role, button)| {
+            (
+                format!("device.buttons.{}", role.name()),
+                Value::String(button.clone()),
+            )
+        })
+        .collect();
+    override_scene(text, &overrides)
+}
+
 /// Sets `value` at `path` inside `table`, creating tables that the file left out (they take
 /// their defaults otherwise).
 fn set(table: &mut Table, path: &str, value: Value) -> Result<(), String> {

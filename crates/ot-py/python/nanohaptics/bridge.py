@@ -82,6 +82,9 @@ __all__ = [
     "encode_sample",
     "encode_force",
     "encode_bye",
+    "encode_refusal",
+    "HelloRefused",
+    "ROLES",
     "force_v2_len",
     "decode",
     "local_force",
@@ -94,7 +97,9 @@ MAGIC = b"NHDB"
 VERSION = 1
 #: The newest protocol version: force packets carry the local model.
 VERSION_2 = 2
-HELLO, WELCOME, SAMPLE, FORCE, BYE = 1, 2, 3, 4, 5
+HELLO, WELCOME, SAMPLE, FORCE, BYE, REFUSAL = 1, 2, 3, 4, 5, 6
+#: The button roles, in the order of the welcome's four role bytes (docs/devices.md).
+ROLES = ("grip", "turn_x", "turn_y", "turn_z")
 #: Largest datagram either side accepts, bytes.
 MAX_PACKET = 1200
 #: Most planes (and most body planes) one answer carries.
@@ -432,10 +437,35 @@ def encode_hello(specs: Specs, version: int = VERSION) -> bytes:
     return _HEADER.pack(MAGIC, _check_version(version), HELLO, 0) + body
 
 
-def encode_welcome(rate_hz: int, start_time_ns: int, scene: str, version: int = VERSION) -> bytes:
-    """A welcome datagram (what the simulator sends; for tests and stand-in simulators)."""
-    return (_HEADER.pack(MAGIC, _check_version(version), WELCOME, 0)
-            + struct.pack("<IQ", rate_hz, start_time_ns) + _string(scene))
+def encode_welcome(rate_hz: int, start_time_ns: int, scene: str, version: int = VERSION,
+                   roles: Optional[Sequence[int]] = None) -> bytes:
+    """A welcome datagram (what the simulator sends; for tests and stand-in simulators);
+    ``roles``: the button index of grip, turn_x, turn_y, turn_z (255: none), or None for a
+    welcome without them (a simulator before issue 41)."""
+    out = (_HEADER.pack(MAGIC, _check_version(version), WELCOME, 0)
+           + struct.pack("<IQ", rate_hz, start_time_ns) + _string(scene))
+    if roles is not None:
+        out += bytes(int(r) for r in roles)
+    return out
+
+
+def encode_refusal(field_name: str, allowed: str, message: str) -> bytes:
+    """A refusal datagram (version byte 1, type 6): the hello's field, the values allowed
+    and the simulator's message (for tests and stand-in simulators)."""
+    return (_HEADER.pack(MAGIC, VERSION, REFUSAL, 0) + _string(field_name) + _string(allowed)
+            + _string(message))
+
+
+class HelloRefused(ConnectionError):
+    """The simulator refused this device's hello: ``field`` (e.g. ``max_force_n``,
+    ``buttons.grip``), the values ``allowed``, and its ``message``, which is also the
+    exception's text."""
+
+    def __init__(self, field_name: str, allowed: str, message: str):
+        super().__init__(message)
+        self.field = field_name
+        self.allowed = allowed
+        self.message = message
 
 
 def encode_sample(seq: int, device_time_ns: int, position_m: Sequence[float], buttons: int,
@@ -575,7 +605,8 @@ def _fixed(data: bytes, kind: str, size: int) -> None:
 
 def decode(data: bytes):
     """Decode a datagram: ``("welcome", dict)`` (``version``, ``rate_hz``,
-    ``start_time_ns``, ``scene``), ``("force", ForceReply)`` (with ``local`` set for a
+    ``start_time_ns``, ``scene``, ``roles``), ``("refusal", dict)`` (``field``, ``allowed``,
+    ``message``), ``("force", ForceReply)`` (with ``local`` set for a
     version-2 packet), ``("bye", reason)``, and the device's packets ``("hello", dict)``
     (``version``, ``specs``) and ``("sample", dict)`` (``seq``, ``device_time_ns``,
     ``position_m``, ``buttons``). Any other bytes raise ValueError naming what is wrong
@@ -596,9 +627,19 @@ def decode(data: bytes):
     if kind == WELCOME:
         rate, start = r.take(_WELCOME, "welcome")
         scene = r.string("welcome scene")
+        roles = None
+        if r.at < len(data):  # the button roles (a simulator before issue 41 sends none)
+            roles = {name: (None if b == 255 else b)
+                     for name, b in zip(ROLES, [r.u8("welcome") for _ in ROLES])}
         r.end("welcome")
         return "welcome", {"version": version, "rate_hz": rate, "start_time_ns": start,
-                           "scene": scene}
+                           "scene": scene, "roles": roles}
+    if kind == REFUSAL:
+        field_name = r.string("refusal field")
+        allowed = r.string("refusal allowed")
+        message = r.string("refusal message")
+        r.end("refusal")
+        return "refusal", {"field": field_name, "allowed": allowed, "message": message}
     if kind == FORCE:
         if version == VERSION:
             _fixed(data, "force", FORCE_LEN)
@@ -901,7 +942,9 @@ class BridgeClient:
 
     def connect(self, timeout_s: float = 30.0) -> dict:
         """Say hello every 50 ms until the simulator welcomes this device;
-        returns the welcome (version, rate_hz, start_time_ns, scene)."""
+        returns the welcome (version, rate_hz, start_time_ns, scene, and roles: the button
+        index of each role in :data:`ROLES`, None for a role no button plays). Raises
+        :class:`HelloRefused` with the simulator's words when it refuses the hello."""
         hello = encode_hello(self.specs, self.protocol)
         deadline = time.monotonic() + timeout_s
         self.sock.settimeout(0.05)
@@ -922,6 +965,9 @@ class BridgeClient:
                 self.welcome = value
                 self.version = value["version"]
                 return value
+            if kind == "refusal":
+                # The same hello would be refused again: say why.
+                raise HelloRefused(value["field"], value["allowed"], value["message"])
         raise TimeoutError(f"no welcome from udp:{self.address[0]}:{self.address[1]} within {timeout_s} s")
 
     def send(self, position_m: Sequence[float], buttons: int = 0,

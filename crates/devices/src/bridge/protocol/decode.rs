@@ -6,7 +6,7 @@ use super::{
     BYE_LEN, FORCE_LEN, HEADER_LEN, LOCAL_FIXED_LEN, MAGIC, MAX_PACKET, SAMPLE_LEN, SAMPLE_V2_LEN,
     VERSION, VERSION_2,
 };
-use super::{ForceReply, Packet, ProtocolError, Sample};
+use super::{ForceReply, Packet, ProtocolError, Refusal, Sample};
 use haptic_types::device::DeviceSpecs;
 use std::borrow::Cow;
 
@@ -28,16 +28,22 @@ impl Packet {
             return Err(ProtocolError::Magic(magic));
         }
         let version = b[4];
+        let mut r = Reader::new(b, HEADER_LEN);
+        if b[5] == 1 {
+            // A hello of any version above 0 is read (its body is the same in every version)
+            // and welcomed with the smaller of its version and 2; one that cannot be accepted
+            // is answered with a refusal naming the field.
+            return hello(version, &mut r).map_err(refusal);
+        }
         if version != VERSION && version != VERSION_2 {
             return Err(ProtocolError::Version(version));
         }
-        let mut r = Reader::new(b, HEADER_LEN);
         match b[5] {
-            1 => hello(version, &mut r),
             2 => welcome(version, &mut r),
             3 => sample(version, b, &mut r),
             4 => force(version, b, &mut r),
             5 => bye(b, &mut r),
+            super::REFUSAL_TYPE => refused(&mut r),
             t => Err(ProtocolError::Type(t)),
         }
     }
@@ -62,8 +68,43 @@ fn fixed(b: &[u8], kind: &'static str, len: usize) -> Result<(), ProtocolError> 
     }
 }
 
+/// A hello's error as a refusal naming the field and the allowed values.
+fn refusal(e: ProtocolError) -> ProtocolError {
+    let layout = "36 bytes of header, rate and limits, then the name and each button as a u8 \
+                  length and 1–32 printable ASCII characters";
+    match e {
+        ProtocolError::Hello(_) => e,
+        ProtocolError::Text(kind) => {
+            let field = if kind == "hello name" {
+                "name"
+            } else {
+                "button_names"
+            };
+            ProtocolError::Hello(Refusal::new(
+                field,
+                "1–32 printable ASCII characters",
+                format!("hello refused: `{field}` is not text"),
+            ))
+        }
+        other => ProtocolError::Hello(Refusal::new(
+            "size",
+            layout,
+            format!("hello refused: {other}"),
+        )),
+    }
+}
+
 /// Type 1, a hello: the device's specifications, checked.
 fn hello(version: u8, r: &mut Reader) -> Result<Packet, ProtocolError> {
+    if version == 0 {
+        return Err(ProtocolError::Hello(Refusal::new(
+            "version",
+            "1 or more (a hello above 2 is welcomed with version 2)",
+            "hello refused: `version` = 0 is out of range: allowed 1 or more (a hello above 2 \
+             is welcomed with version 2)"
+                .into(),
+        )));
+    }
     let rate_hz = r.u32("hello")?;
     let max_force_n = r.f64("hello")?;
     let max_stiffness_n_per_m = r.f64("hello")?;
@@ -86,7 +127,7 @@ fn hello(version: u8, r: &mut Reader) -> Result<Packet, ProtocolError> {
     };
     specs
         .validate()
-        .map_err(|e| ProtocolError::Spec(e.to_string()))?;
+        .map_err(|e| ProtocolError::Hello(Refusal::of_spec(&e)))?;
     Ok(Packet::Hello {
         version,
         rate_hz,
@@ -99,13 +140,38 @@ fn welcome(version: u8, r: &mut Reader) -> Result<Packet, ProtocolError> {
     let rate_hz = r.u32("welcome")?;
     let start_time_ns = r.u64("welcome")?;
     let scene = r.string("welcome scene")?;
+    // The button roles (issue 41); a welcome from an older simulator ends at the scene name.
+    let roles = if r.remaining() == 0 {
+        None
+    } else {
+        Some([
+            r.u8("welcome")?,
+            r.u8("welcome")?,
+            r.u8("welcome")?,
+            r.u8("welcome")?,
+        ])
+    };
     r.end("welcome")?;
     Ok(Packet::Welcome {
         version,
         rate_hz,
         start_time_ns,
         scene,
+        roles,
     })
+}
+
+/// Type 6, a refusal: the field, the allowed values and the message.
+fn refused(r: &mut Reader) -> Result<Packet, ProtocolError> {
+    let field = r.string("refusal field")?;
+    let allowed = r.string("refusal allowed")?;
+    let message = r.string("refusal message")?;
+    r.end("refusal")?;
+    Ok(Packet::Refusal(Refusal {
+        field,
+        allowed,
+        message,
+    }))
 }
 
 /// Type 3, a sample of the size its version gives (`b`: the whole datagram).

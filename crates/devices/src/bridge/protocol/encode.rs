@@ -55,9 +55,13 @@ fn put_local(v: &mut Vec<u8>, m: &LocalModel) {
     }
 }
 
+/// A string as a u8 length and its bytes, cut to 255 bytes at a character boundary.
 fn put_str(v: &mut Vec<u8>, s: &str) {
+    let mut n = s.len().min(255);
+    while !s.is_char_boundary(n) {
+        n -= 1;
+    }
     let b = s.as_bytes();
-    let n = b.len().min(255);
     v.push(n as u8);
     v.extend_from_slice(&b[..n]);
 }
@@ -99,11 +103,21 @@ impl Packet {
                 rate_hz,
                 start_time_ns,
                 scene,
+                roles,
             } => {
                 header(v, *version, 2);
                 v.extend_from_slice(&rate_hz.to_le_bytes());
                 v.extend_from_slice(&start_time_ns.to_le_bytes());
                 put_str(v, scene);
+                if let Some(r) = roles {
+                    v.extend_from_slice(r);
+                }
+            }
+            Packet::Refusal(r) => {
+                header(v, VERSION, super::REFUSAL_TYPE);
+                put_str(v, &r.field);
+                put_str(v, &r.allowed);
+                put_str(v, &r.message);
             }
             Packet::Sample(s) => {
                 let version = if s.two_port_periods.is_some() {

@@ -14,10 +14,11 @@
 //! | type | name    | direction     | body after the header                                              |
 //! |------|---------|---------------|--------------------------------------------------------------------|
 //! | 1    | hello   | device → sim  | rate u32, max force f64 (N), max stiffness f64 (N/m), workspace radius f64 (m), name (u8 length + UTF-8), button count u8, button names (u8 length + UTF-8 each) |
-//! | 2    | welcome | sim → device  | tick rate u32 (Hz), session start u64 (ns since the Unix epoch), scene name (u8 length + UTF-8) |
+//! | 2    | welcome | sim → device  | tick rate u32 (Hz), session start u64 (ns since the Unix epoch), scene name (u8 length + UTF-8), button roles 4 × u8 |
 //! | 3    | sample  | device → sim  | seq u64, device time u64 (ns), position 3 × f64 (m), buttons u32   |
 //! | 4    | force   | sim → device  | seq answered u64, tick u64, force 3 × f64 (N), stiffness 9 × f64 (N/m, row-major), status u8 |
 //! | 5    | bye     | either        | reason u8 (0: end of session, 1: error)                             |
+//! | 6    | refusal | sim → device  | field, allowed values, message (u8 length + UTF-8 each)             |
 //!
 //! The module holds the packets as types (`packets`: [`Packet`], [`Sample`], [`ForceReply`],
 //! [`ProtocolError`]) apart from their codec: `encode` ([`Packet::encode`]) and `decode`
@@ -29,7 +30,7 @@ mod encode;
 mod packets;
 mod reader;
 
-pub use packets::{ForceReply, Packet, ProtocolError, Sample};
+pub use packets::{ForceReply, Packet, ProtocolError, Refusal, Sample};
 
 /// The magic bytes every packet starts with.
 pub const MAGIC: [u8; 4] = *b"NHDB";
@@ -58,6 +59,11 @@ pub const FORCE_LEN: usize = 121;
 pub const BYE_LEN: usize = 9;
 /// Size of the header, bytes.
 const HEADER_LEN: usize = 8;
+/// Shortest time between two refusals the simulator sends, s (a device repeats its hello every
+/// 50 ms; it hears why at most every 100 ms).
+pub const REFUSAL_INTERVAL_S: f64 = 0.1;
+/// The packet type of a refusal.
+pub const REFUSAL_TYPE: u8 = 6;
 
 /// Size of a version-2 force packet with `planes` contact planes, a body or none and
 /// `body_planes` body planes, bytes.
@@ -134,7 +140,10 @@ mod tests {
             rate_hz: 1000,
             start_time_ns: 1_700_000_000_000_000_000,
             scene: "wall".into(),
+            roles: Some([0, 1, 2, 3]),
         };
+        // 8 + 4 + 8 + 1 + 4 ("wall") + 4 role bytes.
+        assert_eq!(w.encode().len(), 29);
         assert_eq!(Packet::decode(&w.encode()), Ok(w));
         assert_eq!(Packet::Bye { reason: 0 }.encode().len(), BYE_LEN);
         // A version-2 sample: the version-1 fields, then the two-port count.
@@ -197,7 +206,8 @@ mod tests {
                 specs: bad.clone()
             }
             .encode()),
-            "device specs: `max_force_n` = inf is out of range: allowed 0.001 ≤ max_force_n ≤ 1000"
+            "hello refused: device specs: `max_force_n` = inf is out of range: allowed 0.001 ≤ \
+             max_force_n ≤ 1000"
         );
         // A force limit of 4e-159 N (found by the libFuzzer bridge target: its squares are
         // subnormal, and clamping to it took 12 s for 20 ticks) is no haptic device.
@@ -209,9 +219,88 @@ mod tests {
                 specs: bad
             }
             .encode()),
-            "device specs: `max_force_n` = 3.7555737088373936e-159 is out of range: allowed \
-             0.001 ≤ max_force_n ≤ 1000"
+            "hello refused: device specs: `max_force_n` = 3.7555737088373936e-159 is out of \
+             range: allowed 0.001 ≤ max_force_n ≤ 1000"
         );
+    }
+
+    /// A hello above version 2 is read (the simulator welcomes it with 2); version 0, bad
+    /// limits, bad names and a bad size are refusals naming the field and the allowed values;
+    /// the reserved bytes are not read.
+    #[test]
+    fn hellos_negotiate_down_or_are_refused_by_field() {
+        let hello = |version: u8, specs: haptic_types::DeviceSpecs| {
+            Packet::Hello {
+                version,
+                rate_hz: 1000,
+                specs,
+            }
+            .encode()
+        };
+        let mut h3 = hello(3, FALCON);
+        assert!(matches!(
+            Packet::decode(&h3),
+            Ok(Packet::Hello { version: 3, .. })
+        ));
+        // Reserved bytes 6–7: sent as 0, never read.
+        h3[6] = 1;
+        h3[7] = 0xff;
+        assert!(matches!(Packet::decode(&h3), Ok(Packet::Hello { .. })));
+        let refusal = |b: &[u8]| match Packet::decode(b) {
+            Err(ProtocolError::Hello(r)) => (r.field, r.allowed),
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(
+            refusal(&hello(0, FALCON)),
+            (
+                "version".into(),
+                "1 or more (a hello above 2 is welcomed with version 2)".into()
+            )
+        );
+        let mut bad = FALCON;
+        bad.workspace_radius_m = 20.0;
+        assert_eq!(
+            refusal(&hello(2, bad)),
+            (
+                "workspace_radius_m".into(),
+                "1e-4 ≤ workspace_radius_m ≤ 10".into()
+            )
+        );
+        let mut many = FALCON;
+        many.button_names = vec![std::borrow::Cow::Borrowed("b"); 33].into();
+        assert_eq!(
+            refusal(&hello(2, many)),
+            ("button_names".into(), "at most 32 buttons".into())
+        );
+        let good = hello(2, FALCON);
+        assert_eq!(refusal(&good[..30]).0, "size");
+        let mut long = good.clone();
+        long.push(0);
+        assert_eq!(refusal(&long).0, "size");
+        // Other packets keep the strict version check.
+        let mut bye = Packet::Bye { reason: 0 }.encode();
+        bye[4] = 3;
+        assert_eq!(Packet::decode(&bye), Err(ProtocolError::Version(3)));
+    }
+
+    /// A refusal is the header (version byte 1, type 6) and three strings; it round-trips,
+    /// and a message longer than 255 bytes is cut at a character boundary.
+    #[test]
+    fn a_refusal_round_trips_with_its_documented_layout() {
+        let r = Packet::Refusal(Refusal::new(
+            "version",
+            "1 or more",
+            "hello refused: `version` = 0".into(),
+        ));
+        let b = r.encode();
+        assert_eq!(&b[..8], b"NHDB\x01\x06\x00\x00");
+        assert_eq!(b.len(), 8 + 1 + 7 + 1 + 9 + 1 + 28);
+        assert_eq!(Packet::decode(&b), Ok(r));
+        let long = Packet::Refusal(Refusal::new("f", "a", "≤".repeat(100)));
+        match Packet::decode(&long.encode()) {
+            Ok(Packet::Refusal(r)) => assert_eq!(r.message, "≤".repeat(85)),
+            other => panic!("{other:?}"),
+        }
     }
 
     /// A local model with every part: two planes, a body, one body plane.

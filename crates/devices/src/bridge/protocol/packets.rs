@@ -27,11 +27,18 @@ pub enum Packet {
         start_time_ns: u64,
         /// Scene name.
         scene: String,
+        /// The button roles in force: the button index of grip, turn_x, turn_y and turn_z,
+        /// 255 where no button plays the role (`None`: a welcome without them, from a
+        /// simulator before issue 41).
+        roles: Option<[u8; 4]>,
     },
     /// One device reading.
     Sample(Sample),
     /// The simulator's answer to a sample.
     Force(ForceReply),
+    /// The simulator cannot accept a hello: which field, what it allows, and the whole
+    /// message (sent at most [`REFUSAL_INTERVAL_S`](super::REFUSAL_INTERVAL_S) apart).
+    Refusal(Refusal),
     /// End of the session.
     Bye {
         /// 0: end of session, 1: error.
@@ -86,6 +93,44 @@ impl ForceReply {
     }
 }
 
+/// Why a hello was refused: the field, the values allowed and the whole message.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refusal {
+    /// The hello's field: `version`, `size`, `name`, `max_force_n`, `max_stiffness_n_per_m`,
+    /// `workspace_radius_m`, `button_names`, `buttons.<role>` (a role the scene maps to a
+    /// button the device lacks) or `specs` (a hello that changes the session's specifications).
+    pub field: String,
+    /// The values allowed, in words.
+    pub allowed: String,
+    /// The simulator's message (names the field, the value and the allowed values).
+    pub message: String,
+}
+
+impl Refusal {
+    /// A refusal of `field` with `allowed` values; `message` the simulator's words.
+    pub fn new(field: &str, allowed: &str, message: String) -> Refusal {
+        Refusal {
+            field: field.to_string(),
+            allowed: allowed.to_string(),
+            message,
+        }
+    }
+
+    /// The refusal of a hello whose specifications `e` names as out of range.
+    pub fn of_spec(e: &haptic_types::device::DeviceError) -> Refusal {
+        use haptic_types::device::DeviceError as E;
+        let message = format!("hello refused: {e}");
+        match e {
+            E::Spec(world_form::ValueError::OutOfRange { field, allowed, .. }) => {
+                Refusal::new(field.trim_matches('`'), allowed, message)
+            }
+            E::BadSpec { field, allowed, .. } => Refusal::new(field, allowed, message),
+            E::Buttons { field, allowed, .. } => Refusal::new(field, allowed, message),
+            _ => Refusal::new("specs", "specifications in range", message),
+        }
+    }
+}
+
 /// Why a datagram was refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ProtocolError {
@@ -130,4 +175,7 @@ pub enum ProtocolError {
     /// Announced specifications out of range.
     #[error("{0}")]
     Spec(String),
+    /// A hello the simulator cannot accept (answered with a [`Packet::Refusal`]).
+    #[error("{}", .0.message)]
+    Hello(Refusal),
 }

@@ -139,6 +139,9 @@ impl<'a> Reader<'a> {
         let b = self.take(n, kind)?;
         String::from_utf8(b.to_vec()).map_err(|_| ProtocolError::Text(kind))
     }
+    pub(super) fn remaining(&self) -> usize {
+        self.b.len().saturating_sub(self.at)
+    }
     pub(super) fn end(&self, kind: &'static str) -> Result<(), ProtocolError> {
         if self.at == self.b.len() {
             Ok(())

@@ -44,7 +44,11 @@ pub const WORLD: WorldKind = WorldKind {
     check: |text| super::table::pick::<OtParams>(text, "optical_tweezers").map(drop),
     build: |text, config| {
         let p: OtParams = world_table(text, "optical_tweezers")?;
-        Ok(Box::new(OpticalScene::new(p, &config.world_limits())?))
+        let roles = super::device::roles_in(text, &config.specs)?;
+        let scene = OpticalScene::new(p, &config.world_limits())?;
+        Ok(Box::new(
+            scene.with_grip(roles.bit(haptic_types::Role::Grip)),
+        ))
     },
 };
 
@@ -52,6 +56,8 @@ pub const WORLD: WorldKind = WorldKind {
 pub struct OpticalScene {
     world: World,
     look: Look,
+    /// The button bit that grabs (the device's `grip` role; `None`: none does).
+    grip_bit: Option<u32>,
 }
 
 impl OpticalScene {
@@ -63,7 +69,15 @@ impl OpticalScene {
         Ok(OpticalScene {
             world,
             look: Look::of(&p),
+            grip_bit: Some(0),
         })
+    }
+
+    /// The same scene grabbing with button `bit` (the device's `grip` role; `None`: no button
+    /// grabs). A new scene grabs with button 0.
+    pub fn with_grip(mut self, bit: Option<u32>) -> Self {
+        self.grip_bit = bit;
+        self
     }
 
     /// The steering counters so far (rebuilds, warm ticks, solves).
@@ -94,7 +108,7 @@ impl Scene for OpticalScene {
     fn step(&mut self, input: &SceneInput, out: &mut SceneOutput) {
         let r = self.world.step(&Input {
             cursor_m: [input.cursor_m[0], input.cursor_m[1]],
-            grab: input.buttons.pressed(0),
+            grab: self.grip_bit.is_some_and(|b| input.buttons.pressed(b)),
         });
         for e in &r.events {
             out.events.push(Event::new(
