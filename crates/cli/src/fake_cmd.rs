@@ -169,16 +169,7 @@ fn button_names(a: &FakeArgs) -> Result<Option<Vec<String>>, String> {
         .map(|b| b.trim().to_string())
         .filter(|b| !b.is_empty())
         .collect();
-    let specs = DeviceSpecs {
-        button_names: names
-            .iter()
-            .cloned()
-            .map(std::borrow::Cow::Owned)
-            .collect::<Vec<_>>()
-            .into(),
-        ..haptic_types::device::FALCON
-    };
-    specs
+    haptic_devices::bridge::fake::with_button_names(haptic_types::device::FALCON, &names)
         .validate()
         .map_err(|e| format!("--button-names: {e}"))?;
     Ok(Some(names))
@@ -217,15 +208,7 @@ fn config(a: &FakeArgs) -> Result<Config, String> {
         None => model.specs().clone(),
     };
     let specs = match &names {
-        Some(n) => DeviceSpecs {
-            button_names: n
-                .iter()
-                .cloned()
-                .map(std::borrow::Cow::Owned)
-                .collect::<Vec<_>>()
-                .into(),
-            ..base
-        },
+        Some(n) => haptic_devices::bridge::fake::with_button_names(base, n),
         None => base,
     };
     let script = script(a, &specs)?;

@@ -472,6 +472,10 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
     assert!(d["energy_to_hand_j"].as_f64().unwrap() < 0.0, "{d}");
     let o = nh(&["replay", rec.to_str().unwrap(), "--verify"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    let forty: String = (0..40)
+        .map(|i| format!("b{i}"))
+        .collect::<Vec<_>>()
+        .join(",");
     for (args, err) in [
         (
             vec!["--model", "omega"],
@@ -484,6 +488,11 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
         (
             vec!["--ideal"],
             "error: --ideal needs --grip (it removes a modelled device's encoder counts)",
+        ),
+        (
+            vec!["--button-names", forty.as_str()],
+            "error: --button-names: device specs: `button_names` = 40 buttons is out of range: \
+             allowed at most 32 buttons",
         ),
     ] {
         let mut a = vec!["fake-device", "udp:127.0.0.1:1"];

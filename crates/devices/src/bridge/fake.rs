@@ -138,16 +138,21 @@ pub fn fake_specs(cfg: &FakeConfig, buttons: Option<&[String]>) -> DeviceSpecs {
         None => cfg.model.specs().clone(),
     };
     match buttons {
-        Some(names) => DeviceSpecs {
-            button_names: names
-                .iter()
-                .cloned()
-                .map(std::borrow::Cow::Owned)
-                .collect::<Vec<_>>()
-                .into(),
-            ..specs
-        },
+        Some(names) => with_button_names(specs, names),
         None => specs,
+    }
+}
+
+/// `specs` announcing the buttons `names` instead of its own (`--button-names`).
+pub fn with_button_names(specs: DeviceSpecs, names: &[String]) -> DeviceSpecs {
+    DeviceSpecs {
+        button_names: names
+            .iter()
+            .cloned()
+            .map(std::borrow::Cow::Owned)
+            .collect::<Vec<_>>()
+            .into(),
+        ..specs
     }
 }
 
