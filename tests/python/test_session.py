@@ -80,22 +80,32 @@ def test_wall_scene_caps_stiffness_and_clamps_force():
     assert any("stiffness_capped" in name for _, name, _ in run["events"])
 
 
-def test_operator_choices_change_the_motion():
+def test_operator_choices_change_the_motion(tmp_path):
     rigid = nh.run_scene(SCENES / "wall.toml", operator="rigid")
     hand = nh.run_scene(SCENES / "wall.toml", operator="hand")
     soft = nh.run_scene(SCENES / "wall.toml", operator={"stiffness_n_per_m": 100.0})
     assert not np.array_equal(rigid["device_position_m"], hand["device_position_m"])
     assert not np.array_equal(hand["device_position_m"], soft["device_position_m"])
-    # Another device: the script's buttons are checked against it.
+    # Another device: the built-in scripts bind their buttons by role, so the wall's plays on
+    # a Touch (its grip is the Touch's button1; its turn_x, which a Touch has no button for,
+    # is left out).
+    touch = nh.run_scene(SCENES / "wall.toml", device="touch")
+    pressed = [text for _, name, text in touch["events"] if name == "button.down"]
+    assert pressed == ["button1"], pressed
+    # A script that names one device's button is checked against another's: the error names
+    # the script file, line and column of the field.
+    text = (SCENES / "wall.script.toml").read_text().replace(
+        'role = "grip"', 'name = "centre"', 1
+    )
+    named = tmp_path / "wall.script.toml"
+    named.write_text(text)
     with pytest.raises(ValueError) as e:
-        nh.run_scene(SCENES / "wall.toml", device="touch")
-    # The error names the script file, line and column of the field.
+        nh.run_scene(SCENES / "wall.toml", script=named, device="touch")
     line = next(
-        n for n, l in enumerate((SCENES / "wall.script.toml").read_text().splitlines(), 1)
-        if l.startswith("name = \"centre\"")
+        n for n, l in enumerate(text.splitlines(), 1) if l.startswith('name = "centre"')
     )
     assert str(e.value) == (
-        f"{SCENES / 'wall.script.toml'}:{line}:8: script: `button[0].name`: device `touch` has "
+        f"{named}:{line}:8: script: `button[0].name`: device `touch` has "
         "no button `centre` (allowed: button1, button2)"
     )
 
