@@ -10,6 +10,7 @@
 pub mod fake;
 pub mod protocol;
 pub mod rule;
+pub mod rxbuf;
 pub mod udp;
 
 pub use udp::{BridgeConfig, UdpDevice};
