@@ -303,7 +303,7 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
         },
         Some(&stop),
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| session_error(e, buttons.as_deref()))?;
     if let Some(pb) = pb {
         pb.finish_and_clear();
     }
@@ -324,6 +324,43 @@ pub(crate) fn cmd(args: RunArgs) -> Result<u8, String> {
         return Ok(status::INTERRUPTED);
     }
     Ok(status::SUCCESS)
+}
+
+/// A session's error as the user reads it. With `--buttons` the scene the session read is the
+/// file rewritten with the flag's roles, so a button the device lacks is named by the flag
+/// (`--buttons grip`), not by a line of a text the user never saw; any other error in the
+/// rewritten scene says so beside its place.
+fn session_error(e: SessionError, buttons: Option<&str>) -> String {
+    use haptic_engine::check::SceneError;
+    let Some(flag) = buttons else {
+        return e.to_string();
+    };
+    match e {
+        SessionError::SceneFile { at, error } => match *error {
+            SceneError::OutOfRange {
+                field,
+                value,
+                allowed,
+            } if field.starts_with("device.buttons.")
+                && haptic_types::buttons::parse_overrides(flag).is_ok_and(|pairs| {
+                    pairs
+                        .iter()
+                        .any(|(r, _)| field == format!("device.buttons.{}", r.name()))
+                }) =>
+            {
+                let role = field.trim_start_matches("device.buttons.");
+                world_form::value::out_of_range(&format!("`--buttons {role}`"), value, &allowed)
+            }
+            error => format!("{at} (the scene as --buttons {flag} rewrote it): {error}"),
+        },
+        SessionError::DefaultScript { ref at, .. } => {
+            let at = at.to_string();
+            let text = e.to_string();
+            let rest = text.strip_prefix(&at).unwrap_or(&text);
+            format!("{at} (the scene as --buttons {flag} rewrote it){rest}")
+        }
+        other => other.to_string(),
+    }
 }
 
 /// A flag raised by the first Ctrl-C (SIGINT) or SIGTERM: the session stops cleanly after

@@ -47,18 +47,36 @@ fn the_command_line_moves_a_role_and_the_summary_says_so() {
     );
     let o = run(&[&base[..], &["--buttons", "grip=zz"]].concat());
     assert!(!o.status.success());
+    // Named by the flag, not by a line of the scene as the flag rewrote it (which the user
+    // never saw: it pointed at line 40 of a 68-line file that has no `[device]` table).
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: `--buttons grip` = \"zz\" is out of range: allowed a button of device `falcon`: \
+         centre, plus, minus, forward"
+    );
+    let o = run(&[&base[..], &["--buttons", "grip=centre,turn_z=zz"]].concat());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: `--buttons turn_z` = \"zz\" is out of range: allowed a button of device \
+         `falcon`: centre, plus, minus, forward"
+    );
+    // Any other error in the rewritten scene says where it is in that text.
+    let lone = Path::new(env!("CARGO_TARGET_TMPDIR")).join("buttons_flag_lone.toml");
+    std::fs::copy(root().join("scenes/brickworld.toml"), &lone).unwrap();
+    let o = run(&["run", lone.to_str().unwrap(), "--buttons", "grip=centre"]);
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
-        e.contains(
-            "scene: `device.buttons.grip` = \"zz\" is out of range: allowed a button of device \
-             `falcon`: centre, plus, minus, forward"
-        ),
+        e.starts_with(&format!(
+            "error: {}:56:18 (the scene as --buttons grip=centre rewrote it): \
+             `scene.default_script` = \"brickworld.script.toml\": cannot read ",
+            lone.display()
+        )),
         "{e}"
     );
     let o = run(&[&base[..], &["--buttons", "hold=centre"]].concat());
-    let e = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        e.contains("`--buttons` = \"hold\" is out of range: allowed a role: grip, turn_x"),
-        "{e}"
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: `--buttons` = \"hold\" is out of range: allowed a role: grip, turn_x, turn_y, \
+         turn_z"
     );
 }

@@ -494,6 +494,11 @@ fn a_loosely_held_falcon_carries_a_brick_without_buzz_over_the_bridge() {
             "error: --button-names: device specs: `button_names` = 40 buttons is out of range: \
              allowed at most 32 buttons",
         ),
+        (
+            vec!["--button-names", "a,b,a"],
+            "error: --button-names: device specs: `button_names` = \"a\" (buttons 0 and 2) is out \
+             of range: allowed distinct names (a role is bound to a button by its name)",
+        ),
     ] {
         let mut a = vec!["fake-device", "udp:127.0.0.1:1"];
         a.extend(args);

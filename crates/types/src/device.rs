@@ -157,6 +157,17 @@ impl DeviceSpecs {
                 allowed: "1–32 printable ASCII characters per name".into(),
             });
         }
+        // A role is bound to a button by its name: two buttons of one name would make the
+        // binding ambiguous.
+        let names = &self.button_names;
+        if let Some((i, b)) = (names.iter().enumerate()).find(|(i, b)| names[..*i].contains(b)) {
+            let first = names.iter().position(|x| x == b).unwrap_or(0);
+            return Err(DeviceError::BadSpec {
+                field: "button_names",
+                value: format!("\"{}\" (buttons {first} and {i})", b.escape_default()),
+                allowed: "distinct names (a role is bound to a button by its name)".into(),
+            });
+        }
         Ok(())
     }
 

@@ -272,6 +272,25 @@ mod tests {
             refusal(&hello(2, many)),
             ("button_names".into(), "at most 32 buttons".into())
         );
+        // Roles bind to buttons by name: a hello naming two buttons alike is refused.
+        let mut twice = FALCON;
+        twice.button_names = ["a", "b", "a"]
+            .map(std::borrow::Cow::Borrowed)
+            .to_vec()
+            .into();
+        let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
+        assert_eq!(
+            e(&hello(2, twice.clone())),
+            "hello refused: device specs: `button_names` = \"a\" (buttons 0 and 2) is out of \
+             range: allowed distinct names (a role is bound to a button by its name)"
+        );
+        assert_eq!(
+            refusal(&hello(2, twice)),
+            (
+                "button_names".into(),
+                "distinct names (a role is bound to a button by its name)".into()
+            )
+        );
         let good = hello(2, FALCON);
         assert_eq!(refusal(&good[..30]).0, "size");
         let mut long = good.clone();
