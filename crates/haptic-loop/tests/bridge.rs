@@ -127,10 +127,22 @@ fn five_percent_loss_and_2_ms_jitter_are_survived_and_replay_bit_for_bit() {
     for (n, (s, g)) in a.device_seq.iter().zip(&a.device_age_ticks).enumerate() {
         assert_eq!(s + u64::from(*g), first + n as u64, "tick {n}");
     }
+    // One tick per device period from the loop's first tick to its last (above); when those
+    // are is the machine's: the loop's first tick takes up the device's numbering once the
+    // session is set up, and it ticks on stale samples past the device's last until the bye
+    // arrives. Measured (slots of the first and last tick, the device's 2000 periods): idle,
+    // 3–7 and 1998; under eight busy loops on the 2 cores, 1–43 and 1998–2008. The bounds
+    // hold a loop that ran the device's session through: it started within 0.1 s of the
+    // device and ended within 50 ms of its last sample.
     let ticks = a.tick.len() as u64;
+    let end = ticks - 1 + first;
+    println!(
+        "lossy: {ticks} ticks, slots {first}..{end}, device {} periods, {} sent",
+        dev.ticks, dev.sent
+    );
     assert!(
-        ticks <= dev.ticks && ticks + 20 >= dev.ticks,
-        "{ticks} ticks, {} periods",
+        first <= 100 && end + 2 >= dev.ticks && end <= dev.ticks + 50,
+        "slots {first}..{end}, {} periods",
         dev.ticks
     );
     for (f, s) in a.device_force_n.iter().zip(&a.status) {
@@ -156,10 +168,16 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
     let (r, dev) = session_with(bridged(addr, &out), move || run_fake(&f, None).unwrap());
     let a = &r.arrays;
     let first = a.device_age_ticks.iter().position(|&g| g >= 50).unwrap();
-    let last_fresh = (0..first)
-        .rev()
-        .find(|&i| a.device_age_ticks[i] == 0)
-        .unwrap();
+    // The tick that first read the device's last sample before it went silent (on a loaded
+    // machine that sample may itself arrive a tick or two late: its age then starts above 0,
+    // as CI's scheduler made it once).
+    let last = a.device_seq[first];
+    let last_fresh = (0..first).find(|&i| a.device_seq[i] == last).unwrap();
+    let age0 = a.device_age_ticks[last_fresh];
+    assert!(
+        age0 < 9,
+        "the last sample was {age0} ticks old when first read"
+    );
     let f0 = vec3::norm(a.world_force_n[last_fresh]);
     assert!(f0 > 4.0, "in contact when the device vanished: {f0} N");
     // Full force through the 3 ms grace (ages 1 and 2 run 1.5 and 2.5 ms after the last
@@ -167,15 +185,17 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
     for k in 1..=30 {
         let i = last_fresh + k;
         let f = vec3::norm(a.device_force_n[i]);
-        assert_eq!(a.device_age_ticks[i], k as u32);
-        let expected = if k <= 2 {
+        let age = age0 + k as u32;
+        assert_eq!(a.device_age_ticks[i], age);
+        assert_eq!(a.device_seq[i], last);
+        let expected = if age <= 2 {
             1.0
         } else {
-            (9.0 - k as f64).max(0.0) / 7.0
+            (9.0 - f64::from(age)).max(0.0) / 7.0
         };
-        assert_eq!(a.watchdog[i], expected, "age {k}");
-        if k >= 9 {
-            assert_eq!(f, 0.0, "age {k} ms: {f} N");
+        assert_eq!(a.watchdog[i], expected, "age {age}");
+        if age >= 9 {
+            assert_eq!(f, 0.0, "age {age} ms: {f} N");
             assert_eq!(a.device_stiffness_n_per_m[i], [0.0; 9]);
         }
     }
@@ -187,7 +207,7 @@ fn a_device_that_vanishes_gets_zero_force_within_10_ms_and_soft_engagement_on_re
             .unwrap()
     };
     let lost = after("device.lost");
-    assert_eq!(lost.0, (last_fresh + 9) as u64);
+    assert_eq!(lost.0, (last_fresh + 9 - age0 as usize) as u64);
     // It comes back: soft engagement restarts from zero.
     let back = after("device.resumed");
     let b = back.0 as usize;
@@ -442,7 +462,9 @@ fn a_version_2_device_gets_the_local_model_and_reports_its_two_port_periods() {
     let addr = free_port();
     let out = tmp("v2.mcap");
     let mut opts = bridged(addr, &out);
-    opts.seconds = Some(0.05);
+    // The device's bye ends the session (a session of 50 ticks ended before a lockstep client
+    // on a loaded machine had sent its 50 samples: the ticks ran on, stale, without them).
+    opts.seconds = Some(10.0);
     let client = move || {
         let s = UdpSocket::bind("127.0.0.1:0").unwrap();
         s.set_read_timeout(Some(Duration::from_millis(20))).unwrap();
@@ -482,12 +504,15 @@ fn a_version_2_device_gets_the_local_model_and_reports_its_two_port_periods() {
                 }
             }
         }
+        s.send_to(&Packet::Bye { reason: 0 }.encode(), addr)
+            .unwrap();
         (version, locals)
     };
     let h = std::thread::spawn(move || run_session(&opts, &mut |_, _| {}));
     let (version, locals) = client();
     let r = h.join().unwrap().unwrap();
     assert_eq!(version, 2);
+    assert_eq!(r.end, "device_ended");
     assert_eq!(locals.len(), 50);
     for m in locals {
         let m = m.expect("a version-2 answer carries the local model");
