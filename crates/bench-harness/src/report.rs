@@ -156,7 +156,10 @@ mod tests {
 
     #[test]
     fn writes_the_section_with_facts_body_and_figure_paths() {
-        let dir = std::env::temp_dir().join(format!("bench-harness-test-{}", std::process::id()));
+        let dir = std::env::current_exe()
+            .unwrap()
+            .with_file_name("test-tmp")
+            .join(format!("bench-harness-test-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let mut r = Report::start_in(&dir, "demo", "demo — a section").unwrap();
         assert!(dir.join("docs/figures").is_dir());
@@ -185,7 +188,10 @@ mod tests {
 
     #[test]
     fn output_override_and_root() {
-        let dir = std::env::temp_dir().join(format!("bench-harness-out-{}", std::process::id()));
+        let dir = std::env::current_exe()
+            .unwrap()
+            .with_file_name("test-tmp")
+            .join(format!("bench-harness-out-{}", std::process::id()));
         let r = Report::start_in(&dir, "x", "x")
             .unwrap()
             .output(Some(dir.join("elsewhere/x.md")));

@@ -45,7 +45,8 @@ struct Session {
 }
 
 fn start(scene: &str, name: &str) -> Session {
-    let out = std::env::temp_dir().join(format!("nh-play-{}-{name}.mcap", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-play-{}-{name}.mcap", std::process::id()));
     let mut c = PlayConfig::new(SceneSource::resolve(scene.as_ref()).unwrap(), out.clone());
     c.port = 0;
     c.seconds = Some(60.0);

@@ -563,7 +563,10 @@ mod tests {
 
     #[test]
     fn a_wav_file_reads_back() {
-        let p = std::env::temp_dir().join(format!("nh-audio-{}.wav", std::process::id()));
+        // Under target/, beside the test binary.
+        let dir = std::env::current_exe().unwrap().with_file_name("test-tmp");
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join(format!("nh-audio-{}.wav", std::process::id()));
         let s = synthesize(&[impact(0.01, 0.3)], None, 0.1, SAMPLE_RATE_HZ).unwrap();
         write_wav(&p, &s, SAMPLE_RATE_HZ).unwrap();
         let r = hound::WavReader::open(&p).unwrap();

@@ -6,6 +6,15 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// Where these tests write: `test-tmp` beside the test binary, under `target/`.
+fn scratch() -> PathBuf {
+    let d = std::env::current_exe()
+        .expect("exe")
+        .with_file_name("test-tmp");
+    std::fs::create_dir_all(&d).expect("dir");
+    d
+}
+
 /// The end picture of every demo scene frames the action: the box of its bodies (not the
 /// ground, plate or substrate) is in the picture and fills at least 45 % of its width or
 /// height, and no label covers a body or leaves the picture
@@ -13,7 +22,7 @@ fn root() -> PathBuf {
 #[test]
 fn every_end_picture_frames_its_bodies_and_no_label_covers_one() {
     use haptic_loop::session::{SceneSource, SessionOptions, run_session};
-    let dir = std::env::temp_dir().join(format!("nanohaptics-frame-{}", std::process::id()));
+    let dir = scratch().join(format!("nanohaptics-frame-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
     for b in haptic_loop::builtin::SCENES {
         let rec = dir.join(format!("{}.mcap", b.name));
@@ -73,7 +82,7 @@ fn every_end_picture_frames_its_bodies_and_no_label_covers_one() {
 
 #[test]
 fn golden_recording_becomes_frames_and_a_gif() {
-    let dir = std::env::temp_dir().join(format!("nanohaptics-render-{}", std::process::id()));
+    let dir = scratch().join(format!("nanohaptics-render-{}", std::process::id()));
     let gif_path = dir.join("ot.gif");
     let args = RenderArgs {
         input: root().join("recordings/optical_tweezers.mcap"),
@@ -115,7 +124,7 @@ fn golden_recording_becomes_frames_and_a_gif() {
 /// the defaults: every 33 ticks at 1 kHz, 640 px).
 #[test]
 fn the_wall_gif_is_the_one_the_render_doc_quotes() {
-    let dir = std::env::temp_dir().join(format!("nanohaptics-render-doc-{}", std::process::id()));
+    let dir = scratch().join(format!("nanohaptics-render-doc-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
     let gif = dir.join("wall.gif");
     let s = run(&RenderArgs {
@@ -138,7 +147,7 @@ fn the_wall_gif_is_the_one_the_render_doc_quotes() {
 
 #[test]
 fn optical_tweezers_frames_from_the_recorded_state_equal_the_recomputed_ones() {
-    let dir = std::env::temp_dir().join(format!("nanohaptics-render-ot-{}", std::process::id()));
+    let dir = scratch().join(format!("nanohaptics-render-ot-{}", std::process::id()));
     let args = |out: &str| RenderArgs {
         input: root().join("recordings/optical_tweezers.mcap"),
         out: Some(dir.join(out)),
@@ -240,7 +249,7 @@ fn onset_and_peak(x: &[f64], sr: f64, t: f64) -> (f64, f64) {
 /// (read back from the WAV that `render --audio` wrote for the golden brick recording).
 #[test]
 fn the_wav_has_a_sound_on_each_recorded_impact() {
-    let wav = std::env::temp_dir().join(format!("nh-brick-{}.wav", std::process::id()));
+    let wav = scratch().join(format!("nh-brick-{}.wav", std::process::id()));
     let s = run(&audio_args("recordings/brickworld.mcap", &wav, false)).expect("audio");
     assert!(s.written[0].starts_with("WAV sound"), "{}", s.written[0]);
     let (x, sr) = read_wav(&wav);
@@ -309,7 +318,7 @@ fn a_brick_dropped_from_higher_sounds_louder() {
     use haptic_devices::source::OperatorChoice;
     use haptic_loop::session::{SceneSource, SessionOptions, run_session};
     use lesson::scripts::{BRICK_PICK_MM, ScriptText};
-    let dir = std::env::temp_dir().join(format!("nh-drops-{}", std::process::id()));
+    let dir = scratch().join(format!("nh-drops-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
     let [x0, y0, z0] = BRICK_PICK_MM;
     let mut level = Vec::new();
@@ -366,7 +375,7 @@ fn a_brick_dropped_from_higher_sounds_louder() {
 
 #[test]
 fn audio_flags_are_checked() {
-    let wav = std::env::temp_dir().join(format!("nh-wall-{}.wav", std::process::id()));
+    let wav = scratch().join(format!("nh-wall-{}.wav", std::process::id()));
     let e = run(&audio_args("recordings/wall.mcap", &wav, true))
         .unwrap_err()
         .to_string();
@@ -410,10 +419,10 @@ fn audio_flags_are_checked() {
 fn a_gif_faster_than_50_fps_is_refused() {
     let args = RenderArgs {
         input: root().join("recordings/optical_tweezers.mcap"),
-        out: Some(std::env::temp_dir().join("nanohaptics-render-refused")),
+        out: Some(scratch().join("nanohaptics-render-refused")),
         every: Some(10),
         width: 320,
-        gif: Some(std::env::temp_dir().join("nanohaptics-render-refused.gif")),
+        gif: Some(scratch().join("nanohaptics-render-refused.gif")),
         view: None,
         audio: None,
         proximity: false,
@@ -457,7 +466,7 @@ fn the_out_extension_chooses_the_format() {
 
 #[test]
 fn a_recording_becomes_the_file_its_name_says() {
-    let dir = std::env::temp_dir().join(format!("nanohaptics-out-{}", std::process::id()));
+    let dir = scratch().join(format!("nanohaptics-out-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
     let base = RenderArgs {
         input: root().join("recordings/wall.mcap"),

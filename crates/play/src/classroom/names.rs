@@ -117,7 +117,10 @@ mod tests {
         assert_eq!(file_stem(".."), "student");
         assert_eq!(file_stem("Zoë"), "Zo");
         assert_eq!(file_stem("..hidden"), "hidden");
-        let dir = std::env::temp_dir().join(format!("nh-names-{}", std::process::id()));
+        let dir = std::env::current_exe()
+            .unwrap()
+            .with_file_name("test-tmp")
+            .join(format!("nh-names-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let a = recording_path(&dir, "Ada", 7, &[]);
         assert_eq!(a, dir.join("Ada-7.mcap"));

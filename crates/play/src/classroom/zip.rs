@@ -82,7 +82,10 @@ mod tests {
             ("empty.mcap".to_string(), Vec::new()),
         ];
         let z = zip_stored(&files).unwrap();
-        let dir = std::env::temp_dir().join(format!("nh-zip-{}", std::process::id()));
+        let dir = std::env::current_exe()
+            .unwrap()
+            .with_file_name("test-tmp")
+            .join(format!("nh-zip-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("class.zip");
         std::fs::write(&p, &z).unwrap();

@@ -52,7 +52,9 @@ impl Browser {
         let exe = chromium()?;
         // One profile directory per browser: two browsers on one profile would be one browser.
         static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-        let dir = std::env::temp_dir().join(format!(
+        // Under target/, beside the test (or bench) binary.
+        let here = std::env::current_exe().map_err(|e| e.to_string())?;
+        let dir = here.with_file_name("test-tmp").join(format!(
             "nh-chromium-{}-{}",
             std::process::id(),
             NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
