@@ -50,8 +50,14 @@ mod tests {
             .collect();
         assert_eq!(locked, ["snap"]);
         let g = &m.steps[3];
-        assert_eq!(g.switch_pairs().collect::<Vec<_>>(), [("gravity_m_per_s2", 0.0)]);
-        assert_eq!(m.steps[4].switch_pairs().collect::<Vec<_>>(), [("inertia", 0.0)]);
+        assert_eq!(
+            g.switch_pairs().collect::<Vec<_>>(),
+            [("gravity_m_per_s2", 0.0)]
+        );
+        assert_eq!(
+            m.steps[4].switch_pairs().collect::<Vec<_>>(),
+            [("inertia", 0.0)]
+        );
         assert_eq!(
             m.steps[7].done,
             Condition::AtomPutBack {
@@ -60,6 +66,9 @@ mod tests {
             }
         );
         assert_eq!(m.steps[10].done, Condition::Time { seconds: 15.0 });
-        assert_eq!((m.steps[0].kind, m.steps[5].kind), ("brickworld", "nanoworld"));
+        assert_eq!(
+            (m.steps[0].kind, m.steps[5].kind),
+            ("brickworld", "nanoworld")
+        );
     }
 }

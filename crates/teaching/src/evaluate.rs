@@ -7,7 +7,9 @@ use haptic_types::Event;
 
 /// A state field the condition needs that the scene does not report.
 #[derive(Clone, Debug, thiserror::Error, PartialEq, Eq)]
-#[error("condition `{condition}` reads the state field `{field}`, which the scene does not report (its fields: {fields})")]
+#[error(
+    "condition `{condition}` reads the state field `{field}`, which the scene does not report (its fields: {fields})"
+)]
 pub struct MissingField {
     /// The condition's name.
     pub condition: &'static str,
@@ -90,9 +92,7 @@ impl Evaluator {
             Condition::BrickThrown => Watch::Event(&["brick.thrown"]),
             Condition::BrickPlaced => Watch::Event(&["brick.slot_filled"]),
             Condition::AtomSnapped => Watch::Event(&["nano.snap"]),
-            Condition::AtomPickedUp => {
-                Watch::Event(&["nano.atom_attached", "nano.atom_picked_up"])
-            }
+            Condition::AtomPickedUp => Watch::Event(&["nano.atom_attached", "nano.atom_picked_up"]),
             Condition::AtomPulledOff => Watch::Event(&["nano.pull_off"]),
             Condition::AtomPutBack { within_m, away_m } => Watch::PutBack {
                 within_m,
@@ -248,8 +248,13 @@ mod tests {
 
     #[test]
     fn a_condition_without_its_state_field_is_refused() {
-        let err = Evaluator::new(Condition::HouseComplete, "brickworld", &fields(&["a"]), 1000)
-            .unwrap_err();
+        let err = Evaluator::new(
+            Condition::HouseComplete,
+            "brickworld",
+            &fields(&["a"]),
+            1000,
+        )
+        .unwrap_err();
         assert_eq!(
             err.to_string(),
             "condition `house_complete` reads the state field `complete_s`, which the scene \

@@ -245,9 +245,7 @@ fn check(text: &str, dir: Option<&Path>) -> Result<Lesson, LessonError> {
     if raw.step.is_empty() {
         return Err(LessonError::invalid(
             "step",
-            format!(
-                "lists no steps: a lesson has 1 to {MAX_STEPS} steps, each a [[step]] table"
-            ),
+            format!("lists no steps: a lesson has 1 to {MAX_STEPS} steps, each a [[step]] table"),
         ));
     }
     if raw.step.len() > MAX_STEPS {
@@ -315,11 +313,12 @@ fn step(
             SwitchValue::Number(x) => *x,
         };
         let field = at(&format!("switches.{name}"));
-        let spec = haptic_types::switch::check(kind, scene.world.switches(), name, value)
-            .map_err(|source| LessonError::Switch {
+        let spec = haptic_types::switch::check(kind, scene.world.switches(), name, value).map_err(
+            |source| LessonError::Switch {
                 field: field.clone(),
                 source,
-            })?;
+            },
+        )?;
         scene
             .world
             .set_switch(spec.name, value)
@@ -428,11 +427,10 @@ fn condition(field: &str, d: &RawDone, kind: &str, scene: &str) -> Result<Condit
         return Err(LessonError::invalid(
             when_field,
             format!(
-                "= \"{}\" cannot happen in scene \"{scene}\": it reads {}, which a {} world never \
-                 emits (allowed in a {kind} scene: {})",
+                "= \"{}\" cannot happen in scene \"{scene}\": it reads {}, which a {kind} scene \
+                 never emits (allowed in a {kind} scene: {})",
                 d.when,
                 word.reads,
-                kind,
                 condition::names_for(kind)
             ),
         ));
@@ -537,8 +535,9 @@ fn question(field: &str, q: &RawQuestion) -> Result<Question, LessonError> {
                 return Err(LessonError::invalid(
                     choices_field,
                     format!(
-                        "lists {} choices: a choice question lists 2 to {MAX_CHOICES}",
-                        choices.len()
+                        "lists {} choice{}: a choice question lists 2 to {MAX_CHOICES}",
+                        choices.len(),
+                        if choices.len() == 1 { "" } else { "s" }
                     ),
                 ));
             }
@@ -605,4 +604,3 @@ impl Step {
         self.switches.iter().map(|s| (s.name.as_str(), s.value))
     }
 }
-
