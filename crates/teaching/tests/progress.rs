@@ -65,9 +65,9 @@ proptest! {
                 prop_assert_eq!(after, before);
             }
             // Leaving the first place of a step needs the step open.
-            for s in 0..m.steps.len() {
+            for (s, is_open) in open.iter().enumerate() {
                 if p.step_start(s) == Some(before) && after > before {
-                    prop_assert!(open[s], "left the start of locked step {s}");
+                    prop_assert!(*is_open, "left the start of locked step {s}");
                 }
             }
             // A student waiting at a locked step can neither answer nor tick.
