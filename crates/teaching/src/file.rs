@@ -336,6 +336,12 @@ fn step(
         });
     }
     let done = condition(&at("done"), &s.done, kind, &s.scene)?;
+    let state_fields = scene.world.state_fields();
+    // The condition's state fields are the scene's (a world that reports other fields is
+    // refused here, not when the step runs).
+    crate::evaluate::Evaluator::new(done, kind, &state_fields, scene.rate_hz).map_err(|e| {
+        LessonError::invalid(at("done.when"), format!("= \"{}\": {e}", s.done.when))
+    })?;
     let before = s
         .before
         .as_ref()
@@ -353,7 +359,7 @@ fn step(
         source: scene.source,
         kind,
         rate_hz: scene.rate_hz,
-        state_fields: scene.world.state_fields(),
+        state_fields,
         switches,
         task,
         done,
