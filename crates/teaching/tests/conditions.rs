@@ -116,6 +116,14 @@ fn the_brick_steps_are_met_on_the_tick_the_world_reports_them() {
         let thrown = first(&a, "brick.thrown").unwrap();
         assert_eq!(all(s, &a), Some(thrown), "{id}");
         assert_eq!(thrown, (release * 1000.0).ceil() as u64, "{id}");
+        // What the gravity-off step asks the student to predict: with gravity the thrown brick
+        // lands (an impact with the ground) within the 2 s the script goes on; without it, it
+        // flies on and never meets the ground.
+        let landed = a
+            .events
+            .iter()
+            .any(|e| e.0 > thrown && e.1 == "brick.impact" && e.2.contains("\"ground\""));
+        assert_eq!(landed, id != "gravity-off", "{id}");
         // Carried and never let go: not thrown.
         let (carry, _) = scripts::brick_lift(&[]);
         assert_eq!(all(s, &run(s, Some(carry), None)), None, "{id}");

@@ -235,3 +235,61 @@ fn the_example_of_the_docs_reads() {
     assert_eq!(l.test.len(), 1);
     assert!(l.steps[2].locked);
 }
+
+/// The rows of the first Markdown table after `heading` in `doc`, cells trimmed.
+fn table_after(doc: &str, heading: &str) -> Vec<Vec<String>> {
+    let from = doc.find(heading).expect(heading);
+    doc[from..]
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'))
+        .skip(2)
+        .map(|l| {
+            l.trim_matches('|')
+                .split(" | ")
+                .map(|c| c.trim().to_string())
+                .collect()
+        })
+        .collect()
+}
+
+/// docs/teaching.md's tables say what the module and the vocabulary are.
+#[test]
+fn the_tables_of_the_docs_are_the_module_and_the_vocabulary() {
+    let doc = include_str!("../../../docs/teaching.md");
+    let m = teaching::builtin::module().unwrap();
+    let rows = table_after(doc, "## The built-in module");
+    assert_eq!(rows.len(), m.steps.len());
+    for (i, (row, s)) in rows.iter().zip(&m.steps).enumerate() {
+        assert_eq!(row[0], (i + 1).to_string());
+        let id = if s.locked {
+            format!("`{}` (locked)", s.id)
+        } else {
+            format!("`{}`", s.id)
+        };
+        assert_eq!(row[1], id);
+        assert!(row[2].starts_with(s.kind), "{row:?}");
+        for (name, _) in s.switch_pairs() {
+            assert!(row[2].contains(name), "{row:?}");
+        }
+        assert_eq!(row[2].contains(','), !s.switches.is_empty(), "{row:?}");
+        assert!(
+            row[4].starts_with(&format!("`{}`", s.done.name())),
+            "{row:?}"
+        );
+    }
+    let rows = table_after(doc, "## The condition vocabulary");
+    assert_eq!(rows.len(), teaching::condition::WORDS.len());
+    for (row, w) in rows.iter().zip(teaching::condition::WORDS.iter()) {
+        assert_eq!(row[0], format!("`{}`", w.name));
+        let kinds = if w.kinds.is_empty() {
+            "every scene".to_string()
+        } else {
+            w.kinds.join(", ")
+        };
+        assert_eq!(row[2], kinds);
+        for p in w.params {
+            assert!(row[1].contains(&format!("`{}`", p.name)), "{row:?}");
+        }
+    }
+}
