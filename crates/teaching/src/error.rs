@@ -33,6 +33,12 @@ pub enum LessonError {
         /// What the scene allows.
         source: SwitchError,
     },
+    /// The lesson file cannot be read.
+    #[error("lesson: cannot read the file: {message}")]
+    Io {
+        /// The OS error.
+        message: String,
+    },
     /// A step's scene cannot be read or built.
     #[error("lesson: `{field}` = \"{scene}\": {message}")]
     Scene {
@@ -51,6 +57,7 @@ impl LessonError {
     pub fn position(&self, text: &str) -> Option<Position> {
         match self {
             LessonError::Syntax { offset, .. } => offset.map(|o| position(text, o)),
+            LessonError::Io { .. } => None,
             // A field that is absent (`step` of a lesson without steps): the `[lesson]` table.
             LessonError::Invalid { field, .. }
             | LessonError::Switch { field, .. }

@@ -147,11 +147,32 @@ struct RawStep {
     after: Option<RawQuestion>,
 }
 
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum SwitchValue {
-    Bool(bool),
-    Number(f64),
+/// A switch's value as written: a number, or `true` / `false` (1 / 0).
+struct SwitchValue(f64);
+
+impl<'de> Deserialize<'de> for SwitchValue {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = SwitchValue;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number, or true / false")
+            }
+            fn visit_bool<E>(self, b: bool) -> Result<SwitchValue, E> {
+                Ok(SwitchValue(f64::from(u8::from(b))))
+            }
+            fn visit_i64<E>(self, x: i64) -> Result<SwitchValue, E> {
+                Ok(SwitchValue(x as f64))
+            }
+            fn visit_u64<E>(self, x: u64) -> Result<SwitchValue, E> {
+                Ok(SwitchValue(x as f64))
+            }
+            fn visit_f64<E>(self, x: f64) -> Result<SwitchValue, E> {
+                Ok(SwitchValue(x))
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 #[derive(Deserialize)]
@@ -195,9 +216,8 @@ pub fn load_lesson(path: &Path) -> Result<Lesson, LessonFileError> {
             file: file.clone(),
             at: None,
         },
-        error: Box::new(LessonError::Syntax {
-            message: format!("cannot read the file: {e}"),
-            offset: None,
+        error: Box::new(LessonError::Io {
+            message: e.to_string(),
         }),
     })?;
     parse_lesson(&text, &file, path.parent())
@@ -307,11 +327,7 @@ fn step(
     let mut scene = scenes.get(&at("scene"), &s.scene, dir)?;
     let kind = scene.world.kind();
     let mut switches = Vec::with_capacity(s.switches.len());
-    for (name, v) in &s.switches {
-        let value = match v {
-            SwitchValue::Bool(b) => f64::from(u8::from(*b)),
-            SwitchValue::Number(x) => *x,
-        };
+    for (name, &SwitchValue(value)) in &s.switches {
         let field = at(&format!("switches.{name}"));
         let spec = haptic_types::switch::check(kind, scene.world.switches(), name, value).map_err(
             |source| LessonError::Switch {

@@ -40,6 +40,15 @@ fn err(text: &str) -> String {
 }
 
 #[test]
+fn a_missing_file_is_named() {
+    let e = teaching::load_lesson(std::path::Path::new("no/such.lesson.toml")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "no/such.lesson.toml: lesson: cannot read the file: No such file or directory (os error 2)"
+    );
+}
+
+#[test]
 fn a_good_lesson_reads() {
     let l = parse_lesson(GOOD, "my.lesson.toml", None).unwrap();
     assert_eq!(l.steps.len(), 2);
@@ -177,6 +186,18 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
             r("id = \"snap\"", "id = \"Snap It\""),
             "my.lesson.toml:20:6: lesson: `step[1].id` = \"Snap It\" is not an id: allowed 1 to \
              64 lower-case letters, digits, - and _",
+        ),
+        (
+            "a switch value that is not a number",
+            r("gravity_m_per_s2 = 0.0", "gravity_m_per_s2 = \"zero\""),
+            "my.lesson.toml:14:33: lesson: invalid type: string \"zero\", expected a number, or \
+             true / false",
+        ),
+        (
+            "an on/off switch given a number between",
+            r("inertia = true", "inertia = 0.5"),
+            "my.lesson.toml:14:48: lesson: `step[0].switches.inertia`: switch `inertia` = 0.5 is \
+             out of range: allowed true / false (1 / 0)",
         ),
         (
             "an empty task",
