@@ -34,8 +34,15 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
     #[test]
-    fn never_backwards_never_into_a_locked_step(ops in proptest::collection::vec(op(), 0..400)) {
-        let m = module();
+    fn never_backwards_never_into_a_locked_step(
+        locked in proptest::collection::vec(proptest::bool::weighted(0.3), 11),
+        ops in proptest::collection::vec(op(), 0..400),
+    ) {
+        // The built-in module with any steps locked at the start.
+        let mut m = module();
+        for (s, l) in m.steps.iter_mut().zip(&locked) {
+            s.locked = *l;
+        }
         let mut p = Progress::new(&m);
         // The test's own record of which steps are open.
         let mut open: Vec<bool> = m.steps.iter().map(|s| !s.locked).collect();
@@ -76,7 +83,11 @@ proptest! {
                 prop_assert!(not_now);
                 prop_assert_eq!(after, before);
             }
-            prop_assert_eq!(p.place() == Place::Waiting(5), p.position() == p.step_start(5).unwrap() && !open[5]);
+            // Waiting at a step is being at its start while it is locked.
+            for (s, is_open) in open.iter().enumerate() {
+                let at_start = p.step_start(s) == Some(p.position());
+                prop_assert_eq!(p.place() == Place::Waiting(s), at_start && !is_open);
+            }
         }
     }
 }
