@@ -7,7 +7,7 @@ use haptic_devices::source::OperatorChoice;
 use haptic_loop::session::{SessionArrays, SessionOptions, run_session};
 use haptic_types::Event;
 use lesson::scripts::{self, ScriptText};
-use teaching::{Evaluator, Lesson, Step};
+use teaching::{Condition, Evaluator, Lesson, Step};
 
 fn module() -> Lesson {
     teaching::builtin::module().unwrap_or_else(|e| panic!("{e}"))
@@ -44,8 +44,13 @@ fn run(s: &Step, script: Option<String>, seconds: Option<f64>) -> SessionArrays 
 
 /// Feeds the first `ticks` ticks of a run to the step's evaluator; the tick it was met on.
 fn evaluate(s: &Step, a: &SessionArrays, ticks: usize) -> Option<u64> {
+    evaluate_as(s.done, s, a, ticks)
+}
+
+/// [`evaluate`] with another condition of the vocabulary, in the step's scene.
+fn evaluate_as(c: Condition, s: &Step, a: &SessionArrays, ticks: usize) -> Option<u64> {
     assert_eq!(a.state_fields, s.state_fields);
-    let mut e = Evaluator::new(s.done, s.kind, &s.state_fields, s.rate_hz).unwrap();
+    let mut e = Evaluator::new(c, s.kind, &s.state_fields, s.rate_hz).unwrap();
     let n = a.state_fields.len();
     let mut k = 0;
     for (i, row) in a.state.chunks(n).take(ticks).enumerate() {
@@ -85,7 +90,19 @@ fn the_brick_steps_are_met_on_the_tick_the_world_reports_them() {
     assert_eq!(column(&house, "slots_filled")[done as usize], 4.0);
     assert_eq!(column(&house, "slots_filled")[done as usize - 1], 3.0);
     let (lift, _) = scripts::brick_lift(&[]);
-    assert_eq!(all(s, &run(s, Some(lift.clone()), None)), None);
+    let lifted = run(s, Some(lift.clone()), None);
+    assert_eq!(all(s, &lifted), None);
+    // `brick_placed`, the vocabulary's other brick condition: the house's first filled slot;
+    // a brick lifted and carried fills none.
+    let placed = first(&house, "brick.slot_filled").unwrap();
+    assert!(placed < done);
+    let n = house.tick.len();
+    assert_eq!(
+        evaluate_as(Condition::BrickPlaced, s, &house, n),
+        Some(placed)
+    );
+    let n = lifted.tick.len();
+    assert_eq!(evaluate_as(Condition::BrickPlaced, s, &lifted, n), None);
 
     // Lifting: met on the first tick the held brick is 0.1 m above where it was grabbed.
     let s = step(&m, "lift");
@@ -164,9 +181,9 @@ fn the_atom_steps_are_met_on_the_tick_the_world_reports_them() {
         .at(0.0, [-1.0, -1.0, dev_z(0.45 + 1.5)])
         .at(2.0, [-1.0, -1.0, dev_z(0.45 + 1.5)])
         .text();
-    let b = run(s, Some(hover), None);
-    assert_eq!(first(&b, "nano.snap"), None);
-    assert_eq!(all(s, &b), None);
+    let hovered = run(s, Some(hover), None);
+    assert_eq!(first(&hovered, "nano.snap"), None);
+    assert_eq!(all(s, &hovered), None);
 
     // The content question's "about ten times harder": the game's release at ten times the
     // snap force.
@@ -223,6 +240,15 @@ fn the_atom_steps_are_met_on_the_tick_the_world_reports_them() {
         dist(met)
     );
     assert!((taken..met).any(|i| dist(i) >= 2e-9));
+    // `atom_picked_up`, the vocabulary's other atom condition: met on the tick the atom came
+    // onto the tip; hovering above the surface picks up nothing.
+    let n = a.tick.len();
+    assert_eq!(
+        evaluate_as(Condition::AtomPickedUp, s, &a, n),
+        Some(taken as u64)
+    );
+    let n = hovered.tick.len();
+    assert_eq!(evaluate_as(Condition::AtomPickedUp, s, &hovered, n), None);
     // The irreversibility the step shows: the atom is still on the tip at the end.
     assert_eq!(*column(&a, "carried_atoms").last().unwrap(), 1.0);
     // Carried away and never brought back: not met.

@@ -107,6 +107,13 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
              atom_pulled_off, atom_put_back, time)",
         ),
         (
+            "a condition in a scene without either world",
+            r("scene = \"nanoworld\"", "scene = \"wall\""),
+            "my.lesson.toml:24:17: lesson: `step[1].done.when` = \"atom_snapped\" cannot happen \
+             in scene \"wall\": it reads nano.snap, which a wall scene never emits (allowed in a \
+             wall scene: time)",
+        ),
+        (
             "question without choices",
             r(", choices = [\"fall\", \"fly\"]", ""),
             "my.lesson.toml:17:1: lesson: `step[0].before.choices` is missing: a choice question \
