@@ -99,6 +99,14 @@ enum Cmd {
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
+        /// Instead of comparing, serve the recording as a page to watch in a browser: play
+        /// and pause, speed, a timeline to scrub, the world drawn as in the game, the events
+        /// and the sound (Ctrl-C ends). A damaged file is refused as `--verify` refuses it.
+        #[arg(long, conflicts_with_all = ["verify", "salvage", "json"])]
+        serve: bool,
+        /// With --serve: the page's port on 127.0.0.1 (0: any free port).
+        #[arg(long, default_value_t = 8766, requires = "serve")]
+        port: u16,
     },
     /// Channels, duration and tick statistics of a recording.
     Info {
@@ -199,9 +207,16 @@ where
         Cmd::Render(args) => render_cmd::cmd(&args),
         Cmd::Replay {
             rec,
+            serve: true,
+            port,
+            ..
+        } => recording_cmd::serve(&rec, port),
+        Cmd::Replay {
+            rec,
             verify,
             salvage,
             json,
+            ..
         } => recording_cmd::replay(&rec, verify, salvage, json),
         Cmd::Info { rec, salvage, json } => recording_cmd::info(&rec, salvage, json),
         Cmd::Lesson(a) => lesson_cmd::cmd(&a),

@@ -9,6 +9,38 @@ use recording::read_recording_file;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+/// `replay FILE --serve`: re-simulates the recording into the replay page's frames, serves
+/// them on 127.0.0.1:`port` until Ctrl-C.
+pub(crate) fn serve(rec: &Path, port: u16) -> Result<u8, String> {
+    eprintln!(
+        "{}: re-simulating the session for the page ...",
+        rec.display()
+    );
+    let t = std::time::Instant::now();
+    let book =
+        play::replay::ReplayBook::from_file(rec).map_err(|e| format!("{}: {e}", rec.display()))?;
+    let (ticks, frames) = (book.ticks, book.frames.len());
+    let stop = crate::run_cmd::interrupt_flag()?;
+    let mut server =
+        play::replay::ReplayServer::start(book, rec.to_path_buf(), port).map_err(|e| {
+            format!(
+                "cannot serve the page on 127.0.0.1:{port}: {e} (choose another with --port, or \
+                 --port 0 for any free port)"
+            )
+        })?;
+    println!(
+        "{}: {ticks} ticks in {frames} frames ({:.1} s); open {} in a browser (Ctrl-C ends)",
+        rec.display(),
+        t.elapsed().as_secs_f64(),
+        server.url()
+    );
+    while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    server.stop();
+    Ok(status::SUCCESS)
+}
+
 pub(crate) fn replay(rec: &Path, strict: bool, salvage: bool, json: bool) -> Result<u8, String> {
     let r = read_recording_file(rec, salvage).map_err(|e| format!("{}: {e}", rec.display()))?;
     let report = verify(&r).map_err(|e| format!("{}: replay failed: {e}", rec.display()))?;

@@ -40,6 +40,7 @@ pub mod http;
 pub mod input;
 pub mod protocol;
 pub mod publish;
+pub mod replay;
 pub mod server;
 pub mod session;
 pub mod wslink;

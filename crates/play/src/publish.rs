@@ -276,6 +276,29 @@ fn refresh_hello(shared: &Shared, name: &str, value: f64) {
     }
 }
 
+/// Where the publisher's messages go: a live session's pages ([`Shared`]), or a replay's
+/// list of frames ([`crate::replay`]).
+pub trait Outlet: Send + Sync {
+    /// Sends `m` to every page.
+    fn broadcast(&self, m: &Message);
+    /// Sends `m` to page `page` only.
+    fn send_to(&self, page: u64, m: Message);
+    /// A live switch was applied: the value a page that connects later is told.
+    fn switched(&self, name: &str, value: f64);
+}
+
+impl Outlet for Shared {
+    fn broadcast(&self, m: &Message) {
+        Shared::broadcast(self, m);
+    }
+    fn send_to(&self, page: u64, m: Message) {
+        Shared::send_to(self, page, m);
+    }
+    fn switched(&self, name: &str, value: f64) {
+        refresh_hello(self, name, value);
+    }
+}
+
 /// The publisher thread's loop: runs until the session's `Finish` (or the channel closes).
 /// `proximity_on_distance_m`: the distance below which the proximity tone sounds, m (`None`:
 /// no tone), sent to the pages with the ticks.
@@ -287,8 +310,19 @@ pub fn run_publisher(
     proximity_on_distance_m: Option<f64>,
 ) -> PublishSummary {
     crate::background::lower_priority();
+    publish(rx, shared, rate_hz, state_fields, proximity_on_distance_m)
+}
+
+/// [`run_publisher`]'s loop on this thread, into `out`.
+pub fn publish(
+    rx: Receiver<ToPublisher>,
+    out: Arc<dyn Outlet>,
+    rate_hz: u32,
+    state_fields: Vec<String>,
+    proximity_on_distance_m: Option<f64>,
+) -> PublishSummary {
     let mut p = Publisher {
-        shared,
+        shared: out,
         dt: 1.0 / f64::from(rate_hz.max(1)),
         state_fields,
         sum: PublishSummary::default(),
@@ -335,7 +369,7 @@ pub fn run_publisher(
                 }
             }
             ToPublisher::Switched { tick, name, value } => {
-                refresh_hello(&p.shared, &name, value);
+                p.shared.switched(&name, value);
                 let m = ServerMsg::Switched { tick, name, value };
                 p.shared.broadcast(&Message::text(m.to_json()));
             }
@@ -358,7 +392,7 @@ pub fn run_publisher(
 /// The publisher's state between messages: the ticks not yet sent to the pages' synthesis,
 /// and the events and sounds since the last frame.
 struct Publisher {
-    shared: Arc<Shared>,
+    shared: Arc<dyn Outlet>,
     dt: f64,
     state_fields: Vec<String>,
     sum: PublishSummary,

@@ -435,7 +435,7 @@ impl PageSession {
 
 /// The page's `hello`: the scene, the device, the view's mapping, the menu of switches with
 /// their values now and the state fields.
-fn hello_message(
+pub(crate) fn hello_message(
     scene_name: &str,
     lp: &HapticLoop,
     specs: &DeviceSpecs,
