@@ -272,6 +272,11 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
             serde_json::from_value::<ServerMsg>(m.clone()).unwrap();
         }
     }
+    // A session still running is not replayed yet; the replay is the teacher's alone.
+    let t0 = &tokens[0];
+    let running = get(&host, &format!("/replay/index.json?s={t0}&code=TEACH123"));
+    assert!(running.starts_with("HTTP/1.1 409 Conflict"), "{running}");
+    assert!(running.contains("session is still running: it can be replayed once it has ended"));
     // The teacher ends every session; each page gets its end and its own recording.
     send(&mut teacher, json!({"type": "end_all"}));
     let r = read_for(&mut teacher, 0.5);
@@ -291,6 +296,18 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
             &dl[..60.min(dl.len())]
         );
     }
+    // The teacher watches an ended session again: the replay page and its data, made from the
+    // student's recording (its ticks checked against the summary below); not without the code.
+    let page = get(&host, &format!("/replay?s={t0}&code=TEACH123"));
+    assert!(page.starts_with("HTTP/1.1 200 OK"), "{page}");
+    assert!(page.contains(r#"<script type="module" src="/replay.js"></script>"#));
+    let index = get(&host, &format!("/replay/index.json?s={t0}&code=TEACH123"));
+    assert!(index.starts_with("HTTP/1.1 200 OK"), "{index}");
+    let index: Value = serde_json::from_str(index.split("\r\n\r\n").nth(1).unwrap()).unwrap();
+    for path in ["/replay", "/replay/index.json", "/replay/sound.f32"] {
+        let r = get(&host, &format!("{path}?s={t0}&code=WRONG"));
+        assert!(r.starts_with("HTTP/1.1 403 Forbidden"), "{path}: {r}");
+    }
     let zip = get(&host, "/recordings.zip?code=TEACH123");
     assert!(zip.starts_with("HTTP/1.1 200 OK\r\nContent-Type: application/zip"));
 
@@ -302,6 +319,17 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
         "{:?}",
         summary.refused
     );
+    let first = summary
+        .students
+        .iter()
+        .find(|s| {
+            s.session
+                .recording
+                .to_string_lossy()
+                .contains(&format!("{}", index["file"].as_str().unwrap()))
+        })
+        .expect("the replayed recording is a student's");
+    assert_eq!(index["ticks"].as_u64(), Some(first.session.stats.ticks));
     // The forged teacher link, the cross-site form, the other site's and the bare POST.
     assert_eq!(summary.refused.origin, 4);
     assert_eq!(summary.refused.head, 1, "the GET link to /join");

@@ -195,6 +195,18 @@ fn the_teacher_page_watches_switches_ends_and_collects_the_class() {
         .unwrap();
     assert_eq!(zip[1], 0x0403_4b50, "a zip's first local header");
     assert_eq!(zip[2], 3, "three recordings in the zip");
+    // Each ended session has its Watch link: the first opens the replay page, which loads the
+    // student's session re-simulated from their recording.
+    let watch = b
+        .eval("[...document.querySelectorAll('#students tbody tr a')].filter(a => a.textContent === 'Watch').map(a => a.href)")
+        .unwrap();
+    let watch = watch.as_array().unwrap();
+    assert_eq!(watch.len(), 3, "{watch:?}");
+    b.open(watch[0].as_str().unwrap()).unwrap();
+    b.wait_for("window.__replay && window.__replay.ready", 30.0)
+        .unwrap();
+    let ticks = b.eval("__replay.index.ticks").unwrap().as_u64().unwrap();
+    assert!(ticks > 0);
     b.check().unwrap();
     links_stop.store(true, Ordering::Relaxed);
     assert!(

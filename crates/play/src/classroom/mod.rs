@@ -483,6 +483,7 @@ pub fn run(
         class_limits(config),
         Arc::new(routes::ClassRoutes {
             class: class.clone(),
+            replays: Default::default(),
         }),
         shutdown,
     )

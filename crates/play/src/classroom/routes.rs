@@ -1,15 +1,19 @@
 //! The classroom's paths: the join page and `POST /join`, each student's page (`/play?s=TOKEN`,
 //! the page's modules, `/ws?s=TOKEN`, `/recording.mcap?s=TOKEN`), and the teacher's
-//! (`/teacher?code=…`, `/teacher/ws?code=…`, `/recordings.zip?code=…`). Every request passed
+//! (`/teacher?code=…`, `/teacher/ws?code=…`, `/recordings.zip?code=…`, and a student's ended
+//! session replayed: `/replay?s=TOKEN&code=…` with its data under `/replay/`). Every request passed
 //! the listener's gate and its `Host`/`Origin` check before it reaches these. Joining changes
 //! the class (a session, a name taken), so it is a form `POST` from the join page itself
 //! ([`webguard::form`]): a link or a page from another site cannot fill the class with names.
 
-use super::{Class, JoinError, teacher};
+use super::{Class, JoinError, Phase, teacher};
 use crate::http::{accept_upgrade, respond, respond_text};
+use crate::replay::{ReplayBook, server as replay};
 use crate::server::{PAGE_FILES, Routes, page_link, serve_download, serve_page_file};
+use std::collections::HashMap;
 use std::net::TcpStream;
 use std::sync::Arc;
+use std::sync::Mutex;
 use webguard::Head;
 use webguard::gate::Gate;
 
@@ -21,6 +25,8 @@ const TEACHER_JS: &str = include_str!("page/teacher.js");
 /// The classroom's routes.
 pub(crate) struct ClassRoutes {
     pub(crate) class: Arc<Class>,
+    /// The students' ended sessions made ready to replay, by token (made on the first ask).
+    pub(crate) replays: Mutex<HashMap<String, Arc<ReplayBook>>>,
 }
 
 /// Escapes text for HTML.
@@ -167,6 +173,60 @@ impl ClassRoutes {
     }
 }
 
+impl ClassRoutes {
+    /// The teacher's replay of a student's ended session (`?s=TOKEN&code=…`): the page, or
+    /// its data. A session still running is not replayed yet (409).
+    fn replay_route(&self, mut stream: TcpStream, head: &Head) {
+        let Some(s) = head.query("s").and_then(|t| self.class.student(&t)) else {
+            return respond_text(
+                &mut stream,
+                "404 Not Found",
+                "no such session in this class",
+            );
+        };
+        let ended = s.status.lock().is_ok_and(|st| st.phase == Phase::Ended);
+        if !ended {
+            return respond_text(
+                &mut stream,
+                "409 Conflict",
+                &format!(
+                    "{}'s session is still running: it can be replayed once it has ended",
+                    s.name
+                ),
+            );
+        }
+        if !replay::is_data_path(head.path()) {
+            replay::serve_page(&mut stream, head.path(), "/replay");
+            return;
+        }
+        let cached = self
+            .replays
+            .lock()
+            .ok()
+            .and_then(|m| m.get(&s.token).cloned());
+        let book = match cached {
+            Some(b) => b,
+            None => match ReplayBook::from_file(&s.out) {
+                Ok(b) => {
+                    let b = Arc::new(b);
+                    if let Ok(mut m) = self.replays.lock() {
+                        m.insert(s.token.clone(), b.clone());
+                    }
+                    b
+                }
+                Err(e) => {
+                    return respond_text(
+                        &mut stream,
+                        "500 Internal Server Error",
+                        &format!("{}: {e}", s.out.display()),
+                    );
+                }
+            },
+        };
+        replay::serve_data(&mut stream, head, &book);
+    }
+}
+
 impl Routes for ClassRoutes {
     fn post_paths(&self) -> &'static [&'static str] {
         &["/join"]
@@ -217,6 +277,17 @@ impl Routes for ClassRoutes {
                     Err(e) => respond_text(&mut stream, "500 Internal Server Error", &e),
                 }
             }
+            "/replay.js" => {
+                replay::serve_page(&mut stream, "/replay.js", "/replay");
+            }
+            p if (p == "/replay" || replay::is_data_path(p)) && self.teacher_ok(&head, gate) => {
+                self.replay_route(stream, &head)
+            }
+            p if p == "/replay" || replay::is_data_path(p) => respond_text(
+                &mut stream,
+                "403 Forbidden",
+                "the teacher's code is wrong or missing: use the teacher address printed at start",
+            ),
             "/teacher" | "/teacher/ws" | "/recordings.zip" => respond_text(
                 &mut stream,
                 "403 Forbidden",

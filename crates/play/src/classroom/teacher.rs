@@ -63,6 +63,7 @@ pub(crate) fn class_json(class: &Class, gate: &Gate) -> String {
             let st = s.status.lock().map(|st| st.clone()).ok();
             serde_json::json!({
                 "name": s.name,
+                "token": s.token,
                 "pages": s.pages(),
                 "recording": s.out.file_name().map(|n| n.to_string_lossy().to_string()),
                 "status": st,

@@ -52,81 +52,92 @@ fn json(stream: &mut TcpStream, body: &str) {
     );
 }
 
-impl ReplayRoutes {
-    /// `frames.json?from=K&count=N`: the range checked, named in the refusal.
-    fn frames(&self, stream: &mut TcpStream, head: &Head) {
-        let n = self.book.frames.len();
-        let arg = |key: &str, default: usize| -> Result<usize, String> {
-            match head.query(key) {
-                None => Ok(default),
-                Some(v) => v
-                    .parse::<usize>()
-                    .map_err(|_| format!("`{key}` = \"{}\" is not a count", v.escape_default())),
-            }
-        };
-        let range = arg("from", 0).and_then(|from| {
-            let count = arg("count", MAX_FRAMES)?;
-            if from > n {
-                return Err(format!(
-                    "`from` = {from} is out of range: allowed 0 ≤ from ≤ {n}"
-                ));
-            }
-            if count > MAX_FRAMES {
-                return Err(format!(
-                    "`count` = {count} is out of range: allowed 0 ≤ count ≤ {MAX_FRAMES}"
-                ));
-            }
-            Ok(from..(from + count).min(n))
-        });
-        match range {
-            Ok(r) => {
-                let body = format!("[{}]", self.book.frames[r].join(","));
-                json(stream, &body);
-            }
-            Err(e) => respond_text(stream, "400 Bad Request", &e),
+/// `frames.json?from=K&count=N` of `book`: the range checked, named in the refusal.
+fn frames(stream: &mut TcpStream, head: &Head, book: &ReplayBook) {
+    let n = book.frames.len();
+    let arg = |key: &str, default: usize| -> Result<usize, String> {
+        match head.query(key) {
+            None => Ok(default),
+            Some(v) => v
+                .parse::<usize>()
+                .map_err(|_| format!("`{key}` = \"{}\" is not a count", v.escape_default())),
         }
+    };
+    let range = arg("from", 0).and_then(|from| {
+        let count = arg("count", MAX_FRAMES)?;
+        if from > n {
+            return Err(format!(
+                "`from` = {from} is out of range: allowed 0 ≤ from ≤ {n}"
+            ));
+        }
+        if count > MAX_FRAMES {
+            return Err(format!(
+                "`count` = {count} is out of range: allowed 0 ≤ count ≤ {MAX_FRAMES}"
+            ));
+        }
+        Ok(from..(from + count).min(n))
+    });
+    match range {
+        Ok(r) => json(stream, &format!("[{}]", book.frames[r].join(","))),
+        Err(e) => respond_text(stream, "400 Bad Request", &e),
+    }
+}
+
+/// Whether `path` is one of the replay's data paths (`/replay/…`).
+pub fn is_data_path(path: &str) -> bool {
+    path.starts_with("/replay/")
+}
+
+/// Serves the replay page's own files: the page (at `page_path`), `/replay.js` and the play
+/// page's modules it imports; false for any other path.
+pub fn serve_page(stream: &mut TcpStream, path: &str, page_path: &str) -> bool {
+    if path == page_path {
+        respond(
+            stream,
+            "200 OK",
+            "text/html; charset=utf-8",
+            "",
+            HTML.as_bytes(),
+        );
+    } else if path == "/replay.js" {
+        respond(
+            stream,
+            "200 OK",
+            "text/javascript; charset=utf-8",
+            "",
+            JS.as_bytes(),
+        );
+    } else if SHARED.contains(&path) {
+        serve_page_file(stream, path);
+    } else {
+        return false;
+    }
+    true
+}
+
+/// Serves the data path `head` asks for (see [`is_data_path`]) from `book`.
+pub fn serve_data(stream: &mut TcpStream, head: &Head, book: &ReplayBook) {
+    match head.path() {
+        "/replay/hello.json" => json(stream, &book.hello),
+        "/replay/index.json" => json(stream, &book.index_json()),
+        "/replay/frames.json" => frames(stream, head, book),
+        "/replay/sound.f32" => {
+            let bytes: Vec<u8> = book.sound.iter().flat_map(|s| s.to_le_bytes()).collect();
+            respond(stream, "200 OK", "application/octet-stream", "", &bytes);
+        }
+        _ => respond_text(stream, "404 Not Found", "not found"),
     }
 }
 
 impl Routes for ReplayRoutes {
     fn route(&self, mut stream: TcpStream, head: Head, _gate: &Arc<Gate>) {
         let path = head.path();
+        let page = if path == "/index.html" { "/" } else { path };
+        if serve_page(&mut stream, page, "/") {
+            return;
+        }
         match path {
-            "/" | "/index.html" => respond(
-                &mut stream,
-                "200 OK",
-                "text/html; charset=utf-8",
-                "",
-                HTML.as_bytes(),
-            ),
-            "/replay.js" => respond(
-                &mut stream,
-                "200 OK",
-                "text/javascript; charset=utf-8",
-                "",
-                JS.as_bytes(),
-            ),
-            p if SHARED.contains(&p) => {
-                serve_page_file(&mut stream, path);
-            }
-            "/replay/hello.json" => json(&mut stream, &self.book.hello),
-            "/replay/index.json" => json(&mut stream, &self.book.index_json()),
-            "/replay/frames.json" => self.frames(&mut stream, &head),
-            "/replay/sound.f32" => {
-                let bytes: Vec<u8> = self
-                    .book
-                    .sound
-                    .iter()
-                    .flat_map(|s| s.to_le_bytes())
-                    .collect();
-                respond(
-                    &mut stream,
-                    "200 OK",
-                    "application/octet-stream",
-                    "",
-                    &bytes,
-                );
-            }
+            p if is_data_path(p) => serve_data(&mut stream, &head, &self.book),
             "/recording.mcap" => serve_download(&mut stream, Some(self.file.clone()), ""),
             "/favicon.ico" => respond(&mut stream, "204 No Content", "image/x-icon", "", b""),
             _ => respond_text(&mut stream, "404 Not Found", "not found"),

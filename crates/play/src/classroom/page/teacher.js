@@ -53,6 +53,16 @@ function row(s) {
     b.textContent = 'End';
     b.addEventListener('click', () => send({ type: 'end', student: s.name }));
     tr.children[8].appendChild(b);
+  } else if (st) {
+    // An ended session: watch it again (re-simulated from the recording) in a new tab.
+    const a = document.createElement('a');
+    const p = new URLSearchParams(q);
+    p.set('s', s.token);
+    a.href = `/replay?${p}`;
+    a.target = '_blank';
+    a.textContent = 'Watch';
+    a.setAttribute('aria-label', `watch ${s.name}'s session again`);
+    tr.children[8].appendChild(a);
   }
   return tr;
 }

@@ -23,6 +23,15 @@ let shown = -1;
 
 function fail(e) { R.errors.push(String(e)); say(`replay error: ${e}`); }
 
+// A data path with the page's own query (a class's replay names the student and carries the
+// teacher's code) and `params`.
+function api(path, params = {}) {
+  const q = new URLSearchParams(location.search);
+  for (const [k, v] of Object.entries(params)) q.set(k, String(v));
+  const s = q.toString();
+  return s ? `${path}?${s}` : path;
+}
+
 async function getJSON(url) {
   const r = await fetch(url);
   if (!r.ok) throw new Error(`${url}: ${r.status} ${await r.text()}`);
@@ -30,7 +39,7 @@ async function getJSON(url) {
 }
 
 function chunk(c) {
-  if (!chunks.has(c)) chunks.set(c, getJSON(`/replay/frames.json?from=${c * CHUNK}&count=${CHUNK}`));
+  if (!chunks.has(c)) chunks.set(c, getJSON(api('/replay/frames.json', { from: c * CHUNK, count: CHUNK })));
   return chunks.get(c);
 }
 
@@ -176,7 +185,7 @@ async function start() {
   window.addEventListener('resize', resize);
   resize();
   installControls();
-  const [index, hello] = await Promise.all([getJSON('/replay/index.json'), getJSON('/replay/hello.json')]);
+  const [index, hello] = await Promise.all([getJSON(api('/replay/index.json')), getJSON(api('/replay/hello.json'))]);
   R.index = index;
   R.hello = hello;
   P.hello = hello;
@@ -190,7 +199,8 @@ async function start() {
   const tl = $('timeline');
   tl.max = String(lastTick);
   tl.setAttribute('aria-valuetext', '0 s');
-  const r = await fetch('/replay/sound.f32');
+  $('download').href = api('/recording.mcap');
+  const r = await fetch(api('/replay/sound.f32'));
   if (!r.ok) throw new Error(`/replay/sound.f32: ${r.status}`);
   samples = new Float32Array(await r.arrayBuffer());
   R.sound.samples = samples.length;
