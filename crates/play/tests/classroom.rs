@@ -326,7 +326,7 @@ fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {
             s.session
                 .recording
                 .to_string_lossy()
-                .contains(&format!("{}", index["file"].as_str().unwrap()))
+                .contains(index["file"].as_str().unwrap())
         })
         .expect("the replayed recording is a student's");
     assert_eq!(index["ticks"].as_u64(), Some(first.session.stats.ticks));
