@@ -73,6 +73,13 @@ impl Coupling {
         max_fraction: 0.6,
         damping_ratio: 0.9,
     };
+    /// The stiffer coupling the bound points to: the spring at 0.6 of the rated stiffness and
+    /// the high-frequency stiffness at all of it (a scene setting, not a default).
+    pub const STIFF: Coupling = Coupling {
+        stiffness_fraction: 0.6,
+        max_fraction: 1.0,
+        damping_ratio: 0.9,
+    };
 }
 
 /// Periods measured and the carry's intended amplitude (m) at `hz`.
