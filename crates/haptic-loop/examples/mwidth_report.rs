@@ -283,8 +283,8 @@ fn main() {
          is a third of the Falcon's, not three times it). Only the delta.3's rated stiffness \
          admits 5 % at all, and only as a spring at its whole k_max (+4.1 %); the stiffer \
          coupling measured in the table (0.6/1.0) brings the Falcon to +8.1 % (loose) and \
-         +8.6 % (firm) at 0 ms but is unstable in half its runs, and on the 4 kHz devices it is cancelled by the \
-         servo effect below.",
+         +8.6 % (firm) at 0 ms but is unstable in half its runs; on the delta.3 the servo effect below grows with \
+         the coupling's stiffness (+8.0 to +13.2 %).",
     );
     md.para(
         "How to read: the felt error follows the coupling's |K / (K − m ω²)| at 0 ms on the \
