@@ -23,7 +23,7 @@ if [ "$assemble_only" = 0 ] && [ ! -x .venv-bench/bin/python ]; then
 fi
 export NANOHAPTICS_PYTHON="$PWD/.venv-bench/bin/python"
 
-order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live bridge-10khz soak determinism zwidth link adapters brickworld nanoworld teaching-game play render sweeps fuzz)
+order=(ot-physics ot-envelope ot-tick haptic-loop haptic-loop-live bridge-10khz soak determinism zwidth mwidth link adapters brickworld nanoworld teaching-game play render sweeps fuzz)
 for crate in "${order[@]}"; do
   if [ "$assemble_only" = 0 ] && [ -f "crates/$crate/examples/bench_report.rs" ]; then
     echo "==> $crate-report"
@@ -35,6 +35,8 @@ if [ "$assemble_only" = 0 ]; then
   cargo run --release -q -p haptic-loop --features live --example haptic-loop-live-report -- --out docs/bench/haptic-loop-live.md > /dev/null
   echo "==> haptic-loop-zwidth-report (Z-width and margins in closed loop, about 10 s)"
   cargo run --release -q -p haptic-loop --example haptic-loop-zwidth-report -- --out docs/bench/zwidth.md > /dev/null
+  echo "==> haptic-loop-mwidth-report (M-width: the brick masses carried behind a link, about 2 min)"
+  cargo run --release -q -p haptic-loop --example haptic-loop-mwidth-report -- --out docs/bench/mwidth.md > /dev/null
   echo "==> haptic-loop-link-report (stability against delay and transparency behind a link, about 30 s)"
   cargo run --release -q -p haptic-loop --example haptic-loop-link-report -- --out docs/bench/link.md > /dev/null
   echo "==> the Python device adapters' own latency against their mock SDKs (about 20 s)"

@@ -108,7 +108,7 @@ RANKS = {
         "record_sink replay_device live",
         "error",
         "replay closed_loop sinks",
-        "builtin",
+        "builtin mwidth",
         "setup",
         "session",
         "stepper sound media",

@@ -361,14 +361,9 @@ fn a_2_hz_carry_is_felt_as_its_inertia_within_the_couplings_bound() {
             let ks = (c.max_fraction - c.stiffness_fraction) * k_max;
             let b = 2.0 * c.damping_ratio * (k * m).sqrt();
             assert!(k.max(ks) < m / (DT * DT), "the springs are not capped");
-            // K(iΩ) = k + iΩ b k_s / (k_s + iΩ b) = k + (Ω² b² k_s + iΩ b k_s²) / (k_s² + Ω² b²)
-            let den = ks * ks + (omega * b).powi(2);
-            let kk = (
-                k + (omega * b).powi(2) * ks / den,
-                omega * b * ks * ks / den,
-            );
+            // |K / (K − M Ω²)| with K(iΩ) = k + iΩ b k_s / (k_s + iΩ b).
+            let h = haptic_types::local::felt_mass_ratio(k, ks, b, m, omega);
             let mw2 = m * omega * omega;
-            let h = kk.0.hypot(kk.1) / (kk.0 - mw2).hypot(kk.1);
             let (locked, free) = (1.0 / (1.0 - mw2 / (k + ks)), 1.0 / (1.0 - mw2 / k));
             println!(
                 "coupling: 2 Hz carry felt {peak:.4} N against M A Ω² = {ma:.4} N: ratio \

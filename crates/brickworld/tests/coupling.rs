@@ -133,11 +133,7 @@ fn carry_2_hz() -> (f64, f64) {
     let k = 0.3 * k_max;
     let ks = (0.6 - 0.3) * k_max;
     let b = 2.0 * w.params().coupling.damping_ratio * (k * m).sqrt();
-    // iω b k_s / (k_s + iω b) = (ω² b² k_s + iω b k_s²) / (k_s² + ω² b²)
-    let den_m = ks * ks + (om * b).powi(2);
-    let z = (k + (om * b).powi(2) * ks / den_m, om * b * ks * ks / den_m);
-    let zm = (z.0 - m * om * om, z.1);
-    let tr = ((z.0 * z.0 + z.1 * z.1) / (zm.0 * zm.0 + zm.1 * zm.1)).sqrt();
+    let tr = haptic_types::local::felt_mass_ratio(k, ks, b, m, om);
     let predicted = m * amp * om * om * tr;
     println!(
         "2 Hz carry: peak felt {peak_felt:.4} N, peak M a(brick) {peak_ma:.4} N, worst tick \

@@ -29,6 +29,7 @@ pub mod encode;
 pub mod error;
 pub mod live;
 pub mod media;
+pub mod mwidth;
 pub mod record_sink;
 pub mod replay;
 pub mod replay_device;

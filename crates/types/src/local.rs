@@ -159,6 +159,34 @@ impl Body {
     }
 }
 
+/// The felt-mass ratio of a body of mass `m` (kg) carried through the coupling of [`Body`]
+/// (spring `k`, damper `b` through the series spring `k_s`; N/m, N·s/m) by a hand moving at
+/// `omega` (rad/s): the amplitude of the force the hand feels over `m ω²` times the hand's
+/// amplitude, `|K / (K − m ω²)|` with the coupling's impedance
+/// `K(iω) = k + iω b k_s / (k_s + iω b)` (continuous time; the code's steps change it by a
+/// fraction of `ω h`). It lies between the dashpot's two limits, locked
+/// (`1 / (1 − m ω² / (k + k_s))`) and free (`1 / (1 − m ω² / k)`), and is 1 for a rigid
+/// coupling: the felt inertia's error is this less 1, about `m ω² / k` while that is small.
+///
+/// ```
+/// use haptic_types::local::felt_mass_ratio;
+/// // The brick world's 0.5 kg brick on a Falcon (issue 31): +15.86 % at 2 Hz.
+/// let w = 4.0 * std::f64::consts::PI;
+/// let h = felt_mass_ratio(360.0, 360.0, 2.0 * 0.9 * (360.0f64 * 0.5).sqrt(), 0.5, w);
+/// assert!((h - 1.1586).abs() < 5e-5);
+/// ```
+pub fn felt_mass_ratio(k: f64, k_s: f64, b: f64, m: f64, omega: f64) -> f64 {
+    // iω b k_s / (k_s + iω b) = (ω² b² k_s + iω b k_s²) / (k_s² + ω² b²); a free dashpot
+    // (b = 0 or k_s = 0) adds nothing.
+    let (wb, den) = (omega * b, k_s * k_s + (omega * b).powi(2));
+    let (re, im) = if den > 0.0 {
+        (k + wb * wb * k_s / den, wb * k_s * k_s / den)
+    } else {
+        (k, 0.0)
+    };
+    re.hypot(im) / (re - m * omega * omega).hypot(im)
+}
+
 /// The scene's primitives in the world frame and units (m, N, N/m, kg), before the loop maps
 /// them to the device ([`LocalModel`]).
 #[derive(Clone, Debug, Default, PartialEq)]
