@@ -11,18 +11,54 @@ use world_form::fmt_num;
 /// that states it.
 pub const RULES: [(&str, &str); 14] = [
     ("hello", "Protocol, version 1: hello"),
-    ("hello.repeat", "Protocol, version 1: hello (repeat every 50 ms until welcomed)"),
-    ("packets", "Protocol, version 1: the version byte and size of each packet"),
-    ("sample.seq", "Protocol, version 1: sample (+1 per sample, from 0 after each hello)"),
-    ("sample.rate", "Protocol, version 1: welcome (send one sample per tick)"),
-    ("sample.buttons", "Protocol, version 1: hello (bit i of a sample is button i)"),
-    ("sample.two_port", "Protocol, version 2: sample (the two-port count since the hello)"),
-    ("render.planes", "What a device renders between answers, rule 3 (the planes)"),
-    ("render.body", "What a device renders between answers, rules 1–3 and the body"),
-    ("loss.samples", "The device's samples are the clock (one per tick, whatever is lost)"),
-    ("loss.body", "What a device renders between answers, rule 2 (answers whenever they arrive)"),
-    ("silence.samples", "The device's samples are the clock (one per tick, whatever is lost)"),
-    ("silence.resume", "What a device renders between answers, rule 2 and the hold time"),
+    (
+        "hello.repeat",
+        "Protocol, version 1: hello (repeat every 50 ms until welcomed)",
+    ),
+    (
+        "packets",
+        "Protocol, version 1: the version byte and size of each packet",
+    ),
+    (
+        "sample.seq",
+        "Protocol, version 1: sample (+1 per sample, from 0 after each hello)",
+    ),
+    (
+        "sample.rate",
+        "Protocol, version 1: welcome (send one sample per tick)",
+    ),
+    (
+        "sample.buttons",
+        "Protocol, version 1: hello (bit i of a sample is button i)",
+    ),
+    (
+        "sample.two_port",
+        "Protocol, version 2: sample (the two-port count since the hello)",
+    ),
+    (
+        "render.planes",
+        "What a device renders between answers, rule 3 (the planes)",
+    ),
+    (
+        "render.body",
+        "What a device renders between answers, rules 1–3 and the body",
+    ),
+    (
+        "loss.samples",
+        "The device's samples are the clock (one per tick, whatever is lost)",
+    ),
+    (
+        "loss.body",
+        "What a device renders between answers, rule 2 (answers whenever they arrive)",
+    ),
+    (
+        "silence.samples",
+        "The device's samples are the clock (one per tick, whatever is lost)",
+    ),
+    (
+        "silence.resume",
+        "What a device renders between answers, rule 2 and the hold time",
+    ),
     ("bye", "Protocol, version 1: bye"),
 ];
 
@@ -59,7 +95,14 @@ struct Judge<'a> {
 }
 
 impl Judge<'_> {
-    fn push(&mut self, rule: &'static str, pass: bool, figure: String, bound: String, value: Option<f64>) {
+    fn push(
+        &mut self,
+        rule: &'static str,
+        pass: bool,
+        figure: String,
+        bound: String,
+        value: Option<f64>,
+    ) {
         self.push_verdict(
             rule,
             if pass { Verdict::Pass } else { Verdict::Fail },
@@ -89,7 +132,10 @@ impl Judge<'_> {
     }
 
     fn in_stage(&self, stage: Stage) -> impl Iterator<Item = &Received> {
-        self.obs.samples.iter().filter(move |s| s.stage == Some(stage))
+        self.obs
+            .samples
+            .iter()
+            .filter(move |s| s.stage == Some(stage))
     }
 
     /// Samples per second that arrived in `stages`, Hz.
@@ -154,10 +200,37 @@ pub fn judge(obs: &Observed) -> Vec<RuleResult> {
     let f_max = specs.limits.max_force_n;
     let wall = f_max / obs.wall_n_per_m;
     let brick = f_max / obs.coupling_n_per_m;
-    depth(&mut j, "render.planes", Stage::Wall, 0.0, wall, "wall", obs.wall_n_per_m, true);
-    depth(&mut j, "render.body", Stage::Brick, 0.0, brick, "brick's floor", obs.coupling_n_per_m, true);
+    depth(
+        &mut j,
+        "render.planes",
+        Stage::Wall,
+        0.0,
+        wall,
+        "wall",
+        obs.wall_n_per_m,
+        true,
+    );
+    depth(
+        &mut j,
+        "render.body",
+        Stage::Brick,
+        0.0,
+        brick,
+        "brick's floor",
+        obs.coupling_n_per_m,
+        true,
+    );
     continues(&mut j, "loss.samples", Stage::Loss, base);
-    depth(&mut j, "loss.body", Stage::Loss, 0.0, brick, "brick's floor", obs.coupling_n_per_m, false);
+    depth(
+        &mut j,
+        "loss.body",
+        Stage::Loss,
+        0.0,
+        brick,
+        "brick's floor",
+        obs.coupling_n_per_m,
+        false,
+    );
     continues(&mut j, "silence.samples", Stage::Silence, base);
     depth(
         &mut j,
@@ -184,7 +257,10 @@ fn hello_repeat(j: &mut Judge) {
         Some(i) => j.push(
             "hello.repeat",
             (lo..=hi).contains(&i),
-            format!("the unanswered hello repeated after {} ms", fmt_num((i * 1e4).round() / 10.0)),
+            format!(
+                "the unanswered hello repeated after {} ms",
+                fmt_num((i * 1e4).round() / 10.0)
+            ),
             bound,
             Some(i),
         ),
@@ -249,7 +325,11 @@ fn numbering(j: &mut Judge) {
         format!(
             "{n} samples, the first numbered {} after the hello; {skipped} skipped, {repeated} \
              repeated, {backwards} backwards",
-            if firsts.is_empty() { "-".into() } else { firsts.join(", ") }
+            if firsts.is_empty() {
+                "-".into()
+            } else {
+                firsts.join(", ")
+            }
         ),
         format!(
             "from 0 after each hello, +1 per sample; none repeated or backwards, at most {} % \
@@ -284,7 +364,12 @@ fn rate(j: &mut Judge) -> f64 {
 fn buttons(j: &mut Judge, n: usize) {
     let mask = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
     let seen = j.obs.samples.iter().fold(0u32, |a, s| a | s.buttons);
-    let bad = j.obs.samples.iter().filter(|s| s.buttons & !mask != 0).count();
+    let bad = j
+        .obs
+        .samples
+        .iter()
+        .filter(|s| s.buttons & !mask != 0)
+        .count();
     j.push(
         "sample.buttons",
         bad == 0,
@@ -350,7 +435,13 @@ fn depth(
 ) {
     let from = stage.span_s().0 + settle_s;
     let Some(floor) = j.obs.floor_m else {
-        j.push(rule, false, format!("the {} stage was not reached", stage.name()), String::new(), None);
+        j.push(
+            rule,
+            false,
+            format!("the {} stage was not reached", stage.name()),
+            String::new(),
+            None,
+        );
         return;
     };
     let depths: Vec<f64> = j
@@ -359,20 +450,34 @@ fn depth(
         .map(|s| floor - s.position_m[2])
         .collect();
     let bound = format!(
-        "{}{} (the device's {} N against {} N/m)",
+        "{}≤ {} (the device's {} N against {} N/m)",
         if contact { "in contact, " } else { "" },
-        format!("≤ {}", mm(bound_m)),
-        fmt_num(j.obs.hello.as_ref().map_or(0.0, |h| h.specs.limits.max_force_n)),
+        mm(bound_m),
+        fmt_num(
+            j.obs
+                .hello
+                .as_ref()
+                .map_or(0.0, |h| h.specs.limits.max_force_n)
+        ),
         fmt_num(k)
     );
     let Some(deepest) = depths.iter().copied().reduce(f64::max) else {
-        j.push(rule, false, format!("no samples in the {} stage", stage.name()), bound, None);
+        j.push(
+            rule,
+            false,
+            format!("no samples in the {} stage", stage.name()),
+            bound,
+            None,
+        );
         return;
     };
     let figure = if deepest > 0.0 {
         format!("deepest {} below the {what}", mm(deepest))
     } else {
-        format!("never reached the {what} (closest {} above it)", mm(-deepest))
+        format!(
+            "never reached the {what} (closest {} above it)",
+            mm(-deepest)
+        )
     };
     j.push(
         rule,
@@ -410,13 +515,19 @@ fn bye(j: &mut Judge) {
         .map(|s| s.t_s - o.bye_s)
         .reduce(f64::max);
     let own = match o.device_bye_s {
-        Some(t) if t < o.bye_s => format!("; the device said bye itself at {} s, before the end", fmt_num((t * 100.0).round() / 100.0)),
+        Some(t) if t < o.bye_s => format!(
+            "; the device said bye itself at {} s, before the end",
+            fmt_num((t * 100.0).round() / 100.0)
+        ),
         Some(_) => "; the device said bye too".into(),
         None => String::new(),
     };
     let early = o.device_bye_s.is_some_and(|t| t < o.bye_s);
     let figure = match last {
-        Some(d) => format!("the last sample {} ms after the check's bye{own}", fmt_num((d * 1e4).round() / 10.0)),
+        Some(d) => format!(
+            "the last sample {} ms after the check's bye{own}",
+            fmt_num((d * 1e4).round() / 10.0)
+        ),
         None => format!("no sample after the check's bye{own}"),
     };
     j.push(

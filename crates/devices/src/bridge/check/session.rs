@@ -68,7 +68,7 @@ impl CheckConfig {
 }
 
 /// The hello the device said.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct HelloSeen {
     /// Its version byte.
     pub version: u8,
@@ -79,7 +79,7 @@ pub struct HelloSeen {
 }
 
 /// One sample as the check received it.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Received {
     /// Arrival, s from the welcome.
     pub t_s: f64,
@@ -101,7 +101,7 @@ pub struct Received {
 }
 
 /// Everything the check observed, for the rules.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
 pub struct Observed {
     /// The address the check listened on.
     pub bind: SocketAddr,
@@ -267,7 +267,11 @@ fn wait_hello(
             }
             return Err(CheckError::NoHello(m));
         }
-        let (n, from) = match recv(socket, &mut buf, (deadline - now).min(Duration::from_millis(50)))? {
+        let (n, from) = match recv(
+            socket,
+            &mut buf,
+            (deadline - now).min(Duration::from_millis(50)),
+        )? {
             Some(x) => x,
             None => continue,
         };
@@ -301,7 +305,11 @@ fn wait_hello(
 }
 
 /// Waits for the hello from `peer` to be repeated (the first came at `at`): the interval, s.
-fn wait_repeat(socket: &UdpSocket, peer: SocketAddr, at: Instant) -> Result<Option<f64>, CheckError> {
+fn wait_repeat(
+    socket: &UdpSocket,
+    peer: SocketAddr,
+    at: Instant,
+) -> Result<Option<f64>, CheckError> {
     let deadline = at + Duration::from_secs_f64(HELLO_REPEAT_WAIT_S);
     let mut buf = [0u8; 2048];
     loop {
@@ -405,7 +413,9 @@ impl Link<'_> {
                 return Ok(());
             }
             let next = self.pending.front().map_or(end, |p| p.0.min(end));
-            let wait = next.saturating_duration_since(now).min(Duration::from_millis(5));
+            let wait = next
+                .saturating_duration_since(now)
+                .min(Duration::from_millis(5));
             if let Some((n, from)) = recv(self.socket, &mut buf, wait)? {
                 if from == self.peer {
                     self.datagram(&buf[..n], world, obs)?;

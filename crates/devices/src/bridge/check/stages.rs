@@ -72,7 +72,9 @@ impl Stage {
                 "push the stylus down gently (well under the device's maximum force) onto the \
                  wall 2 mm below it, and keep pushing to the end"
             }
-            Stage::Brick => "keep pushing: a brick on the stylus now rests on a floor where the wall was",
+            Stage::Brick => {
+                "keep pushing: a brick on the stylus now rests on a floor where the wall was"
+            }
             Stage::Loss => "keep pushing: 20 % of the answers are dropped",
             Stage::Silence => "keep pushing: no answers for 0.5 s",
             Stage::Resume => "keep pushing: answers again, the force engaged from zero over 0.25 s",

@@ -112,10 +112,11 @@ impl CheckWorld {
                 self.floor_m = Some(z - super::stages::WALL_GAP_M);
                 self.prims = Prims::Wall;
             }
-            (Stage::Brick | Stage::Loss | Stage::Silence | Stage::Resume, Prims::None | Prims::Wall) => {
-                let floor = *self
-                    .floor_m
-                    .get_or_insert(p[2] - super::stages::WALL_GAP_M);
+            (
+                Stage::Brick | Stage::Loss | Stage::Silence | Stage::Resume,
+                Prims::None | Prims::Wall,
+            ) => {
+                let floor = *self.floor_m.get_or_insert(p[2] - super::stages::WALL_GAP_M);
                 let k = self.coupling_n_per_m;
                 self.prims = Prims::Brick(Body {
                     position_m: [p[0], p[1], p[2].max(floor)],
