@@ -5,8 +5,11 @@
 //! - [`protocol`]: the versioned wire format (`docs/device-bridge.md` has the byte layout);
 //! - [`udp`]: the simulator's side, a [`HapticDevice`](haptic_types::device::HapticDevice) with a
 //!   watchdog-friendly sample clock and fault counters;
-//! - [`fake`]: a stand-in device process with injectable loss, jitter, latency and an outage.
+//! - [`fake`]: a stand-in device process with injectable loss, jitter, latency and an outage;
+//! - [`check`]: the simulator's side played against a lab's device adapter, rule by rule
+//!   (`nanohaptics device-check`).
 
+pub mod check;
 pub mod fake;
 pub mod protocol;
 pub mod rule;
