@@ -3,7 +3,7 @@
 
 use crate::run_cmd::parse_operator;
 use crate::status;
-use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake_as};
+use haptic_devices::bridge::fake::{FakeConfig, FakeReport, Fault, run_fake_as};
 use haptic_devices::local::Protocol;
 use haptic_devices::source::DeviceSource;
 use haptic_devices::source::OperatorChoice;
@@ -20,6 +20,10 @@ pub(crate) struct FakeArgs {
     /// Script file (TOML) the stylus plays (default: the built-in wall-press script).
     #[arg(long)]
     script: Option<PathBuf>,
+    /// Play the hand `nanohaptics device-check` asks for instead of a script: still for
+    /// 0.6 s, then 8 mm down and held (with --grip, a modelled device held by that hand).
+    #[arg(long, conflicts_with = "script")]
+    check_hand: bool,
     /// `hand` (default: a simulated hand pushed by the force), `rigid`, or
     /// `hand:mass_kg=0.3,stiffness_n_per_m=300,...` (also spelled `--hand`).
     #[arg(long, alias = "hand", default_value = "hand")]
@@ -66,6 +70,11 @@ pub(crate) struct FakeArgs {
     /// (`--button-names a,b,c`: a device the simulator maps by index; docs/devices.md).
     #[arg(long)]
     button_names: Option<String>,
+    /// Break one rule of the bridge document on purpose, to see `nanohaptics device-check`
+    /// fail by rule: numbers-from-1, ignores-planes, backs-off-in-silence or half-rate
+    /// (docs/device-bridge.md, "Checking your adapter before the first session").
+    #[arg(long)]
+    fault: Option<String>,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -141,6 +150,10 @@ fn physical(a: &FakeArgs) -> Result<Option<(Mechanics, Grip)>, String> {
 /// `specs` (its button events by role or by that device's button names), errors located.
 fn script(a: &FakeArgs, specs: &DeviceSpecs) -> Result<Script, String> {
     let (text, origin) = match &a.script {
+        _ if a.check_hand => (
+            haptic_devices::bridge::check::stages::hand_script(),
+            "device-check's hand".into(),
+        ),
         Some(p) => (
             haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?,
             p.display().to_string(),
@@ -225,6 +238,14 @@ fn config(a: &FakeArgs) -> Result<Config, String> {
         // Up to a day: a soak plays for hours.
         check("seconds", s, 1e-3, 86400.0, "s")?;
     }
+    let fault = a.fault.as_deref().map(Fault::parse).transpose()?;
+    if fault == Some(Fault::IgnoresPlanes) && (physical.is_none() || protocol != Protocol::V2) {
+        return Err(
+            "--fault ignores-planes needs a modelled device speaking protocol 2 (--grip, \
+             --protocol 2): only such a device renders planes"
+                .into(),
+        );
+    }
     let cfg = FakeConfig {
         target,
         model,
@@ -240,6 +261,7 @@ fn config(a: &FakeArgs) -> Result<Config, String> {
         wait_s: check("wait-s", a.wait_s, 0.0, 86400.0, "s")?,
         bye: true,
         protocol,
+        fault,
     };
     Ok((cfg, physical, names))
 }
@@ -250,6 +272,12 @@ fn print_report(r: &FakeReport, physical: Option<(Mechanics, Grip)>, ideal: bool
         "fake-device: {} periods, {} samples sent, {} dropped (loss), {} silent (outage), {} replies",
         r.ticks, r.sent, r.dropped, r.silent, r.replies
     );
+    if r.held_back > 0 {
+        println!(
+            "  {} periods sent no sample (the fault backs-off-in-silence)",
+            r.held_back
+        );
+    }
     println!(
         "  round trip p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; peak force {:.3} N (within limits: {})",
         r.round_trip.p50_ns as f64 / 1e3,

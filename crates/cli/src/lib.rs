@@ -38,6 +38,7 @@
 
 mod classroom_cmd;
 mod demo_cmd;
+mod device_check_cmd;
 mod doctor_cmd;
 mod fake_cmd;
 mod lesson_cmd;
@@ -60,8 +61,8 @@ pub mod status {
     pub const SUCCESS: u8 = 0;
     /// An error (bad input, an unreadable file): the message is on stderr after `error: `.
     pub const ERROR: u8 = 1;
-    /// A replay diverged (`replay --verify`, `demo`); clap's usage errors (a bad argument)
-    /// exit with 2 as well.
+    /// A replay diverged (`replay --verify`, `demo`) or a device failed a rule of
+    /// `device-check`; clap's usage errors (a bad argument) exit with 2 as well.
     pub const DIVERGED: u8 = 2;
     /// Stopped by Ctrl-C (SIGINT) or SIGTERM, the recording finished (the shell's 128 + 2).
     pub const INTERRUPTED: u8 = 130;
@@ -129,6 +130,10 @@ enum Cmd {
     /// A stand-in haptic device process: plays a script over the UDP bridge to `nanohaptics run
     /// --device udp:HOST:PORT`, with injectable loss, jitter, latency and an outage.
     FakeDevice(fake_cmd::FakeArgs),
+    /// Check a lab's device adapter against the bridge document before its first session:
+    /// listen as the simulator does, drive the device through a fixed 6 s sequence (a wall, a
+    /// carried brick, lost answers, silence, bye) and report rule by rule, with the figures.
+    DeviceCheck(device_check_cmd::DeviceCheckArgs),
     /// The macro-vs-nano lesson: run both house tasks and the lesson's experiments, write a
     /// Markdown report with figures (`--out DIR`).
     Lesson(lesson_cmd::LessonArgs),
@@ -226,6 +231,7 @@ where
         Cmd::Demo { scenes, out, json } => demo_cmd::demo(scenes.as_deref(), &out, json),
         Cmd::Scenes { action, dir } => demo_cmd::scenes(action.as_deref(), dir.as_deref()),
         Cmd::FakeDevice(a) => fake_cmd::cmd(a),
+        Cmd::DeviceCheck(a) => device_check_cmd::cmd(&a),
     };
     match res {
         Ok(code) => code,

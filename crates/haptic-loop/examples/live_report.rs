@@ -73,6 +73,7 @@ fn run_case(c: &Case) -> (SessionReport, FakeReport) {
         wait_s: 30.0,
         bye: true,
         protocol: haptic_devices::local::Protocol::V2,
+        fault: None,
     };
     let h = std::thread::spawn(move || run_session(&o, &mut |_, _| {}).unwrap());
     let dev = run_fake(&f, None).unwrap();

@@ -71,6 +71,7 @@ fn fake(addr: SocketAddr) -> FakeConfig {
         wait_s: 20.0,
         bye: true,
         protocol: haptic_devices::local::Protocol::V2,
+        fault: None,
     }
 }
 

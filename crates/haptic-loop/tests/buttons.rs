@@ -145,6 +145,7 @@ fn brick_device(
         wait_s: 20.0,
         bye: true,
         protocol: haptic_devices::local::Protocol::V2,
+        fault: None,
     };
     let specs = fake_specs(&cfg, names);
     cfg.script = Script::from_toml(&read("scenes/brickworld.script.toml"), &specs).unwrap();

@@ -407,6 +407,7 @@ fn a_bridged_device_joins_as_a_student_and_the_teacher_sees_and_ends_it() {
         wait_s: 20.0,
         bye: true,
         protocol: haptic_devices::local::Protocol::V2,
+        fault: None,
     };
     let dev = std::thread::spawn(move || run_fake(&fake, None));
     // The teacher sees the device playing, and its page link lets a page watch it.

@@ -263,6 +263,7 @@ fn a_bridged_device_is_the_hand_and_the_page_watches() {
         wait_s: 20.0,
         bye: true,
         protocol: haptic_devices::local::Protocol::V2,
+        fault: None,
     };
     let dev = std::thread::spawn(move || run_fake(&fake, None));
     let msgs = read_for(&mut ws, 0.6);

@@ -62,6 +62,67 @@ pub struct FakeConfig {
     pub bye: bool,
     /// The protocol a modelled device asks for in its hello (the session may answer with 1).
     pub protocol: Protocol,
+    /// A deliberate fault, to see `device-check` fail by rule (`None`: a device that follows
+    /// the document).
+    pub fault: Option<Fault>,
+}
+
+/// A deliberate fault of the fake device (`fake-device --fault`), each breaking one rule of
+/// `docs/device-bridge.md` as a lab's adapter might, so that `nanohaptics device-check` can be
+/// seen failing by rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// Numbers its samples from 1 after the welcome, not from 0.
+    NumbersFrom1,
+    /// Renders none of the local model's contact planes (the carried body's own surfaces
+    /// still hold the body); a modelled device speaking protocol 2 only.
+    IgnoresPlanes,
+    /// Backs off when answers stop: after [`BACK_OFF_AFTER_S`] without one it sends only every
+    /// tenth period's sample (numbered +1 per sample sent).
+    BacksOffInSilence,
+    /// Runs its servo, and so sends its samples, at half the welcome's rate.
+    HalfRate,
+}
+
+/// How long without an answer before [`Fault::BacksOffInSilence`] backs off, s.
+pub const BACK_OFF_AFTER_S: f64 = 0.1;
+
+impl Fault {
+    /// Every fault, in the order of [`Fault::names`].
+    pub const ALL: [Fault; 4] = [
+        Fault::NumbersFrom1,
+        Fault::IgnoresPlanes,
+        Fault::BacksOffInSilence,
+        Fault::HalfRate,
+    ];
+
+    /// The fault's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fault::NumbersFrom1 => "numbers-from-1",
+            Fault::IgnoresPlanes => "ignores-planes",
+            Fault::BacksOffInSilence => "backs-off-in-silence",
+            Fault::HalfRate => "half-rate",
+        }
+    }
+
+    /// The names, comma-separated (for messages).
+    pub fn names() -> String {
+        Fault::ALL.map(Fault::name).join(", ")
+    }
+
+    /// The fault named `name`, or an error listing the names.
+    pub fn parse(name: &str) -> Result<Fault, String> {
+        Fault::ALL
+            .into_iter()
+            .find(|f| f.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "--fault `{name}` is not a fault (allowed: {})",
+                    Fault::names()
+                )
+            })
+    }
 }
 
 /// What the simulator's welcome said.
@@ -93,6 +154,9 @@ pub struct FakeReport {
     pub dropped: u64,
     /// Samples not sent during the outage.
     pub silent: u64,
+    /// Periods that sent no sample because the device backed off (the fault
+    /// `backs-off-in-silence`).
+    pub held_back: u64,
     /// Force packets received.
     pub replies: u64,
     /// Round trip from sending a sample to receiving its answer, ns.
@@ -164,10 +228,24 @@ pub fn run_fake_as(
     stop: Option<&AtomicBool>,
 ) -> Result<FakeReport, DeviceError> {
     let specs = fake_specs(cfg, buttons);
+    if cfg.fault == Some(Fault::IgnoresPlanes)
+        && (cfg.physical.is_none() || cfg.protocol != Protocol::V2)
+    {
+        return Err(DeviceError::Link(
+            "the fault `ignores-planes` needs a modelled device speaking protocol 2 (--grip, \
+             --protocol 2): only such a device renders planes"
+                .into(),
+        ));
+    }
     let socket = open_socket(cfg.target)?;
     // 1. Hello until welcome.
     let welcome = handshake(&socket, cfg, &specs, stop)?;
-    let rate_hz = welcome.rate_hz;
+    // A device with the fault `half-rate` runs its servo at half the welcome's rate.
+    let rate_hz = if cfg.fault == Some(Fault::HalfRate) {
+        (welcome.rate_hz / 2).max(1)
+    } else {
+        welcome.rate_hz
+    };
     // 2. A receiver thread timestamps each reply.
     let receiver = Receiver::spawn(&socket, cfg.target)?;
     // 3. The servo loop.
@@ -196,6 +274,7 @@ pub fn run_fake_as(
         pacer.start(),
     );
     let dt = 1.0 / f64::from(rate_hz);
+    let mut next_seq = u64::from(cfg.fault == Some(Fault::NumbersFrom1));
     for k in 0..ticks {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) || receiver.done.load(Ordering::Relaxed)
         {
@@ -209,23 +288,30 @@ pub fn run_fake_as(
         pacer.wait_for(k);
         servo.rep.ticks += 1;
         let t = TickTime::new(k, rate_hz);
+        // The period's sample number (`None`: a device that backs off sends none this period).
+        let seq = servo.sends(k).then(|| {
+            next_seq += 1;
+            next_seq - 1
+        });
         let (position_m, buttons, two_port) = match modelled.as_mut() {
-            Some(m) => m.read(k, t.time_s, dt, protocol, &cfg.script, &mut servo),
+            Some(m) => m.read(k, seq, t.time_s, dt, protocol, &cfg.script, &mut servo),
             None => read_rigid(other.as_mut(), &servo, t)?,
         };
-        servo.queue(k, t.time_s, position_m, buttons, two_port);
+        if let Some(seq) = seq {
+            servo.queue(seq, t.time_s, position_m, buttons, two_port);
+        }
         servo.send_due();
         // A modelled device renders an answer when it arrives, as a driver's servo thread
         // does: wait for the answer to this period's sample for up to half a period, so the
         // force of sample k is held over [k, k + 1] (plus the round trip), not a period late.
-        if modelled.is_some() && servo.sent_at.contains_key(&k) {
-            receiver.await_answer(k, Duration::from_nanos(500_000_000 / u64::from(rate_hz)));
+        if let Some(seq) = seq.filter(|s| modelled.is_some() && servo.sent_at.contains_key(s)) {
+            receiver.await_answer(seq, Duration::from_nanos(500_000_000 / u64::from(rate_hz)));
         }
         // Replies that arrived since the last period.
         for r in receiver.take() {
             servo.reply(&r, modelled.is_none());
             if let Some(m) = modelled.as_mut() {
-                m.receive(&r.force);
+                m.receive(&r.force, cfg.fault);
             }
         }
         servo.forget_unanswered(k, rate_hz);
@@ -267,10 +353,13 @@ struct Modelled {
 impl Modelled {
     /// Period `k` at `time_s` (s; periods of `dt` s): the device and hand over the last period,
     /// rendered by the device side (the force its motors rendered goes to `servo`), then its
-    /// encoder reading (m), the script's buttons and, in protocol 2, the two-port layer's count.
+    /// encoder reading (m, kept as sample `seq`'s when one is sent), the script's buttons and,
+    /// in protocol 2, the two-port layer's count.
+    #[allow(clippy::too_many_arguments)]
     fn read(
         &mut self,
         k: u64,
+        seq: Option<u64>,
         time_s: f64,
         dt: f64,
         protocol: Protocol,
@@ -289,15 +378,22 @@ impl Modelled {
             servo.felt(self.plant.last_force_n());
         }
         let reading = self.plant.reading_m();
-        self.side.record_reading(k, reading);
+        if let Some(seq) = seq {
+            self.side.record_reading(seq, reading);
+        }
         let count = (protocol == Protocol::V2)
             .then(|| u32::try_from(self.side.interventions()).unwrap_or(u32::MAX));
         (reading, script.buttons(time_s).0, count)
     }
 
-    /// An answer, handed to the device side as it arrives.
-    fn receive(&mut self, f: &ForceReply) {
-        self.side.receive(&f.command(), f.local.as_deref().cloned());
+    /// An answer, handed to the device side as it arrives (with the fault `ignores-planes`,
+    /// its contact planes dropped).
+    fn receive(&mut self, f: &ForceReply, fault: Option<Fault>) {
+        let mut local = f.local.as_deref().cloned();
+        if let (Some(m), Some(Fault::IgnoresPlanes)) = (local.as_mut(), fault) {
+            m.planes.clear();
+        }
+        self.side.receive(&f.command(), local);
     }
 }
 
@@ -480,6 +576,8 @@ struct Servo<'a> {
     rtt: Vec<u64>,
     rep: FakeReport,
     last_sent: Option<Instant>,
+    /// When the last answer arrived.
+    last_reply: Option<Instant>,
     outage_begun: bool,
     /// The force received last, N.
     force: [f64; 3],
@@ -517,6 +615,7 @@ impl<'a> Servo<'a> {
                 ..Default::default()
             },
             last_sent: None,
+            last_reply: None,
             outage_begun: false,
             force: [0.0; 3],
             felt: [0.0; 3],
@@ -535,8 +634,21 @@ impl<'a> Servo<'a> {
         }
     }
 
-    /// Period `k`'s sample at `time_s`: silent in the outage, dropped with the loss's
-    /// probability, or else queued after the latency and a jitter draw.
+    /// Whether period `k` sends a sample: always, but for a device with the fault
+    /// `backs-off-in-silence` that has had no answer for [`BACK_OFF_AFTER_S`] (every tenth
+    /// period then); a sample held back is counted.
+    fn sends(&mut self, k: u64) -> bool {
+        let backing_off = self.cfg.fault == Some(Fault::BacksOffInSilence)
+            && self
+                .last_reply
+                .is_some_and(|t| t.elapsed().as_secs_f64() > BACK_OFF_AFTER_S);
+        let send = !backing_off || k % 10 == 0;
+        self.rep.held_back += u64::from(!send);
+        send
+    }
+
+    /// Sample `k`'s at `time_s`: silent in the outage, dropped with the loss's probability,
+    /// or else queued after the latency and a jitter draw.
     fn queue(
         &mut self,
         k: u64,
@@ -607,6 +719,7 @@ impl<'a> Servo<'a> {
         let rep = &mut self.rep;
         let f = r.force.force_n;
         rep.replies += 1;
+        self.last_reply = Some(r.at);
         let mag = vec3::norm(f);
         if !vec3::is_finite(f) || mag > self.max_force_n {
             rep.forces_within_limits = false;

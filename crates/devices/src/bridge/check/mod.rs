@@ -23,5 +23,5 @@ pub mod world;
 
 pub use error::CheckError;
 pub use report::{Report, RuleResult, Verdict};
-pub use session::{CheckConfig, run_check};
+pub use session::{CheckConfig, run_check, run_check_on};
 pub use stages::Stage;

@@ -85,6 +85,10 @@ pub const BYE_STOP_S: f64 = 0.5;
 /// the hand's return).
 pub const RESUME_SETTLE_S: f64 = 0.5;
 
+/// How long after the brick stage begins the brick is judged, s: the stylus starts the stage
+/// where the wall left it, so a device that failed the wall is not failed twice for it.
+pub const BRICK_SETTLE_S: f64 = 0.25;
+
 fn mm(x: f64) -> String {
     format!("{} mm", fmt_num((x * 1e5).round() / 100.0))
 }
@@ -214,7 +218,7 @@ pub fn judge(obs: &Observed) -> Vec<RuleResult> {
         &mut j,
         "render.body",
         Stage::Brick,
-        0.0,
+        BRICK_SETTLE_S,
         brick,
         "brick's floor",
         obs.coupling_n_per_m,

@@ -40,7 +40,7 @@ impl CheckConfig {
     /// Parses `udp:HOST:PORT` or `udp:PORT` (loopback), with the bridge's own messages; 1 kHz,
     /// a 60 s wait.
     pub fn parse(spec: &str) -> Result<CheckConfig, CheckError> {
-        let bind = super::super::parse_endpoint(spec, "udp", "device", "udp:127.0.0.1:9870")
+        let bind = super::super::parse_endpoint(spec, "udp", "address", "udp:127.0.0.1:9870")
             .map_err(CheckError::Address)?;
         Ok(CheckConfig {
             bind,
@@ -150,14 +150,31 @@ pub fn run_check(cfg: &CheckConfig, progress: &mut dyn FnMut(&str)) -> Result<Re
         addr: cfg.bind,
         reason: e.to_string(),
     })?;
-    super::super::rxbuf::enlarge(&socket, super::super::rxbuf::RECEIVE_BUFFER_BYTES);
+    run_check_on(&socket, cfg, progress)
+}
+
+/// As [`run_check`], on a socket already bound (its address is the one reported; `cfg.bind`
+/// is not used): a test binds port 0 and tells the device the port.
+pub fn run_check_on(
+    socket: &UdpSocket,
+    cfg: &CheckConfig,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Report, CheckError> {
+    cfg.validate()?;
+    let cfg = &CheckConfig {
+        bind: socket
+            .local_addr()
+            .map_err(|e| CheckError::Socket(e.to_string()))?,
+        ..cfg.clone()
+    };
+    super::super::rxbuf::enlarge(socket, super::super::rxbuf::RECEIVE_BUFFER_BYTES);
     let sock_err = |e: std::io::Error| CheckError::Socket(e.to_string());
     progress(&format!(
         "waiting up to {} s for a device's hello on udp:{}",
         world_form::fmt_num(cfg.wait_s),
         cfg.bind
     ));
-    let first = wait_hello(&socket, cfg)?;
+    let first = wait_hello(socket, cfg)?;
     let mut obs = Observed {
         bind: cfg.bind,
         hello: None,
@@ -185,7 +202,7 @@ pub fn run_check(cfg: &CheckConfig, progress: &mut dyn FnMut(&str)) -> Result<Re
             return Ok(Report::judge(&obs));
         }
     };
-    obs.hello_repeat_s = wait_repeat(&socket, peer, at)?;
+    obs.hello_repeat_s = wait_repeat(socket, peer, at)?;
     obs.version = hello.version.min(super::super::protocol::VERSION_2);
     let welcome = welcome_packet(&hello.specs, obs.version, cfg.rate_hz);
     socket.send_to(&welcome, peer).map_err(sock_err)?;
@@ -204,7 +221,7 @@ pub fn run_check(cfg: &CheckConfig, progress: &mut dyn FnMut(&str)) -> Result<Re
     ));
     obs.hello = Some(hello);
     let mut link = Link {
-        socket: &socket,
+        socket,
         peer,
         t0,
         welcome,

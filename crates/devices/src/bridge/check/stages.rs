@@ -51,6 +51,31 @@ pub const LOSS: f64 = 0.2;
 /// simulator's `[loop]` engagement does after `device.resumed`).
 pub const ENGAGE_S: f64 = 0.25;
 
+/// How far below its start the check's own hand ([`hand_script`]) pushes the stylus, m: 6 mm
+/// through the wall, which a loose (300 N/m) or firm (1000 N/m) grip does with a force well
+/// under a Touch's, Falcon's, delta.3's or Inverse3's largest.
+pub const HAND_PUSH_M: f64 = 0.008;
+
+/// When the check's hand starts pushing and when it is down, s from the welcome.
+pub const HAND_PUSH_S: (f64, f64) = (0.6, 1.0);
+
+/// The script of a hand that does what the stages ask (`fake-device --check-hand`): still
+/// through the handshake, then down [`HAND_PUSH_M`] over [`HAND_PUSH_S`], held there for a
+/// minute (the check's bye ends it first).
+pub fn hand_script() -> String {
+    let push_mm = HAND_PUSH_M * 1e3;
+    let (t1, t2) = HAND_PUSH_S;
+    format!(
+        "[script]\n\
+         name = \"device-check's hand: still, then {push_mm} mm down and held\"\n\
+         duration_s = 60.0\n\
+         [[waypoint]]\nt_s = 0.0\nposition_mm = [0.0, 0.0, 0.0]\n\
+         [[waypoint]]\nt_s = {t1:?}\nposition_mm = [0.0, 0.0, 0.0]\n\
+         [[waypoint]]\nt_s = {t2:?}\nposition_mm = [0.0, 0.0, -{push_mm:?}]\n\
+         [[waypoint]]\nt_s = 60.0\nposition_mm = [0.0, 0.0, -{push_mm:?}]\n"
+    )
+}
+
 impl Stage {
     /// The stage's name in the report.
     pub fn name(self) -> &'static str {
@@ -128,5 +153,16 @@ mod tests {
         assert_eq!(stage_at(4.6), Some(Stage::Silence));
         assert_eq!(stage_at(total_s()), None);
         assert_eq!(total_s(), 6.0);
+    }
+
+    #[test]
+    fn the_hand_script_pushes_6_mm_through_the_wall_after_the_handshake() {
+        let specs = haptic_types::device::DeviceModel::Falcon.specs().clone();
+        let s = crate::Script::from_toml(&hand_script(), &specs).unwrap();
+        assert_eq!(s.position(0.5), [0.0; 3]);
+        assert_eq!(s.position(1.0), [0.0, 0.0, -0.008]);
+        assert_eq!(s.position(5.9), [0.0, 0.0, -0.008]);
+        let wall_depth = -s.position(3.0)[2] - WALL_GAP_M;
+        assert!((wall_depth - 0.006).abs() < 1e-15);
     }
 }
