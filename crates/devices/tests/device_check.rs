@@ -189,3 +189,71 @@ fn no_hello_within_the_wait_names_what_arrived_instead() {
         "{e}"
     );
 }
+
+/// The document's section lists every rule in the report's order and the bounds and stage
+/// times the check uses.
+#[test]
+fn the_documents_tables_are_the_checks_rules_bounds_and_stages() {
+    use haptic_devices::bridge::check::{rules, session, world};
+    let doc = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/device-bridge.md"),
+    )
+    .unwrap();
+    let start = doc
+        .find("## Checking your adapter before the first session")
+        .unwrap();
+    let sec = &doc[start..];
+    let sec = &sec[..sec[3..].find("\n## ").unwrap()];
+    // Every rule, in order.
+    let mut at = 0;
+    for (rule, _) in rules::RULES {
+        let row = format!("\n| `{rule}` |");
+        let i = sec[at..].find(&row).unwrap_or_else(|| panic!("{rule}"));
+        at += i + row.len();
+    }
+    // The stages, with their spans.
+    for (stage, _) in stages::STAGES {
+        let (a, b) = stage.span_s();
+        let row = format!(
+            "\n| {} | {}–{} |",
+            stage.name(),
+            world_form::fmt_num(a),
+            world_form::fmt_num(b)
+        );
+        assert!(sec.contains(&row), "{row}");
+    }
+    let (lo, hi) = rules::HELLO_REPEAT_S;
+    for (text, ok) in [
+        (
+            format!("every {}–{} ms", lo * 1e3, hi * 1e3),
+            (lo, hi) == (0.02, 0.2),
+        ),
+        ("the rate ± 5 %".into(), rules::RATE_TOLERANCE == 0.05),
+        (
+            "its own rate ± 10 %".into(),
+            rules::CONTINUE_TOLERANCE == 0.1,
+        ),
+        ("at most 1 % skipped".into(), rules::SKIP_TOLERANCE == 0.01),
+        ("no sample 500 ms after it".into(), rules::BYE_STOP_S == 0.5),
+        (
+            "from 0.25 s into the stage".into(),
+            rules::BRICK_SETTLE_S == 0.25,
+        ),
+        (
+            "from 0.5 s into the stage".into(),
+            rules::RESUME_SETTLE_S == 0.5,
+        ),
+        ("one answer in five dropped".into(), stages::LOSS == 0.2),
+        ("20 ms late".into(), stages::LATENCY_S == 0.02),
+        ("a 0.1 kg brick".into(), world::BRICK_MASS_KG == 0.1),
+        ("over 0.25 s".into(), stages::ENGAGE_S == 0.25),
+        ("a wall 2 mm below".into(), stages::WALL_GAP_M == 0.002),
+        ("100 ms pass without an answer".into(), {
+            haptic_devices::bridge::fake::BACK_OFF_AFTER_S == 0.1
+        }),
+        ("1 s after the bye".into(), session::AFTER_BYE_S == 1.0),
+    ] {
+        assert!(sec.contains(&text), "the document lacks `{text}`");
+        assert!(ok, "`{text}` is not the check's value");
+    }
+}
