@@ -239,13 +239,7 @@ fn config(a: &FakeArgs) -> Result<Config, String> {
         check("seconds", s, 1e-3, 86400.0, "s")?;
     }
     let fault = a.fault.as_deref().map(Fault::parse).transpose()?;
-    if fault == Some(Fault::IgnoresPlanes) && (physical.is_none() || protocol != Protocol::V2) {
-        return Err(
-            "--fault ignores-planes needs a modelled device speaking protocol 2 (--grip, \
-             --protocol 2): only such a device renders planes"
-                .into(),
-        );
-    }
+    haptic_devices::bridge::fault::applies(fault, physical.is_some(), protocol)?;
     let cfg = FakeConfig {
         target,
         model,

@@ -194,7 +194,7 @@ fn no_hello_within_the_wait_names_what_arrived_instead() {
 /// times the check uses.
 #[test]
 fn the_documents_tables_are_the_checks_rules_bounds_and_stages() {
-    use haptic_devices::bridge::check::{rules, session, world};
+    use haptic_devices::bridge::check::{rules, world};
     let doc = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/device-bridge.md"),
     )
@@ -251,7 +251,7 @@ fn the_documents_tables_are_the_checks_rules_bounds_and_stages() {
         ("100 ms pass without an answer".into(), {
             haptic_devices::bridge::fake::BACK_OFF_AFTER_S == 0.1
         }),
-        ("1 s after the bye".into(), session::AFTER_BYE_S == 1.0),
+        ("1 s after the bye".into(), stages::AFTER_BYE_S == 1.0),
     ] {
         assert!(sec.contains(&text), "the document lacks `{text}`");
         assert!(ok, "`{text}` is not the check's value");

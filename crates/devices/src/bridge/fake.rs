@@ -13,6 +13,7 @@
 //! passivity layer; the figures it reports (jumps, energy) are of the force its motors
 //! rendered, what the hand felt.
 
+pub use super::fault::{BACK_OFF_AFTER_S, Fault};
 use super::protocol::{ForceReply, Packet, Sample};
 use crate::local::{DeviceSide, Protocol};
 use crate::script::Script;
@@ -65,64 +66,6 @@ pub struct FakeConfig {
     /// A deliberate fault, to see `device-check` fail by rule (`None`: a device that follows
     /// the document).
     pub fault: Option<Fault>,
-}
-
-/// A deliberate fault of the fake device (`fake-device --fault`), each breaking one rule of
-/// `docs/device-bridge.md` as a lab's adapter might, so that `nanohaptics device-check` can be
-/// seen failing by rule.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Fault {
-    /// Numbers its samples from 1 after the welcome, not from 0.
-    NumbersFrom1,
-    /// Renders none of the local model's contact planes (the carried body's own surfaces
-    /// still hold the body); a modelled device speaking protocol 2 only.
-    IgnoresPlanes,
-    /// Backs off when answers stop: after [`BACK_OFF_AFTER_S`] without one it sends only every
-    /// tenth period's sample (numbered +1 per sample sent).
-    BacksOffInSilence,
-    /// Runs its servo, and so sends its samples, at half the welcome's rate.
-    HalfRate,
-}
-
-/// How long without an answer before [`Fault::BacksOffInSilence`] backs off, s.
-pub const BACK_OFF_AFTER_S: f64 = 0.1;
-
-impl Fault {
-    /// Every fault, in the order of [`Fault::names`].
-    pub const ALL: [Fault; 4] = [
-        Fault::NumbersFrom1,
-        Fault::IgnoresPlanes,
-        Fault::BacksOffInSilence,
-        Fault::HalfRate,
-    ];
-
-    /// The fault's name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Fault::NumbersFrom1 => "numbers-from-1",
-            Fault::IgnoresPlanes => "ignores-planes",
-            Fault::BacksOffInSilence => "backs-off-in-silence",
-            Fault::HalfRate => "half-rate",
-        }
-    }
-
-    /// The names, comma-separated (for messages).
-    pub fn names() -> String {
-        Fault::ALL.map(Fault::name).join(", ")
-    }
-
-    /// The fault named `name`, or an error listing the names.
-    pub fn parse(name: &str) -> Result<Fault, String> {
-        Fault::ALL
-            .into_iter()
-            .find(|f| f.name() == name)
-            .ok_or_else(|| {
-                format!(
-                    "--fault `{name}` is not a fault (allowed: {})",
-                    Fault::names()
-                )
-            })
-    }
 }
 
 /// What the simulator's welcome said.
@@ -228,24 +171,12 @@ pub fn run_fake_as(
     stop: Option<&AtomicBool>,
 ) -> Result<FakeReport, DeviceError> {
     let specs = fake_specs(cfg, buttons);
-    if cfg.fault == Some(Fault::IgnoresPlanes)
-        && (cfg.physical.is_none() || cfg.protocol != Protocol::V2)
-    {
-        return Err(DeviceError::Link(
-            "the fault `ignores-planes` needs a modelled device speaking protocol 2 (--grip, \
-             --protocol 2): only such a device renders planes"
-                .into(),
-        ));
-    }
+    super::fault::applies(cfg.fault, cfg.physical.is_some(), cfg.protocol)
+        .map_err(DeviceError::Link)?;
     let socket = open_socket(cfg.target)?;
     // 1. Hello until welcome.
     let welcome = handshake(&socket, cfg, &specs, stop)?;
-    // A device with the fault `half-rate` runs its servo at half the welcome's rate.
-    let rate_hz = if cfg.fault == Some(Fault::HalfRate) {
-        (welcome.rate_hz / 2).max(1)
-    } else {
-        welcome.rate_hz
-    };
+    let rate_hz = super::fault::servo_rate_hz(cfg.fault, welcome.rate_hz);
     // 2. A receiver thread timestamps each reply.
     let receiver = Receiver::spawn(&socket, cfg.target)?;
     // 3. The servo loop.

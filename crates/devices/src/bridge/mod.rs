@@ -11,6 +11,7 @@
 
 pub mod check;
 pub mod fake;
+pub mod fault;
 pub mod protocol;
 pub mod rule;
 pub mod rxbuf;

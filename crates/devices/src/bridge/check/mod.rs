@@ -11,17 +11,21 @@
 //! - [`world`]: the check's own world (a plane, a brick on a coupling), answered as the
 //!   simulator answers (protocol 1's force and stiffness, protocol 2's local model);
 //! - [`session`]: the socket: handshake, answers (delayed, dropped, withheld), the bye;
-//! - [`rules`]: the rules and their judgement; [`report`]: the result, as text or JSON;
+//! - [`observed`]: what the check saw; [`rules`]: the rules and their judgement;
+//!   [`verdict`]: one rule's result; [`report`]: the whole result, as text or JSON;
 //! - [`error`]: what stops the check before it can judge anything.
 
 pub mod error;
+pub mod observed;
 pub mod report;
 pub mod rules;
 pub mod session;
 pub mod stages;
+pub mod verdict;
 pub mod world;
 
 pub use error::CheckError;
-pub use report::{Report, RuleResult, Verdict};
+pub use report::Report;
 pub use session::{CheckConfig, run_check, run_check_on};
 pub use stages::Stage;
+pub use verdict::{RuleResult, Verdict};

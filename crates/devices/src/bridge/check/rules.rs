@@ -2,9 +2,9 @@
 //! device's datagrams, their timing and the stylus positions they carry
 //! (`docs/device-bridge.md`, "Checking your adapter before the first session", has the table).
 
-use super::report::{RuleResult, Verdict};
-use super::session::{Observed, Received};
+use super::observed::{Observed, Received};
 use super::stages::Stage;
+use super::verdict::{RuleResult, Verdict};
 use world_form::fmt_num;
 
 /// Every rule, in the report's order: its name and the section of `docs/device-bridge.md`
@@ -273,7 +273,7 @@ fn hello_repeat(j: &mut Judge) {
             false,
             format!(
                 "the unanswered hello was not repeated within {} s",
-                fmt_num(super::session::HELLO_REPEAT_WAIT_S)
+                fmt_num(super::stages::HELLO_REPEAT_WAIT_S)
             ),
             bound,
             None,

@@ -5,23 +5,17 @@
 
 use super::super::protocol::{ForceReply, Packet, ProtocolError, Refusal, Sample};
 use super::error::CheckError;
+use super::observed::{HelloSeen, Observed, Received};
 use super::report::Report;
-use super::stages::{self, LATENCY_S, LOSS, Stage};
+use super::stages::{self, AFTER_BYE_S, HELLO_REPEAT_WAIT_S, LATENCY_S, LOSS, Stage};
 use super::world::CheckWorld;
 use haptic_types::ButtonRoles;
 use haptic_types::device::DeviceSpecs;
-use haptic_types::vec3::Vec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
-
-/// How long the check waits for the hello's repeat before it welcomes the first, s.
-pub const HELLO_REPEAT_WAIT_S: f64 = 1.0;
-
-/// How long the check listens after its bye, s.
-pub const AFTER_BYE_S: f64 = 1.0;
 
 /// Where the check listens and how it welcomes.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,80 +59,6 @@ impl CheckConfig {
         }
         Ok(())
     }
-}
-
-/// The hello the device said.
-#[derive(Clone, Debug, PartialEq)]
-pub struct HelloSeen {
-    /// Its version byte.
-    pub version: u8,
-    /// Its servo rate, Hz (information).
-    pub rate_hz: u32,
-    /// Its specifications.
-    pub specs: DeviceSpecs,
-}
-
-/// One sample as the check received it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Received {
-    /// Arrival, s from the welcome.
-    pub t_s: f64,
-    /// The stage it arrived in (`None`: after the sequence, around the bye).
-    pub stage: Option<Stage>,
-    /// Hellos welcomed before it (1 for the session's first; a device that restarts says
-    /// hello again and numbers from 0).
-    pub hellos: u32,
-    /// Its sequence number.
-    pub seq: u64,
-    /// Stylus position, m.
-    pub position_m: Vec3,
-    /// Button bits.
-    pub buttons: u32,
-    /// Its version byte (1: 52 bytes, 2: 56 bytes with the two-port count).
-    pub version: u8,
-    /// The two-port count of a version-2 sample.
-    pub two_port_periods: Option<u32>,
-}
-
-/// Everything the check observed, for the rules.
-#[derive(Clone, Debug)]
-pub struct Observed {
-    /// The address the check listened on.
-    pub bind: SocketAddr,
-    /// The first hello.
-    pub hello: Option<HelloSeen>,
-    /// The refusal of a hello that cannot be accepted (the simulator's message).
-    pub refused: Option<Refusal>,
-    /// Time from the first hello to its repeat, s (`None`: no repeat within
-    /// [`HELLO_REPEAT_WAIT_S`]).
-    pub hello_repeat_s: Option<f64>,
-    /// The session's version (the smaller of the hello's and 2).
-    pub version: u8,
-    /// The welcome's rate, Hz.
-    pub rate_hz: u32,
-    /// Every sample from the device, in arrival order.
-    pub samples: Vec<Received>,
-    /// Datagrams from the device after the welcome.
-    pub datagrams: u64,
-    /// Of those, not a valid packet (size, version byte, type, magic), or a packet only the
-    /// simulator sends.
-    pub malformed: u64,
-    /// The first malformed datagram's reason.
-    pub first_malformed: Option<String>,
-    /// Answers sent, and dropped on purpose in the loss stage.
-    pub answers_sent: u64,
-    /// Answers dropped in the loss stage.
-    pub answers_dropped: u64,
-    /// The wall's and floor's offset along +z, m.
-    pub floor_m: Option<f64>,
-    /// The wall's stiffness, N/m.
-    pub wall_n_per_m: f64,
-    /// The brick coupling's spring, N/m.
-    pub coupling_n_per_m: f64,
-    /// When the check said bye, s from the welcome.
-    pub bye_s: f64,
-    /// When the device said bye, s from the welcome.
-    pub device_bye_s: Option<f64>,
 }
 
 /// Runs the check on `cfg`'s address: waits for a device, drives it through the stages and
@@ -235,26 +155,41 @@ pub fn run_check_on(
     };
     let end = t0 + Duration::from_secs_f64(stages::total_s());
     link.run_until(end, &mut world, &mut obs, progress)?;
-    // The last packet, then the bye; then listen for what the device still sends.
-    let last = Packet::Force(ForceReply {
-        seq: link.last_answered,
-        tick: u64::MAX,
-        force_n: [0.0; 3],
-        stiffness_n_per_m: [0.0; 9],
-        status: 0,
-        local: None,
-    });
-    link.pending.clear();
-    socket.send_to(&last.encode(), peer).map_err(sock_err)?;
-    socket
-        .send_to(&Packet::Bye { reason: 0 }.encode(), peer)
-        .map_err(sock_err)?;
-    obs.bye_s = t0.elapsed().as_secs_f64();
-    progress("bye: the check said bye; listening 1 s for the device to stop");
-    let after = Instant::now() + Duration::from_secs_f64(AFTER_BYE_S);
-    link.run_until(after, &mut world, &mut obs, &mut |_| {})?;
-    obs.floor_m = world.floor_m();
+    link.finish(&mut world, &mut obs, progress)?;
     Ok(Report::judge(&obs))
+}
+
+impl Link<'_> {
+    /// The last packet, then the bye; then listens [`AFTER_BYE_S`] for what the device still
+    /// sends.
+    fn finish(
+        &mut self,
+        world: &mut CheckWorld,
+        obs: &mut Observed,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<(), CheckError> {
+        let (socket, peer) = (self.socket, self.peer);
+        let sock_err = |e: std::io::Error| CheckError::Socket(e.to_string());
+        let last = Packet::Force(ForceReply {
+            seq: self.last_answered,
+            tick: u64::MAX,
+            force_n: [0.0; 3],
+            stiffness_n_per_m: [0.0; 9],
+            status: 0,
+            local: None,
+        });
+        self.pending.clear();
+        socket.send_to(&last.encode(), peer).map_err(sock_err)?;
+        socket
+            .send_to(&Packet::Bye { reason: 0 }.encode(), peer)
+            .map_err(sock_err)?;
+        obs.bye_s = self.t0.elapsed().as_secs_f64();
+        progress("bye: the check said bye; listening 1 s for the device to stop");
+        let after = Instant::now() + Duration::from_secs_f64(AFTER_BYE_S);
+        self.run_until(after, world, obs, &mut |_| {})?;
+        obs.floor_m = world.floor_m();
+        Ok(())
+    }
 }
 
 /// Waits for the first hello: the device's address, the hello and when it came; or a hello

@@ -35,6 +35,12 @@ pub const STAGES: [(Stage, f64); 6] = [
     (Stage::Resume, 1.0),
 ];
 
+/// How long the check waits for the hello's repeat before it welcomes the first, s.
+pub const HELLO_REPEAT_WAIT_S: f64 = 1.0;
+
+/// How long the check listens after its bye, s.
+pub const AFTER_BYE_S: f64 = 1.0;
+
 /// How far below the stylus (its position at the end of the handshake) the wall and the
 /// floor lie, m.
 pub const WALL_GAP_M: f64 = 0.002;
