@@ -10,16 +10,30 @@ use haptic_devices::{Grip, Mechanics, Script};
 use haptic_types::DeviceModel;
 use std::net::UdpSocket;
 
-/// Runs the check on a loopback port against a modelled `mech` held by the check's hand with
-/// `grip`, with `fault`; the report and the fake device's outcome.
-fn check(mech: Mechanics, grip: Grip, fault: Option<Fault>) -> Report {
+/// Starts the check on a free loopback port, waiting `wait_s` (s) for the hello: its address
+/// and the thread that returns its outcome.
+fn start_check(
+    wait_s: f64,
+) -> (
+    std::net::SocketAddr,
+    std::thread::JoinHandle<Result<Report, haptic_devices::bridge::check::CheckError>>,
+) {
     let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
     let addr = socket.local_addr().unwrap();
     let cfg = CheckConfig {
-        wait_s: 20.0,
+        wait_s,
         ..CheckConfig::parse(&format!("udp:{addr}")).unwrap()
     };
-    let checker = std::thread::spawn(move || run_check_on(&socket, &cfg, &mut |_| {}));
+    (
+        addr,
+        std::thread::spawn(move || run_check_on(&socket, &cfg, &mut |_| {})),
+    )
+}
+
+/// Runs the check on a loopback port against a modelled `mech` held by the check's hand with
+/// `grip`, with `fault`; the report and the fake device's outcome.
+fn check(mech: Mechanics, grip: Grip, fault: Option<Fault>) -> Report {
+    let (addr, checker) = start_check(20.0);
     let specs = haptic_devices::modelled::preset_specs(&mech);
     let fake = FakeConfig {
         target: addr,
@@ -128,13 +142,7 @@ fn a_modelled_falcon_and_delta3_pass_every_rule_and_each_fault_fails_its_own() {
 #[test]
 fn a_refused_hello_fails_the_hello_rule_with_the_simulators_words() {
     use haptic_devices::bridge::protocol::Packet;
-    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
-    let addr = socket.local_addr().unwrap();
-    let cfg = CheckConfig {
-        wait_s: 20.0,
-        ..CheckConfig::parse(&format!("udp:{addr}")).unwrap()
-    };
-    let checker = std::thread::spawn(move || run_check_on(&socket, &cfg, &mut |_| {}));
+    let (addr, checker) = start_check(20.0);
     let mut specs = DeviceModel::Falcon.specs().clone();
     specs.limits.max_force_n = -1.0;
     let hello = Packet::Hello {
@@ -172,13 +180,7 @@ fn a_refused_hello_fails_the_hello_rule_with_the_simulators_words() {
 /// No hello within the wait: the check says so, with what arrived instead.
 #[test]
 fn no_hello_within_the_wait_names_what_arrived_instead() {
-    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
-    let addr = socket.local_addr().unwrap();
-    let cfg = CheckConfig {
-        wait_s: 0.5,
-        ..CheckConfig::parse(&format!("udp:{addr}")).unwrap()
-    };
-    let checker = std::thread::spawn(move || run_check_on(&socket, &cfg, &mut |_| {}));
+    let (addr, checker) = start_check(0.5);
     let device = UdpSocket::bind("127.0.0.1:0").unwrap();
     device.send_to(b"not a packet", addr).unwrap();
     let e = checker.join().unwrap().unwrap_err().to_string();
