@@ -56,8 +56,8 @@ ALLOWED = {
     },
     # Lesson files, the built-in module, the step evaluator and the progress: scenes are read
     # through the sessions crate (built-in names, files, switches), so a page can drive a lesson
-    # without the report's figures.
-    "nanohaptics-teaching": {"haptic-engine", "haptic-loop", "haptic-types", "world-form"},
+    # without the lesson report's figures; the class report draws its two charts with `chart`.
+    "nanohaptics-teaching": {"chart", "haptic-engine", "haptic-loop", "haptic-types", "world-form"},
     "nanohaptics-play": {
         "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-recording", "render",
         "webguard", "world-form",

@@ -14,12 +14,16 @@
 //! * [`progress`]: a student's way through a lesson (never backwards, never into a locked
 //!   step), the answers and the ticks on each step.
 //! * [`builtin`]: the built-in module, written from the teaching paper.
+//! * [`class_report`]: the class report a teacher downloads (CSV for a spreadsheet, a Markdown
+//!   page with charts) from the students' progress and what their sessions measured.
 //!
 //! What it is not: no page, no server, no loop. It reads scenes through the sessions crate
 //! (`haptic-loop`) and is its own crate so that a page can drive a lesson without the
 //! report's figures (`nanohaptics-lesson`).
 
 pub mod builtin;
+mod cells;
+pub mod class_report;
 pub mod condition;
 pub mod error;
 pub mod evaluate;
