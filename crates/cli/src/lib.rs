@@ -17,7 +17,9 @@
 //! nanohaptics fake-device udp:HOST:PORT|udp:PORT [--script S] [--operator rigid|hand|hand:k=v,...]
 //!                 [--model falcon|touch|delta3|inverse3] [--grip loose|firm|k=...,b=...[,m=...]]
 //!                 [--ideal] [--protocol 1|2] [--loss P] [--jitter-ms J] [--latency-ms L]
-//!                 [--seed N] [--seconds T] [--outage START:SECONDS] [--wait-s S] [--json]
+//!                 [--seed N] [--seconds T] [--outage START:SECONDS] [--wait-s S]
+//!                 [--button-names a,b,c] [--check-hand] [--fault NAME] [--json]
+//! nanohaptics device-check udp:HOST:PORT|udp:PORT [--rate HZ] [--wait-s S] [--json]
 //! nanohaptics replay REC.mcap [--verify] [--salvage] [--json]
 //! nanohaptics info REC.mcap [--salvage] [--json]
 //! nanohaptics render REC.mcap --out DIR|FILE.png|FILE.gif [--every N] [--width W] [--gif FILE]
@@ -27,8 +29,9 @@
 //! nanohaptics demo [--scenes DIR] [--out DIR] [--json]
 //! ```
 //! Every command's own `--help` gives each option's unit, range and default. Exit status
-//! ([`status`]): 0 success, 1 error (bad input, unreadable file), 2 replay diverged (or a bad
-//! argument, clap's usage error), 130 stopped by Ctrl-C, 141 ended by a closed pipe.
+//! ([`status`]): 0 success, 1 error (bad input, unreadable file), 2 replay diverged or a device
+//! failed `device-check` (or a bad argument, clap's usage error), 130 stopped by Ctrl-C, 141
+//! ended by a closed pipe.
 //!
 //! This library is the whole program: [`main_with_args`] parses the arguments, runs the
 //! command and returns the exit status. The `nanohaptics` binary (`src/main.rs`) calls it with
