@@ -2,8 +2,10 @@
 //! loopback, measured from both ends.
 //!
 //! `cargo run --release -p nanohaptics-play --example play-bench -- [--seconds S] [--pages N]
-//! [--out FILE]` (`--pages N`: only the rows with N pages; `NH_BENCH_NO_RT=1` in the
-//! environment: the tick thread without real-time scheduling, for comparison)
+//! [--input mixed|pointer|wheel|keys] [--out FILE]` (`--pages N`: only the rows with N pages;
+//! `--input`: the hand moved by the pointer and the wheel in turn, the default, or by one
+//! alone; `NH_BENCH_NO_RT=1` in the environment: the tick thread without real-time scheduling,
+//! for comparison)
 //! runs, each for S seconds (default 10) of play:
 //! 0. brickworld with a Rust WebSocket client as the hand and no browser (the baseline);
 //! 1. brickworld, one page that plays (the pointer circles at 60 events/s);
@@ -61,7 +63,42 @@ struct Outcome {
     dropped: u64,
 }
 
-fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result<Outcome, String> {
+/// The input-path probe the playing page is given (see `session`).
+const PROBE: &str = "(() => { const q = { wheel: [], move: [], send: [], long: [] }; \
+    window.__probe = q; \
+    const at = (list) => (e) => list.push(performance.now() - e.timeStamp); \
+    window.addEventListener('wheel', at(q.wheel), { capture: true, passive: true }); \
+    for (const k of ['pointermove', 'pointerrawupdate']) window.addEventListener(k, at(q.move), { capture: true }); \
+    const send = WebSocket.prototype.send; \
+    WebSocket.prototype.send = function (m) { \
+      if (typeof m === 'string' && m.startsWith('{\"type\":\"input\"')) { \
+        const t = JSON.parse(m).t_ms; q.send.push(performance.timeOrigin + performance.now() - t); } \
+      return send.call(this, m); }; \
+    const t0 = performance.now(); \
+    new PerformanceObserver((l) => { for (const e of l.getEntries()) if (e.startTime >= t0) q.long.push(e.duration); }) \
+      .observe({ type: 'longtask' }); \
+    return 0; })()";
+
+/// What the playing page's hand is moved with (`--input`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Input {
+    /// The pointer and the wheel in turn (the default).
+    Mixed,
+    /// The pointer alone, circling.
+    Pointer,
+    /// The wheel alone.
+    Wheel,
+    /// PageDown and PageUp held in turn.
+    Keys,
+}
+
+fn session(
+    scene: &'static str,
+    pages: usize,
+    nice: i32,
+    seconds: f64,
+    input: Input,
+) -> Result<Outcome, String> {
     let out = std::env::temp_dir().join(format!("nh-play-bench-{}.mcap", std::process::id()));
     let mut c = PlayConfig::new(
         SceneSource::resolve(scene.as_ref()).map_err(|e| e.to_string())?,
@@ -87,6 +124,10 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
         b.eval("document.getElementById('go').click(); 0")?;
     }
     browsers[0].wait_for("window.__play.role === 'hand'", 10.0)?;
+    // Where the hand's time goes on the page (issue 43 item 3): each input event's wait from
+    // its timestamp to its dispatch (the capture listener runs first), by kind; the input
+    // messages' wait from the event to the socket's send; and the main thread's long tasks.
+    browsers[0].eval(PROBE)?;
     let r = browsers[0].eval("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.left + r.width / 2, r.top + r.height / 2, 0.46 * Math.min(r.width, r.height)]; })()")?;
     let (cx, cy, k) = (
         r[0].as_f64().unwrap_or(0.0),
@@ -95,25 +136,43 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
     );
     let t0 = Instant::now();
     let mut i = 0u64;
+    let mut key_down: Option<&str> = None;
     while t0.elapsed().as_secs_f64() < seconds {
         let a = i as f64 * 0.05;
         let rr = 0.4 * k;
         let (x, y) = (cx + rr * a.cos(), cy + rr * a.sin());
-        if i % 2 == 0 {
-            browsers[0].mouse("mouseMoved", x, y, false, 0.0)?;
-        } else {
-            // The wheel, every other event: 0.5 of the ball's radius (the wheel's 0.0015 per
-            // unit) down twice, up twice, between heights -0.7 and 0.3 (the first step is up
-            // 0.3): the hand taps the ground, or what lies on it, about four times a second.
-            let w = i / 2;
-            let dy = if w == 0 {
+        // The wheel's step, for its n-th event: 0.5 of the ball's radius (the wheel's 0.0015
+        // per unit) down twice, up twice, between heights -0.7 and 0.3 (the first step is up
+        // 0.3): the hand taps the ground, or what lies on it, about four times a second.
+        let wheel = |w: u64| {
+            if w == 0 {
                 -200.0
             } else if (w - 1) % 4 < 2 {
                 333.3
             } else {
                 -333.3
-            };
-            browsers[0].mouse("mouseWheel", x, y, false, dy)?;
+            }
+        };
+        match input {
+            Input::Mixed if i % 2 == 0 => browsers[0].mouse("mouseMoved", x, y, false, 0.0)?,
+            Input::Mixed => browsers[0].mouse("mouseWheel", x, y, false, wheel(i / 2))?,
+            Input::Pointer => browsers[0].mouse("mouseMoved", x, y, false, 0.0)?,
+            Input::Wheel => browsers[0].mouse("mouseWheel", cx, cy, false, wheel(i / 2))?,
+            // The keys: PageDown and PageUp held in turn for a quarter of a second each (the
+            // page moves the hand by the keys held each frame and sends it then).
+            Input::Keys if i % 15 == 0 => {
+                let next = if (i / 15) % 2 == 0 {
+                    "PageDown"
+                } else {
+                    "PageUp"
+                };
+                if let Some(k) = key_down {
+                    browsers[0].key(k, false, false)?;
+                }
+                browsers[0].key(next, true, false)?;
+                key_down = Some(next);
+            }
+            Input::Keys => {}
         }
         i += 1;
         let next = Duration::from_secs_f64(i as f64 / 60.0);
@@ -121,6 +180,26 @@ fn session(scene: &'static str, pages: usize, nice: i32, seconds: f64) -> Result
             std::thread::sleep(w);
         }
     }
+    let probe = browsers[0].eval(
+        "(() => { const q = window.__probe; return [q.wheel, q.move, q.send, q.long]; })()",
+    )?;
+    let ms = |i: usize| -> Vec<f64> {
+        probe[i]
+            .as_array()
+            .map(|a| a.iter().filter_map(Value::as_f64).collect())
+            .unwrap_or_default()
+    };
+    let long = ms(3);
+    eprintln!(
+        "{scene}: the page's input path: event → dispatch, wheel {}; pointer moves {}; event → \
+         socket send {}; long tasks (≥ 50 ms) {} totalling {:.0} ms, the longest {:.0} ms",
+        fmt(LatencyMs::of(&ms(0))),
+        fmt(LatencyMs::of(&ms(1))),
+        fmt(LatencyMs::of(&ms(2))),
+        long.len(),
+        long.iter().fold(0.0, |a, b| a + b),
+        long.iter().copied().fold(0.0, f64::max),
+    );
     let mut fps = Vec::new();
     let mut audio = Vec::new();
     let mut audio_ts = Vec::new();
@@ -330,6 +409,18 @@ fn main() {
     // `--pages N`: only the rows with N pages (and the browsers at normal nice), e.g. the three
     // runs of 60 s with three pages behind issue 33's deadline target.
     let only_pages: Option<usize> = opt("--pages").and_then(|s| s.parse().ok());
+    // `--input pointer|wheel|keys`: the playing page's hand moved by that alone (default: the
+    // pointer and the wheel in turn), to tell where input → force goes (issue 43 item 3).
+    let input = match opt("--input").as_deref() {
+        None | Some("mixed") => Input::Mixed,
+        Some("pointer") => Input::Pointer,
+        Some("wheel") => Input::Wheel,
+        Some("keys") => Input::Keys,
+        Some(other) => {
+            eprintln!("--input `{other}`: allowed mixed, pointer, wheel, keys");
+            std::process::exit(2);
+        }
+    };
     let load0 = loadavg();
     let t0 = Instant::now();
     // (scene, pages, nice of the browsers)
@@ -357,7 +448,7 @@ fn main() {
         let o = if pages == 0 {
             no_browser(scene, seconds)
         } else {
-            session(scene, pages, nice, seconds)
+            session(scene, pages, nice, seconds, input)
         };
         let label = if nice != 0 {
             format!("{pages} (nice {nice})")
