@@ -38,6 +38,7 @@ pub mod classroom;
 
 pub mod http;
 pub mod input;
+pub mod lesson;
 pub mod protocol;
 pub mod publish;
 pub mod replay;
@@ -85,6 +86,10 @@ pub struct PlayConfig {
     /// the server's, publisher's and pages' threads stay at normal priority); `None`: ask for
     /// nothing (`--no-rt`). What it got is in the summary's `session.stats.realtime`.
     pub rt: Option<haptic_engine::realtime::RtRequest>,
+    /// A lesson to take the student through (`play --lesson`): the scene above is then unused,
+    /// each step runs its own, recorded to `out` without its extension, a directory, as
+    /// `STEP-ID.mcap` ([`lesson`]).
+    pub lesson: Option<teaching::Lesson>,
 }
 
 impl PlayConfig {
@@ -100,6 +105,7 @@ impl PlayConfig {
             keep_serving_s: None,
             limits: Limits::default(),
             rt: Some(haptic_engine::realtime::RtRequest::default()),
+            lesson: None,
         }
     }
 }
@@ -121,6 +127,19 @@ pub struct PlaySummary {
     /// Requests, connections and messages the server refused, by reason (forged `Host` or
     /// `Origin`, limits).
     pub refused: RefusedCounts,
+    /// The lesson, when one was played: the student's progress and each step's world.
+    pub lesson: Option<LessonOutcome>,
+}
+
+/// What a lesson of `play --lesson` came to.
+#[derive(Debug)]
+pub struct LessonOutcome {
+    /// The student's progress (answers, ticks on each step, test scores).
+    pub progress: teaching::Progress,
+    /// Each step's world as it ran, in order (its recording, its met tick).
+    pub runs: Vec<lesson::StepRun>,
+    /// The directory of the steps' recordings.
+    pub dir: PathBuf,
 }
 
 impl PlaySummary {
@@ -213,6 +232,9 @@ pub fn run(
     stop: &AtomicBool,
     on_ready: &mut dyn FnMut(&str),
 ) -> Result<PlaySummary, PlayError> {
+    if let Some(lesson) = &config.lesson {
+        return run_lesson(config, lesson.clone(), stop, on_ready);
+    }
     let scene_src = &config.scene;
     let file = scene_src.parse()?;
     // One start time for a bridged device's welcome and the recording.
@@ -281,6 +303,57 @@ pub fn run(
         messages_dropped: shared.dropped.load(Ordering::Relaxed),
         page_messages_refused: shared.refused.load(Ordering::Relaxed),
         refused: server.gate().refused.snapshot(),
+        lesson: None,
+    })
+}
+
+/// `run` with a lesson: serves the page, takes the student through `lesson` (each step's world
+/// in real time, the page the hand), then serves the completion screen as `run` does the end
+/// screen. The summary's session is the last step's.
+fn run_lesson(
+    config: &PlayConfig,
+    lesson: teaching::Lesson,
+    stop: &AtomicBool,
+    on_ready: &mut dyn FnMut(&str),
+) -> Result<PlaySummary, PlayError> {
+    let shared = Arc::new(Shared::default());
+    let mut server =
+        Server::start(config.port, shared.clone(), config.limits.clone()).map_err(|e| {
+            PlayError::Serve {
+                port: config.port,
+                message: e.to_string(),
+            }
+        })?;
+    let url = server.url();
+    on_ready(&url);
+    let mut driver =
+        lesson::LessonDriver::new(lesson, shared.clone(), config.out.with_extension(""));
+    let r = driver.run(Pacing::Realtime, config.rt.as_ref(), stop);
+    if let Err(e) = r {
+        server.stop(&shared);
+        return Err(PlayError::Failed(e.to_string()));
+    }
+    serve_end_screen(config, stop);
+    server.stop(&shared);
+    let dir = driver.dir().to_path_buf();
+    let progress = driver.progress().clone();
+    let mut runs = driver.into_runs();
+    let session = match runs.last_mut() {
+        Some(r) => std::mem::take(&mut r.session),
+        None => return Err(PlayError::NotStarted),
+    };
+    Ok(PlaySummary {
+        url,
+        session,
+        pages_served: shared.pages_served.load(Ordering::Relaxed),
+        messages_dropped: shared.dropped.load(Ordering::Relaxed),
+        page_messages_refused: shared.refused.load(Ordering::Relaxed),
+        refused: server.gate().refused.snapshot(),
+        lesson: Some(LessonOutcome {
+            progress,
+            runs,
+            dir,
+        }),
     })
 }
 

@@ -15,6 +15,8 @@ mod shared;
 #[cfg(test)]
 mod tests;
 
+#[cfg(test)]
+pub(crate) use page_link::on_message as on_page_message;
 pub use page_link::page_link;
 pub use play_server::{PlayRoutes, Server};
 pub use shared::{PAGE_QUEUE, Page, SceneLink, Shared, SwitchRequest, WRITE_TIMEOUT_S};
