@@ -309,7 +309,7 @@ pub fn run(
 
 /// `run` with a lesson: serves the page, takes the student through `lesson` (each step's world
 /// in real time, the page the hand), then serves the completion screen as `run` does the end
-/// screen. The summary's session is the last step's.
+/// screen. The summary's session is the last step's (each step's is in the lesson's runs).
 fn run_lesson(
     config: &PlayConfig,
     lesson: teaching::Lesson,
@@ -337,10 +337,9 @@ fn run_lesson(
     server.stop(&shared);
     let dir = driver.dir().to_path_buf();
     let progress = driver.progress().clone();
-    let mut runs = driver.into_runs();
-    let session = match runs.last_mut() {
-        Some(r) => std::mem::take(&mut r.session),
-        None => return Err(PlayError::NotStarted),
+    let runs = driver.into_runs();
+    let Some(session) = runs.last().map(|r| r.session.clone()) else {
+        return Err(PlayError::NotStarted);
     };
     Ok(PlaySummary {
         url,

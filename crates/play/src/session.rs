@@ -122,7 +122,7 @@ pub enum Step {
 }
 
 /// What a live session produced: the one summary `play` and the classroom both wrap.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct SessionSummary {
     /// How it ended: `completed` (its length ran), `stopped` (the player, the teacher or the
     /// program ended it), `device_ended` (a bridged device said goodbye); the words of

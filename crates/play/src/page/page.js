@@ -16,6 +16,7 @@ export const P = (window.__play = {
   },
   inputsSent: 0,
   said: [], menu: {},
+  lesson: null, lessons: [], answersSent: 0, stepEnds: [],
 });
 
 const logEl = $('log');

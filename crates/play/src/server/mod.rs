@@ -72,6 +72,7 @@ pub const PAGE_FILES: &[PageFile] = &[
     file("/synth.js", JS, include_str!("../page/synth.js")),
     file("/messages.js", JS, include_str!("../page/messages.js")),
     file("/events.js", JS, include_str!("../page/events.js")),
+    file("/lesson.js", JS, include_str!("../page/lesson.js")),
 ];
 
 /// What a listening server does with a request that passed its [`Gate`] and its
