@@ -4,7 +4,8 @@
 //! until the tip snaps to the surface), says what they noticed in a text area, answers the
 //! post-test and sees the completion with the scores. Every answer reaches the progress; each
 //! step's recording replays bit for bit, its switches on its first tick; the questions are
-//! labelled form controls and the live region says each place. The screenshot of a question
+//! labelled form controls and the live region says each place. A step opens alone by its
+//! address (`?step=ID`), an unknown one is said, and E stops the lesson. The screenshot of a question
 //! goes to the target folder's `tmp/figures/play/` (`scripts/figures.sh` writes it to
 //! docs/figures/play/).
 
@@ -22,6 +23,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::sleep;
 use std::time::Duration;
 use teaching::Answer;
+
+/// One browser at a time: the tests share two cores with the real-time loop.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 const W: u32 = 1280;
 const H: u32 = 760;
@@ -97,6 +105,7 @@ fn choose(b: &mut Browser, i: usize, label: &str) {
 
 #[test]
 fn a_student_completes_a_lesson_by_keyboard_and_each_step_replays() {
+    let _one = serial();
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("nh-lesson-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -238,4 +247,74 @@ fn a_student_completes_a_lesson_by_keyboard_and_each_step_replays() {
         .map(|(t, _, _)| *t)
         .collect();
     assert_eq!(snaps, vec![snap.met_at.unwrap()]);
+}
+
+/// Serves `LESSON` with `play --lesson`; (url, stop, handle).
+fn serve(
+    name: &str,
+) -> (
+    String,
+    Arc<AtomicBool>,
+    std::thread::JoinHandle<Result<play::PlaySummary, play::PlayError>>,
+) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-lesson-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let lesson = teaching::parse_lesson(LESSON, "two.lesson.toml", None).unwrap();
+    let mut c = PlayConfig::new(
+        SceneSource::resolve("brickworld".as_ref()).unwrap(),
+        dir.join("lesson.mcap"),
+    );
+    c.port = 0;
+    c.lesson = Some(lesson);
+    let stop = Arc::new(AtomicBool::new(false));
+    let play::Running { url, handle } = play::start(c, stop.clone()).unwrap();
+    (url, stop, handle)
+}
+
+#[test]
+fn a_step_opens_by_its_address_for_a_demonstration_and_an_unknown_one_is_said() {
+    let _one = serial();
+    let (url, stop, handle) = serve("url");
+    let mut b = Browser::launch(W, H).unwrap_or_else(|e| panic!("{e}"));
+    // An unknown step: the page says why, and the lesson stays at its start.
+    b.open(&format!("{url}?step=lift")).unwrap();
+    b.wait_for("window.__play.errors.length > 0", 10.0).unwrap();
+    assert_eq!(
+        b.eval("[window.__play.errors[0].field, window.__play.errors[0].message, document.getElementById('announce').textContent, window.__play.lesson.place]").unwrap(),
+        json!(["step.id", "step `lift` is not in the lesson (its steps: float, snap)", "step `lift` is not in the lesson (its steps: float, snap)", "pre_test"])
+    );
+    // The locked nano step by its address: no tests, no wait, its world at once.
+    b.open(&format!("{url}?step=snap")).unwrap();
+    b.wait_for("window.__play.lesson !== null && window.__play.lesson.step_id === 'snap' && window.__play.hello !== null", 10.0).unwrap();
+    assert_eq!(
+        b.eval("[window.__play.lesson.title, window.__play.lesson.place, window.__play.lesson.steps, window.__play.hello.kind, document.activeElement.id]").unwrap(),
+        json!(["Two steps: step snap (demonstration)", "doing", 1, "nanoworld", "go"])
+    );
+    // Start, then E before the tip snaps: the lesson stops there, with the end screen.
+    press(&mut b, "Enter");
+    b.wait_for(
+        "window.__play.role === 'hand' && window.__play.frames > 5",
+        10.0,
+    )
+    .unwrap();
+    press(&mut b, "e");
+    b.wait_for("window.__play.ended !== null", 10.0).unwrap();
+    assert_eq!(
+        b.eval("[window.__play.ended.end, document.getElementById('end').classList.contains('hidden'), window.__play.lesson.place]").unwrap(),
+        json!(["stopped", false, "doing"])
+    );
+    b.check().unwrap();
+    stop.store(true, Ordering::Relaxed);
+    let s = handle.join().unwrap().unwrap();
+    let l = s.lesson.unwrap();
+    assert_eq!(
+        (l.runs.len(), l.runs[0].id.as_str(), l.runs[0].met_at),
+        (1, "snap", None)
+    );
+    assert_eq!(s.session.end, "stopped");
+    assert!(s.session.stats.ticks > 0);
+    assert_eq!(l.progress.steps()[0].ticks, s.session.stats.ticks);
+    let rec = recording::read_recording_file(&s.session.recording, false).unwrap();
+    assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }

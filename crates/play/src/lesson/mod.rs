@@ -324,6 +324,10 @@ impl LessonDriver {
                 continue;
             };
             let mut world = world?;
+            // The page's Start (its first hand) starts the first world; later ones at once.
+            if !self.shared.input.wait_first(stop) {
+                world.session.request_end();
+            }
             world.session.run(pacing.clone(), rt, stop);
             let run = self.close_world(world);
             if let Some(e) = &run.session.error {

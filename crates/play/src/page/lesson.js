@@ -75,6 +75,10 @@ export function onLesson(m) {
   $('lesson-panel').classList.remove('hidden');
   $('lesson-now').textContent = m.step === null ? '' : `${m.step_title}: ${m.task}`;
   $('lesson-words').textContent = m.words;
+  // A stopped world ended the lesson: its end screen stays. A completed one was a step's end
+  // (seen as the session's by a page that connected after it): the lesson goes on.
+  if (P.ended && P.ended.end !== 'completed') return;
+  if (P.ended) { P.stepEnds.push(P.ended); P.ended = null; }
   const card = $('lesson');
   $('end').classList.add('hidden');
   if (QUESTION_PLACES.has(m.place)) {

@@ -123,9 +123,10 @@ function onFrame(f) {
 // `end`: the session's figures and the recording's download.
 function onEnd(m) {
   announceEvents([], true);
-  // In a lesson a step's world ended, not the page's session: the next `lesson` message says
-  // what follows (the hand goes on into the next step's world).
-  if (lessonRuns()) { P.stepEnds.push(m); return; }
+  // In a lesson a step's world completed, not the page's session: the next `lesson` message
+  // says what follows (the hand goes on into the next step's world). A stopped world (E,
+  // Ctrl-C) ends the lesson there, with the end screen.
+  if (lessonRuns() && m.end === 'completed') { P.stepEnds.push(m); return; }
   finishAudio(P.sound.nextTick);
   P.ended = m;
   const rows = [['how it ended', m.end], ['time', `${m.seconds.toFixed(2)} s`], ['score', (m.state.score ?? 0).toFixed(1)]];
