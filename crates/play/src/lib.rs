@@ -22,6 +22,9 @@
 //! - **The protocol** ([`protocol`]): one typed message enum per direction, [`protocol::ServerMsg`]
 //!   and [`protocol::PageMsg`], tabled in `docs/play.md`.
 //!
+//! - **The lesson** ([`lesson`]): `play --lesson` takes one student through a lesson of
+//!   `nanohaptics-teaching`, each step its own session and recording, its condition watched on
+//!   the tick thread ([`PlayConfig::lesson`]; `docs/teaching.md`).
 //! - **The classroom** ([`classroom`]): one server for a whole class, a session per student
 //!   ticked by shared workers, a teacher page, the recordings as one zip.
 //! - **Safe to reach** ([`webguard::gate`]): `Host` and `Origin` checked on every request and

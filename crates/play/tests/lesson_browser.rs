@@ -174,6 +174,11 @@ fn a_student_completes_a_lesson_by_keyboard_and_each_step_replays() {
     b.key("PageDown", false, false).unwrap();
     r.unwrap();
 
+    // The snap sounded: the second world's sound stream started again at its tick 0 and the
+    // synthesis played the snap's onset.
+    b.wait_for("(() => { const e = window.__play.events.find(e => e[1] === 'nano.snap'); return !!e && window.__play.sound.played.some(p => p[0] === e[0]); })()", 10.0).unwrap();
+    assert_eq!(b.eval("window.__play.sound.restarts").unwrap(), 1);
+
     // What they noticed: a labelled text area, typed, Tab to Answer, Enter.
     assert_eq!(focused(&mut b)[0], "TEXTAREA");
     assert_eq!(

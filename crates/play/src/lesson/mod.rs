@@ -14,7 +14,7 @@
 
 mod view;
 
-use crate::protocol::{LessonView, PageAnswer, ServerMsg};
+use crate::protocol::{LessonAsk, LessonView, PageAnswer, ServerMsg};
 use crate::server::Shared;
 use crate::session::{Hand, PageSession, SessionSpec, SessionSummary};
 use haptic_engine::pacing::Pacing;
@@ -27,18 +27,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 use teaching::progress::ProgressError;
 use teaching::{Answer, Evaluator, Lesson, Place, Progress};
-
-/// What a page asked of the lesson: (page id, the ask).
-pub type LessonAsk = (u64, Ask);
-
-/// A page's ask of the lesson.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Ask {
-    /// The answer to the question now.
-    Answer(PageAnswer),
-    /// Open step `id` for a demonstration.
-    Step(String),
-}
 
 /// What the driver refuses a page.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -208,8 +196,8 @@ impl LessonDriver {
         };
         for (page, ask) in asks {
             let r = match ask {
-                Ask::Answer(a) => self.answer(a).map(|_| ()),
-                Ask::Step(id) => self.open_step(&id),
+                LessonAsk::Answer(a) => self.answer(a).map(|_| ()),
+                LessonAsk::Step(id) => self.open_step(&id),
             };
             if let Err(e) = r {
                 self.shared.error_to(page, e.field(), &e.to_string());

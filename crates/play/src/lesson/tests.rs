@@ -5,6 +5,7 @@
 
 use super::*;
 use crate::input::WORKSPACE_FILL;
+use crate::protocol::LessonAsk;
 use crate::server::Page;
 use crate::session::Step;
 use haptic_engine::clock::Batch;
@@ -221,7 +222,7 @@ fn a_world_condition_completes_its_step_on_the_tick_the_world_reports_it() {
 #[test]
 fn answers_reach_the_progress_and_bad_ones_are_refused_with_their_reason() {
     let (mut d, shared, rx) = driver("answers");
-    let ask = |a: Ask| {
+    let ask = |a: LessonAsk| {
         shared
             .lesson_asks
             .lock()
@@ -231,9 +232,9 @@ fn answers_reach_the_progress_and_bad_ones_are_refused_with_their_reason() {
             .push((1, a))
     };
     sent(&rx);
-    ask(Ask::Answer(PageAnswer::Choice(2)));
-    ask(Ask::Answer(PageAnswer::Text("weight".into())));
-    ask(Ask::Answer(PageAnswer::Choice(1)));
+    ask(LessonAsk::Answer(PageAnswer::Choice(2)));
+    ask(LessonAsk::Answer(PageAnswer::Text("weight".into())));
+    ask(LessonAsk::Answer(PageAnswer::Choice(1)));
     d.take_asks();
     let msgs = sent(&rx);
     assert_eq!(msgs[0]["type"], "error");
@@ -324,7 +325,7 @@ fn a_step_opened_by_its_url_is_a_demonstration_and_an_unknown_one_is_refused() {
         .unwrap()
         .as_mut()
         .unwrap()
-        .push((1, Ask::Step("lift".into())));
+        .push((1, LessonAsk::Step("lift".into())));
     d.take_asks();
     let msgs = sent(&rx);
     assert_eq!(msgs[0]["field"], "step.id");

@@ -5,7 +5,7 @@
 
 import { $, P, log, say } from './page.js';
 import { aimAtWorkspace } from './camera.js';
-import { finishAudio, onSoundTicks } from './sound.js';
+import { finishAudio, onSoundTicks, restartAudio } from './sound.js';
 import { eventClass, sentence } from './events.js';
 import { lessonRuns, onLesson } from './lesson.js';
 
@@ -60,6 +60,8 @@ function showSwitch(name, v) {
 
 // `hello`: the scene, the device, the menu; the Start button opens.
 function onHello(h) {
+  // A lesson's next world: its ticks (and its sound's) start again at 0.
+  if (lessonRuns() && P.hello) restartAudio();
   P.hello = h;
   $('title').textContent = h.scene;
   aimAtWorkspace(h);
@@ -126,7 +128,7 @@ function onEnd(m) {
   // In a lesson a step's world completed, not the page's session: the next `lesson` message
   // says what follows (the hand goes on into the next step's world). A stopped world (E,
   // Ctrl-C) ends the lesson there, with the end screen.
-  if (lessonRuns() && m.end === 'completed') { P.stepEnds.push(m); return; }
+  if (lessonRuns() && m.end === 'completed') { P.stepEnds.push(m); finishAudio(m.ticks); return; }
   finishAudio(P.sound.nextTick);
   P.ended = m;
   const rows = [['how it ended', m.end], ['time', `${m.seconds.toFixed(2)} s`], ['score', (m.state.score ?? 0).toFixed(1)]];

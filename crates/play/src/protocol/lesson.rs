@@ -63,3 +63,13 @@ pub enum PageAnswer {
     /// A short text.
     Text(String),
 }
+
+/// What a page asked of the lesson (its `answer` and `step` messages), queued for the lesson's
+/// driver.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LessonAsk {
+    /// The answer to the question now.
+    Answer(PageAnswer),
+    /// Open step `id` alone, for a demonstration.
+    Step(String),
+}

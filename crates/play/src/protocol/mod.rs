@@ -26,7 +26,7 @@ mod sound;
 #[cfg(test)]
 mod tests;
 
-pub use lesson::{LessonView, PageAnswer, QuestionView, Scores};
+pub use lesson::{LessonAsk, LessonView, PageAnswer, QuestionView, Scores};
 pub use page::{MAX_MESSAGE_BYTES, PageInput, PageMsg, ProtocolError, parse};
 pub use server::{
     EndReport, EventAt, Frame, FrameView, Hello, LatencyMs, Mapping, Role, ServerMsg, SoundAt,

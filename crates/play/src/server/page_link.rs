@@ -2,8 +2,7 @@
 
 use super::{PAGE_QUEUE, Page, SceneLink, Shared};
 use crate::input::page_to_device;
-use crate::lesson::Ask;
-use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
+use crate::protocol::{self, LessonAsk, PageMsg, ProtocolError, Role, ServerMsg};
 use crate::wslink::{self, Incoming, LinkConfig};
 use std::net::TcpStream;
 use std::sync::Arc;
@@ -72,8 +71,8 @@ pub(crate) fn on_message(shared: &Shared, id: u64, text: &str) {
                 }
             }
         }
-        PageMsg::Answer { answer } => ask_lesson(shared, id, "answer", Ask::Answer(answer)),
-        PageMsg::Step { id: step } => ask_lesson(shared, id, "step.id", Ask::Step(step)),
+        PageMsg::Answer { answer } => ask_lesson(shared, id, "answer", LessonAsk::Answer(answer)),
+        PageMsg::Step { id: step } => ask_lesson(shared, id, "step.id", LessonAsk::Step(step)),
         PageMsg::End => {
             if is_player(shared) || link.as_ref().is_some_and(|l| !l.page_is_hand) {
                 shared.end_requested.store(true, Ordering::Relaxed);
@@ -85,7 +84,7 @@ pub(crate) fn on_message(shared: &Shared, id: u64, text: &str) {
 }
 
 /// Queues page `id`'s ask for the lesson's driver; refused (`field`) when no lesson runs.
-fn ask_lesson(shared: &Shared, id: u64, field: &str, ask: Ask) {
+fn ask_lesson(shared: &Shared, id: u64, field: &str, ask: LessonAsk) {
     let queued = match shared.lesson_asks.lock() {
         Ok(mut q) => q.as_mut().map(|q| q.push((id, ask))).is_some(),
         Err(_) => false,
