@@ -363,3 +363,37 @@ fn a_step_opened_by_its_url_is_a_demonstration_and_an_unknown_one_is_refused() {
         "this session runs no lesson (a lesson is played with nanohaptics play --lesson)"
     );
 }
+
+#[test]
+fn every_step_of_the_builtin_module_opens_its_world_with_its_switches() {
+    let module = teaching::builtin::module().unwrap();
+    for step in &module.steps {
+        let shared = Arc::new(Shared::default());
+        let mut d = LessonDriver::new(module.clone(), shared.clone(), dir("builtin"));
+        d.open_step(&step.id).unwrap();
+        if step.before.is_some() {
+            assert_eq!(d.progress().place(), Place::Before(0), "{}", step.id);
+            let a = match &step.before.as_ref().unwrap().kind {
+                teaching::QuestionKind::Choice { .. } => PageAnswer::Choice(0),
+                teaching::QuestionKind::Text => PageAnswer::Text("a guess".into()),
+            };
+            d.answer(a).unwrap();
+        }
+        let mut w = d.open_world().unwrap().unwrap();
+        let hello: serde_json::Value =
+            serde_json::from_str(&shared.hello.lock().unwrap().clone().unwrap()).unwrap();
+        assert_eq!(hello["kind"], step.kind, "{}", step.id);
+        for (name, value) in step.switch_pairs() {
+            let s = hello["switches"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|s| s["name"] == name)
+                .unwrap();
+            assert_eq!(s["value"].as_f64(), Some(value), "{} {name}", step.id);
+        }
+        w.session.request_end();
+        assert_eq!(w.session.step(&mut Batch), Step::Ended);
+        assert_eq!(d.close_world(w).met_at, None);
+    }
+}
