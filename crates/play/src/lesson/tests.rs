@@ -371,9 +371,9 @@ fn every_step_of_the_builtin_module_opens_its_world_with_its_switches() {
         let shared = Arc::new(Shared::default());
         let mut d = LessonDriver::new(module.clone(), shared.clone(), dir("builtin"));
         d.open_step(&step.id).unwrap();
-        if step.before.is_some() {
+        if let Some(before) = &step.before {
             assert_eq!(d.progress().place(), Place::Before(0), "{}", step.id);
-            let a = match &step.before.as_ref().unwrap().kind {
+            let a = match &before.kind {
                 teaching::QuestionKind::Choice { .. } => PageAnswer::Choice(0),
                 teaching::QuestionKind::Text => PageAnswer::Text("a guess".into()),
             };
