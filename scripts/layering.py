@@ -58,13 +58,14 @@ ALLOWED = {
     # through the sessions crate (built-in names, files, switches), so a page can drive a lesson
     # without the lesson report's figures; the class report draws its two charts with `chart`.
     "nanohaptics-teaching": {"chart", "haptic-engine", "haptic-loop", "haptic-types", "world-form"},
+    # The page runs a lesson (`play --lesson`): lesson files, the evaluator and the progress.
     "nanohaptics-play": {
-        "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-recording", "render",
-        "webguard", "world-form",
+        "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-recording",
+        "nanohaptics-teaching", "render", "webguard", "world-form",
     },
     "nanohaptics-cli": {
         "haptic-devices", "haptic-engine", "haptic-loop", "haptic-types", "nanohaptics-lesson",
-        "nanohaptics-play", "nanohaptics-recording", "render", "world-form",
+        "nanohaptics-play", "nanohaptics-recording", "nanohaptics-teaching", "render", "world-form",
     },
     # The wheel sits on top: besides its bindings it carries the whole program (the
     # `nanohaptics` command of `pip install nanohaptics`, docs/python.md), so it depends on the

@@ -22,6 +22,9 @@
 //! - **The protocol** ([`protocol`]): one typed message enum per direction, [`protocol::ServerMsg`]
 //!   and [`protocol::PageMsg`], tabled in `docs/play.md`.
 //!
+//! - **The lesson** ([`lesson`]): `play --lesson` takes one student through a lesson of
+//!   `nanohaptics-teaching`, each step its own session and recording, its condition watched on
+//!   the tick thread ([`PlayConfig::lesson`]; `docs/teaching.md`).
 //! - **The classroom** ([`classroom`]): one server for a whole class, a session per student
 //!   ticked by shared workers, a teacher page, the recordings as one zip.
 //! - **Safe to reach** ([`webguard::gate`]): `Host` and `Origin` checked on every request and
@@ -38,6 +41,7 @@ pub mod classroom;
 
 pub mod http;
 pub mod input;
+pub mod lesson;
 pub mod protocol;
 pub mod publish;
 pub mod replay;
@@ -85,6 +89,10 @@ pub struct PlayConfig {
     /// the server's, publisher's and pages' threads stay at normal priority); `None`: ask for
     /// nothing (`--no-rt`). What it got is in the summary's `session.stats.realtime`.
     pub rt: Option<haptic_engine::realtime::RtRequest>,
+    /// A lesson to take the student through (`play --lesson`): the scene above is then unused,
+    /// each step runs its own, recorded to `out` without its extension, a directory, as
+    /// `STEP-ID.mcap` ([`lesson`]).
+    pub lesson: Option<teaching::Lesson>,
 }
 
 impl PlayConfig {
@@ -100,6 +108,7 @@ impl PlayConfig {
             keep_serving_s: None,
             limits: Limits::default(),
             rt: Some(haptic_engine::realtime::RtRequest::default()),
+            lesson: None,
         }
     }
 }
@@ -121,6 +130,19 @@ pub struct PlaySummary {
     /// Requests, connections and messages the server refused, by reason (forged `Host` or
     /// `Origin`, limits).
     pub refused: RefusedCounts,
+    /// The lesson, when one was played: the student's progress and each step's world.
+    pub lesson: Option<LessonOutcome>,
+}
+
+/// What a lesson of `play --lesson` came to.
+#[derive(Debug)]
+pub struct LessonOutcome {
+    /// The student's progress (answers, ticks on each step, test scores).
+    pub progress: teaching::Progress,
+    /// Each step's world as it ran, in order (its recording, its met tick).
+    pub runs: Vec<lesson::StepRun>,
+    /// The directory of the steps' recordings.
+    pub dir: PathBuf,
 }
 
 impl PlaySummary {
@@ -213,6 +235,9 @@ pub fn run(
     stop: &AtomicBool,
     on_ready: &mut dyn FnMut(&str),
 ) -> Result<PlaySummary, PlayError> {
+    if let Some(lesson) = &config.lesson {
+        return run_lesson(config, lesson.clone(), stop, on_ready);
+    }
     let scene_src = &config.scene;
     let file = scene_src.parse()?;
     // One start time for a bridged device's welcome and the recording.
@@ -281,6 +306,56 @@ pub fn run(
         messages_dropped: shared.dropped.load(Ordering::Relaxed),
         page_messages_refused: shared.refused.load(Ordering::Relaxed),
         refused: server.gate().refused.snapshot(),
+        lesson: None,
+    })
+}
+
+/// `run` with a lesson: serves the page, takes the student through `lesson` (each step's world
+/// in real time, the page the hand), then serves the completion screen as `run` does the end
+/// screen. The summary's session is the last step's (each step's is in the lesson's runs).
+fn run_lesson(
+    config: &PlayConfig,
+    lesson: teaching::Lesson,
+    stop: &AtomicBool,
+    on_ready: &mut dyn FnMut(&str),
+) -> Result<PlaySummary, PlayError> {
+    let shared = Arc::new(Shared::default());
+    let mut server =
+        Server::start(config.port, shared.clone(), config.limits.clone()).map_err(|e| {
+            PlayError::Serve {
+                port: config.port,
+                message: e.to_string(),
+            }
+        })?;
+    let url = server.url();
+    on_ready(&url);
+    let mut driver =
+        lesson::LessonDriver::new(lesson, shared.clone(), config.out.with_extension(""));
+    let r = driver.run(Pacing::Realtime, config.rt.as_ref(), stop);
+    if let Err(e) = r {
+        server.stop(&shared);
+        return Err(PlayError::Failed(e.to_string()));
+    }
+    serve_end_screen(config, stop);
+    server.stop(&shared);
+    let dir = driver.dir().to_path_buf();
+    let progress = driver.progress().clone();
+    let runs = driver.into_runs();
+    let Some(session) = runs.last().map(|r| r.session.clone()) else {
+        return Err(PlayError::NotStarted);
+    };
+    Ok(PlaySummary {
+        url,
+        session,
+        pages_served: shared.pages_served.load(Ordering::Relaxed),
+        messages_dropped: shared.dropped.load(Ordering::Relaxed),
+        page_messages_refused: shared.refused.load(Ordering::Relaxed),
+        refused: server.gate().refused.snapshot(),
+        lesson: Some(LessonOutcome {
+            progress,
+            runs,
+            dir,
+        }),
     })
 }
 

@@ -106,6 +106,10 @@ pub struct SessionSpec<'a> {
 /// the loop): what a teacher page shows of a student.
 pub type Reporter = Box<dyn FnMut(u64, u64, &HapticLoop) + Send>;
 
+/// Called after every tick with the loop ([`PageSession::with_watcher`]); `true` completes the
+/// session (a lesson step's condition met).
+pub type Watcher = Box<dyn FnMut(&HapticLoop) -> bool + Send>;
+
 /// What one [`PageSession::step`] did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Step {
@@ -118,7 +122,7 @@ pub enum Step {
 }
 
 /// What a live session produced: the one summary `play` and the classroom both wrap.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct SessionSummary {
     /// How it ended: `completed` (its length ran), `stopped` (the player, the teacher or the
     /// program ended it), `device_ended` (a bridged device said goodbye); the words of
@@ -165,6 +169,7 @@ pub struct PageSession {
     end: Option<EndReason>,
     error: Option<String>,
     reporter: Option<(u64, Reporter)>,
+    watcher: Option<Watcher>,
     sound_block_ticks: u64,
 }
 
@@ -176,14 +181,34 @@ impl PageSession {
         hand: Hand,
         shared: Arc<Shared>,
     ) -> Result<PageSession, SessionError> {
+        Self::open_with_switches(spec, hand, shared, &[])
+    }
+
+    /// [`PageSession::open`] with `switches` (name, value) set on the world before its first
+    /// tick: recorded as that tick's switches (so a replay sets them too) and shown in the
+    /// pages' menu from the start. A lesson step's switches.
+    pub fn open_with_switches(
+        spec: &SessionSpec<'_>,
+        hand: Hand,
+        shared: Arc<Shared>,
+        switches: &[(&str, f64)],
+    ) -> Result<PageSession, SessionError> {
         let specs = hand.device_ref().specs().clone();
-        let Setup { lp, header, sinks } = Setup::new(&SetupOptions {
+        let Setup {
+            mut lp,
+            header,
+            sinks,
+        } = Setup::new(&SetupOptions {
             operator: Some(spec.operator.clone()),
             keep_arrays: false,
             out: Some(spec.out.clone()),
             start_time_ns: Some(spec.start_time_ns),
             ..SetupOptions::new(spec.scene, specs.clone(), "realtime", &spec.link)
         })?;
+        for (name, value) in switches {
+            lp.switch(name, *value)
+                .map_err(|error| SessionError::Switch { tick: 0, error })?;
+        }
         announce(
             &shared,
             spec.scene_name,
@@ -209,6 +234,7 @@ impl PageSession {
             end: None,
             error: None,
             reporter: None,
+            watcher: None,
             sound_block_ticks: publish::SOUND_BLOCK_TICKS,
         })
     }
@@ -216,6 +242,13 @@ impl PageSession {
     /// Calls `reporter` after every `every` ticks, and once more at the end.
     pub fn with_reporter(mut self, every: u64, reporter: Reporter) -> Self {
         self.reporter = Some((every.max(1), reporter));
+        self
+    }
+
+    /// Calls `watcher` after every tick; the session completes (ends as `completed`) after the
+    /// tick on which it returns `true`.
+    pub fn with_watcher(mut self, watcher: Watcher) -> Self {
+        self.watcher = Some(watcher);
         self
     }
 
@@ -340,6 +373,11 @@ impl PageSession {
             && n % *every == 0
         {
             report(n + 1, self.engine.missed(), &self.lp);
+        }
+        if let Some(watch) = self.watcher.as_mut()
+            && watch(&self.lp)
+        {
+            self.end = Some(EndReason::Completed);
         }
         Step::Ticked
     }

@@ -91,7 +91,7 @@ export function installInput() {
     hand.n[2] -= e.deltaY * 0.0015; sendHand(e.timeStamp);
   }, { passive: false });
   window.addEventListener('keydown', (e) => {
-    if (e.target && (e.target.tagName === 'INPUT' || e.target.tagName === 'BUTTON' || e.target.tagName === 'A')) return;
+    if (e.target && ['INPUT', 'TEXTAREA', 'BUTTON', 'A'].includes(e.target.tagName)) return;
     const k = e.key;
     if (MOVE[k]) { held.set(k, e.shiftKey ? 0.2 : 1); e.preventDefault(); }
     else if (k === ' ') { if (!e.repeat) { hand.grip = !hand.grip; sendHand(e.timeStamp); } e.preventDefault(); }

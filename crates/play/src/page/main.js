@@ -8,6 +8,7 @@
 //   synth.js     the synthesis, an AudioWorklet processor (render --audio's, ported)
 //   messages.js  the WebSocket and a handler per message type
 //   events.js    the events in words: which the player hears, which stay in the recording
+//   lesson.js    the lesson (play --lesson): its questions as forms, the step's task, the end
 // window.__play holds figures for tests and benches.
 
 import { $, P } from './page.js';
@@ -16,6 +17,7 @@ import { draw } from './draw.js';
 import { gripping, installInput, pollKeysAndPad, sendHand } from './input.js';
 import { startAudio } from './sound.js';
 import { connect, send } from './messages.js';
+import { installLesson } from './lesson.js';
 
 $('go').addEventListener('click', () => {
   $('start').classList.add('hidden');
@@ -38,5 +40,6 @@ function loop(t) {
 window.addEventListener('resize', resize);
 resize();
 installInput();
+installLesson();
 connect();
 requestAnimationFrame(loop);

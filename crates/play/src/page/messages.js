@@ -5,8 +5,9 @@
 
 import { $, P, log, say } from './page.js';
 import { aimAtWorkspace } from './camera.js';
-import { finishAudio, onSoundTicks } from './sound.js';
+import { finishAudio, onSoundTicks, restartAudio } from './sound.js';
 import { eventClass, sentence } from './events.js';
+import { lessonRuns, onLesson } from './lesson.js';
 
 let ws = null;
 
@@ -59,6 +60,8 @@ function showSwitch(name, v) {
 
 // `hello`: the scene, the device, the menu; the Start button opens.
 function onHello(h) {
+  // A lesson's next world: its ticks (and its sound's) start again at 0.
+  if (lessonRuns() && P.hello) restartAudio();
   P.hello = h;
   $('title').textContent = h.scene;
   aimAtWorkspace(h);
@@ -89,7 +92,11 @@ function onHello(h) {
   $('start-msg').textContent = h.page_is_hand
     ? `${h.scene}. Press Start: the page is the hand (pointer, keyboard or gamepad).`
     : `${h.scene}. A device is the hand; this page shows and sounds the session.`;
-  $('go').disabled = false; $('go').focus();
+  $('go').disabled = false;
+  // In a lesson the page stays the hand from one step's world to the next.
+  if (lessonRuns() && P.role === 'hand') { $('start').classList.add('hidden'); return; }
+  if (lessonRuns()) $('start').classList.remove('hidden');
+  $('go').focus();
 }
 
 // `frame`: the drawing (kept for the next animation frame), the events and sounds, the HUD.
@@ -118,6 +125,10 @@ function onFrame(f) {
 // `end`: the session's figures and the recording's download.
 function onEnd(m) {
   announceEvents([], true);
+  // In a lesson a step's world completed, not the page's session: the next `lesson` message
+  // says what follows (the hand goes on into the next step's world). A stopped world (E,
+  // Ctrl-C) ends the lesson there, with the end screen.
+  if (lessonRuns() && m.end === 'completed') { P.stepEnds.push(m); finishAudio(m.ticks); return; }
   finishAudio(P.sound.nextTick);
   P.ended = m;
   const rows = [['how it ended', m.end], ['time', `${m.seconds.toFixed(2)} s`], ['score', (m.state.score ?? 0).toFixed(1)]];
@@ -160,6 +171,7 @@ const HANDLERS = new Map([
   ['switched', onSwitched],
   ['error', (m) => { P.errors.push(m); say(m.message); }],
   ['end', onEnd],
+  ['lesson', onLesson],
 ]);
 
 // Opens the link: text messages to their handlers, binary ones (sound ticks) to the sound.

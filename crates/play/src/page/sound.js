@@ -76,6 +76,15 @@ export function onSoundTicks(buf) {
   else if (waiting.length < 2000) waiting.push(buf);
 }
 
+// A new world (a lesson's next step) whose ticks start again at 0: the synthesis starts a new
+// stream at its first sound ticks.
+export function restartAudio() {
+  P.sound.restarts++; P.sound.nextTick = 0;
+  if (!actx) return;
+  if (node) node.port.postMessage({ restart: true });
+  else waiting.push({ restart: true });
+}
+
 // The session ended after `ticks` ticks: the worklet plays its last samples, then reports.
 export function finishAudio(ticks) {
   if (!actx) return;

@@ -259,6 +259,7 @@ class Synth extends AudioWorkletProcessor {
     this.port.onmessage = (e) => {
       if (e.data instanceof ArrayBuffer) this.take(e.data, Date.now());
       else if (e.data && Number.isFinite(e.data.finish)) this.finish(e.data.finish);
+      else if (e.data && e.data.restart) { this.synth = null; this.ending = false; this.heard.restarts++; }
     };
   }
 

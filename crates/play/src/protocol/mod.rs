@@ -1,10 +1,10 @@
 //! The page ↔ server protocol over the WebSocket (`/ws`): one type per direction.
 //!
 //! - **Server → page**: [`ServerMsg`], JSON text messages tagged by `type` (`hello`, `waiting`,
-//!   `role`, `frame`, `switched`, `error`, `end`), written by [`ServerMsg::to_json`] (the one
+//!   `role`, `frame`, `switched`, `error`, `end`, `lesson`), written by [`ServerMsg::to_json`] (the one
 //!   place a server message becomes text), and binary sound ticks ([`SoundTicks`]).
 //! - **Page → server**: [`PageMsg`], JSON text messages tagged by `type` (`start`, `input`,
-//!   `switch`, `end`), read by [`parse`], which checks every field: a bad one gets a typed
+//!   `switch`, `end`, `answer`, `step`), read by [`parse`], which checks every field: a bad one gets a typed
 //!   [`ProtocolError`] naming the field and its allowed range (sent back to the page as an
 //!   `error` message; the session goes on).
 //!
@@ -19,12 +19,14 @@
 //! itself (`synth.js`, an AudioWorklet port of [`render::audio::StreamSynth`]). The layout is
 //! [`SoundTicks::encode`]'s.
 
+mod lesson;
 mod page;
 mod server;
 mod sound;
 #[cfg(test)]
 mod tests;
 
+pub use lesson::{LessonAsk, LessonView, PageAnswer, QuestionView, Scores};
 pub use page::{MAX_MESSAGE_BYTES, PageInput, PageMsg, ProtocolError, parse};
 pub use server::{
     EndReport, EventAt, Frame, FrameView, Hello, LatencyMs, Mapping, Role, ServerMsg, SoundAt,

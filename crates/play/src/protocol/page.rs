@@ -1,6 +1,7 @@
 //! Page → server: the JSON messages ([`PageMsg`]), read and checked by [`parse`] with a typed
 //! [`ProtocolError`] naming the field and its allowed range.
 
+use super::lesson::PageAnswer;
 use serde::Serialize;
 use serde_json::Value;
 
@@ -20,7 +21,9 @@ pub enum ProtocolError {
     #[error("page message is binary (allowed: JSON text)")]
     Binary,
     /// An unknown `type`.
-    #[error("page message `type` = {0} is unknown (allowed: start, input, switch, end)")]
+    #[error(
+        "page message `type` = {0} is unknown (allowed: start, input, switch, end, answer, step)"
+    )]
     UnknownType(String),
     /// A field missing or of the wrong type.
     #[error("page message field `{field}` is {got} (expected: {expected})")]
@@ -90,11 +93,23 @@ pub enum PageMsg {
     },
     /// The player ends the session.
     End,
+    /// The student's answer to the lesson's question now.
+    Answer {
+        /// The answer: a choice's index or a short text.
+        #[serde(flatten)]
+        answer: PageAnswer,
+    },
+    /// Open the lesson at step `id` for a demonstration (the page's `?step=ID`).
+    Step {
+        /// The step's id.
+        id: String,
+    },
 }
 
 impl PageMsg {
     /// The `type` of every page message, in the order of the enum's variants.
-    pub const TYPES: &'static [&'static str] = &["start", "input", "switch", "end"];
+    pub const TYPES: &'static [&'static str] =
+        &["start", "input", "switch", "end", "answer", "step"];
 
     /// The message's `type` on the wire.
     pub fn type_name(&self) -> &'static str {
@@ -103,6 +118,8 @@ impl PageMsg {
             PageMsg::Input(_) => "input",
             PageMsg::Switch { .. } => "switch",
             PageMsg::End => "end",
+            PageMsg::Answer { .. } => "answer",
+            PageMsg::Step { .. } => "step",
         }
     }
 
@@ -122,12 +139,21 @@ impl PageMsg {
                 value: 0.5,
             },
             PageMsg::End,
+            PageMsg::Answer {
+                answer: PageAnswer::Choice(1),
+            },
+            PageMsg::Step { id: "float".into() },
         ];
         // A new variant stops this match from compiling: give it an example above and its
         // `type` in `PageMsg::TYPES` (and a row in docs/play.md's table).
         for m in &msgs {
             match m {
-                PageMsg::Start | PageMsg::Input(_) | PageMsg::Switch { .. } | PageMsg::End => {}
+                PageMsg::Start
+                | PageMsg::Input(_)
+                | PageMsg::Switch { .. }
+                | PageMsg::End
+                | PageMsg::Answer { .. }
+                | PageMsg::Step { .. } => {}
             }
         }
         msgs
@@ -180,7 +206,7 @@ pub fn parse(text: &str, button_mask: u32) -> Result<PageMsg, ProtocolError> {
             return Err(ProtocolError::Field {
                 field: "type".into(),
                 got: kind(other),
-                expected: "one of start, input, switch, end",
+                expected: "one of start, input, switch, end, answer, step",
             });
         }
     };
@@ -189,6 +215,8 @@ pub fn parse(text: &str, button_mask: u32) -> Result<PageMsg, ProtocolError> {
         "end" => Ok(PageMsg::End),
         "switch" => parse_switch(&v),
         "input" => parse_input(&v, button_mask),
+        "answer" => parse_answer(&v),
+        "step" => parse_step(&v),
         other => Err(ProtocolError::UnknownType(format!(
             "\"{}\"",
             other.escape_default()
@@ -318,4 +346,66 @@ fn input_buttons(v: &Value, button_mask: u32) -> Result<u32, ProtocolError> {
     )?;
     // every bit is one of the mask's: it fits in a u32
     Ok(b as u32)
+}
+
+/// Most choices a lesson's question has (the answer's index is below it).
+const MAX_CHOICES: u64 = 8;
+
+/// An `answer` message: exactly one of `choice` (an integer 0 ≤ choice < 8) and `text` (a
+/// string; its length is checked against the question by the lesson).
+fn parse_answer(v: &Value) -> Result<PageMsg, ProtocolError> {
+    let answer = match (v.get("choice"), v.get("text")) {
+        (Some(Value::Number(n)), None) => match n.as_u64() {
+            Some(i) if i < MAX_CHOICES => PageAnswer::Choice(i as usize),
+            _ => {
+                return Err(ProtocolError::OutOfRange {
+                    field: "answer.choice".into(),
+                    value: n.to_string(),
+                    allowed: format!("an integer 0 ≤ choice < {MAX_CHOICES}"),
+                });
+            }
+        },
+        (None, Some(Value::String(t))) => PageAnswer::Text(t.clone()),
+        (Some(c), None) => {
+            return Err(ProtocolError::Field {
+                field: "answer.choice".into(),
+                got: kind(Some(c)),
+                expected: "an integer",
+            });
+        }
+        (None, Some(t)) => {
+            return Err(ProtocolError::Field {
+                field: "answer.text".into(),
+                got: kind(Some(t)),
+                expected: "a string",
+            });
+        }
+        (c, _) => {
+            return Err(ProtocolError::Field {
+                field: "answer".into(),
+                got: if c.is_some() {
+                    "both choice and text".into()
+                } else {
+                    "missing choice and text".into()
+                },
+                expected: "exactly one of choice (an integer) and text (a string)",
+            });
+        }
+    };
+    Ok(PageMsg::Answer { answer })
+}
+
+/// A `step` message: a step id of 1–64 characters (whether the lesson has it is the lesson's
+/// to say).
+fn parse_step(v: &Value) -> Result<PageMsg, ProtocolError> {
+    match v.get("id") {
+        Some(Value::String(s)) if (1..=64).contains(&s.chars().count()) => {
+            Ok(PageMsg::Step { id: s.clone() })
+        }
+        other => Err(ProtocolError::Field {
+            field: "step.id".into(),
+            got: kind(other),
+            expected: "a step id of 1–64 characters",
+        }),
+    }
 }

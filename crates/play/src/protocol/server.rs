@@ -1,5 +1,6 @@
 //! Server → page: the JSON messages ([`ServerMsg`]) and their parts.
 
+use super::lesson::{LessonView, QuestionView};
 use haptic_engine::runner::EndReason;
 use haptic_types::primitive::{Ball, Primitive, Rgba};
 use serde::{Deserialize, Deserializer, Serialize};
@@ -49,12 +50,15 @@ pub enum ServerMsg {
     /// The session is over: its figures and where to download its recording (sent to every
     /// page, and to each page that connects later).
     End(EndReport),
+    /// Where the student is in the lesson (`play --lesson`): sent to every page on every move,
+    /// and to a page that connects later.
+    Lesson(Box<LessonView>),
 }
 
 impl ServerMsg {
     /// The `type` of every server message, in the order of the enum's variants.
     pub const TYPES: &'static [&'static str] = &[
-        "hello", "waiting", "role", "frame", "switched", "error", "end",
+        "hello", "waiting", "role", "frame", "switched", "error", "end", "lesson",
     ];
 
     /// The message's `type` on the wire.
@@ -67,6 +71,7 @@ impl ServerMsg {
             ServerMsg::Switched { .. } => "switched",
             ServerMsg::Error { .. } => "error",
             ServerMsg::End(_) => "end",
+            ServerMsg::Lesson(_) => "lesson",
         }
     }
 
@@ -149,6 +154,22 @@ impl ServerMsg {
                 recording_file: Some("play.mcap".into()),
                 recording_bytes: Some(4096),
             }),
+            ServerMsg::Lesson(Box::new(LessonView {
+                title: "Sticky atoms".into(),
+                place: "before".into(),
+                step: Some(1),
+                steps: 3,
+                step_id: "float".into(),
+                step_title: "A brick without gravity".into(),
+                task: "Gravity is off. Throw a brick.".into(),
+                question: Some(QuestionView {
+                    prompt: "What will the brick do?".into(),
+                    choices: vec!["Fall".into(), "Fly on".into()],
+                    max_chars: 2000,
+                }),
+                score: None,
+                words: "Step 2 of 3, A brick without gravity. Before you start: What will the brick do?".into(),
+            })),
         ];
         // A new variant stops this match from compiling: give it an example above and its
         // `type` in `ServerMsg::TYPES` (and a row in docs/play.md's table).
@@ -160,7 +181,8 @@ impl ServerMsg {
                 | ServerMsg::Frame(_)
                 | ServerMsg::Switched { .. }
                 | ServerMsg::Error { .. }
-                | ServerMsg::End(_) => {}
+                | ServerMsg::End(_)
+                | ServerMsg::Lesson(_) => {}
             }
         }
         msgs

@@ -42,11 +42,11 @@ fn bad_messages_name_the_field_and_range() {
     );
     assert_eq!(
         err(r#"{"kind":"input"}"#),
-        "page message field `type` is missing (expected: one of start, input, switch, end)"
+        "page message field `type` is missing (expected: one of start, input, switch, end, answer, step)"
     );
     assert_eq!(
         err(r#"{"type":"jump"}"#),
-        "page message `type` = \"jump\" is unknown (allowed: start, input, switch, end)"
+        "page message `type` = \"jump\" is unknown (allowed: start, input, switch, end, answer, step)"
     );
     let input = |rest: &str| format!(r#"{{"type":"input","seq":1,{rest}}}"#);
     assert_eq!(
@@ -248,4 +248,58 @@ fn no_input_panics() {
             }
         }
     }
+}
+
+#[test]
+fn a_lesson_answer_and_step_parse_and_bad_ones_name_their_field() {
+    assert_eq!(
+        parse(r#"{"type":"answer","choice":1}"#, 0),
+        Ok(PageMsg::Answer {
+            answer: PageAnswer::Choice(1)
+        })
+    );
+    assert_eq!(
+        parse(r#"{"type":"answer","text":"it stuck"}"#, 0),
+        Ok(PageMsg::Answer {
+            answer: PageAnswer::Text("it stuck".into())
+        })
+    );
+    assert_eq!(
+        parse(r#"{"type":"step","id":"snap"}"#, 0),
+        Ok(PageMsg::Step { id: "snap".into() })
+    );
+    assert_eq!(
+        err(r#"{"type":"answer","choice":8}"#),
+        "page message field `answer.choice` = 8 is out of range: allowed an integer 0 ≤ choice < 8"
+    );
+    assert_eq!(
+        err(r#"{"type":"answer","choice":-1}"#),
+        "page message field `answer.choice` = -1 is out of range: allowed an integer 0 ≤ choice < 8"
+    );
+    assert_eq!(
+        err(r#"{"type":"answer","choice":"1"}"#),
+        "page message field `answer.choice` is a string (expected: an integer)"
+    );
+    assert_eq!(
+        err(r#"{"type":"answer","text":3}"#),
+        "page message field `answer.text` is the number 3 (expected: a string)"
+    );
+    assert_eq!(
+        err(r#"{"type":"answer","choice":1,"text":"a"}"#),
+        "page message field `answer` is both choice and text (expected: exactly one of choice (an integer) and text (a string))"
+    );
+    assert_eq!(
+        err(r#"{"type":"answer"}"#),
+        "page message field `answer` is missing choice and text (expected: exactly one of choice (an integer) and text (a string))"
+    );
+    assert_eq!(
+        err(r#"{"type":"step","id":""}"#),
+        "page message field `step.id` is a string (expected: a step id of 1–64 characters)"
+    );
+    // A text longer than a message may be is refused whole.
+    let long = format!(r#"{{"type":"answer","text":"{}"}}"#, "x".repeat(4100));
+    assert_eq!(
+        err(&long),
+        "page message of 4127 bytes is too long (allowed: at most 4096 bytes)"
+    );
 }

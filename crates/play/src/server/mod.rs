@@ -15,6 +15,8 @@ mod shared;
 #[cfg(test)]
 mod tests;
 
+#[cfg(test)]
+pub(crate) use page_link::on_message as on_page_message;
 pub use page_link::page_link;
 pub use play_server::{PlayRoutes, Server};
 pub use shared::{PAGE_QUEUE, Page, SceneLink, Shared, SwitchRequest, WRITE_TIMEOUT_S};
@@ -70,6 +72,7 @@ pub const PAGE_FILES: &[PageFile] = &[
     file("/synth.js", JS, include_str!("../page/synth.js")),
     file("/messages.js", JS, include_str!("../page/messages.js")),
     file("/events.js", JS, include_str!("../page/events.js")),
+    file("/lesson.js", JS, include_str!("../page/lesson.js")),
 ];
 
 /// What a listening server does with a request that passed its [`Gate`] and its

@@ -2,7 +2,7 @@
 
 use super::{PAGE_QUEUE, Page, SceneLink, Shared};
 use crate::input::page_to_device;
-use crate::protocol::{self, PageMsg, ProtocolError, Role, ServerMsg};
+use crate::protocol::{self, LessonAsk, PageMsg, ProtocolError, Role, ServerMsg};
 use crate::wslink::{self, Incoming, LinkConfig};
 use std::net::TcpStream;
 use std::sync::Arc;
@@ -13,7 +13,7 @@ use tungstenite::Message;
 use webguard::gate::Gate;
 
 /// Handles one page message from page `id`.
-pub(super) fn on_message(shared: &Shared, id: u64, text: &str) {
+pub(crate) fn on_message(shared: &Shared, id: u64, text: &str) {
     let link = shared.scene.lock().ok().and_then(|s| s.clone());
     let mask = link.as_ref().map_or(0, |l| l.button_mask);
     let msg = match protocol::parse(text, mask) {
@@ -71,6 +71,8 @@ pub(super) fn on_message(shared: &Shared, id: u64, text: &str) {
                 }
             }
         }
+        PageMsg::Answer { answer } => ask_lesson(shared, id, "answer", LessonAsk::Answer(answer)),
+        PageMsg::Step { id: step } => ask_lesson(shared, id, "step.id", LessonAsk::Step(step)),
         PageMsg::End => {
             if is_player(shared) || link.as_ref().is_some_and(|l| !l.page_is_hand) {
                 shared.end_requested.store(true, Ordering::Relaxed);
@@ -78,6 +80,21 @@ pub(super) fn on_message(shared: &Shared, id: u64, text: &str) {
                 shared.error_to(id, "type", "only the page that plays can end the session");
             }
         }
+    }
+}
+
+/// Queues page `id`'s ask for the lesson's driver; refused (`field`) when no lesson runs.
+fn ask_lesson(shared: &Shared, id: u64, field: &str, ask: LessonAsk) {
+    let queued = match shared.lesson_asks.lock() {
+        Ok(mut q) => q.as_mut().map(|q| q.push((id, ask))).is_some(),
+        Err(_) => false,
+    };
+    if !queued {
+        shared.error_to(
+            id,
+            field,
+            "this session runs no lesson (a lesson is played with nanohaptics play --lesson)",
+        );
     }
 }
 
@@ -116,6 +133,9 @@ pub fn page_link(stream: TcpStream, shared: &Arc<Shared>, gate: &Gate) {
     })));
     if let Some(end) = shared.end.lock().ok().and_then(|e| e.clone()) {
         let _ = tx.try_send(Message::text(end));
+    }
+    if let Some(lesson) = shared.lesson.lock().ok().and_then(|l| l.clone()) {
+        let _ = tx.try_send(Message::text(lesson));
     }
     let (wake, wake_rx) = wslink::wake_pair().unzip();
     if let Ok(mut pages) = shared.pages.lock() {

@@ -47,6 +47,11 @@ pub struct Shared {
     pub recording: Mutex<Option<PathBuf>>,
     /// The page's hand.
     pub input: Arc<SharedInput>,
+    /// The `lesson` message (JSON) now, for pages that connect later (`play --lesson`).
+    pub lesson: Mutex<Option<String>>,
+    /// What pages asked of the lesson, (page id, ask), waiting for its driver (`None`: no lesson
+    /// runs).
+    pub lesson_asks: Mutex<Option<Vec<(u64, crate::protocol::LessonAsk)>>>,
     /// Switches waiting for the next tick.
     pub switches: Mutex<Vec<SwitchRequest>>,
     /// The player asked to end the session.

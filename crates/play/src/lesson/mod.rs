@@ -1,0 +1,344 @@
+//! The lesson in the page (`nanohaptics play --lesson`): the driver that takes one student
+//! through a lesson of `nanohaptics-teaching` on a play server.
+//!
+//! The driver holds the lesson and the student's [`Progress`]; the pages' answers (and a
+//! demonstration's `?step=ID`) reach it through [`Shared::lesson_asks`] and every move is told
+//! to the pages as a `lesson` message ([`view`]). A step's world is one [`PageSession`] of its
+//! own (the session object every front end uses): opened with the step's scene and its
+//! switches set before the first tick (recorded as that tick's switches), watched after every
+//! tick by the step's [`Evaluator`] on the tick thread, completed on the tick the condition is
+//! met, and recorded to `DIR/STEP-ID.mcap`.
+//!
+//! A lone student has no teacher to open a locked step: `play --lesson` opens it when the
+//! student reaches it (the `lesson` message says so first).
+
+mod view;
+
+use crate::protocol::{LessonAsk, LessonView, PageAnswer, ServerMsg};
+use crate::server::Shared;
+use crate::session::{Hand, PageSession, SessionSpec, SessionSummary};
+use haptic_engine::pacing::Pacing;
+use haptic_engine::realtime::RtRequest;
+use haptic_loop::session::{SessionError, now_unix_ns};
+use haptic_loop::setup::session_device;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+use teaching::progress::ProgressError;
+use teaching::{Answer, Evaluator, Lesson, Place, Progress};
+
+/// What the driver refuses a page.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LessonAskError {
+    /// The answer does not fit the question now (or none is asked).
+    #[error(transparent)]
+    Progress(#[from] ProgressError),
+    /// `?step=ID` names no step of the lesson.
+    #[error("step `{id}` is not in the lesson (its steps: {steps})")]
+    UnknownStep {
+        /// The id asked for.
+        id: String,
+        /// The lesson's step ids, comma-separated.
+        steps: String,
+    },
+    /// `?step=ID` after the student began the lesson.
+    #[error("a step is opened by its URL only before the lesson begins: the student is at {place}")]
+    Begun {
+        /// Where the student is, in words.
+        place: String,
+    },
+}
+
+impl LessonAskError {
+    /// The page message's field the error is about.
+    pub fn field(&self) -> &'static str {
+        match self {
+            LessonAskError::Progress(_) => "answer",
+            _ => "step.id",
+        }
+    }
+}
+
+/// One step's world as it ran.
+#[derive(Debug)]
+pub struct StepRun {
+    /// The step (0 = the lesson's first).
+    pub step: usize,
+    /// Its id (the recording's name).
+    pub id: String,
+    /// The tick of the step (0 = its first) on which its condition was met; `None`: it was
+    /// stopped first.
+    pub met_at: Option<u64>,
+    /// The session: its end, ticks, state and recording.
+    pub session: SessionSummary,
+}
+
+/// A step's world, open: its session (step it, or run it) until the evaluator completes it.
+pub struct StepWorld {
+    /// The step (0 = the lesson's first).
+    pub step: usize,
+    /// The step's session.
+    pub session: PageSession,
+}
+
+/// The lesson of one student on a play server.
+pub struct LessonDriver {
+    lesson: Lesson,
+    progress: Progress,
+    shared: Arc<Shared>,
+    dir: PathBuf,
+    runs: Vec<StepRun>,
+}
+
+impl LessonDriver {
+    /// The student at the start of `lesson`, the pages of `shared` told so; each step's
+    /// recording goes to `dir` (made when the first step opens).
+    pub fn new(lesson: Lesson, shared: Arc<Shared>, dir: PathBuf) -> LessonDriver {
+        let progress = Progress::new(&lesson);
+        if let Ok(mut q) = shared.lesson_asks.lock() {
+            *q = Some(Vec::new());
+        }
+        let d = LessonDriver {
+            lesson,
+            progress,
+            shared,
+            dir,
+            runs: Vec::new(),
+        };
+        d.tell();
+        d
+    }
+
+    /// The lesson (a demonstration's: its one step).
+    pub fn lesson(&self) -> &Lesson {
+        &self.lesson
+    }
+
+    /// The student's progress.
+    pub fn progress(&self) -> &Progress {
+        &self.progress
+    }
+
+    /// The steps' worlds as they ran, in order.
+    pub fn runs(&self) -> &[StepRun] {
+        &self.runs
+    }
+
+    /// The recording of step `id`: `DIR/ID.mcap`.
+    pub fn recording_of(&self, id: &str) -> PathBuf {
+        self.dir.join(format!("{id}.mcap"))
+    }
+
+    /// What the pages are told now.
+    pub fn view(&self) -> LessonView {
+        view::of(&self.lesson, &self.progress)
+    }
+
+    /// Tells every page (and later ones) where the student is.
+    fn tell(&self) {
+        let text = ServerMsg::Lesson(Box::new(self.view())).to_json();
+        if let Ok(mut l) = self.shared.lesson.lock() {
+            *l = Some(text.clone());
+        }
+        self.shared.broadcast(&tungstenite::Message::text(text));
+    }
+
+    /// Records the answer to the question asked now and moves on (the pages told).
+    pub fn answer(&mut self, answer: PageAnswer) -> Result<Place, LessonAskError> {
+        let place = self.progress.answer(match answer {
+            PageAnswer::Choice(i) => Answer::Choice(i),
+            PageAnswer::Text(t) => Answer::Text(t),
+        })?;
+        self.tell();
+        Ok(place)
+    }
+
+    /// A demonstration of step `id` (the page's `?step=ID`): the lesson becomes that step
+    /// alone (open, its questions, no pre- or post-test). Only before the lesson begins.
+    pub fn open_step(&mut self, id: &str) -> Result<(), LessonAskError> {
+        let Some(step) = self.lesson.steps.iter().find(|s| s.id == id) else {
+            return Err(LessonAskError::UnknownStep {
+                id: id.to_string(),
+                steps: self
+                    .lesson
+                    .steps
+                    .iter()
+                    .map(|s| s.id.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        };
+        if self.progress.position() != 0 || !self.runs.is_empty() {
+            return Err(LessonAskError::Begun {
+                place: teaching::progress::describe(self.progress.place()),
+            });
+        }
+        let mut step = step.clone();
+        step.locked = false;
+        self.lesson = Lesson {
+            title: format!("{}: step {} (demonstration)", self.lesson.title, step.id),
+            description: self.lesson.description.clone(),
+            test: Vec::new(),
+            steps: vec![step],
+        };
+        self.progress = Progress::new(&self.lesson);
+        self.tell();
+        Ok(())
+    }
+
+    /// Takes what the pages asked since the last call: each answer or step applied, or
+    /// refused to its page with the reason.
+    pub fn take_asks(&mut self) {
+        let asks = match self.shared.lesson_asks.lock() {
+            Ok(mut q) => q.as_mut().map(std::mem::take).unwrap_or_default(),
+            Err(_) => return,
+        };
+        for (page, ask) in asks {
+            let r = match ask {
+                LessonAsk::Answer(a) => self.answer(a).map(|_| ()),
+                LessonAsk::Step(id) => self.open_step(&id),
+            };
+            if let Err(e) = r {
+                self.shared.error_to(page, e.field(), &e.to_string());
+            }
+        }
+    }
+
+    /// A locked step the student reached opens (no teacher in `play`); true when one did.
+    pub fn open_for_lone_student(&mut self) -> bool {
+        match self.progress.place() {
+            Place::Waiting(s) => {
+                let _ = self.progress.open(s);
+                self.tell();
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Opens the world of the step the student is doing: its scene, its switches set before
+    /// the first tick, its evaluator watching every tick, its recording `DIR/ID.mcap`. `None`
+    /// when the student is not at a step's task.
+    pub fn open_world(&mut self) -> Option<Result<StepWorld, SessionError>> {
+        let Place::Doing(s) = self.progress.place() else {
+            return None;
+        };
+        Some(
+            self.open_world_of(s)
+                .map(|session| StepWorld { step: s, session }),
+        )
+    }
+
+    fn open_world_of(&mut self, s: usize) -> Result<PageSession, SessionError> {
+        let step = &self.lesson.steps[s];
+        let file = step.source.parse()?;
+        std::fs::create_dir_all(&self.dir).map_err(|e| SessionError::Io {
+            path: self.dir.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let start_time_ns = now_unix_ns();
+        let hand = Hand::open(session_device(&file, None, start_time_ns), &self.shared)?;
+        // The last step's end screen and download are not this step's.
+        if let Ok(mut e) = self.shared.end.lock() {
+            *e = None;
+        }
+        let spec = SessionSpec {
+            scene: &step.source,
+            scene_name: &file.scene.name,
+            out: self.recording_of(&step.id),
+            recording_url: "/recording.mcap".into(),
+            start_time_ns,
+            operator: "person (browser page)".into(),
+            link: "page".into(),
+            seconds: None,
+            ticks: None,
+        };
+        let switches: Vec<(&str, f64)> = step.switch_pairs().collect();
+        let mut evaluator = Evaluator::new(step.done, step.kind, &step.state_fields, step.rate_hz)
+            .map_err(|e| SessionError::Option(format!("step `{}`: {e}", step.id)))?;
+        let mut state = Vec::with_capacity(step.state_fields.len());
+        let session = PageSession::open_with_switches(&spec, hand, self.shared.clone(), &switches)?
+            .with_sound_block(crate::publish::PLAY_SOUND_BLOCK_TICKS)
+            .with_watcher(Box::new(move |lp| {
+                state.clear();
+                lp.scene_state(&mut state);
+                evaluator.feed(&lp.last_result().events, &state)
+            }));
+        Ok(session)
+    }
+
+    /// Closes a step's world: its session finished, its ticks counted into the progress (the
+    /// last one meeting the condition when the watcher completed it), the pages told.
+    pub fn close_world(&mut self, world: StepWorld) -> &StepRun {
+        let StepWorld { step: s, session } = world;
+        let summary = session.finish();
+        let met = summary.end == "completed";
+        let ticks = summary.stats.ticks;
+        for t in 0..ticks {
+            let _ = self.progress.tick(met && t + 1 == ticks);
+        }
+        self.runs.push(StepRun {
+            step: s,
+            id: self.lesson.steps[s].id.clone(),
+            met_at: (met && ticks > 0).then(|| ticks - 1),
+            session: summary,
+        });
+        self.tell();
+        let n = self.runs.len() - 1;
+        &self.runs[n]
+    }
+
+    /// Runs the lesson to its end (or until `stop`): answers taken as they come, a locked
+    /// step opened for the lone student, each step's world run under `pacing` (`rt` for its
+    /// tick thread) until its condition is met. Ends early when a step's world was stopped
+    /// (the player ended it, or `stop`) or failed.
+    pub fn run(
+        &mut self,
+        pacing: Pacing,
+        rt: Option<&RtRequest>,
+        stop: &AtomicBool,
+    ) -> Result<(), SessionError> {
+        loop {
+            self.take_asks();
+            if self.progress.place() == Place::Finished || stop.load(Ordering::Relaxed) {
+                return Ok(());
+            }
+            if self.open_for_lone_student() {
+                continue;
+            }
+            let Some(world) = self.open_world() else {
+                std::thread::sleep(Duration::from_millis(10));
+                continue;
+            };
+            let mut world = world?;
+            // The page's Start (its first hand) starts the first world; later ones at once.
+            if !self.shared.input.wait_first(stop) {
+                world.session.request_end();
+            }
+            world.session.run(pacing.clone(), rt, stop);
+            let run = self.close_world(world);
+            if let Some(e) = &run.session.error {
+                return Err(SessionError::Sink(e.clone()));
+            }
+            if run.met_at.is_none() {
+                return Ok(());
+            }
+            // A page's End ends this step's world, not the next one's.
+            self.shared.end_requested.store(false, Ordering::Relaxed);
+        }
+    }
+
+    /// The steps' worlds as they ran (the driver done with).
+    pub fn into_runs(self) -> Vec<StepRun> {
+        self.runs
+    }
+
+    /// Where the recordings go.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+}
+
+#[cfg(test)]
+mod tests;
