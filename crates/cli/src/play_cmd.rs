@@ -93,6 +93,13 @@ pub fn cmd(a: &PlayArgs) -> Result<u8, String> {
             post.1,
             l.dir.display()
         );
+        if let Some(md) = l
+            .report
+            .iter()
+            .find(|p| p.extension().is_some_and(|e| e == "md"))
+        {
+            println!("lesson report: {}", md.display());
+        }
     }
     Ok(status::SUCCESS)
 }

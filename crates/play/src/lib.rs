@@ -143,6 +143,9 @@ pub struct LessonOutcome {
     pub runs: Vec<lesson::StepRun>,
     /// The directory of the steps' recordings.
     pub dir: PathBuf,
+    /// The lesson's report written there when it ended (`class-steps.csv`, `class-tests.csv`,
+    /// `class-report.md` and its charts; [`lesson::report`]).
+    pub report: Vec<PathBuf>,
 }
 
 impl PlaySummary {
@@ -340,6 +343,12 @@ fn run_lesson(
     server.stop(&shared);
     let dir = driver.dir().to_path_buf();
     let progress = driver.progress().clone();
+    let report = if driver.runs().is_empty() {
+        Vec::new()
+    } else {
+        lesson::report::write(&dir, "student", driver.lesson(), &progress, driver.runs())
+            .map_err(|e| PlayError::Failed(format!("the lesson's report: {e}")))?
+    };
     let runs = driver.into_runs();
     let Some(session) = runs.last().map(|r| r.session.clone()) else {
         return Err(PlayError::NotStarted);
@@ -355,6 +364,7 @@ fn run_lesson(
             progress,
             runs,
             dir,
+            report,
         }),
     })
 }

@@ -243,6 +243,64 @@ fn a_student_completes_a_lesson_by_keyboard_and_each_step_replays() {
         (sched[0].0, sched[0].1.name.as_str(), sched[0].1.value),
         (0, "gravity_m_per_s2", 0.0)
     );
+    // The lesson's report beside the recordings: each step's row from the progress and its
+    // world, the largest force felt read back from the step's recording.
+    let names: Vec<String> = l
+        .report
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "class-steps.csv",
+            "class-tests.csv",
+            "class-report.md",
+            "class-time-per-step.png",
+            "class-pre-post.png"
+        ]
+    );
+    assert!(l.report.iter().all(|p| p.parent() == Some(l.dir.as_path())));
+    for r in &l.runs {
+        let a = read_arrays(&r.session.recording, false).unwrap();
+        let peak = a
+            .columns
+            .device_force_n
+            .iter()
+            .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
+            .fold(0.0, f64::max);
+        assert_eq!(r.peak_force_n, peak, "{}", r.id);
+    }
+    assert!(snap.peak_force_n > 0.0);
+    let steps = std::fs::read_to_string(&l.report[0]).unwrap();
+    let rows: Vec<&str> = steps.lines().collect();
+    assert_eq!(rows.len(), 3, "{steps}");
+    let num = |v: Option<f64>| v.map_or(String::new(), world_form::fmt_num);
+    assert_eq!(
+        rows[1],
+        format!(
+            "student,1,float,No gravity,done,0.5,0.499,{},{},Float,",
+            num(Some(float.peak_force_n)),
+            num(float.session.state("score"))
+        )
+    );
+    let nano_hz = f64::from(read_arrays(&snap.session.recording, false).unwrap().rate_hz);
+    let snap_ticks = snap.session.stats.ticks;
+    assert_eq!(
+        rows[2],
+        format!(
+            "student,2,snap,Snap to contact,done,{},{},{},{},,it pulled",
+            num(Some(snap_ticks as f64 / nano_hz)),
+            num(snap.met_at.map(|t| t as f64 / nano_hz)),
+            num(Some(snap.peak_force_n)),
+            num(snap.session.state("score"))
+        )
+    );
+    let md = std::fs::read_to_string(&l.report[2]).unwrap();
+    assert!(
+        md.contains("| student | the end of the lesson | 2 of 2 |"),
+        "{md}"
+    );
     // The snap step ended on the tick of the world's one snap.
     let a = read_arrays(&snap.session.recording, false).unwrap();
     let snaps: Vec<u64> = a

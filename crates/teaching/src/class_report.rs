@@ -266,13 +266,16 @@ fn page(
     lesson: &Lesson,
     students: &[StudentRecord],
 ) -> (String, Option<BarChart>, Option<BarChart>) {
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
     let mut m = format!(
-        "# Class report: {}\n\n{} student{}, a lesson of {} steps and {} test questions.\n\n",
+        "# Class report: {}\n\n{} student{}, a lesson of {} step{} and {} test question{}.\n\n",
         md(&lesson.title),
         students.len(),
-        if students.len() == 1 { "" } else { "s" },
+        plural(students.len()),
         lesson.steps.len(),
-        lesson.test.len()
+        plural(lesson.steps.len()),
+        lesson.test.len(),
+        plural(lesson.test.len())
     );
     m.push_str(&where_each_is(lesson, students));
     let (times, time_chart) = time_per_step(lesson, students);

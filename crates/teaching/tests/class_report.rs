@@ -244,3 +244,26 @@ fn the_median_is_the_middle_or_the_mean_of_the_middle_two() {
     assert_eq!(median(&[5.0, 1.0, 3.0]), Some(3.0));
     assert_eq!(median(&[f64::NAN, 1.0]), Some(1.0));
 }
+
+#[test]
+fn one_student_one_step_is_said_in_the_singular() {
+    let mut l = lesson();
+    l.steps.truncate(1);
+    l.test.truncate(1);
+    let p = Progress::new(&l);
+    let r = class_report::class_report(
+        &l,
+        &[StudentRecord {
+            name: "Di",
+            progress: &p,
+            figures: &[],
+        }],
+    );
+    assert!(
+        r.markdown.starts_with(
+            "# Class report: Sticky atoms\n\n1 student, a lesson of 1 step and 1 test question.\n"
+        ),
+        "{}",
+        r.markdown
+    );
+}

@@ -12,6 +12,7 @@
 //! A lone student has no teacher to open a locked step: `play --lesson` opens it when the
 //! student reaches it (the `lesson` message says so first).
 
+pub mod report;
 mod view;
 
 use crate::protocol::{LessonAsk, LessonView, PageAnswer, ServerMsg};
@@ -23,7 +24,7 @@ use haptic_loop::session::{SessionError, now_unix_ns};
 use haptic_loop::setup::session_device;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
 use teaching::progress::ProgressError;
 use teaching::{Answer, Evaluator, Lesson, Place, Progress};
@@ -72,6 +73,9 @@ pub struct StepRun {
     pub met_at: Option<u64>,
     /// The session: its end, ticks, state and recording.
     pub session: SessionSummary,
+    /// The largest force sent to the hand in the step's world, N (the recording's
+    /// `device_force_n` at its largest).
+    pub peak_force_n: f64,
 }
 
 /// A step's world, open: its session (step it, or run it) until the evaluator completes it.
@@ -80,6 +84,9 @@ pub struct StepWorld {
     pub step: usize,
     /// The step's session.
     pub session: PageSession,
+    /// The largest force sent to the hand so far, N (an `f64`'s bits; the tick thread's
+    /// watcher raises it).
+    peak_force: Arc<AtomicU64>,
 }
 
 /// The lesson of one student on a play server.
@@ -224,13 +231,22 @@ impl LessonDriver {
         let Place::Doing(s) = self.progress.place() else {
             return None;
         };
+        let peak_force = Arc::new(AtomicU64::new(0f64.to_bits()));
         Some(
-            self.open_world_of(s)
-                .map(|session| StepWorld { step: s, session }),
+            self.open_world_of(s, peak_force.clone())
+                .map(|session| StepWorld {
+                    step: s,
+                    session,
+                    peak_force,
+                }),
         )
     }
 
-    fn open_world_of(&mut self, s: usize) -> Result<PageSession, SessionError> {
+    fn open_world_of(
+        &mut self,
+        s: usize,
+        peak_force: Arc<AtomicU64>,
+    ) -> Result<PageSession, SessionError> {
         let step = &self.lesson.steps[s];
         let file = step.source.parse()?;
         std::fs::create_dir_all(&self.dir).map_err(|e| SessionError::Io {
@@ -261,6 +277,11 @@ impl LessonDriver {
         let session = PageSession::open_with_switches(&spec, hand, self.shared.clone(), &switches)?
             .with_sound_block(crate::publish::PLAY_SOUND_BLOCK_TICKS)
             .with_watcher(Box::new(move |lp| {
+                let f = lp.last_result().device_force_n;
+                let m = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+                if m > f64::from_bits(peak_force.load(Ordering::Relaxed)) {
+                    peak_force.store(m.to_bits(), Ordering::Relaxed);
+                }
                 state.clear();
                 lp.scene_state(&mut state);
                 evaluator.feed(&lp.last_result().events, &state)
@@ -271,7 +292,11 @@ impl LessonDriver {
     /// Closes a step's world: its session finished, its ticks counted into the progress (the
     /// last one meeting the condition when the watcher completed it), the pages told.
     pub fn close_world(&mut self, world: StepWorld) -> &StepRun {
-        let StepWorld { step: s, session } = world;
+        let StepWorld {
+            step: s,
+            session,
+            peak_force,
+        } = world;
         let summary = session.finish();
         let met = summary.end == "completed";
         let ticks = summary.stats.ticks;
@@ -283,6 +308,7 @@ impl LessonDriver {
             id: self.lesson.steps[s].id.clone(),
             met_at: (met && ticks > 0).then(|| ticks - 1),
             session: summary,
+            peak_force_n: f64::from_bits(peak_force.load(Ordering::Relaxed)),
         });
         self.tell();
         let n = self.runs.len() - 1;

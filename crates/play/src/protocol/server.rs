@@ -79,31 +79,7 @@ impl ServerMsg {
     /// and programs that check what they read).
     pub fn examples() -> Vec<ServerMsg> {
         let msgs = vec![
-            ServerMsg::Hello(Hello {
-                scene: "wall".into(),
-                kind: "wall".into(),
-                rate_hz: 1000,
-                device: "falcon".into(),
-                workspace_radius_m: 0.04,
-                max_force_n: 8.0,
-                buttons: vec!["centre".into(), "plus".into()],
-                page_is_hand: true,
-                display_scale: 10.0,
-                mapping: Mapping {
-                    origin_m: [0.0, -0.05, 0.2],
-                    workspace_scale: 20.0,
-                },
-                switches: vec![SwitchInfo {
-                    name: "friction".into(),
-                    min: 0.0,
-                    max: 10.0,
-                    boolean: false,
-                    doc: "friction coefficient of every contact".into(),
-                    value: Some(0.6),
-                }],
-                state_fields: vec!["score".into()],
-                seconds: None,
-            }),
+            ServerMsg::Hello(example_hello()),
             ServerMsg::Waiting {
                 waiting_for: "the device's hello".into(),
             },
@@ -154,22 +130,7 @@ impl ServerMsg {
                 recording_file: Some("play.mcap".into()),
                 recording_bytes: Some(4096),
             }),
-            ServerMsg::Lesson(Box::new(LessonView {
-                title: "Sticky atoms".into(),
-                place: "before".into(),
-                step: Some(1),
-                steps: 3,
-                step_id: "float".into(),
-                step_title: "A brick without gravity".into(),
-                task: "Gravity is off. Throw a brick.".into(),
-                question: Some(QuestionView {
-                    prompt: "What will the brick do?".into(),
-                    choices: vec!["Fall".into(), "Fly on".into()],
-                    max_chars: 2000,
-                }),
-                score: None,
-                words: "Step 2 of 3, A brick without gravity. Before you start: What will the brick do?".into(),
-            })),
+            ServerMsg::Lesson(Box::new(example_lesson())),
         ];
         // A new variant stops this match from compiling: give it an example above and its
         // `type` in `ServerMsg::TYPES` (and a row in docs/play.md's table).
@@ -413,3 +374,53 @@ fn null_as_nan<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>,
 }
 
 // Page → server.
+
+/// The example `hello` of [`ServerMsg::examples`].
+fn example_hello() -> Hello {
+    Hello {
+        scene: "wall".into(),
+        kind: "wall".into(),
+        rate_hz: 1000,
+        device: "falcon".into(),
+        workspace_radius_m: 0.04,
+        max_force_n: 8.0,
+        buttons: vec!["centre".into(), "plus".into()],
+        page_is_hand: true,
+        display_scale: 10.0,
+        mapping: Mapping {
+            origin_m: [0.0, -0.05, 0.2],
+            workspace_scale: 20.0,
+        },
+        switches: vec![SwitchInfo {
+            name: "friction".into(),
+            min: 0.0,
+            max: 10.0,
+            boolean: false,
+            doc: "friction coefficient of every contact".into(),
+            value: Some(0.6),
+        }],
+        state_fields: vec!["score".into()],
+        seconds: None,
+    }
+}
+
+/// The example `lesson` of [`ServerMsg::examples`].
+fn example_lesson() -> LessonView {
+    LessonView {
+        title: "Sticky atoms".into(),
+        place: "before".into(),
+        step: Some(1),
+        steps: 3,
+        step_id: "float".into(),
+        step_title: "A brick without gravity".into(),
+        task: "Gravity is off. Throw a brick.".into(),
+        question: Some(QuestionView {
+            prompt: "What will the brick do?".into(),
+            choices: vec!["Fall".into(), "Fly on".into()],
+            max_chars: 2000,
+        }),
+        score: None,
+        words: "Step 2 of 3, A brick without gravity. Before you start: What will the brick do?"
+            .into(),
+    }
+}
