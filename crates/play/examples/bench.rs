@@ -64,8 +64,11 @@ struct Outcome {
 }
 
 /// The input-path probe the playing page is given (see `session`).
-const PROBE: &str = "(() => { const q = { wheel: [], move: [], send: [], long: [] }; \
+const PROBE: &str = "(() => { const q = { wheel: [], move: [], send: [], long: [], frame: [] }; \
     window.__probe = q; \
+    const raf = window.requestAnimationFrame.bind(window); \
+    window.requestAnimationFrame = (cb) => raf((t) => { const a = performance.now(); \
+      try { cb(t); } finally { q.frame.push(performance.now() - a); } }); \
     const at = (list) => (e) => list.push(performance.now() - e.timeStamp); \
     window.addEventListener('wheel', at(q.wheel), { capture: true, passive: true }); \
     for (const k of ['pointermove', 'pointerrawupdate']) window.addEventListener(k, at(q.move), { capture: true }); \
@@ -181,7 +184,7 @@ fn session(
         }
     }
     let probe = browsers[0].eval(
-        "(() => { const q = window.__probe; return [q.wheel, q.move, q.send, q.long]; })()",
+        "(() => { const q = window.__probe; return [q.wheel, q.move, q.send, q.long, q.frame]; })()",
     )?;
     let ms = |i: usize| -> Vec<f64> {
         probe[i]
@@ -192,10 +195,12 @@ fn session(
     let long = ms(3);
     eprintln!(
         "{scene}: the page's input path: event → dispatch, wheel {}; pointer moves {}; event → \
-         socket send {}; long tasks (≥ 50 ms) {} totalling {:.0} ms, the longest {:.0} ms",
+         socket send {}; each animation frame's work (its callbacks: drawing, the keys) {}; \
+         long tasks (≥ 50 ms) {} totalling {:.0} ms, the longest {:.0} ms",
         fmt(LatencyMs::of(&ms(0))),
         fmt(LatencyMs::of(&ms(1))),
         fmt(LatencyMs::of(&ms(2))),
+        fmt(LatencyMs::of(&ms(4))),
         long.len(),
         long.iter().fold(0.0, |a, b| a + b),
         long.iter().copied().fold(0.0, f64::max),
