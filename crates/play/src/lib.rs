@@ -255,16 +255,7 @@ pub fn run(
     }
     let rate = file.loop_.rate_hz;
     let ticks = config.seconds.map(|s| ticks_for(s, rate)).transpose()?;
-    let shared = Arc::new(Shared::default());
-    let mut server =
-        Server::start(config.port, shared.clone(), config.limits.clone()).map_err(|e| {
-            PlayError::Serve {
-                port: config.port,
-                message: e.to_string(),
-            }
-        })?;
-    let url = server.url();
-    on_ready(&url);
+    let (shared, mut server, url) = serve_page(config, on_ready)?;
 
     let hand = Hand::open(device, &shared)?;
     let page_is_hand = hand.is_page();
@@ -302,15 +293,7 @@ pub fn run(
     }
     serve_end_screen(config, stop);
     server.stop(&shared);
-    Ok(PlaySummary {
-        url,
-        session,
-        pages_served: shared.pages_served.load(Ordering::Relaxed),
-        messages_dropped: shared.dropped.load(Ordering::Relaxed),
-        page_messages_refused: shared.refused.load(Ordering::Relaxed),
-        refused: server.gate().refused.snapshot(),
-        lesson: None,
-    })
+    Ok(summary(url, session, &shared, &server, None))
 }
 
 /// `run` with a lesson: serves the page, takes the student through `lesson` (each step's world
@@ -322,16 +305,7 @@ fn run_lesson(
     stop: &AtomicBool,
     on_ready: &mut dyn FnMut(&str),
 ) -> Result<PlaySummary, PlayError> {
-    let shared = Arc::new(Shared::default());
-    let mut server =
-        Server::start(config.port, shared.clone(), config.limits.clone()).map_err(|e| {
-            PlayError::Serve {
-                port: config.port,
-                message: e.to_string(),
-            }
-        })?;
-    let url = server.url();
-    on_ready(&url);
+    let (shared, mut server, url) = serve_page(config, on_ready)?;
     let mut driver =
         lesson::LessonDriver::new(lesson, shared.clone(), config.out.with_extension(""));
     let r = driver.run(Pacing::Realtime, config.rt.as_ref(), stop);
@@ -353,20 +327,51 @@ fn run_lesson(
     let Some(session) = runs.last().map(|r| r.session.clone()) else {
         return Err(PlayError::NotStarted);
     };
-    Ok(PlaySummary {
+    let lesson = LessonOutcome {
+        progress,
+        runs,
+        dir,
+        report,
+    };
+    Ok(summary(url, session, &shared, &server, Some(lesson)))
+}
+
+/// Starts the page's server on `config`'s port and tells `on_ready` its address.
+fn serve_page(
+    config: &PlayConfig,
+    on_ready: &mut dyn FnMut(&str),
+) -> Result<(Arc<Shared>, Server, String), PlayError> {
+    let shared = Arc::new(Shared::default());
+    let server =
+        Server::start(config.port, shared.clone(), config.limits.clone()).map_err(|e| {
+            PlayError::Serve {
+                port: config.port,
+                message: e.to_string(),
+            }
+        })?;
+    let url = server.url();
+    on_ready(&url);
+    Ok((shared, server, url))
+}
+
+/// What a `play` run came to: its `session` (a lesson's last step's), what the server at `url`
+/// served and refused, and the `lesson` when one was played.
+fn summary(
+    url: String,
+    session: SessionSummary,
+    shared: &Shared,
+    server: &Server,
+    lesson: Option<LessonOutcome>,
+) -> PlaySummary {
+    PlaySummary {
         url,
         session,
         pages_served: shared.pages_served.load(Ordering::Relaxed),
         messages_dropped: shared.dropped.load(Ordering::Relaxed),
         page_messages_refused: shared.refused.load(Ordering::Relaxed),
         refused: server.gate().refused.snapshot(),
-        lesson: Some(LessonOutcome {
-            progress,
-            runs,
-            dir,
-            report,
-        }),
-    })
+        lesson,
+    }
 }
 
 /// Keeps the server up (the end screen and the recording's download) for
