@@ -254,6 +254,10 @@ fn the_documents_tables_are_the_checks_rules_bounds_and_stages() {
             haptic_devices::bridge::fake::BACK_OFF_AFTER_S == 0.1
         }),
         ("1 s after the bye".into(), stages::AFTER_BYE_S == 1.0),
+        (
+            "at most 150 000 samples".into(),
+            haptic_devices::bridge::check::observed::MAX_SAMPLES == 150_000,
+        ),
     ] {
         assert!(sec.contains(&text), "the document lacks `{text}`");
         assert!(ok, "`{text}` is not the check's value");

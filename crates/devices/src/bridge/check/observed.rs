@@ -8,6 +8,11 @@ use haptic_types::device::DeviceSpecs;
 use haptic_types::vec3::Vec3;
 use std::net::SocketAddr;
 
+/// Most samples the check keeps: 20 kHz (twice the fastest welcome) over the 6 s sequence and
+/// the 1 s after its bye, rounded up. A device sending more is flooding the check, which keeps
+/// its memory bounded and fails `packets`.
+pub const MAX_SAMPLES: usize = 150_000;
+
 /// The hello the device said.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HelloSeen {
@@ -66,6 +71,8 @@ pub struct Observed {
     pub malformed: u64,
     /// The first malformed datagram's reason.
     pub first_malformed: Option<String>,
+    /// Samples that arrived after [`MAX_SAMPLES`] were kept (counted, not kept).
+    pub over_cap: u64,
     /// Answers sent, and dropped on purpose in the loss stage.
     pub answers_sent: u64,
     /// Answers dropped in the loss stage.

@@ -287,11 +287,22 @@ fn packets(j: &mut Judge) {
     if let Some(m) = &o.first_malformed {
         figure.push_str(&format!(" (the first: {m})"));
     }
+    if o.over_cap > 0 {
+        figure.push_str(&format!(
+            "; {} samples past the check's {} not kept",
+            o.over_cap,
+            super::observed::MAX_SAMPLES
+        ));
+    }
     j.push(
         "packets",
-        o.malformed == 0 && o.datagrams > 0,
+        o.malformed == 0 && o.over_cap == 0 && o.datagrams > 0,
         figure,
-        "none malformed: samples of 52 bytes with version byte 1 or 56 with 2, byes of 9".into(),
+        format!(
+            "none malformed (samples of 52 bytes with version byte 1 or 56 with 2, byes of 9), \
+             at most {} samples",
+            super::observed::MAX_SAMPLES
+        ),
         Some(o.malformed as f64),
     );
 }
@@ -544,4 +555,51 @@ fn bye(j: &mut Judge) {
         ),
         Some(last.unwrap_or(0.0)),
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bridge::check::observed::HelloSeen;
+
+    /// What a welcomed Falcon that sent nothing but `over_cap` samples past the cap leaves.
+    fn observed(over_cap: u64) -> Observed {
+        Observed {
+            bind: "127.0.0.1:9".parse().unwrap_or_else(|_| unreachable!()),
+            hello: Some(HelloSeen {
+                version: 2,
+                rate_hz: 1000,
+                specs: haptic_types::device::DeviceModel::Falcon.specs().clone(),
+            }),
+            refused: None,
+            hello_repeat_s: Some(0.05),
+            version: 2,
+            rate_hz: 1000,
+            samples: Vec::new(),
+            datagrams: 10,
+            malformed: 0,
+            first_malformed: None,
+            over_cap,
+            answers_sent: 0,
+            answers_dropped: 0,
+            floor_m: None,
+            wall_n_per_m: 3000.0,
+            coupling_n_per_m: 1500.0,
+            bye_s: 6.0,
+            device_bye_s: None,
+        }
+    }
+
+    #[test]
+    fn a_flood_past_the_cap_fails_packets_and_says_so() {
+        let packets = |o: &Observed| judge(o).into_iter().find(|r| r.rule == "packets");
+        let ok = packets(&observed(0)).unwrap_or_else(|| unreachable!());
+        assert_eq!(ok.verdict, Verdict::Pass);
+        let r = packets(&observed(7)).unwrap_or_else(|| unreachable!());
+        assert_eq!(r.verdict, Verdict::Fail);
+        assert_eq!(
+            r.figure,
+            "10 datagrams, 0 malformed; 7 samples past the check's 150000 not kept"
+        );
+    }
 }

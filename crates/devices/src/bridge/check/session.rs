@@ -106,6 +106,7 @@ pub fn run_check_on(
         datagrams: 0,
         malformed: 0,
         first_malformed: None,
+        over_cap: 0,
         answers_sent: 0,
         answers_dropped: 0,
         floor_m: None,
@@ -415,6 +416,10 @@ impl Link<'_> {
         world: &mut CheckWorld,
         obs: &mut Observed,
     ) {
+        if obs.samples.len() >= super::observed::MAX_SAMPLES {
+            obs.over_cap += 1;
+            return;
+        }
         let stage = stages::stage_at(t_s);
         obs.samples.push(Received {
             t_s,
