@@ -37,6 +37,12 @@ pub struct ClassroomArgs {
     /// The name the bridged device plays under.
     #[arg(long, default_value = "device")]
     pub device_name: String,
+    /// Take every student through a lesson (FILE, or without it the built-in module): each
+    /// step runs its own scene (SCENE is then the bridged device's only), each student's
+    /// steps recorded to OUT_DIR/NAME-START/STEP-ID.mcap; the teacher page follows every
+    /// student and opens or holds steps; the class report is written to OUT_DIR at the end.
+    #[arg(long, value_name = "FILE", num_args = 0..=1)]
+    pub lesson: Option<Option<PathBuf>>,
     #[command(flatten)]
     pub(crate) rt: crate::rt_args::RtArgs,
 }
@@ -62,6 +68,7 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
     c.max_students = a.max_students;
     c.seconds = a.seconds;
     c.device_name = a.device_name.clone();
+    c.lesson = crate::play_cmd::lesson(a.lesson.as_ref())?;
     c.rt = a.rt.request()?;
     c.device = crate::play_cmd::bridged_device(
         a.device.as_deref(),
@@ -75,6 +82,13 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
             c.max_students,
             c.out_dir.display()
         );
+        if let Some(l) = &c.lesson {
+            println!(
+                "  lesson         {} ({} steps; the teacher page opens the locked ones)",
+                l.title,
+                l.steps.len()
+            );
+        }
         if listen.is_loopback() {
             println!(
                 "  students open  {}  (on this computer a name is enough)",
@@ -122,6 +136,13 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
     );
     for st in &s.students {
         println!("  {}", st.line());
+    }
+    if let Some(md) = s
+        .report
+        .iter()
+        .find(|p| p.extension().is_some_and(|e| e == "md"))
+    {
+        println!("class report: {}", md.display());
     }
     let r = s.refused;
     println!(

@@ -36,7 +36,7 @@ pub struct PlayArgs {
 
 /// The lesson of `--lesson`: the file's (refused with its line, column, field and what is
 /// allowed), or the built-in module.
-fn lesson(arg: Option<&Option<PathBuf>>) -> Result<Option<teaching::Lesson>, String> {
+pub(crate) fn lesson(arg: Option<&Option<PathBuf>>) -> Result<Option<teaching::Lesson>, String> {
     match arg {
         None => Ok(None),
         Some(None) => teaching::builtin::module()

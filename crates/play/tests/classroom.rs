@@ -5,129 +5,17 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
+use common::class::{Ws, get, http, join, post_join, read_for, send, start, ws};
 use haptic_loop::session::SceneSource;
-use play::classroom::{ClassAddresses, ClassConfig, ClassSummary, run};
+use play::classroom::{ClassConfig, run};
 use play::protocol::ServerMsg;
 use recording::read_recording_file;
 use serde_json::{Value, json};
-use std::io::{Read, Write};
-use std::net::TcpStream;
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
-use tungstenite::stream::MaybeTlsStream;
-use tungstenite::{Message, WebSocket};
-
-type Ws = WebSocket<MaybeTlsStream<TcpStream>>;
-
-struct Running {
-    addr: ClassAddresses,
-    host: String,
-    stop: Arc<AtomicBool>,
-    handle: JoinHandle<Result<ClassSummary, play::PlayError>>,
-    dir: PathBuf,
-}
-
-fn start(name: &str, max: usize) -> Running {
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("nh-class-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let mut c = ClassConfig::new(
-        SceneSource::resolve("brickworld".as_ref()).unwrap(),
-        dir.clone(),
-    );
-    c.port = 0;
-    c.max_students = max;
-    c.teacher_code = Some("TEACH123".into());
-    let stop = Arc::new(AtomicBool::new(false));
-    let s2 = stop.clone();
-    let (tx, rx) = std::sync::mpsc::channel();
-    let handle = std::thread::spawn(move || {
-        run(&c, &s2, &mut |a| {
-            let _ = tx.send(a.clone());
-        })
-    });
-    let addr = rx.recv_timeout(Duration::from_secs(20)).unwrap();
-    let host = addr
-        .student_url
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .to_string();
-    Running {
-        addr,
-        host,
-        stop,
-        handle,
-        dir,
-    }
-}
-
-fn http(host: &str, request: &str) -> String {
-    let mut s = TcpStream::connect(host).unwrap();
-    s.write_all(request.as_bytes()).unwrap();
-    let mut out = Vec::new();
-    s.read_to_end(&mut out).unwrap();
-    String::from_utf8_lossy(&out).to_string()
-}
-
-fn get(host: &str, path: &str) -> String {
-    http(
-        host,
-        &format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n"),
-    )
-}
-
-/// A form `POST` to `/join` from the join page (`name` URL-encoded), with `headers` (each
-/// ending in `\r\n`) in place of the page's own `Origin` and `Sec-Fetch-Site`.
-fn post_join(host: &str, name: &str, headers: Option<&str>) -> String {
-    let body = format!("name={name}");
-    let own = format!("Origin: http://{host}\r\nSec-Fetch-Site: same-origin\r\n");
-    http(
-        host,
-        &format!(
-            "POST /join HTTP/1.1\r\nHost: {host}\r\n{}Content-Type: \
-             application/x-www-form-urlencoded\r\nContent-Length: {}\r\n\r\n{body}",
-            headers.unwrap_or(&own),
-            body.len()
-        ),
-    )
-}
-
-/// Joins as `name` through the join page's form; the session token from the redirect.
-fn join(host: &str, name: &str) -> String {
-    let r = post_join(host, name, None);
-    assert!(r.starts_with("HTTP/1.1 303 See Other"), "{r}");
-    let loc = r
-        .lines()
-        .find_map(|l| l.strip_prefix("Location: /play?s="))
-        .unwrap();
-    loc.trim().to_string()
-}
-
-fn ws(host: &str, path: &str) -> Ws {
-    let (ws, _) = tungstenite::connect(format!("ws://{host}{path}").as_str()).unwrap();
-    if let MaybeTlsStream::Plain(s) = ws.get_ref() {
-        s.set_read_timeout(Some(Duration::from_millis(5))).unwrap();
-    }
-    ws
-}
-
-fn read_for(ws: &mut Ws, secs: f64) -> Vec<Value> {
-    let t0 = Instant::now();
-    let mut out = Vec::new();
-    while t0.elapsed().as_secs_f64() < secs {
-        if let Ok(Message::Text(t)) = ws.read() {
-            out.push(serde_json::from_str(t.as_str()).unwrap());
-        }
-    }
-    out
-}
-
-fn send(ws: &mut Ws, v: Value) {
-    ws.send(Message::text(v.to_string())).unwrap();
-}
 
 #[test]
 fn a_class_of_three_plays_is_watched_switched_ended_and_collected() {

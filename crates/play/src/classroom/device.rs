@@ -40,6 +40,7 @@ pub(crate) fn run_device_student(
         out: out.clone(),
         shared: shared.clone(),
         status: Mutex::new(Status::waiting()),
+        lesson: None,
     });
     if let Ok(mut s) = class.students.lock() {
         s.push(student.clone());
@@ -56,6 +57,7 @@ pub(crate) fn run_device_student(
     if let Ok(mut f) = class.finished.lock() {
         f.push(StudentSummary {
             name: name.to_string(),
+            step: None,
             session,
         });
     }

@@ -3,6 +3,7 @@
 //! shows of them.
 
 use super::{Student, StudentSummary};
+use crate::lesson::StepWorld;
 use crate::session::{PageSession, Step};
 use haptic_engine::clock::Worker;
 use haptic_engine::timing::Pacer;
@@ -20,43 +21,84 @@ pub enum Phase {
     Ended,
 }
 
+/// What a worker ticks for a student: their session, or the world of their lesson's step.
+enum Held {
+    Session(PageSession),
+    Step(StepWorld),
+}
+
 /// A student's session as a worker holds it.
 pub struct Live {
     /// Who plays it.
     pub student: Arc<Student>,
-    session: PageSession,
+    held: Held,
     playing: bool,
 }
 
+/// A session a worker let go, closed on the finisher thread.
+pub enum Finished {
+    /// A student's session, closed.
+    Session(Box<StudentSummary>),
+    /// The world of a step of `student`'s lesson, to close through their lesson.
+    Step(Arc<Student>, Box<StepWorld>),
+}
+
+/// `session` reporting to `student`'s teacher-page status every [`super::STATUS_EVERY_TICKS`]
+/// ticks.
+fn reporting(student: &Arc<Student>, session: PageSession) -> PageSession {
+    let st = student.clone();
+    session.with_reporter(
+        super::STATUS_EVERY_TICKS,
+        Box::new(move |ticks, missed, lp| st.report(ticks, missed, lp)),
+    )
+}
+
 impl Live {
-    /// `student`'s session, which reports to their teacher-page status every
-    /// [`super::STATUS_EVERY_TICKS`] ticks.
+    /// `student`'s session, which reports to their teacher-page status.
     pub fn new(student: Arc<Student>, session: PageSession) -> Self {
-        let st = student.clone();
-        let session = session.with_reporter(
-            super::STATUS_EVERY_TICKS,
-            Box::new(move |ticks, missed, lp| st.report(ticks, missed, lp)),
-        );
+        let session = reporting(&student, session);
         Live {
             student,
-            session,
+            held: Held::Session(session),
             playing: false,
+        }
+    }
+
+    /// The world of a step of `student`'s lesson, which reports to their status (its time is
+    /// the time on the step).
+    pub fn step(student: Arc<Student>, world: StepWorld) -> Self {
+        let world = world.map_session(|s| reporting(&student, s));
+        Live {
+            student,
+            held: Held::Step(world),
+            playing: false,
+        }
+    }
+
+    fn session(&self) -> &PageSession {
+        match &self.held {
+            Held::Session(s) => s,
+            Held::Step(w) => &w.session,
         }
     }
 
     /// Whether it ended (the worker hands it to the finisher).
     pub fn ended(&self) -> bool {
-        self.session.ended()
+        self.session().ended()
     }
 
     /// Ends it at its next cycle (the class is stopping).
     pub fn request_end(&self) {
-        self.session.request_end();
+        self.session().request_end();
     }
 
     /// This session's part of worker cycle `k` of `pacer`: one step of the session.
     pub fn cycle(&mut self, k: u64, pacer: &Pacer) {
-        let step = self.session.step(&mut Worker { pacer, k });
+        let session = match &mut self.held {
+            Held::Session(s) => s,
+            Held::Step(w) => &mut w.session,
+        };
+        let step = session.step(&mut Worker { pacer, k });
         if step == Step::Ticked && !self.playing {
             self.playing = true;
             self.student.set_phase(super::Phase::Playing);
@@ -65,12 +107,19 @@ impl Live {
 
     /// Closes the session (on the finisher thread): the statistics, the recording's end, the
     /// publisher's last frame, and the end screen with the recording's download for its pages.
-    pub fn finish(self: Box<Self>) -> StudentSummary {
-        let session = self.session.finish();
-        self.student.set_phase(super::Phase::Ended);
-        StudentSummary {
-            name: self.student.name.clone(),
-            session,
+    /// A lesson step's world is handed back to be closed through the student's lesson.
+    pub fn finish(self: Box<Self>) -> Finished {
+        match self.held {
+            Held::Session(s) => {
+                let session = s.finish();
+                self.student.set_phase(super::Phase::Ended);
+                Finished::Session(Box::new(StudentSummary {
+                    name: self.student.name.clone(),
+                    step: None,
+                    session,
+                }))
+            }
+            Held::Step(w) => Finished::Step(self.student, Box::new(w)),
         }
     }
 }

@@ -18,23 +18,31 @@
 //!
 //! - **A real device** ([`ClassConfig::device`]): a device bridged over UDP joins as a student,
 //!   its session paced by the device on its own thread.
+//! - **A lesson** ([`ClassConfig::lesson`], `classroom --lesson`; [`lesson`]): each student
+//!   takes it on their page, each step's world ticked by the same workers. The teacher page
+//!   follows where each student is, their time on the step and their answers as they come.
+//!   The teacher opens the next step for everyone or holds the class before one. The class
+//!   report ([`teaching::class_report`]) is in the recordings' zip, and it is written beside
+//!   the recordings at the end.
 //!
 //! What it is not: no accounts, no TLS, no persistence across restarts (the recordings stay in
 //! the folder).
 
 mod device;
+pub mod lesson;
 mod live;
 pub mod names;
 mod routes;
 mod sched;
 mod teacher;
+mod threads;
 pub mod zip;
 
 use crate::PlayError;
 use crate::input::PageDevice;
 use crate::server::{Listener, Shared};
 use crate::session::{Hand, PageSession, SessionSpec, SessionSummary};
-use haptic_loop::session::{SceneSource, SessionError, now_unix_ns, ticks_for};
+use haptic_loop::session::{SceneSource, now_unix_ns};
 use live::Live;
 pub use live::Phase;
 use std::hash::{BuildHasher, Hasher};
@@ -44,7 +52,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::Sender;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
-use webguard::gate::{Limits, RefusedCounts};
+use threads::{Plan, class_limits, start_coach, start_device, start_finisher, start_workers};
+use webguard::gate::RefusedCounts;
 
 /// Ticks between two updates of what the teacher page shows of a student (50 ms at 1 kHz).
 pub const STATUS_EVERY_TICKS: u64 = 50;
@@ -80,6 +89,10 @@ pub struct ClassConfig {
     pub device: Option<haptic_devices::bridge::BridgeConfig>,
     /// The name the bridged device plays under.
     pub device_name: String,
+    /// A lesson every student takes (`None`: every student plays [`ClassConfig::scene`]).
+    /// Each step runs its own scene, and their rates must agree (one schedule for the
+    /// workers). A student's steps are recorded to `out_dir/NAME-START/STEP-ID.mcap`.
+    pub lesson: Option<teaching::Lesson>,
     /// The tick workers' real-time scheduling (default `SCHED_FIFO` 50 and memory locked; the
     /// workers are not pinned, so each core can take one); `None`: ask for nothing (`--no-rt`).
     pub rt: Option<haptic_engine::realtime::RtRequest>,
@@ -100,6 +113,7 @@ impl ClassConfig {
             workers: None,
             device: None,
             device_name: "device".into(),
+            lesson: None,
             rt: Some(haptic_engine::realtime::RtRequest::default()),
         }
     }
@@ -143,12 +157,14 @@ pub struct Student {
     pub name: String,
     /// Their session's token (the page's `?s=`).
     pub token: String,
-    /// Their recording.
+    /// Their recording (a lesson's: the folder of its steps' recordings).
     pub out: PathBuf,
     /// Their session's link to their pages.
     pub shared: Arc<Shared>,
     /// What the teacher sees.
     pub status: Mutex<Status>,
+    /// Their way through the class's lesson, if it has one.
+    pub(crate) lesson: Option<Mutex<lesson::StudentLesson>>,
 }
 
 impl Status {
@@ -202,6 +218,8 @@ impl Student {
 pub struct StudentSummary {
     /// The student.
     pub name: String,
+    /// The lesson's step the session was the world of (`None`: no lesson).
+    pub step: Option<String>,
     /// Their session.
     pub session: SessionSummary,
 }
@@ -211,8 +229,12 @@ impl StudentSummary {
     pub fn line(&self) -> String {
         let s = &self.session;
         format!(
-            "{}: {}, {} ticks, {} missed deadlines, score {}, recording {}{}",
+            "{}{}: {}, {} ticks, {} missed deadlines, score {}, recording {}{}",
             self.name,
+            self.step
+                .as_deref()
+                .map(|id| format!(", step {id}"))
+                .unwrap_or_default(),
             s.end,
             s.stats.ticks,
             s.stats.missed,
@@ -239,6 +261,8 @@ pub struct ClassSummary {
     pub workers: usize,
     /// The real-time scheduling the workers got (the first worker's; they all ask alike).
     pub realtime: haptic_engine::realtime::RtStatus,
+    /// The files of the class report written at the end, with a lesson (none without).
+    pub report: Vec<PathBuf>,
 }
 
 /// Why a student could not join.
@@ -301,6 +325,7 @@ pub(crate) struct Class {
     teacher_code: String,
     join_code: Option<String>,
     students: Mutex<Vec<Arc<Student>>>,
+    lesson: Option<lesson::ClassLesson>,
     workers: Vec<WorkerLink>,
     pub(crate) finished: Mutex<Vec<StudentSummary>>,
     ended: AtomicUsize,
@@ -346,13 +371,28 @@ impl Class {
             start_ns / 1_000_000_000,
             &taken,
         );
+        let shared = Arc::new(Shared::default());
+        let token = random_code(24, b"0123456789abcdefghijklmnopqrstuvwxyz");
+        if let Some(cl) = &self.lesson {
+            // The lesson's coach opens each step's world when the student reaches it.
+            let dir = out.with_extension("");
+            let lesson = cl.student(shared.clone(), dir.clone(), &name, &token);
+            let student = Arc::new(Student {
+                name,
+                token,
+                out: dir,
+                shared,
+                status: Mutex::new(Status::waiting()),
+                lesson: Some(Mutex::new(lesson)),
+            });
+            students.push(student.clone());
+            return Ok(student);
+        }
         let file = self
             .config
             .scene
             .parse()
             .map_err(|e| JoinError::Setup(e.to_string()))?;
-        let shared = Arc::new(Shared::default());
-        let token = random_code(24, b"0123456789abcdefghijklmnopqrstuvwxyz");
         let hand = Hand::Page(PageDevice::new(
             file.device.model.specs().clone(),
             shared.input.clone(),
@@ -376,8 +416,15 @@ impl Class {
             out,
             shared,
             status: Mutex::new(Status::waiting()),
+            lesson: None,
         });
-        let live = Box::new(Live::new(student.clone(), session));
+        self.dispatch(Box::new(Live::new(student.clone(), session)))?;
+        students.push(student.clone());
+        Ok(student)
+    }
+
+    /// Hands `live` to the least busy worker.
+    pub(crate) fn dispatch(&self, live: Box<Live>) -> Result<(), JoinError> {
         let (tx, load) = self
             .workers
             .iter()
@@ -387,9 +434,7 @@ impl Class {
         tx.lock()
             .map_err(|_| JoinError::Setup("the class is shutting down".into()))?
             .send(live)
-            .map_err(|_| JoinError::Setup("the class is shutting down".into()))?;
-        students.push(student.clone());
-        Ok(student)
+            .map_err(|_| JoinError::Setup("the class is shutting down".into()))
     }
 
     /// The class of `config` playing `plan`, ticked by `workers`.
@@ -418,6 +463,7 @@ impl Class {
                     .unwrap_or_else(|| random_code(6, b"0123456789"))
             }),
             students: Mutex::new(Vec::new()),
+            lesson: config.lesson.clone().map(lesson::ClassLesson::new),
             workers,
             finished: Mutex::new(Vec::new()),
             ended: AtomicUsize::new(0),
@@ -490,9 +536,16 @@ pub fn run(
     .map_err(serve_err)?;
     let addresses = class.addresses(listener.addr());
     let device = start_device(config, &class, &worker_stop)?;
+    let coach_stop = Arc::new(AtomicBool::new(false));
+    let coach = start_coach(&class, &coach_stop).map_err(serve_err)?;
     on_ready(&addresses);
     while !stop.load(Ordering::Relaxed) {
         std::thread::sleep(Duration::from_millis(20));
+    }
+    // No step's world opens once the class stops.
+    coach_stop.store(true, Ordering::Relaxed);
+    if let Some(c) = coach {
+        let _ = c.join();
     }
     worker_stop.store(true, Ordering::Relaxed);
     let mut realtime = haptic_engine::realtime::RtStatus::default();
@@ -517,9 +570,22 @@ pub fn run(
     }
     let _ = finisher.join();
     for s in class.students() {
+        if let Some(m) = &s.lesson {
+            lesson::locked(m).ended = true;
+            s.set_phase(Phase::Ended);
+        }
         s.shared.shutdown.store(true, Ordering::Relaxed);
     }
     listener.stop();
+    let report = match lesson::class_report(&class) {
+        Some(r) => r.write(&config.out_dir).map_err(|e| {
+            PlayError::Failed(format!(
+                "the class report in {}: {e}",
+                config.out_dir.display()
+            ))
+        })?,
+        None => Vec::new(),
+    };
     let students = class
         .finished
         .lock()
@@ -531,140 +597,6 @@ pub fn run(
         refused: listener.gate().refused.snapshot(),
         workers: class.workers.len(),
         realtime,
+        report,
     })
-}
-
-/// What a class plays, checked before anyone joins.
-struct Plan {
-    scene_name: String,
-    kind: &'static str,
-    switches: &'static [haptic_types::SwitchSpec],
-    rate_hz: u32,
-    ticks: Option<u64>,
-}
-
-impl Plan {
-    /// Checks the class's size, its scene (whole) and session length, and makes the
-    /// recordings' folder.
-    fn check(config: &ClassConfig) -> Result<Plan, PlayError> {
-        if !(1..=MAX_CLASS).contains(&config.max_students) {
-            return Err(PlayError::Session(SessionError::Option(
-                haptic_types::value::ValueError::out_of_range(
-                    "--max-students",
-                    config.max_students as f64,
-                    "1 ≤ students ≤ 200",
-                )
-                .to_string(),
-            )));
-        }
-        let file = config.scene.parse()?;
-        let loaded = haptic_loop::scene::load_scene(&config.scene.text, Some(file.device.model))
-            .map_err(|e| config.scene.locate(e))?;
-        let (switches, kind) = (loaded.scene.switches(), loaded.scene.kind());
-        let rate_hz = file.loop_.rate_hz;
-        let ticks = config.seconds.map(|s| ticks_for(s, rate_hz)).transpose()?;
-        std::fs::create_dir_all(&config.out_dir).map_err(|e| {
-            PlayError::Session(SessionError::Option(format!(
-                "cannot create the recordings' folder {}: {e}",
-                config.out_dir.display()
-            )))
-        })?;
-        Ok(Plan {
-            scene_name: file.scene.name.clone(),
-            kind,
-            switches,
-            rate_hz,
-            ticks,
-        })
-    }
-}
-
-/// The tick workers (one per core, at most four, or as configured), each with its inbox and
-/// its count of sessions; an ended session goes to `finished`.
-fn start_workers(
-    config: &ClassConfig,
-    plan: &Plan,
-    finished: &Sender<Box<Live>>,
-    stop: &Arc<AtomicBool>,
-) -> std::io::Result<(Vec<WorkerLink>, Vec<WorkerHandle>)> {
-    let n = config
-        .workers
-        .unwrap_or_else(|| {
-            std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(1)
-        })
-        .clamp(1, 4);
-    let period_ns = 1_000_000_000 / u64::from(plan.rate_hz.max(1));
-    let mut workers = Vec::new();
-    let mut handles = Vec::new();
-    for i in 0..n {
-        let (tx, rx) = std::sync::mpsc::channel();
-        let load = Arc::new(AtomicUsize::new(0));
-        let (l, f, s) = (load.clone(), finished.clone(), stop.clone());
-        let rt = config
-            .rt
-            .map(|r| haptic_engine::realtime::RtRequest { pin: false, ..r });
-        handles.push(
-            std::thread::Builder::new()
-                .name(format!("class-tick-{i}"))
-                .spawn(move || sched::worker(rx, f, period_ns, l, s, rt))?,
-        );
-        workers.push((Mutex::new(tx), load));
-    }
-    Ok((workers, handles))
-}
-
-/// The finisher: closes each ended session off the tick threads.
-fn start_finisher(
-    class: Arc<Class>,
-    ended: std::sync::mpsc::Receiver<Box<Live>>,
-) -> std::io::Result<std::thread::JoinHandle<()>> {
-    std::thread::Builder::new()
-        .name("class-finish".into())
-        .spawn(move || {
-            while let Ok(l) = ended.recv() {
-                let s = l.finish();
-                class.ended.fetch_add(1, Ordering::Relaxed);
-                if let Ok(mut f) = class.finished.lock() {
-                    f.push(s);
-                }
-            }
-        })
-}
-
-/// A connection per page file, a link per page: four per student from one address on
-/// loopback (every student of a test or a one-machine class shares 127.0.0.1).
-fn class_limits(config: &ClassConfig) -> Limits {
-    Limits {
-        max_connections: 8 * config.max_students + 16,
-        max_per_address: if config.listen.is_loopback() {
-            8 * config.max_students + 16
-        } else {
-            16
-        },
-        ..Limits::default()
-    }
-}
-
-/// The bridged device's student on a thread of its own, when the class has one.
-fn start_device(
-    config: &ClassConfig,
-    class: &Arc<Class>,
-    stop: &Arc<AtomicBool>,
-) -> Result<Option<std::thread::JoinHandle<Result<(), String>>>, PlayError> {
-    let Some(b) = config.device.clone() else {
-        return Ok(None);
-    };
-    let name = names::check_name(&config.device_name)
-        .map_err(|e| PlayError::Session(SessionError::Option(format!("--device-name: {e}"))))?;
-    let (c, s) = (class.clone(), stop.clone());
-    std::thread::Builder::new()
-        .name("class-device".into())
-        .spawn(move || device::run_device_student(&c, b, &name, &s))
-        .map(Some)
-        .map_err(|e| PlayError::Serve {
-            port: config.port,
-            message: e.to_string(),
-        })
 }

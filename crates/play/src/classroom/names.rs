@@ -76,7 +76,9 @@ pub fn recording_path(dir: &Path, name: &str, start_s: u64, taken: &[PathBuf]) -
             format!("{stem}-{k}.mcap")
         };
         let p = dir.join(file);
-        if !p.exists() && !taken.contains(&p) {
+        // A lesson's student records into the folder of the same name without `.mcap`.
+        let folder = p.with_extension("");
+        if !p.exists() && !folder.exists() && !taken.contains(&p) && !taken.contains(&folder) {
             return p;
         }
         k += 1;

@@ -1,12 +1,13 @@
 //! The classroom's paths: the join page and `POST /join`, each student's page (`/play?s=TOKEN`,
 //! the page's modules, `/ws?s=TOKEN`, `/recording.mcap?s=TOKEN`), and the teacher's
 //! (`/teacher?code=…`, `/teacher/ws?code=…`, `/recordings.zip?code=…`, and a student's ended
-//! session replayed: `/replay?s=TOKEN&code=…` with its data under `/replay/`). Every request passed
+//! session replayed: `/replay?s=TOKEN&code=…`, a lesson's finished step
+//! `/replay?s=TOKEN&step=ID&code=…`, with its data under `/replay/`). Every request passed
 //! the listener's gate and its `Host`/`Origin` check before it reaches these. Joining changes
 //! the class (a session, a name taken), so it is a form `POST` from the join page itself
 //! ([`webguard::form`]): a link or a page from another site cannot fill the class with names.
 
-use super::{Class, JoinError, Phase, teacher};
+use super::{Class, JoinError, Phase, lesson, teacher};
 use crate::http::{accept_upgrade, respond, respond_text};
 use crate::replay::{ReplayBook, server as replay};
 use crate::server::{PAGE_FILES, Routes, page_link, serve_download, serve_page_file};
@@ -53,11 +54,16 @@ fn join_page(class: &Class, error: Option<&str>, name: &str) -> String {
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>nanohaptics classroom: join</title><link rel="stylesheet" href="/class.css"></head>
 <body><main class="join"><h1>Join the class</h1>
-<p>Scene: <b>{scene}</b>. Enter your name: you get your own world and your own recording.</p>
+<p>{what}: <b>{scene}</b>. Enter your name: you get your own world and your own recording.</p>
 {error}<form method="post" action="/join">
 <label>Your name <input name="name" value="{name}" required maxlength="32" autocomplete="off" autofocus></label>
 {code}<button type="submit">Join</button></form></main></body></html>
 "#,
+        what = if class.lesson.is_some() {
+            "Lesson"
+        } else {
+            "Scene"
+        },
         scene = esc(&class.scene_name),
         name = esc(name),
     )
@@ -184,7 +190,26 @@ impl ClassRoutes {
                 "no such session in this class",
             );
         };
-        let ended = s.status.lock().is_ok_and(|st| st.phase == Phase::Ended);
+        let (file, key) = if s.lesson.is_some() {
+            // A lesson's student: one of their steps, once its world has closed.
+            let Some(id) = head.query("step") else {
+                return respond_text(
+                    &mut stream,
+                    "400 Bad Request",
+                    &format!(
+                        "{} is taking a lesson: name the step to replay (&step=ID)",
+                        s.name
+                    ),
+                );
+            };
+            match lesson::step_recording(&s, &id) {
+                Ok(p) => (p, format!("{}/{id}", s.token)),
+                Err(e) => return respond_text(&mut stream, "409 Conflict", &e),
+            }
+        } else {
+            (s.out.clone(), s.token.clone())
+        };
+        let ended = s.lesson.is_some() || s.status.lock().is_ok_and(|st| st.phase == Phase::Ended);
         if !ended {
             return respond_text(
                 &mut stream,
@@ -199,18 +224,14 @@ impl ClassRoutes {
             replay::serve_page(&mut stream, head.path(), "/replay");
             return;
         }
-        let cached = self
-            .replays
-            .lock()
-            .ok()
-            .and_then(|m| m.get(&s.token).cloned());
+        let cached = self.replays.lock().ok().and_then(|m| m.get(&key).cloned());
         let book = match cached {
             Some(b) => b,
-            None => match ReplayBook::from_file(&s.out) {
+            None => match ReplayBook::from_file(&file) {
                 Ok(b) => {
                     let b = Arc::new(b);
                     if let Ok(mut m) = self.replays.lock() {
-                        m.insert(s.token.clone(), b.clone());
+                        m.insert(key, b.clone());
                     }
                     b
                 }
@@ -218,7 +239,7 @@ impl ClassRoutes {
                     return respond_text(
                         &mut stream,
                         "500 Internal Server Error",
-                        &format!("{}: {e}", s.out.display()),
+                        &format!("{}: {e}", file.display()),
                     );
                 }
             },

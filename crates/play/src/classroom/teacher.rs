@@ -1,8 +1,10 @@
-//! The teacher's link: every student's status four times a second (`class`), and the
-//! teacher's commands — a switch for the class or one student, end one session or all — each
-//! answered (`done` or `error`). And the zip of every finished recording.
+//! The teacher's link: every student's status four times a second (`class`; in a lesson,
+//! where each student is, their time on the step and their answers), and the teacher's
+//! commands — a switch for the class or one student, end one session or all; in a lesson, open
+//! the next locked step, open a step or hold the class before one — each answered (`done` or
+//! `error`). And the zip of every finished recording (with a lesson, the class report too).
 
-use super::{Class, Phase};
+use super::{Class, Phase, lesson};
 use crate::wslink::{self, Incoming, LinkConfig};
 use std::net::TcpStream;
 use std::sync::atomic::Ordering;
@@ -34,6 +36,19 @@ pub enum TeacherMsg {
     },
     /// End every session.
     EndAll,
+    /// Open the lesson's first step locked for the class, for everyone.
+    OpenNext,
+    /// Open step `step` (its id) for everyone: students waiting at it go on.
+    OpenStep {
+        /// The step's id.
+        step: String,
+    },
+    /// Hold the class before step `step` (its id): it is locked for everyone who has not
+    /// entered it.
+    HoldStep {
+        /// The step's id.
+        step: String,
+    },
 }
 
 /// What the teacher page is sent.
@@ -67,6 +82,8 @@ pub(crate) fn class_json(class: &Class, gate: &Gate) -> String {
                 "pages": s.pages(),
                 "recording": s.out.file_name().map(|n| n.to_string_lossy().to_string()),
                 "status": st,
+                "lesson": s.lesson.as_ref().map(|m| lesson::locked(m).view()),
+                "steps_run": lesson::steps_run(s),
             })
         })
         .collect();
@@ -87,10 +104,34 @@ pub(crate) fn class_json(class: &Class, gate: &Gate) -> String {
         "join_code": class.join_code,
         "switches": switches,
         "students": students,
+        "lesson": class.lesson.as_ref().map(|cl| {
+            let locks = cl.locks();
+            serde_json::json!({
+                "title": cl.lesson.title,
+                "steps": cl.lesson.steps.iter().zip(locks).map(|(s, locked)| serde_json::json!({
+                    "id": s.id, "title": s.title, "locked": locked,
+                })).collect::<Vec<_>>(),
+            })
+        }),
         "ended": class.ended.load(Ordering::Relaxed),
         "refused": gate.refused.snapshot(),
     })
     .to_string()
+}
+
+/// The students playing or waiting (named `name`, or all).
+fn active(class: &Class, name: Option<&str>) -> Vec<std::sync::Arc<super::Student>> {
+    class
+        .students()
+        .into_iter()
+        .filter(|s| {
+            s.status
+                .lock()
+                .map(|st| st.phase != Phase::Ended)
+                .unwrap_or(false)
+        })
+        .filter(|s| name.is_none_or(|n| s.name == n))
+        .collect()
 }
 
 /// Carries out one teacher command; the answer in words.
@@ -102,70 +143,26 @@ pub(crate) fn command(class: &Class, text: &str) -> TeacherReply {
                 field: "type".into(),
                 message: format!(
                     "not a teacher command ({e}): allowed switch {{name, value, student?}}, end \
-                     {{student}}, end_all"
+                     {{student}}, end_all, open_next, open_step {{step}}, hold_step {{step}}"
                 ),
             };
         }
     };
-    let active = |name: Option<&str>| {
-        class
-            .students()
-            .into_iter()
-            .filter(|s| {
-                s.status
-                    .lock()
-                    .map(|st| st.phase != Phase::Ended)
-                    .unwrap_or(false)
-            })
-            .filter(|s| name.is_none_or(|n| s.name == n))
-            .collect::<Vec<_>>()
-    };
+    let active = |name: Option<&str>| active(class, name);
     match msg {
+        TeacherMsg::OpenNext | TeacherMsg::OpenStep { .. } | TeacherMsg::HoldStep { .. } => {
+            lesson_command(class, msg)
+        }
+        TeacherMsg::Switch { .. } if class.lesson.is_some() => TeacherReply::Error {
+            field: "switch.name".into(),
+            message: "in a lesson each step sets its own switches: open or hold steps instead"
+                .into(),
+        },
         TeacherMsg::Switch {
             name,
             value,
             student,
-        } => {
-            let spec = match haptic_types::switch::check(class.kind, class.switches, &name, value) {
-                Ok(s) => s,
-                Err(e) => {
-                    let field = match e {
-                        haptic_types::SwitchError::Unknown { .. } => "switch.name",
-                        _ => "switch.value",
-                    };
-                    return TeacherReply::Error {
-                        field: field.into(),
-                        message: e.to_string(),
-                    };
-                }
-            };
-            let targets = active(student.as_deref());
-            if targets.is_empty() {
-                return TeacherReply::Error {
-                    field: "switch.student".into(),
-                    message: match student {
-                        Some(n) => format!("no student `{n}` is playing or waiting"),
-                        None => "no student is playing or waiting".into(),
-                    },
-                };
-            }
-            for s in &targets {
-                if let Ok(mut q) = s.shared.switches.lock() {
-                    q.push((0, spec.name.to_string(), value));
-                }
-            }
-            TeacherReply::Done {
-                message: format!(
-                    "{} = {} for {}",
-                    spec.name,
-                    world_form::fmt_num(value),
-                    match student {
-                        Some(n) => n,
-                        None => format!("{} students", targets.len()),
-                    }
-                ),
-            }
-        }
+        } => switch_command(class, &name, value, student),
         TeacherMsg::End { student } => match active(Some(&student)).first() {
             Some(s) => {
                 s.shared.end_requested.store(true, Ordering::Relaxed);
@@ -187,6 +184,102 @@ pub(crate) fn command(class: &Class, text: &str) -> TeacherReply {
                 message: format!("ended {} sessions", all.len()),
             }
         }
+    }
+}
+
+/// A switch for the class (`student`: `None`) or one student.
+fn switch_command(class: &Class, name: &str, value: f64, student: Option<String>) -> TeacherReply {
+    let spec = match haptic_types::switch::check(class.kind, class.switches, name, value) {
+        Ok(s) => s,
+        Err(e) => {
+            let field = match e {
+                haptic_types::SwitchError::Unknown { .. } => "switch.name",
+                _ => "switch.value",
+            };
+            return TeacherReply::Error {
+                field: field.into(),
+                message: e.to_string(),
+            };
+        }
+    };
+    let targets = active(class, student.as_deref());
+    if targets.is_empty() {
+        return TeacherReply::Error {
+            field: "switch.student".into(),
+            message: match student {
+                Some(n) => format!("no student `{n}` is playing or waiting"),
+                None => "no student is playing or waiting".into(),
+            },
+        };
+    }
+    for s in &targets {
+        if let Ok(mut q) = s.shared.switches.lock() {
+            q.push((0, spec.name.to_string(), value));
+        }
+    }
+    TeacherReply::Done {
+        message: format!(
+            "{} = {} for {}",
+            spec.name,
+            world_form::fmt_num(value),
+            match student {
+                Some(n) => n,
+                None => format!("{} students", targets.len()),
+            }
+        ),
+    }
+}
+
+/// A lesson's command: open the next locked step, open one, or hold the class before one.
+fn lesson_command(class: &Class, msg: TeacherMsg) -> TeacherReply {
+    let Some(cl) = &class.lesson else {
+        return TeacherReply::Error {
+            field: "type".into(),
+            message: "the class has no lesson (start it with `classroom --lesson`)".into(),
+        };
+    };
+    let (step, open) = match msg {
+        TeacherMsg::OpenNext => match cl.next_locked() {
+            Some(s) => (Ok(s), true),
+            None => {
+                return TeacherReply::Error {
+                    field: "open_next".into(),
+                    message: "every step of the lesson is open".into(),
+                };
+            }
+        },
+        TeacherMsg::OpenStep { step } => (cl.step_index(&step), true),
+        TeacherMsg::HoldStep { step } => (cl.step_index(&step), false),
+        _ => {
+            return TeacherReply::Error {
+                field: "type".into(),
+                message: "not a lesson command".into(),
+            };
+        }
+    };
+    let s = match step {
+        Ok(s) => s,
+        Err(message) => {
+            return TeacherReply::Error {
+                field: "step".into(),
+                message,
+            };
+        }
+    };
+    let n = cl.set_open(class, s, open);
+    let id = &cl.lesson.steps[s].id;
+    TeacherReply::Done {
+        message: if open {
+            format!(
+                "step {} ({id}) is open for everyone: {n} students told",
+                s + 1
+            )
+        } else {
+            format!(
+                "the class is held before step {} ({id}): {n} students told",
+                s + 1
+            )
+        },
     }
 }
 
@@ -244,10 +337,37 @@ impl wslink::Peer for TeacherPeer<'_> {
     }
 }
 
-/// A zip of every finished recording (the sessions still running are not in it).
+/// A zip of every finished recording (the sessions still running are not in it); with a
+/// lesson, every step's recording whose world has closed (`NAME-START/STEP-ID.mcap`) and the
+/// class report as it stands (written to the recordings' folder first).
 pub(crate) fn zip_of_recordings(class: &Class) -> Result<Vec<u8>, String> {
     let mut files = Vec::new();
+    if let Some(report) = lesson::class_report(class) {
+        let dir = &class.config.out_dir;
+        for p in report.write(dir).map_err(|e| e.to_string())? {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .unwrap_or_default();
+            let bytes =
+                std::fs::read(&p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+            files.push((name, bytes));
+        }
+    }
     for s in class.students() {
+        if s.lesson.is_some() {
+            let folder = s.out.file_name().map(|n| n.to_string_lossy().to_string());
+            for id in lesson::steps_run(&s) {
+                let p = lesson::step_recording(&s, &id)?;
+                let bytes =
+                    std::fs::read(&p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+                files.push((
+                    format!("{}/{id}.mcap", folder.as_deref().unwrap_or("")),
+                    bytes,
+                ));
+            }
+            continue;
+        }
         let ended = s
             .status
             .lock()

@@ -13,7 +13,7 @@
 //! student reaches it (the `lesson` message says so first).
 
 pub mod report;
-mod view;
+pub(crate) mod view;
 
 use crate::protocol::{LessonAsk, LessonView, PageAnswer, ServerMsg};
 use crate::server::Shared;
@@ -89,6 +89,16 @@ pub struct StepWorld {
     peak_force: Arc<AtomicU64>,
 }
 
+impl StepWorld {
+    /// The same world with its session passed through `f` (a classroom adds its reporter).
+    pub fn map_session(self, f: impl FnOnce(PageSession) -> PageSession) -> StepWorld {
+        StepWorld {
+            session: f(self.session),
+            ..self
+        }
+    }
+}
+
 /// The lesson of one student on a play server.
 pub struct LessonDriver {
     lesson: Lesson,
@@ -96,6 +106,10 @@ pub struct LessonDriver {
     shared: Arc<Shared>,
     dir: PathBuf,
     runs: Vec<StepRun>,
+    /// The operator the steps' recordings name.
+    operator: String,
+    /// Where the pages download a step's recording.
+    recording_url: String,
 }
 
 impl LessonDriver {
@@ -112,9 +126,30 @@ impl LessonDriver {
             shared,
             dir,
             runs: Vec::new(),
+            operator: "person (browser page)".into(),
+            recording_url: "/recording.mcap".into(),
         };
         d.tell();
         d
+    }
+
+    /// The same driver with the steps' recordings naming `operator` and offered to the pages
+    /// at `recording_url` (a classroom student's: their name, their token's address).
+    pub fn with_page(mut self, operator: String, recording_url: String) -> LessonDriver {
+        self.operator = operator;
+        self.recording_url = recording_url;
+        self
+    }
+
+    /// Opens (`open`) or locks step `s` (the teacher's), the pages told; the place then.
+    pub fn set_open(&mut self, s: usize, open: bool) -> Result<Place, ProgressError> {
+        let place = if open {
+            self.progress.open(s)?
+        } else {
+            self.progress.lock(s)?
+        };
+        self.tell();
+        Ok(place)
     }
 
     /// The lesson (a demonstration's: its one step).
@@ -263,9 +298,9 @@ impl LessonDriver {
             scene: &step.source,
             scene_name: &file.scene.name,
             out: self.recording_of(&step.id),
-            recording_url: "/recording.mcap".into(),
+            recording_url: self.recording_url.clone(),
             start_time_ns,
-            operator: "person (browser page)".into(),
+            operator: self.operator.clone(),
             link: "page".into(),
             seconds: None,
             ticks: None,

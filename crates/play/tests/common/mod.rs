@@ -1,3 +1,4 @@
 //! Helpers shared by the browser tests and the play bench.
 pub mod cdp;
+pub mod class;
 pub mod live;

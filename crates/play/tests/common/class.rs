@@ -1,0 +1,144 @@
+//! A class served by the test and reached as its pages would: HTTP requests, the join form,
+//! the students' and the teacher's WebSocket links.
+#![allow(dead_code)]
+
+use haptic_loop::session::SceneSource;
+use play::classroom::{ClassAddresses, ClassConfig, ClassSummary, run};
+use serde_json::Value;
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::{Message, WebSocket};
+
+pub type Ws = WebSocket<MaybeTlsStream<TcpStream>>;
+
+/// A class served on a thread of the test.
+pub struct Running {
+    pub addr: ClassAddresses,
+    pub host: String,
+    pub stop: Arc<AtomicBool>,
+    pub handle: JoinHandle<Result<ClassSummary, play::PlayError>>,
+    pub dir: PathBuf,
+}
+
+/// A class of at most `max` on brickworld (the teacher's code TEACH123), its recordings in
+/// the target folder's `nh-class-PID-NAME`.
+pub fn start(name: &str, max: usize) -> Running {
+    start_with(name, max, None)
+}
+
+/// [`start`] with a lesson.
+pub fn start_with(name: &str, max: usize, lesson: Option<teaching::Lesson>) -> Running {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("nh-class-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut c = ClassConfig::new(
+        SceneSource::resolve("brickworld".as_ref()).unwrap(),
+        dir.clone(),
+    );
+    c.port = 0;
+    c.max_students = max;
+    c.teacher_code = Some("TEACH123".into());
+    c.lesson = lesson;
+    let stop = Arc::new(AtomicBool::new(false));
+    let s2 = stop.clone();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let handle = std::thread::spawn(move || {
+        run(&c, &s2, &mut |a| {
+            let _ = tx.send(a.clone());
+        })
+    });
+    let addr = rx.recv_timeout(Duration::from_secs(20)).unwrap();
+    let host = addr
+        .student_url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    Running {
+        addr,
+        host,
+        stop,
+        handle,
+        dir,
+    }
+}
+
+pub fn http(host: &str, request: &str) -> String {
+    let mut s = TcpStream::connect(host).unwrap();
+    s.write_all(request.as_bytes()).unwrap();
+    let mut out = Vec::new();
+    s.read_to_end(&mut out).unwrap();
+    String::from_utf8_lossy(&out).to_string()
+}
+
+/// `GET path`: the whole response's bytes.
+pub fn get_bytes(host: &str, path: &str) -> Vec<u8> {
+    let mut s = TcpStream::connect(host).unwrap();
+    s.write_all(format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n").as_bytes())
+        .unwrap();
+    let mut out = Vec::new();
+    s.read_to_end(&mut out).unwrap();
+    out
+}
+
+pub fn get(host: &str, path: &str) -> String {
+    http(
+        host,
+        &format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n\r\n"),
+    )
+}
+
+/// A form `POST` to `/join` from the join page (`name` URL-encoded), with `headers` (each
+/// ending in `\r\n`) in place of the page's own `Origin` and `Sec-Fetch-Site`.
+pub fn post_join(host: &str, name: &str, headers: Option<&str>) -> String {
+    let body = format!("name={name}");
+    let own = format!("Origin: http://{host}\r\nSec-Fetch-Site: same-origin\r\n");
+    http(
+        host,
+        &format!(
+            "POST /join HTTP/1.1\r\nHost: {host}\r\n{}Content-Type: \
+             application/x-www-form-urlencoded\r\nContent-Length: {}\r\n\r\n{body}",
+            headers.unwrap_or(&own),
+            body.len()
+        ),
+    )
+}
+
+/// Joins as `name` through the join page's form; the session token from the redirect.
+pub fn join(host: &str, name: &str) -> String {
+    let r = post_join(host, name, None);
+    assert!(r.starts_with("HTTP/1.1 303 See Other"), "{r}");
+    let loc = r
+        .lines()
+        .find_map(|l| l.strip_prefix("Location: /play?s="))
+        .unwrap();
+    loc.trim().to_string()
+}
+
+pub fn ws(host: &str, path: &str) -> Ws {
+    let (ws, _) = tungstenite::connect(format!("ws://{host}{path}").as_str()).unwrap();
+    if let MaybeTlsStream::Plain(s) = ws.get_ref() {
+        s.set_read_timeout(Some(Duration::from_millis(5))).unwrap();
+    }
+    ws
+}
+
+pub fn read_for(ws: &mut Ws, secs: f64) -> Vec<Value> {
+    let t0 = Instant::now();
+    let mut out = Vec::new();
+    while t0.elapsed().as_secs_f64() < secs {
+        if let Ok(Message::Text(t)) = ws.read() {
+            out.push(serde_json::from_str(t.as_str()).unwrap());
+        }
+    }
+    out
+}
+
+pub fn send(ws: &mut Ws, v: Value) {
+    ws.send(Message::text(v.to_string())).unwrap();
+}
