@@ -340,6 +340,42 @@ def test_classroom_serves_the_class_and_ctrl_c_ends_it(scratch, sigint_raises):
     assert rest.startswith("refused: 0 in all (0 host, 0 origin, "), out
 
 
+def test_classroom_lesson_serves_the_builtin_module_and_writes_the_class_report(
+    scratch, sigint_raises
+):
+    p = subprocess.Popen(
+        [str(COMMAND), "classroom", "--lesson", "--port", "0", "--out-dir", "class"],
+        cwd=scratch, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    stdout = Lines(p.stdout)
+    try:
+        head = [stdout.next(60) for _ in range(5)]
+        assert head[0] == "classroom: up to 40 students, recordings in class\n", head
+        assert head[1] == (
+            "  lesson         Forces at the nanoscale (11 steps; the teacher page opens the "
+            "locked ones)\n"
+        ), head
+        student = re.fullmatch(
+            r"  students open  (http://127\.0\.0\.1:\d+/)  \(on this computer a name is enough\)\n",
+            head[2],
+        )
+        assert student, head
+        with urllib.request.urlopen(student.group(1), timeout=10) as r:
+            assert "Lesson: <b>Forces at the nanoscale</b>" in r.read().decode("utf-8")
+        took = interrupt(p)
+        out, err = stdout.rest(), p.stderr.read()
+    finally:
+        end(p, stdout)
+    assert took < 5, f"{took:.1f} s after Ctrl-C"
+    assert (p.returncode, err) == (0, ""), err
+    # The class report of nobody, written where the recordings go, and said.
+    assert "class report: class/class-report.md\n" in out, out
+    steps = (scratch / "class" / "class-steps.csv").read_text()
+    assert steps == (
+        "student,step,step_id,step_title,state,seconds,met_at_s,peak_force_n,score,before,after\n"
+    )
+
+
 def test_ctrl_c_ends_a_command_without_its_own_handler_at_once(scratch, sigint_raises):
     # fake-device waits up to 30 s for a simulator's welcome; this socket never answers.
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as silent:

@@ -867,3 +867,36 @@ fn every_command_names_a_device_the_same_way() {
         "error: device: device link: no device said hello on udp:127.0.0.1:1 within 0 s"
     );
 }
+
+/// `classroom --lesson FILE` refuses a lesson file with a mistake before it serves anything:
+/// the file's line and column, the field and what is allowed, exit 1.
+#[test]
+fn classroom_lesson_refuses_a_bad_lesson_file_with_its_place() {
+    let dir = tmp("class-lesson");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.lesson.toml");
+    std::fs::write(
+        &bad,
+        "[lesson]\ntitle = \"x\"\n[[step]]\nid = \"a\"\ntitle = \"A\"\nscene = \"brickworld\"\n\
+         task = \"t\"\ndone = { when = \"atom_snapped\" }\n",
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+        .args(["classroom", "--port", "0", "--lesson", "bad.lesson.toml"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(String::from_utf8_lossy(&o.stdout), "");
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: bad.lesson.toml:8:17: lesson: `step[0].done.when` = \"atom_snapped\" cannot \
+         happen in scene \"brickworld\": it reads nano.snap, which a brickworld scene never \
+         emits (allowed in a brickworld scene: house_complete, brick_lifted, brick_thrown, \
+         brick_placed, time)"
+    );
+    assert!(
+        !dir.join("class").exists(),
+        "nothing served, no folder made"
+    );
+}

@@ -10,102 +10,10 @@
 
 mod common;
 
-use common::class::{Ws, get, join, read_for, send, start_with, ws};
+use common::class::{Page, TWO_STEP_LESSON, Ws, get, hand, join, read_for, send, start_with, ws};
 use recording::read_recording_file;
 use serde_json::{Value, json};
 use std::sync::atomic::Ordering;
-use std::time::{Duration, Instant};
-
-const LESSON: &str = r#"
-[lesson]
-title = "Two worlds"
-
-[[test]]
-prompt = "Which force holds a few atoms to a surface?"
-answer = "choice"
-choices = ["Their weight", "Surface attraction"]
-correct = "Surface attraction"
-
-[[step]]
-id = "float"
-title = "No gravity"
-scene = "brickworld"
-switches = { gravity_m_per_s2 = 0.0 }
-task = "Watch the bricks."
-done = { when = "time", seconds = 0.3 }
-after = { prompt = "What did the bricks do?", answer = "text" }
-
-[[step]]
-id = "atoms"
-title = "Atoms"
-scene = "nanoworld"
-locked = true
-task = "Watch the atoms."
-done = { when = "time", seconds = 0.2 }
-"#;
-
-/// The latest `lesson` message a page was sent among `got` (or `None`).
-fn last_lesson(got: &[Value]) -> Option<Value> {
-    got.iter().rev().find(|m| m["type"] == "lesson").cloned()
-}
-
-/// A student's page link and what it was sent but not yet looked at.
-struct Page {
-    ws: Ws,
-    unread: Vec<Value>,
-}
-
-impl Page {
-    fn new(ws: Ws) -> Page {
-        Page {
-            ws,
-            unread: Vec::new(),
-        }
-    }
-
-    /// Reads until the lesson reaches `place` (within 10 s): the messages up to that one
-    /// (the rest stay unread).
-    fn until_place(&mut self, place: &str) -> Vec<Value> {
-        let t0 = Instant::now();
-        loop {
-            if let Some(i) = self
-                .unread
-                .iter()
-                .position(|m| m["type"] == "lesson" && m["place"] == place)
-            {
-                return self.unread.drain(..=i).collect();
-            }
-            assert!(
-                t0.elapsed() < Duration::from_secs(10),
-                "the lesson never reached `{place}`; the last: {:?}",
-                last_lesson(&self.unread)
-            );
-            self.unread.extend(read_for(&mut self.ws, 0.05));
-        }
-    }
-
-    /// Reads until the page is sent a `hello` (a step's world opened): its scene's kind.
-    fn hello_kind(&mut self) -> String {
-        let t0 = Instant::now();
-        loop {
-            if let Some(i) = self.unread.iter().position(|m| m["type"] == "hello") {
-                let h: Vec<Value> = self.unread.drain(..=i).collect();
-                return h[i]["kind"].as_str().unwrap().to_string();
-            }
-            assert!(t0.elapsed() < Duration::from_secs(10), "no hello");
-            self.unread.extend(read_for(&mut self.ws, 0.05));
-        }
-    }
-}
-
-/// The page starts the hand and keeps it still at the middle of the workspace.
-fn hand(page: &mut Page, seq: &mut u64) {
-    *seq += 1;
-    send(
-        &mut page.ws,
-        json!({"type": "input", "seq": *seq, "pos": [0.0, 0.0, 0.3], "buttons": 0, "t_ms": *seq as f64}),
-    );
-}
 
 /// The teacher's latest `class` message.
 fn class_now(teacher: &mut Ws) -> Value {
@@ -145,7 +53,7 @@ fn a_class_takes_a_lesson_the_teacher_follows_opens_and_holds() {
         .join(format!("nh-class-lesson-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("two.lesson.toml");
-    std::fs::write(&file, LESSON).unwrap();
+    std::fs::write(&file, TWO_STEP_LESSON).unwrap();
     let lesson = teaching::load_lesson(&file).unwrap();
     let c = start_with("lesson", 4, Some(lesson));
     let host = c.host.clone();

@@ -4,7 +4,7 @@
 
 use haptic_loop::session::SceneSource;
 use play::classroom::{ClassAddresses, ClassConfig, ClassSummary, run};
-use serde_json::Value;
+use serde_json::{Value, json};
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::path::PathBuf;
@@ -141,4 +141,97 @@ pub fn read_for(ws: &mut Ws, secs: f64) -> Vec<Value> {
 
 pub fn send(ws: &mut Ws, v: Value) {
     ws.send(Message::text(v.to_string())).unwrap();
+}
+
+/// A lesson of two short steps: a pre-test question; 0.3 s of bricks with gravity off, then
+/// "what did the bricks do?"; 0.2 s of atoms, locked for the teacher.
+pub const TWO_STEP_LESSON: &str = r#"
+[lesson]
+title = "Two worlds"
+
+[[test]]
+prompt = "Which force holds a few atoms to a surface?"
+answer = "choice"
+choices = ["Their weight", "Surface attraction"]
+correct = "Surface attraction"
+
+[[step]]
+id = "float"
+title = "No gravity"
+scene = "brickworld"
+switches = { gravity_m_per_s2 = 0.0 }
+task = "Watch the bricks."
+done = { when = "time", seconds = 0.3 }
+after = { prompt = "What did the bricks do?", answer = "text" }
+
+[[step]]
+id = "atoms"
+title = "Atoms"
+scene = "nanoworld"
+locked = true
+task = "Watch the atoms."
+done = { when = "time", seconds = 0.2 }
+"#;
+
+/// The latest `lesson` message a page was sent among `got` (or `None`).
+pub fn last_lesson(got: &[Value]) -> Option<Value> {
+    got.iter().rev().find(|m| m["type"] == "lesson").cloned()
+}
+
+/// A student's page link and what it was sent but not yet looked at.
+pub struct Page {
+    pub ws: Ws,
+    pub unread: Vec<Value>,
+}
+
+impl Page {
+    pub fn new(ws: Ws) -> Page {
+        Page {
+            ws,
+            unread: Vec::new(),
+        }
+    }
+
+    /// Reads until the lesson reaches `place` (within 10 s): the messages up to that one
+    /// (the rest stay unread).
+    pub fn until_place(&mut self, place: &str) -> Vec<Value> {
+        let t0 = Instant::now();
+        loop {
+            if let Some(i) = self
+                .unread
+                .iter()
+                .position(|m| m["type"] == "lesson" && m["place"] == place)
+            {
+                return self.unread.drain(..=i).collect();
+            }
+            assert!(
+                t0.elapsed() < Duration::from_secs(10),
+                "the lesson never reached `{place}`; the last: {:?}",
+                last_lesson(&self.unread)
+            );
+            self.unread.extend(read_for(&mut self.ws, 0.05));
+        }
+    }
+
+    /// Reads until the page is sent a `hello` (a step's world opened): its scene's kind.
+    pub fn hello_kind(&mut self) -> String {
+        let t0 = Instant::now();
+        loop {
+            if let Some(i) = self.unread.iter().position(|m| m["type"] == "hello") {
+                let h: Vec<Value> = self.unread.drain(..=i).collect();
+                return h[i]["kind"].as_str().unwrap().to_string();
+            }
+            assert!(t0.elapsed() < Duration::from_secs(10), "no hello");
+            self.unread.extend(read_for(&mut self.ws, 0.05));
+        }
+    }
+}
+
+/// The page starts the hand and keeps it still at the middle of the workspace.
+pub fn hand(page: &mut Page, seq: &mut u64) {
+    *seq += 1;
+    send(
+        &mut page.ws,
+        json!({"type": "input", "seq": *seq, "pos": [0.0, 0.0, 0.3], "buttons": 0, "t_ms": *seq as f64}),
+    );
 }
