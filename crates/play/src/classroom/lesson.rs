@@ -241,7 +241,7 @@ fn coach_one(class: &Class, student: &Arc<Student>) {
     }
     let place = l.driver.progress().place();
     if place == Place::Finished || student.shared.end_requested.load(Ordering::Relaxed) {
-        end(&mut l, student);
+        end(class, &mut l, student);
         return;
     }
     if !matches!(place, Place::Doing(_)) {
@@ -253,20 +253,23 @@ fn coach_one(class: &Class, student: &Arc<Student>) {
                 Ok(()) => l.world_out = true,
                 Err(e) => {
                     l.error = Some(e.to_string());
-                    end(&mut l, student);
+                    end(class, &mut l, student);
                 }
             }
         }
         Some(Err(e)) => {
             l.error = Some(e.to_string());
-            end(&mut l, student);
+            end(class, &mut l, student);
         }
         None => {}
     }
 }
 
-/// The student's lesson ended.
-fn end(l: &mut StudentLesson, student: &Student) {
+/// The student's lesson ended (counted once among the class's ended sessions).
+pub(crate) fn end(class: &Class, l: &mut StudentLesson, student: &Student) {
+    if !l.ended {
+        class.ended.fetch_add(1, Ordering::Relaxed);
+    }
     l.ended = true;
     student.set_phase(Phase::Ended);
 }
@@ -274,7 +277,11 @@ fn end(l: &mut StudentLesson, student: &Student) {
 /// Closes a step's world through `student`'s lesson (on the finisher thread): its recording
 /// complete, its ticks counted, their pages told. A world stopped before its condition was met
 /// (their End, the teacher's, the class stopping) or failed ends their lesson.
-pub(crate) fn close_step(student: &Arc<Student>, world: StepWorld) -> StudentSummary {
+pub(crate) fn close_step(
+    class: &Class,
+    student: &Arc<Student>,
+    world: StepWorld,
+) -> StudentSummary {
     let Some(m) = &student.lesson else {
         // Not a lesson's student: the world closes alone.
         let session = world.session.finish();
@@ -299,7 +306,7 @@ pub(crate) fn close_step(student: &Arc<Student>, world: StepWorld) -> StudentSum
         student.shared.end_requested.store(false, Ordering::Relaxed);
     } else {
         l.error = error;
-        end(&mut l, student);
+        end(class, &mut l, student);
     }
     summary
 }

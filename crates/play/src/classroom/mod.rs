@@ -571,8 +571,7 @@ pub fn run(
     let _ = finisher.join();
     for s in class.students() {
         if let Some(m) = &s.lesson {
-            lesson::locked(m).ended = true;
-            s.set_phase(Phase::Ended);
+            lesson::end(&class, &mut lesson::locked(m), &s);
         }
         s.shared.shutdown.store(true, Ordering::Relaxed);
     }

@@ -143,10 +143,15 @@ pub(super) fn start_finisher(
         .spawn(move || {
             while let Ok(l) = ended.recv() {
                 let s = match l.finish() {
-                    live::Finished::Session(s) => *s,
-                    live::Finished::Step(student, world) => lesson::close_step(&student, *world),
+                    live::Finished::Session(s) => {
+                        class.ended.fetch_add(1, Ordering::Relaxed);
+                        *s
+                    }
+                    // A lesson's step: its student's lesson counts once, when it ends.
+                    live::Finished::Step(student, world) => {
+                        lesson::close_step(&class, &student, *world)
+                    }
                 };
-                class.ended.fetch_add(1, Ordering::Relaxed);
                 if let Ok(mut f) = class.finished.lock() {
                     f.push(s);
                 }
