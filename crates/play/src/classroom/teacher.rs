@@ -35,9 +35,9 @@ pub enum TeacherMsg {
         student: String,
     },
     /// End every session.
-    EndAll,
+    EndAll {},
     /// Open the lesson's first step locked for the class, for everyone.
-    OpenNext,
+    OpenNext {},
     /// Open step `step` (its id) for everyone: students waiting at it go on.
     OpenStep {
         /// The step's id.
@@ -150,7 +150,7 @@ pub(crate) fn command(class: &Class, text: &str) -> TeacherReply {
     };
     let active = |name: Option<&str>| active(class, name);
     match msg {
-        TeacherMsg::OpenNext | TeacherMsg::OpenStep { .. } | TeacherMsg::HoldStep { .. } => {
+        TeacherMsg::OpenNext {} | TeacherMsg::OpenStep { .. } | TeacherMsg::HoldStep { .. } => {
             lesson_command(class, msg)
         }
         TeacherMsg::Switch { .. } if class.lesson.is_some() => TeacherReply::Error {
@@ -175,7 +175,7 @@ pub(crate) fn command(class: &Class, text: &str) -> TeacherReply {
                 message: format!("no student `{student}` is playing or waiting"),
             },
         },
-        TeacherMsg::EndAll => {
+        TeacherMsg::EndAll {} => {
             let all = active(None);
             for s in &all {
                 s.shared.end_requested.store(true, Ordering::Relaxed);
@@ -239,7 +239,7 @@ fn lesson_command(class: &Class, msg: TeacherMsg) -> TeacherReply {
         };
     };
     let (step, open) = match msg {
-        TeacherMsg::OpenNext => match cl.next_locked() {
+        TeacherMsg::OpenNext {} => match cl.next_locked() {
             Some(s) => (Ok(s), true),
             None => {
                 return TeacherReply::Error {
@@ -383,4 +383,61 @@ pub(crate) fn zip_of_recordings(class: &Class) -> Result<Vec<u8>, String> {
         }
     }
     super::zip::zip_stored(&files).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TeacherMsg;
+
+    /// docs/play.md's table of the teacher's commands: each row parses as a command with the
+    /// fields it names, and the table lists every command there is.
+    #[test]
+    fn the_documented_commands_are_the_teacher_link_s() {
+        let doc = include_str!("../../../../docs/play.md");
+        let at = doc.find("| command | fields | does |").expect("the table");
+        let rows: Vec<&str> = doc[at..]
+            .lines()
+            .skip(2)
+            .take_while(|l| l.starts_with('|'))
+            .collect();
+        let mut kinds = Vec::new();
+        for row in &rows {
+            let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+            let kind = cells[1].trim_matches('`');
+            let mut msg = serde_json::json!({ "type": kind });
+            for f in ["name", "student", "step"] {
+                if cells[2].contains(&format!("`{f}`")) {
+                    msg[f] = "x".into();
+                }
+            }
+            if cells[2].contains("`value`") {
+                msg["value"] = 0.5.into();
+            }
+            let parsed: Result<TeacherMsg, _> = serde_json::from_value(msg.clone());
+            assert!(parsed.is_ok(), "{msg}: {parsed:?}");
+            kinds.push(kind.to_string());
+        }
+        assert_eq!(
+            kinds,
+            [
+                "switch",
+                "end",
+                "end_all",
+                "open_next",
+                "open_step",
+                "hold_step"
+            ]
+        );
+        // Unknown commands and fields are refused.
+        assert!(serde_json::from_str::<TeacherMsg>(r#"{"type":"skip"}"#).is_err());
+        for extra in [
+            r#"{"type":"open_next","step":"a"}"#,
+            r#"{"type":"end_all","student":"a"}"#,
+        ] {
+            assert!(
+                serde_json::from_str::<TeacherMsg>(extra).is_err(),
+                "{extra}"
+            );
+        }
+    }
 }
