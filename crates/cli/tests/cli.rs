@@ -900,3 +900,44 @@ fn classroom_lesson_refuses_a_bad_lesson_file_with_its_place() {
         "nothing served, no folder made"
     );
 }
+
+/// A flag that cannot apply to a lesson is refused, not ignored: `--seconds` (a step ends when
+/// its condition is met) for `play --lesson` and `classroom --lesson`, `--device` for `play
+/// --lesson` (each step's world takes the page as the hand).
+#[test]
+fn lesson_refuses_the_flags_it_cannot_apply() {
+    let dir = tmp("lesson-flags");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (args, said) in [
+        (
+            &["play", "--lesson", "--port", "0", "--seconds", "5"][..],
+            "error: --seconds does not apply to a lesson: each step ends when its condition is \
+             met, and the lesson when the student finishes it or ends it",
+        ),
+        (
+            &["classroom", "--lesson", "--port", "0", "--seconds", "5"][..],
+            "error: --seconds does not apply to a lesson: each step ends when its condition is \
+             met, and the lesson when the student finishes it or is ended",
+        ),
+        (
+            &[
+                "play",
+                "--lesson",
+                "--port",
+                "0",
+                "--device",
+                "udp:127.0.0.1:9",
+            ][..],
+            "error: --device does not apply to a lesson: each step's world takes the page as \
+             the hand",
+        ),
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_nanohaptics"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{args:?}");
+        assert_eq!(String::from_utf8_lossy(&o.stderr).trim(), said, "{args:?}");
+    }
+}

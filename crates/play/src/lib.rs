@@ -239,6 +239,19 @@ pub fn run(
     on_ready: &mut dyn FnMut(&str),
 ) -> Result<PlaySummary, PlayError> {
     if let Some(lesson) = &config.lesson {
+        // Neither applies to a lesson: refused, not ignored.
+        let refuse = |m: &str| Err(PlayError::Session(SessionError::Option(m.into())));
+        if config.seconds.is_some() {
+            return refuse(
+                "--seconds does not apply to a lesson: each step ends when its condition is met, \
+                 and the lesson when the student finishes it or ends it",
+            );
+        }
+        if config.device.is_some() {
+            return refuse(
+                "--device does not apply to a lesson: each step's world takes the page as the hand",
+            );
+        }
         return run_lesson(config, lesson.clone(), stop, on_ready);
     }
     let scene_src = &config.scene;

@@ -302,7 +302,7 @@ fn a_class_takes_a_lesson_the_teacher_follows_opens_and_holds() {
 }
 
 #[test]
-fn a_lesson_whose_steps_tick_at_two_rates_is_refused_naming_them() {
+fn a_lesson_at_two_rates_or_with_a_session_length_is_refused() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("nh-class-rates-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -328,6 +328,15 @@ fn a_lesson_whose_steps_tick_at_two_rates_is_refused_naming_them() {
         e.to_string(),
         "lesson: step `a` ticks at 1000 Hz and step `b` at 10000 Hz: a class ticks every \
          session on one schedule, so every step must tick at the same rate"
+    );
+    // A session length has no meaning in a lesson: refused, not ignored.
+    c.lesson = Some(teaching::builtin::module().unwrap());
+    c.seconds = Some(60.0);
+    let e = play::classroom::run(&c, &stop, &mut |_| panic!("served")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "--seconds does not apply to a lesson: each step ends when its condition is met, and \
+         the lesson when the student finishes it or is ended"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

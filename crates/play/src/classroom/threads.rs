@@ -59,6 +59,13 @@ impl Plan {
             Some(l) => lesson_rate(l)?,
             None => file.loop_.rate_hz,
         };
+        if config.lesson.is_some() && config.seconds.is_some() {
+            return Err(PlayError::Session(SessionError::Option(
+                "--seconds does not apply to a lesson: each step ends when its condition is met, \
+                 and the lesson when the student finishes it or is ended"
+                    .into(),
+            )));
+        }
         let ticks = config.seconds.map(|s| ticks_for(s, rate_hz)).transpose()?;
         std::fs::create_dir_all(&config.out_dir).map_err(|e| {
             PlayError::Session(SessionError::Option(format!(
