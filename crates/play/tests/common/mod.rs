@@ -1,3 +1,4 @@
 //! Helpers shared by the browser tests and the play bench.
 pub mod cdp;
 pub mod live;
+pub mod pilot;
