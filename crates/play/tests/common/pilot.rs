@@ -299,11 +299,12 @@ impl<'a> Pilot<'a> {
 
     // ---- the brick world ----------------------------------------------------------------
 
-    /// The bricks drawn (solid boxes after the ground, not the grey obstacles).
-    pub fn bricks(&mut self) -> Vec<Body> {
-        let v = self.eval(
-            "window.__play.lastFrame.prims.filter((p, i) => i > 0 && p.k === 'box' && p.col[3] >= 0.5 && !(p.col[0] === p.col[1] && p.col[1] === p.col[2])).map(p => [p.c, p.q, p.col[0] > 0.8])",
-        );
+    /// The boxes of the last frame that the page expression `filter` (of a primitive `p` and
+    /// its index `i`) keeps; held: drawn in the held brick's colour.
+    fn boxes(&mut self, filter: &str) -> Vec<Body> {
+        let v = self.eval(&format!(
+            "window.__play.lastFrame.prims.filter((p, i) => p.k === 'box' && ({filter})).map(p => [p.c, p.q, p.col[3] >= 0.5 && p.col[0] > 0.8])"
+        ));
         v.as_array()
             .unwrap()
             .iter()
@@ -315,20 +316,14 @@ impl<'a> Pilot<'a> {
             .collect()
     }
 
+    /// The bricks drawn (solid boxes after the ground, not the grey obstacles).
+    pub fn bricks(&mut self) -> Vec<Body> {
+        self.boxes("i > 0 && p.col[3] >= 0.5 && !(p.col[0] === p.col[1] && p.col[1] === p.col[2])")
+    }
+
     /// The blueprint's slots still empty (the translucent boxes the page draws).
     pub fn ghost_slots(&mut self) -> Vec<Body> {
-        let v = self.eval(
-            "window.__play.lastFrame.prims.filter(p => p.k === 'box' && p.col[3] < 0.5).map(p => [p.c, p.q, p.h])",
-        );
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|b| Body {
-                c: v3(&b[0]),
-                q: quat(&b[1]),
-                held: false,
-            })
-            .collect()
+        self.boxes("p.col[3] < 0.5")
     }
 
     /// The brick's half height (m): the drawn boxes' z half extent.
