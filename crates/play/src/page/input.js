@@ -60,8 +60,9 @@ const MOVE = { ArrowLeft: [-1, 0, 0], ArrowRight: [1, 0, 0], ArrowUp: [0, 1, 0],
 const KEY_SPEED = 0.5; // unit-ball radii per second
 // While keys move the hand it is stepped and sent every KEY_STEP_MS, not only at the frame
 // rate: a hand sent at 60 Hz moves in 16 ms steps (6.7 mm in the brick world at full key
-// speed), and the worlds' release estimate reads the hand between two steps as at rest, so
-// Space never threw a brick. In 4 ms steps (1.6 mm) it reads the key's speed.
+// speed), and the brick world's release estimate reads the hand between two steps as at
+// rest, so Space never threw a brick. In 4 ms steps (1.6 mm) about half the releases read as
+// throws (BENCHMARKS.md, "the built-in module by keyboard alone"); a late timer still gives 0.
 const KEY_STEP_MS = 4;
 let lastKeyStep = performance.now();
 
