@@ -123,7 +123,7 @@ fn do_step(p: &mut Pilot, i: usize, kind: &str, done: Condition) {
         }
         (Condition::BrickLifted { height_m }, _) => p.lift_brick(height_m, &past),
         (Condition::BrickThrown, _) => {
-            let speeds = p.throw_brick(&past, 12);
+            let speeds = p.throw_brick(&past, 20);
             println!("  release speeds (m/s): {speeds:.3?}");
         }
         (Condition::AtomSnapped, _) => {
