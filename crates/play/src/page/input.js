@@ -58,6 +58,25 @@ function pointerTo(e) {
 
 const MOVE = { ArrowLeft: [-1, 0, 0], ArrowRight: [1, 0, 0], ArrowUp: [0, 1, 0], ArrowDown: [0, -1, 0], PageUp: [0, 0, 1], PageDown: [0, 0, -1] };
 const KEY_SPEED = 0.5; // unit-ball radii per second
+// While keys move the hand it is stepped and sent every KEY_STEP_MS, not only at the frame
+// rate: a hand sent at 60 Hz moves in 16 ms steps (6.7 mm in the brick world at full key
+// speed), and the brick world's release estimate reads the hand between two steps as at
+// rest, so Space never threw a brick. In 4 ms steps (1.6 mm) about half the releases read as
+// throws (BENCHMARKS.md, "the built-in module by keyboard alone"); a late timer still gives 0.
+const KEY_STEP_MS = 4;
+let lastKeyStep = performance.now();
+
+// Moves the hand by the keys held since the last key step; whether it moved.
+function stepKeys() {
+  const t = performance.now();
+  const dt = Math.min(0.1, (t - lastKeyStep) / 1000); lastKeyStep = t;
+  for (const [k, f] of held) {
+    const m = MOVE[k], v = KEY_SPEED * f * dt;
+    if (m[2]) { hand.n[2] += m[2] * v; }
+    else { const [x, y] = horiz(m[0], m[1]); hand.n[0] += x * v; hand.n[1] += y * v; }
+  }
+  return held.size > 0;
+}
 
 // Listens to the pointer, the wheel and the keys.
 export function installInput() {
@@ -93,8 +112,8 @@ export function installInput() {
   window.addEventListener('keydown', (e) => {
     if (e.target && ['INPUT', 'TEXTAREA', 'BUTTON', 'A'].includes(e.target.tagName)) return;
     const k = e.key;
-    if (MOVE[k]) { held.set(k, e.shiftKey ? 0.2 : 1); e.preventDefault(); }
-    else if (k === ' ') { if (!e.repeat) { hand.grip = !hand.grip; sendHand(e.timeStamp); } e.preventDefault(); }
+    if (MOVE[k]) { if (!held.size) stepKeys(); held.set(k, e.shiftKey ? 0.2 : 1); e.preventDefault(); }
+    else if (k === ' ') { if (!e.repeat) { stepKeys(); hand.grip = !hand.grip; sendHand(e.timeStamp); } e.preventDefault(); }
     else if (k === '1' || k === '2' || k === '3') { hand.turn[+k - 1] = true; sendHand(e.timeStamp); }
     else if (k === 'a' || k === 'A') cam.yaw += 0.08;
     else if (k === 'd' || k === 'D') cam.yaw -= 0.08;
@@ -109,18 +128,13 @@ export function installInput() {
     held.delete(e.key);
     if (e.key === '1' || e.key === '2' || e.key === '3') { hand.turn[+e.key - 1] = false; sendHand(e.timeStamp); }
   });
+  setInterval(() => { if (held.size && P.hello && P.role === 'hand' && stepKeys()) sendHand(); }, KEY_STEP_MS);
 }
 
 // Moves the hand by the keys held and the gamepad over `dt` s, rumbles the gamepad with the
 // force, and sends the hand when it moved (and at least every 100 ms).
 export function pollKeysAndPad(dt) {
-  let moved = false;
-  for (const [k, f] of held) {
-    const m = MOVE[k], v = KEY_SPEED * f * dt;
-    if (m[2]) { hand.n[2] += m[2] * v; }
-    else { const [x, y] = horiz(m[0], m[1]); hand.n[0] += x * v; hand.n[1] += y * v; }
-    moved = true;
-  }
+  let moved = stepKeys();
   const pads = navigator.getGamepads ? navigator.getGamepads() : [];
   for (const gp of pads) {
     if (!gp) continue;

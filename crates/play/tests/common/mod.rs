@@ -2,3 +2,4 @@
 pub mod cdp;
 pub mod class;
 pub mod live;
+pub mod pilot;
