@@ -2,4 +2,5 @@
 pub mod cdp;
 pub mod class;
 pub mod live;
+pub mod module;
 pub mod pilot;

@@ -1,47 +1,23 @@
-//! The built-in module (`play --lesson` without a file) in a real browser, by keyboard alone:
-//! Debian's headless `chromium`, driven through the DevTools Protocol by a keyboard pilot
-//! (`common/pilot.rs`) that reads what the page shows and acts only through key events. A
-//! student answers the pre-test, builds the brick house, lifts, throws (gravity on, gravity
-//! off), lifts with inertia off, snaps the tip, pulls it off, tries to put an atom back, builds
-//! the atom house, throws a brick and tries to throw an atom, answering each question before
-//! and after, and the post-test. Every step's condition is met; every answer reaches the
-//! progress; each step's recording verifies and replays bit for bit.
+//! The built-in module by keyboard: what a student at the keyboard does at each step of
+//! `crates/teaching/modules/nanoscale.toml`, through the keyboard pilot ([`super::pilot`]), and
+//! the whole way through a lesson's places (the questions, each step's world) on one page.
+#![allow(dead_code)]
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
-
-mod common;
-
-use common::cdp::Browser;
-use common::pilot::Pilot;
-use haptic_loop::session::{SceneSource, read_arrays};
-use play::PlayConfig;
+use super::pilot::Pilot;
 use serde_json::{Value, json};
-use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use teaching::condition::Condition;
-use teaching::{Answer, Question, QuestionKind};
-
-/// One browser at a time: the tests share two cores with the real-time loop.
-static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-const W: u32 = 1280;
-const H: u32 = 760;
+use teaching::{Answer, Lesson, Question, QuestionKind};
 
 /// The page's expression that the lesson has moved past step `i`'s world.
-fn past(i: usize) -> String {
+pub fn past(i: usize) -> String {
     format!("window.__play.lesson.step !== {i} || window.__play.lesson.place !== 'doing'")
 }
 
 /// Answers the question the page shows by keyboard and waits for the page's next place:
 /// a choice (the first radio is focused: Space checks it, each ArrowDown checks the next;
 /// Enter submits), or a text typed into the text area (Tab to Answer, Enter).
-fn answer(p: &mut Pilot, q: &Question, choice: usize, text: &str) -> Answer {
+pub fn answer(p: &mut Pilot, q: &Question, choice: usize, text: &str) -> Answer {
     let before = p.eval("window.__play.lessons.length");
     let focused = p.eval("[document.activeElement.tagName, document.activeElement.type || '']");
     let a = match &q.kind {
@@ -74,14 +50,14 @@ fn answer(p: &mut Pilot, q: &Question, choice: usize, text: &str) -> Answer {
 }
 
 /// The place the page shows and its step.
-fn place(p: &mut Pilot) -> (String, Value) {
+pub fn place(p: &mut Pilot) -> (String, Value) {
     let v = p.eval("[window.__play.lesson.place, window.__play.lesson.step]");
     (v[0].as_str().unwrap_or("").to_string(), v[1].clone())
 }
 
 /// A point over the substrate's middle (the slab the page draws first), 1.5 nm or more from
 /// every orange atom and outside the loading zone, `z` above the surface.
-fn clear_spot(p: &mut Pilot, z: f64) -> [f64; 3] {
+pub fn clear_spot(p: &mut Pilot, z: f64) -> [f64; 3] {
     let c = p.eval("window.__play.lastFrame.prims[0].c");
     let mid = [c[0].as_f64().unwrap(), c[1].as_f64().unwrap()];
     let atoms = p.atoms();
@@ -104,7 +80,7 @@ fn clear_spot(p: &mut Pilot, z: f64) -> [f64; 3] {
 }
 
 /// Does step `i` of the module by keyboard until the page moves past it.
-fn do_step(p: &mut Pilot, i: usize, kind: &str, done: Condition) {
+pub fn do_step(p: &mut Pilot, i: usize, kind: &str, done: Condition) {
     let past = past(i);
     match (done, kind) {
         (Condition::HouseComplete, "brickworld") => {
@@ -179,7 +155,7 @@ fn do_step(p: &mut Pilot, i: usize, kind: &str, done: Condition) {
 }
 
 /// Words a student might write after step `id`.
-fn words_after(id: &str) -> &'static str {
+pub fn words_after(id: &str) -> &'static str {
     match id {
         "brick-house" => "its weight",
         "lift" => "it pulled back",
@@ -191,56 +167,70 @@ fn words_after(id: &str) -> &'static str {
     }
 }
 
-#[test]
-fn a_student_completes_the_built_in_module_by_keyboard_and_each_step_replays() {
-    let _one = serial();
-    let module = teaching::builtin::module().unwrap();
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("nh-module-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let mut c = PlayConfig::new(
-        SceneSource::resolve("brickworld".as_ref()).unwrap(),
-        dir.join("module.mcap"),
-    );
-    c.port = 0;
-    c.lesson = Some(module.clone());
-    let stop = Arc::new(AtomicBool::new(false));
-    let play::Running { url, handle } = play::start(c, stop.clone()).unwrap();
-    let mut b = Browser::launch(W, H).unwrap_or_else(|e| panic!("{e}"));
-    b.open(&url).unwrap();
-    let mut p = Pilot::new(&mut b);
-    let t_all = Instant::now();
+/// What a student answered and how long each step's world took them.
+#[derive(Debug, Default)]
+pub struct Taken {
+    /// The pre-test's answers.
+    pub pre: Vec<Option<Answer>>,
+    /// Each step's answer before and after (`None`: no question).
+    pub befores: Vec<Option<Answer>>,
+    pub afters: Vec<Option<Answer>>,
+    /// The post-test's answers.
+    pub post: Vec<Option<Answer>>,
+    /// Each step's wall time, from its world's first frames to the page moving on.
+    pub walls: Vec<Duration>,
+}
 
-    // The pre-test: each content question answered right.
-    let correct = |q: &Question| match &q.kind {
+/// The index of test question `q`'s correct choice.
+pub fn correct(q: &Question) -> usize {
+    match &q.kind {
         QuestionKind::Choice { correct, .. } => correct.unwrap(),
         QuestionKind::Text => panic!("a test question is a choice"),
-    };
-    let mut pre = Vec::new();
+    }
+}
+
+/// Takes `lesson` on the page `p` drives, by keyboard alone: the pre-test (`right`: each
+/// answered right, else each answered with the first choice), then steps `0..steps` (each
+/// question before and after answered, each world's condition met), then, when every step was
+/// taken, the post-test (right). A locked step the student reaches calls `at_locked(step)`,
+/// which must open it. Stops at step `steps`'s task when `steps` is short of the lesson.
+pub fn take_lesson(
+    p: &mut Pilot,
+    lesson: &Lesson,
+    steps: usize,
+    right: bool,
+    at_locked: &mut dyn FnMut(usize),
+) -> Taken {
+    let mut t = Taken::default();
     p.b.wait_for(
-        "window.__play.lesson !== null && window.__play.lesson.place === 'pre_test'",
+        "!!window.__play && window.__play.lesson !== null && window.__play.lesson.place === 'pre_test'",
         20.0,
     )
     .unwrap();
-    for q in &module.test {
-        assert_eq!(place(&mut p).0, "pre_test");
-        pre.push(Some(answer(&mut p, q, correct(q), "")));
+    for q in &lesson.test {
+        assert_eq!(place(p).0, "pre_test");
+        let c = if right { correct(q) } else { 0 };
+        t.pre.push(Some(answer(p, q, c, "")));
     }
-
-    // The steps.
-    let mut befores = Vec::new();
-    let mut afters = Vec::new();
-    let mut walls = Vec::new();
-    for (i, step) in module.steps.iter().enumerate() {
+    for (i, step) in lesson.steps.iter().enumerate().take(steps) {
+        if step.locked {
+            p.b.wait_for(
+                &format!(
+                    "window.__play.lesson.step === {i} && window.__play.lesson.place === 'waiting'"
+                ),
+                20.0,
+            )
+            .unwrap();
+            at_locked(i);
+        }
         p.b.wait_for(
             &format!("window.__play.lesson.step === {i} && ['before', 'doing'].includes(window.__play.lesson.place)"),
             20.0,
         )
         .unwrap();
-        befores.push(step.before.as_ref().map(|q| {
-            assert_eq!(place(&mut p).0, "before");
-            answer(&mut p, q, 1, "")
+        t.befores.push(step.before.as_ref().map(|q| {
+            assert_eq!(place(p).0, "before");
+            answer(p, q, 1, "")
         }));
         p.b.wait_for(
             &format!("window.__play.lesson.step === {i} && window.__play.lesson.place === 'doing'"),
@@ -267,104 +257,33 @@ fn a_student_completes_the_built_in_module_by_keyboard_and_each_step_replays() {
         }
         println!("step {} `{}` ({})", i + 1, step.id, step.done.name());
         let t0 = Instant::now();
-        do_step(&mut p, i, step.kind, step.done);
+        do_step(p, i, step.kind, step.done);
         p.let_go();
         p.b.wait_for(&past(i), 20.0).unwrap();
         let wall = t0.elapsed();
         println!("  done in {:.1} s of wall time", wall.as_secs_f64());
-        walls.push(wall);
-        afters.push(step.after.as_ref().map(|q| {
+        t.walls.push(wall);
+        t.afters.push(step.after.as_ref().map(|q| {
             p.b.wait_for("window.__play.lesson.place === 'after'", 10.0)
                 .unwrap();
-            answer(&mut p, q, 1, words_after(&step.id))
+            answer(p, q, 1, words_after(&step.id))
         }));
     }
-
-    // The post-test, then the end with the scores.
-    let mut post = Vec::new();
-    for q in &module.test {
+    if steps < lesson.steps.len() {
+        let i = steps;
+        p.b.wait_for(
+            &format!("window.__play.lesson.step === {i} && ['before', 'doing'].includes(window.__play.lesson.place)"),
+            20.0,
+        )
+        .unwrap();
+        return t;
+    }
+    for q in &lesson.test {
         p.b.wait_for("window.__play.lesson.place === 'post_test'", 10.0)
             .unwrap();
-        post.push(Some(answer(&mut p, q, correct(q), "")));
+        t.post.push(Some(answer(p, q, correct(q), "")));
     }
     p.b.wait_for("window.__play.lesson.place === 'finished'", 10.0)
         .unwrap();
-    let n = module.test.len();
-    assert_eq!(
-        p.eval("document.getElementById('lesson-score').textContent"),
-        json!(format!(
-            "Before the lesson: {n} of {n} right. After: {n} of {n} right."
-        ))
-    );
-    p.b.check().unwrap();
-    println!(
-        "the whole module: {:.1} s of wall time",
-        t_all.elapsed().as_secs_f64()
-    );
-    stop.store(true, Ordering::Relaxed);
-    let summary = handle.join().unwrap().unwrap();
-    let l = summary.lesson.unwrap();
-
-    // Every answer reached the progress.
-    let pr = &l.progress;
-    assert_eq!(pr.place(), teaching::Place::Finished);
-    assert_eq!(pr.pre_test(), pre.as_slice());
-    assert_eq!(pr.post_test(), post.as_slice());
-    assert_eq!(
-        (pr.test_score(true), pr.test_score(false)),
-        ((n, n), (n, n))
-    );
-    for (i, s) in pr.steps().iter().enumerate() {
-        assert_eq!(s.before, befores[i], "{}", module.steps[i].id);
-        assert_eq!(s.after, afters[i], "{}", module.steps[i].id);
-    }
-
-    // Each step its own world, met on a tick of it, recorded as STEP-ID.mcap, replaying bit
-    // for bit.
-    assert_eq!(l.runs.len(), module.steps.len());
-    for (i, r) in l.runs.iter().enumerate() {
-        let step = &module.steps[i];
-        assert_eq!((r.step, r.id.as_str()), (i, step.id.as_str()));
-        assert_eq!(r.session.recording, l.dir.join(format!("{}.mcap", step.id)));
-        let met = r
-            .met_at
-            .unwrap_or_else(|| panic!("step {} not met", step.id));
-        assert_eq!(pr.steps()[i].met_at, Some(met));
-        assert_eq!(pr.steps()[i].ticks, r.session.stats.ticks);
-        let rec = recording::read_recording_file(&r.session.recording, false).unwrap();
-        assert!(
-            haptic_loop::replay::verify(&rec).unwrap().ok(),
-            "{} does not replay bit for bit",
-            step.id
-        );
-        let a = read_arrays(&r.session.recording, false).unwrap();
-        let hz = f64::from(a.rate_hz);
-        // The condition's event is in the recording on the tick the step was met.
-        let names: &[&str] = match step.done {
-            Condition::BrickThrown => &["brick.thrown"],
-            Condition::AtomSnapped => &["nano.snap"],
-            Condition::AtomPulledOff => &["nano.pull_off"],
-            Condition::HouseComplete if step.kind == "nanoworld" => &["nano.house_complete"],
-            _ => &[],
-        };
-        if !names.is_empty() {
-            assert!(
-                a.events
-                    .iter()
-                    .any(|(t, n, _)| *t == met && names.contains(&n.as_str())),
-                "{}: no {names:?} on tick {met}",
-                step.id
-            );
-        }
-        if let Condition::Time { seconds } = step.done {
-            assert_eq!(met + 1, (seconds * hz).round() as u64, "{}", step.id);
-        }
-        println!(
-            "{:>14}: met at {:7.3} s of sim time ({} ticks), {:5.1} s of wall time",
-            step.id,
-            (met + 1) as f64 / hz,
-            r.session.stats.ticks,
-            walls[i].as_secs_f64()
-        );
-    }
+    t
 }
