@@ -14,6 +14,7 @@
 mod common;
 
 use common::cdp::Browser;
+use common::figures;
 use common::live;
 use haptic_loop::session::{SceneSource, read_arrays};
 use play::{PlayConfig, PlayError, PlaySummary};
@@ -57,16 +58,6 @@ fn start(scene: &str, name: &str) -> Session {
         stop,
         handle,
         out,
-    }
-}
-
-/// Where the screenshots go: under the target folder, so a test run leaves the tracked tree as
-/// it was; `scripts/figures.sh` names `docs/figures/play` in `NANOHAPTICS_FIGURES_DIR` to
-/// regenerate the docs' figures.
-fn figures() -> PathBuf {
-    match std::env::var_os("NANOHAPTICS_FIGURES_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("figures/play"),
     }
 }
 

@@ -13,24 +13,13 @@ mod common;
 
 use common::cdp::Browser;
 use common::class::{Page, TWO_STEP_LESSON, hand, join, send, start_with, ws};
+use common::figures;
 use recording::read_recording_file;
 use serde_json::{Value, json};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::thread::sleep;
 use std::time::Duration;
-
-fn figures() -> PathBuf {
-    match std::env::var_os("NANOHAPTICS_FIGURES_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("figures/play"),
-    }
-}
-
-fn press(b: &mut Browser, key: &str) {
-    b.key(key, true, false).unwrap();
-    b.key(key, false, false).unwrap();
-}
 
 fn place_is(b: &mut Browser, place: &str) {
     b.wait_for(
@@ -44,18 +33,18 @@ fn place_is(b: &mut Browser, place: &str) {
 fn choose(b: &mut Browser, i: usize) {
     assert_eq!(b.eval("document.activeElement.type").unwrap(), "radio");
     if i == 0 {
-        press(b, " ");
+        b.press(" ");
     }
     for _ in 0..i {
-        press(b, "ArrowDown");
+        b.press("ArrowDown");
     }
-    press(b, "Enter");
+    b.press("Enter");
 }
 
 /// Types `text` into the focused element, key by key.
 fn type_text(b: &mut Browser, text: &str) {
     for c in text.chars() {
-        press(b, &c.to_string());
+        b.press(&c.to_string());
     }
 }
 
@@ -89,7 +78,7 @@ fn the_teacher_page_follows_a_class_through_a_lesson() {
     )
     .unwrap();
     type_text(&mut s, "Ada");
-    press(&mut s, "Enter");
+    s.press("Enter");
     place_is(&mut s, "pre_test");
     choose(&mut s, 1);
     // Bo takes the lesson through a page link: the pre-test wrong, then step 1's world.
@@ -105,11 +94,11 @@ fn the_teacher_page_follows_a_class_through_a_lesson() {
     // Ada: Start by Enter; the 0.3 s step completes by itself; what she noticed, typed.
     place_is(&mut s, "doing");
     s.wait_for("window.__play.hello !== null && !document.getElementById('go').disabled && document.activeElement === document.getElementById('go')", 10.0).unwrap();
-    press(&mut s, "Enter");
+    s.press("Enter");
     place_is(&mut s, "after");
     type_text(&mut s, "they floated");
-    press(&mut s, "Tab");
-    press(&mut s, "Enter");
+    s.press("Tab");
+    s.press("Enter");
     // The next step is locked: she waits for the teacher.
     place_is(&mut s, "waiting");
     pb.until_place("after");

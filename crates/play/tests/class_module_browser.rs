@@ -31,11 +31,6 @@ use teaching::{Lesson, QuestionKind};
 const W: u32 = 1280;
 const H: u32 = 760;
 
-fn press(b: &mut Browser, key: &str) {
-    b.key(key, true, false).unwrap();
-    b.key(key, false, false).unwrap();
-}
-
 /// Joins the class at `url` by keyboard: the name typed into the focused field, Enter.
 fn join_by_keyboard(b: &mut Browser, url: &str, name: &str) {
     b.open(url).unwrap();
@@ -45,9 +40,9 @@ fn join_by_keyboard(b: &mut Browser, url: &str, name: &str) {
     )
     .unwrap();
     for c in name.chars() {
-        press(b, &c.to_string());
+        b.press(&c.to_string());
     }
-    press(b, "Enter");
+    b.press("Enter");
 }
 
 /// Once `until` holds on the teacher page, its rows (each student's name and step) are `rows`.

@@ -7,14 +7,14 @@
 
 mod common;
 
-use common::class::{Ws, get, http, join, post_join, read_for, send, start, ws};
+use common::class::{
+    Running, Ws, get, http, join, post_join, read_for, send, start, start_config, ws,
+};
 use haptic_loop::session::SceneSource;
-use play::classroom::{ClassConfig, run};
 use play::protocol::ServerMsg;
 use recording::read_recording_file;
 use serde_json::{Value, json};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 #[test]
@@ -255,30 +255,20 @@ fn a_bridged_device_joins_as_a_student_and_the_teacher_sees_and_ends_it() {
         .local_addr()
         .unwrap()
         .port();
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("nh-class-{}-device", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let mut c = ClassConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), dir.clone());
-    c.port = 0;
-    c.teacher_code = Some("T".into());
-    let mut b = BridgeConfig::parse(&format!("udp:127.0.0.1:{port}")).unwrap();
-    b.wait_s = 30.0;
-    c.device = Some(b);
-    c.device_name = "Falcon lab 2".into();
-    let stop = Arc::new(AtomicBool::new(false));
-    let s2 = stop.clone();
-    let (tx, rx) = std::sync::mpsc::channel();
-    let handle = std::thread::spawn(move || {
-        run(&c, &s2, &mut |a| {
-            let _ = tx.send(a.clone());
-        })
+    let Running {
+        host,
+        stop,
+        handle,
+        dir,
+        ..
+    } = start_config("device", |c| {
+        c.scene = SceneSource::resolve("wall".as_ref()).unwrap();
+        c.teacher_code = Some("T".into());
+        let mut b = BridgeConfig::parse(&format!("udp:127.0.0.1:{port}")).unwrap();
+        b.wait_s = 30.0;
+        c.device = Some(b);
+        c.device_name = "Falcon lab 2".into();
     });
-    let addr = rx.recv_timeout(Duration::from_secs(20)).unwrap();
-    let host = addr
-        .student_url
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .to_string();
     let text = SceneSource::builtin("wall").unwrap().scripts[0].1.clone();
     let fake = FakeConfig {
         target: format!("127.0.0.1:{port}").parse().unwrap(),

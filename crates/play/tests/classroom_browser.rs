@@ -9,12 +9,11 @@
 mod common;
 
 use common::cdp::Browser;
-use haptic_loop::session::SceneSource;
-use play::classroom::{ClassConfig, run};
+use common::class::{Running, start_config};
+use common::figures;
 use recording::read_recording_file;
 use serde_json::json;
 use std::net::TcpStream;
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::sleep;
@@ -23,16 +22,6 @@ use tungstenite::stream::MaybeTlsStream;
 use tungstenite::{Message, WebSocket};
 
 type Ws = WebSocket<MaybeTlsStream<TcpStream>>;
-
-/// Where the screenshots go: under the target folder, so a test run leaves the tracked tree as
-/// it was; `scripts/figures.sh` names `docs/figures/play` in `NANOHAPTICS_FIGURES_DIR` to
-/// regenerate the docs' figures.
-fn figures() -> PathBuf {
-    match std::env::var_os("NANOHAPTICS_FIGURES_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("figures/play"),
-    }
-}
 
 /// A student playing through a page link (no browser): joins, starts, and moves the hand
 /// down and back up until `stop`.
@@ -98,29 +87,13 @@ fn link_student(
 
 #[test]
 fn the_teacher_page_watches_switches_ends_and_collects_the_class() {
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("nh-class-browser-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let mut c = ClassConfig::new(
-        SceneSource::resolve("brickworld".as_ref()).unwrap(),
-        dir.clone(),
-    );
-    c.port = 0;
-    c.teacher_code = Some("TEACH123".into());
-    let stop = Arc::new(AtomicBool::new(false));
-    let s2 = stop.clone();
-    let (tx, rx) = std::sync::mpsc::channel();
-    let class = std::thread::spawn(move || {
-        run(&c, &s2, &mut |a| {
-            let _ = tx.send(a.clone());
-        })
-    });
-    let addr = rx.recv_timeout(Duration::from_secs(20)).unwrap();
-    let host = addr
-        .student_url
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .to_string();
+    let Running {
+        addr,
+        host,
+        stop,
+        handle: class,
+        dir,
+    } = start_config("browser", |_| {});
     let mut b = Browser::launch(1100, 640).unwrap();
 
     // A student joins in the browser: the join page, a name, Start.

@@ -14,6 +14,7 @@
 mod common;
 
 use common::cdp::Browser;
+use common::figures;
 use haptic_loop::session::{SceneSource, read_arrays};
 use play::PlayConfig;
 use serde_json::{Value, json};
@@ -63,18 +64,6 @@ done = { when = "atom_snapped" }
 after = { prompt = "What did you feel?", answer = "text" }
 "#;
 
-fn figures() -> PathBuf {
-    match std::env::var_os("NANOHAPTICS_FIGURES_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("figures/play"),
-    }
-}
-
-fn press(b: &mut Browser, key: &str) {
-    b.key(key, true, false).unwrap();
-    b.key(key, false, false).unwrap();
-}
-
 fn place_is(b: &mut Browser, place: &str) {
     b.wait_for(
         &format!("window.__play.lesson !== null && window.__play.lesson.place === '{place}'"),
@@ -94,13 +83,13 @@ fn focused(b: &mut Browser) -> Value {
 fn choose(b: &mut Browser, i: usize, label: &str) {
     assert_eq!(focused(b)[1], "radio");
     if i == 0 {
-        press(b, " ");
+        b.press(" ");
     }
     for _ in 0..i {
-        press(b, "ArrowDown");
+        b.press("ArrowDown");
     }
     assert_eq!(focused(b)[2], label);
-    press(b, "Enter");
+    b.press("Enter");
 }
 
 #[test]
@@ -156,7 +145,7 @@ fn a_student_completes_a_lesson_by_keyboard_and_each_step_replays() {
     b.wait_for("window.__play.hello !== null && !document.getElementById('go').disabled && document.activeElement === document.getElementById('go')", 10.0).unwrap();
     assert_eq!(b.eval("[window.__play.hello.kind, window.__play.menu.gravity_m_per_s2, document.getElementById('lesson-now').textContent]").unwrap(),
         json!(["brickworld", 0, "No gravity: Gravity is off: watch the bricks for half a second."]));
-    press(&mut b, "Enter");
+    b.press("Enter");
     b.wait_for("window.__play.role === 'hand'", 10.0).unwrap();
 
     // The time step completes by itself; the locked step opens for the lone student and its
@@ -187,11 +176,11 @@ fn a_student_completes_a_lesson_by_keyboard_and_each_step_replays() {
         "Your answer (up to 2000 characters)"
     );
     for k in ["i", "t", " ", "p", "u", "l", "l", "e", "d"] {
-        press(&mut b, k);
+        b.press(k);
     }
-    press(&mut b, "Tab");
+    b.press("Tab");
     assert_eq!(b.eval("document.activeElement.id").unwrap(), "answer-go");
-    press(&mut b, "Enter");
+    b.press("Enter");
 
     place_is(&mut b, "post_test");
     choose(&mut b, 1, "Surface attraction");
@@ -355,13 +344,13 @@ fn a_step_opens_by_its_address_for_a_demonstration_and_an_unknown_one_is_said() 
         json!(["Two steps: step snap (demonstration)", "doing", 1, "nanoworld", "go"])
     );
     // Start, then E before the tip snaps: the lesson stops there, with the end screen.
-    press(&mut b, "Enter");
+    b.press("Enter");
     b.wait_for(
         "window.__play.role === 'hand' && window.__play.frames > 5",
         10.0,
     )
     .unwrap();
-    press(&mut b, "e");
+    b.press("e");
     b.wait_for("window.__play.ended !== null", 10.0).unwrap();
     assert_eq!(
         b.eval("[window.__play.ended.end, document.getElementById('end').classList.contains('hidden'), window.__play.lesson.place]").unwrap(),

@@ -10,6 +10,7 @@
 mod common;
 
 use common::cdp::Browser;
+use common::figures;
 use common::live::hash;
 use haptic_engine::sink::{Sink, SinkError, TickView};
 use haptic_loop::replay::Resimulation;
@@ -19,15 +20,6 @@ use play::replay::{ReplayBook, ReplayServer, SAMPLE_RATE_HZ};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
-
-/// Where the screenshot goes: under the target folder (`scripts/figures.sh` names
-/// `docs/figures/play` in `NANOHAPTICS_FIGURES_DIR` to regenerate the docs' figures).
-fn figures() -> PathBuf {
-    match std::env::var_os("NANOHAPTICS_FIGURES_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("figures/play"),
-    }
-}
 
 fn golden(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -296,6 +296,13 @@ impl Browser {
         self.call("Input.dispatchMouseEvent", p).map(drop)
     }
 
+    /// A key pressed and let go (no Shift).
+    pub fn press(&mut self, key: &str) {
+        self.key(key, true, false).unwrap_or_else(|e| panic!("{e}"));
+        self.key(key, false, false)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+
     /// A key going down or up (`key` as in `KeyboardEvent.key`, e.g. `ArrowLeft`, ` `, `e`).
     pub fn key(&mut self, key: &str, down: bool, shift: bool) -> Result<(), String> {
         let (code, vk) = match key {

@@ -29,11 +29,21 @@ pub struct Running {
 /// A class of at most `max` on brickworld (the teacher's code TEACH123), its recordings in
 /// the target folder's `nh-class-PID-NAME`.
 pub fn start(name: &str, max: usize) -> Running {
-    start_with(name, max, None)
+    start_config(name, |c| c.max_students = max)
 }
 
 /// [`start`] with a lesson.
 pub fn start_with(name: &str, max: usize, lesson: Option<teaching::Lesson>) -> Running {
+    start_config(name, |c| {
+        c.max_students = max;
+        c.lesson = lesson;
+    })
+}
+
+/// A class on brickworld, any free port, the teacher's code TEACH123, its recordings in the
+/// target folder's `nh-class-PID-NAME`, with what `configure` changes; served on a thread once
+/// its addresses are known.
+pub fn start_config(name: &str, configure: impl FnOnce(&mut ClassConfig)) -> Running {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("nh-class-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -42,9 +52,8 @@ pub fn start_with(name: &str, max: usize, lesson: Option<teaching::Lesson>) -> R
         dir.clone(),
     );
     c.port = 0;
-    c.max_students = max;
     c.teacher_code = Some("TEACH123".into());
-    c.lesson = lesson;
+    configure(&mut c);
     let stop = Arc::new(AtomicBool::new(false));
     let s2 = stop.clone();
     let (tx, rx) = std::sync::mpsc::channel();

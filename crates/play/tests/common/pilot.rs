@@ -97,8 +97,7 @@ impl<'a> Pilot<'a> {
 
     /// A key pressed and let go.
     pub fn press(&mut self, key: &str) {
-        self.b.key(key, true, false).unwrap();
-        self.b.key(key, false, false).unwrap();
+        self.b.press(key);
     }
 
     /// Reads the world's mapping from the page's hello (after each new world).
