@@ -381,12 +381,31 @@ impl<'a> Pilot<'a> {
                 lying(self).expect("the new brick in the zone")
             }
         };
-        self.grab_brick(brick);
-        brick
+        // A brick that drifts (gravity off: one nudged floats on) may slip the grip: take the
+        // brick again from where the frame shows it now, a few times.
+        let mut brick = brick;
+        for _ in 0..4 {
+            if self.try_grab_brick(brick) {
+                return brick;
+            }
+            self.next_frame();
+            brick = lying(self).unwrap_or(brick);
+        }
+        panic!("could not take the brick at {:?}", brick.c);
     }
 
-    /// Takes the brick lying at `brick` into the hand: over its top, down onto it, Space.
+    /// Takes the brick lying at `brick` into the hand (panics if it cannot).
     pub fn grab_brick(&mut self, brick: Body) {
+        assert!(
+            self.try_grab_brick(brick),
+            "could not take the brick at {:?}",
+            brick.c
+        );
+    }
+
+    /// Takes the brick lying at `brick` into the hand: over its top, down onto it, Space;
+    /// whether the world says the hand holds it.
+    pub fn try_grab_brick(&mut self, brick: Body) -> bool {
         let hz = self.brick_half_height();
         let top = brick.c[2] + hz;
         let here = self.hand_world();
@@ -405,13 +424,13 @@ impl<'a> Pilot<'a> {
                 .wait_for("window.__play.lastFrame.state.holding === 1", 0.6)
                 .is_ok()
             {
-                return;
+                return true;
             }
             if self.gripping() {
                 self.grip();
             }
         }
-        panic!("could not take the brick at {:?}", brick.c);
+        false
     }
 
     /// Moves the carried brick's centre to `w` (m) within `tol_m`, closing the loop on the
