@@ -134,6 +134,9 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
         s.workers,
         s.realtime.describe()
     );
+    for (i, c) in s.schedule.iter().enumerate() {
+        println!("  tick worker {}: {}", i + 1, c.describe());
+    }
     for st in &s.students {
         println!("  {}", st.line());
     }

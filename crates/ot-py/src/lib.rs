@@ -43,6 +43,12 @@ pub mod trap;
 
 use pyo3::prelude::*;
 
+/// The extension's allocator, as the `nanohaptics` binary's (crates/cli/src/main.rs): the wheel's
+/// `nanohaptics classroom` runs its real-time tick workers in this library, and glibc's arena
+/// locks made them wait on the threads that free their memory.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Haptic manipulation at the nanoscale, from Python: optical-trap dynamics
 /// (GaussianTrap), the inverse trap solver and working envelope (solve_trap,
 /// working_envelope, clip_command), the nano world (NanoWorld) and the brick

@@ -2,7 +2,8 @@
 //! client on loopback playing the brick world, measured from both ends.
 //!
 //! `cargo run --release -p nanohaptics-play --example classroom-bench -- [--students N]
-//! [--seconds S] [--runs R] [--out FILE]` (defaults 30 students, 20 s, 3 runs).
+//! [--seconds S] [--runs R] [--workers W] [--no-rt] [--out FILE]` (defaults 30 students, 20 s,
+//! 3 runs, the class's own number of workers, real time asked for).
 //!
 //! The server (`play::classroom::run`) runs in this process; the students run in a child
 //! process (this program with `--clients`), so the server's CPU time is this process's alone.
@@ -11,7 +12,13 @@
 //!
 //! Figures per run: missed 1 ms deadlines over every session's ticks, input → force (the
 //! input's wall time to the tick whose force used it, from the server), frames/s each page
-//! received, and the server's CPU use (user + system, in cores).
+//! received, the server's and the students' CPU use (user + system, in cores), each worker's
+//! cycles (how late they began, their work, the cost of one session's tick), and whether every
+//! recording replays bit for bit.
+
+/// The programs' allocator, as the `nanohaptics` binary's (crates/cli/src/main.rs).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 use haptic_loop::session::SceneSource;
 use play::classroom::{ClassConfig, run};
@@ -147,9 +154,43 @@ struct RunFigures {
     sessions: usize,
     errors: usize,
     workers: usize,
+    client_cores: f64,
+    late_cycles: u64,
+    began_late: u64,
+    cycles: u64,
+    start_p99_us: f64,
+    start_max_us: f64,
+    work_p99_us: f64,
+    per_session_us: f64,
+    replayed: usize,
+    policy: &'static str,
 }
 
-fn one_run(n: usize, secs: f64) -> RunFigures {
+/// The students' process's CPU time (user + system of waited-for children), s.
+fn children_cpu_s() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = after.split_whitespace().collect();
+    let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    // Fields 16 and 17 of stat (cutime, cstime), in clock ticks of 100 Hz.
+    (t(13) + t(14)) / 100.0
+}
+
+/// How many of `summary`'s recordings replay bit for bit.
+fn replaying(summary: &play::classroom::ClassSummary) -> usize {
+    summary
+        .students
+        .iter()
+        .filter(|s| {
+            recording::read_recording_file(&s.session.recording, false)
+                .ok()
+                .and_then(|r| haptic_loop::replay::verify(&r).ok())
+                .is_some_and(|v| v.ok())
+        })
+        .count()
+}
+
+fn one_run(n: usize, secs: f64, workers: Option<usize>, rt: bool) -> RunFigures {
     let dir = std::env::temp_dir().join(format!("nh-class-bench-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let mut c = ClassConfig::new(
@@ -158,6 +199,10 @@ fn one_run(n: usize, secs: f64) -> RunFigures {
     );
     c.port = 0;
     c.max_students = n;
+    c.workers = workers;
+    if !rt {
+        c.rt = None;
+    }
     let stop = Arc::new(AtomicBool::new(false));
     let s2 = stop.clone();
     let (tx, rx) = std::sync::mpsc::channel();
@@ -175,6 +220,7 @@ fn one_run(n: usize, secs: f64) -> RunFigures {
         .to_string();
     let exe = std::env::current_exe().expect("this program");
     let cpu0 = cpu_s();
+    let ccpu0 = children_cpu_s();
     let w0 = Instant::now();
     let nice = std::env::var("CLIENT_NICE").unwrap_or_else(|_| "0".into());
     let out = Command::new("nice")
@@ -192,6 +238,7 @@ fn one_run(n: usize, secs: f64) -> RunFigures {
         .expect("the students' process");
     let wall = w0.elapsed().as_secs_f64();
     let cpu = cpu_s() - cpu0;
+    let client_cores = (children_cpu_s() - ccpu0) / wall;
     stop.store(true, Ordering::Relaxed);
     let summary = server
         .join()
@@ -226,8 +273,27 @@ fn one_run(n: usize, secs: f64) -> RunFigures {
         .collect();
     let mut p99_sorted = p99s.clone();
     p99_sorted.sort_by(f64::total_cmp);
+    let replayed = replaying(&summary);
     let _ = std::fs::remove_dir_all(&dir);
+    let us = |ns: u64| ns as f64 / 1e3;
+    let sched = &summary.schedule;
+    let session_ticks: u64 = sched.iter().map(|c| c.session_ticks).sum();
     RunFigures {
+        client_cores,
+        late_cycles: sched.iter().map(|c| c.late_cycles).sum(),
+        began_late: sched.iter().map(|c| c.began_late).sum(),
+        cycles: sched.iter().map(|c| c.cycles).sum(),
+        start_p99_us: us(sched.iter().map(|c| c.started().p99_ns).max().unwrap_or(0)),
+        start_max_us: us(sched.iter().map(|c| c.started().max_ns).max().unwrap_or(0)),
+        work_p99_us: us(sched.iter().map(|c| c.work().p99_ns).max().unwrap_or(0)),
+        per_session_us: sched
+            .iter()
+            .map(|c| c.per_session_ns() * c.session_ticks as f64)
+            .sum::<f64>()
+            / session_ticks.max(1) as f64
+            / 1e3,
+        replayed,
+        policy: summary.realtime.policy(),
         ticks,
         missed,
         worst_missed_pct,
@@ -263,46 +329,74 @@ fn main() {
     let n = arg(&args, "--students", 30usize);
     let secs = arg(&args, "--seconds", 20.0);
     let runs = arg(&args, "--runs", 3usize);
+    let workers: Option<usize> = args
+        .iter()
+        .position(|a| a == "--workers")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok());
+    let rt = !args.iter().any(|a| a == "--no-rt");
     let out: String = arg(&args, "--out", String::new());
     let load0 = load();
     let mut rows = Vec::new();
     for r in 0..runs {
         eprintln!("run {}/{runs}: {n} students for {secs} s …", r + 1);
-        let f = one_run(n, secs);
+        let f = one_run(n, secs, workers, rt);
         eprintln!(
-            "  {} sessions, missed {:.3} %, input → force p99 {:.1} ms, {:.1} frames/s (min), {:.2} cores",
+            "  {} sessions on {} workers ({}), missed {:.3} % (worst session {:.3} %), input → force p99 {:.1} ms, \
+             {:.1} frames/s (min), server {:.2} cores, students {:.2} cores; cycles {} late of {} \
+             ({} begun a period late), start p99/max {:.0}/{:.0} µs, work p99 {:.0} µs, one \
+             session's tick {:.1} µs; {} of {} recordings replay",
             f.sessions,
+            f.workers,
+            f.policy,
             100.0 * f.missed as f64 / f.ticks.max(1) as f64,
+            f.worst_missed_pct,
             f.worst_p99_ms,
             f.fps_min,
-            f.cpu_cores
+            f.cpu_cores,
+            f.client_cores,
+            f.late_cycles,
+            f.cycles,
+            f.began_late,
+            f.start_p99_us,
+            f.start_max_us,
+            f.work_p99_us,
+            f.per_session_us,
+            f.replayed,
+            f.sessions
         );
         rows.push(f);
     }
     let load1 = load();
+    let wflag = workers.map_or(String::new(), |w| format!(" --workers {w}"));
+    let rtflag = if rt { "" } else { " --no-rt" };
     let mut md = format!(
         "# Classroom bench: {n} students on one machine\n\n\
          Machine: {} cores, shared. Load average (1, 5, 15 min) at start `{load0}`, at end \
          `{load1}`. Command: `cargo run --release -p nanohaptics-play --example classroom-bench \
-         -- --students {n} --seconds {secs} --runs {runs} --out docs/bench/classroom.md`.\n\n\
+         -- --students {n} --seconds {secs} --runs {runs}{wflag}{rtflag} --out docs/bench/classroom.md`.\n\n\
          Each run serves one class (`play::classroom::run`, the built-in brick world at 1 kHz, \
          loopback) to {n} students in a second process: each joins by name, presses Start and \
          moves its hand at 60 inputs/s for {secs} s while reading every frame and sound-ticks message. \
          Missed deadlines are over every tick of every session (a missed tick sends zero force \
          and is recorded, so each session replays bit for bit); input → force is the input's \
          wall time to the tick whose force used it, per session (median and worst session's \
-         p99); frames/s is what each page received; CPU is the server process's user + system \
-         time over the run's wall time, in cores (the students' process not included).\n\n\
-         | run | sessions | worker threads | ticks | missed deadlines | worst session | input → force p99, median session (ms) | worst session (ms) | frames/s per page, min / median | server CPU (cores) | client errors |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|\n",
+         p99); frames/s is what each page received; CPU is the server process's and the \
+         students' process's user + system time over the run's wall time, in cores; the workers' \
+         cycles: how many ran past their deadline (of them, begun a whole period late), how late \
+         they began (p99 / max) and one session's tick (the cycles' work over the sessions they \
+         ticked); replayed: the recordings that replay bit for bit.\n\n\
+         | run | sessions | workers (scheduler) | ticks | missed deadlines | worst session | input → force p99, median session (ms) | worst session (ms) | frames/s per page, min / median | CPU server / students (cores) | late cycles (begun late) of all | cycle start p99 / max (µs) | one session's tick (µs) | replayed | client errors |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         std::thread::available_parallelism().map_or(0, |n| n.get())
     );
     for (i, f) in rows.iter().enumerate() {
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} ({:.3} %) | {:.3} % | {:.1} | {:.1} | {:.1} / {:.1} | {:.2} | {} |\n",
+            "| {} | {} | {} ({}) | {} | {} ({:.3} %) | {:.3} % | {:.1} | {:.1} | {:.1} / {:.1} | {:.2} / {:.2} | {} ({}) of {} | {:.0} / {:.0} | {:.1} | {} of {} | {} |\n",
             i + 1,
             f.sessions,
             f.workers,
+            f.policy,
             f.ticks,
             f.missed,
             100.0 * f.missed as f64 / f.ticks.max(1) as f64,
@@ -312,6 +406,15 @@ fn main() {
             f.fps_min,
             f.fps_median,
             f.cpu_cores,
+            f.client_cores,
+            f.late_cycles,
+            f.began_late,
+            f.cycles,
+            f.start_p99_us,
+            f.start_max_us,
+            f.per_session_us,
+            f.replayed,
+            f.sessions,
             f.errors
         ));
     }

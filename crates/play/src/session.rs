@@ -102,9 +102,20 @@ pub struct SessionSpec<'a> {
     pub ticks: Option<u64>,
 }
 
-/// Called every few ticks ([`PageSession::with_reporter`]) with (ticks run, missed deadlines,
-/// the loop): what a teacher page shows of a student.
-pub type Reporter = Box<dyn FnMut(u64, u64, &HapticLoop) + Send>;
+/// Where a session is, for its [`Reporter`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Ticks run.
+    pub ticks: u64,
+    /// Missed deadlines.
+    pub missed: u64,
+    /// The session's last report (at its finish, off the tick thread): it must not be skipped.
+    pub last: bool,
+}
+
+/// Called every few ticks ([`PageSession::with_reporter`]) on the tick thread, and once at the
+/// finish, with where the session is and the loop: what a teacher page shows of a student.
+pub type Reporter = Box<dyn FnMut(&Progress, &HapticLoop) + Send>;
 
 /// Called after every tick with the loop ([`PageSession::with_watcher`]); `true` completes the
 /// session (a lesson step's condition met).
@@ -274,6 +285,26 @@ impl PageSession {
         self.shared.end_requested.store(true, Ordering::Relaxed);
     }
 
+    /// Whether its next step begins it or has begun it: its hand is there (a page's first
+    /// input; a bridged device at once), or its end was asked for, or it has begun.
+    pub fn ready(&self) -> bool {
+        self.started
+            || self.end.is_some()
+            || self.shared.end_requested.load(Ordering::Relaxed)
+            || !self.hand.is_page()
+            || self.shared.input.latest().1.is_some()
+    }
+
+    /// Begins it now when it is [`PageSession::ready`] and has not begun: the pages' publisher
+    /// and the recording's start (a thread each and a file), which a shared tick worker should
+    /// not wait for. Its first step then runs its first tick. Nothing else changes: the same
+    /// recording, the same ticks.
+    pub fn begin(&mut self) {
+        if !self.started && self.end.is_none() && self.ready() {
+            self.start();
+        }
+    }
+
     /// Starts the session: the pages' publisher, the sinks (the recording's start).
     fn start(&mut self) {
         let (tx, rx) = std::sync::mpsc::channel::<ToPublisher>();
@@ -372,7 +403,12 @@ impl PageSession {
         if let Some((every, report)) = self.reporter.as_mut()
             && n % *every == 0
         {
-            report(n + 1, self.engine.missed(), &self.lp);
+            let p = Progress {
+                ticks: n + 1,
+                missed: self.engine.missed(),
+                last: false,
+            };
+            report(&p, &self.lp);
         }
         if let Some(watch) = self.watcher.as_mut()
             && watch(&self.lp)
@@ -411,7 +447,12 @@ impl PageSession {
         let end = self.end.unwrap_or(EndReason::Stopped);
         let ticks = self.engine.ticks();
         if let Some((_, report)) = self.reporter.as_mut() {
-            report(ticks, self.engine.missed(), &self.lp);
+            let p = Progress {
+                ticks,
+                missed: self.engine.missed(),
+                last: true,
+            };
+            report(&p, &self.lp);
         }
         let link = self.hand.device_ref().link_counters();
         let mut list = self.sinks.list();

@@ -347,3 +347,59 @@ fn a_bridged_device_joins_as_a_student_and_the_teacher_sees_and_ends_it() {
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A session waits in the class's lobby until its page's Start and is begun there, off the tick
+/// workers: a student who never starts never reaches a worker, so the workers' cycles hold the
+/// started student alone; at the end the waiting one is still ended whole (an empty recording
+/// that replays), and each worker reports its cycles.
+#[test]
+fn a_session_waits_in_the_lobby_until_its_start_and_the_workers_report_their_cycles() {
+    let c = start_config("lobby", |c| {
+        c.max_students = 2;
+        c.workers = Some(1);
+    });
+    let host = c.host.clone();
+    let (t_go, t_wait) = (join(&host, "Go"), join(&host, "Wait"));
+    let mut go = ws(&host, &format!("/ws?s={t_go}"));
+    let _wait = ws(&host, &format!("/ws?s={t_wait}"));
+    send(&mut go, json!({"type": "start"}));
+    for seq in 1..=3 {
+        send(
+            &mut go,
+            json!({"type": "input", "seq": seq, "pos": [0.0, 0.0, 0.3], "buttons": 0, "t_ms": seq as f64}),
+        );
+    }
+    let got = read_for(&mut go, 1.0);
+    assert!(got.iter().any(|m| m["type"] == "frame"), "Go plays");
+    c.stop.store(true, Ordering::Relaxed);
+    let summary = c.handle.join().unwrap().unwrap();
+    assert_eq!(summary.workers, 1);
+    assert_eq!(summary.schedule.len(), 1);
+    let w = &summary.schedule[0];
+    let by = |n: &str| {
+        summary
+            .students
+            .iter()
+            .find(|s| s.name == n)
+            .unwrap_or_else(|| panic!("{n} is in the summary"))
+    };
+    let (g, wt) = (by("Go"), by("Wait"));
+    assert!(g.session.stats.ticks > 100, "{}", g.line());
+    assert_eq!(wt.session.stats.ticks, 0, "{}", wt.line());
+    assert_eq!(wt.session.end, "stopped");
+    // Until the stop the worker held Go alone: every cycle but the last (the stop's, when the
+    // lobby hands Wait over to be ended) ticked one session. Go's ticks ran one per cycle.
+    assert!(w.most_sessions <= 2, "{}", w.describe());
+    assert!(
+        w.session_ticks >= g.session.stats.ticks && w.session_ticks <= w.cycles + 2,
+        "{} ({} ticks)",
+        w.describe(),
+        g.session.stats.ticks
+    );
+    assert!(w.cycles >= g.session.stats.ticks, "{}", w.describe());
+    for s in [g, wt] {
+        let rec = read_recording_file(&s.session.recording, false).unwrap();
+        let v = haptic_loop::replay::verify(&rec).unwrap();
+        assert!(v.ok(), "{}: {:?}", s.name, v);
+    }
+}

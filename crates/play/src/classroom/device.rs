@@ -98,7 +98,7 @@ fn session(
         .map_err(|e| e.to_string())?
         .with_reporter(
             super::STATUS_EVERY_TICKS,
-            Box::new(move |ticks, missed, lp| st.report(ticks, missed, lp)),
+            Box::new(move |p, lp| st.report(p, lp)),
         );
     student.set_phase(Phase::Playing);
     session.run(Pacing::DeviceClock, class.config.rt.as_ref(), stop);

@@ -49,7 +49,7 @@ fn reporting(student: &Arc<Student>, session: PageSession) -> PageSession {
     let st = student.clone();
     session.with_reporter(
         super::STATUS_EVERY_TICKS,
-        Box::new(move |ticks, missed, lp| st.report(ticks, missed, lp)),
+        Box::new(move |p, lp| st.report(p, lp)),
     )
 }
 
@@ -85,6 +85,19 @@ impl Live {
     /// Whether it ended (the worker hands it to the finisher).
     pub fn ended(&self) -> bool {
         self.session().ended()
+    }
+
+    /// Whether it can begin (its hand is there or its end was asked for) or has begun.
+    pub fn ready(&self) -> bool {
+        self.session().ready()
+    }
+
+    /// Begins it when it is ready, off the worker (see `lobby`).
+    pub fn begin(&mut self) {
+        match &mut self.held {
+            Held::Session(s) => s.begin(),
+            Held::Step(w) => w.session.begin(),
+        }
     }
 
     /// Ends it at its next cycle (the class is stopping).

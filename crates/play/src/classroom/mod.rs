@@ -31,6 +31,7 @@
 mod device;
 pub mod lesson;
 mod live;
+mod lobby;
 pub mod names;
 mod routes;
 mod sched;
@@ -45,6 +46,7 @@ use crate::session::{Hand, PageSession, SessionSpec, SessionSummary};
 use haptic_loop::session::{SceneSource, now_unix_ns};
 use live::Live;
 pub use live::Phase;
+pub use sched::CycleStats;
 use std::hash::{BuildHasher, Hasher};
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
@@ -52,7 +54,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::Sender;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
-use threads::{Plan, class_limits, start_coach, start_device, start_finisher, start_workers};
+use threads::{
+    Plan, class_limits, start_coach, start_device, start_finisher, start_lobby, start_workers,
+};
 use webguard::gate::RefusedCounts;
 
 /// Ticks between two updates of what the teacher page shows of a student (50 ms at 1 kHz).
@@ -149,6 +153,12 @@ pub struct Status {
     pub state: Vec<(String, f64)>,
     /// The switches' values now (name, value).
     pub switches: Vec<(String, f64)>,
+    /// The state's values as last read (reused, so a report allocates nothing).
+    #[serde(skip)]
+    values: Vec<f64>,
+    /// The kind of scene the names are of (a lesson's steps change it).
+    #[serde(skip)]
+    kind: &'static str,
 }
 
 /// A student of the class.
@@ -178,26 +188,56 @@ impl Status {
             force_n: 0.0,
             state: Vec::new(),
             switches: Vec::new(),
+            values: Vec::new(),
+            kind: "",
         }
     }
 }
 
 impl Student {
-    /// Updates what the teacher sees: `ticks` run (`missed` of them late) of `lp`, and its
-    /// state, force and switches after the last.
-    fn report(&self, ticks: u64, missed: u64, lp: &haptic_engine::HapticLoop) {
-        let mut state = Vec::new();
-        lp.scene().state(&mut state);
-        let f = lp.last_result().device_force_n;
+    /// Updates what the teacher sees: where the session is (`p`) and `lp`'s state, force and
+    /// switches after its last tick. On the tick thread (every [`STATUS_EVERY_TICKS`] ticks) it
+    /// never waits: when the teacher page is reading the status this report is skipped (the next
+    /// comes 50 ticks later); the last report, at the finish, waits. It allocates only when the
+    /// scene changes (a lesson's next step), for the state's and switches' names.
+    fn report(&self, p: &crate::session::Progress, lp: &haptic_engine::HapticLoop) {
+        let mut st = if p.last {
+            match self.status.lock() {
+                Ok(st) => st,
+                Err(_) => return,
+            }
+        } else {
+            match self.status.try_lock() {
+                Ok(st) => st,
+                Err(_) => return,
+            }
+        };
+        let (ticks, missed) = (p.ticks, p.missed);
         let scene = lp.scene();
-        let switches = scene.switch_values();
-        if let Ok(mut st) = self.status.lock() {
-            st.ticks = ticks;
-            st.time_s = ticks as f64 / f64::from(lp.config().rate_hz);
-            st.missed = missed;
-            st.force_n = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-            st.state = scene.state_fields().into_iter().zip(state).collect();
-            st.switches = switches;
+        if st.kind != scene.kind() {
+            st.kind = scene.kind();
+            st.state.clear();
+            st.switches = scene.switch_values();
+        }
+        let f = lp.last_result().device_force_n;
+        st.ticks = ticks;
+        st.time_s = ticks as f64 / f64::from(lp.config().rate_hz);
+        st.missed = missed;
+        st.force_n = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+        let mut values = std::mem::take(&mut st.values);
+        values.clear();
+        scene.state(&mut values);
+        if st.state.len() != values.len() {
+            st.state = scene.state_fields().into_iter().map(|n| (n, 0.0)).collect();
+        }
+        for ((_, v), x) in st.state.iter_mut().zip(&values) {
+            *v = *x;
+        }
+        st.values = values;
+        for (name, v) in st.switches.iter_mut() {
+            if let Some(x) = scene.switch_value(name) {
+                *v = x;
+            }
         }
     }
 
@@ -261,6 +301,8 @@ pub struct ClassSummary {
     pub workers: usize,
     /// The real-time scheduling the workers got (the first worker's; they all ask alike).
     pub realtime: haptic_engine::realtime::RtStatus,
+    /// Each worker's cycles: how late they began, their work, how many ran late.
+    pub schedule: Vec<sched::CycleStats>,
     /// The files of the class report written at the end, with a lesson (none without).
     pub report: Vec<PathBuf>,
 }
@@ -312,7 +354,7 @@ fn random_code(n: usize, alphabet: &[u8]) -> String {
 /// A worker's inbox and its count of sessions.
 type WorkerLink = (Mutex<Sender<Box<Live>>>, Arc<AtomicUsize>);
 /// A worker's thread; it returns the real-time scheduling it got.
-type WorkerHandle = std::thread::JoinHandle<haptic_engine::realtime::RtStatus>;
+type WorkerHandle = std::thread::JoinHandle<sched::WorkerReport>;
 
 /// The class's state shared by the routes, the workers and the finisher.
 pub(crate) struct Class {
@@ -327,6 +369,7 @@ pub(crate) struct Class {
     students: Mutex<Vec<Arc<Student>>>,
     lesson: Option<lesson::ClassLesson>,
     workers: Vec<WorkerLink>,
+    lobby: Mutex<Sender<Box<Live>>>,
     pub(crate) finished: Mutex<Vec<StudentSummary>>,
     ended: AtomicUsize,
     shutdown: Arc<AtomicBool>,
@@ -423,8 +466,18 @@ impl Class {
         Ok(student)
     }
 
-    /// Hands `live` to the least busy worker.
+    /// Hands `live` to the lobby, which begins it at its page's Start and then hands it to a
+    /// worker.
     pub(crate) fn dispatch(&self, live: Box<Live>) -> Result<(), JoinError> {
+        self.lobby
+            .lock()
+            .map_err(|_| JoinError::Setup("the class is shutting down".into()))?
+            .send(live)
+            .map_err(|_| JoinError::Setup("the class is shutting down".into()))
+    }
+
+    /// Hands `live` to the least busy worker.
+    pub(crate) fn to_worker(&self, live: Box<Live>) -> Result<(), JoinError> {
         let (tx, load) = self
             .workers
             .iter()
@@ -442,6 +495,7 @@ impl Class {
         config: &ClassConfig,
         plan: Plan,
         workers: Vec<WorkerLink>,
+        lobby: Sender<Box<Live>>,
         shutdown: Arc<AtomicBool>,
     ) -> Class {
         let loopback = config.listen.is_loopback();
@@ -465,6 +519,7 @@ impl Class {
             students: Mutex::new(Vec::new()),
             lesson: config.lesson.clone().map(lesson::ClassLesson::new),
             workers,
+            lobby: Mutex::new(lobby),
             finished: Mutex::new(Vec::new()),
             ended: AtomicUsize::new(0),
             shutdown,
@@ -522,7 +577,16 @@ pub fn run(
         start_workers(config, &plan, &fin_tx, &worker_stop).map_err(serve_err)?;
     drop(fin_tx);
     let shutdown = Arc::new(AtomicBool::new(false));
-    let class = Arc::new(Class::new(config, plan, workers, shutdown.clone()));
+    let (lobby_tx, lobby_rx) = std::sync::mpsc::channel::<Box<Live>>();
+    let class = Arc::new(Class::new(
+        config,
+        plan,
+        workers,
+        lobby_tx,
+        shutdown.clone(),
+    ));
+    let lobby_stop = Arc::new(AtomicBool::new(false));
+    let lobby = start_lobby(&class, lobby_rx, &lobby_stop).map_err(serve_err)?;
     let finisher = start_finisher(class.clone(), fin_rx).map_err(serve_err)?;
     let mut listener = Listener::start(
         SocketAddr::new(config.listen, config.port),
@@ -547,13 +611,18 @@ pub fn run(
     if let Some(c) = coach {
         let _ = c.join();
     }
+    // The sessions still waiting for their Start go to the workers to end.
+    lobby_stop.store(true, Ordering::Relaxed);
+    let _ = lobby.join();
     worker_stop.store(true, Ordering::Relaxed);
     let mut realtime = haptic_engine::realtime::RtStatus::default();
+    let mut schedule = Vec::new();
     for (i, h) in handles.into_iter().enumerate() {
-        if let Ok(st) = h.join()
-            && i == 0
-        {
-            realtime = st;
+        if let Ok(r) = h.join() {
+            if i == 0 {
+                realtime = r.realtime;
+            }
+            schedule.push(r.cycles);
         }
     }
     if let Some(d) = device {
@@ -596,6 +665,7 @@ pub fn run(
         refused: listener.gate().refused.snapshot(),
         workers: class.workers.len(),
         realtime,
+        schedule,
         report,
     })
 }

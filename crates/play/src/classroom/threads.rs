@@ -4,7 +4,7 @@
 
 use super::live::{self, Live};
 use super::{
-    Class, ClassConfig, MAX_CLASS, WorkerHandle, WorkerLink, device, lesson, names, sched,
+    Class, ClassConfig, MAX_CLASS, WorkerHandle, WorkerLink, device, lesson, lobby, names, sched,
 };
 use crate::PlayError;
 use haptic_loop::session::{SessionError, ticks_for};
@@ -26,6 +26,18 @@ pub(super) fn start_coach(
         .name("class-coach".into())
         .spawn(move || lesson::coach(&c, &s))
         .map(Some)
+}
+
+/// The lobby (`lobby.rs`) on a thread of its own: sessions wait there for their page's Start.
+pub(super) fn start_lobby(
+    class: &Arc<Class>,
+    inbox: std::sync::mpsc::Receiver<Box<Live>>,
+    stop: &Arc<AtomicBool>,
+) -> std::io::Result<std::thread::JoinHandle<()>> {
+    let (c, s) = (class.clone(), stop.clone());
+    std::thread::Builder::new()
+        .name("class-lobby".into())
+        .spawn(move || lobby::lobby(&c, inbox, &s))
 }
 
 /// What a class plays, checked before anyone joins.
