@@ -134,7 +134,8 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
         s.workers,
         s.realtime.describe()
     );
-    for (i, c) in s.schedule.iter().enumerate() {
+    // The workers that ticked (none when nobody played).
+    for (i, c) in s.schedule.iter().enumerate().filter(|(_, c)| c.cycles > 0) {
         println!("  tick worker {}: {}", i + 1, c.describe());
     }
     for st in &s.students {

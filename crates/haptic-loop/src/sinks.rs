@@ -64,9 +64,11 @@ impl SessionSinks {
         }
     }
 
-    /// The sinks, in delivery order.
+    /// The sinks, in delivery order, with room for one more (a front end's own, such as
+    /// `play`'s pages): one allocation a tick, never a reallocation.
     pub fn list(&mut self) -> Vec<&mut dyn Sink> {
-        let mut v: Vec<&mut dyn Sink> = vec![&mut self.totals];
+        let mut v: Vec<&mut dyn Sink> = Vec::with_capacity(5);
+        v.push(&mut self.totals);
         if self.keep_arrays {
             v.push(&mut self.arrays);
         }
