@@ -128,6 +128,12 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
         println!("Ctrl-C ends every session and prints the class's figures.");
     })
     .map_err(|e| e.to_string())?;
+    print_summary(&s);
+    Ok(status::SUCCESS)
+}
+
+/// The class's figures at its end: the workers, each student, the report, the refusals.
+fn print_summary(s: &play::classroom::ClassSummary) {
     println!(
         "{} student sessions on {} tick workers; real time: {}",
         s.students.len(),
@@ -161,5 +167,4 @@ pub fn cmd(a: &ClassroomArgs) -> Result<u8, String> {
         r.rate,
         r.head
     );
-    Ok(status::SUCCESS)
 }

@@ -155,6 +155,7 @@ struct RunFigures {
     errors: usize,
     workers: usize,
     client_cores: f64,
+    steal_ms: f64,
     late_cycles: u64,
     began_late: u64,
     cycles: u64,
@@ -164,6 +165,17 @@ struct RunFigures {
     per_session_us: f64,
     replayed: usize,
     policy: &'static str,
+}
+
+/// The machine's stolen time so far (the hypervisor ran other guests on its cores), s summed
+/// over the cores: `/proc/stat`'s steal, in clock ticks of 100 Hz.
+fn steal_s() -> f64 {
+    let stat = std::fs::read_to_string("/proc/stat").unwrap_or_default();
+    stat.lines()
+        .find(|l| l.starts_with("cpu "))
+        .and_then(|l| l.split_whitespace().nth(8))
+        .and_then(|v| v.parse::<f64>().ok())
+        .map_or(0.0, |t| t / 100.0)
 }
 
 /// The students' process's CPU time (user + system of waited-for children), s.
@@ -221,6 +233,7 @@ fn one_run(n: usize, secs: f64, workers: Option<usize>, rt: bool) -> RunFigures 
     let exe = std::env::current_exe().expect("this program");
     let cpu0 = cpu_s();
     let ccpu0 = children_cpu_s();
+    let steal0 = steal_s();
     let w0 = Instant::now();
     let nice = std::env::var("CLIENT_NICE").unwrap_or_else(|_| "0".into());
     let out = Command::new("nice")
@@ -239,6 +252,7 @@ fn one_run(n: usize, secs: f64, workers: Option<usize>, rt: bool) -> RunFigures 
     let wall = w0.elapsed().as_secs_f64();
     let cpu = cpu_s() - cpu0;
     let client_cores = (children_cpu_s() - ccpu0) / wall;
+    let steal_ms = (steal_s() - steal0) * 1e3;
     stop.store(true, Ordering::Relaxed);
     let summary = server
         .join()
@@ -280,6 +294,7 @@ fn one_run(n: usize, secs: f64, workers: Option<usize>, rt: bool) -> RunFigures 
     let session_ticks: u64 = sched.iter().map(|c| c.session_ticks).sum();
     RunFigures {
         client_cores,
+        steal_ms,
         late_cycles: sched.iter().map(|c| c.late_cycles).sum(),
         began_late: sched.iter().map(|c| c.began_late).sum(),
         cycles: sched.iter().map(|c| c.cycles).sum(),
@@ -345,7 +360,7 @@ fn main() {
             "  {} sessions on {} workers ({}), missed {:.3} % (worst session {:.3} %), input → force p99 {:.1} ms, \
              {:.1} frames/s (min), server {:.2} cores, students {:.2} cores; cycles {} late of {} \
              ({} begun a period late), start p99/max {:.0}/{:.0} µs, work p99 {:.0} µs, one \
-             session's tick {:.1} µs; {} of {} recordings replay",
+             session's tick {:.1} µs; {} of {} recordings replay; {:.0} ms stolen",
             f.sessions,
             f.workers,
             f.policy,
@@ -363,7 +378,8 @@ fn main() {
             f.work_p99_us,
             f.per_session_us,
             f.replayed,
-            f.sessions
+            f.sessions,
+            f.steal_ms
         );
         rows.push(f);
     }
@@ -385,14 +401,16 @@ fn main() {
          students' process's user + system time over the run's wall time, in cores; the workers' \
          cycles: how many ran past their deadline (of them, begun a whole period late), how late \
          they began (p99 / max) and one session's tick (the cycles' work over the sessions they \
-         ticked); replayed: the recordings that replay bit for bit.\n\n\
-         | run | sessions | workers (scheduler) | ticks | missed deadlines | worst session | input → force p99, median session (ms) | worst session (ms) | frames/s per page, min / median | CPU server / students (cores) | late cycles (begun late) of all | cycle start p99 / max (µs) | one session's tick (µs) | replayed | client errors |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         ticked); stolen: the time the hypervisor gave the machine's cores to other guests during \
+         the run (`/proc/stat`'s steal, summed over the cores); replayed: the recordings that \
+         replay bit for bit.\n\n\
+         | run | sessions | workers (scheduler) | ticks | missed deadlines | worst session | input → force p99, median session (ms) | worst session (ms) | frames/s per page, min / median | CPU server / students (cores) | late cycles (begun late) of all | cycle start p99 / max (µs) | one session's tick (µs) | stolen (ms) | replayed | client errors |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         std::thread::available_parallelism().map_or(0, |n| n.get())
     );
     for (i, f) in rows.iter().enumerate() {
         md.push_str(&format!(
-            "| {} | {} | {} ({}) | {} | {} ({:.3} %) | {:.3} % | {:.1} | {:.1} | {:.1} / {:.1} | {:.2} / {:.2} | {} ({}) of {} | {:.0} / {:.0} | {:.1} | {} of {} | {} |\n",
+            "| {} | {} | {} ({}) | {} | {} ({:.3} %) | {:.3} % | {:.1} | {:.1} | {:.1} / {:.1} | {:.2} / {:.2} | {} ({}) of {} | {:.0} / {:.0} | {:.1} | {:.0} | {} of {} | {} |\n",
             i + 1,
             f.sessions,
             f.workers,
@@ -413,6 +431,7 @@ fn main() {
             f.start_p99_us,
             f.start_max_us,
             f.per_session_us,
+            f.steal_ms,
             f.replayed,
             f.sessions,
             f.errors

@@ -557,6 +557,24 @@ impl Class {
     }
 }
 
+/// Waits for the stopped workers: the real time the first got (they all ask alike) and every
+/// worker's cycles.
+fn join_workers(
+    handles: Vec<WorkerHandle>,
+) -> (haptic_engine::realtime::RtStatus, Vec<sched::CycleStats>) {
+    let mut realtime = haptic_engine::realtime::RtStatus::default();
+    let mut schedule = Vec::new();
+    for (i, h) in handles.into_iter().enumerate() {
+        if let Ok(r) = h.join() {
+            if i == 0 {
+                realtime = r.realtime;
+            }
+            schedule.push(r.cycles);
+        }
+    }
+    (realtime, schedule)
+}
+
 /// Runs a class: serves the join page, the students' pages and the teacher page (their
 /// addresses are given to `on_ready` as soon as the port is bound), ticks every student's
 /// session, and on `stop` ends every session cleanly (each recording complete) and returns
@@ -615,16 +633,7 @@ pub fn run(
     lobby_stop.store(true, Ordering::Relaxed);
     let _ = lobby.join();
     worker_stop.store(true, Ordering::Relaxed);
-    let mut realtime = haptic_engine::realtime::RtStatus::default();
-    let mut schedule = Vec::new();
-    for (i, h) in handles.into_iter().enumerate() {
-        if let Ok(r) = h.join() {
-            if i == 0 {
-                realtime = r.realtime;
-            }
-            schedule.push(r.cycles);
-        }
-    }
+    let (realtime, schedule) = join_workers(handles);
     if let Some(d) = device {
         // A device that never said hello is not waited for (its own wait may be long): its
         // session never began and has nothing to write.
