@@ -5,7 +5,9 @@
 // its peak amplitude), the proximity tone (220 Hz → 880 Hz below the on-distance, pitch and
 // amplitude interpolated between tick centres, phase continuous), and samples beyond the
 // ±0.98 ceiling limited to it. Its input is the server's binary sound ticks (protocol/sound.rs's
-// SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it.
+// SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it,
+// with the restarts and finishes, which come from the page's link worker (link.js, route.js)
+// on a MessagePort of their own (the page posts it to the node's port as `{ link: port }`).
 //
 // The samples go through a FIFO to the output, which plays a lead behind the processor's
 // clock sized from the ticks' measured arrival jitter. The processor counts the samples it
@@ -256,11 +258,15 @@ class Synth extends AudioWorkletProcessor {
       if (this.synth) this.synth.finish(o.offline.ticks * this.dt);
       this.primed = true;
     }
-    this.port.onmessage = (e) => {
+    // The node's port (the page), and the link worker's (`{ link: MessagePort }`, sent by the
+    // page through the node's): sound ticks, restarts and finishes, in the order they came.
+    const onMessage = (e) => {
       if (e.data instanceof ArrayBuffer) this.take(e.data, Date.now());
       else if (e.data && Number.isFinite(e.data.finish)) this.finish(e.data.finish);
       else if (e.data && e.data.restart) { this.synth = null; this.ending = false; this.heard.restarts++; }
+      else if (e.data && e.data.link) e.data.link.onmessage = onMessage;
     };
+    this.port.onmessage = onMessage;
   }
 
   // The session ended after `ticks` ticks: the stream's last samples, then the end.

@@ -27,8 +27,11 @@ pub struct Browser {
     pub errors: Vec<String>,
     /// Events of the page not yet looked at.
     pub events: Vec<Value>,
-    /// The URL of every WebSocket the page opened, in order (kept however many events come).
+    /// The URL of every WebSocket the page opened, in order (kept however many events come),
+    /// its workers' included (the page's link is a Worker's).
     pub websockets: Vec<String>,
+    /// Workers the page started, paused until their errors and sockets are watched too.
+    workers: Vec<String>,
 }
 
 fn chromium() -> Result<PathBuf, String> {
@@ -110,6 +113,7 @@ impl Browser {
             errors: Vec::new(),
             events: Vec::new(),
             websockets: Vec::new(),
+            workers: Vec::new(),
         };
         let t = b.call_browser("Target.createTarget", json!({"url": "about:blank"}))?;
         let target = t["targetId"].as_str().ok_or("no targetId")?.to_string();
@@ -126,6 +130,11 @@ impl Browser {
         ] {
             b.call(m, json!({}))?;
         }
+        // The page's workers: each starts paused, is watched as the page is, then runs.
+        b.call(
+            "Target.setAutoAttach",
+            json!({"autoAttach": true, "waitForDebuggerOnStart": true, "flatten": true}),
+        )?;
         b.call(
             "Emulation.setDeviceMetricsOverride",
             json!({"width": w, "height": h, "deviceScaleFactor": 1, "mobile": false}),
@@ -156,6 +165,11 @@ impl Browser {
                 "load failed: {}",
                 p["errorText"].as_str().unwrap_or("?")
             )),
+            "Target.attachedToTarget" => {
+                if let Some(id) = p["sessionId"].as_str() {
+                    self.workers.push(id.to_string());
+                }
+            }
             "Network.webSocketCreated" => {
                 self.websockets
                     .push(p["url"].as_str().unwrap_or("?").to_string());
@@ -180,11 +194,32 @@ impl Browser {
     }
 
     fn send(&mut self, method: &str, params: Value, session: bool) -> Result<Value, String> {
+        // Workers attached since the last command: watched, then let run.
+        while let Some(w) = self.workers.pop() {
+            for m in [
+                "Runtime.enable",
+                "Log.enable",
+                "Network.enable",
+                "Runtime.runIfWaitingForDebugger",
+            ] {
+                self.send_to(m, json!({}), Some(&w))?;
+            }
+        }
+        let page = self.session.clone();
+        self.send_to(method, params, session.then_some(page.as_str()))
+    }
+
+    fn send_to(
+        &mut self,
+        method: &str,
+        params: Value,
+        session: Option<&str>,
+    ) -> Result<Value, String> {
         self.next += 1;
         let id = self.next;
         let mut msg = json!({"id": id, "method": method, "params": params});
-        if session {
-            msg["sessionId"] = json!(self.session);
+        if let Some(session) = session {
+            msg["sessionId"] = json!(session);
         }
         self.ws
             .send(Message::text(msg.to_string()))
