@@ -193,8 +193,10 @@ impl Browser {
         }
     }
 
-    fn send(&mut self, method: &str, params: Value, session: bool) -> Result<Value, String> {
-        // Workers attached since the last command: watched, then let run.
+    /// Workers (and worklets) attached since: watched as the page is, then let run, without
+    /// waiting for the answers (a command may be waiting on the worker: an AudioWorklet's
+    /// `addModule`).
+    fn release_workers(&mut self) -> Result<(), String> {
         while let Some(w) = self.workers.pop() {
             for m in [
                 "Runtime.enable",
@@ -202,24 +204,23 @@ impl Browser {
                 "Network.enable",
                 "Runtime.runIfWaitingForDebugger",
             ] {
-                self.send_to(m, json!({}), Some(&w))?;
+                self.next += 1;
+                let msg = json!({"id": self.next, "method": m, "params": {}, "sessionId": w});
+                self.ws
+                    .send(Message::text(msg.to_string()))
+                    .map_err(|e| e.to_string())?;
             }
         }
-        let page = self.session.clone();
-        self.send_to(method, params, session.then_some(page.as_str()))
+        Ok(())
     }
 
-    fn send_to(
-        &mut self,
-        method: &str,
-        params: Value,
-        session: Option<&str>,
-    ) -> Result<Value, String> {
+    fn send(&mut self, method: &str, params: Value, session: bool) -> Result<Value, String> {
+        self.release_workers()?;
         self.next += 1;
         let id = self.next;
         let mut msg = json!({"id": id, "method": method, "params": params});
-        if let Some(session) = session {
-            msg["sessionId"] = json!(session);
+        if session {
+            msg["sessionId"] = json!(self.session);
         }
         self.ws
             .send(Message::text(msg.to_string()))
@@ -239,6 +240,7 @@ impl Browser {
                 return Ok(v["result"].clone());
             }
             self.note(&v);
+            self.release_workers()?;
         }
     }
 
