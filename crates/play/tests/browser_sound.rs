@@ -38,9 +38,9 @@ mod common;
 
 use common::cdp::{Browser, base64_decode};
 use common::live;
+use haptic_engine::runner::EndReason;
 use haptic_loop::session::{SceneSource, SessionArrays, read_arrays};
 use play::PlayConfig;
-use haptic_engine::runner::EndReason;
 use play::protocol::{ServerMsg, SoundKind, SoundOn, SoundTick, SoundTicks};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -595,7 +595,10 @@ fn the_links_route_keeps_restarts_and_finishes_in_the_order_of_the_ticks() {
     let (mut b, server) = PageServer::open("nh-sound-route.mcap");
     let msgs = ServerMsg::examples();
     let [hello, frame, stopped, lesson] = [0, 3, 6, 7].map(|i| msgs[i].to_json());
-    assert!(stopped.contains(r#""end":"stopped","ticks":2000"#), "{stopped}");
+    assert!(
+        stopped.contains(r#""end":"stopped","ticks":2000"#),
+        "{stopped}"
+    );
     let ServerMsg::End(mut e) = msgs[6].clone() else {
         panic!("the sixth example is an end")
     };

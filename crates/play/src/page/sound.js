@@ -70,14 +70,16 @@ export function onLinkReport(d) {
   } else if (Number.isFinite(d.stamp) && s.pageMs.length < 100000) s.pageMs.push(Date.now() - d.stamp);
 }
 
-// The worklet's reports: the end of the stream (what it heard), a sound lost to a drop, or a
-// sound's first sample rendered.
+// The worklet's reports: the end of the stream (what it heard), a stream a restart ended (a
+// lesson's world before the next: what it heard), a sound lost to a drop, or a sound's first
+// sample rendered.
 function onWorklet(m) {
   const s = P.sound;
   if (m.kind === 'done') {
     s.live = m;
     s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs;
   }
+  else if (m.kind === 'stream') s.streams.push(m);
   else if (m.kind === 'lost') s.lost.push([m.tick, m.index]);
   else { if (s.played.length < 100000) s.played.push([m.tick, m.index]); onRendered(m); }
 }

@@ -33,7 +33,9 @@
 // StreamSynth::finish does: the last samples are queued and played, the FIFO running empty then
 // is the end rather than an underrun, and the processor reports `done` with the hash. With
 // `offline` options (a test's OfflineAudioContext) it takes all its ticks at construction and
-// plays from sample 0.
+// plays from sample 0. A `{ restart: true }` message (a lesson's next world) reports what the
+// stream so far heard (`stream`, whether or not it was played to its end) and starts a new one,
+// its hash, drops and `first` afresh (`restarts` 1); underruns and drops stay counted.
 
 const A_MAX = 0.8, CEILING = 0.98, ATTACK_S = 5e-4, TONE_AMPLITUDE = 0.12;
 const TAU = 2 * Math.PI; // std::f64::consts::TAU
@@ -263,10 +265,20 @@ class Synth extends AudioWorkletProcessor {
     const onMessage = (e) => {
       if (e.data instanceof ArrayBuffer) this.take(e.data, Date.now());
       else if (e.data && Number.isFinite(e.data.finish)) this.finish(e.data.finish);
-      else if (e.data && e.data.restart) { this.synth = null; this.ending = false; this.heard.restarts++; }
+      else if (e.data && e.data.restart) this.restart();
       else if (e.data && e.data.link) e.data.link.onmessage = onMessage;
     };
     this.port.onmessage = onMessage;
+  }
+
+  // A new stream (a lesson's next world, its ticks from 0): what the last one heard is
+  // reported (`stream`; `complete`: it was played to its end), then heard afresh.
+  restart() {
+    this.port.postMessage({ ...this.report('stream'), complete: this.done });
+    // The last stream's samples not yet played are not the new one's.
+    this.synth = null; this.ending = false; this.done = false;
+    this.fifo.clear(0); this.primed = false; this.onsets = [];
+    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], restarts: 1 };
   }
 
   // The session ended after `ticks` ticks: the stream's last samples, then the end.
