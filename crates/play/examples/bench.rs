@@ -214,7 +214,7 @@ fn session(
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
-        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs]; })()")?;
+        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs]; })()")?;
         for p in v[5].as_array().into_iter().flatten() {
             for (k, part) in parts.iter_mut().take(3).enumerate() {
                 if let Some(x) = p[k].as_f64() {
@@ -239,15 +239,17 @@ fn session(
         samples_dropped += v[9].as_u64().unwrap_or(0);
         lead = v[10].as_f64().or(lead);
         late = v[13].as_f64().or(late);
-        let page_ms: Vec<f64> = v[14]
-            .as_array()
-            .map(|a| a.iter().filter_map(Value::as_f64).collect())
-            .unwrap_or_default();
+        let list = |v: &Value| -> Vec<f64> {
+            v.as_array()
+                .map(|a| a.iter().filter_map(Value::as_f64).collect())
+                .unwrap_or_default()
+        };
         eprintln!(
-            "{scene}: a page got {} sounds in {} ticks; tick → the page's main thread {}",
+            "{scene}: a page got {} sounds in {} ticks; tick → the page's link worker {}, → the page's main thread {}",
             v[11].as_u64().unwrap_or(0),
             v[12].as_u64().unwrap_or(0),
-            fmt(LatencyMs::of(&page_ms))
+            fmt(LatencyMs::of(&list(&v[15]))),
+            fmt(LatencyMs::of(&list(&v[14])))
         );
         b.check()?;
     }

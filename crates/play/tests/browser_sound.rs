@@ -19,6 +19,10 @@
 //! 50 ms stall and a 300 ms stall over the first sound underrun, drop the backlog and still
 //! play only the track's samples, each sound played or lost once.
 //!
+//! The link worker's route (route.js), also clock-free: fed the server's own messages in a
+//! lesson's order, it sends the worklet the first world's ticks, its finish, the restart and
+//! the second world's ticks in that order, and counts what the page reads.
+//!
 //! Tolerance: none. The worklet computes in f64 as the Rust code does, with the same formulas
 //! in the same order, and writes Float32 (the same round-to-nearest as Rust's `as f32`); only
 //! the transcendental functions could differ (V8's `Math.sin`/`exp`/`pow` against glibc's,
@@ -34,9 +38,10 @@ mod common;
 
 use common::cdp::{Browser, base64_decode};
 use common::live;
+use haptic_engine::runner::EndReason;
 use haptic_loop::session::{SceneSource, SessionArrays, read_arrays};
 use play::PlayConfig;
-use play::protocol::{SoundKind, SoundOn, SoundTick, SoundTicks};
+use play::protocol::{ServerMsg, SoundKind, SoundOn, SoundTick, SoundTicks};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -549,6 +554,147 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_no_underrun_lengthens_it() 
         "{after:?} vs {idle_lo}..{idle_hi}"
     );
     capped(&p);
+    b.check().unwrap();
+    server.close();
+}
+
+/// A sound-ticks message from `first` of `walls.len()` ticks (their wall times, ms), with a
+/// thud on each tick of `sounds` ([tick, index]), base64.
+fn block(first: u64, walls: &[f64], sounds: &[[u64; 2]]) -> String {
+    let m = SoundTicks {
+        first_tick: first,
+        tone_on_distance_m: None,
+        ticks: walls
+            .iter()
+            .map(|&wall_ms| SoundTick {
+                wall_ms,
+                nearest_m: 1.0,
+            })
+            .collect(),
+        sounds: sounds
+            .iter()
+            .map(|&[tick, index]| SoundOn {
+                tick,
+                index: index as u32,
+                kind: SoundKind::Thud,
+                amplitude: 0.5,
+            })
+            .collect(),
+    };
+    base64(&m.encode())
+}
+
+/// The link's route (route.js), driven in the page with no socket and no clock: what reaches
+/// the worklet's port, in order, and the counts the page reads. A lesson's second world
+/// restarts the stream after the first world's finish and before its own first ticks; a
+/// stopped session finishes after the last tick heard; a play session's second hello restarts
+/// nothing; a gap is counted; ticks before the audio opens are counted but not kept; while the
+/// worklet loads 2000 tick messages wait, and the finish after them; with no audio nothing does.
+#[test]
+fn the_links_route_keeps_restarts_and_finishes_in_the_order_of_the_ticks() {
+    let (mut b, server) = PageServer::open("nh-sound-route.mcap");
+    let msgs = ServerMsg::examples();
+    let [hello, frame, stopped, lesson] = [0, 3, 6, 7].map(|i| msgs[i].to_json());
+    assert!(
+        stopped.contains(r#""end":"stopped","ticks":2000"#),
+        "{stopped}"
+    );
+    let ServerMsg::End(mut e) = msgs[6].clone() else {
+        panic!("the sixth example is an end")
+    };
+    e.end = EndReason::Completed;
+    e.ticks = 4;
+    let completed = ServerMsg::End(e).to_json();
+    let js = format!(
+        r#"(async () => {{
+  const {{ SoundRoute }} = await import('/route.js');
+  const ab = (s) => Uint8Array.from(atob(s), (c) => c.charCodeAt(0)).buffer;
+  const [A, B, C, D] = [{a}, {b}, {c}, {d}];
+  const [hello, frame, stopped, lesson, completed] = [{hello}, {frame}, {stopped}, {lesson}, {completed}];
+  // The worklet's port: what it was sent, in order (a tick message by its first tick).
+  const port = () => {{
+    const got = [];
+    return {{ got, postMessage: (m) => got.push(m instanceof ArrayBuffer ? `ticks ${{Number(new DataView(m).getBigUint64(0, true))}}` : JSON.stringify(m)) }};
+  }};
+  // A lesson: two worlds.
+  const r = new SoundRoute(), p = port();
+  const l = [r.text(lesson), r.text(hello), r.binary(ab(A), 1005), r.report()];
+  r.audioOn();
+  l.push(r.binary(ab(B), 1010), r.text(frame));
+  r.connect(p);
+  l.push(r.text(completed), r.text(lesson), r.text(hello), r.binary(ab(C), 2003), r.text(stopped), r.report(), r.report());
+  // A play session: a gap, a second hello, an end.
+  const r2 = new SoundRoute(), p2 = port();
+  r2.text(hello); r2.audioOn(); r2.connect(p2);
+  r2.binary(ab(A), 1001); r2.binary(ab(D), 1006); r2.text(hello); r2.text(completed);
+  // The worklet loads: 2000 tick messages (B: ticks 2 and 3) wait of 2001, and the finish
+  // after them, after tick 3.
+  const r3 = new SoundRoute(), p3 = port();
+  r3.text(hello); r3.audioOn();
+  for (let i = 0; i < 2001; i++) r3.binary(ab(B), 0);
+  r3.text(stopped); r3.connect(p3);
+  // No audio in this browser: nothing is kept, nothing sent.
+  const r4 = new SoundRoute(), p4 = port();
+  r4.audioOn(); r4.binary(ab(A), 0); r4.audioNone(); r4.binary(ab(B), 0); r4.text(stopped); r4.connect(p4);
+  return {{ lesson: [l, p.got], play: [p2.got, r2.report()], loading: [p3.got.length, p3.got[1999], p3.got[2000]], none: [p4.got, r4.report().messages] }};
+}})()"#,
+        a = json!(block(0, &[1000.0, 1001.0], &[[1, 0]])),
+        b = json!(block(2, &[1002.0, 1003.0], &[])),
+        c = json!(block(0, &[2000.0, 2001.0], &[[0, 0]])),
+        d = json!(block(5, &[1005.0], &[])),
+        hello = json!(hello),
+        frame = json!(frame),
+        stopped = json!(stopped),
+        lesson = json!(lesson),
+        completed = json!(completed),
+    );
+    let v = b.eval(&js).unwrap();
+    // (Whole milliseconds come back from the page as integers.)
+    let counts = |messages, ticks, sounds, first: i64, next, gaps, restarts, sent, link| {
+        json!({"messages": messages, "ticks": ticks, "sounds": sounds, "firstTick": first,
+            "nextTick": next, "gaps": gaps, "restarts": restarts, "sent": sent, "linkMs": link})
+    };
+    assert_eq!(
+        v["lesson"],
+        json!([
+            [
+                // The first lesson message and hello; A (its sound's tick 1 at 1001 ms) before
+                // the audio: counted, not kept.
+                true,
+                true,
+                1001,
+                counts(1, 2, 1, 0, 2, 0, 0, json!([[1, 0]]), json!([4])),
+                // B waits; a frame is no stream's start or end.
+                null,
+                false,
+                // The step's end, the next lesson message, the next world's hello, its ticks
+                // C, the lesson stopped.
+                true,
+                true,
+                true,
+                2000,
+                true,
+                counts(3, 6, 2, 0, 2, 0, 1, json!([[0, 0]]), json!([3])),
+                null
+            ],
+            [
+                "ticks 2",
+                r#"{"finish":4}"#,
+                r#"{"restart":true}"#,
+                "ticks 0",
+                r#"{"finish":2}"#
+            ]
+        ])
+    );
+    assert_eq!(
+        v["play"],
+        json!([
+            ["ticks 0", "ticks 5", r#"{"finish":6}"#],
+            counts(2, 3, 1, 0, 6, 1, 0, json!([[1, 0]]), json!([0]))
+        ])
+    );
+    assert_eq!(v["loading"], json!([2001, "ticks 2", r#"{"finish":4}"#]));
+    assert_eq!(v["none"], json!([[], 2]));
     b.check().unwrap();
     server.close();
 }

@@ -198,10 +198,39 @@ fn a_student_completes_a_lesson_by_keyboard_and_each_step_replays() {
             0
         ])
     );
+    // The second world completed: the worklet played its stream to the end and reported it;
+    // the first world's stream it reported when the restart came.
+    b.wait_for("window.__play.sound.live !== null", 10.0)
+        .unwrap();
+    let sound = b.eval("window.__play.sound").unwrap();
     b.check().unwrap();
     stop.store(true, Ordering::Relaxed);
     let summary = handle.join().unwrap().unwrap();
     let l = summary.lesson.unwrap();
+    // Each world's sound, bit for bit against `render --audio` of its recording from its tick
+    // 0: the restart reached the worklet after the first world's ticks and its finish and
+    // before the second's first ticks (the link sends all three on one port, in order). The
+    // first stream may be cut short by the restart (its last samples not yet played).
+    let streams = sound["streams"].as_array().unwrap();
+    assert_eq!(streams.len(), 1, "one restart: {streams:?}");
+    let (first, second) = (&streams[0], &sound["live"]);
+    assert_eq!(
+        (first["kind"].as_str(), second["kind"].as_str()),
+        (Some("stream"), Some("done"))
+    );
+    for (r, run, kind, complete) in [
+        (first, &l.runs[0], "brickworld", first["complete"] == true),
+        (second, &l.runs[1], "nanoworld", true),
+    ] {
+        let a = read_arrays(&run.session.recording, false).unwrap();
+        let (sr, track, _, played) = common::live::check_samples(&a, kind, r, complete);
+        println!(
+            "{}: {played} of {} samples at {sr} Hz played (complete {complete})",
+            run.id,
+            track.len()
+        );
+    }
+    assert_eq!(second["restarts"], 1);
 
     // Every answer reached the progress.
     let p = &l.progress;

@@ -4,9 +4,13 @@
 //   camera.js    the orbit camera and the projection
 //   draw.js      a frame's shapes on the canvas
 //   input.js     pointer, keyboard and gamepad as the hand
-//   sound.js     the audio output and the sound ticks to the synthesis
+//   sound.js     the audio output, the synthesis's node and the sound's counts
 //   synth.js     the synthesis, an AudioWorklet processor (render --audio's, ported)
-//   messages.js  the WebSocket and a handler per message type
+//   messages.js  the link's worker and a handler per message type
+//   link.js      the link, a dedicated Worker: the WebSocket; the sound ticks go from it
+//                straight to the synthesis's port, the text messages to this thread
+//   route.js     the link's routing: the ticks counted and to the synthesis, a lesson's
+//                restarts and the ends in their order (no socket, no clock: tested alone)
 //   events.js    the events in words: which the player hears, which stay in the recording
 //   lesson.js    the lesson (play --lesson): its questions as forms, the step's task, the end
 // window.__play holds figures for tests and benches.

@@ -1,19 +1,23 @@
-// nanohaptics play: the link to the server. One WebSocket (`/ws` and the page's own query):
-// JSON text messages tagged by `type` (docs/play.md's table; crates/play/src/protocol/'s
-// ServerMsg and PageMsg), each handled by its entry in HANDLERS, and binary sound ticks for
-// the sound module. The events' words are events.js's.
+// nanohaptics play: the link to the server. One WebSocket (`/ws` and the page's own query),
+// owned by a dedicated Worker (link.js), which sends the binary sound ticks straight to the
+// synthesis and passes the JSON text messages on to this thread: each tagged by `type`
+// (docs/play.md's table; crates/play/src/protocol/'s ServerMsg and PageMsg) and handled by its
+// entry in HANDLERS. The events' words are events.js's.
 
 import { $, P, log, say } from './page.js';
 import { aimAtWorkspace } from './camera.js';
-import { finishAudio, onSoundTicks, restartAudio } from './sound.js';
+import { onLinkReport } from './sound.js';
 import { eventClass, sentence } from './events.js';
 import { lessonRuns, onLesson } from './lesson.js';
 
-let ws = null;
+const LINK_URL = new URL('./link.js', import.meta.url);
+let link = null;
 
 // Sends a page message (an object with its `type`) if the link is open.
-export function send(o) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(o)); }
+export function send(o) { if (link) link.postMessage({ send: JSON.stringify(o) }); }
 
+// A message to the link worker (`transfer`: the objects it takes over, a MessagePort).
+export function toLink(m, transfer) { if (link) link.postMessage(m, transfer || []); }
 // The events of a frame, in words (events.js classes them): the game's events of half a
 // second in one sentence, repeats counted ("grabbed brick 1; slot 1 filled with brick 1"),
 // so a screen reader is not flooded; the grip at once. The loop's timing, safety and device
@@ -60,8 +64,7 @@ function showSwitch(name, v) {
 
 // `hello`: the scene, the device, the menu; the Start button opens.
 function onHello(h) {
-  // A lesson's next world: its ticks (and its sound's) start again at 0.
-  if (lessonRuns() && P.hello) restartAudio();
+  // A lesson's next world: the link (route.js) has restarted the sound's stream at tick 0.
   P.hello = h;
   $('title').textContent = h.scene;
   aimAtWorkspace(h);
@@ -128,8 +131,8 @@ function onEnd(m) {
   // In a lesson a step's world completed, not the page's session: the next `lesson` message
   // says what follows (the hand goes on into the next step's world). A stopped world (E,
   // Ctrl-C) ends the lesson there, with the end screen.
-  if (lessonRuns() && m.end === 'completed') { P.stepEnds.push(m); finishAudio(m.ticks); return; }
-  finishAudio(P.sound.nextTick);
+  // The link (route.js) has finished the sound's stream, in the same order.
+  if (lessonRuns() && m.end === 'completed') { P.stepEnds.push(m); return; }
   P.ended = m;
   const rows = [['how it ended', m.end], ['time', `${m.seconds.toFixed(2)} s`], ['score', (m.state.score ?? 0).toFixed(1)]];
   for (const k of ['slots_filled', 'house_score', 'dropped', 'comfort_exceeded_s', 'complete_s']) {
@@ -174,17 +177,23 @@ const HANDLERS = new Map([
   ['lesson', onLesson],
 ]);
 
-// Opens the link: text messages to their handlers, binary ones (sound ticks) to the sound.
+// Opens the link: the worker opens the socket; text messages come back to their handlers, the
+// link's reports (the sound's counts) to the sound module.
 export function connect() {
   // `/ws` with the page's own query (a classroom's `?s=TOKEN` comes back with the link).
   const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
-  ws = new WebSocket(`${scheme}://${location.host}/ws${location.search}`);
-  ws.binaryType = 'arraybuffer';
-  ws.onmessage = (ev) => {
-    if (typeof ev.data !== 'string') { onSoundTicks(ev.data); return; }
-    const m = JSON.parse(ev.data);
-    const handle = HANDLERS.get(m.type);
-    if (handle) handle(m);
+  try {
+    link = new Worker(LINK_URL, { type: 'module' });
+  } catch (err) { say('this browser cannot open the link to the server'); return; }
+  link.onmessage = (e) => {
+    const d = e.data;
+    if (typeof d === 'string') {
+      const m = JSON.parse(d);
+      const handle = HANDLERS.get(m.type);
+      if (handle) handle(m);
+    } else if (d.closed) { if (!P.ended) say('the server closed the link'); }
+    else onLinkReport(d);
   };
-  ws.onclose = () => { if (!P.ended) say('the server closed the link'); };
+  link.onerror = () => say('the link to the server failed to load');
+  link.postMessage({ open: `${scheme}://${location.host}/ws${location.search}` });
 }

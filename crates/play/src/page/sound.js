@@ -1,16 +1,18 @@
 // nanohaptics play: sound. The page synthesises it: the server's binary sound ticks (per tick
 // its wall time and the distance to the nearest object, and the sounds that start on it; see
-// protocol/sound.rs's SoundTicks) go to an AudioWorklet (synth.js), which runs the same synthesis as
-// `nanohaptics render REC --audio OUT.wav --proximity` at the AudioContext's own sample rate.
-// The audio starts on the Start press (a user gesture); `m` mutes it. For the benches, each
-// sound's tick → output latency is measured when the worklet renders its first sample. For the
-// tests, the page keeps the sounds it was sent and those the worklet played (or lost to a
-// drop), and at the session's end the worklet's hash of every sample it played (`P.sound.live`).
+// protocol/sound.rs's SoundTicks) go from the link worker (link.js, route.js) straight to an
+// AudioWorklet (synth.js) through a MessagePort, never through this thread; the worklet runs
+// the same synthesis as `nanohaptics render REC --audio OUT.wav --proximity` at the
+// AudioContext's own sample rate. The audio starts on the Start press (a user gesture); `m`
+// mutes it. For the benches, each sound's tick → output latency is measured when the worklet
+// renders its first sample. For the tests, the page keeps the sounds it was sent (counted by
+// the link) and those the worklet played (or lost to a drop), and at the session's end the
+// worklet's hash of every sample it played (`P.sound.live`).
 
 import { P, say } from './page.js';
+import { toLink } from './messages.js';
 
 let actx = null, gain = null, node = null, muted = false;
-let waiting = []; // sound ticks received while the worklet loads
 // The lead (how far the worklet plays behind its own clock), s: the worklet sizes it from the
 // ticks' measured arrival jitter (synth.js), past the earliest arrival at least LEAD_S until
 // it has measured 4 s and at most LEAD_MAX_S (a stall longer than that underruns and its
@@ -38,10 +40,14 @@ export function startAudio() {
       });
       node.port.onmessage = (e) => onWorklet(e.data);
       node.connect(gain);
-      for (const b of waiting) node.port.postMessage(b, b instanceof ArrayBuffer ? [b] : []);
-      waiting = [];
-    }).catch(() => { node = null; say('sound is not available in this browser'); });
-  } catch (err) { actx = null; say('sound is not available in this browser'); }
+      // The link's port to the worklet: the sound ticks (and what waited) go through it.
+      const ch = new MessageChannel();
+      node.port.postMessage({ link: ch.port1 }, [ch.port1]);
+      toLink({ port: ch.port2 }, [ch.port2]);
+    }).catch(() => { node = null; toLink({ audio: 'none' }); say('sound is not available in this browser'); });
+    // The link keeps the ticks from now until the worklet's port comes.
+    toLink({ audio: 'on' });
+  } catch (err) { actx = null; toLink({ audio: 'none' }); say('sound is not available in this browser'); }
 }
 
 // Sound on or off.
@@ -51,55 +57,29 @@ export function toggleMute() {
   say(muted ? 'sound off' : 'sound on');
 }
 
-// One binary sound-ticks message (an ArrayBuffer): counted, then to the worklet.
-export function onSoundTicks(buf) {
+// The link's reports: its counts of the sound ticks (the same fields as before the link had a
+// worker; `linkMs`: tick → the link worker has it, per message with a sound), and the wall
+// time of a tick with a sound as the link passes it on (`pageMs`: tick → this thread has it).
+export function onLinkReport(d) {
   const s = P.sound;
-  if (buf.byteLength >= 24) {
-    const dv = new DataView(buf);
-    const first = Number(dv.getBigUint64(0, true));
-    if (s.firstTick < 0) s.firstTick = first;
-    else if (first !== s.nextTick) s.gaps++;
-    const nt = dv.getUint32(16, true), ns = dv.getUint32(20, true);
-    s.nextTick = first + nt; s.ticks += nt; s.sounds += ns;
-    // Each sound: its tick (u64) and its index in the session's list (u32).
-    for (let j = 0, at = 24 + 16 * nt; j < ns && at + 24 <= buf.byteLength && s.sent.length < 100000; j++, at += 24) {
-      const tick = Number(dv.getBigUint64(at, true));
-      s.sent.push([tick, dv.getUint32(at + 8, true)]);
-      // Tick → the page has it (before the worklet), ms.
-      const i = tick - first;
-      if (j === 0 && i >= 0 && i < nt && s.pageMs.length < 100000) s.pageMs.push(Date.now() - dv.getFloat64(24 + 16 * i, true));
-    }
-  }
-  s.messages++;
-  if (!actx) return;
-  if (node) node.port.postMessage(buf, [buf]);
-  else if (waiting.length < 2000) waiting.push(buf);
+  if (d.counts) {
+    const c = d.counts;
+    for (const k of ['messages', 'ticks', 'sounds', 'firstTick', 'nextTick', 'gaps', 'restarts']) s[k] = c[k];
+    for (const x of c.sent) s.sent.push(x);
+    for (const x of c.linkMs) s.linkMs.push(x);
+  } else if (Number.isFinite(d.stamp) && s.pageMs.length < 100000) s.pageMs.push(Date.now() - d.stamp);
 }
 
-// A new world (a lesson's next step) whose ticks start again at 0: the synthesis starts a new
-// stream at its first sound ticks.
-export function restartAudio() {
-  P.sound.restarts++; P.sound.nextTick = 0;
-  if (!actx) return;
-  if (node) node.port.postMessage({ restart: true });
-  else waiting.push({ restart: true });
-}
-
-// The session ended after `ticks` ticks: the worklet plays its last samples, then reports.
-export function finishAudio(ticks) {
-  if (!actx) return;
-  if (node) node.port.postMessage({ finish: ticks });
-  else waiting.push({ finish: ticks });
-}
-
-// The worklet's reports: the end of the stream (what it heard), a sound lost to a drop, or a
-// sound's first sample rendered.
+// The worklet's reports: the end of the stream (what it heard), a stream a restart ended (a
+// lesson's world before the next: what it heard), a sound lost to a drop, or a sound's first
+// sample rendered.
 function onWorklet(m) {
   const s = P.sound;
   if (m.kind === 'done') {
     s.live = m;
     s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs;
   }
+  else if (m.kind === 'stream') s.streams.push(m);
   else if (m.kind === 'lost') s.lost.push([m.tick, m.index]);
   else { if (s.played.length < 100000) s.played.push([m.tick, m.index]); onRendered(m); }
 }

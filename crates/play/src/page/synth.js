@@ -5,7 +5,9 @@
 // its peak amplitude), the proximity tone (220 Hz → 880 Hz below the on-distance, pitch and
 // amplitude interpolated between tick centres, phase continuous), and samples beyond the
 // ±0.98 ceiling limited to it. Its input is the server's binary sound ticks (protocol/sound.rs's
-// SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it.
+// SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it,
+// with the restarts and finishes, which come from the page's link worker (link.js, route.js)
+// on a MessagePort of their own (the page posts it to the node's port as `{ link: port }`).
 //
 // The samples go through a FIFO to the output, which plays a lead behind the processor's
 // clock sized from the ticks' measured arrival jitter. The processor counts the samples it
@@ -31,7 +33,9 @@
 // StreamSynth::finish does: the last samples are queued and played, the FIFO running empty then
 // is the end rather than an underrun, and the processor reports `done` with the hash. With
 // `offline` options (a test's OfflineAudioContext) it takes all its ticks at construction and
-// plays from sample 0.
+// plays from sample 0. A `{ restart: true }` message (a lesson's next world) reports what the
+// stream so far heard (`stream`, whether or not it was played to its end) and starts a new one,
+// its hash, drops and `first` afresh (`restarts` 1); underruns and drops stay counted.
 
 const A_MAX = 0.8, CEILING = 0.98, ATTACK_S = 5e-4, TONE_AMPLITUDE = 0.12;
 const TAU = 2 * Math.PI; // std::f64::consts::TAU
@@ -256,11 +260,25 @@ class Synth extends AudioWorkletProcessor {
       if (this.synth) this.synth.finish(o.offline.ticks * this.dt);
       this.primed = true;
     }
-    this.port.onmessage = (e) => {
+    // The node's port (the page), and the link worker's (`{ link: MessagePort }`, sent by the
+    // page through the node's): sound ticks, restarts and finishes, in the order they came.
+    const onMessage = (e) => {
       if (e.data instanceof ArrayBuffer) this.take(e.data, Date.now());
       else if (e.data && Number.isFinite(e.data.finish)) this.finish(e.data.finish);
-      else if (e.data && e.data.restart) { this.synth = null; this.ending = false; this.heard.restarts++; }
+      else if (e.data && e.data.restart) this.restart();
+      else if (e.data && e.data.link) e.data.link.onmessage = onMessage;
     };
+    this.port.onmessage = onMessage;
+  }
+
+  // A new stream (a lesson's next world, its ticks from 0): what the last one heard is
+  // reported (`stream`; `complete`: it was played to its end), then heard afresh.
+  restart() {
+    this.port.postMessage({ ...this.report('stream'), complete: this.done });
+    // The last stream's samples not yet played are not the new one's.
+    this.synth = null; this.ending = false; this.done = false;
+    this.fifo.clear(0); this.primed = false; this.onsets = [];
+    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], restarts: 1 };
   }
 
   // The session ended after `ticks` ticks: the stream's last samples, then the end.

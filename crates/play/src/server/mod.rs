@@ -57,7 +57,7 @@ const fn file(path: &'static str, content_type: &'static str, body: &'static str
 }
 
 /// Every file of the page: the HTML, the style sheet and the JavaScript modules (`main.js`
-/// imports the others). These paths, `/ws`, `/favicon.ico` and `/recording.mcap` are all the
+/// imports the others; `messages.js` starts `link.js`, a Worker, which imports `route.js`). These paths, `/ws`, `/favicon.ico` and `/recording.mcap` are all the
 /// server answers; anything else is 404.
 pub const PAGE_FILES: &[PageFile] = &[
     file("/", HTML, INDEX_HTML),
@@ -71,6 +71,8 @@ pub const PAGE_FILES: &[PageFile] = &[
     file("/sound.js", JS, include_str!("../page/sound.js")),
     file("/synth.js", JS, include_str!("../page/synth.js")),
     file("/messages.js", JS, include_str!("../page/messages.js")),
+    file("/link.js", JS, include_str!("../page/link.js")),
+    file("/route.js", JS, include_str!("../page/route.js")),
     file("/events.js", JS, include_str!("../page/events.js")),
     file("/lesson.js", JS, include_str!("../page/lesson.js")),
 ];

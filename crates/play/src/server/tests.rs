@@ -43,7 +43,7 @@ fn last_error(rx: &Receiver<Message>) -> serde_json::Value {
 }
 
 /// The modules `body` imports, and those it loads by URL (`new URL('./synth.js',
-/// import.meta.url)`: the AudioWorklet's module).
+/// import.meta.url)`: the AudioWorklet's module; `./link.js`: the link's Worker).
 fn imports(body: &str) -> Vec<String> {
     let imported = body
         .lines()

@@ -27,8 +27,11 @@ pub struct Browser {
     pub errors: Vec<String>,
     /// Events of the page not yet looked at.
     pub events: Vec<Value>,
-    /// The URL of every WebSocket the page opened, in order (kept however many events come).
+    /// The URL of every WebSocket the page opened, in order (kept however many events come),
+    /// its workers' included (the page's link is a Worker's).
     pub websockets: Vec<String>,
+    /// Workers the page started, paused until their errors and sockets are watched too.
+    workers: Vec<String>,
 }
 
 fn chromium() -> Result<PathBuf, String> {
@@ -110,6 +113,7 @@ impl Browser {
             errors: Vec::new(),
             events: Vec::new(),
             websockets: Vec::new(),
+            workers: Vec::new(),
         };
         let t = b.call_browser("Target.createTarget", json!({"url": "about:blank"}))?;
         let target = t["targetId"].as_str().ok_or("no targetId")?.to_string();
@@ -126,6 +130,11 @@ impl Browser {
         ] {
             b.call(m, json!({}))?;
         }
+        // The page's workers: each starts paused, is watched as the page is, then runs.
+        b.call(
+            "Target.setAutoAttach",
+            json!({"autoAttach": true, "waitForDebuggerOnStart": true, "flatten": true}),
+        )?;
         b.call(
             "Emulation.setDeviceMetricsOverride",
             json!({"width": w, "height": h, "deviceScaleFactor": 1, "mobile": false}),
@@ -156,6 +165,11 @@ impl Browser {
                 "load failed: {}",
                 p["errorText"].as_str().unwrap_or("?")
             )),
+            "Target.attachedToTarget" => {
+                if let Some(id) = p["sessionId"].as_str() {
+                    self.workers.push(id.to_string());
+                }
+            }
             "Network.webSocketCreated" => {
                 self.websockets
                     .push(p["url"].as_str().unwrap_or("?").to_string());
@@ -179,7 +193,29 @@ impl Browser {
         }
     }
 
+    /// Workers (and worklets) attached since: watched as the page is, then let run, without
+    /// waiting for the answers (a command may be waiting on the worker: an AudioWorklet's
+    /// `addModule`).
+    fn release_workers(&mut self) -> Result<(), String> {
+        while let Some(w) = self.workers.pop() {
+            for m in [
+                "Runtime.enable",
+                "Log.enable",
+                "Network.enable",
+                "Runtime.runIfWaitingForDebugger",
+            ] {
+                self.next += 1;
+                let msg = json!({"id": self.next, "method": m, "params": {}, "sessionId": w});
+                self.ws
+                    .send(Message::text(msg.to_string()))
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        Ok(())
+    }
+
     fn send(&mut self, method: &str, params: Value, session: bool) -> Result<Value, String> {
+        self.release_workers()?;
         self.next += 1;
         let id = self.next;
         let mut msg = json!({"id": id, "method": method, "params": params});
@@ -204,6 +240,7 @@ impl Browser {
                 return Ok(v["result"].clone());
             }
             self.note(&v);
+            self.release_workers()?;
         }
     }
 
