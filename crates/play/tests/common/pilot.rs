@@ -63,6 +63,10 @@ pub fn yaw(q: [f64; 4]) -> f64 {
     2.0 * q[2].atan2(q[3])
 }
 
+/// A brick whose centre is higher than this (m) floats: it is not taken (gravity off lets a
+/// nudged one drift up out of the hand's reach).
+const LYING_BELOW_M: f64 = 0.12;
+
 /// The pilot of one page.
 pub struct Pilot<'a> {
     /// The browser it drives.
@@ -338,8 +342,19 @@ impl<'a> Pilot<'a> {
     }
 
     /// Makes a brick appear (the hand enters the loading zone) and takes it into the hand:
-    /// down onto its top, Space. Returns the brick as it lay.
+    /// down onto its top, Space. Returns the brick as it lay. A brick that floats off (gravity
+    /// off: a nudged one drifts up out of the hand's reach) is left, and another taken.
     pub fn fetch_brick(&mut self) -> Body {
+        for _ in 0..3 {
+            if let Some(b) = self.try_fetch_brick() {
+                return b;
+            }
+        }
+        panic!("could not take a brick in three tries");
+    }
+
+    /// [`Pilot::fetch_brick`] once: `None` when the brick slipped the grip every time.
+    fn try_fetch_brick(&mut self) -> Option<Body> {
         let (lo, hi) = self.loading_zone();
         let inside = |p: V3| p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1];
         let here = self.hand_world();
@@ -355,7 +370,7 @@ impl<'a> Pilot<'a> {
         let lying = |p: &mut Pilot| {
             p.bricks()
                 .into_iter()
-                .filter(|b| !b.held && near(b.c))
+                .filter(|b| !b.held && near(b.c) && b.c[2] < LYING_BELOW_M)
                 .min_by(|a, b| a.c[2].total_cmp(&b.c[2]))
         };
         // A brick the zone gave when the world began under the hand, or a new one: the hand
@@ -386,12 +401,16 @@ impl<'a> Pilot<'a> {
         let mut brick = brick;
         for _ in 0..4 {
             if self.try_grab_brick(brick) {
-                return brick;
+                return Some(brick);
             }
             self.next_frame();
-            brick = lying(self).unwrap_or(brick);
+            match lying(self) {
+                Some(b) => brick = b,
+                None => break,
+            }
         }
-        panic!("could not take the brick at {:?}", brick.c);
+        eprintln!("  could not take the brick at {:?}: another", brick.c);
+        None
     }
 
     /// Takes the brick lying at `brick` into the hand (panics if it cannot).
