@@ -45,8 +45,10 @@ pub const DEFAULT_PRIORITY: u8 = 50;
 pub struct RtRequest {
     /// `SCHED_FIFO` priority, 1–99.
     pub priority: u8,
-    /// Lock the process's memory (`mlockall(MCL_CURRENT | MCL_FUTURE)`): no page fault in a
-    /// tick. Only tried where it cannot make a later allocation fail (a process with
+    /// Lock the process's memory (`mlockall(MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT)`): no page
+    /// is paged out once touched, and locking populates nothing (a page faults in once, at its
+    /// first touch), so its cost does not grow with what the allocator keeps: a tick faults no
+    /// page it touched before. Only tried where it cannot make a later allocation fail (a process with
     /// `CAP_IPC_LOCK` or an unlimited `RLIMIT_MEMLOCK`).
     pub lock_memory: bool,
     /// Pin the thread to one core (the last it may run on) when it may run on more than one.
@@ -484,8 +486,14 @@ mod sys {
         }
         if req.lock_memory {
             if has_cap(CAP_IPC_LOCK) || rlimit(libc::RLIMIT_MEMLOCK).is_none() {
+                // MCL_ONFAULT: lock pages as they are touched, never populate them here (the
+                // allocator's kept memory made a lock that populated it take 250 ms in the
+                // wheel, long enough for a bridged device's first samples to be lost).
                 // SAFETY: mlockall takes flags only.
-                if unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) } == 0 {
+                if unsafe {
+                    libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE | libc::MCL_ONFAULT)
+                } == 0
+                {
                     st.memory_locked = true;
                 } else {
                     st.lock_refused = Some(Refusal::Errno(errno()));
