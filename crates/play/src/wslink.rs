@@ -7,8 +7,12 @@
 //!
 //! A link with a [`WakeRx`] (a game page's, on unix) waits for the page's socket and for its
 //! peer's queue at once (`poll`), so a queued message (a tick's sound input) goes out as soon
-//! as it is queued; without one, the loop reads with a `read_wait` timeout and writes after
-//! each read, so a message can wait up to `read_wait` (2 ms) for its turn.
+//! as it is queued; without one, the loop waits up to `read_wait` for the page and writes
+//! after each wait, so a message can wait up to `read_wait` (2 ms) for its turn.
+//!
+//! On unix the socket never blocks: what a page does not take stays in the bounded write
+//! buffer and is tried again each turn, so a page that stops reading holds neither its link's
+//! reads nor the server's end. At the close, what is left gets [`CLOSE_WAIT`] to go out.
 
 use std::net::TcpStream;
 #[cfg(unix)]
@@ -101,37 +105,33 @@ impl WakeRx {
     }
 }
 
-/// How long a read waits once `poll` said the page's socket is readable (the rest of a frame).
-const READ_SLICE: Duration = Duration::from_micros(200);
+/// How long the close waits for a page to take what is left (its last messages, the close).
+pub const CLOSE_WAIT: Duration = Duration::from_millis(500);
 
 /// Waits up to `timeout` for the socket `fd` or the wake-up to be readable: (socket, wake-up).
 #[cfg(unix)]
-#[allow(unsafe_code)] // one libc::poll on two descriptors this link owns
-fn wait(fd: std::os::fd::RawFd, wake: &WakeRx, timeout: Duration) -> (bool, bool) {
+#[allow(unsafe_code)] // one libc::poll on the descriptors this link owns
+fn wait(fd: std::os::fd::RawFd, wake: Option<&WakeRx>, timeout: Duration) -> (bool, bool) {
     use std::os::fd::AsRawFd;
-    let mut fds = [
-        libc::pollfd {
-            fd,
-            events: libc::POLLIN,
-            revents: 0,
-        },
-        libc::pollfd {
-            fd: wake.rx.as_raw_fd(),
-            events: libc::POLLIN,
-            revents: 0,
-        },
-    ];
+    let poll_fd = |fd| libc::pollfd {
+        fd,
+        events: libc::POLLIN,
+        revents: 0,
+    };
+    let mut fds = [poll_fd(fd), poll_fd(wake.map_or(-1, |w| w.rx.as_raw_fd()))];
     let ms = i32::try_from(timeout.as_millis())
         .unwrap_or(i32::MAX)
         .max(1);
-    // SAFETY: `fds` is an array of two initialised pollfd, valid for the call's duration.
-    let n = unsafe { libc::poll(fds.as_mut_ptr(), 2, ms) };
+    let n_fds: libc::nfds_t = if wake.is_some() { 2 } else { 1 };
+    // SAFETY: `fds` is an array of two initialised pollfd, valid for the call's duration, and
+    // `n_fds` is at most its length.
+    let n = unsafe { libc::poll(fds.as_mut_ptr(), n_fds, ms) };
     if n < 0 {
-        // Interrupted or failed: read (within READ_SLICE) as if the socket were ready.
+        // Interrupted or failed: read as if the socket were ready (it does not block).
         return (true, false);
     }
     let ready = |f: &libc::pollfd| f.revents & (libc::POLLIN | libc::POLLHUP | libc::POLLERR) != 0;
-    (ready(&fds[0]), ready(&fds[1]))
+    (ready(&fds[0]), wake.is_some() && ready(&fds[1]))
 }
 
 /// Runs the link on `stream` until the page closes it, the peer stops, or a limit of `gate`
@@ -145,14 +145,10 @@ pub fn run(
 ) {
     #[cfg(unix)]
     let fd = std::os::fd::AsRawFd::as_raw_fd(&stream);
+    #[cfg(unix)]
+    let _ = stream.set_nonblocking(true);
     #[cfg(not(unix))]
-    let wake: Option<&WakeRx> = wake.and(None);
-    let read_timeout = if wake.is_some() {
-        READ_SLICE
-    } else {
-        link.read_wait
-    };
-    let _ = stream.set_read_timeout(Some(read_timeout));
+    let _ = stream.set_read_timeout(Some(link.read_wait));
     let max = gate.limits.max_message_bytes;
     let mut config = WebSocketConfig::default()
         .max_message_size(Some(max))
@@ -168,16 +164,18 @@ pub fn run(
     // The last read returned a message: more may wait in the WebSocket's buffer, unseen by poll.
     let mut again = false;
     'link: while !peer.stopped() {
-        let readable = match wake {
-            #[cfg(unix)]
-            Some(w) if !again => {
-                let (readable, woken) = wait(fd, w, link.read_wait);
-                if woken {
-                    w.drain();
-                }
-                readable
+        #[cfg(unix)]
+        let readable = again || {
+            let (readable, woken) = wait(fd, wake, link.read_wait);
+            if woken && let Some(w) = wake {
+                w.drain();
             }
-            _ => true,
+            readable
+        };
+        #[cfg(not(unix))]
+        let readable = {
+            let _ = (again, wake);
+            true
         };
         let mut msg = if readable {
             ws.read()
@@ -208,25 +206,34 @@ pub fn run(
             }
             Err(_) => break,
         }
-        let mut wrote = false;
         while let Some(m) = peer.next_out() {
             match ws.write(m) {
-                Ok(()) => wrote = true,
-                Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {
-                    wrote = true;
-                }
+                Ok(()) => {}
+                // Buffered: it goes out when the page takes what is before it.
+                Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {}
                 // The page has not taken what was written: this message is dropped, counted,
                 // and the rest wait in the peer's bounded queue.
                 Err(tungstenite::Error::WriteBufferFull(_)) => {
                     peer.dropped();
-                    wrote = true;
                     break;
                 }
                 Err(_) => break 'link,
             }
         }
-        if wrote && ws.flush().is_err() {
-            let _ = ws.flush();
+        // Every turn, so what a busy page left in the buffer goes out once it reads again.
+        match ws.flush() {
+            Ok(()) => {}
+            Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+            Err(_) => break,
+        }
+    }
+    // The close and what is left get CLOSE_WAIT, not the socket's whole write timeout.
+    let _ = ws.get_mut().set_nonblocking(false);
+    let _ = ws.get_mut().set_write_timeout(Some(CLOSE_WAIT));
+    // What the peer queued before it stopped (a session's end) goes before the close.
+    while let Some(m) = peer.next_out() {
+        if ws.write(m).is_err() {
+            break;
         }
     }
     let _ = ws.close(None);

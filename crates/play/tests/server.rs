@@ -86,6 +86,16 @@ fn page(url: &str) -> Ws {
     ws
 }
 
+/// Waits for the session's hello (within 10 s), then presses Start, as the page does (its
+/// Start button is enabled by the hello).
+fn start_when_open(ws: &mut Ws) {
+    let t0 = Instant::now();
+    while !read_for(ws, 0.05).iter().any(|m| m["type"] == "hello") {
+        assert!(t0.elapsed() < Duration::from_secs(10), "no hello in 10 s");
+    }
+    send(ws, serde_json::json!({"type": "start"}));
+}
+
 /// The text messages that arrive within `secs` (each one also read as a typed
 /// [`ServerMsg`]: what the server sends is what the protocol's type says).
 fn read_for(ws: &mut Ws, secs: f64) -> Vec<Value> {
@@ -393,7 +403,7 @@ fn forged_origin_and_host_are_refused_counted_and_change_nothing() {
     assert!(upgrade(&url, &lh, &format!("http://{lh}")).starts_with("HTTP/1.1 101"));
     // A real page plays; too big a message closes only its own link.
     let mut p = page(&url);
-    send(&mut p, serde_json::json!({"type": "start"}));
+    start_when_open(&mut p);
     send(
         &mut p,
         serde_json::json!({"type": "input", "seq": 1, "pos": [0, 0, 0], "buttons": 0, "t_ms": 1}),
@@ -457,7 +467,7 @@ fn a_page_that_stops_reading_loses_frames_never_the_loop() {
     let addr = url.trim_start_matches("http://").trim_end_matches('/');
     // The player's page.
     let mut p = page(&url);
-    send(&mut p, serde_json::json!({"type": "start"}));
+    start_when_open(&mut p);
     // A page that opens its link and then never reads, with a small receive buffer so its
     // socket fills within a second.
     let raw = TcpStream::connect(addr).unwrap();
@@ -491,7 +501,15 @@ fn a_page_that_stops_reading_loses_frames_never_the_loop() {
     send(&mut p, serde_json::json!({"type": "end"}));
     let _ = read_for(&mut p, 0.3);
     stop.store(true, Ordering::Relaxed);
+    let tj = Instant::now();
     let s = h.join().unwrap().unwrap();
+    // The end did not wait for the stalled page: no write waited out its socket's timeout (its
+    // link gets CLOSE_WAIT at the close; the 5 s timeout, twice a turn, held it 21.7 s).
+    let ended_in = tj.elapsed();
+    assert!(
+        ended_in < Duration::from_secs(play::server::WRITE_TIMEOUT_S),
+        "the end took {ended_in:?}"
+    );
     // The stalled page's queue overflowed: its frames were dropped, counted…
     assert!(s.messages_dropped > 0, "{s:?}");
     // …while the player's page kept receiving them in the last second,

@@ -23,6 +23,15 @@ pub(crate) fn on_message(shared: &Shared, id: u64, text: &str) {
     let is_player = |sh: &Shared| sh.player.lock().map(|p| *p == Some(id)).unwrap_or(false);
     match msg {
         PageMsg::Start => {
+            // Before the session is open nobody knows yet whether the page is the hand: the
+            // page offers Start only after the hello, so an early one is answered, not kept.
+            if link.is_none() {
+                return shared.error_to(
+                    id,
+                    "type",
+                    "the session is not open yet: press Start after its hello",
+                );
+            }
             if link.as_ref().is_some_and(|l| l.page_is_hand)
                 && let Ok(mut p) = shared.player.lock()
                 && p.is_none()

@@ -200,3 +200,23 @@ fn with_a_device_as_the_hand_the_pages_only_watch() {
     );
     assert_eq!(sh.input.latest().0.count, 0);
 }
+
+#[test]
+fn a_start_before_the_hello_is_refused_by_name_and_a_start_after_it_plays() {
+    let (sh, r1, _) = shared(true);
+    let link = sh.scene.lock().unwrap().take();
+    // The session is not open yet (no scene, no hello): the start is answered, not lost.
+    on_message(&sh, 1, r#"{"type":"start"}"#);
+    let e = last_error(&r1);
+    assert_eq!(e["type"], "error");
+    assert_eq!(e["field"], "type");
+    assert_eq!(
+        e["message"],
+        "the session is not open yet: press Start after its hello"
+    );
+    assert_eq!(*sh.player.lock().unwrap(), None);
+    // Once it is open, the same page's start makes it the hand.
+    *sh.scene.lock().unwrap() = link;
+    on_message(&sh, 1, r#"{"type":"start"}"#);
+    assert_eq!(last_error(&r1)["role"], "hand");
+}
