@@ -163,7 +163,7 @@ pub fn run(
     let mut rate = RateLimit::new(gate.limits.messages_per_s);
     // The last read returned a message: more may wait in the WebSocket's buffer, unseen by poll.
     let mut again = false;
-    'link: while !peer.stopped() {
+    while !peer.stopped() {
         #[cfg(unix)]
         let readable = again || {
             let (readable, woken) = wait(fd, wake, link.read_wait);
@@ -206,28 +206,40 @@ pub fn run(
             }
             Err(_) => break,
         }
-        while let Some(m) = peer.next_out() {
-            match ws.write(m) {
-                Ok(()) => {}
-                // Buffered: it goes out when the page takes what is before it.
-                Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {}
-                // The page has not taken what was written: this message is dropped, counted,
-                // and the rest wait in the peer's bounded queue.
-                Err(tungstenite::Error::WriteBufferFull(_)) => {
-                    peer.dropped();
-                    break;
-                }
-                Err(_) => break 'link,
-            }
-        }
-        // Every turn, so what a busy page left in the buffer goes out once it reads again.
-        match ws.flush() {
-            Ok(()) => {}
-            Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {}
-            Err(_) => break,
+        if !write_out(&mut ws, peer) {
+            break;
         }
     }
-    // The close and what is left get CLOSE_WAIT, not the socket's whole write timeout.
+    close(ws, peer);
+}
+
+/// Writes what the peer has queued and flushes; false when the link is gone.
+fn write_out(ws: &mut WebSocket<TcpStream>, peer: &mut dyn Peer) -> bool {
+    while let Some(m) = peer.next_out() {
+        match ws.write(m) {
+            Ok(()) => {}
+            // Buffered: it goes out when the page takes what is before it.
+            Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+            // The page has not taken what was written: this message is dropped, counted,
+            // and the rest wait in the peer's bounded queue.
+            Err(tungstenite::Error::WriteBufferFull(_)) => {
+                peer.dropped();
+                break;
+            }
+            Err(_) => return false,
+        }
+    }
+    // Every turn, so what a busy page left in the buffer goes out once it reads again.
+    match ws.flush() {
+        Ok(()) => true,
+        Err(tungstenite::Error::Io(e)) => e.kind() == std::io::ErrorKind::WouldBlock,
+        Err(_) => false,
+    }
+}
+
+/// Closes the link: the close and what is left get CLOSE_WAIT, not the socket's whole write
+/// timeout.
+fn close(mut ws: WebSocket<TcpStream>, peer: &mut dyn Peer) {
     let _ = ws.get_mut().set_nonblocking(false);
     let _ = ws.get_mut().set_write_timeout(Some(CLOSE_WAIT));
     // What the peer queued before it stopped (a session's end) goes before the close.
