@@ -214,7 +214,7 @@ fn session(
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
-        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs]; })()")?;
+        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs, S.cadence]; })()")?;
         for p in v[5].as_array().into_iter().flatten() {
             for (k, part) in parts.iter_mut().take(3).enumerate() {
                 if let Some(x) = p[k].as_f64() {
@@ -251,6 +251,13 @@ fn session(
             fmt(LatencyMs::of(&list(&v[15]))),
             fmt(LatencyMs::of(&list(&v[14])))
         );
+        let c = &v[16];
+        if c.is_object() {
+            eprintln!(
+                "{scene}: the audio thread rendered {} quanta a callback (largest {}), one every {} ms p50, {} ms p99 ({} callbacks)",
+                c["quanta"][0], c["quanta"][1], c["ms"][0], c["ms"][1], c["callbacks"]
+            );
+        }
         b.check()?;
     }
     browsers[0].key("e", true, false)?;

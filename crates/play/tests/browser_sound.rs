@@ -698,3 +698,41 @@ fn the_links_route_keeps_restarts_and_finishes_in_the_order_of_the_ticks() {
     b.check().unwrap();
     server.close();
 }
+
+/// The worklet's render-cadence probe, with the times given (no clock): quanta within 1 ms of
+/// the one before are one callback; it reports the most frequent and the largest callback in
+/// quanta and the ms between callbacks, p50 and p99.
+#[test]
+fn the_worklets_cadence_counts_the_quanta_of_each_callback_and_the_ms_between_them() {
+    let (mut b, _server) = PageServer::open("nh-sound-cadence.mcap");
+    let js = r#"(async () => {
+  const src = await (await fetch('/synth.js')).text();
+  globalThis.sampleRate = 44100; globalThis.currentTime = 0;
+  globalThis.AudioWorkletProcessor = class {};
+  globalThis.registerProcessor = () => {};
+  const Cadence = new Function(src + '; return Cadence;')();
+  // A device that renders 3 quanta every 9 ms, 98 times, then once 10 quanta after 40 ms.
+  const c = new Cadence(), before = c.report();
+  let t = 1000;
+  for (let k = 0; k < 99; k++, t += 9) { c.quantum(t); c.quantum(t); c.quantum(t + 1); }
+  t += 31;
+  for (let q = 0; q < 10; q++) c.quantum(t + Math.floor(q / 2));
+  c.quantum(t + 100);
+  // One quantum every 3 ms (a regular clock, Date.now()'s whole ms: 2.9 ms steps).
+  const r = new Cadence();
+  for (let q = 0; q < 1000; q++) r.quantum(Math.floor(q * 128 / 44.1));
+  return { before, bursts: c.report(), regular: r.report() };
+})()"#;
+    let v = b.eval(js).unwrap();
+    assert_eq!(v["before"], serde_json::Value::Null);
+    // 99 callbacks of 3 and one of 10 closed; 98 gaps of 9 ms, one of 40 and one of 100: the
+    // p99 is the 99th of the 100 (nearest rank), 40.
+    assert_eq!(
+        v["bursts"],
+        json!({"quanta": [3, 10], "ms": [9, 40], "callbacks": 100})
+    );
+    assert_eq!(
+        v["regular"],
+        json!({"quanta": [1, 1], "ms": [3, 3], "callbacks": 999})
+    );
+}

@@ -77,7 +77,7 @@ function onWorklet(m) {
   const s = P.sound;
   if (m.kind === 'done') {
     s.live = m;
-    s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs;
+    s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence;
   }
   else if (m.kind === 'stream') s.streams.push(m);
   else if (m.kind === 'lost') s.lost.push([m.tick, m.index]);
@@ -91,7 +91,7 @@ function onWorklet(m) {
 // getOutputTimestamp() (the output's own estimate of when it plays), minus the same.
 function onRendered(m) {
   const s = P.sound;
-  s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs;
+  s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence;
   if (s.latencyMs.length >= 100000) return;
   const outS = actx.outputLatency || 0, baseS = actx.baseLatency || 0;
   s.outputLatencyS = outS; s.baseLatencyS = baseS;

@@ -223,6 +223,46 @@ class Fifo {
   clear(first) { this.head = 0; this.tail = 0; this.first = first; }
 }
 
+// The audio thread's render cadence, in the wall clock: quanta rendered back to back (within
+// 1 ms of the one before; Date.now() counts whole ms) are one callback of the output device. A
+// device that renders k quanta at a time makes every arrival look up to k quanta late against
+// the processor's clock however punctual it was, so the lead must cover a callback: this
+// measures how many quanta a callback renders and how often one comes (a probe: it changes
+// nothing that is played).
+class Cadence {
+  constructor() {
+    this.last = -Infinity; this.start = -Infinity; this.size = 0;
+    this.sizes = new Uint32Array(33); // callbacks by their quanta (32: 32 or more)
+    this.gaps = new Uint32Array(201); // callbacks by the ms from the one before (200: 200 or more)
+  }
+
+  quantum(now) {
+    if (now - this.last <= 1) this.size++;
+    else {
+      if (this.size > 0) {
+        this.sizes[Math.min(this.size, 32)]++;
+        if (Number.isFinite(this.start)) this.gaps[Math.min(200, now - this.start)]++;
+      }
+      this.start = now; this.size = 1;
+    }
+    this.last = now;
+  }
+
+  // The quanta of a callback (the most frequent, the largest) and the ms between callbacks
+  // (p50, p99); null before two callbacks.
+  report() {
+    let mode = 0, max = 0, n = 0;
+    for (let k = 1; k < this.sizes.length; k++) {
+      if (this.sizes[k] > this.sizes[mode]) mode = k;
+      if (this.sizes[k]) max = k;
+    }
+    for (const c of this.gaps) n += c;
+    if (!n) return null;
+    const at = (q) => { let c = 0; for (let g = 0; g < this.gaps.length; g++) { c += this.gaps[g]; if (c >= q * n) return g; } return this.gaps.length - 1; };
+    return { quanta: [mode, max], ms: [at(0.5), at(0.99)], callbacks: n };
+  }
+}
+
 class Synth extends AudioWorkletProcessor {
   constructor(options) {
     super();
@@ -250,6 +290,7 @@ class Synth extends AudioWorkletProcessor {
     this.underruns = 0; this.dropped = 0;
     this.minLevel = Infinity; this.quanta = 0;
     this.offline = !!o.offline;
+    this.cadence = new Cadence();
     // What was heard: the FNV-1a hash of the samples played, their count, the first one's
     // session index, a checkpoint of the hash every second played, the [index, count] of each
     // drop, the restarts after a long gap; `ending`: the stream was finished.
@@ -390,6 +431,7 @@ class Synth extends AudioWorkletProcessor {
   process(inputs, outputs) {
     const out = outputs[0][0];
     if (!out) return true;
+    if (!this.offline) this.cadence.quantum(Date.now());
     const r = this.render(out);
     this.clock += out.length;
     return r;
@@ -455,11 +497,11 @@ class Synth extends AudioWorkletProcessor {
   }
 
   // The lead past the window's earliest arrival and the window's jitter (its largest minus
-  // its smallest lateness), ms (null: nothing measured).
+  // its smallest lateness), ms (null: nothing measured), and the render cadence.
   leadReport() {
     const [early, late] = this.window();
     const ms = (x) => (Number.isFinite(x) ? x / sampleRate * 1000 : null);
-    return { leadMs: ms(this.lead - early), jitterMs: ms(late - early) };
+    return { leadMs: ms(this.lead - early), jitterMs: ms(late - early), cadence: this.cadence.report() };
   }
 
   // The counts and what was heard (`kind`: 'done' at the end of the stream).
