@@ -72,11 +72,11 @@ const PROBE: &str = "(() => { const q = { wheel: [], move: [], send: [], long: [
     const at = (list) => (e) => list.push(performance.now() - e.timeStamp); \
     window.addEventListener('wheel', at(q.wheel), { capture: true, passive: true }); \
     for (const k of ['pointermove', 'pointerrawupdate']) window.addEventListener(k, at(q.move), { capture: true }); \
-    const send = WebSocket.prototype.send; \
-    WebSocket.prototype.send = function (m) { \
-      if (typeof m === 'string' && m.startsWith('{\"type\":\"input\"')) { \
-        const t = JSON.parse(m).t_ms; q.send.push(performance.timeOrigin + performance.now() - t); } \
-      return send.call(this, m); }; \
+    const post = Worker.prototype.postMessage; \
+    Worker.prototype.postMessage = function (m, t) { \
+      if (m && typeof m.send === 'string' && m.send.startsWith('{\"type\":\"input\"')) { \
+        const w = JSON.parse(m.send).t_ms; q.send.push(performance.timeOrigin + performance.now() - w); } \
+      return post.call(this, m, t); }; \
     const t0 = performance.now(); \
     new PerformanceObserver((l) => { for (const e of l.getEntries()) if (e.startTime >= t0) q.long.push(e.duration); }) \
       .observe({ type: 'longtask' }); \
@@ -129,7 +129,8 @@ fn session(
     browsers[0].wait_for("window.__play.role === 'hand'", 10.0)?;
     // Where the hand's time goes on the page (issue 43 item 3): each input event's wait from
     // its timestamp to its dispatch (the capture listener runs first), by kind; the input
-    // messages' wait from the event to the socket's send; and the main thread's long tasks.
+    // messages' wait from the event to their hand-over to the link's Worker (which sends them
+    // on its socket as they come); and the main thread's long tasks.
     browsers[0].eval(PROBE)?;
     let r = browsers[0].eval("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.left + r.width / 2, r.top + r.height / 2, 0.46 * Math.min(r.width, r.height)]; })()")?;
     let (cx, cy, k) = (
@@ -195,7 +196,7 @@ fn session(
     let long = ms(3);
     eprintln!(
         "{scene}: the page's input path: event → dispatch, wheel {}; pointer moves {}; event → \
-         socket send {}; each animation frame's work (its callbacks: drawing, the keys) {}; \
+         the link's worker {}; each animation frame's work (its callbacks: drawing, the keys) {}; \
          long tasks (≥ 50 ms) {} totalling {:.0} ms, the longest {:.0} ms",
         fmt(LatencyMs::of(&ms(0))),
         fmt(LatencyMs::of(&ms(1))),
