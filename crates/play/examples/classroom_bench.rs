@@ -132,14 +132,19 @@ fn clients(host: &str, n: usize, secs: f64) {
     }
 }
 
-/// This process's CPU time (user + system), s.
-fn cpu_s() -> f64 {
+/// The sum of two adjacent time fields of this process's `/proc/self/stat`, s: `first` is
+/// the field's index after the command's closing parenthesis (clock ticks of 100 Hz).
+fn stat_pair_s(first: usize) -> f64 {
     let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
     let after = stat.rsplit(')').next().unwrap_or("");
     let f: Vec<&str> = after.split_whitespace().collect();
     let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
-    // Fields 14 and 15 of stat (utime, stime), in clock ticks of 100 Hz.
-    (t(11) + t(12)) / 100.0
+    (t(first) + t(first + 1)) / 100.0
+}
+
+/// This process's CPU time (user + system: fields 14 and 15 of stat, utime and stime), s.
+fn cpu_s() -> f64 {
+    stat_pair_s(11)
 }
 
 struct RunFigures {
@@ -178,14 +183,10 @@ fn steal_s() -> f64 {
         .map_or(0.0, |t| t / 100.0)
 }
 
-/// The students' process's CPU time (user + system of waited-for children), s.
+/// The students' process's CPU time (user + system of waited-for children: fields 16 and 17
+/// of stat, cutime and cstime), s.
 fn children_cpu_s() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit(')').next().unwrap_or("");
-    let f: Vec<&str> = after.split_whitespace().collect();
-    let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
-    // Fields 16 and 17 of stat (cutime, cstime), in clock ticks of 100 Hz.
-    (t(13) + t(14)) / 100.0
+    stat_pair_s(13)
 }
 
 /// How many of `summary`'s recordings replay bit for bit.
