@@ -407,6 +407,7 @@ impl World {
             planes,
             body,
             body_planes,
+            ..Default::default()
         }
     }
 }

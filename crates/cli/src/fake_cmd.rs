@@ -40,10 +40,12 @@ pub(crate) struct FakeArgs {
     /// With --grip: an ideal device (no encoder counts, no force resolution).
     #[arg(long)]
     ideal: bool,
-    /// The bridge protocol a modelled device asks for: 2 (the default: it renders the
-    /// simulator's local model at its own servo rate, behind the two-port passivity layer) or
-    /// 1 (the answered force and stiffness only; docs/device-bridge.md).
-    #[arg(long, default_value_t = 2)]
+    /// The bridge protocol a modelled device asks for: 3 (the default: it renders the
+    /// simulator's local model, with a bond that breaks where the world's contact lets go, at
+    /// its own servo rate, behind the two-port passivity layer), 2 (the local model without
+    /// the bond, as the Python adapters) or 1 (the answered force and stiffness only;
+    /// docs/device-bridge.md).
+    #[arg(long, default_value_t = 3)]
     protocol: u8,
     /// Probability that a sample is lost, 0–1.
     #[arg(long, default_value_t = 0.0)]
@@ -206,10 +208,9 @@ fn config(a: &FakeArgs) -> Result<Config, String> {
         }
         Err(e) => return Err(e.to_string()),
     };
-    let protocol = match a.protocol {
-        1 => Protocol::V1,
-        2 => Protocol::V2,
-        p => return Err(out_of_range("--protocol", p, "1 or 2")),
+    let protocol = match Protocol::of_version(a.protocol) {
+        Some(p) => p,
+        None => return Err(out_of_range("--protocol", a.protocol, "1, 2 or 3")),
     };
     let physical = physical(a)?;
     // Every device announces its own buttons (a modelled preset its preset's); the built-in
@@ -297,7 +298,7 @@ fn print_report(r: &FakeReport, physical: Option<(Mechanics, Grip)>, ideal: bool
         println!(
             "  protocol {}{}",
             r.protocol,
-            if r.protocol == 2 {
+            if r.protocol >= 2 {
                 format!(
                     ": the local model rendered at the device's servo rate; the two-port layer held the force back on {} servo periods",
                     r.two_port_interventions

@@ -100,7 +100,7 @@ fn bad_arguments_are_refused_naming_the_flag_and_the_range() {
     ]);
     assert_eq!(
         String::from_utf8_lossy(&o.stderr),
-        "error: --fault ignores-planes needs a modelled device speaking protocol 2 (--grip, \
-         --protocol 2): only such a device renders planes\n"
+        "error: --fault ignores-planes needs a modelled device speaking protocol 2 or 3 \
+         (--grip, --protocol 2): only such a device renders planes\n"
     );
 }

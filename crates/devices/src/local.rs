@@ -8,6 +8,8 @@
 //! - **Protocol 1** renders the newest answer's `F0 − K (p − p0)`, with `p0` the reading that
 //!   answer was computed from (the device keeps its recent readings by sequence number), so
 //!   the answer's local stiffness is felt without delay however late the answer arrives.
+//! - **Protocol 3** renders protocol 2's model with its bond: a spring that breaks where the
+//!   world's contact lets go, at the position read now.
 //! - **Protocol 2** renders the answer's [`LocalModel`]: its residual, its contact planes at
 //!   the position read now, and the carried body ([`Body`]), integrated here one step per
 //!   sample with the reading sent, as the simulator integrates it: each answer restarts the
@@ -37,6 +39,9 @@ pub enum Protocol {
     V1,
     /// The local model (protocol version 2), with the two-port passivity layer.
     V2,
+    /// The local model with a bond, a spring that breaks (protocol version 3,
+    /// `haptic_types::local::Bond`), with the two-port passivity layer.
+    V3,
 }
 
 impl Protocol {
@@ -45,7 +50,23 @@ impl Protocol {
         match self {
             Protocol::V1 => 1,
             Protocol::V2 => 2,
+            Protocol::V3 => 3,
         }
+    }
+
+    /// The protocol of version `v` (1, 2 or 3).
+    pub fn of_version(v: u8) -> Option<Protocol> {
+        match v {
+            1 => Some(Protocol::V1),
+            2 => Some(Protocol::V2),
+            3 => Some(Protocol::V3),
+            _ => None,
+        }
+    }
+
+    /// Whether the device renders a local model (versions 2 and 3) behind the two-port layer.
+    pub fn has_local_model(self) -> bool {
+        self != Protocol::V1
     }
 }
 
@@ -161,10 +182,10 @@ impl DeviceSide {
         let p0 = reading_at_or_before(&self.readings, cmd.seq)
             .or_else(|| self.readings.front().map(|r| r.1))
             .unwrap_or([0.0; 3]);
-        let local = if self.protocol == Protocol::V2 {
-            local
-        } else {
-            None
+        let local = match self.protocol {
+            Protocol::V1 => None,
+            Protocol::V2 => local.map(|m| LocalModel { bond: None, ..m }),
+            Protocol::V3 => local,
         };
         let lag = i128::from(cmd.tick) - i128::from(cmd.seq);
         let offset = *self.tick_offset.get_or_insert(lag);
@@ -231,7 +252,7 @@ impl DeviceSide {
         if n > self.max_force_n {
             f = vec3::scale(f, self.max_force_n / n);
         }
-        if self.protocol == Protocol::V2 {
+        if self.protocol.has_local_model() {
             f = self.bound(f, v, servo_s);
             if !vec3::is_finite(f) {
                 f = [0.0; 3];

@@ -75,6 +75,7 @@ fn answer(seq: u64, p0: [f64; 3], with_local: bool) -> ForceReply {
         } else {
             -0.05 - 1e-4 * seq as f64
         },
+        bond: None,
     };
     ForceReply {
         seq,

@@ -208,7 +208,7 @@ impl TickEngine {
             lp.mark_deadline_missed();
         }
         if dev.wants_local_model() {
-            dev.set_local_model(lp.local_model());
+            dev.set_local_model(lp.local_model(dev.local_model_version()));
         }
         dev.set_force(&lp.command(sample.seq))?;
         let compute_ns = t0.elapsed().as_nanos() as u64;

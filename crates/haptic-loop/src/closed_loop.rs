@@ -208,7 +208,7 @@ pub fn run_linked(
         Protocol::V1 => 0,
         // Measured: with a lead of one round trip, the carried brick on a loosely held
         // Delta.3 behind 10 ms has 1–2 jumps (1.18–1.36 N) earlier still (its body).
-        Protocol::V2 => window,
+        Protocol::V2 | Protocol::V3 => window,
     };
     let mut meter = Meter::new(ticks, reserve_j, window, lead);
     Runner::new(vec![&mut meter]).run(
@@ -339,7 +339,11 @@ impl HapticDevice for SimulatedLink {
     }
 
     fn wants_local_model(&self) -> bool {
-        self.protocol == Protocol::V2
+        self.protocol.has_local_model()
+    }
+
+    fn local_model_version(&self) -> u8 {
+        self.protocol.version()
     }
 
     fn set_local_model(&mut self, model: haptic_types::local::LocalModel) {

@@ -1,15 +1,17 @@
 //! Every built-in scene on every device preset, loose grip and firm, behind a link (issue 31):
 //! one-way latency {0, 0.5, 1, 2, 5, 10, 20, 50} ms, each also with 1 ms of jitter and 5 % loss
-//! in both directions, the device side speaking bridge protocol 2 (the local model, the
-//! two-port passivity layer). The criteria are issue 22's
+//! in both directions, the device side speaking bridge protocol 3 (the local model with its
+//! bond, the two-port passivity layer). The criteria are issue 22's
 //! ([`haptic_loop::closed_loop::Report::stable`]), measured on the force the device's motors
 //! rendered: no undeclared jump above 1 N, at most 10 % of the power above 50 Hz, the observer
 //! within its reserve.
 //!
 //! Asserted: every run up to 10 ms one way is stable (the target); the 20 and 50 ms runs (the
 //! goal) are printed with their figures and must keep the energy the motors put into the hand
-//! below 0.1 J. And the contrast that is the reason for protocol 2: the carried brick
-//! on a loosely held Falcon buzzes behind 2 ms with protocol 1 and not with protocol 2.
+//! below 0.1 J. And the contrasts that are the reasons for protocols 2 and 3: the carried
+//! brick on a loosely held Falcon buzzes behind 2 ms with protocol 1 and not with protocol 2;
+//! the atoms' pull-off behind 10 ms pulls a quarter harder than the world with protocol 2 and
+//! as the world with protocol 3.
 #![allow(clippy::unwrap_used)]
 
 use haptic_devices::link::LinkParams;
@@ -112,7 +114,7 @@ fn run_all(cases: &[Case]) -> Vec<Run> {
                         None => Linked::IDEAL,
                         Some(ms) => Linked {
                             link: link(ms, c.bad),
-                            protocol: Protocol::V2,
+                            protocol: Protocol::V3,
                         },
                     };
                     let (r, t) =
@@ -177,6 +179,8 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
     let mut untransparent = Vec::new();
     let mut unbuilt = Vec::new();
     let mut over_peak = Vec::new();
+    // The nano world's peak felt force against the ideal link's, 0–10 ms (the bond's scene).
+    let (mut nano_lo, mut nano_hi) = (f64::MAX, 0.0f64);
     let (mut goal_unstable, mut goal_runs) = (0, 0);
     let mut worst_goal_energy: f64 = f64::NEG_INFINITY;
     let mut worst_target_energy: f64 = f64::NEG_INFINITY;
@@ -222,6 +226,9 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
         if peak > 1.2 {
             over_peak.push(format!("{label}: {peak:.3}"));
         }
+        if case.scene == "nanoworld.toml" {
+            (nano_lo, nano_hi) = (nano_lo.min(peak), nano_hi.max(peak));
+        }
         if peak < 0.8 || (ms <= 2.0 && peak > 1.2) {
             untransparent.push(format!("{label}: peak {peak:.3} of the ideal link's"));
         }
@@ -240,6 +247,9 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
          link's; the wall's felt stiffness {wall_lo:.4}–{wall_hi:.4} of the ideal link's"
     );
     println!("peak above 1.2 × the ideal link's (5 and 10 ms): {over_peak:#?}");
+    println!(
+        "the atoms' peak felt force at 0–10 ms: {nano_lo:.3}–{nano_hi:.3} of the ideal link's"
+    );
     assert!(unstable.is_empty(), "unstable up to 10 ms: {unstable:#?}");
     assert!(worst_target_energy <= 0.01, "{worst_target_energy} J");
     assert!(
@@ -253,20 +263,28 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
         (0.065..0.075).contains(&worst_goal_energy),
         "{worst_goal_energy} J"
     );
+    // The atoms behind 0–10 ms: within 20 % of the ideal link's peak both ways in all 64
+    // runs, 0.990–1.000 measured (docs/devices.md). With protocol 2 the device extrapolated the
+    // adhesion's `F0 − K (p − p0)` past the pull-off for a round trip, where the world's force
+    // drops to 0: 14 of them pulled 1.21–1.29 × (Touch, firm, 10 ms: 0.50 N against 0.40 N);
+    // protocol 3's bond breaks where the world lets go.
+    assert!(
+        nano_lo >= 0.985 && nano_hi <= 1.005,
+        "the atoms' peak {nano_lo:.3}–{nano_hi:.3}"
+    );
     // Measured, not yet met (issue 40's target is 20 % at every latency to 10 ms): the peak
     // force grows with the delay where the world's own dynamics move the spring the hand
-    // pulls on during the round trip, up to +50 %. 31 of the 320 runs at 0–10 ms exceed +20 %:
-    // 3 at 5 ms (the 10 kHz trap), 28 at 10 ms; none at 0–2 ms. Traced, one run each:
-    // - the atoms (Touch, firm, 10 ms: 0.50 N against 0.40 N): the device extrapolates the
-    //   adhesion's `F0 − K (p − p0)` for a round trip past the pull-off, where the world's
-    //   force drops to 0;
+    // pulls on during the round trip, up to +50 %. 17 of the 320 runs at 0–10 ms exceed +20 %
+    // (31 with protocol 2): 4 at 5 ms (the 10 kHz trap), 13 at 10 ms; none at 0–2 ms. Traced,
+    // one run each:
     // - the 10 kHz trap (Touch, firm, 10 ms: 1.67 N against 1.14 N): the working envelope
-    //   moves with the particle, which the device holds still for the round trip;
+    //   moves with the particle, which the device holds still for the round trip. Tried and
+    //   not kept: the envelope's edge as a plane moving at the particle's velocity made 13
+    //   runs unstable (chatter as the hand left the edge; held still, the same);
     // - the brick on a Delta.3 (loose, 10 ms, jitter and loss: 2.67 N against 1.81 N): the
     //   carried brick lands on the house while the device's body, which meets only the
     //   planes the answer named, is a round trip behind the world's.
-    // Each needs a primitive protocol 2 does not have (a spring that breaks, a moving plane).
-    assert_eq!(over_peak.len(), 31, "{over_peak:#?}");
+    assert_eq!(over_peak.len(), 17, "{over_peak:#?}");
     // Every house is built in both worlds at 0–10 ms (the last exception, a Falcon at 1 ms
     // with jitter and loss, was a one-count flicker thrown as a release velocity).
     assert!(
@@ -305,6 +323,41 @@ fn the_carried_brick_buzzes_behind_2_ms_with_protocol_1_and_not_with_protocol_2(
     assert!(v2.stable() && v2.energy_to_hand_j < 0.0);
     // The house still gets built through the link.
     assert!(v2.house_complete_s.is_some_and(|t| t > 0.0));
+}
+
+/// Why protocol 3: the atoms on a firmly held Touch behind 10 ms each way. With protocol 2 the
+/// anchored tip's adhesion is the residual's linear spring, which the device extrapolates for
+/// a round trip past the pull-off, where the world's force has dropped to 0: the hand feels a
+/// pull the world never gave. Protocol 3's bond breaks at the world's pull-off.
+#[test]
+fn the_atoms_pull_off_behind_10_ms_overshoots_with_protocol_2_and_not_with_protocol_3() {
+    let (scene, script) = (read("nanoworld.toml"), read("nanoworld.script.toml"));
+    let run = |l: &Linked| {
+        run_linked(&scene, &script, Mechanics::TOUCH, Grip::FIRM, l, None)
+            .unwrap()
+            .0
+    };
+    let behind = |protocol| Linked {
+        link: LinkParams::latency_ms(10.0),
+        protocol,
+    };
+    let ideal = run(&Linked::IDEAL);
+    let (v2, v3) = (run(&behind(Protocol::V2)), run(&behind(Protocol::V3)));
+    let (p2, p3) = (
+        v2.peak_force_n / ideal.peak_force_n,
+        v3.peak_force_n / ideal.peak_force_n,
+    );
+    println!(
+        "ideal link peak {:.4} N; 10 ms: protocol 2 {:.4} N ({p2:.3}), protocol 3 {:.4} N ({p3:.3})",
+        ideal.peak_force_n, v2.peak_force_n, v3.peak_force_n
+    );
+    // docs/devices.md: "0.50 N against the world's 0.40 N (1.254 ×) with protocol 2, the
+    // world's 0.40 N (1.000 ×) with protocol 3" (simulated: exact).
+    assert!((1.25..1.26).contains(&p2), "{p2}");
+    assert!((0.999..1.001).contains(&p3), "{p3}");
+    assert!(v2.stable() && v3.stable());
+    assert!(v3.energy_to_hand_j <= 0.01, "{} J", v3.energy_to_hand_j);
+    assert!(v3.house_complete_s.is_none_or(|t| t > 0.0));
 }
 
 /// A linked run is simulated in whole nanoseconds with seeded draws: every scene repeats to

@@ -147,10 +147,9 @@ impl World {
             .any(|d| d.member == member && d.target_atom == t)
     }
 
-    /// Release the anchored tip if the pull reaches the weakest link's pull-off force.
-    pub(crate) fn maybe_release(&mut self, a: &Anchor, events: &mut Vec<Event>) {
-        let k = self.laws.get(a.pair).stiffness_n_per_m;
-        let pull = bond_pull(k * (self.cursor - a.tip_position_m), a.normal);
+    /// The weakest link of an anchored tip's chain and its pull-off force, N: the pull at
+    /// which the anchor lets go.
+    pub(crate) fn weakest_link(&self, a: &Anchor) -> (BrokenLink, f64) {
         let po = |p: PairKind| self.laws.get(p).pull_off_n;
         let mut links: Vec<(BrokenLink, f64)> = Vec::with_capacity(3);
         match a.member {
@@ -169,6 +168,14 @@ impl World {
                 weakest = *l;
             }
         }
+        weakest
+    }
+
+    /// Release the anchored tip if the pull reaches the weakest link's pull-off force.
+    pub(crate) fn maybe_release(&mut self, a: &Anchor, events: &mut Vec<Event>) {
+        let k = self.laws.get(a.pair).stiffness_n_per_m;
+        let pull = bond_pull(k * (self.cursor - a.tip_position_m), a.normal);
+        let weakest = self.weakest_link(a);
         if pull < weakest.1 {
             return;
         }

@@ -374,6 +374,12 @@ pub trait HapticDevice {
     fn wants_local_model(&self) -> bool {
         false
     }
+    /// The bridge protocol version whose local model the device renders (2, or 3 with the
+    /// bond of `crate::local::Bond`, a spring that breaks); asked only when
+    /// [`HapticDevice::wants_local_model`].
+    fn local_model_version(&self) -> u8 {
+        2
+    }
     /// The local model that goes with the next [`HapticDevice::set_force`] (protocol-2 devices
     /// only; others ignore it).
     fn set_local_model(&mut self, _model: crate::local::LocalModel) {}

@@ -71,7 +71,7 @@ pub struct FakeConfig {
 /// What the simulator's welcome said.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct WelcomeInfo {
-    /// The session's protocol version (1, or 2: the local model).
+    /// The session's protocol version (1; 2: the local model; 3: with its bond).
     pub version: u8,
     /// The session's tick rate, Hz: the device sends one sample per tick.
     pub rate_hz: u32,
@@ -180,11 +180,7 @@ pub fn run_fake_as(
     // 2. A receiver thread timestamps each reply.
     let receiver = Receiver::spawn(&socket, cfg.target)?;
     // 3. The servo loop.
-    let protocol = if welcome.version == super::protocol::VERSION_2 {
-        Protocol::V2
-    } else {
-        Protocol::V1
-    };
+    let protocol = Protocol::of_version(welcome.version).unwrap_or(Protocol::V1);
     let mut modelled = cfg.physical.map(|(mech, grip)| Modelled {
         plant: Plant::new(mech, grip, cfg.script.position(0.0)),
         side: DeviceSide::new(protocol, mech.limits.max_force_n, 1.0 / f64::from(rate_hz)),
@@ -312,7 +308,8 @@ impl Modelled {
         if let Some(seq) = seq {
             self.side.record_reading(seq, reading);
         }
-        let count = (protocol == Protocol::V2)
+        let count = protocol
+            .has_local_model()
             .then(|| u32::try_from(self.side.interventions()).unwrap_or(u32::MAX));
         (reading, script.buttons(time_s).0, count)
     }

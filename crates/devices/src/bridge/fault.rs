@@ -68,10 +68,9 @@ pub fn applies(
     modelled: bool,
     protocol: crate::local::Protocol,
 ) -> Result<(), String> {
-    if fault == Some(Fault::IgnoresPlanes) && (!modelled || protocol != crate::local::Protocol::V2)
-    {
+    if fault == Some(Fault::IgnoresPlanes) && (!modelled || !protocol.has_local_model()) {
         return Err(
-            "--fault ignores-planes needs a modelled device speaking protocol 2 \
+            "--fault ignores-planes needs a modelled device speaking protocol 2 or 3 \
                     (--grip, --protocol 2): only such a device renders planes"
                 .into(),
         );

@@ -105,7 +105,7 @@ struct State {
     ended: bool,
     error: Option<String>,
     c: Counters,
-    /// The protocol version of the session: the device's hello's, at most version 2.
+    /// The protocol version of the session: the device's hello's, at most version 3.
     version: u8,
     /// The last refusal, for the simulator's own message when no device is welcomed.
     last_refusal: Option<String>,
@@ -215,8 +215,8 @@ fn answer_hello(
     }
     st.peer = Some(from);
     st.last_seq = None;
-    // Negotiate down: a hello above version 2 is welcomed with 2.
-    st.version = version.min(super::protocol::VERSION_2);
+    // Negotiate down: a hello above version 3 is welcomed with 3.
+    st.version = version.min(super::protocol::VERSION_3);
     let welcome = Packet::Welcome {
         version: st.version,
         rate_hz: config.rate_hz,
@@ -516,7 +516,11 @@ impl HapticDevice for UdpDevice {
     }
 
     fn wants_local_model(&self) -> bool {
-        self.version == super::protocol::VERSION_2
+        self.version >= super::protocol::VERSION_2
+    }
+
+    fn local_model_version(&self) -> u8 {
+        self.version
     }
 
     fn set_local_model(&mut self, model: haptic_types::local::LocalModel) {
@@ -528,7 +532,7 @@ impl HapticDevice for UdpDevice {
             let local = self
                 .local
                 .take()
-                .filter(|_| self.version == 2)
+                .filter(|_| self.version >= super::protocol::VERSION_2)
                 .map(Box::new);
             let p = Packet::Force(ForceReply {
                 seq: cmd.seq,

@@ -3,7 +3,7 @@
 //! answered force at the answered reading.
 
 use super::HapticLoop;
-use haptic_types::local::{Body, LocalModel, Plane};
+use haptic_types::local::{Body, Bond, LocalModel, Plane};
 use haptic_types::tick::status;
 use haptic_types::vec3::{self, Vec3};
 
@@ -18,11 +18,18 @@ impl HapticLoop {
     /// [`HapticLoop::command`]'s force; a scene without primitives sends its force with its
     /// local stiffness as the residual (what protocol 1 renders). `world_energy_j` is the work
     /// the answered forces did on the readings received: the two-port layer's budget.
-    pub fn local_model(&self) -> LocalModel {
+    ///
+    /// `version` is the session's protocol: from 3 on, the model also carries the scene's bond
+    /// (`haptic_types::local::Bond`, a spring that breaks); before it, the scene's answer and
+    /// stiffness stand in for it in the residual, as protocol 2 always did.
+    pub fn local_model(&self, version: u8) -> LocalModel {
         let r = &self.result;
         let mut prims = self.primitives.borrow_mut();
         prims.clear();
         self.scene.local_primitives(&mut prims);
+        if version < 3 {
+            prims.bond = None;
+        }
         let m = &self.config.mapping;
         let (ws, fs) = (m.workspace_scale, m.force_scale);
         let kd = fs * ws;
@@ -60,25 +67,32 @@ impl HapticLoop {
             .iter()
             .map(|p| plane_to_device(p, 0.0))
             .collect();
+        // A bond's breaking stretch is a length: the gain softens its spring, not where it
+        // breaks.
+        let bond = prims.bond.map(|b| Bond {
+            anchor_m: to_device(b.anchor_m),
+            normal: b.normal,
+            stiffness_n_per_m: b.stiffness_n_per_m * kd * gain,
+            break_m: b.break_m / ws,
+        });
         let world_energy_j = self.initial_tank_j() - self.tank_j;
-        if planes.is_empty() && body.is_none() {
-            return LocalModel {
-                residual_force_n: r.device_force_n,
-                residual_stiffness_n_per_m: r.device_stiffness_n_per_m,
-                planes,
-                body,
-                body_planes,
-                world_energy_j,
-            };
+        let model = LocalModel {
+            residual_force_n: r.device_force_n,
+            residual_stiffness_n_per_m: r.device_stiffness_n_per_m,
+            planes,
+            body,
+            body_planes,
+            world_energy_j,
+            bond,
+        };
+        if model.planes.is_empty() && model.body.is_none() && model.bond.is_none() {
+            return model;
         }
         let p0 = to_device(r.cursor_m);
         let model = LocalModel {
             residual_force_n: [0.0; 3],
             residual_stiffness_n_per_m: [0.0; 9],
-            planes,
-            body,
-            body_planes,
-            world_energy_j,
+            ..model
         };
         let mut local = model.static_force(p0, p0);
         if let Some(b) = &model.body {

@@ -97,41 +97,7 @@ impl Target {
             }
             "params" => t.seeds = crate::params::seeds(),
             "page" => t.seeds = crate::page::seeds(),
-            "bridge" => {
-                let sample = Sample {
-                    seq: 7,
-                    device_time_ns: 1_000_000,
-                    position_m: [0.001, -0.002, -0.006],
-                    buttons: 1,
-                    two_port_periods: None,
-                };
-                t.seeds = vec![
-                    Packet::Hello {
-                        version: 1,
-                        rate_hz: 1000,
-                        specs: falcon().clone(),
-                    }
-                    .encode(),
-                    Packet::Hello {
-                        version: 2,
-                        rate_hz: 1000,
-                        specs: DeviceModel::Touch.specs().clone(),
-                    }
-                    .encode(),
-                    Packet::Force(ForceReply {
-                        seq: 7,
-                        tick: 7,
-                        force_n: [0.0, 0.0, 1.0],
-                        stiffness_n_per_m: [0.0; 9],
-                        status: 0,
-                        local: Some(Box::new(seed_local_model())),
-                    })
-                    .encode(),
-                    seed_welcome(),
-                    Packet::Sample(sample).encode(),
-                    Packet::Bye { reason: 0 }.encode(),
-                ];
-            }
+            "bridge" => t.seeds = bridge_seeds(),
             _ => {
                 let exe = std::env::current_exe().map_err(|e| e.to_string())?;
                 let prog =
@@ -223,6 +189,62 @@ fn selftest(index: u64, timeout: Duration) -> Outcome {
     }
 }
 
+/// The bridge target's seeds: hellos of versions 1 and 2, answers of versions 2 and 3, a
+/// welcome, a sample and a bye.
+fn bridge_seeds() -> Vec<Vec<u8>> {
+    let sample = Sample {
+        seq: 7,
+        device_time_ns: 1_000_000,
+        position_m: [0.001, -0.002, -0.006],
+        buttons: 1,
+        two_port_periods: None,
+    };
+    vec![
+        Packet::Hello {
+            version: 1,
+            rate_hz: 1000,
+            specs: falcon().clone(),
+        }
+        .encode(),
+        Packet::Hello {
+            version: 2,
+            rate_hz: 1000,
+            specs: DeviceModel::Touch.specs().clone(),
+        }
+        .encode(),
+        Packet::Force(ForceReply {
+            seq: 7,
+            tick: 7,
+            force_n: [0.0, 0.0, 1.0],
+            stiffness_n_per_m: [0.0; 9],
+            status: 0,
+            local: Some(Box::new(seed_local_model())),
+        })
+        .encode(),
+        // A version-3 answer: the model with the nano world's bond.
+        Packet::Force(ForceReply {
+            seq: 8,
+            tick: 8,
+            force_n: [0.0, 0.0, -0.2],
+            stiffness_n_per_m: [0.0; 9],
+            status: 0,
+            local: Some(Box::new(haptic_types::local::LocalModel {
+                bond: Some(haptic_types::local::Bond {
+                    anchor_m: [0.0, 0.0, -0.001],
+                    normal: [0.0, 0.0, 1.0],
+                    stiffness_n_per_m: 200.0,
+                    break_m: 0.004,
+                }),
+                ..Default::default()
+            })),
+        })
+        .encode(),
+        seed_welcome(),
+        Packet::Sample(sample).encode(),
+        Packet::Bye { reason: 0 }.encode(),
+    ]
+}
+
 /// A protocol-2 local model for the bridge target's seeds: a floor plane, a carried body on its
 /// coupling, the floor under the body.
 fn seed_local_model() -> haptic_types::local::LocalModel {
@@ -250,6 +272,7 @@ fn seed_local_model() -> haptic_types::local::LocalModel {
         }),
         body_planes: vec![floor(-0.02, 0.0)],
         world_energy_j: 0.0,
+        bond: None,
     }
 }
 

@@ -349,6 +349,30 @@ impl Scene for NanoScene {
         };
     }
 
+    /// The anchored tip's contact as a bond (protocol 3): the adhesion's spring `k`, which
+    /// breaks at the weakest link's pull-off (game mode; the physical cantilever has none).
+    fn local_primitives(&self, out: &mut haptic_types::local::WorldPrimitives) {
+        let Some(world) = &self.world else {
+            return;
+        };
+        let (Interaction::Game(_), TipContact::Anchored(a), Some(pull_off_n)) = (
+            &self.params.interaction,
+            world.tip_contact(),
+            world.anchor_pull_off_n(),
+        ) else {
+            return;
+        };
+        let k = world.laws().get(a.pair).stiffness_n_per_m;
+        if k > 0.0 && pull_off_n > 0.0 {
+            out.bond = Some(haptic_types::local::Bond {
+                anchor_m: v(a.tip_position_m),
+                normal: v(a.normal),
+                stiffness_n_per_m: k,
+                break_m: pull_off_n / k,
+            });
+        }
+    }
+
     fn state(&self, out: &mut Vec<f64>) {
         match &self.world {
             Some(w) => {

@@ -488,6 +488,15 @@ impl World {
     pub fn tip_contact(&self) -> TipContact {
         self.contact
     }
+    /// The pull-off force of the anchored tip's weakest link, N (`None` when the tip is free):
+    /// the anchor lets go once `|k (cursor − anchor)|`, counting the pull away from the
+    /// contact and the shear but not a press into it, reaches it.
+    pub fn anchor_pull_off_n(&self) -> Option<f64> {
+        match self.contact {
+            TipContact::Anchored(a) => Some(self.weakest_link(&a).1),
+            TipContact::Free => None,
+        }
+    }
     /// The loading zone, if any.
     pub fn loading_zone(&self) -> Option<&LoadingZone> {
         self.params.loading_zone.as_ref()

@@ -4,7 +4,7 @@
 use super::reader::Reader;
 use super::{
     BYE_LEN, FORCE_LEN, HEADER_LEN, LOCAL_FIXED_LEN, MAGIC, MAX_PACKET, SAMPLE_LEN, SAMPLE_V2_LEN,
-    VERSION, VERSION_2,
+    VERSION, VERSION_2, VERSION_3,
 };
 use super::{ForceReply, Packet, ProtocolError, Refusal, Sample};
 use haptic_types::device::DeviceSpecs;
@@ -31,11 +31,11 @@ impl Packet {
         let mut r = Reader::new(b, HEADER_LEN);
         if b[5] == 1 {
             // A hello of any version above 0 is read (its body is the same in every version)
-            // and welcomed with the smaller of its version and 2; one that cannot be accepted
+            // and welcomed with the smaller of its version and 3; one that cannot be accepted
             // is answered with a refusal naming the field.
             return hello(version, &mut r).map_err(refusal);
         }
-        if version != VERSION && version != VERSION_2 {
+        if !(VERSION..=VERSION_3).contains(&version) {
             return Err(ProtocolError::Version(version));
         }
         match b[5] {
@@ -99,9 +99,9 @@ fn hello(version: u8, r: &mut Reader) -> Result<Packet, ProtocolError> {
     if version == 0 {
         return Err(ProtocolError::Hello(Refusal::new(
             "version",
-            "1 or more (a hello above 2 is welcomed with version 2)",
-            "hello refused: `version` = 0 is out of range: allowed 1 or more (a hello above 2 \
-             is welcomed with version 2)"
+            "1 or more (a hello above 3 is welcomed with version 3)",
+            "hello refused: `version` = 0 is out of range: allowed 1 or more (a hello above 3 \
+             is welcomed with version 3)"
                 .into(),
         )));
     }
@@ -174,7 +174,8 @@ fn refused(r: &mut Reader) -> Result<Packet, ProtocolError> {
     }))
 }
 
-/// Type 3, a sample of the size its version gives (`b`: the whole datagram).
+/// Type 3, a sample of the size its version gives (`b`: the whole datagram; a version-3
+/// sample is a version-2 sample).
 fn sample(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError> {
     if version == VERSION {
         fixed(b, "sample", SAMPLE_LEN)?;
@@ -186,7 +187,7 @@ fn sample(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError
         device_time_ns: r.u64("sample")?,
         position_m: [r.f64("sample")?, r.f64("sample")?, r.f64("sample")?],
         buttons: r.u32("sample")?,
-        two_port_periods: if version == VERSION_2 {
+        two_port_periods: if version >= VERSION_2 {
             Some(r.u32("sample")?)
         } else {
             None
@@ -194,8 +195,8 @@ fn sample(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError
     }))
 }
 
-/// Type 4, a force: the version-1 fields, then in version 2 the local model (`b`: the whole
-/// datagram).
+/// Type 4, a force: the version-1 fields, then in version 2 the local model, and in version 3
+/// the local model and its bond (`b`: the whole datagram).
 fn force(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError> {
     if version == VERSION {
         fixed(b, "force", FORCE_LEN)?;
@@ -214,12 +215,20 @@ fn force(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError>
         *x = r.f64("force")?;
     }
     let status = r.u8("force")?;
-    let local = if version == VERSION_2 {
-        let m = r.local()?;
-        r.end("force (version 2)")?;
-        Some(Box::new(m))
-    } else {
-        None
+    let local = match version {
+        VERSION_2 => {
+            let m = r.local()?;
+            r.end("force (version 2)")?;
+            Some(Box::new(m))
+        }
+        VERSION_3 => {
+            let mut m = r.local()?;
+            m.bond = Some(r.bond()?);
+            m.check(f64::INFINITY).map_err(ProtocolError::Local)?;
+            r.end("force (version 3)")?;
+            Some(Box::new(m))
+        }
+        _ => None,
     };
     Ok(Packet::Force(ForceReply {
         seq,

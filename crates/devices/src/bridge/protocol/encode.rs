@@ -1,6 +1,6 @@
 //! Encoding packets to datagrams.
 
-use super::{MAGIC, Packet, VERSION, VERSION_2};
+use super::{MAGIC, Packet, VERSION, VERSION_2, VERSION_3};
 use haptic_types::local::{LocalModel, MAX_PLANES, Plane};
 
 fn header(v: &mut Vec<u8>, version: u8, t: u8) {
@@ -137,10 +137,10 @@ impl Packet {
                 }
             }
             Packet::Force(f) => {
-                let version = if f.local.is_some() {
-                    VERSION_2
-                } else {
-                    VERSION
+                let version = match &f.local {
+                    Some(m) if m.bond.is_some() => VERSION_3,
+                    Some(_) => VERSION_2,
+                    None => VERSION,
                 };
                 header(v, version, 4);
                 v.extend_from_slice(&f.seq.to_le_bytes());
@@ -151,6 +151,11 @@ impl Packet {
                 v.push(f.status);
                 if let Some(m) = &f.local {
                     put_local(v, m);
+                    if let Some(b) = &m.bond {
+                        put_f64s(v, &b.anchor_m);
+                        put_f64s(v, &b.normal);
+                        put_f64s(v, &[b.stiffness_n_per_m, b.break_m]);
+                    }
                 }
             }
             Packet::Bye { reason } => {

@@ -1,15 +1,19 @@
-//! The device bridge's wire format, versions 1 and 2 (documented byte for byte in
+//! The device bridge's wire format, versions 1, 2 and 3 (documented byte for byte in
 //! `docs/device-bridge.md`).
 //!
 //! Every packet is one UDP datagram, little-endian, byte-packed, starting with an 8-byte header:
-//! the magic `NHDB`, the version (1 or 2), the packet type and two reserved zero bytes.
+//! the magic `NHDB`, the version (1, 2 or 3), the packet type and two reserved zero bytes.
 //!
 //! Version 2 (issue 31) adds the local model a device renders between answers
 //! (`haptic_types::local`): a device that says hello with version 2 is welcomed with version 2
 //! and every force packet it receives carries the local model after the version-1 fields.
 //! A version-2 sample also carries the device side's count of servo periods its two-port
 //! layer acted on (the simulator reports the largest in its link counters, which the recording
-//! keeps). Byes are the same in both versions (sent with version 1, read with either).
+//! keeps). Byes are the same in every version (sent with version 1, read with any).
+//!
+//! Version 3 adds the local model's bond (`haptic_types::local::Bond`, a spring that breaks):
+//! a force packet whose model has one is a version-2 force packet followed by the bond, with
+//! version byte 3; the session's samples are version-2 samples.
 //!
 //! | type | name    | direction     | body after the header                                              |
 //! |------|---------|---------------|--------------------------------------------------------------------|
@@ -36,8 +40,11 @@ pub use packets::{ForceReply, Packet, ProtocolError, Refusal, Sample};
 pub const MAGIC: [u8; 4] = *b"NHDB";
 /// The protocol version of samples and byes (the same in both versions).
 pub const VERSION: u8 = 1;
-/// The newest protocol version this build speaks: 2, the local model.
+/// Protocol version 2: the local model.
 pub const VERSION_2: u8 = 2;
+/// The newest protocol version this build speaks: 3, the local model with a bond (a spring
+/// that breaks).
+pub const VERSION_3: u8 = 3;
 /// Size of the local model's fixed part after a version-1 force packet, bytes (residual
 /// force and stiffness, world energy).
 const LOCAL_FIXED_LEN: usize = 12 * 8 + 8;
@@ -46,6 +53,8 @@ const PLANE_LEN: usize = 5 * 8;
 /// Size of the body on the wire: position, velocity, mass, three coupling constants, damper
 /// share, external force, substeps (u32), restitution.
 const BODY_LEN: usize = 16 * 8 + 4 + 8;
+/// Size of the bond on the wire: anchor, normal, stiffness, breaking stretch.
+const BOND_LEN: usize = 8 * 8;
 /// Largest datagram accepted, bytes (a hello with 32 buttons of 32 characters fits).
 pub const MAX_PACKET: usize = 1200;
 /// Size of a sample packet, bytes.
@@ -76,6 +85,11 @@ pub fn force_v2_len(planes: usize, body: bool, body_planes: usize) -> usize {
         + if body { BODY_LEN } else { 0 }
         + 1
         + body_planes * PLANE_LEN
+}
+
+/// Size of a version-3 force packet (a version-2 one and its bond), bytes.
+pub fn force_v3_len(planes: usize, body: bool, body_planes: usize) -> usize {
+    force_v2_len(planes, body, body_planes) + BOND_LEN
 }
 
 #[cfg(test)]
@@ -191,8 +205,8 @@ mod tests {
             "datagram of 1201 bytes is over the 1200-byte limit"
         );
         let mut v = good.clone();
-        v[4] = 3;
-        assert_eq!(e(&v), "protocol version 3 (this build speaks 1 and 2)");
+        v[4] = 4;
+        assert_eq!(e(&v), "protocol version 4 (this build speaks 1, 2 and 3)");
         v[4] = 1;
         v[5] = 9;
         assert_eq!(e(&v), "unknown packet type 9");
@@ -224,7 +238,7 @@ mod tests {
         );
     }
 
-    /// A hello above version 2 is read (the simulator welcomes it with 2); version 0, bad
+    /// A hello above version 3 is read (the simulator welcomes it with 3); version 0, bad
     /// limits, bad names and a bad size are refusals naming the field and the allowed values;
     /// the reserved bytes are not read.
     #[test]
@@ -237,10 +251,10 @@ mod tests {
             }
             .encode()
         };
-        let mut h3 = hello(3, FALCON);
+        let mut h3 = hello(4, FALCON);
         assert!(matches!(
             Packet::decode(&h3),
-            Ok(Packet::Hello { version: 3, .. })
+            Ok(Packet::Hello { version: 4, .. })
         ));
         // Reserved bytes 6–7: sent as 0, never read.
         h3[6] = 1;
@@ -254,7 +268,7 @@ mod tests {
             refusal(&hello(0, FALCON)),
             (
                 "version".into(),
-                "1 or more (a hello above 2 is welcomed with version 2)".into()
+                "1 or more (a hello above 3 is welcomed with version 3)".into()
             )
         );
         let mut bad = FALCON;
@@ -298,8 +312,8 @@ mod tests {
         assert_eq!(refusal(&long).0, "size");
         // Other packets keep the strict version check.
         let mut bye = Packet::Bye { reason: 0 }.encode();
-        bye[4] = 3;
-        assert_eq!(Packet::decode(&bye), Err(ProtocolError::Version(3)));
+        bye[4] = 4;
+        assert_eq!(Packet::decode(&bye), Err(ProtocolError::Version(4)));
     }
 
     /// A refusal is the header (version byte 1, type 6) and three strings; it round-trips,
@@ -357,7 +371,67 @@ mod tests {
                 stiffness_n_per_m: 0.0,
             }],
             world_energy_j: -0.125,
+            bond: None,
         }
+    }
+
+    /// A model with a bond travels as a version-3 force packet: the version-2 packet and 64
+    /// bytes of bond, read back bit for bit; a version-3 packet one byte short or long, or
+    /// with a bond out of range, is refused by name.
+    #[test]
+    fn a_version_3_force_packet_carries_the_bond_after_the_model() {
+        let bond = haptic_types::local::Bond {
+            anchor_m: [0.001, -0.002, 0.003],
+            normal: [0.0, 0.6, 0.8],
+            stiffness_n_per_m: 350.0,
+            break_m: 0.0025,
+        };
+        let m = LocalModel {
+            bond: Some(bond),
+            ..full_model()
+        };
+        let b = at_rest(m.clone()).encode();
+        assert_eq!(b[4], 3);
+        let (n, body, nb) = (m.planes.len(), m.body.is_some(), m.body_planes.len());
+        assert_eq!(b.len(), force_v3_len(n, body, nb));
+        assert_eq!(b.len(), force_v2_len(n, body, nb) + 64);
+        match Packet::decode(&b) {
+            Ok(Packet::Force(f)) => assert_eq!(f.local.as_deref(), Some(&m)),
+            other => panic!("{other:?}"),
+        }
+        // Without a bond the same model is a version-2 packet.
+        let v2 = at_rest(full_model()).encode();
+        assert_eq!((v2[4], v2.len()), (2, b.len() - 64));
+        let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
+        assert_eq!(
+            e(&b[..b.len() - 1]),
+            format!(
+                "force (version 3) packet of {} bytes is too short (needs {})",
+                b.len() - 1,
+                b.len()
+            )
+        );
+        let mut long = b.clone();
+        long.push(0);
+        assert_eq!(
+            e(&long),
+            format!(
+                "force (version 3) packet of {} bytes is too long (expected {})",
+                b.len() + 1,
+                b.len()
+            )
+        );
+        let broken = LocalModel {
+            bond: Some(haptic_types::local::Bond {
+                break_m: -1.0,
+                ..bond
+            }),
+            ..full_model()
+        };
+        assert_eq!(
+            e(&at_rest(broken).encode()),
+            "force packet's local model: bond.break_m = -1 is out of range: allowed 0 < s ≤ 1 m"
+        );
     }
 
     #[test]

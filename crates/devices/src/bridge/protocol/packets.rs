@@ -10,7 +10,8 @@ use haptic_types::vec3::Vec3;
 pub enum Packet {
     /// A device announces itself and its specifications.
     Hello {
-        /// The protocol version the device speaks (1, or 2: it renders the local model).
+        /// The protocol version the device speaks (1; 2: it renders the local model; 3: and
+        /// its bond).
         version: u8,
         /// The device's own servo rate, Hz (information: the session's tick rate rules).
         rate_hz: u32,
@@ -19,7 +20,7 @@ pub enum Packet {
     },
     /// The simulator accepts a device.
     Welcome {
-        /// The protocol version of the session (the device's, at most [`VERSION_2`](super::VERSION_2)).
+        /// The protocol version of the session (the device's, at most [`VERSION_3`](super::VERSION_3)).
         version: u8,
         /// The session's tick rate, Hz: send one sample per tick.
         rate_hz: u32,
@@ -76,7 +77,8 @@ pub struct ForceReply {
     /// Status bits of the tick (1 clamped, 2 input invalid, 4 deadline missed, 8 stiffness over
     /// cap, 16 force invalid, 32 watchdog, 64 passivity controller, 128 force-rate limit).
     pub status: u8,
-    /// The local model (version 2 only; `None`: a version-1 packet).
+    /// The local model (versions 2 and 3; `None`: a version-1 packet). A model with a bond is
+    /// sent as a version-3 packet.
     pub local: Option<Box<LocalModel>>,
 }
 
@@ -161,7 +163,7 @@ pub enum ProtocolError {
     #[error("bad magic {0:02x?} (expected NHDB)")]
     Magic([u8; 4]),
     /// Another protocol version.
-    #[error("protocol version {0} (this build speaks 1 and 2)")]
+    #[error("protocol version {0} (this build speaks 1, 2 and 3)")]
     Version(u8),
     /// A local model out of range.
     #[error("force packet's local model: {0}")]

@@ -2,7 +2,7 @@
 //! local model, each failure an error naming the packet.
 
 use super::ProtocolError;
-use haptic_types::local::{Body, LocalModel, MAX_PLANES, Plane};
+use haptic_types::local::{Body, Bond, LocalModel, MAX_PLANES, Plane};
 
 /// A bounds-checked little-endian reader over one datagram.
 pub(super) struct Reader<'a> {
@@ -98,11 +98,27 @@ impl<'a> Reader<'a> {
             body,
             body_planes,
             world_energy_j,
+            ..LocalModel::default()
         };
         // Finite, unit normals, masses and stiffnesses non-negative; the stiffnesses' cap is the
         // simulator's (it sends only what the device announced it renders).
         m.check(f64::INFINITY).map_err(ProtocolError::Local)?;
         Ok(m)
+    }
+
+    /// The bond after a version-3 force packet's local model: anchor, normal, stiffness and
+    /// breaking stretch (checked with the model).
+    pub(super) fn bond(&mut self) -> Result<Bond, ProtocolError> {
+        let kind = "force (version 3)";
+        let anchor_m = self.f64s::<3>(kind)?;
+        let normal = self.f64s::<3>(kind)?;
+        let [stiffness_n_per_m, break_m] = self.f64s::<2>(kind)?;
+        Ok(Bond {
+            anchor_m,
+            normal,
+            stiffness_n_per_m,
+            break_m,
+        })
     }
 
     fn take(&mut self, n: usize, kind: &'static str) -> Result<&[u8], ProtocolError> {

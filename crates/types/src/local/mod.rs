@@ -25,6 +25,10 @@
 //! assert!((f[2] - 2.0).abs() < 1e-12);
 //! ```
 
+mod bond;
+
+pub use bond::Bond;
+
 use crate::value::ValueError;
 use crate::vec3::{self, Vec3};
 use world_form::fmt_num;
@@ -197,6 +201,8 @@ pub struct WorldPrimitives {
     pub body: Option<Body>,
     /// Surfaces the carried body touches or nears (hard contacts on its grip point).
     pub body_planes: Vec<Plane>,
+    /// The anchored contact of an adhesive world: a spring that breaks (protocol 3).
+    pub bond: Option<Bond>,
 }
 
 impl WorldPrimitives {
@@ -205,6 +211,7 @@ impl WorldPrimitives {
         self.planes.clear();
         self.body = None;
         self.body_planes.clear();
+        self.bond = None;
     }
 }
 
@@ -226,6 +233,8 @@ pub struct LocalModel {
     /// (the work of the forces it answered on the readings it received), J: the device never
     /// gives the hand more than this plus its reserve (the two-port passivity layer).
     pub world_energy_j: f64,
+    /// A spring that breaks (protocol 3; none in a version-2 session).
+    pub bond: Option<Bond>,
 }
 
 impl Default for LocalModel {
@@ -237,13 +246,14 @@ impl Default for LocalModel {
             body: None,
             body_planes: Vec::new(),
             world_energy_j: 0.0,
+            bond: None,
         }
     }
 }
 
 impl LocalModel {
     /// The residual and the planes at `p` for the answered reading `p0` (the body excluded: it
-    /// has a state of its own), N.
+    /// has a state of its own) and the bond, N.
     pub fn static_force(&self, p: Vec3, p0: Vec3) -> Vec3 {
         let d = vec3::sub(p, p0);
         let k = &self.residual_stiffness_n_per_m;
@@ -253,6 +263,9 @@ impl LocalModel {
         }
         for pl in &self.planes {
             f = vec3::add(f, pl.force(p));
+        }
+        if let Some(b) = &self.bond {
+            f = vec3::add(f, b.force(p));
         }
         f
     }
@@ -278,6 +291,7 @@ impl LocalModel {
             }
         }
         check_planes("body plane", &self.body_planes)?;
+        bond::check(self, max_stiffness_n_per_m)?;
         if let Some(b) = &self.body {
             if !(0.0..=1.0).contains(&b.restitution) {
                 return Err(range("body.restitution", b.restitution, "0 ≤ e ≤ 1"));
@@ -326,7 +340,7 @@ impl LocalModel {
 }
 
 /// The message of a local-model number out of range (the one wording, [`ValueError`]).
-fn range(
+pub(crate) fn range(
     field: impl Into<std::borrow::Cow<'static, str>>,
     value: f64,
     allowed: impl Into<std::borrow::Cow<'static, str>>,
