@@ -39,7 +39,7 @@ def same_force(got, want):
 # ---------------------------------------------------------------- the reference trace
 
 
-@pytest.mark.parametrize("index", [0, 1], ids=["protocol-1", "protocol-2"])
+@pytest.mark.parametrize("index", [0, 1, 2], ids=["protocol-1", "protocol-2", "protocol-3"])
 def test_the_device_side_renders_the_rust_reference_trace(index):
     case = json.loads(FIXTURE.read_text(encoding="utf-8"))["cases"][index]
     side = bridge.DeviceSide(case["protocol"], case["max_force_n"], case["period_s"])
@@ -73,6 +73,12 @@ def test_the_device_side_renders_the_rust_reference_trace(index):
         assert all(r.local is not None and len(r.local.planes) == 2 for r in packets)
         assert any(r.local.body is not None and r.local.body_planes for r in packets)
         assert side.interventions > 0
+        # Protocol 3's bond (samples 30–119) in version-3 packets, none in protocol 2's.
+        bonded = [r.seq for r in packets if r.local.bond is not None]
+        if case["protocol"] == 3:
+            assert (min(bonded), max(bonded)) == (30, 119)
+        else:
+            assert bonded == []
     # Same operations in the same order: the same bits, not merely close (on 64-bit builds,
     # whose float arithmetic is plain IEEE double, as Rust's).
     if sys.maxsize > 2**32:
@@ -96,8 +102,8 @@ def test_a_dropped_answer_and_a_silent_link_render_as_the_rust_side_would():
     assert side.render((0.0, 0.0, -0.002), 1e-3) == (0.0, 0.0, 1.0)
     # A force over the device's maximum is scaled down along its direction.
     assert side.render((0.0, 0.0, -0.050), 1e-3) == pytest.approx((0.0, 0.0, 8.0))
-    with pytest.raises(ValueError, match="protocol = 3: allowed 1 or 2"):
-        bridge.DeviceSide(3, 8.0, 1e-3)
+    with pytest.raises(ValueError, match="protocol = 4: allowed 1, 2 or 3"):
+        bridge.DeviceSide(4, 8.0, 1e-3)
 
 
 # ---------------------------------------------------------------- malformed packets
@@ -178,7 +184,19 @@ def test_malformed_version_2_packets_are_refused_by_name():
     r.local.planes = r.local.planes * 3
     with pytest.raises(ValueError, match="6 planes: allowed at most 4"):
         bridge.encode_force(r)
-    assert error(b"NHDB\x03\x04\x00\x00").startswith("protocol version 3")
+    assert error(b"NHDB\x04\x04\x00\x00").startswith("protocol version 4")
+    # A version-3 packet: the version-2 one and its bond, checked like the rest of the model.
+    r = full_reply()
+    r.local.bond = bridge.Bond((0.0, 0.0, 0.001), (0.0, 0.6, 0.8), 350.0, 0.0025)
+    b = bridge.encode_force(r)
+    assert (b[4], len(b)) == (3, bridge.force_v3_len(2, True, 1))
+    assert len(b) == len(bridge.encode_force(full_reply())) + 64
+    assert bridge.decode(b)[1].local == r.local
+    assert error(b[:-1]) == f"force (version 3) packet of {len(b) - 1} bytes is too short (needs {len(b)})"
+    assert error(b + b"\x00") == f"force (version 3) packet of {len(b) + 1} bytes is too long (expected {len(b)})"
+    r.local.bond.break_m = -1.0
+    assert error(bridge.encode_force(r)) == (
+        "force packet's local model: bond.break_m = -1 is out of range: allowed 0 < s ≤ 1 m")
     assert error(b"GET / HT") == "bad magic [47, 45, 54, 20] (expected NHDB)"
 
 
@@ -264,7 +282,7 @@ def press_the_wall(port, protocol):
     return client, welcome, sent, answers, side
 
 
-@pytest.mark.parametrize("protocol", [2, 1])
+@pytest.mark.parametrize("protocol", [3, 2, 1])
 def test_a_live_session_on_the_wall_in_each_protocol(tmp_path, protocol):
     port = free_port()
     t, sim = bridged_session(port, tmp_path / f"v{protocol}.mcap")
@@ -274,10 +292,11 @@ def test_a_live_session_on_the_wall_in_each_protocol(tmp_path, protocol):
     assert sim["stats"]["end"] == "device_ended"
     assert sim["stats"]["link"]["received"] == sent and client.seq >= 500
     assert len(answers) >= 0.9 * sent
-    if protocol == 2:
+    if protocol >= 2:
         for reply, p0 in answers:
             m = reply.local
-            assert m is not None and len(m.planes) == 1 and m.body is None
+            # The wall has no bond: a version-3 session answers with version-2 packets.
+            assert m is not None and len(m.planes) == 1 and m.body is None and m.bond is None
             wall = m.planes[0]
             assert wall.normal == (0.0, 0.0, 1.0) and wall.offset_m == pytest.approx(WALL_Z_M, abs=1e-15)
             # The residual makes the model give exactly the answered force at the answered reading.

@@ -1,6 +1,7 @@
 """The C reference in docs/device-bridge.md compiles as printed and follows the document's
-rules: rule 2's ticks (unsigned, the offset signed, the last packet), a plane's force, and a
-version-1 answer that keeps the body without rendering its pull (issue 41)."""
+rules: rule 2's ticks (unsigned, the offset signed, the last packet), a plane's force, a
+version-1 answer that keeps the body without rendering its pull (issue 41), and version 3's
+bond, which holds in pull and in press and breaks at its stretch."""
 
 import re
 import shutil
@@ -43,6 +44,14 @@ int main(void) {
     s.model = 0;
     nh_render(&s, p, 2.5e-4, f);
     printf("%.6f %d\n", f[2], s.have_body);
+    /* Version 3's bond: 500 N/m anchored at 0, breaking at 2 mm of pull or shear. */
+    double a[3] = {0.0, 0.0, 0.0}, n[3] = {0.0, 0.0, 1.0};
+    double pulls[3][3] = {{0.0, 0.0, 0.0015}, {0.0, 0.0, 0.0025}, {0.0, 0.0, -0.003}};
+    for (int j = 0; j < 3; j++) {
+        double g[3] = {0.0, 0.0, 0.0};
+        nh_bond_add(a, n, 500.0, 0.002, pulls[j], g);
+        printf("%.6f\n", g[2]);
+    }
     return 0;
 }
 """
@@ -51,8 +60,11 @@ int main(void) {
 def c_reference() -> str:
     doc = (ROOT / "docs" / "device-bridge.md").read_text()
     blocks = re.findall(r"```c\n(.*?)```", doc, re.S)
-    assert len(blocks) == 1
-    return blocks[0]
+    # The reference (versions 1 and 2), then version 3's bond, which the document prints first.
+    reference = [b for b in blocks if "nh_accept" in b]
+    bond = [b for b in blocks if "nh_bond_add" in b]
+    assert (len(blocks), len(reference), len(bond)) == (2, 1, 1)
+    return reference[0] + "\n" + bond[0]
 
 
 @pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler")
@@ -72,4 +84,7 @@ def test_the_c_reference_compiles_and_follows_the_rules():
         "5.000000",  # the wall: 5000 N/m, 1 mm in
         "-0.100000",  # the body's pull: 100 N/m over 1 mm, felt downwards
         "0.000000 1",  # a version-1 answer: F0 - K (p - p0) = 0, the body kept
+        "-0.750000",  # the bond holds at 1.5 mm of pull: 0.75 N back
+        "0.000000",  # broken at 2.5 mm
+        "1.500000",  # 3 mm pressed in: it holds, pushing out
     ]

@@ -15,6 +15,9 @@
 //! 3. **Transparency**: the wall at half the device's rated stiffness pressed 2 mm by a firm
 //!    hand: the stiffness the hand feels (the slope of the rendered force against the
 //!    reading) divided by the wall's; and the drag in free space at 0.1 m/s, at each latency.
+//! 4. **The atoms' pull-off**: the nano world on each preset, loose and firm, behind 2, 5 and
+//!    10 ms: the peak force the hand feels over the ideal link's, protocol 2 (the adhesion as
+//!    the residual's linear spring) against protocol 3 (the bond, a spring that breaks).
 #![allow(clippy::unwrap_used)]
 
 use bench_harness::chart::{Chart, Scale, Series, Style};
@@ -78,7 +81,8 @@ fn main() {
          rule for late samples; the device renders each answer from its arrival with the \
          device-side library (`haptic_devices::local`). Protocol 1 renders `F0 − K (p − p0)`; \
          protocol 2 renders the world's local model (contact planes, the carried brick) at the \
-         device's servo rate, behind the two-port passivity layer. Loose hand: 300 N/m, \
+         device's servo rate, behind the two-port passivity layer; protocol 3 adds the bond, \
+         a spring that breaks at the nano world's pull-off. Loose hand: 300 N/m, \
          2 N·s/m; firm: 1000 N/m, 8 N·s/m. Stable: no undeclared force jump above 1 N, at most \
          10 % of the power above 50 Hz, the observer within its reserve.",
     );
@@ -229,6 +233,52 @@ fn main() {
          own Z-width puts it, whatever the latency. Transparency is the felt slope over the \
          wall's; the drag is the mean force magnitude gliding at 0.1 m/s in free space.",
     );
+    pull_off(&mut md, &read);
     let (path, _) = md.finish().unwrap();
     println!("wrote {}", path.display());
+}
+
+/// 4. The atoms' pull-off behind the link, protocols 2 and 3.
+fn pull_off(md: &mut Report, read: &dyn Fn(&str) -> String) {
+    md.heading("The atoms' pull-off: the peak the hand feels, protocol 2 against 3");
+    let (text, stext) = (read("nanoworld.toml"), read("nanoworld.script.toml"));
+    let mut t = Table::new([
+        "device",
+        "grip",
+        "one-way latency (ms)",
+        "ideal link's peak (N)",
+        "protocol 2 / ideal",
+        "protocol 3 / ideal",
+    ]);
+    for mech in PRESETS {
+        for (grip, held) in [(Grip::LOOSE, "loose"), (Grip::FIRM, "firm")] {
+            let peak = |l: &Linked| {
+                run_linked(&text, &stext, mech, grip, l, None)
+                    .unwrap()
+                    .0
+                    .peak_force_n
+            };
+            let ideal = peak(&Linked::IDEAL);
+            for ms in [2.0, 5.0, 10.0] {
+                t.row([
+                    mech.name.to_string(),
+                    held.to_string(),
+                    format!("{ms}"),
+                    format!("{ideal:.4}"),
+                    format!("{:.3}", peak(&linked(ms, Protocol::V2)) / ideal),
+                    format!("{:.3}", peak(&linked(ms, Protocol::V3)) / ideal),
+                ])
+                .unwrap();
+            }
+        }
+    }
+    md.table(&t);
+    md.para(
+        "How to read: the anchored tip's adhesion is a spring until the pull reaches the \
+         pull-off, where the world's force drops to zero. Protocol 2 sends it as the residual's \
+         linear spring, which the device goes on rendering for a round trip past the pull-off: \
+         the hand is pulled harder than the world ever pulls, more with the delay. Protocol 3 \
+         sends a bond, a spring that breaks at the world's pull-off, evaluated at the position \
+         read now: the peak is the world's at every latency (docs/device-bridge.md).",
+    );
 }

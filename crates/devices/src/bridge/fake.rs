@@ -106,6 +106,8 @@ pub struct FakeReport {
     pub round_trip: Percentiles,
     /// Largest force received, N.
     pub max_force_n: f64,
+    /// Largest force a modelled device's motors rendered on the hand, N (0 otherwise).
+    pub max_felt_n: f64,
     /// The protocol the session speaks (from the welcome).
     pub protocol: u8,
     /// Periods whose force changed by more than 1 N from the period before (a buzz shows
@@ -671,6 +673,7 @@ impl<'a> Servo<'a> {
     /// The force a modelled device's motors rendered over the last period, N.
     fn felt(&mut self, f: [f64; 3]) {
         self.jump(f);
+        self.rep.max_felt_n = self.rep.max_felt_n.max(vec3::norm(f));
         self.felt = f;
     }
 

@@ -15,8 +15,8 @@ library only), plus adapters for real devices through their Python SDKs:
   VerseGrip handle for buttons) through ``HaplyHardwareAPI`` (Haply's Python
   API over USB serial).
 
-Two protocol versions. A device says hello with the version it speaks and the
-simulator's welcome names the session's (the device's, at most 2):
+Three protocol versions. A device says hello with the version it speaks and the
+simulator's welcome names the session's (the device's, at most 3):
 
 * **version 1**: each force packet carries the force F0 (N) computed at the
   answered reading p0 and a local stiffness K (N/m, 3×3); the device renders
@@ -31,8 +31,13 @@ simulator's welcome names the session's (the device's, at most 2):
   layer: once the work done on the hand runs more than 0.02 J past the world's
   it adds damping (at most 2 N·s/m), and past a second 0.02 J it also scales the
   force down, to zero two reserves further on.
+* **version 3** (``protocol=3``): version 2 with a *bond* (:class:`Bond`), a
+  spring that breaks where the world's contact lets go (the nano world's
+  anchored tip): the device renders ``k (a − p)`` until the stylus has pulled it
+  past its breaking stretch, and nothing beyond, so a pull-off behind a link is
+  felt where the world lets go, not a round trip later.
 
-:class:`DeviceSide` is the device's rendering for both versions, a line-by-line
+:class:`DeviceSide` is the device's rendering for every version, a line-by-line
 port of the Rust ``haptic_devices::local::DeviceSide`` (the same forces to the
 last bit on ``tests/python/fixtures/device_side.json``): record each reading
 sent (:meth:`DeviceSide.record_reading`), hand it each answer as it arrives
@@ -62,6 +67,7 @@ __all__ = [
     "MAGIC",
     "VERSION",
     "VERSION_2",
+    "VERSION_3",
     "MAX_PACKET",
     "MAX_PLANES",
     "DEVICE_RESERVE_J",
@@ -69,6 +75,7 @@ __all__ = [
     "Specs",
     "Plane",
     "Body",
+    "Bond",
     "LocalModel",
     "ForceReply",
     "DeviceSide",
@@ -86,6 +93,7 @@ __all__ = [
     "HelloRefused",
     "ROLES",
     "force_v2_len",
+    "force_v3_len",
     "decode",
     "local_force",
     "run",
@@ -95,8 +103,11 @@ MAGIC = b"NHDB"
 #: The protocol version of samples and byes (the same in both versions), and of version-1
 #: hellos, welcomes and force packets.
 VERSION = 1
-#: The newest protocol version: force packets carry the local model.
+#: Protocol version 2: force packets carry the local model.
 VERSION_2 = 2
+#: The newest protocol version: a force packet whose model has a bond (a spring that breaks)
+#: carries it after the model.
+VERSION_3 = 3
 HELLO, WELCOME, SAMPLE, FORCE, BYE, REFUSAL = 1, 2, 3, 4, 5, 6
 #: The button roles, in the order of the welcome's four role bytes (docs/devices.md).
 ROLES = ("grip", "turn_x", "turn_y", "turn_z")
@@ -117,11 +128,13 @@ _FORCE = struct.Struct("<QQ3d9dB")  # seq answered, tick, force, stiffness, stat
 _PLANE = struct.Struct("<5d")  # normal, offset, stiffness
 _BODY = struct.Struct("<16dId")  # position, velocity, m, k, k_s, b, damper, external, substeps, e
 _LOCAL_FIXED = struct.Struct("<13d")  # residual force, residual stiffness, world energy
+_BOND = struct.Struct("<8d")  # anchor, normal, stiffness, breaking stretch
 SAMPLE_LEN = _HEADER.size + _SAMPLE.size  # 52
 FORCE_LEN = _HEADER.size + _FORCE.size  # 121
 BYE_LEN = _HEADER.size + 1  # 9
 _V2_MIN_LEN = FORCE_LEN + _LOCAL_FIXED.size + 3  # 228: no planes, no body, no body planes
 _V2_KIND = "force (version 2)"
+_V3_KIND = "force (version 3)"
 
 Vec3 = Tuple[float, float, float]
 _ZERO: Vec3 = (0.0, 0.0, 0.0)
@@ -303,6 +316,34 @@ class Body:
 
 
 @dataclass
+class Bond:
+    """A spring that breaks (protocol 3): ``F = k (a − p)`` while the stretch
+    ``s(p) = |d − min(0, n·d) n|`` (``d = p − a``: the pull away from the surface and the
+    shear count, a press into it does not) is below ``break_m``, zero from there."""
+
+    #: Where the spring holds the stylus, m.
+    anchor_m: Vec3
+    #: Unit normal of the surface bonded to, pointing to the stylus's side.
+    normal: Vec3
+    #: The spring's stiffness, N/m.
+    stiffness_n_per_m: float
+    #: The stretch at which it breaks, m (> 0).
+    break_m: float
+
+    def stretch_m(self, p: Sequence[float]) -> float:
+        """The bond's stretch at ``p``, m."""
+        d = _sub(p, self.anchor_m)
+        along = _dot(d, self.normal)
+        return _norm(_sub(d, _scale(self.normal, _min(along, 0.0))))
+
+    def force(self, p: Sequence[float]) -> Vec3:
+        """The bond's pull at ``p``, N."""
+        if self.stretch_m(p) < self.break_m:
+            return _scale(_sub(self.anchor_m, p), self.stiffness_n_per_m)
+        return _ZERO
+
+
+@dataclass
 class LocalModel:
     """What one version-2 answer asks the device to render until the next:
     ``F(p) = F_r − K_r (p − p0) + Σ planes(p) − body pull(p)`` (see :class:`DeviceSide`)."""
@@ -320,6 +361,8 @@ class LocalModel:
     body_planes: List[Plane] = field(default_factory=list)
     #: The net work the world's answers did on the hand since the session began, J.
     world_energy_j: float = 0.0
+    #: A spring that breaks (a version-3 packet); None in version 2.
+    bond: Optional[Bond] = None
 
     def static_force(self, p: Sequence[float], p0: Sequence[float]) -> Vec3:
         """The residual and the planes at ``p`` for the answered reading ``p0`` (the body
@@ -332,6 +375,8 @@ class LocalModel:
              f[2] - (k[6] * d[0] + k[7] * d[1] + k[8] * d[2]))
         for pl in self.planes:
             f = _add(f, pl.force(p))
+        if self.bond is not None:
+            f = _add(f, self.bond.force(p))
         return f
 
     def check(self, max_stiffness_n_per_m: float = math.inf) -> None:
@@ -380,6 +425,19 @@ class LocalModel:
                 raise ValueError(
                     f"body damping {_fmt(b.damping_n_s_per_m)} N·s/m is out of range: "
                     "allowed 0 ≤ b ≤ 10000 N·s/m")
+        bond = self.bond
+        if bond is not None:
+            n = _norm(bond.normal)
+            if not _finite(bond.anchor_m) or not _finite(bond.normal) or abs(n - 1.0) > 1e-6:
+                raise ValueError(
+                    "bond: the anchor must be finite and the normal a finite unit vector")
+            if not 0.0 <= bond.stiffness_n_per_m <= max_stiffness_n_per_m:
+                raise ValueError(
+                    f"bond.stiffness_n_per_m = {_fmt(bond.stiffness_n_per_m)} is out of range: "
+                    f"allowed 0 ≤ k ≤ {_fmt(max_stiffness_n_per_m)} N/m")
+            if not (bond.break_m > 0.0 and bond.break_m <= 1.0):
+                raise ValueError(
+                    f"bond.break_m = {_fmt(bond.break_m)} is out of range: allowed 0 < s ≤ 1 m")
 
 
 # ---------------------------------------------------------------- packets
@@ -407,7 +465,7 @@ class ForceReply:
     stiffness_n_per_m: Tuple[float, ...]  # 9 values, row-major 3x3
     status: int
     received_at: float = 0.0  # time.perf_counter() on arrival, s
-    #: The local model (a version-2 packet); None for a version-1 packet.
+    #: The local model (a version-2 or 3 packet); None for a version-1 packet.
     local: Optional[LocalModel] = None
 
 
@@ -417,14 +475,14 @@ def _string(s: str) -> bytes:
 
 
 def _check_version(version: int, what: str = "version") -> int:
-    if version not in (VERSION, VERSION_2):
-        raise ValueError(f"{what} = {version!r}: allowed 1 or 2")
+    if version not in (VERSION, VERSION_2, VERSION_3):
+        raise ValueError(f"{what} = {version!r}: allowed 1, 2 or 3")
     return int(version)
 
 
 def encode_hello(specs: Specs, version: int = VERSION) -> bytes:
-    """The hello datagram of a device with ``specs`` speaking protocol ``version`` (1, or 2:
-    it renders the local model)."""
+    """The hello datagram of a device with ``specs`` speaking protocol ``version`` (1; 2: it
+    renders the local model; 3: and its bond)."""
     body = struct.pack(
         "<Iddd",
         specs.rate_hz,
@@ -495,9 +553,11 @@ def _planes_bytes(planes: Sequence[Plane], what: str) -> bytes:
 
 def encode_force(reply: ForceReply) -> bytes:
     """A force datagram (what the simulator sends): version 2 with the local model when
-    ``reply.local`` is set, else version 1. Raises ValueError for more than four planes."""
+    ``reply.local`` is set, version 3 when that model has a bond, else version 1. Raises
+    ValueError for more than four planes."""
     m = reply.local
-    out = _HEADER.pack(MAGIC, VERSION if m is None else VERSION_2, FORCE, 0) + _FORCE.pack(
+    version = VERSION if m is None else (VERSION_2 if m.bond is None else VERSION_3)
+    out = _HEADER.pack(MAGIC, version, FORCE, 0) + _FORCE.pack(
         reply.seq, reply.tick, *reply.force_n, *reply.stiffness_n_per_m, reply.status)
     if m is None:
         return out
@@ -511,12 +571,21 @@ def encode_force(reply: ForceReply) -> bytes:
             *b.position_m, *b.velocity_m_per_s, b.mass_kg, b.stiffness_n_per_m,
             b.series_stiffness_n_per_m, b.damping_n_s_per_m, *b.damper_m, *b.external_force_n,
             b.substeps, b.restitution)
-    return out + _planes_bytes(m.body_planes, "body planes")
+    out += _planes_bytes(m.body_planes, "body planes")
+    if m.bond is not None:
+        d = m.bond
+        out += _BOND.pack(*d.anchor_m, *d.normal, d.stiffness_n_per_m, d.break_m)
+    return out
 
 
 def force_v2_len(planes: int, body: bool, body_planes: int) -> int:
     """Size of a version-2 force packet, bytes: 228 + 40 per plane + 140 for a body."""
     return _V2_MIN_LEN + 40 * planes + (_BODY.size if body else 0) + 40 * body_planes
+
+
+def force_v3_len(planes: int, body: bool, body_planes: int) -> int:
+    """Size of a version-3 force packet, bytes: a version-2 one and its 64-byte bond."""
+    return force_v2_len(planes, body, body_planes) + _BOND.size
 
 
 class _Reader:
@@ -564,6 +633,10 @@ class _Reader:
             v = self.take(_PLANE, kind)
             out.append(Plane(v[0:3], v[3], v[4]))
         return out
+
+    def bond(self) -> Bond:
+        v = self.take(_BOND, _V3_KIND)
+        return Bond(anchor_m=v[0:3], normal=v[3:6], stiffness_n_per_m=v[6], break_m=v[7])
 
     def local(self) -> LocalModel:
         kind = _V2_KIND
@@ -619,10 +692,10 @@ def decode(data: bytes):
     magic, version, kind, _ = _HEADER.unpack_from(data)
     if magic != MAGIC:
         raise ValueError(f"bad magic [{', '.join(f'{b:02x}' for b in magic)}] (expected NHDB)")
-    if version not in (VERSION, VERSION_2):
+    if version not in (VERSION, VERSION_2, VERSION_3):
         # Worded so that "(this client speaks 1)", the text tests/python/test_live.py matches
         # since version 1, still appears.
-        raise ValueError(f"protocol version {version} (this client speaks 1) and 2")
+        raise ValueError(f"protocol version {version} (this client speaks 1), 2 and 3")
     r = _Reader(data, _HEADER.size)
     if kind == WELCOME:
         rate, start = r.take(_WELCOME, "welcome")
@@ -651,18 +724,26 @@ def decode(data: bytes):
         if version == VERSION_2:
             local = r.local()
             r.end(_V2_KIND)
+        elif version == VERSION_3:
+            local = r.local()
+            local.bond = r.bond()
+            try:
+                local.check(math.inf)
+            except ValueError as e:
+                raise ValueError(f"force packet's local model: {e}") from None
+            r.end(_V3_KIND)
         return "force", ForceReply(v[0], v[1], tuple(v[2:5]), tuple(v[5:14]), v[14], local=local)
     if kind == BYE:
         _fixed(data, "bye", BYE_LEN)
         return "bye", data[8]
     if kind == SAMPLE:
-        if version == VERSION_2:
+        if version >= VERSION_2:  # a version-3 sample is a version-2 sample
             _fixed(data, "sample (version 2)", SAMPLE_LEN + 4)
         else:
             _fixed(data, "sample", SAMPLE_LEN)
         seq, t_ns, x, y, z, buttons = _SAMPLE.unpack_from(data, _HEADER.size)
         out = {"seq": seq, "device_time_ns": t_ns, "position_m": (x, y, z), "buttons": buttons}
-        if version == VERSION_2:
+        if version >= VERSION_2:
             out["two_port_periods"] = struct.unpack_from("<I", data, SAMPLE_LEN)[0]
         return "sample", out
     if kind == HELLO:
@@ -817,7 +898,9 @@ class DeviceSide:
         p0 = _reading_at_or_before(self._readings, reply.seq)
         if p0 is None:
             p0 = self._readings[0][1] if self._readings else _ZERO
-        local = reply.local if self.protocol == VERSION_2 else None
+        local = reply.local if self.protocol >= VERSION_2 else None
+        if local is not None and self.protocol == VERSION_2 and local.bond is not None:
+            local = dataclasses.replace(local, bond=None)
         lag = reply.tick - reply.seq
         offset = lag if self._tick_offset is None else self._tick_offset
         self._tick_offset = min(offset, lag)
@@ -879,7 +962,7 @@ class DeviceSide:
         n = _norm(f)
         if n > self.max_force_n:
             f = _scale(f, self.max_force_n / n)
-        if self.protocol == VERSION_2:
+        if self.protocol >= VERSION_2:
             f = self._bound(f, v, servo_s)
             if not _finite(f):
                 f = _ZERO
@@ -977,7 +1060,7 @@ class BridgeClient:
         seq = self.seq
         self.seq += 1
         t = time.perf_counter_ns() - self._t0
-        n = two_port_periods if self.version == VERSION_2 else None
+        n = two_port_periods if self.version is not None and self.version >= VERSION_2 else None
         self.sock.sendto(encode_sample(seq, t, position_m, buttons, n), self.address)
         return seq
 
