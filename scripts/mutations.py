@@ -98,6 +98,24 @@ MUTATIONS = (
         count=1,
         tests=(("-p", "haptic-loop", "--test", "link"),),
     ),
+    Mutation(
+        name="bond-never-breaks",
+        what="protocol 3's bond never breaks (the device pulls past the pull-off, as protocol 2 did)",
+        path="crates/types/src/local/bond.rs",
+        old="self.stretch_m(p) < self.break_m",
+        new="self.stretch_m(p) < f64::INFINITY",
+        count=1,
+        tests=(
+            (
+                "-p",
+                "haptic-loop",
+                "--test",
+                "link",
+                "the_atoms_pull_off_behind_10_ms_overshoots_with_protocol_2_and_not_with_protocol_3",
+            ),
+            ("-p", "haptic-devices", "--test", "device_side_fixture"),
+        ),
+    ),
 )
 
 
