@@ -287,13 +287,15 @@ fn print_report(r: &FakeReport, physical: Option<(Mechanics, Grip)>, ideal: bool
     );
     if let Some((m, g)) = physical {
         println!(
-            "  modelled {} held {} ({} N/m, {} N·s/m){}: the motors did {:+.4} J of work on the hand",
+            "  modelled {} held {} ({} N/m, {} N·s/m){}: the motors did {:+.4} J of work on the hand, \
+             the largest force they put on it {:.3} N",
             m.name,
             g.label(),
             g.stiffness_n_per_m,
             g.damping_n_s_per_m,
             if ideal { ", ideal sensing" } else { "" },
-            r.energy_to_hand_j
+            r.energy_to_hand_j,
+            r.max_felt_n
         );
         println!(
             "  protocol {}{}",
