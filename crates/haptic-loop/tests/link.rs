@@ -279,8 +279,12 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
     // one run each:
     // - the 10 kHz trap (Touch, firm, 10 ms: 1.67 N against 1.14 N): the working envelope
     //   moves with the particle, which the device holds still for the round trip. Tried and
-    //   not kept: the envelope's edge as a plane moving at the particle's velocity made 13
-    //   runs unstable (chatter as the hand left the edge; held still, the same);
+    //   not kept, each measured on this grid: the envelope's edge as a plane moving at the
+    //   particle's velocity (13 runs unstable: chatter as the hand left the edge; held still,
+    //   the same); the residual's spring drifting at the particle's velocity (6 unstable to
+    //   10 ms, 39 of 160 at 20–50 ms: the particle slows as it catches up, the extrapolation
+    //   does not); the world's stiffness reported only beyond the envelope (21 over +20 %,
+    //   16 unstable: the residual's spring inside the envelope is what holds the edge at once);
     // - the brick on a Delta.3 (loose, 10 ms, jitter and loss: 2.67 N against 1.81 N): the
     //   carried brick lands on the house while the device's body, which meets only the
     //   planes the answer named, is a round trip behind the world's.
