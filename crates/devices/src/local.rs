@@ -8,8 +8,6 @@
 //! - **Protocol 1** renders the newest answer's `F0 − K (p − p0)`, with `p0` the reading that
 //!   answer was computed from (the device keeps its recent readings by sequence number), so
 //!   the answer's local stiffness is felt without delay however late the answer arrives.
-//! - **Protocol 3** renders protocol 2's model with its bond: a spring that breaks where the
-//!   world's contact lets go, at the position read now.
 //! - **Protocol 2** renders the answer's [`LocalModel`]: its residual, its contact planes at
 //!   the position read now, and the carried body ([`Body`]), integrated here one step per
 //!   sample with the reading sent, as the simulator integrates it: each answer restarts the
@@ -17,15 +15,16 @@
 //!   readings sent since, so in free carry the device's body and the simulator's are one
 //!   trajectory, the device's ahead by the link's delay, and the coupling's dynamics never
 //!   wait for the link.
+//! - **Protocol 3** renders protocol 2's model with its bond: a spring that breaks where the
+//!   world's contact lets go, at the position read now.
 //!
-//! Both run behind the **two-port passivity layer** (after Ryu, Artigas and Preusche 2010):
-//! the device counts the work its motors did on the hand, `W_dev = Σ F·Δp` over its servo
+//! Protocols 2 and 3 run behind the **two-port passivity layer** (after Ryu, Artigas and Preusche
+//! 2010): the device counts the work its motors did on the hand, `W_dev = Σ F·Δp` over its servo
 //! periods, and the simulator reports the work its answers did on the readings it received,
-//! `W_world`. Whatever the link's delay, loss or jitter, once `W_dev` exceeds
-//! `W_world + R` (the reserve) the device adds damping to take the surplus back, and once the
-//! surplus passes a second reserve it scales its force down, to zero at `W_world + 4R`: the
-//! hand never receives more than the world delivered plus four reserves, 0.08 J (each servo
-//! period of intervention is counted).
+//! `W_world`. Whatever the link's delay, loss or jitter, once `W_dev` exceeds `W_world + R` (the
+//! reserve) the device adds damping to take the surplus back, and once the surplus passes a second
+//! reserve it scales its force down, to zero at `W_world + 4R`: the hand never receives more than
+//! the world delivered plus four reserves, 0.08 J (each servo period of intervention is counted).
 
 use haptic_types::device::ForceCommand;
 use haptic_types::local::{Body, LocalModel};
