@@ -11,6 +11,7 @@ contact planes, a carried body with its contact plane, the two-port layer acting
 import json
 import math
 import random
+import re
 import sys
 import time
 from pathlib import Path
@@ -383,3 +384,103 @@ def test_an_adapter_renders_the_local_model_at_its_servo_rate_until_hold_s(mock_
     dev.attach(None)
     dev.close()
     assert mock_haply["forces"][-1] == (0.0, 0.0, 0.0)
+
+
+# ---------------------------------------------------------------- protocol 3 on the atoms
+
+
+def nano_path(t):
+    """The built-in nano script's stylus at ``t`` s (m): its waypoints, linearly between them."""
+    text = (ROOT / "scenes" / "nanoworld.script.toml").read_text(encoding="utf-8")
+    ts = [float(x) for x in re.findall(r"^t_s = ([-0-9.e]+)$", text, re.M)]
+    ps = [tuple(float(v) * 1e-3 for v in m.split(","))
+          for m in re.findall(r"^position_mm = \[([^\]]*)\]$", text, re.M)]
+    assert len(ts) == len(ps) > 10
+    for (t0, p0), (t1, p1) in zip(zip(ts, ps), zip(ts[1:], ps[1:])):
+        if t <= t1:
+            s = max(0.0, (t - t0) / (t1 - t0))
+            return tuple(a + (b - a) * s for a, b in zip(p0, p1))
+    return ps[-1]
+
+
+def test_a_version_3_session_on_the_atoms_carries_bonds_that_the_device_side_renders(tmp_path):
+    """A Python device speaking protocol 3 against the simulator's nano world: welcomed with 3,
+    it gets the anchored tip as a bond in version-3 packets (decoded here from the simulator's
+    own bytes), each model exact at its answered reading, and its DeviceSide renders the bond's
+    k (a − p) while it holds and nothing of it past its breaking stretch."""
+    import threading
+
+    import nanohaptics as nh
+
+    port = free_port()
+    result = {}
+
+    def sim():
+        result.update(nh.run_scene(str(ROOT / "scenes" / "nanoworld.toml"),
+                                   device=f"udp:127.0.0.1:{port}",
+                                   out=str(tmp_path / "v3.mcap"), wait_s=20.0))
+
+    t = threading.Thread(target=sim)
+    t.start()
+    specs = bridge.Specs("falcon", 8.0, 3000.0, 0.04, FALCON_BUTTONS)
+    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=3)
+    welcome = client.connect(20.0)
+    period = 1.0 / welcome["rate_hz"]
+    side = bridge.DeviceSide(welcome["version"], specs.max_force_n, period)
+    readings, bonded, sent = {}, [], 0
+    next_t = time.perf_counter()
+    try:
+        while client.seq * period < 3.5:  # the first pull-off falls in it (bond_link.rs)
+            p = nano_path(client.seq * period)
+            readings[client.seq] = p
+            side.record_reading(client.seq, p)
+            seq = client.send(p, two_port_periods=side.interventions)
+            sent += 1
+            while True:
+                reply = client.receive(max(0.0, next_t + period - time.perf_counter()))
+                if reply is None:
+                    break
+                side.receive(reply)
+                if reply.local is not None and reply.local.bond is not None:
+                    bonded.append((reply, readings[reply.seq]))
+                if reply.seq >= seq:
+                    break
+            side.render(p, period)
+            next_t += period
+            delay = next_t - time.perf_counter()
+            if delay > 0:
+                time.sleep(delay)
+            else:  # late: skip the missed numbers, as bridge.run does
+                missed = int(-delay // period)
+                for k in range(missed):
+                    readings[client.seq + k] = p
+                    side.record_reading(client.seq + k, p)
+                client.seq += missed
+                next_t += missed * period
+    finally:
+        client.close()
+    t.join()
+    assert welcome["version"] == 3 and client.version == 3
+    assert result["stats"]["end"] == "device_ended"
+    assert len(bonded) > 20, len(bonded)
+    print(f"{len(bonded)} bonded answers of {sent} samples")
+    for reply, p0 in bonded:
+        m = reply.local
+        b = m.bond
+        assert b.normal and abs(math.sqrt(sum(x * x for x in b.normal)) - 1.0) < 1e-9
+        assert 0.0 < b.break_m <= 1.0 and b.stiffness_n_per_m > 0.0
+        # The residual makes the model exact at the answered reading.
+        assert m.static_force(p0, p0) == pytest.approx(reply.force_n, abs=1e-9)
+    # The device side renders the newest bond: its spring while it holds, none past its break.
+    reply, p0 = bonded[-1]
+    b = reply.local.bond
+    side = bridge.DeviceSide(3, specs.max_force_n, period)
+    side.record_reading(reply.seq, p0)
+    assert side.receive(reply)
+    held = tuple(a + 0.5 * b.break_m * n for a, n in zip(b.anchor_m, b.normal))
+    broken = tuple(a + 1.5 * b.break_m * n for a, n in zip(b.anchor_m, b.normal))
+    r = reply.local.residual_force_n
+    f_held = side.render(held, period)
+    want = tuple(r[i] + (b.anchor_m[i] - held[i]) * b.stiffness_n_per_m for i in range(3))
+    assert f_held == pytest.approx(want, abs=1e-9)
+    assert side.render(broken, period) == pytest.approx(tuple(r), abs=1e-9)
