@@ -235,28 +235,21 @@ def engaged(reply):
     return reply.stiffness_n_per_m[8] == pytest.approx(WALL_K_N_PER_M)
 
 
-def press_the_wall(port, protocol):
-    """A scripted stylus through BridgeClient and DeviceSide at 1 kHz, as bridge.run paces a
-    device (missed periods skip their sequence numbers): from 10 mm above the origin down to
-    1 mm inside the wall (z = -6 mm) in 0.3 s, held there to 0.5 s, and longer (at most 3 s)
-    if a stall of this machine restarted the soft engagement. Returns the welcome, the number
-    of samples sent, every answer with the reading it answers, and the device side."""
-    specs = bridge.Specs("falcon", 8.0, 6000.0, 0.04, FALCON_BUTTONS)  # the wall's 5000 N/m uncapped
-    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=protocol)
-    welcome = client.connect(20.0)
-    period = 1.0 / welcome["rate_hz"]
-    side = bridge.DeviceSide(welcome["version"], specs.max_force_n, period)
+def pace(client, side, path, going, two_port=False):
+    """Sends the stylus at ``path(t)`` through ``client`` once a period of ``side`` while
+    ``going(t, answers)``, as bridge.run paces a device (missed periods skip their sequence
+    numbers), hands every answer to ``side`` and renders each period; with ``two_port`` each
+    sample carries the side's two-port count. Closes the client; returns the samples sent and
+    every answer with the reading it answers."""
+    period = side.period_s
     readings, answers, sent = {}, [], 0
     next_t = time.perf_counter()
     try:
-        while True:
-            t = client.seq * period
-            if t >= 3.0 or (t >= 0.5 and answers and engaged(answers[-1][0])):
-                break
-            p = (0.0, 0.0, 0.010 + (WALL_Z_M - 0.001 - 0.010) * min(t / 0.3, 1.0))
+        while going(client.seq * period, answers):
+            p = path(client.seq * period)
             readings[client.seq] = p
             side.record_reading(client.seq, p)
-            seq = client.send(p)
+            seq = client.send(p, two_port_periods=side.interventions if two_port else None)
             sent += 1
             while True:
                 reply = client.receive(max(0.0, next_t + period - time.perf_counter()))
@@ -280,6 +273,27 @@ def press_the_wall(port, protocol):
                 next_t += missed * period
     finally:
         client.close()
+    return sent, answers
+
+
+def press_the_wall(port, protocol):
+    """A scripted stylus through BridgeClient and DeviceSide at 1 kHz, as bridge.run paces a
+    device (missed periods skip their sequence numbers): from 10 mm above the origin down to
+    1 mm inside the wall (z = -6 mm) in 0.3 s, held there to 0.5 s, and longer (at most 3 s)
+    if a stall of this machine restarted the soft engagement. Returns the welcome, the number
+    of samples sent, every answer with the reading it answers, and the device side."""
+    specs = bridge.Specs("falcon", 8.0, 6000.0, 0.04, FALCON_BUTTONS)  # the wall's 5000 N/m uncapped
+    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=protocol)
+    welcome = client.connect(20.0)
+    side = bridge.DeviceSide(welcome["version"], specs.max_force_n, 1.0 / welcome["rate_hz"])
+
+    def path(t):
+        return (0.0, 0.0, 0.010 + (WALL_Z_M - 0.001 - 0.010) * min(t / 0.3, 1.0))
+
+    def going(t, answers):
+        return not (t >= 3.0 or (t >= 0.5 and answers and engaged(answers[-1][0])))
+
+    sent, answers = pace(client, side, path, going)
     return client, welcome, sent, answers, side
 
 
@@ -433,38 +447,9 @@ def test_a_version_3_session_on_the_atoms_carries_bonds_that_the_device_side_ren
     welcome = client.connect(20.0)
     period = 1.0 / welcome["rate_hz"]
     side = bridge.DeviceSide(welcome["version"], specs.max_force_n, period)
-    readings, bonded, sent = {}, [], 0
-    next_t = time.perf_counter()
-    try:
-        while client.seq * period < 3.5:  # the first pull-off falls in it (bond_link.rs)
-            p = nano_path(client.seq * period)
-            readings[client.seq] = p
-            side.record_reading(client.seq, p)
-            seq = client.send(p, two_port_periods=side.interventions)
-            sent += 1
-            while True:
-                reply = client.receive(max(0.0, next_t + period - time.perf_counter()))
-                if reply is None:
-                    break
-                side.receive(reply)
-                if reply.local is not None and reply.local.bond is not None:
-                    bonded.append((reply, readings[reply.seq]))
-                if reply.seq >= seq:
-                    break
-            side.render(p, period)
-            next_t += period
-            delay = next_t - time.perf_counter()
-            if delay > 0:
-                time.sleep(delay)
-            else:  # late: skip the missed numbers, as bridge.run does
-                missed = int(-delay // period)
-                for k in range(missed):
-                    readings[client.seq + k] = p
-                    side.record_reading(client.seq + k, p)
-                client.seq += missed
-                next_t += missed * period
-    finally:
-        client.close()
+    # The first pull-off falls within 3.5 s (bond_link.rs).
+    sent, answers = pace(client, side, nano_path, lambda t, _: t < 3.5, two_port=True)
+    bonded = [(r, p0) for r, p0 in answers if r.local is not None and r.local.bond is not None]
     t.join()
     assert welcome["version"] == 3 and client.version == 3
     assert result["stats"]["end"] == "device_ended"
