@@ -205,6 +205,57 @@ fn the_passivity_controller_damps_energy_returned_beyond_the_reserve() {
     }
 }
 
+/// The observer integrates the work over the path the world saw: every valid sample the loop
+/// takes moves the cursor, and the force held over the last tick works along that step. A
+/// sample one tick late (age 1) is still a new reading: a link whose every answer comes a
+/// tick late, or that alternates on-time and late samples, is observed as the on-time one
+/// (found by CI: the late readings were skipped and the whole press was charged at once on the
+/// next on-time one, at the deepest force, and the device side's two-port layer then held the
+/// wall back).
+#[test]
+fn the_observer_counts_the_work_of_late_samples_as_of_on_time_ones() {
+    let path = |n: u64| 0.001 - 2.9e-5 * n as f64; // into the wall at 29 mm/s
+    // Tick n reads sample n − lag(n): `lag` 0 is the on-time link.
+    let run = |lag: &dyn Fn(u64) -> u64| {
+        let mut l = looped(WALL);
+        let mut out = Vec::new();
+        for n in 0..120u64 {
+            let d = lag(n).min(n);
+            let s = DeviceSample {
+                seq: n - d,
+                age_ticks: d as u32,
+                ..at(path(n - d))
+            };
+            let r = l.tick(s, false).clone();
+            out.push((s.position_m[2], r.device_force_n[2], l.passivity_tank_j()));
+        }
+        out
+    };
+    let on_time = run(&|_| 0);
+    let late = run(&|_| 1);
+    let jitter = run(&|n| [0, 1, 1, 0, 2, 0, 1][n as usize % 7]);
+    // 2.45 mm into a 3000 N/m wall (the Falcon's cap): −½ k d² = −9.0 mJ of work on the
+    // hand, less the explicit sum's ½ k d Δz = 0.1 mJ.
+    let e_on = 0.02 - on_time[119].2;
+    assert!((-0.0090..-0.0086).contains(&e_on), "{e_on} J");
+    // One tick late: the same readings a tick later, the same work.
+    for n in 1..120 {
+        assert_eq!(late[n].2, on_time[n - 1].2, "tick {n}");
+    }
+    // Any pattern of lateness: 0.02 J − Σ F_(n−1) (z_n − z_(n−1)) over the readings taken.
+    for run in [&on_time, &late, &jitter] {
+        let mut e = 0.02;
+        for n in 1..120 {
+            e -= run[n - 1].1 * (run[n].0 - run[n - 1].0);
+            assert!(
+                (run[n].2 - e).abs() < 1e-15,
+                "tick {n}: {} J, expected {e} J",
+                run[n].2
+            );
+        }
+    }
+}
+
 use proptest::prelude::*;
 
 fn coord() -> impl Strategy<Value = f64> {

@@ -10,27 +10,29 @@ use haptic_types::tick::status;
 use haptic_types::vec3::{self, Vec3};
 
 impl HapticLoop {
-    /// The passivity observer: the device displacement since the last fresh valid sample
-    /// (`None` for a stale or invalid one), after charging the tank with the work `f_prev`
-    /// did over it. The observer always observes (its reading is reported); the controller
-    /// acts only when the scene has it on.
+    /// The passivity observer: the device displacement since the last valid sample (`None`
+    /// for an invalid one and the first valid one), after charging the tank with the work
+    /// `f_prev` did over it: the work over the path the world's cursor took. A late sample
+    /// (age > 0) counts as an on-time one: it is either a new reading (the tick's own came
+    /// late, an earlier one came in its place) or the last one again, which moved nothing.
+    /// The observer always observes (its reading is reported); the controller acts only when
+    /// the scene has it on.
     pub(super) fn observe(
         &mut self,
         sample: &DeviceSample,
         valid: bool,
         f_prev: Vec3,
     ) -> Option<Vec3> {
-        let dp = match (self.last_position_m, valid) {
-            (Some(p0), true) if sample.age_ticks == 0 => Some(vec3::sub(sample.position_m, p0)),
-            _ => None,
-        };
+        if !valid {
+            return None;
+        }
+        let dp = self
+            .last_position_m
+            .map(|p0| vec3::sub(sample.position_m, p0));
         if let Some(d) = dp {
             self.tank_j -= vec3::dot(f_prev, d);
         }
-        // (a fresh valid sample gave `dp`; the first valid one starts the observer)
-        if dp.is_some() || (self.last_position_m.is_none() && valid) {
-            self.last_position_m = Some(sample.position_m);
-        }
+        self.last_position_m = Some(sample.position_m);
         dp
     }
 
