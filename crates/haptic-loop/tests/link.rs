@@ -256,9 +256,12 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
         untransparent.is_empty(),
         "not transparent: {untransparent:#?}"
     );
-    // docs/devices.md: "at 20 and 50 ms, 148 of 160 are [stable], and the most the motors put
-    // into a hand there is 0.07 J". The link is simulated and seeded: the count is exact.
-    assert_eq!((goal_runs - goal_unstable, goal_runs), (148, 160));
+    // docs/devices.md: "at 20 and 50 ms, 147 of 160 are [stable], and the most the motors put
+    // into a hand there is 0.07 J". The link is simulated and seeded: the count is exact. (148
+    // before the observer counted late samples' steps: only jittered runs changed: of the
+    // loosely held traps at 20–50 ms, three turned unstable, each on one jump of 1.03–1.17 N
+    // against the 1 N rule, and two stable.)
+    assert_eq!((goal_runs - goal_unstable, goal_runs), (147, 160));
     assert!(
         (0.065..0.075).contains(&worst_goal_energy),
         "{worst_goal_energy} J"
