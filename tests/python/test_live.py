@@ -245,6 +245,7 @@ def mock_dhd(monkeypatch):
 def test_a_force_dimension_device_announces_its_limits(tmp_path, mock_dhd):
     dev = bridge.ForceDimensionDevice()
     assert dev.specs().name == "delta.3" and dev.specs().max_force_n == 12.0
+    dev.close()
 
     def session(k):
         mock_dhd["forces"].clear()
@@ -263,6 +264,11 @@ def test_a_force_dimension_device_announces_its_limits(tmp_path, mock_dhd):
         felt = np.array(mock_dhd["forces"])
         assert felt[:, 2].max() == pytest.approx(6.0, rel=0.1)
         assert np.all(np.linalg.norm(sim["device_force_n"], axis=1) <= 12.0)
+        # Pressing into a wall gives the hand no energy: the two-port layer never acts (it did
+        # when the world's energy skipped samples that came a tick late, and held the wall to
+        # 5.1 N), and the world's account of the work matches the hand's.
+        assert stats["two_port_interventions"] == 0
+        assert stats["work_j"] == pytest.approx(-0.5 * 3000.0 * 0.002**2, rel=0.05)
         assert sim["stats"]["link"]["received"] == stats["sent"]
 
     retry_while_disturbed(session, check)
