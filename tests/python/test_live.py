@@ -67,6 +67,37 @@ def test_session_arguments_are_checked_by_name():
         nh.Session(WALL, device="phantom")
 
 
+def test_a_session_may_be_used_and_dropped_from_any_thread(tmp_path):
+    # A press 2 mm into the wall over 400 ticks, from a worker thread, against the same ticks
+    # on this thread: the same forces to the bit (a session is one object, whichever thread
+    # calls it; it was bound to its creator's thread before).
+    path = [(0.0, 0.0, -0.003 - 0.004 * k / 400) for k in range(400)]
+
+    def press(s):
+        return np.array([s.tick(p) for p in path])
+
+    here = press(nh.Session(WALL, device="falcon", arrays=False))
+    s = nh.Session(WALL, device="falcon", out=tmp_path / "worker.mcap")
+    out = {}
+    t = threading.Thread(target=lambda: out.update(f=press(s), tick=s.tick_index))
+    t.start()
+    t.join()
+    assert out["tick"] == 400 and np.array_equal(out["f"], here)
+    assert out["f"][-1, 2] > 5.0  # 2 mm deep, engaged: the 3000 N/m cap at work
+    s.close()
+    # Dropped on another thread without a close: no "unsendable" error, nothing leaked.
+    seen = []
+    old, sys.unraisablehook = sys.unraisablehook, seen.append
+    try:
+        held = [nh.Session(WALL, device="falcon")]
+        t = threading.Thread(target=held.clear)
+        t.start()
+        t.join()
+    finally:
+        sys.unraisablehook = old
+    assert held == [] and seen == []
+
+
 # ---------------------------------------------------------------- bridge protocol
 
 

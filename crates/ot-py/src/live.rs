@@ -12,6 +12,7 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
+use std::sync::{Mutex, PoisonError};
 
 use crate::convert::numbers;
 use crate::json::to_py;
@@ -30,15 +31,32 @@ use crate::session::{arrays_to_py, path_arg, session_error};
 /// Each :meth:`tick` takes the device reading (position in metres, device
 /// frame; buttons) and returns the force to render (N, device frame): finite
 /// and within the device's maximum, zero on an invalid reading.
-#[pyclass(unsendable, module = "nanohaptics")]
+///
+/// A session may be used, and dropped, from any thread (one call at a time).
+#[pyclass(module = "nanohaptics")]
 pub struct Session {
-    inner: Option<Stepper>,
+    // A Mutex makes the session `Sync`, as pyo3 asks of a class any thread may reach; the
+    // calls that change it hold `&mut self` and take it without locking.
+    inner: Mutex<Option<Stepper>>,
 }
 
 impl Session {
-    fn stepper(&self) -> PyResult<&Stepper> {
-        self.inner
+    /// Runs `f` on the open session's stepper (a closed session raises RuntimeError).
+    fn with<R>(&self, f: impl FnOnce(&Stepper) -> PyResult<R>) -> PyResult<R> {
+        // A panic while the lock was held cannot leave a stepper half-changed for a reader
+        // here (only `&mut self` calls change it, without the lock): take it back.
+        let guard = self.inner.lock().unwrap_or_else(PoisonError::into_inner);
+        f(guard
             .as_ref()
+            .ok_or_else(|| PyRuntimeError::new_err("the session is closed"))?)
+    }
+
+    /// The open session's stepper, to change (a closed session raises RuntimeError).
+    fn stepper_mut(&mut self) -> PyResult<&mut Stepper> {
+        self.inner
+            .get_mut()
+            .unwrap_or_else(PoisonError::into_inner)
+            .as_mut()
             .ok_or_else(|| PyRuntimeError::new_err("the session is closed"))
     }
 }
@@ -116,7 +134,7 @@ impl Session {
         o.out = out.map(|p| path_arg(p, "out")).transpose()?;
         o.arrays = arrays;
         Ok(Session {
-            inner: Some(Stepper::new(o).map_err(session_error)?),
+            inner: Mutex::new(Some(Stepper::new(o).map_err(session_error)?)),
         })
     }
 
@@ -137,8 +155,8 @@ impl Session {
                 p.data.len()
             )));
         }
-        let names: Vec<String> = self
-            .stepper()?
+        let s = self.stepper_mut()?;
+        let names: Vec<String> = s
             .haptic_loop()
             .config()
             .specs
@@ -147,10 +165,6 @@ impl Session {
             .map(|b| b.to_string())
             .collect();
         let bits = buttons_arg(buttons, &names)?;
-        let s = self
-            .inner
-            .as_mut()
-            .ok_or_else(|| PyRuntimeError::new_err("the session is closed"))?;
         let r = s
             .tick(DeviceSample::new(
                 [p.data[0], p.data[1], p.data[2]],
@@ -174,21 +188,13 @@ impl Session {
                 PyValueError::new_err(format!("switch `{name}`: value must be a number or a bool"))
             })?
         };
-        let s = self
-            .inner
-            .as_mut()
-            .ok_or_else(|| PyRuntimeError::new_err("the session is closed"))?;
-        s.switch(name, v).map_err(session_error)
+        self.stepper_mut()?.switch(name, v).map_err(session_error)
     }
 
     /// Local stiffness sent with the last force, (3, 3) N/m, device frame.
     #[getter]
     fn stiffness<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let k = self
-            .stepper()?
-            .haptic_loop()
-            .last_result()
-            .device_stiffness_n_per_m;
+        let k = self.with(|s| Ok(s.haptic_loop().last_result().device_stiffness_n_per_m))?;
         PyArray1::from_slice(py, &k).reshape([3, 3])
     }
 
@@ -197,66 +203,70 @@ impl Session {
     /// controller, 128 force-rate limit).
     #[getter]
     fn status(&self) -> PyResult<u8> {
-        Ok(self.stepper()?.haptic_loop().last_result().status)
+        self.with(|s| Ok(s.haptic_loop().last_result().status))
     }
 
     /// Events of the last tick: [(name, detail)].
     #[getter]
     fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let l = PyList::empty(py);
-        for e in &self.stepper()?.haptic_loop().last_result().events {
-            l.append((e.name.as_str(), e.detail.as_str()))?;
-        }
-        Ok(l)
+        self.with(|s| {
+            let l = PyList::empty(py);
+            for e in &s.haptic_loop().last_result().events {
+                l.append((e.name.as_str(), e.detail.as_str()))?;
+            }
+            Ok(l)
+        })
     }
 
     /// Cursor of the last tick, (3,) m, world frame.
     #[getter]
     fn cursor<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(PyArray1::from_slice(
-            py,
-            &self.stepper()?.haptic_loop().last_result().cursor_m,
-        ))
+        let c = self.with(|s| Ok(s.haptic_loop().last_result().cursor_m))?;
+        Ok(PyArray1::from_slice(py, &c))
     }
 
     /// The scene's state after the last tick: {field: value}.
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let lp = self.stepper()?.haptic_loop();
-        let mut v = Vec::new();
-        lp.scene_state(&mut v);
-        let d = PyDict::new(py);
-        for (k, x) in lp.scene().state_fields().into_iter().zip(v) {
-            d.set_item(k, x)?;
-        }
-        Ok(d)
+        self.with(|s| {
+            let lp = s.haptic_loop();
+            let mut v = Vec::new();
+            lp.scene_state(&mut v);
+            let d = PyDict::new(py);
+            for (k, x) in lp.scene().state_fields().into_iter().zip(v) {
+                d.set_item(k, x)?;
+            }
+            Ok(d)
+        })
     }
 
     /// Index of the next tick.
     #[getter]
     fn tick_index(&self) -> PyResult<u64> {
-        Ok(self.stepper()?.haptic_loop().next_tick())
+        self.with(|s| Ok(s.haptic_loop().next_tick()))
     }
 
     /// Tick rate, Hz.
     #[getter]
     fn rate_hz(&self) -> PyResult<u32> {
-        Ok(self.stepper()?.haptic_loop().config().rate_hz)
+        self.with(|s| Ok(s.haptic_loop().config().rate_hz))
     }
 
     /// The device's specifications: name, max_force_n, max_stiffness_n_per_m,
     /// workspace_radius_m, buttons.
     #[getter]
     fn device<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = &self.stepper()?.haptic_loop().config().specs;
-        let d = PyDict::new(py);
-        d.set_item("name", s.name.as_ref())?;
-        d.set_item("max_force_n", s.limits.max_force_n)?;
-        d.set_item("max_stiffness_n_per_m", s.limits.max_stiffness_n_per_m)?;
-        d.set_item("workspace_radius_m", s.workspace_radius_m)?;
-        let b: Vec<&str> = s.button_names.iter().map(|b| b.as_ref()).collect();
-        d.set_item("buttons", b)?;
-        Ok(d)
+        self.with(|st| {
+            let s = &st.haptic_loop().config().specs;
+            let d = PyDict::new(py);
+            d.set_item("name", s.name.as_ref())?;
+            d.set_item("max_force_n", s.limits.max_force_n)?;
+            d.set_item("max_stiffness_n_per_m", s.limits.max_stiffness_n_per_m)?;
+            d.set_item("workspace_radius_m", s.workspace_radius_m)?;
+            let b: Vec<&str> = s.button_names.iter().map(|b| b.as_ref()).collect();
+            d.set_item("buttons", b)?;
+            Ok(d)
+        })
     }
 
     /// Ends the session (closes the recording) and returns the per-tick
@@ -265,6 +275,8 @@ impl Session {
     fn close<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self
             .inner
+            .get_mut()
+            .unwrap_or_else(PoisonError::into_inner)
             .take()
             .ok_or_else(|| PyRuntimeError::new_err("the session is already closed"))?;
         let report = s.finish().map_err(session_error)?;
@@ -284,7 +296,12 @@ impl Session {
         py: Python<'_>,
         _exc: &Bound<'_, pyo3::types::PyTuple>,
     ) -> PyResult<bool> {
-        if self.inner.is_some() {
+        if self
+            .inner
+            .get_mut()
+            .unwrap_or_else(PoisonError::into_inner)
+            .is_some()
+        {
             self.close(py)?;
         }
         Ok(false)
