@@ -149,6 +149,10 @@ pub struct Trace {
     pub readings: Vec<[f64; 3]>,
     /// Forces, N.
     pub felt: Vec<[f64; 3]>,
+    /// The loop's answer at each tick: the force it sent the device, N (device frame), computed
+    /// from that tick's reading. What the world asked the hand to feel; `felt` is what the
+    /// device's motors rendered from the answers that had arrived.
+    pub world: Vec<[f64; 3]>,
 }
 
 /// As [`run`], with the device at the far end of `linked.link`: its samples reach the loop
@@ -220,6 +224,7 @@ pub fn run_linked(
         &mut |_, _| {},
     )?;
     let dev = link.dev;
+    let world = std::mem::take(&mut meter.world);
     let mut rep = meter.finish(dev.felt(), f64::from(rate));
     if let Some(i) = lp
         .scene()
@@ -236,6 +241,7 @@ pub fn run_linked(
     let trace = Trace {
         readings: dev.readings().to_vec(),
         felt: dev.felt().to_vec(),
+        world,
     };
     Ok((rep, trace))
 }
@@ -360,6 +366,8 @@ struct Meter {
     /// Ticks by which a felt jump may precede the tick that declares its event.
     lead: u64,
     declared: Vec<u64>,
+    /// Each tick's answer, N (the trace's `world`).
+    world: Vec<[f64; 3]>,
 }
 
 impl Sink for Meter {
@@ -394,10 +402,12 @@ impl Meter {
             window,
             lead,
             declared: Vec::new(),
+            world: Vec::new(),
         }
     }
 
     fn tick(&mut self, i: u64, r: &haptic_types::tick::TickResult) {
+        self.world.push(r.device_force_n);
         let rep = &mut self.rep;
         if r.events
             .iter()
