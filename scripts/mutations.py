@@ -99,6 +99,24 @@ MUTATIONS = (
         tests=(("-p", "haptic-loop", "--test", "link"),),
     ),
     Mutation(
+        name="observer-skips-late-samples",
+        what="the passivity observer skips a sample that came a tick late (the world's energy then "
+        "charges the skipped steps at once, at the force of the next on-time one)",
+        path="crates/engine/src/haptic/input.rs",
+        old="        if !valid {\n            return None;\n        }",
+        new="        if !valid || sample.age_ticks > 0 {\n            return None;\n        }",
+        count=1,
+        tests=(
+            (
+                "-p",
+                "haptic-loop",
+                "--test",
+                "loop_guarantees",
+                "the_observer_counts_the_work_of_late_samples_as_of_on_time_ones",
+            ),
+        ),
+    ),
+    Mutation(
         name="bond-never-breaks",
         what="protocol 3's bond never breaks (the device pulls past the pull-off, as protocol 2 did)",
         path="crates/types/src/local/bond.rs",
