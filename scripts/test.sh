@@ -60,9 +60,12 @@ if [ -d crates/ot-py ]; then
   # maturin >= 1.9.4 sets PYO3_BUILD_EXTENSION_MODULE (pyo3 0.30 has no
   # extension-module feature): the wheel then does not link libpython.
   # pandas and dask[distributed]: the sweep tests (a 2-worker Dask process cluster) and the
-  # docs' sweep examples (the extras `nanohaptics[sweep]` / `[dask]`).
+  # docs' sweep examples (the extras `nanohaptics[sweep]` / `[dask]`). mcap,
+  # mcap-ros2-support and mcap-protobuf-support: the golden recordings read by the MCAP
+  # project's own decoders (test_recording_readers.py) and docs/recording-format.md's example
+  # (a test or doc example whose module is missing fails, docs/testing.md).
   .venv/bin/pip install --quiet "maturin>=1.9.4,<2" "pytest>=8" "numpy>=1.26" "pandas>=1.5" \
-    "dask[distributed]>=2023.1"
+    "dask[distributed]>=2023.1" "mcap>=1.2" "mcap-ros2-support>=0.5" "mcap-protobuf-support>=0.5"
   rm -rf target/wheels-test
   # pyproject.toml (at the workspace root) names crates/ot-py; the wheel is abi3 (CPython >= 3.9).
   .venv/bin/maturin build --release --out target/wheels-test --interpreter .venv/bin/python
