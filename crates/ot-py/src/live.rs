@@ -41,14 +41,17 @@ pub struct Session {
 }
 
 impl Session {
-    /// Runs `f` on the open session's stepper (a closed session raises RuntimeError).
-    fn with<R>(&self, f: impl FnOnce(&Stepper) -> PyResult<R>) -> PyResult<R> {
+    /// What `f` reads from the open session's stepper (a closed session raises RuntimeError).
+    /// `f` makes no Python object: Python runs nothing (no finalizer that might call this
+    /// session again) while the lock is held.
+    fn read<R>(&self, f: impl FnOnce(&Stepper) -> R) -> PyResult<R> {
         // A panic while the lock was held cannot leave a stepper half-changed for a reader
         // here (only `&mut self` calls change it, without the lock): take it back.
         let guard = self.inner.lock().unwrap_or_else(PoisonError::into_inner);
-        f(guard
+        guard
             .as_ref()
-            .ok_or_else(|| PyRuntimeError::new_err("the session is closed"))?)
+            .map(f)
+            .ok_or_else(|| PyRuntimeError::new_err("the session is closed"))
     }
 
     /// The open session's stepper, to change (a closed session raises RuntimeError).
@@ -194,7 +197,7 @@ impl Session {
     /// Local stiffness sent with the last force, (3, 3) N/m, device frame.
     #[getter]
     fn stiffness<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let k = self.with(|s| Ok(s.haptic_loop().last_result().device_stiffness_n_per_m))?;
+        let k = self.read(|s| s.haptic_loop().last_result().device_stiffness_n_per_m)?;
         PyArray1::from_slice(py, &k).reshape([3, 3])
     }
 
@@ -203,70 +206,68 @@ impl Session {
     /// controller, 128 force-rate limit).
     #[getter]
     fn status(&self) -> PyResult<u8> {
-        self.with(|s| Ok(s.haptic_loop().last_result().status))
+        self.read(|s| s.haptic_loop().last_result().status)
     }
 
     /// Events of the last tick: [(name, detail)].
     #[getter]
     fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        self.with(|s| {
-            let l = PyList::empty(py);
-            for e in &s.haptic_loop().last_result().events {
-                l.append((e.name.as_str(), e.detail.as_str()))?;
-            }
-            Ok(l)
-        })
+        let events = self.read(|s| s.haptic_loop().last_result().events.clone())?;
+        let l = PyList::empty(py);
+        for e in &events {
+            l.append((e.name.as_str(), e.detail.as_str()))?;
+        }
+        Ok(l)
     }
 
     /// Cursor of the last tick, (3,) m, world frame.
     #[getter]
     fn cursor<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let c = self.with(|s| Ok(s.haptic_loop().last_result().cursor_m))?;
+        let c = self.read(|s| s.haptic_loop().last_result().cursor_m)?;
         Ok(PyArray1::from_slice(py, &c))
     }
 
     /// The scene's state after the last tick: {field: value}.
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        self.with(|s| {
+        let (fields, values) = self.read(|s| {
             let lp = s.haptic_loop();
             let mut v = Vec::new();
             lp.scene_state(&mut v);
-            let d = PyDict::new(py);
-            for (k, x) in lp.scene().state_fields().into_iter().zip(v) {
-                d.set_item(k, x)?;
-            }
-            Ok(d)
-        })
+            (lp.scene().state_fields(), v)
+        })?;
+        let d = PyDict::new(py);
+        for (k, x) in fields.into_iter().zip(values) {
+            d.set_item(k, x)?;
+        }
+        Ok(d)
     }
 
     /// Index of the next tick.
     #[getter]
     fn tick_index(&self) -> PyResult<u64> {
-        self.with(|s| Ok(s.haptic_loop().next_tick()))
+        self.read(|s| s.haptic_loop().next_tick())
     }
 
     /// Tick rate, Hz.
     #[getter]
     fn rate_hz(&self) -> PyResult<u32> {
-        self.with(|s| Ok(s.haptic_loop().config().rate_hz))
+        self.read(|s| s.haptic_loop().config().rate_hz)
     }
 
     /// The device's specifications: name, max_force_n, max_stiffness_n_per_m,
     /// workspace_radius_m, buttons.
     #[getter]
     fn device<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        self.with(|st| {
-            let s = &st.haptic_loop().config().specs;
-            let d = PyDict::new(py);
-            d.set_item("name", s.name.as_ref())?;
-            d.set_item("max_force_n", s.limits.max_force_n)?;
-            d.set_item("max_stiffness_n_per_m", s.limits.max_stiffness_n_per_m)?;
-            d.set_item("workspace_radius_m", s.workspace_radius_m)?;
-            let b: Vec<&str> = s.button_names.iter().map(|b| b.as_ref()).collect();
-            d.set_item("buttons", b)?;
-            Ok(d)
-        })
+        let s = self.read(|st| st.haptic_loop().config().specs.clone())?;
+        let d = PyDict::new(py);
+        d.set_item("name", s.name.as_ref())?;
+        d.set_item("max_force_n", s.limits.max_force_n)?;
+        d.set_item("max_stiffness_n_per_m", s.limits.max_stiffness_n_per_m)?;
+        d.set_item("workspace_radius_m", s.workspace_radius_m)?;
+        let b: Vec<&str> = s.button_names.iter().map(|b| b.as_ref()).collect();
+        d.set_item("buttons", b)?;
+        Ok(d)
     }
 
     /// Ends the session (closes the recording) and returns the per-tick
