@@ -32,6 +32,7 @@ fn the_committed_corpus_passes_every_target() {
         each("recording", lf::recording),
         each("verify", lf::verify),
         each("scene", lf::scene),
+        each("page", lf::page),
     ];
     // Each target has its seeds and what the campaign kept (docs/bench/fuzz.md).
     assert!(n.iter().all(|&k| k >= 5), "corpus sizes {n:?}");
@@ -41,6 +42,7 @@ fn the_committed_corpus_passes_every_target() {
         "bridge/regress-subnormal-force-limit",
         "params/regress-empty-envelope.toml",
         "scene/regress-deep-trap-slow-envelope.toml",
+        "page/regress-canonical-head-over-limit",
     ] {
         assert!(root.join(f).exists(), "{f}");
     }
