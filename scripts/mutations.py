@@ -134,6 +134,24 @@ MUTATIONS = (
             ("-p", "haptic-devices", "--test", "device_side_fixture"),
         ),
     ),
+    Mutation(
+        name="follower-never-steps",
+        what="protocol 4's follower is never stepped by the device (its particle stays where the answer put it)",
+        path="crates/devices/src/local.rs",
+        old="                f.step(p);",
+        new="                let _ = (&f, p);",
+        count=1,
+        tests=(
+            ("-p", "haptic-devices", "--test", "follower"),
+            (
+                "-p",
+                "haptic-loop",
+                "--test",
+                "link",
+                "the_10_khz_trap_drags_behind_10_ms_with_protocol_3_and_not_with_protocol_4",
+            ),
+        ),
+    ),
 )
 
 

@@ -1,7 +1,9 @@
 """The C reference in docs/device-bridge.md compiles as printed and follows the document's
 rules: rule 2's ticks (unsigned, the offset signed, the last packet), a plane's force, a
-version-1 answer that keeps the body without rendering its pull (issue 41), and version 3's
-bond, which holds in pull and in press and breaks at its stretch."""
+version-1 answer that keeps the body without rendering its pull (issue 41), version 3's
+bond, which holds in pull and in press and breaks at its stretch, and version 4's follower,
+which pushes on the excess only, clips from the free drift when zero is out of reach, and
+drifts by what it keeps of its end velocity (the figures of crates/types' follower tests)."""
 
 import re
 import shutil
@@ -52,6 +54,23 @@ int main(void) {
         nh_bond_add(a, n, 500.0, 0.002, pulls[j], g);
         printf("%.6f\n", g[2]);
     }
+    /* Version 4's follower: the square of half-width 1 mm, 100 N/m, retain 0.1. */
+    nh_follower fo = {{0.0, 0.0}, {0.0, 0.0}, 0.1, 100.0, 4,
+                      {{1e-3, -1e-3}, {1e-3, 1e-3}, {-1e-3, 1e-3}, {-1e-3, -1e-3}}};
+    double inside[3] = {0.5e-3, 0.0, 0.0}, beyond[3] = {3e-3, 0.0, 0.0}, far[3] = {0.1, 0.0, 0.0};
+    double g1[3] = {0.0, 0.0, 0.0}, g2[3] = {0.0, 0.0, 0.0};
+    nh_follower_add(&fo, inside, g1);
+    nh_follower_add(&fo, beyond, g2);
+    printf("%.6f %.6f\n", g1[0], g2[0]);
+    nh_follower drifting = fo;
+    drifting.u[0] = 2e-3;
+    double d5[2] = {5e-3, 1e-3}, c5[2];
+    nh_follower_clip(&drifting, d5, c5);
+    printf("%.6f %.6f\n", c5[0] * 1e3, c5[1] * 1e3);
+    nh_follower_step(&fo, far);
+    printf("%.6f %.6f\n", fo.x[0] * 1e3, fo.u[0] * 1e3);
+    nh_follower_step(&fo, far);
+    printf("%.6f %.6f\n", fo.x[0] * 1e3, fo.u[0] * 1e3);
     return 0;
 }
 """
@@ -60,11 +79,13 @@ int main(void) {
 def c_reference() -> str:
     doc = (ROOT / "docs" / "device-bridge.md").read_text()
     blocks = re.findall(r"```c\n(.*?)```", doc, re.S)
-    # The reference (versions 1 and 2), then version 3's bond, which the document prints first.
+    # The reference (versions 1 and 2), then version 3's bond and version 4's follower, which
+    # the document prints first.
     reference = [b for b in blocks if "nh_accept" in b]
     bond = [b for b in blocks if "nh_bond_add" in b]
-    assert (len(blocks), len(reference), len(bond)) == (2, 1, 1)
-    return reference[0] + "\n" + bond[0]
+    follower = [b for b in blocks if "nh_follower_step" in b]
+    assert (len(blocks), len(reference), len(bond), len(follower)) == (3, 1, 1, 1)
+    return reference[0] + "\n" + bond[0] + "\n" + follower[0]
 
 
 @pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler")
@@ -87,4 +108,8 @@ def test_the_c_reference_compiles_and_follows_the_rules():
         "-0.750000",  # the bond holds at 1.5 mm of pull: 0.75 N back
         "0.000000",  # broken at 2.5 mm
         "1.500000",  # 3 mm pressed in: it holds, pushing out
+        "0.000000 -0.200000",  # inside the envelope nothing; 2 mm beyond, 0.2 N back
+        "3.000000 0.333333",  # from the free drift (2 mm): the edge x = 3 mm at y = 1/3 mm
+        "1.000000 0.200000",  # from rest: 1 mm, the drift 0.1 (2 - 0) = 0.2 mm
+        "2.200000 0.220000",  # the envelope moved by the drift: 1.2 mm more, drift 0.22 mm
     ]

@@ -40,12 +40,13 @@ pub(crate) struct FakeArgs {
     /// With --grip: an ideal device (no encoder counts, no force resolution).
     #[arg(long)]
     ideal: bool,
-    /// The bridge protocol a modelled device asks for: 3 (the default: it renders the
-    /// simulator's local model, with a bond that breaks where the world's contact lets go, at
-    /// its own servo rate, behind the two-port passivity layer), 2 (the local model without
-    /// the bond, as the Python adapters) or 1 (the answered force and stiffness only;
-    /// docs/device-bridge.md).
-    #[arg(long, default_value_t = 3)]
+    /// The bridge protocol a modelled device asks for: 4 (the default: it renders the
+    /// simulator's local model, with a bond that breaks where the world's contact lets go and
+    /// the optical tweezers' held particle stepped through its working envelope, at its own
+    /// servo rate, behind the two-port passivity layer), 3 (without the particle, as the
+    /// Python reference client), 2 (without the bond either, as the Python adapters) or 1 (the
+    /// answered force and stiffness only; docs/device-bridge.md).
+    #[arg(long, default_value_t = 4)]
     protocol: u8,
     /// Probability that a sample is lost, 0–1.
     #[arg(long, default_value_t = 0.0)]
@@ -210,7 +211,7 @@ fn config(a: &FakeArgs) -> Result<Config, String> {
     };
     let protocol = match Protocol::of_version(a.protocol) {
         Some(p) => p,
-        None => return Err(out_of_range("--protocol", a.protocol, "1, 2 or 3")),
+        None => return Err(out_of_range("--protocol", a.protocol, "1, 2, 3 or 4")),
     };
     let physical = physical(a)?;
     // Every device announces its own buttons (a modelled preset its preset's); the built-in

@@ -17,8 +17,12 @@
 //!   wait for the link.
 //! - **Protocol 3** renders protocol 2's model with its bond: a spring that breaks where the
 //!   world's contact lets go, at the position read now.
+//! - **Protocol 4** renders protocol 3's model with its follower: the optical-tweezers world's
+//!   held particle, stepped with each reading through the working envelope the answer sent,
+//!   from the answered sample on (so it starts as the world's particle met that sample), and
+//!   its spring on the excess at the position read now.
 //!
-//! Protocols 2 and 3 run behind the **two-port passivity layer** (after Ryu, Artigas and Preusche
+//! Protocols 2 to 4 run behind the **two-port passivity layer** (after Ryu, Artigas and Preusche
 //! 2010): the device counts the work its motors did on the hand, `W_dev = Σ F·Δp` over its servo
 //! periods, and the simulator reports the work its answers did on the readings it received,
 //! `W_world`. Whatever the link's delay, loss or jitter, once `W_dev` exceeds `W_world + R` (the
@@ -27,7 +31,7 @@
 //! the world delivered plus four reserves, 0.08 J (each servo period of intervention is counted).
 
 use haptic_types::device::ForceCommand;
-use haptic_types::local::{Body, LocalModel};
+use haptic_types::local::{Body, Follower, LocalModel};
 use haptic_types::vec3::{self, Vec3};
 use std::collections::VecDeque;
 
@@ -41,6 +45,10 @@ pub enum Protocol {
     /// The local model with a bond, a spring that breaks (protocol version 3,
     /// `haptic_types::local::Bond`), with the two-port passivity layer.
     V3,
+    /// The local model with a bond and a follower, the held particle of the optical tweezers
+    /// (protocol version 4, `haptic_types::local::Follower`), with the two-port passivity
+    /// layer.
+    V4,
 }
 
 impl Protocol {
@@ -50,20 +58,22 @@ impl Protocol {
             Protocol::V1 => 1,
             Protocol::V2 => 2,
             Protocol::V3 => 3,
+            Protocol::V4 => 4,
         }
     }
 
-    /// The protocol of version `v` (1, 2 or 3).
+    /// The protocol of version `v` (1 to 4).
     pub fn of_version(v: u8) -> Option<Protocol> {
         match v {
             1 => Some(Protocol::V1),
             2 => Some(Protocol::V2),
             3 => Some(Protocol::V3),
+            4 => Some(Protocol::V4),
             _ => None,
         }
     }
 
-    /// Whether the device renders a local model (versions 2 and 3) behind the two-port layer.
+    /// Whether the device renders a local model (versions 2 to 4) behind the two-port layer.
     pub fn has_local_model(self) -> bool {
         self != Protocol::V1
     }
@@ -102,6 +112,9 @@ pub struct DeviceSide {
     /// The carried body as integrated here, and the sequence number of the reading it is to
     /// be stepped with next (its state is the one that reading meets).
     body: Option<(Body, u64)>,
+    /// The follower as stepped here, and the sequence number of the reading it is to be
+    /// stepped with next.
+    follower: Option<(Follower, u64)>,
     /// Work the motors did on the hand, J.
     work_j: f64,
     /// The world's reported work, J.
@@ -127,6 +140,7 @@ impl DeviceSide {
             readings: VecDeque::with_capacity(KEEP_READINGS + 1),
             answer: None,
             body: None,
+            follower: None,
             work_j: 0.0,
             world_j: 0.0,
             reserve_j: DEVICE_RESERVE_J,
@@ -151,9 +165,19 @@ impl DeviceSide {
         self.catch_up(seq);
     }
 
-    /// Steps the body with every kept reading before `seq` it has not met yet (a number the
+    /// Steps the follower and the body with every kept reading before `seq` they have not met
+    /// yet (a number the
     /// device skipped holds the reading before it).
     fn catch_up(&mut self, seq: u64) {
+        if let Some((f, next)) = self.follower.as_mut() {
+            while *next < seq {
+                let Some(p) = reading_at_or_before(&self.readings, *next) else {
+                    break;
+                };
+                f.step(p);
+                *next += 1;
+            }
+        }
         if let Some((body, next)) = self.body.as_mut() {
             let planes = self
                 .answer
@@ -183,8 +207,16 @@ impl DeviceSide {
             .unwrap_or([0.0; 3]);
         let local = match self.protocol {
             Protocol::V1 => None,
-            Protocol::V2 => local.map(|m| LocalModel { bond: None, ..m }),
-            Protocol::V3 => local,
+            Protocol::V2 => local.map(|m| LocalModel {
+                bond: None,
+                follower: None,
+                ..m
+            }),
+            Protocol::V3 => local.map(|m| LocalModel {
+                follower: None,
+                ..m
+            }),
+            Protocol::V4 => local,
         };
         let lag = i128::from(cmd.tick) - i128::from(cmd.seq);
         let offset = *self.tick_offset.get_or_insert(lag);
@@ -194,6 +226,9 @@ impl DeviceSide {
             // The sample whose reading the reported state meets next.
             let next = u64::try_from(i128::from(cmd.tick) - offset.min(lag) + 1).ok();
             self.body = m.body.zip(next);
+            // The follower's state is the one the answered sample met: it replays that
+            // sample's reading first.
+            self.follower = m.follower.clone().zip(next.and_then(|n| n.checked_sub(1)));
         }
         self.answer = Some(Answer {
             cmd: *cmd,
@@ -240,6 +275,9 @@ impl DeviceSide {
                 let mut f = m.static_force(p, a.p0);
                 if let Some((body, _)) = &self.body {
                     f = vec3::sub(f, body.pull(p, self.period_s).0);
+                }
+                if let Some((follower, _)) = &self.follower {
+                    f = vec3::add(f, follower.force(p));
                 }
                 f
             }

@@ -203,7 +203,7 @@ pub fn run_linked(
         protocol: linked.protocol,
         local: None,
     };
-    // With protocol 2 the device's local model meets a contact up to a round trip before the
+    // With protocols 2–4 the device's local model meets a contact up to a round trip before the
     // world declares it (its body, frictionless on its contact planes, sooner still): a
     // declared event explains the jumps within its window on either side. With protocol 1
     // (the ideal link of issue 22 among them) only after it.
@@ -212,7 +212,7 @@ pub fn run_linked(
         Protocol::V1 => 0,
         // Measured: with a lead of one round trip, the carried brick on a loosely held
         // Delta.3 behind 10 ms has 1–2 jumps (1.18–1.36 N) earlier still (its body).
-        Protocol::V2 | Protocol::V3 => window,
+        Protocol::V2 | Protocol::V3 | Protocol::V4 => window,
     };
     let mut meter = Meter::new(ticks, reserve_j, window, lead);
     Runner::new(vec![&mut meter]).run(

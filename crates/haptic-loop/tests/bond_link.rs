@@ -13,36 +13,24 @@
 //! not (0.989–1.000 × on every preset and grip, two runs measured).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use haptic_devices::bridge::BridgeConfig;
-use haptic_devices::bridge::fake::{FakeConfig, FakeReport, run_fake};
+use haptic_devices::bridge::fake::FakeReport;
 use haptic_devices::local::Protocol;
-use haptic_devices::modelled::preset_specs;
-use haptic_devices::{Grip, Mechanics, PRESETS, Script};
+use haptic_devices::{Grip, Mechanics, PRESETS};
 use haptic_loop::closed_loop::{Linked, run_linked};
 use haptic_loop::replay::verify;
-use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
-use haptic_types::DeviceModel;
+use haptic_loop::session::SessionReport;
 use recording::read_recording_file;
-use std::net::{SocketAddr, UdpSocket};
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+mod fake_link;
+use fake_link::read;
 
 /// The script's first pull-off falls within this window, s (the carried atom is set on its
 /// slot and the tip retracts); the runs stop there.
 const SECONDS: f64 = 3.5;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn read(name: &str) -> String {
-    std::fs::read_to_string(root().join("scenes").join(name)).unwrap()
-}
-
-fn out(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("haptic-loop-bond-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
+fn out(name: &str) -> std::path::PathBuf {
+    fake_link::out("bond", name)
 }
 
 /// One bridged session of the nano world against the modelled `mech` held with `grip`,
@@ -53,37 +41,14 @@ fn bridged(
     protocol: Protocol,
     rec: &Path,
 ) -> (SessionReport, FakeReport) {
-    let addr: SocketAddr = UdpSocket::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap();
-    let mut opts =
-        SessionOptions::new(SceneSource::from_path(&root().join("scenes/nanoworld.toml")).unwrap());
-    let mut b = BridgeConfig::parse(&format!("udp:{addr}")).unwrap();
-    b.wait_s = 20.0;
-    opts.device = Some(haptic_devices::source::DeviceSource::Udp(b));
-    opts.out = Some(rec.to_path_buf());
-    let specs = preset_specs(&mech);
-    let f = FakeConfig {
-        target: addr,
-        model: DeviceModel::Falcon,
-        script: Script::from_toml(&read("nanoworld.script.toml"), &specs).unwrap(),
-        hand: None,
-        physical: Some((mech, grip)),
-        loss: 0.05,
-        jitter_s: 0.001,
-        latency_s: 0.010,
-        seed: 3,
-        seconds: Some(SECONDS),
-        outage: None,
-        wait_s: 20.0,
-        bye: true,
+    fake_link::bridged(
+        "nanoworld.toml",
+        "nanoworld.script.toml",
+        SECONDS,
+        (mech, grip),
         protocol,
-        fault: None,
-    };
-    let h = std::thread::spawn(move || run_session(&opts, &mut |_, _| {}));
-    let dev = run_fake(&f, None).unwrap();
-    (h.join().unwrap().unwrap(), dev)
+        rec,
+    )
 }
 
 /// The ideal link's peak felt force for `mech` held with `grip` over the same window, N.

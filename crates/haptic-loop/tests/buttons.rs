@@ -330,11 +330,11 @@ fn refusals_are_rate_limited_and_a_newer_hello_negotiates_down() {
                 .into()
         )
     );
-    // A version-4 hello (a newer device): welcomed with 3, the Falcon's roles.
+    // A version-5 hello (a newer device): welcomed with 4, the Falcon's roles.
     sock.set_read_timeout(Some(Duration::from_millis(200)))
         .unwrap();
     let welcome = loop {
-        sock.send_to(&hello(4, FALCON), addr).unwrap();
+        sock.send_to(&hello(5, FALCON), addr).unwrap();
         if let Ok((n, _)) = sock.recv_from(&mut buf) {
             if let Ok(w @ Packet::Welcome { .. }) = Packet::decode(&buf[..n]) {
                 break w;
@@ -343,7 +343,7 @@ fn refusals_are_rate_limited_and_a_newer_hello_negotiates_down() {
     };
     match welcome {
         Packet::Welcome { version, roles, .. } => {
-            assert_eq!((version, roles), (3, Some([0, 1, 2, 3])));
+            assert_eq!((version, roles), (4, Some([0, 1, 2, 3])));
         }
         other => panic!("{other:?}"),
     }

@@ -215,8 +215,8 @@ fn answer_hello(
     }
     st.peer = Some(from);
     st.last_seq = None;
-    // Negotiate down: a hello above version 3 is welcomed with 3.
-    st.version = version.min(super::protocol::VERSION_3);
+    // Negotiate down: a hello above version 4 is welcomed with 4.
+    st.version = version.min(super::protocol::VERSION_4);
     let welcome = Packet::Welcome {
         version: st.version,
         rate_hz: config.rate_hz,

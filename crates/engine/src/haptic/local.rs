@@ -3,7 +3,7 @@
 //! answered force at the answered reading.
 
 use super::HapticLoop;
-use haptic_types::local::{Body, Bond, LocalModel, Plane};
+use haptic_types::local::{Body, Bond, Follower, LocalModel, Plane};
 use haptic_types::tick::status;
 use haptic_types::vec3::{self, Vec3};
 
@@ -20,8 +20,10 @@ impl HapticLoop {
     /// the answered forces did on the readings received: the two-port layer's budget.
     ///
     /// `version` is the session's protocol: from 3 on, the model also carries the scene's bond
-    /// (`haptic_types::local::Bond`, a spring that breaks); before it, the scene's answer and
-    /// stiffness stand in for it in the residual, as protocol 2 always did.
+    /// (`haptic_types::local::Bond`, a spring that breaks), from 4 on its follower
+    /// (`haptic_types::local::Follower`, the held particle and its working envelope); before
+    /// them, the scene's answer and stiffness stand in for them in the residual, as protocol 2
+    /// always did.
     pub fn local_model(&self, version: u8) -> LocalModel {
         let r = &self.result;
         let mut prims = self.primitives.borrow_mut();
@@ -29,6 +31,9 @@ impl HapticLoop {
         self.scene.local_primitives(&mut prims);
         if version < 3 {
             prims.bond = None;
+        }
+        if version < 4 {
+            prims.follower = None;
         }
         let m = &self.config.mapping;
         let (ws, fs) = (m.workspace_scale, m.force_scale);
@@ -75,6 +80,10 @@ impl HapticLoop {
             stiffness_n_per_m: b.stiffness_n_per_m * kd * gain,
             break_m: b.break_m / ws,
         });
+        let follower = prims
+            .follower
+            .take()
+            .map(|f| follower_to_device(&f, m.origin_m, ws, [kd, gain]));
         let world_energy_j = self.initial_tank_j() - self.tank_j;
         let model = LocalModel {
             residual_force_n: r.device_force_n,
@@ -84,8 +93,13 @@ impl HapticLoop {
             body_planes,
             world_energy_j,
             bond,
+            follower,
         };
-        if model.planes.is_empty() && model.body.is_none() && model.bond.is_none() {
+        if model.planes.is_empty()
+            && model.body.is_none()
+            && model.bond.is_none()
+            && model.follower.is_none()
+        {
             return model;
         }
         let p0 = to_device(r.cursor_m);
@@ -98,9 +112,29 @@ impl HapticLoop {
         if let Some(b) = &model.body {
             local = vec3::sub(local, b.pull(p0, self.config.dt_s()).0);
         }
+        if let Some(f) = &model.follower {
+            local = vec3::add(local, f.force(p0));
+        }
         LocalModel {
             residual_force_n: vec3::sub(r.device_force_n, local),
             ..model
         }
+    }
+}
+
+/// A follower mapped to the device: its position like a point (`(x − origin) / ws`), its drift
+/// and envelope, which are displacements, scaled and not moved, its spring times
+/// `force_scale · workspace_scale` and then the tick's gain (`[kd, gain]`, in that order, as
+/// the planes' springs).
+fn follower_to_device(f: &Follower, origin_m: Vec3, ws: f64, [kd, gain]: [f64; 2]) -> Follower {
+    Follower {
+        position_m: [
+            (f.position_m[0] - origin_m[0]) / ws,
+            (f.position_m[1] - origin_m[1]) / ws,
+        ],
+        drift_m: [f.drift_m[0] / ws, f.drift_m[1] / ws],
+        reach_m: f.reach_m.iter().map(|v| [v[0] / ws, v[1] / ws]).collect(),
+        retain: f.retain,
+        stiffness_n_per_m: f.stiffness_n_per_m * kd * gain,
     }
 }

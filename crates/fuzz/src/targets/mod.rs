@@ -239,6 +239,30 @@ fn bridge_seeds() -> Vec<Vec<u8>> {
             })),
         })
         .encode(),
+        // A version-4 answer: the optical tweezers' held particle and its envelope.
+        Packet::Force(ForceReply {
+            seq: 9,
+            tick: 9,
+            force_n: [-0.4, 0.1, 0.0],
+            stiffness_n_per_m: [0.0; 9],
+            status: 0,
+            local: Some(Box::new(haptic_types::local::LocalModel {
+                follower: Some(haptic_types::local::Follower {
+                    position_m: [0.001, -0.002],
+                    drift_m: [1e-5, 0.0],
+                    reach_m: (0..12)
+                        .map(|k| {
+                            let th = std::f64::consts::TAU * f64::from(k) / 12.0;
+                            [6e-5 * th.cos(), 3e-5 * th.sin()]
+                        })
+                        .collect(),
+                    retain: 0.1,
+                    stiffness_n_per_m: 800.0,
+                }),
+                ..Default::default()
+            })),
+        })
+        .encode(),
         seed_welcome(),
         Packet::Sample(sample).encode(),
         Packet::Bye { reason: 0 }.encode(),
@@ -273,6 +297,7 @@ fn seed_local_model() -> haptic_types::local::LocalModel {
         body_planes: vec![floor(-0.02, 0.0)],
         world_energy_j: 0.0,
         bond: None,
+        follower: None,
     }
 }
 

@@ -187,7 +187,7 @@ fn bridge_sample(wall: &str, s: &Sample) -> Outcome {
 /// force its motors are asked for stays finite and within the limit.
 fn bridge_force(f: &ForceReply) -> Outcome {
     let max = falcon().limits.max_force_n;
-    for protocol in [Protocol::V1, Protocol::V2, Protocol::V3] {
+    for protocol in [Protocol::V1, Protocol::V2, Protocol::V3, Protocol::V4] {
         let mut side = DeviceSide::new(protocol, max, 1e-3);
         side.record_reading(f.seq, [0.0; 3]);
         side.record_reading(f.seq.saturating_add(1), [0.001, 0.0, -0.002]);

@@ -36,7 +36,9 @@ mod tests;
 
 pub use params::{Params, TickMap, WorldError};
 
+use crate::geometry::contains;
 use crate::grid::choose_grid;
+use crate::region::free_drift;
 use crate::steer::{ParticleState, SteerParams};
 use crate::tick::{TickController, TickParams, TickStats};
 use nalgebra::Vector2;
@@ -170,6 +172,9 @@ pub struct World {
     force: V2,
     envelope: Vec<V2>,
     clipping: bool,
+    /// The last grabbed step's particle as the command met it, the anchor of its clip and its
+    /// free drift.
+    clip_from: Option<(V2, V2, V2)>,
 }
 
 impl World {
@@ -258,6 +263,7 @@ impl World {
             force: V2::zeros(),
             envelope: Vec::new(),
             clipping: false,
+            clip_from: None,
         })
     }
 
@@ -283,6 +289,7 @@ impl World {
         self.button_was = input.grab;
         self.excess = V2::zeros();
         self.force = V2::zeros();
+        self.clip_from = None;
         if self.grabbed {
             let state = ParticleState {
                 position: self.position,
@@ -298,6 +305,12 @@ impl World {
                     // reuse the buffer: no allocation once it has grown
                     self.envelope.clear();
                     self.envelope.extend_from_slice(self.controller.envelope());
+                    // The clip's anchor, as `clip_to_polygon` chose it.
+                    let free = free_drift(self.prop.model(), &self.velocity, self.prop.dt());
+                    let anchor = [V2::zeros(), free]
+                        .into_iter()
+                        .find(|a| contains(&self.envelope, a));
+                    self.clip_from = anchor.map(|a| (self.position, a, free));
                 }
                 Err(e) => events.push(Event::ControllerError {
                     message: e.to_string(),
@@ -383,6 +396,17 @@ impl World {
     /// grabbed).
     pub fn envelope(&self) -> &[V2] {
         &self.envelope
+    }
+
+    /// The last step's clip as the held particle met it, world frame, m: its position before
+    /// the step, the anchor the command was clipped from (zero displacement, or the free drift
+    /// when zero is out of reach) and the free drift (where one step takes the particle with
+    /// no trap force), with [`World::envelope`]. `None` when not held, or when neither anchor
+    /// lies in the envelope (the clip then took the nearest boundary point).
+    #[allow(clippy::type_complexity)]
+    pub fn last_clip(&self) -> Option<([f64; 2], [f64; 2], [f64; 2])> {
+        self.clip_from
+            .map(|(p, a, u)| ([p.x, p.y], [a.x, a.y], [u.x, u.y]))
     }
 
     /// The steering counters so far (rebuilds, warm steps, solves).

@@ -14,7 +14,10 @@
 //! - a [`Body`] is the carried body's coupling: the device integrates the body itself (its
 //!   mass on the coupling's spring-damper, under the force the world puts on it), starting
 //!   from the state the simulator reports for the answered sample and replaying its own
-//!   readings since, so the coupling's dynamics never wait for the link.
+//!   readings since, so the coupling's dynamics never wait for the link;
+//! - a [`Bond`] (protocol 3) is a spring that breaks where the world's contact lets go;
+//! - a [`Follower`] (protocol 4) is a particle that follows the stylus through its working
+//!   envelope, stepped by the device with its readings as the body is.
 //!
 //! ```
 //! use haptic_types::local::{LocalModel, Plane};
@@ -26,8 +29,10 @@
 //! ```
 
 mod bond;
+mod follow;
 
 pub use bond::Bond;
+pub use follow::{Follower, MAX_REACH_VERTICES, radial_reach};
 
 use crate::value::ValueError;
 use crate::vec3::{self, Vec3};
@@ -203,6 +208,9 @@ pub struct WorldPrimitives {
     pub body_planes: Vec<Plane>,
     /// The anchored contact of an adhesive world: a spring that breaks (protocol 3).
     pub bond: Option<Bond>,
+    /// The held particle of the optical-tweezers world, as the answered sample met it
+    /// (protocol 4).
+    pub follower: Option<Follower>,
 }
 
 impl WorldPrimitives {
@@ -212,6 +220,7 @@ impl WorldPrimitives {
         self.body = None;
         self.body_planes.clear();
         self.bond = None;
+        self.follower = None;
     }
 }
 
@@ -235,6 +244,9 @@ pub struct LocalModel {
     pub world_energy_j: f64,
     /// A spring that breaks (protocol 3; none in a version-2 session).
     pub bond: Option<Bond>,
+    /// A particle that follows the stylus through its envelope (protocol 4; none before): its
+    /// state is the one the answered sample met, and the device steps it from that sample on.
+    pub follower: Option<Follower>,
 }
 
 impl Default for LocalModel {
@@ -247,6 +259,7 @@ impl Default for LocalModel {
             body_planes: Vec::new(),
             world_energy_j: 0.0,
             bond: None,
+            follower: None,
         }
     }
 }
@@ -292,6 +305,7 @@ impl LocalModel {
         }
         check_planes("body plane", &self.body_planes)?;
         bond::check(self, max_stiffness_n_per_m)?;
+        follow::check(self, max_stiffness_n_per_m)?;
         if let Some(b) = &self.body {
             if !(0.0..=1.0).contains(&b.restitution) {
                 return Err(range("body.restitution", b.restitution, "0 ≤ e ≤ 1"));

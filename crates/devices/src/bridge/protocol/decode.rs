@@ -4,7 +4,7 @@
 use super::reader::Reader;
 use super::{
     BYE_LEN, FORCE_LEN, HEADER_LEN, LOCAL_FIXED_LEN, MAGIC, MAX_PACKET, SAMPLE_LEN, SAMPLE_V2_LEN,
-    VERSION, VERSION_2, VERSION_3,
+    VERSION, VERSION_2, VERSION_3, VERSION_4,
 };
 use super::{ForceReply, Packet, ProtocolError, Refusal, Sample};
 use haptic_types::device::DeviceSpecs;
@@ -31,11 +31,11 @@ impl Packet {
         let mut r = Reader::new(b, HEADER_LEN);
         if b[5] == 1 {
             // A hello of any version above 0 is read (its body is the same in every version)
-            // and welcomed with the smaller of its version and 3; one that cannot be accepted
+            // and welcomed with the smaller of its version and 4; one that cannot be accepted
             // is answered with a refusal naming the field.
             return hello(version, &mut r).map_err(refusal);
         }
-        if !(VERSION..=VERSION_3).contains(&version) {
+        if !(VERSION..=VERSION_4).contains(&version) {
             return Err(ProtocolError::Version(version));
         }
         match b[5] {
@@ -99,9 +99,9 @@ fn hello(version: u8, r: &mut Reader) -> Result<Packet, ProtocolError> {
     if version == 0 {
         return Err(ProtocolError::Hello(Refusal::new(
             "version",
-            "1 or more (a hello above 3 is welcomed with version 3)",
-            "hello refused: `version` = 0 is out of range: allowed 1 or more (a hello above 3 \
-             is welcomed with version 3)"
+            "1 or more (a hello above 4 is welcomed with version 4)",
+            "hello refused: `version` = 0 is out of range: allowed 1 or more (a hello above 4 \
+             is welcomed with version 4)"
                 .into(),
         )));
     }
@@ -195,8 +195,9 @@ fn sample(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError
     }))
 }
 
-/// Type 4, a force: the version-1 fields, then in version 2 the local model, and in version 3
-/// the local model and its bond (`b`: the whole datagram).
+/// Type 4, a force: the version-1 fields, then in version 2 the local model, in version 3 the
+/// local model and its bond, and in version 4 the local model, a bond flag, the bond if the
+/// flag is 1, and the follower (`b`: the whole datagram).
 fn force(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError> {
     if version == VERSION {
         fixed(b, "force", FORCE_LEN)?;
@@ -223,9 +224,25 @@ fn force(version: u8, b: &[u8], r: &mut Reader) -> Result<Packet, ProtocolError>
         }
         VERSION_3 => {
             let mut m = r.local()?;
-            m.bond = Some(r.bond()?);
+            m.bond = Some(r.bond("force (version 3)")?);
             m.check(f64::INFINITY).map_err(ProtocolError::Local)?;
             r.end("force (version 3)")?;
+            Some(Box::new(m))
+        }
+        VERSION_4 => {
+            let mut m = r.local()?;
+            m.bond = match r.u8("force (version 4)")? {
+                0 => None,
+                1 => Some(r.bond("force (version 4)")?),
+                other => {
+                    return Err(ProtocolError::Local(format!(
+                        "bond flag {other}: allowed 0 (none) or 1"
+                    )));
+                }
+            };
+            m.follower = Some(r.follower()?);
+            m.check(f64::INFINITY).map_err(ProtocolError::Local)?;
+            r.end("force (version 4)")?;
             Some(Box::new(m))
         }
         _ => None,

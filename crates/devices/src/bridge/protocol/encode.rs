@@ -1,7 +1,7 @@
 //! Encoding packets to datagrams.
 
-use super::{MAGIC, Packet, VERSION, VERSION_2, VERSION_3};
-use haptic_types::local::{LocalModel, MAX_PLANES, Plane};
+use super::{MAGIC, Packet, VERSION, VERSION_2, VERSION_3, VERSION_4};
+use haptic_types::local::{Bond, Follower, LocalModel, MAX_PLANES, MAX_REACH_VERTICES, Plane};
 
 fn header(v: &mut Vec<u8>, version: u8, t: u8) {
     v.clear();
@@ -52,6 +52,22 @@ fn put_local(v: &mut Vec<u8>, m: &LocalModel) {
     v.push(m.body_planes.len().min(MAX_PLANES) as u8);
     for p in m.body_planes.iter().take(MAX_PLANES) {
         put_plane(v, p);
+    }
+}
+
+fn put_bond(v: &mut Vec<u8>, b: &Bond) {
+    put_f64s(v, &b.anchor_m);
+    put_f64s(v, &b.normal);
+    put_f64s(v, &[b.stiffness_n_per_m, b.break_m]);
+}
+
+fn put_follower(v: &mut Vec<u8>, f: &Follower) {
+    put_f64s(v, &f.position_m);
+    put_f64s(v, &f.drift_m);
+    put_f64s(v, &[f.retain, f.stiffness_n_per_m]);
+    v.push(f.reach_m.len().min(MAX_REACH_VERTICES) as u8);
+    for p in f.reach_m.iter().take(MAX_REACH_VERTICES) {
+        put_f64s(v, p);
     }
 }
 
@@ -138,6 +154,7 @@ impl Packet {
             }
             Packet::Force(f) => {
                 let version = match &f.local {
+                    Some(m) if m.follower.is_some() => VERSION_4,
                     Some(m) if m.bond.is_some() => VERSION_3,
                     Some(_) => VERSION_2,
                     None => VERSION,
@@ -151,10 +168,16 @@ impl Packet {
                 v.push(f.status);
                 if let Some(m) = &f.local {
                     put_local(v, m);
-                    if let Some(b) = &m.bond {
-                        put_f64s(v, &b.anchor_m);
-                        put_f64s(v, &b.normal);
-                        put_f64s(v, &[b.stiffness_n_per_m, b.break_m]);
+                    match (&m.follower, &m.bond) {
+                        (Some(fo), bond) => {
+                            v.push(u8::from(bond.is_some()));
+                            if let Some(b) = bond {
+                                put_bond(v, b);
+                            }
+                            put_follower(v, fo);
+                        }
+                        (None, Some(b)) => put_bond(v, b),
+                        (None, None) => {}
                     }
                 }
             }

@@ -1,8 +1,8 @@
-//! The device bridge's wire format, versions 1, 2 and 3 (documented byte for byte in
+//! The device bridge's wire format, versions 1 to 4 (documented byte for byte in
 //! `docs/device-bridge.md`).
 //!
 //! Every packet is one UDP datagram, little-endian, byte-packed, starting with an 8-byte header:
-//! the magic `NHDB`, the version (1, 2 or 3), the packet type and two reserved zero bytes.
+//! the magic `NHDB`, the version (1 to 4), the packet type and two reserved zero bytes.
 //!
 //! Version 2 (issue 31) adds the local model a device renders between answers
 //! (`haptic_types::local`): a device that says hello with version 2 is welcomed with version 2
@@ -14,6 +14,12 @@
 //! Version 3 adds the local model's bond (`haptic_types::local::Bond`, a spring that breaks):
 //! a force packet whose model has one is a version-2 force packet followed by the bond, with
 //! version byte 3; the session's samples are version-2 samples.
+//!
+//! Version 4 adds the local model's follower (`haptic_types::local::Follower`, the optical
+//! tweezers' held particle and its working envelope): a force packet whose model has one is a
+//! version-2 force packet followed by a bond flag (u8, 0 or 1) and the bond when it is 1, then
+//! the follower, with version byte 4. A version-4 force packet is at most [`MAX_PACKET`] bytes
+//! whatever the model holds.
 //!
 //! | type | name    | direction     | body after the header                                              |
 //! |------|---------|---------------|--------------------------------------------------------------------|
@@ -42,9 +48,11 @@ pub const MAGIC: [u8; 4] = *b"NHDB";
 pub const VERSION: u8 = 1;
 /// Protocol version 2: the local model.
 pub const VERSION_2: u8 = 2;
-/// The newest protocol version this build speaks: 3, the local model with a bond (a spring
-/// that breaks).
+/// Protocol version 3: the local model with a bond (a spring that breaks).
 pub const VERSION_3: u8 = 3;
+/// The newest protocol version this build speaks: 4, the local model with a follower (the
+/// optical tweezers' held particle and its working envelope).
+pub const VERSION_4: u8 = 4;
 /// Size of the local model's fixed part after a version-1 force packet, bytes (residual
 /// force and stiffness, world energy).
 const LOCAL_FIXED_LEN: usize = 12 * 8 + 8;
@@ -55,6 +63,11 @@ const PLANE_LEN: usize = 5 * 8;
 const BODY_LEN: usize = 16 * 8 + 4 + 8;
 /// Size of the bond on the wire: anchor, normal, stiffness, breaking stretch.
 const BOND_LEN: usize = 8 * 8;
+/// Size of the follower's fixed part on the wire: position, drift, retain, stiffness, vertex
+/// count (u8); each vertex adds [`VERTEX_LEN`].
+const FOLLOWER_FIXED_LEN: usize = 6 * 8 + 1;
+/// Size of one envelope vertex on the wire: x, y.
+const VERTEX_LEN: usize = 2 * 8;
 /// Largest datagram accepted, bytes (a hello with 32 buttons of 32 characters fits).
 pub const MAX_PACKET: usize = 1200;
 /// Size of a sample packet, bytes.
@@ -92,11 +105,27 @@ pub fn force_v3_len(planes: usize, body: bool, body_planes: usize) -> usize {
     force_v2_len(planes, body, body_planes) + BOND_LEN
 }
 
+/// Size of a version-4 force packet (a version-2 one, the bond flag and the bond if `bond`,
+/// the follower with `vertices` envelope vertices), bytes.
+pub fn force_v4_len(
+    planes: usize,
+    body: bool,
+    body_planes: usize,
+    bond: bool,
+    vertices: usize,
+) -> usize {
+    force_v2_len(planes, body, body_planes)
+        + 1
+        + if bond { BOND_LEN } else { 0 }
+        + FOLLOWER_FIXED_LEN
+        + vertices * VERTEX_LEN
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use haptic_types::device::{FALCON, TOUCH};
-    use haptic_types::local::{Body, LocalModel, MAX_PLANES, Plane};
+    use haptic_types::local::{Body, LocalModel, MAX_PLANES, MAX_REACH_VERTICES, Plane};
     use proptest::prelude::*;
 
     /// A force reply at tick 1 with no force and no stiffness, carrying the local model `m`.
@@ -205,8 +234,8 @@ mod tests {
             "datagram of 1201 bytes is over the 1200-byte limit"
         );
         let mut v = good.clone();
-        v[4] = 4;
-        assert_eq!(e(&v), "protocol version 4 (this build speaks 1, 2 and 3)");
+        v[4] = 5;
+        assert_eq!(e(&v), "protocol version 5 (this build speaks 1 to 4)");
         v[4] = 1;
         v[5] = 9;
         assert_eq!(e(&v), "unknown packet type 9");
@@ -238,7 +267,7 @@ mod tests {
         );
     }
 
-    /// A hello above version 3 is read (the simulator welcomes it with 3); version 0, bad
+    /// A hello above version 4 is read (the simulator welcomes it with 4); version 0, bad
     /// limits, bad names and a bad size are refusals naming the field and the allowed values;
     /// the reserved bytes are not read.
     #[test]
@@ -251,10 +280,10 @@ mod tests {
             }
             .encode()
         };
-        let mut h3 = hello(4, FALCON);
+        let mut h3 = hello(5, FALCON);
         assert!(matches!(
             Packet::decode(&h3),
-            Ok(Packet::Hello { version: 4, .. })
+            Ok(Packet::Hello { version: 5, .. })
         ));
         // Reserved bytes 6–7: sent as 0, never read.
         h3[6] = 1;
@@ -268,7 +297,7 @@ mod tests {
             refusal(&hello(0, FALCON)),
             (
                 "version".into(),
-                "1 or more (a hello above 3 is welcomed with version 3)".into()
+                "1 or more (a hello above 4 is welcomed with version 4)".into()
             )
         );
         let mut bad = FALCON;
@@ -312,8 +341,8 @@ mod tests {
         assert_eq!(refusal(&long).0, "size");
         // Other packets keep the strict version check.
         let mut bye = Packet::Bye { reason: 0 }.encode();
-        bye[4] = 4;
-        assert_eq!(Packet::decode(&bye), Err(ProtocolError::Version(4)));
+        bye[4] = 5;
+        assert_eq!(Packet::decode(&bye), Err(ProtocolError::Version(5)));
     }
 
     /// A refusal is the header (version byte 1, type 6) and three strings; it round-trips,
@@ -372,7 +401,27 @@ mod tests {
             }],
             world_energy_j: -0.125,
             bond: None,
+            follower: None,
         }
+    }
+
+    /// The packet `b` one byte short and one byte long is refused by size, named `kind`.
+    fn refused_a_byte_off(b: &[u8], kind: &str) {
+        let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
+        let n = b.len();
+        assert_eq!(
+            e(&b[..n - 1]),
+            format!("{kind} packet of {} bytes is too short (needs {n})", n - 1)
+        );
+        let mut long = b.to_vec();
+        long.push(0);
+        assert_eq!(
+            e(&long),
+            format!(
+                "{kind} packet of {} bytes is too long (expected {n})",
+                n + 1
+            )
+        );
     }
 
     /// A model with a bond travels as a version-3 force packet: the version-2 packet and 64
@@ -403,24 +452,7 @@ mod tests {
         let v2 = at_rest(full_model()).encode();
         assert_eq!((v2[4], v2.len()), (2, b.len() - 64));
         let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
-        assert_eq!(
-            e(&b[..b.len() - 1]),
-            format!(
-                "force (version 3) packet of {} bytes is too short (needs {})",
-                b.len() - 1,
-                b.len()
-            )
-        );
-        let mut long = b.clone();
-        long.push(0);
-        assert_eq!(
-            e(&long),
-            format!(
-                "force (version 3) packet of {} bytes is too long (expected {})",
-                b.len() + 1,
-                b.len()
-            )
-        );
+        refused_a_byte_off(&b, "force (version 3)");
         let broken = LocalModel {
             bond: Some(haptic_types::local::Bond {
                 break_m: -1.0,
@@ -431,6 +463,90 @@ mod tests {
         assert_eq!(
             e(&at_rest(broken).encode()),
             "force packet's local model: bond.break_m = -1 is out of range: allowed 0 < s ≤ 1 m"
+        );
+    }
+
+    fn follower(vertices: usize) -> haptic_types::local::Follower {
+        haptic_types::local::Follower {
+            position_m: [0.004, -0.003],
+            drift_m: [1e-5, 2e-5],
+            reach_m: (0..vertices)
+                .map(|k| {
+                    let th = std::f64::consts::TAU * k as f64 / vertices as f64;
+                    [6e-5 * th.cos(), 3e-5 * th.sin()]
+                })
+                .collect(),
+            retain: 0.1,
+            stiffness_n_per_m: 800.0,
+        }
+    }
+
+    /// A model with a follower travels as a version-4 force packet: the version-2 packet, the
+    /// bond flag (and bond), the follower's 49 bytes and 16 a vertex, read back bit for bit;
+    /// the largest (every plane, a body, a bond, 24 vertices) fits one datagram; a packet one
+    /// byte short or long, a bad bond flag or a bad follower is refused by name.
+    #[test]
+    fn a_version_4_force_packet_carries_the_follower_after_the_bond_flag() {
+        let e = |b: &[u8]| Packet::decode(b).unwrap_err().to_string();
+        for (bond, vertices) in [(false, 3), (false, 24), (true, 24)] {
+            let m = LocalModel {
+                bond: bond.then_some(haptic_types::local::Bond {
+                    anchor_m: [0.001, -0.002, 0.003],
+                    normal: [0.0, 0.6, 0.8],
+                    stiffness_n_per_m: 350.0,
+                    break_m: 0.0025,
+                }),
+                follower: Some(follower(vertices)),
+                ..full_model()
+            };
+            let b = at_rest(m.clone()).encode();
+            assert_eq!(b[4], 4);
+            let (n, body, nb) = (m.planes.len(), m.body.is_some(), m.body_planes.len());
+            assert_eq!(b.len(), force_v4_len(n, body, nb, bond, vertices));
+            assert_eq!(
+                b.len(),
+                force_v2_len(n, body, nb) + 1 + if bond { 64 } else { 0 } + 49 + 16 * vertices
+            );
+            match Packet::decode(&b) {
+                Ok(Packet::Force(f)) => assert_eq!(f.local.as_deref(), Some(&m)),
+                other => panic!("{other:?}"),
+            }
+            refused_a_byte_off(&b, "force (version 4)");
+        }
+        let largest = force_v4_len(MAX_PLANES, true, MAX_PLANES, true, MAX_REACH_VERTICES);
+        assert!(largest <= MAX_PACKET, "{largest}");
+        // The bond flag sits right after the version-2 model.
+        let m = LocalModel {
+            follower: Some(follower(8)),
+            ..full_model()
+        };
+        let mut b = at_rest(m).encode();
+        let flag = force_v2_len(2, true, 1);
+        assert_eq!(b[flag], 0);
+        b[flag] = 2;
+        assert_eq!(
+            e(&b),
+            "force packet's local model: bond flag 2: allowed 0 (none) or 1"
+        );
+        let bad = LocalModel {
+            follower: Some(haptic_types::local::Follower {
+                retain: 2.0,
+                ..follower(8)
+            }),
+            ..full_model()
+        };
+        assert_eq!(
+            e(&at_rest(bad).encode()),
+            "force packet's local model: follower.retain = 2 is out of range: allowed 0 ≤ r ≤ 1"
+        );
+        let few = LocalModel {
+            follower: Some(follower(2)),
+            ..full_model()
+        };
+        assert_eq!(
+            e(&at_rest(few).encode()),
+            "force packet's local model: follower.reach_m (vertices) = 2 is out of range: \
+             allowed 3 ≤ n ≤ 24"
         );
     }
 

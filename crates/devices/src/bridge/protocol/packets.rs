@@ -20,7 +20,7 @@ pub enum Packet {
     },
     /// The simulator accepts a device.
     Welcome {
-        /// The protocol version of the session (the device's, at most [`VERSION_3`](super::VERSION_3)).
+        /// The protocol version of the session (the device's, at most [`VERSION_4`](super::VERSION_4)).
         version: u8,
         /// The session's tick rate, Hz: send one sample per tick.
         rate_hz: u32,
@@ -163,7 +163,7 @@ pub enum ProtocolError {
     #[error("bad magic {0:02x?} (expected NHDB)")]
     Magic([u8; 4]),
     /// Another protocol version.
-    #[error("protocol version {0} (this build speaks 1, 2 and 3)")]
+    #[error("protocol version {0} (this build speaks 1 to 4)")]
     Version(u8),
     /// A local model out of range.
     #[error("force packet's local model: {0}")]

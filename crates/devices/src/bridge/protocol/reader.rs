@@ -2,7 +2,9 @@
 //! local model, each failure an error naming the packet.
 
 use super::ProtocolError;
-use haptic_types::local::{Body, Bond, LocalModel, MAX_PLANES, Plane};
+use haptic_types::local::{
+    Body, Bond, Follower, LocalModel, MAX_PLANES, MAX_REACH_VERTICES, Plane,
+};
 
 /// A bounds-checked little-endian reader over one datagram.
 pub(super) struct Reader<'a> {
@@ -106,10 +108,10 @@ impl<'a> Reader<'a> {
         Ok(m)
     }
 
-    /// The bond after a version-3 force packet's local model: anchor, normal, stiffness and
-    /// breaking stretch (checked with the model).
-    pub(super) fn bond(&mut self) -> Result<Bond, ProtocolError> {
-        let kind = "force (version 3)";
+    /// The bond after a version-3 force packet's local model (or a version-4 one's bond flag):
+    /// anchor, normal, stiffness and breaking stretch (checked with the model); `kind` names
+    /// the packet in a refusal.
+    pub(super) fn bond(&mut self, kind: &'static str) -> Result<Bond, ProtocolError> {
         let anchor_m = self.f64s::<3>(kind)?;
         let normal = self.f64s::<3>(kind)?;
         let [stiffness_n_per_m, break_m] = self.f64s::<2>(kind)?;
@@ -118,6 +120,28 @@ impl<'a> Reader<'a> {
             normal,
             stiffness_n_per_m,
             break_m,
+        })
+    }
+
+    /// The follower after a version-4 force packet's bond: position, drift, retain,
+    /// stiffness and the envelope's vertices (checked with the model).
+    pub(super) fn follower(&mut self) -> Result<Follower, ProtocolError> {
+        let kind = "force (version 4)";
+        let position_m = self.f64s::<2>(kind)?;
+        let drift_m = self.f64s::<2>(kind)?;
+        let [retain, stiffness_n_per_m] = self.f64s::<2>(kind)?;
+        // The count is checked with the model (at most MAX_REACH_VERTICES).
+        let n = usize::from(self.u8(kind)?);
+        let mut reach_m = Vec::with_capacity(n.min(MAX_REACH_VERTICES));
+        for _ in 0..n {
+            reach_m.push(self.f64s::<2>(kind)?);
+        }
+        Ok(Follower {
+            position_m,
+            drift_m,
+            reach_m,
+            retain,
+            stiffness_n_per_m,
         })
     }
 

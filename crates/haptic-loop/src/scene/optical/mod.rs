@@ -28,6 +28,7 @@ use haptic_engine::scene::SceneInput;
 use haptic_engine::scene::SceneOutput;
 use haptic_types::Event;
 use haptic_types::Primitive;
+use haptic_types::local::{Follower, MAX_REACH_VERTICES, radial_reach};
 use haptic_types::vec3::Vec3;
 use look::{Look, Shown};
 use nalgebra::Vector2;
@@ -118,6 +119,35 @@ impl Scene for OpticalScene {
         }
         out.force_n = [r.force_n[0], r.force_n[1], 0.0];
         out.stiffness_n_per_m = r.stiffness_n_per_m;
+    }
+
+    /// The held particle and its working envelope as a follower (protocol 4): where the
+    /// command met it, its free drift, the envelope seen from the clip's anchor in
+    /// [`MAX_REACH_VERTICES`] directions less that drift, what it keeps of its velocity, and
+    /// the spring on the excess. None when nothing is
+    /// held, the spring is off, or the clip is not the paper's radial one.
+    fn local_primitives(&self, out: &mut haptic_types::local::WorldPrimitives) {
+        let w = &self.world;
+        let p = w.params();
+        if !(w.grabbed() && p.feedback && p.clip == ot_envelope::ClipMode::Radial) {
+            return;
+        }
+        let Some((from, anchor, free)) = w.last_clip() else {
+            return;
+        };
+        let poly: Vec<[f64; 2]> = w.envelope().iter().map(|v| [v.x, v.y]).collect();
+        if let Some(reach) = radial_reach(&poly, anchor, MAX_REACH_VERTICES) {
+            out.follower = Some(Follower {
+                position_m: from,
+                drift_m: free,
+                reach_m: reach
+                    .iter()
+                    .map(|v| [v[0] - free[0], v[1] - free[1]])
+                    .collect(),
+                retain: p.velocity_retain,
+                stiffness_n_per_m: p.stiffness_n_per_m,
+            });
+        }
     }
 
     fn state(&self, out: &mut Vec<f64>) {
