@@ -18,6 +18,10 @@
 //! 4. **The atoms' pull-off**: the nano world on each preset, loose and firm, behind 2, 5 and
 //!    10 ms: the peak force the hand feels over the ideal link's, protocol 2 (the adhesion as
 //!    the residual's linear spring) against protocol 3 (the bond, a spring that breaks).
+//! 5. **The 10 kHz trap**: the optical tweezers at 10 kHz on each preset, loose and firm,
+//!    behind 2, 5 and 10 ms: the peak force the hand feels over the largest force the world
+//!    answered in the same run, protocol 3 (the excess spring as the residual's linear spring)
+//!    against protocol 4 (the follower: the held particle stepped through its envelope).
 #![allow(clippy::unwrap_used)]
 
 use bench_harness::chart::{Chart, Scale, Series, Style};
@@ -82,7 +86,8 @@ fn main() {
          device-side library (`haptic_devices::local`). Protocol 1 renders `F0 − K (p − p0)`; \
          protocol 2 renders the world's local model (contact planes, the carried brick) at the \
          device's servo rate, behind the two-port passivity layer; protocol 3 adds the bond, \
-         a spring that breaks at the nano world's pull-off. Loose hand: 300 N/m, \
+         a spring that breaks at the nano world's pull-off; protocol 4 the follower, the \
+         optical tweezers' held particle stepped through its working envelope. Loose hand: 300 N/m, \
          2 N·s/m; firm: 1000 N/m, 8 N·s/m. Stable: no undeclared force jump above 1 N, at most \
          10 % of the power above 50 Hz, the observer within its reserve.",
     );
@@ -234,6 +239,7 @@ fn main() {
          wall's; the drag is the mean force magnitude gliding at 0.1 m/s in free space.",
     );
     pull_off(&mut md, &read);
+    trap(&mut md, &read);
     let (path, _) = md.finish().unwrap();
     println!("wrote {}", path.display());
 }
@@ -280,5 +286,63 @@ fn pull_off(md: &mut Report, read: &dyn Fn(&str) -> String) {
          the hand is pulled harder than the world ever pulls, more with the delay. Protocol 3 \
          sends a bond, a spring that breaks at the world's pull-off, evaluated at the position \
          read now: the peak is the world's at every latency (docs/device-bridge.md).",
+    );
+}
+
+/// 5. The 10 kHz trap behind the link: the felt peak over the world's own, protocols 3 and 4.
+fn trap(md: &mut Report, read: &dyn Fn(&str) -> String) {
+    md.heading(
+        "The 10 kHz trap: the peak the hand feels over the world's own, protocol 3 against 4",
+    );
+    let (text, stext) = (
+        read("optical_tweezers_10khz.toml"),
+        read("optical_tweezers.script.toml"),
+    );
+    let mut t = Table::new([
+        "device",
+        "grip",
+        "one-way latency (ms)",
+        "protocol 3: felt / world peak (N)",
+        "protocol 3 ratio",
+        "protocol 4: felt / world peak (N)",
+        "protocol 4 ratio",
+    ]);
+    for mech in PRESETS {
+        for (grip, held) in [(Grip::LOOSE, "loose"), (Grip::FIRM, "firm")] {
+            let peaks = |l: &Linked| {
+                let (r, tr) = run_linked(&text, &stext, mech, grip, l, None).unwrap();
+                let world = tr
+                    .world
+                    .iter()
+                    .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
+                    .fold(0.0, f64::max);
+                (r.peak_force_n, world)
+            };
+            for ms in [2.0, 5.0, 10.0] {
+                let (f3, w3) = peaks(&linked(ms, Protocol::V3));
+                let (f4, w4) = peaks(&linked(ms, Protocol::V4));
+                t.row([
+                    mech.name.to_string(),
+                    held.to_string(),
+                    format!("{ms}"),
+                    format!("{f3:.3} / {w3:.3}"),
+                    format!("{:.3}", f3 / w3),
+                    format!("{f4:.3} / {w4:.3}"),
+                    format!("{:.3}", f4 / w4),
+                ])
+                .unwrap();
+            }
+        }
+    }
+    md.table(&t);
+    md.para(
+        "How to read: the held particle follows the hand at up to its working envelope a tick, \
+         and the world pushes back only on the command beyond the envelope. Protocol 3 sends \
+         that spring as the residual's linear `F0 − K (p − p0)` about a reading a round trip \
+         old: inside the envelope, where the world answers nothing, the hand feels a drag of K \
+         times its travel over the round trip, many times the world's force. Protocol 4 sends \
+         the particle, its free drift and its envelope, and the device steps the particle with \
+         its own readings as the world does: the hand feels the world's force \
+         (docs/device-bridge.md).",
     );
 }
