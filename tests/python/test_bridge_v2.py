@@ -40,7 +40,8 @@ def same_force(got, want):
 # ---------------------------------------------------------------- the reference trace
 
 
-@pytest.mark.parametrize("index", [0, 1, 2], ids=["protocol-1", "protocol-2", "protocol-3"])
+@pytest.mark.parametrize("index", [0, 1, 2, 3],
+                         ids=["protocol-1", "protocol-2", "protocol-3", "protocol-4"])
 def test_the_device_side_renders_the_rust_reference_trace(index):
     case = json.loads(FIXTURE.read_text(encoding="utf-8"))["cases"][index]
     side = bridge.DeviceSide(case["protocol"], case["max_force_n"], case["period_s"])
@@ -74,12 +75,19 @@ def test_the_device_side_renders_the_rust_reference_trace(index):
         assert all(r.local is not None and len(r.local.planes) == 2 for r in packets)
         assert any(r.local.body is not None and r.local.body_planes for r in packets)
         assert side.interventions > 0
-        # Protocol 3's bond (samples 30–119) in version-3 packets, none in protocol 2's.
+        # Protocol 3's bond (samples 30–119) in version-3 and 4 packets, none in protocol 2's;
+        # protocol 4's follower (samples 40–199), its bond flag set where both are answered.
         bonded = [r.seq for r in packets if r.local.bond is not None]
-        if case["protocol"] == 3:
+        following = [r.seq for r in packets if r.local.follower is not None]
+        if case["protocol"] >= 3:
             assert (min(bonded), max(bonded)) == (30, 119)
         else:
             assert bonded == []
+        if case["protocol"] == 4:
+            assert (min(following), max(following)) == (40, 199)
+            assert all(len(r.local.follower.reach_m) == 24 for r in packets if r.local.follower)
+        else:
+            assert following == []
     # Same operations in the same order: the same bits, not merely close (on 64-bit builds,
     # whose float arithmetic is plain IEEE double, as Rust's).
     if sys.maxsize > 2**32:
@@ -103,8 +111,8 @@ def test_a_dropped_answer_and_a_silent_link_render_as_the_rust_side_would():
     assert side.render((0.0, 0.0, -0.002), 1e-3) == (0.0, 0.0, 1.0)
     # A force over the device's maximum is scaled down along its direction.
     assert side.render((0.0, 0.0, -0.050), 1e-3) == pytest.approx((0.0, 0.0, 8.0))
-    with pytest.raises(ValueError, match="protocol = 4: allowed 1, 2 or 3"):
-        bridge.DeviceSide(4, 8.0, 1e-3)
+    with pytest.raises(ValueError, match="protocol = 5: allowed 1, 2, 3 or 4"):
+        bridge.DeviceSide(5, 8.0, 1e-3)
 
 
 # ---------------------------------------------------------------- malformed packets
@@ -147,6 +155,72 @@ def test_a_version_2_force_packet_has_its_documented_layout():
     assert bridge.encode_sample(0, 0, (0.0, 0.0, 0.0), 0)[4] == 1 and bridge.encode_bye()[4] == 1
 
 
+def follower(vertices=24, **kw):
+    reach = [(6e-5 * math.cos(2 * math.pi * k / vertices), 3e-5 * math.sin(2 * math.pi * k / vertices))
+             for k in range(vertices)]
+    args = dict(position_m=(0.004, -0.003), drift_m=(1e-5, 2e-5), reach_m=reach, retain=0.1,
+                stiffness_n_per_m=800.0)
+    args.update(kw)
+    return bridge.Follower(**args)
+
+
+def test_a_version_4_force_packet_carries_the_follower_after_the_bond_flag():
+    """The layout of docs/device-bridge.md's version 4, the Rust encoder's bytes and sizes:
+    the version-2 packet, a bond flag (and the bond), the follower's 49 bytes and 16 a vertex;
+    the largest fits a datagram; a bad flag or a bad follower is refused by name."""
+    bond = bridge.Bond((0.001, -0.002, 0.003), (0.0, 0.6, 0.8), 350.0, 0.0025)
+    for with_bond, vertices in ((False, 3), (False, 24), (True, 24)):
+        r = full_reply()
+        r.local.bond = bond if with_bond else None
+        r.local.follower = follower(vertices)
+        b = bridge.encode_force(r)
+        assert b[4] == 4
+        assert len(b) == bridge.force_v4_len(2, True, 1, with_bond, vertices)
+        assert len(b) == (bridge.force_v2_len(2, True, 1) + 1 + (64 if with_bond else 0) + 49
+                          + 16 * vertices)
+        assert bridge.decode(b)[1].local == r.local
+        with pytest.raises(ValueError, match=r"^force \(version 4\) packet of .* is too short"):
+            bridge.decode(b[:-1])
+        with pytest.raises(ValueError, match=r"^force \(version 4\) packet of .* is too long"):
+            bridge.decode(b + b"\x00")
+    assert bridge.force_v4_len(4, True, 4, True, bridge.MAX_REACH_VERTICES) <= bridge.MAX_PACKET
+    r = full_reply()
+    r.local.follower = follower(8)
+    b = bytearray(bridge.encode_force(r))
+    flag = bridge.force_v2_len(2, True, 1)
+    assert b[flag] == 0
+    b[flag] = 2
+    with pytest.raises(ValueError) as e:
+        bridge.decode(bytes(b))
+    assert str(e.value) == "force packet's local model: bond flag 2: allowed 0 (none) or 1"
+    r.local.follower = follower(8, retain=2.0)
+    with pytest.raises(ValueError) as e:
+        bridge.decode(bridge.encode_force(r))
+    assert str(e.value) == ("force packet's local model: follower.retain = 2 is out of range: "
+                            "allowed 0 ≤ r ≤ 1")
+    r.local.follower = follower(2)
+    with pytest.raises(ValueError) as e:
+        bridge.decode(bridge.encode_force(r))
+    assert str(e.value) == ("force packet's local model: follower.reach_m (vertices) = 2 is out "
+                            "of range: allowed 3 ≤ n ≤ 24")
+
+
+def test_a_follower_steps_and_pushes_as_the_documents_figures_say():
+    """The figures of docs/device-bridge.md's C listing and Rust's follower tests: inside
+    the envelope nothing, 2 mm beyond 0.2 N back; from the free drift when zero is out of
+    reach; from rest 1 mm then 1.2 mm, the drift 0.2 then 0.22 mm."""
+    sq = [(1e-3, -1e-3), (1e-3, 1e-3), (-1e-3, 1e-3), (-1e-3, -1e-3)]
+    f = bridge.Follower((0.0, 0.0), (0.0, 0.0), sq, 0.1, 100.0)
+    assert f.force((0.5e-3, 0.0, 0.0)) == (-0.0, -0.0, 0.0)
+    assert f.force((3e-3, 0.0, 7.0)) == pytest.approx((-0.2, 0.0, 0.0), abs=1e-12)
+    g = bridge.Follower((0.0, 0.0), (2e-3, 0.0), sq, 0.1, 100.0)
+    assert g.clip((5e-3, 1e-3)) == pytest.approx((3e-3, 1e-3 / 3), abs=1e-15)
+    f.step((0.1, 0.0, 0.0))
+    assert f.position_m[0] == pytest.approx(1e-3, abs=1e-15) and f.drift_m[0] == pytest.approx(0.2e-3, abs=1e-15)
+    f.step((0.1, 0.0, 0.0))
+    assert f.position_m[0] == pytest.approx(2.2e-3, abs=1e-15) and f.drift_m[0] == pytest.approx(0.22e-3, abs=1e-15)
+
+
 def test_malformed_version_2_packets_are_refused_by_name():
     good = bridge.encode_force(full_reply())
 
@@ -185,7 +259,7 @@ def test_malformed_version_2_packets_are_refused_by_name():
     r.local.planes = r.local.planes * 3
     with pytest.raises(ValueError, match="6 planes: allowed at most 4"):
         bridge.encode_force(r)
-    assert error(b"NHDB\x04\x04\x00\x00").startswith("protocol version 4")
+    assert error(b"NHDB\x05\x04\x00\x00").startswith("protocol version 5")
     # A version-3 packet: the version-2 one and its bond, checked like the rest of the model.
     r = full_reply()
     r.local.bond = bridge.Bond((0.0, 0.0, 0.001), (0.0, 0.6, 0.8), 350.0, 0.0025)
@@ -235,12 +309,13 @@ def engaged(reply):
     return reply.stiffness_n_per_m[8] == pytest.approx(WALL_K_N_PER_M)
 
 
-def pace(client, side, path, going, two_port=False):
+def pace(client, side, path, going, two_port=False, buttons=None):
     """Sends the stylus at ``path(t)`` through ``client`` once a period of ``side`` while
     ``going(t, answers)``, as bridge.run paces a device (missed periods skip their sequence
     numbers), hands every answer to ``side`` and renders each period; with ``two_port`` each
-    sample carries the side's two-port count. Closes the client; returns the samples sent and
-    every answer with the reading it answers."""
+    sample carries the side's two-port count, and with ``buttons`` the bits ``buttons(t)``.
+    Closes the client; returns the samples sent and every answer with the reading it
+    answers."""
     period = side.period_s
     readings, answers, sent = {}, [], 0
     next_t = time.perf_counter()
@@ -249,7 +324,8 @@ def pace(client, side, path, going, two_port=False):
             p = path(client.seq * period)
             readings[client.seq] = p
             side.record_reading(client.seq, p)
-            seq = client.send(p, two_port_periods=side.interventions if two_port else None)
+            bits = buttons(client.seq * period) if buttons else 0
+            seq = client.send(p, bits, two_port_periods=side.interventions if two_port else None)
             sent += 1
             while True:
                 reply = client.receive(max(0.0, next_t + period - time.perf_counter()))
@@ -411,11 +487,17 @@ def test_an_adapter_renders_the_local_model_at_its_servo_rate_until_hold_s(mock_
 
 def nano_path(t):
     """The built-in nano script's stylus at ``t`` s (m): its waypoints, linearly between them."""
-    text = (ROOT / "scenes" / "nanoworld.script.toml").read_text(encoding="utf-8")
-    ts = [float(x) for x in re.findall(r"^t_s = ([-0-9.e]+)$", text, re.M)]
-    ps = [tuple(float(v) * 1e-3 for v in m.split(","))
-          for m in re.findall(r"^position_mm = \[([^\]]*)\]$", text, re.M)]
-    assert len(ts) == len(ps) > 10
+    return script_path("nanoworld.script.toml", t)
+
+
+def script_path(name, t):
+    """A built-in script's stylus at ``t`` s (m): its waypoints, linearly between them."""
+    import tomllib
+
+    points = tomllib.loads((ROOT / "scenes" / name).read_text(encoding="utf-8"))["waypoint"]
+    ts = [float(w["t_s"]) for w in points]
+    ps = [tuple(float(v) * 1e-3 for v in w["position_mm"]) for w in points]
+    assert len(ts) == len(ps) > 5
     for (t0, p0), (t1, p1) in zip(zip(ts, ps), zip(ts[1:], ps[1:])):
         if t <= t1:
             s = max(0.0, (t - t0) / (t1 - t0))
@@ -478,3 +560,64 @@ def test_a_version_3_session_on_the_atoms_carries_bonds_that_the_device_side_ren
     want = tuple(r[i] + (b.anchor_m[i] - held[i]) * b.stiffness_n_per_m for i in range(3))
     assert render(held) == pytest.approx(want, abs=1e-9)
     assert render(broken) == pytest.approx(tuple(r), abs=1e-9)
+
+
+def test_a_version_4_session_on_the_trap_carries_followers_that_the_device_side_renders(tmp_path):
+    """A Python device speaking protocol 4 against the simulator's optical tweezers (1 kHz):
+    welcomed with 4, it gets the held particle as a follower in version-4 packets (decoded
+    here from the simulator's own bytes), each model exact at its answered reading with the
+    follower's spring included, and a DeviceSide given an answer renders it there."""
+    import threading
+
+    import nanohaptics as nh
+
+    port = free_port()
+    result = {}
+
+    def sim():
+        result.update(nh.run_scene(str(ROOT / "scenes" / "optical_tweezers.toml"),
+                                   device=f"udp:127.0.0.1:{port}",
+                                   out=str(tmp_path / "v4.mcap"), wait_s=20.0))
+
+    t = threading.Thread(target=sim)
+    t.start()
+    specs = bridge.Specs("falcon", 8.0, 3000.0, 0.04, FALCON_BUTTONS)
+    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=4)
+    welcome = client.connect(20.0)
+    period = 1.0 / welcome["rate_hz"]
+    side = bridge.DeviceSide(welcome["version"], specs.max_force_n, period)
+    # The script grabs at 0.3 s (the grip, button 0), steers and drags fast at 4.5 s.
+    sent, answers = pace(client, side, lambda t: script_path("optical_tweezers.script.toml", t),
+                         lambda t, _: t < 4.7, two_port=True,
+                         buttons=lambda t: 1 if t >= 0.3 else 0)
+    following = [(r, p0) for r, p0 in answers if r.local is not None and r.local.follower]
+    t.join()
+    assert welcome["version"] == 4 and client.version == 4
+    assert result["stats"]["end"] == "device_ended"
+    assert len(following) > 0.5 * sent, (len(following), sent)
+    print(f"{len(following)} answers with a follower of {sent} samples")
+    pushed = 0
+    for reply, p0 in following:
+        m = reply.local
+        fo = m.follower
+        # (The spring is 0 until the session's soft engagement has ramped the gain up.)
+        assert len(fo.reach_m) == bridge.MAX_REACH_VERTICES and fo.stiffness_n_per_m >= 0.0
+        assert fo.retain == pytest.approx(0.1)
+        # The residual makes the model exact at the answered reading, the follower included.
+        f = bridge._add(m.static_force(p0, p0), fo.force(p0))
+        assert f == pytest.approx(reply.force_n, abs=1e-9)
+        pushed += math.hypot(*reply.force_n[:2]) > 0.1
+    # The fast drag pushes past the envelope: the world answers with its spring.
+    assert pushed > 10, pushed
+    assert sum(r.local.follower.stiffness_n_per_m > 0.0 for r, _ in following) > 0.9 * len(following)
+    # A device side given an answer renders, at its reading, the answered force (the world's
+    # energy set to 0: a fresh side has done no work, and the hand has done work on the
+    # world, which the two-port layer would hold against it).
+    import dataclasses
+
+    reply, p0 = max(following, key=lambda a: math.hypot(*a[0].force_n[:2]))
+    reply = dataclasses.replace(reply, local=dataclasses.replace(reply.local, world_energy_j=0.0))
+    fresh = bridge.DeviceSide(4, specs.max_force_n, period)
+    fresh.record_reading(reply.seq, p0)
+    assert fresh.receive(reply)
+    assert fresh.render(p0, period) == pytest.approx(reply.force_n, abs=1e-9)

@@ -15,8 +15,8 @@ library only), plus adapters for real devices through their Python SDKs:
   VerseGrip handle for buttons) through ``HaplyHardwareAPI`` (Haply's Python
   API over USB serial).
 
-Three protocol versions. A device says hello with the version it speaks and the
-simulator's welcome names the session's (the device's, at most 3):
+Four protocol versions. A device says hello with the version it speaks and the
+simulator's welcome names the session's (the device's, at most 4):
 
 * **version 1**: each force packet carries the force F0 (N) computed at the
   answered reading p0 and a local stiffness K (N/m, 3×3); the device renders
@@ -36,6 +36,11 @@ simulator's welcome names the session's (the device's, at most 3):
   anchored tip): the device renders ``k (a − p)`` until the stylus has pulled it
   past its breaking stretch, and nothing beyond, so a pull-off behind a link is
   felt where the world lets go, not a round trip later.
+* **version 4** (``protocol=4``): version 3 with a *follower* (:class:`Follower`),
+  the optical tweezers' held particle and its working envelope: the device steps
+  the particle with each reading it sends, as the world does, and renders the
+  spring on the command beyond the envelope, so the trap pushes back where the
+  world does and drags nowhere inside the envelope.
 
 :class:`DeviceSide` is the device's rendering for every version, a line-by-line
 port of the Rust ``haptic_devices::local::DeviceSide`` (the same forces to the
@@ -68,14 +73,17 @@ __all__ = [
     "VERSION",
     "VERSION_2",
     "VERSION_3",
+    "VERSION_4",
     "MAX_PACKET",
     "MAX_PLANES",
+    "MAX_REACH_VERTICES",
     "DEVICE_RESERVE_J",
     "DEVICE_MAX_DAMPING_N_S_PER_M",
     "Specs",
     "Plane",
     "Body",
     "Bond",
+    "Follower",
     "LocalModel",
     "ForceReply",
     "DeviceSide",
@@ -94,6 +102,7 @@ __all__ = [
     "ROLES",
     "force_v2_len",
     "force_v3_len",
+    "force_v4_len",
     "decode",
     "local_force",
     "run",
@@ -105,9 +114,12 @@ MAGIC = b"NHDB"
 VERSION = 1
 #: Protocol version 2: force packets carry the local model.
 VERSION_2 = 2
-#: The newest protocol version: a force packet whose model has a bond (a spring that breaks)
-#: carries it after the model.
+#: Protocol version 3: a force packet whose model has a bond (a spring that breaks) carries it
+#: after the model.
 VERSION_3 = 3
+#: The newest protocol version: a force packet whose model has a follower (the optical
+#: tweezers' held particle) carries a bond flag, the bond if any, then the follower.
+VERSION_4 = 4
 HELLO, WELCOME, SAMPLE, FORCE, BYE, REFUSAL = 1, 2, 3, 4, 5, 6
 #: The button roles, in the order of the welcome's four role bytes (docs/devices.md).
 ROLES = ("grip", "turn_x", "turn_y", "turn_z")
@@ -135,6 +147,9 @@ BYE_LEN = _HEADER.size + 1  # 9
 _V2_MIN_LEN = FORCE_LEN + _LOCAL_FIXED.size + 3  # 228: no planes, no body, no body planes
 _V2_KIND = "force (version 2)"
 _V3_KIND = "force (version 3)"
+_V4_KIND = "force (version 4)"
+_FOLLOWER = struct.Struct("<6dB")  # position, drift, retain, stiffness, vertex count
+_VERTEX = struct.Struct("<2d")
 
 Vec3 = Tuple[float, float, float]
 _ZERO: Vec3 = (0.0, 0.0, 0.0)
@@ -343,6 +358,117 @@ class Bond:
         return _ZERO
 
 
+#: Most vertices of a follower's envelope (protocol 4).
+MAX_REACH_VERTICES = 24
+
+
+def _cross2(a, b) -> float:
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def _contains(poly, p) -> bool:
+    """Whether ``p`` lies inside the polygon (even–odd rule), as Rust's."""
+    inside = False
+    j = len(poly) - 1
+    for i in range(len(poly)):
+        a, b = poly[i], poly[j]
+        if (a[1] > p[1]) != (b[1] > p[1]):
+            x = a[0] + _div(p[1] - a[1], b[1] - a[1]) * (b[0] - a[0])
+            if p[0] < x:
+                inside = not inside
+        j = i
+    return inside
+
+
+def _first_crossing(poly, a, b) -> Optional[float]:
+    """The first ``t`` in (0, 1] where the segment ``a + t (b − a)`` meets the boundary."""
+    r = (b[0] - a[0], b[1] - a[1])
+    n = len(poly)
+    best = None
+    for i in range(n):
+        q, q2 = poly[i], poly[(i + 1) % n]
+        s = (q2[0] - q[0], q2[1] - q[1])
+        den = _cross2(r, s)
+        if den == 0.0:
+            continue
+        qa = (q[0] - a[0], q[1] - a[1])
+        t = _cross2(qa, s) / den
+        u = _cross2(qa, r) / den
+        if 0.0 < t <= 1.0 and -1e-12 <= u <= 1.0 + 1e-12 and (best is None or t < best):
+            best = t
+    return best
+
+
+def _nearest_on_boundary(poly, p):
+    best_d, best = math.inf, (p[0], p[1])
+    for i in range(len(poly)):
+        a, b = poly[i], poly[(i + 1) % len(poly)]
+        d = (b[0] - a[0], b[1] - a[1])
+        l2 = d[0] * d[0] + d[1] * d[1]
+        if l2 > 0.0:
+            t = ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2
+            t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+        else:
+            t = 0.0
+        q = (a[0] + d[0] * t, a[1] + d[1] * t)
+        dist = math.hypot(p[0] - q[0], p[1] - q[1])
+        if dist < best_d:
+            best_d, best = dist, q
+    return best
+
+
+@dataclass
+class Follower:
+    """A particle that follows the stylus in the device's x–y plane (protocol 4: the optical
+    tweezers' held particle). Each sample it moves by the command ``d = p − x`` clipped to
+    its working envelope (``reach_m`` shifted by the free drift ``u``), radially from zero
+    displacement when the envelope holds it, else from the free drift; the stylus feels
+    ``−k (d − clip(d))`` along x and y. After a displacement ``a`` the drift becomes
+    ``retain · (2a − u)``. A port of Rust's ``haptic_types::local::Follower``."""
+
+    #: The particle's centre, m, as the next sample meets it (x, y).
+    position_m: Tuple[float, float]
+    #: Its free drift over one sample, m.
+    drift_m: Tuple[float, float]
+    #: The envelope less the drift, m, counter-clockwise (3 to :data:`MAX_REACH_VERTICES`).
+    reach_m: List[Tuple[float, float]]
+    #: The share of its velocity kept from one sample to the next (0–1).
+    retain: float
+    #: The spring on the excess, N/m.
+    stiffness_n_per_m: float
+
+    def clip(self, d) -> Tuple[float, float]:
+        """The command ``d`` (m, from the particle) clipped to the envelope."""
+        u = self.drift_m
+        rel = (d[0] - u[0], d[1] - u[1])
+        if _contains(self.reach_m, rel):
+            c = rel
+        else:
+            anchor = next((a for a in ((-u[0], -u[1]), (0.0, 0.0))
+                           if _contains(self.reach_m, a)), None)
+            t = None if anchor is None else _first_crossing(self.reach_m, anchor, rel)
+            if t is not None:
+                c = (anchor[0] + (rel[0] - anchor[0]) * t, anchor[1] + (rel[1] - anchor[1]) * t)
+            else:
+                c = _nearest_on_boundary(self.reach_m, rel)
+        return (c[0] + u[0], c[1] + u[1])
+
+    def force(self, p: Sequence[float]) -> Vec3:
+        """The spring on the excess at ``p``, N (nothing along z)."""
+        d = (p[0] - self.position_m[0], p[1] - self.position_m[1])
+        c = self.clip(d)
+        k = self.stiffness_n_per_m
+        return (-k * (d[0] - c[0]), -k * (d[1] - c[1]), 0.0)
+
+    def step(self, p: Sequence[float]) -> None:
+        """One sample with the stylus at ``p``."""
+        d = (p[0] - self.position_m[0], p[1] - self.position_m[1])
+        a = self.clip(d)
+        self.position_m = (self.position_m[0] + a[0], self.position_m[1] + a[1])
+        u = self.drift_m
+        self.drift_m = (self.retain * (2.0 * a[0] - u[0]), self.retain * (2.0 * a[1] - u[1]))
+
+
 @dataclass
 class LocalModel:
     """What one version-2 answer asks the device to render until the next:
@@ -361,8 +487,10 @@ class LocalModel:
     body_planes: List[Plane] = field(default_factory=list)
     #: The net work the world's answers did on the hand since the session began, J.
     world_energy_j: float = 0.0
-    #: A spring that breaks (a version-3 packet); None in version 2.
+    #: A spring that breaks (a version-3 or 4 packet); None in version 2.
     bond: Optional[Bond] = None
+    #: The held particle and its envelope (a version-4 packet); None before version 4.
+    follower: Optional[Follower] = None
 
     def static_force(self, p: Sequence[float], p0: Sequence[float]) -> Vec3:
         """The residual and the planes at ``p`` for the answered reading ``p0`` (the body
@@ -438,6 +566,27 @@ class LocalModel:
             if not (bond.break_m > 0.0 and bond.break_m <= 1.0):
                 raise ValueError(
                     f"bond.break_m = {_fmt(bond.break_m)} is out of range: allowed 0 < s ≤ 1 m")
+        fo = self.follower
+        if fo is not None:
+            if not (_finite(fo.position_m) and _finite(fo.drift_m)
+                    and all(_finite(v) for v in fo.reach_m)):
+                raise ValueError("follower: the position, drift and envelope must be finite")
+            n = len(fo.reach_m)
+            if not 3 <= n <= MAX_REACH_VERTICES:
+                raise ValueError(
+                    f"follower.reach_m (vertices) = {n} is out of range: "
+                    f"allowed 3 ≤ n ≤ {MAX_REACH_VERTICES}")
+            zero = (-fo.drift_m[0], -fo.drift_m[1])
+            if not _contains(fo.reach_m, (0.0, 0.0)) and not _contains(fo.reach_m, zero):
+                raise ValueError(
+                    "follower: the envelope must hold zero displacement or the free drift")
+            if not 0.0 <= fo.retain <= 1.0:
+                raise ValueError(
+                    f"follower.retain = {_fmt(fo.retain)} is out of range: allowed 0 ≤ r ≤ 1")
+            if not 0.0 <= fo.stiffness_n_per_m <= max_stiffness_n_per_m:
+                raise ValueError(
+                    f"follower.stiffness_n_per_m = {_fmt(fo.stiffness_n_per_m)} is out of "
+                    f"range: allowed 0 ≤ k ≤ {_fmt(max_stiffness_n_per_m)} N/m")
 
 
 # ---------------------------------------------------------------- packets
@@ -475,8 +624,8 @@ def _string(s: str) -> bytes:
 
 
 def _check_version(version: int, what: str = "version") -> int:
-    if version not in (VERSION, VERSION_2, VERSION_3):
-        raise ValueError(f"{what} = {version!r}: allowed 1, 2 or 3")
+    if version not in (VERSION, VERSION_2, VERSION_3, VERSION_4):
+        raise ValueError(f"{what} = {version!r}: allowed 1, 2, 3 or 4")
     return int(version)
 
 
@@ -553,10 +702,16 @@ def _planes_bytes(planes: Sequence[Plane], what: str) -> bytes:
 
 def encode_force(reply: ForceReply) -> bytes:
     """A force datagram (what the simulator sends): version 2 with the local model when
-    ``reply.local`` is set, version 3 when that model has a bond, else version 1. Raises
-    ValueError for more than four planes."""
+    ``reply.local`` is set, version 3 when that model has a bond, version 4 when it has a
+    follower, else version 1. Raises ValueError for more than four planes or more than
+    :data:`MAX_REACH_VERTICES` envelope vertices."""
     m = reply.local
-    version = VERSION if m is None else (VERSION_2 if m.bond is None else VERSION_3)
+    if m is None:
+        version = VERSION
+    elif m.follower is not None:
+        version = VERSION_4
+    else:
+        version = VERSION_2 if m.bond is None else VERSION_3
     out = _HEADER.pack(MAGIC, version, FORCE, 0) + _FORCE.pack(
         reply.seq, reply.tick, *reply.force_n, *reply.stiffness_n_per_m, reply.status)
     if m is None:
@@ -572,9 +727,19 @@ def encode_force(reply: ForceReply) -> bytes:
             b.series_stiffness_n_per_m, b.damping_n_s_per_m, *b.damper_m, *b.external_force_n,
             b.substeps, b.restitution)
     out += _planes_bytes(m.body_planes, "body planes")
+    if m.follower is not None:
+        out += b"\x00" if m.bond is None else b"\x01"
     if m.bond is not None:
         d = m.bond
         out += _BOND.pack(*d.anchor_m, *d.normal, d.stiffness_n_per_m, d.break_m)
+    fo = m.follower
+    if fo is not None:
+        if len(fo.reach_m) > MAX_REACH_VERTICES:
+            raise ValueError(f"{len(fo.reach_m)} envelope vertices: allowed at most "
+                             f"{MAX_REACH_VERTICES}")
+        out += _FOLLOWER.pack(*fo.position_m, *fo.drift_m, fo.retain, fo.stiffness_n_per_m,
+                              len(fo.reach_m))
+        out += b"".join(_VERTEX.pack(*v) for v in fo.reach_m)
     return out
 
 
@@ -586,6 +751,13 @@ def force_v2_len(planes: int, body: bool, body_planes: int) -> int:
 def force_v3_len(planes: int, body: bool, body_planes: int) -> int:
     """Size of a version-3 force packet, bytes: a version-2 one and its 64-byte bond."""
     return force_v2_len(planes, body, body_planes) + _BOND.size
+
+
+def force_v4_len(planes: int, body: bool, body_planes: int, bond: bool, vertices: int) -> int:
+    """Size of a version-4 force packet, bytes: a version-2 one, the bond flag, the 64-byte
+    bond if any, the follower's 49 bytes and 16 a vertex."""
+    return (force_v2_len(planes, body, body_planes) + 1 + (_BOND.size if bond else 0)
+            + _FOLLOWER.size + _VERTEX.size * vertices)
 
 
 class _Reader:
@@ -634,9 +806,15 @@ class _Reader:
             out.append(Plane(v[0:3], v[3], v[4]))
         return out
 
-    def bond(self) -> Bond:
-        v = self.take(_BOND, _V3_KIND)
+    def bond(self, kind: str = _V3_KIND) -> Bond:
+        v = self.take(_BOND, kind)
         return Bond(anchor_m=v[0:3], normal=v[3:6], stiffness_n_per_m=v[6], break_m=v[7])
+
+    def follower(self) -> Follower:
+        v = self.take(_FOLLOWER, _V4_KIND)
+        reach = [self.take(_VERTEX, _V4_KIND) for _ in range(v[6])]
+        return Follower(position_m=v[0:2], drift_m=v[2:4], reach_m=reach, retain=v[4],
+                        stiffness_n_per_m=v[5])
 
     def local(self) -> LocalModel:
         kind = _V2_KIND
@@ -692,10 +870,10 @@ def decode(data: bytes):
     magic, version, kind, _ = _HEADER.unpack_from(data)
     if magic != MAGIC:
         raise ValueError(f"bad magic [{', '.join(f'{b:02x}' for b in magic)}] (expected NHDB)")
-    if version not in (VERSION, VERSION_2, VERSION_3):
+    if version not in (VERSION, VERSION_2, VERSION_3, VERSION_4):
         # Worded so that "(this client speaks 1)", the text tests/python/test_live.py matches
         # since version 1, still appears.
-        raise ValueError(f"protocol version {version} (this client speaks 1), 2 and 3")
+        raise ValueError(f"protocol version {version} (this client speaks 1), 2, 3 and 4")
     r = _Reader(data, _HEADER.size)
     if kind == WELCOME:
         rate, start = r.take(_WELCOME, "welcome")
@@ -732,6 +910,19 @@ def decode(data: bytes):
             except ValueError as e:
                 raise ValueError(f"force packet's local model: {e}") from None
             r.end(_V3_KIND)
+        elif version == VERSION_4:
+            local = r.local()
+            flag = r.u8(_V4_KIND)
+            if flag not in (0, 1):
+                raise ValueError(
+                    f"force packet's local model: bond flag {flag}: allowed 0 (none) or 1")
+            local.bond = r.bond(_V4_KIND) if flag == 1 else None
+            local.follower = r.follower()
+            try:
+                local.check(math.inf)
+            except ValueError as e:
+                raise ValueError(f"force packet's local model: {e}") from None
+            r.end(_V4_KIND)
         return "force", ForceReply(v[0], v[1], tuple(v[2:5]), tuple(v[5:14]), v[14], local=local)
     if kind == BYE:
         _fixed(data, "bye", BYE_LEN)
@@ -794,6 +985,10 @@ class DeviceSide:
       (the state the sample after the answered one meets) and stepped again through the
       readings sent since. An answer without a local model (a version-1 packet) renders
       ``F0 − K (p − p0)``.
+    * Protocol 3 adds the answer's :class:`Bond`, protocol 4 its :class:`Follower`: the held
+      particle, stepped here with each reading sent from the answered sample on (the state
+      the simulator reports is the particle as that sample met it), and its spring on the
+      excess at the position read now.
 
     Answers of an older tick than the one rendered are dropped; a non-finite force renders
     as zero (a non-finite reading counts no work); a
@@ -833,6 +1028,9 @@ class DeviceSide:
         # to be stepped with next (its state is the one that reading meets).
         self._body: Optional[Body] = None
         self._body_next = 0
+        # Protocol 4's follower as stepped here, and the reading it is to be stepped with next.
+        self._follower: Optional[Follower] = None
+        self._follower_next = 0
         self._work_j = 0.0
         self._world_j = 0.0
         self._reserve_j = DEVICE_RESERVE_J
@@ -873,7 +1071,16 @@ class DeviceSide:
         self._catch_up(seq)
 
     def _catch_up(self, seq: int) -> None:
-        """Steps the body with every kept reading before ``seq`` it has not met yet."""
+        """Steps the follower and the body with every kept reading before ``seq`` they have
+        not met yet."""
+        fo = self._follower
+        if fo is not None:
+            while self._follower_next < seq:
+                p = _reading_at_or_before(self._readings, self._follower_next)
+                if p is None:
+                    break
+                fo.step(p)
+                self._follower_next += 1
         body = self._body
         if body is None:
             return
@@ -901,6 +1108,8 @@ class DeviceSide:
         local = reply.local if self.protocol >= VERSION_2 else None
         if local is not None and self.protocol == VERSION_2 and local.bond is not None:
             local = dataclasses.replace(local, bond=None)
+        if local is not None and self.protocol < VERSION_4 and local.follower is not None:
+            local = dataclasses.replace(local, follower=None)
         lag = reply.tick - reply.seq
         offset = lag if self._tick_offset is None else self._tick_offset
         self._tick_offset = min(offset, lag)
@@ -912,6 +1121,14 @@ class DeviceSide:
                 self._body_next = nxt
             else:
                 self._body = None
+            # The follower's state is the one the answered sample met: it replays that
+            # sample's reading first.
+            fo = local.follower
+            if fo is not None and nxt >= 1:
+                self._follower = dataclasses.replace(fo, reach_m=list(fo.reach_m))
+                self._follower_next = nxt - 1
+            else:
+                self._follower = None
         self._answer = _Answer(reply, p0, local)
         if self._readings:
             self._catch_up(self._readings[-1][0])
@@ -925,6 +1142,7 @@ class DeviceSide:
             self._forgotten_tick = self._answer.reply.tick
         self._answer = None
         self._body = None
+        self._follower = None
 
     def render(self, p: Sequence[float], servo_s: float) -> Vec3:
         """The force to render at the reading ``p`` (m) for the next servo period of
@@ -957,6 +1175,8 @@ class DeviceSide:
             f = a.local.static_force(p, a.p0)
             if self._body is not None:
                 f = _sub(f, self._body.pull(p, self.period_s)[0])
+            if self._follower is not None:
+                f = _add(f, self._follower.force(p))
         if not _finite(f):
             f = _ZERO
         n = _norm(f)
