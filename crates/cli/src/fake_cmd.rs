@@ -17,7 +17,8 @@ use world_form::fmt_num;
 pub(crate) struct FakeArgs {
     /// The simulator's bridge address, `udp:HOST:PORT` or `udp:PORT` (loopback).
     target: String,
-    /// Script file (TOML) the stylus plays (default: the built-in wall-press script).
+    /// Script file (TOML) the stylus plays, or a built-in script by name (`optical_tweezers`,
+    /// or a built-in scene's name for its default script; default: the built-in wall press).
     #[arg(long)]
     script: Option<PathBuf>,
     /// Play the hand `nanohaptics device-check` asks for instead of a script: still for
@@ -157,10 +158,17 @@ fn script(a: &FakeArgs, specs: &DeviceSpecs) -> Result<Script, String> {
             haptic_devices::bridge::check::stages::hand_script(),
             "device-check's hand".into(),
         ),
-        Some(p) => (
-            haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?,
-            p.display().to_string(),
-        ),
+        // A file that is not there may name a built-in script, as `run` takes built-in scenes.
+        Some(p) => match (
+            p.exists(),
+            haptic_loop::builtin::script(&p.to_string_lossy()),
+        ) {
+            (false, Some((file, text))) => (text.to_string(), format!("built-in {file}")),
+            _ => (
+                haptic_loop::session::read_toml_text(p).map_err(|e| format!("--script: {e}"))?,
+                p.display().to_string(),
+            ),
+        },
         None => (
             FAKE_SCRIPT.to_string(),
             "built-in fake-device script".into(),

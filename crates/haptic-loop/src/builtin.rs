@@ -44,6 +44,20 @@ pub fn find(name: &str) -> Option<&'static Builtin> {
     SCENES.iter().find(|b| b.name == n)
 }
 
+/// The built-in script named `name`: its file name (`optical_tweezers.script.toml`), that name
+/// without `.script.toml`, or a built-in scene's name (its default script); the file name and
+/// the text.
+pub fn script(name: &str) -> Option<(&'static str, &'static str)> {
+    let stem = name
+        .strip_suffix(".script.toml")
+        .or_else(|| name.strip_suffix(".toml"))
+        .unwrap_or(name);
+    SCENES
+        .iter()
+        .find(|b| b.script_file.strip_suffix(".script.toml") == Some(stem) || b.name == stem)
+        .map(|b| (b.script_file, b.script))
+}
+
 /// Names of the built-in scenes, comma-separated (for error messages).
 pub fn names() -> String {
     SCENES.iter().map(|b| b.name).collect::<Vec<_>>().join(", ")
@@ -77,6 +91,17 @@ pub fn export(dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> 
 mod tests {
     use super::*;
     use crate::scene::load_scene;
+
+    #[test]
+    fn a_builtin_script_is_found_by_its_file_name_its_stem_or_its_scenes_name() {
+        let (file, text) = script("optical_tweezers.script.toml").unwrap();
+        assert_eq!(file, "optical_tweezers.script.toml");
+        assert!(text.contains("drag it fast"));
+        assert_eq!(script("optical_tweezers").unwrap().0, file);
+        assert_eq!(script("optical_tweezers_10khz").unwrap().0, file);
+        assert_eq!(script("wall.toml").unwrap().0, "wall.script.toml");
+        assert!(script("no_such_script").is_none());
+    }
 
     #[test]
     fn every_builtin_scene_loads_and_names_its_shipped_script() {
