@@ -505,11 +505,11 @@ def script_path(name, t):
     return ps[-1]
 
 
-def test_a_version_3_session_on_the_atoms_carries_bonds_that_the_device_side_renders(tmp_path):
-    """A Python device speaking protocol 3 against the simulator's nano world: welcomed with 3,
-    it gets the anchored tip as a bond in version-3 packets (decoded here from the simulator's
-    own bytes), each model exact at its answered reading, and its DeviceSide renders the bond's
-    k (a − p) while it holds and nothing of it past its breaking stretch."""
+def live_session(tmp_path, scene, protocol):
+    """The simulator running built-in ``scene`` in a thread, waiting for a device on a free
+    loopback port, and a Python client speaking ``protocol`` welcomed by it: returns the
+    thread, the dict the run fills, the client, its welcome, the device's specs and a
+    DeviceSide of the session's version."""
     import threading
 
     import nanohaptics as nh
@@ -518,17 +518,25 @@ def test_a_version_3_session_on_the_atoms_carries_bonds_that_the_device_side_ren
     result = {}
 
     def sim():
-        result.update(nh.run_scene(str(ROOT / "scenes" / "nanoworld.toml"),
-                                   device=f"udp:127.0.0.1:{port}",
-                                   out=str(tmp_path / "v3.mcap"), wait_s=20.0))
+        result.update(nh.run_scene(str(ROOT / "scenes" / scene), device=f"udp:127.0.0.1:{port}",
+                                   out=str(tmp_path / f"v{protocol}.mcap"), wait_s=20.0))
 
     t = threading.Thread(target=sim)
     t.start()
     specs = bridge.Specs("falcon", 8.0, 3000.0, 0.04, FALCON_BUTTONS)
-    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=3)
+    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=protocol)
     welcome = client.connect(20.0)
-    period = 1.0 / welcome["rate_hz"]
-    side = bridge.DeviceSide(welcome["version"], specs.max_force_n, period)
+    side = bridge.DeviceSide(welcome["version"], specs.max_force_n, 1.0 / welcome["rate_hz"])
+    return t, result, client, welcome, specs, side
+
+
+def test_a_version_3_session_on_the_atoms_carries_bonds_that_the_device_side_renders(tmp_path):
+    """A Python device speaking protocol 3 against the simulator's nano world: welcomed with 3,
+    it gets the anchored tip as a bond in version-3 packets (decoded here from the simulator's
+    own bytes), each model exact at its answered reading, and its DeviceSide renders the bond's
+    k (a − p) while it holds and nothing of it past its breaking stretch."""
+    t, result, client, welcome, specs, side = live_session(tmp_path, "nanoworld.toml", 3)
+    period = side.period_s
     # The first pull-off falls within 3.5 s (bond_link.rs).
     sent, answers = pace(client, side, nano_path, lambda t, _: t < 3.5, two_port=True)
     bonded = [(r, p0) for r, p0 in answers if r.local is not None and r.local.bond is not None]
@@ -567,25 +575,8 @@ def test_a_version_4_session_on_the_trap_carries_followers_that_the_device_side_
     welcomed with 4, it gets the held particle as a follower in version-4 packets (decoded
     here from the simulator's own bytes), each model exact at its answered reading with the
     follower's spring included, and a DeviceSide given an answer renders it there."""
-    import threading
-
-    import nanohaptics as nh
-
-    port = free_port()
-    result = {}
-
-    def sim():
-        result.update(nh.run_scene(str(ROOT / "scenes" / "optical_tweezers.toml"),
-                                   device=f"udp:127.0.0.1:{port}",
-                                   out=str(tmp_path / "v4.mcap"), wait_s=20.0))
-
-    t = threading.Thread(target=sim)
-    t.start()
-    specs = bridge.Specs("falcon", 8.0, 3000.0, 0.04, FALCON_BUTTONS)
-    client = bridge.BridgeClient(("127.0.0.1", port), specs, protocol=4)
-    welcome = client.connect(20.0)
-    period = 1.0 / welcome["rate_hz"]
-    side = bridge.DeviceSide(welcome["version"], specs.max_force_n, period)
+    t, result, client, welcome, specs, side = live_session(tmp_path, "optical_tweezers.toml", 4)
+    period = side.period_s
     # The script grabs at 0.3 s (the grip, button 0), steers and drags fast at 4.5 s.
     sent, answers = pace(client, side, lambda t: script_path("optical_tweezers.script.toml", t),
                          lambda t, _: t < 4.7, two_port=True,

@@ -18,9 +18,7 @@
 use haptic_devices::bridge::fake::FakeReport;
 use haptic_devices::local::Protocol;
 use haptic_devices::{Grip, Mechanics, PRESETS};
-use haptic_loop::replay::verify;
 use haptic_loop::session::SessionReport;
-use recording::read_recording_file;
 use std::path::{Path, PathBuf};
 
 mod fake_link;
@@ -108,14 +106,7 @@ fn the_10_khz_trap_behind_10_ms_of_real_link_feels_the_worlds_force_on_every_pre
                 lines.last().unwrap(),
                 dev.jump_times_s
             );
-            assert!(dev.energy_to_hand_j <= 0.01, "{}", lines.last().unwrap());
-            assert!(dev.forces_within_limits);
-            let v = verify(&read_recording_file(&rec, false).unwrap()).unwrap();
-            assert!(
-                v.ok(),
-                "{} {held}: the recording does not replay",
-                mech.name
-            );
+            fake_link::assert_sound_and_replayed(&dev, &rec, lines.last().unwrap());
         }
     }
     // The contrast on the real link: protocol 3 drags the hand (the round trip's length varies

@@ -76,3 +76,14 @@ pub fn bridged(
     let dev = run_fake(&f, None).unwrap();
     (h.join().unwrap().unwrap(), dev)
 }
+
+/// What every real-link run must show whatever the scene: at most 0.01 J into the hand
+/// (`line` says which run), every force within the device's limit, and a recording that
+/// replays bit for bit.
+pub fn assert_sound_and_replayed(dev: &FakeReport, rec: &Path, line: &str) {
+    assert!(dev.energy_to_hand_j <= 0.01, "{line}");
+    assert!(dev.forces_within_limits, "{line}");
+    let v =
+        haptic_loop::replay::verify(&recording::read_recording_file(rec, false).unwrap()).unwrap();
+    assert!(v.ok(), "{line}: the recording does not replay");
+}
