@@ -487,17 +487,18 @@ def test_an_adapter_renders_the_local_model_at_its_servo_rate_until_hold_s(mock_
 
 def nano_path(t):
     """The built-in nano script's stylus at ``t`` s (m): its waypoints, linearly between them."""
-    return script_path("nanoworld.script.toml", t)
+    return script_path("nanoworld.script.toml", t, least=11)
 
 
-def script_path(name, t):
-    """A built-in script's stylus at ``t`` s (m): its waypoints, linearly between them."""
+def script_path(name, t, least=6):
+    """A built-in script's stylus at ``t`` s (m): its waypoints (at least ``least``),
+    linearly between them."""
     import tomllib
 
     points = tomllib.loads((ROOT / "scenes" / name).read_text(encoding="utf-8"))["waypoint"]
     ts = [float(w["t_s"]) for w in points]
     ps = [tuple(float(v) * 1e-3 for v in w["position_mm"]) for w in points]
-    assert len(ts) == len(ps) > 5
+    assert len(ts) == len(ps) >= least
     for (t0, p0), (t1, p1) in zip(zip(ts, ps), zip(ts[1:], ps[1:])):
         if t <= t1:
             s = max(0.0, (t - t0) / (t1 - t0))
