@@ -152,6 +152,24 @@ MUTATIONS = (
             ),
         ),
     ),
+    Mutation(
+        name="edge-planes-sent",
+        what="the brick world sends a neighbour's edge seen across a gap as a plane for the carried body, at the angle it is seen from",
+        path="crates/brickworld/src/hand/carry.rs",
+        old="if c.dist <= 0.0 || faces(n, &pose) || faces(n, co.position()) {",
+        new="if c.dist.is_finite() || faces(n, &pose) || faces(n, co.position()) {",
+        count=1,
+        tests=(
+            ("-p", "brickworld", "--test", "local_planes"),
+            (
+                "-p",
+                "haptic-loop",
+                "--test",
+                "link",
+                "every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_10_ms",
+            ),
+        ),
+    ),
 )
 
 

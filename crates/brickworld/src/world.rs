@@ -292,10 +292,16 @@ impl World {
     pub(crate) fn carried_contacts(
         &self,
         grip_m: [f64; 3],
+        velocity_m_per_s: [f64; 3],
         margin_m: f64,
     ) -> Vec<haptic_types::local::Plane> {
-        self.hand
-            .carried_contacts(&self.params, &self.bricks, grip_m, margin_m)
+        self.hand.carried_contacts(
+            &self.params,
+            &self.bricks,
+            grip_m,
+            velocity_m_per_s,
+            margin_m,
+        )
     }
 
     /// Number of bricks the physics engine currently simulates (awake), for cost accounting.
@@ -398,6 +404,7 @@ impl World {
                 let speed = Vector::from_array(b.velocity_m_per_s).length();
                 self.carried_contacts(
                     b.position_m,
+                    b.velocity_m_per_s,
                     crate::local::NEAR_SURFACE_M.max(speed * crate::local::LOOKAHEAD_S),
                 )
             }

@@ -248,7 +248,7 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
         if case.scene == "nanoworld.toml" {
             (nano_lo, nano_hi) = (nano_lo.min(peak), nano_hi.max(peak));
         }
-        if peak < 0.8 || (ms <= 2.0 && peak > 1.2) {
+        if !(0.8..=1.2).contains(&peak) {
             untransparent.push(format!("{label}: peak {peak:.3} of the ideal link's"));
         }
         if let (Some(k), Some(k0)) = (wall_n_per_m, ideal_wall) {
@@ -279,13 +279,13 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
         untransparent.is_empty(),
         "not transparent: {untransparent:#?}"
     );
-    // docs/devices.md: "at 20 and 50 ms, 152 of 160 are [stable], and the most the motors put
-    // into a hand there is 0.07 J". The link is simulated and seeded: the count is exact. (147
-    // with protocol 3: protocol 4's follower steadied all four unstable 10 kHz trap runs; of
+    // docs/devices.md: "at 20 and 50 ms, 156 of 160 are [stable], and the most the motors put
+    // into a hand there is 0.07 J". The link is simulated and seeded: the count is exact. (152
+    // before the brick's edge planes went, 147 with protocol 3: protocol 4's follower steadied all four unstable 10 kHz trap runs; of
     // the 1 kHz trap's, a loose Falcon and a loose Delta.3 at 50 ms turned stable and a firm
     // Delta.3 at 20 ms unstable, on one jump of 1.006 N against the 1 N rule. 148 before the
     // observer counted late samples.)
-    assert_eq!((goal_runs - goal_unstable, goal_runs), (152, 160));
+    assert_eq!((goal_runs - goal_unstable, goal_runs), (156, 160));
     assert!(
         (0.065..0.075).contains(&worst_goal_energy),
         "{worst_goal_energy} J"
@@ -299,36 +299,35 @@ fn every_scene_on_every_device_is_stable_and_transparent_behind_a_link_of_up_to_
         nano_lo >= 0.985 && nano_hi <= 1.005,
         "the atoms' peak {nano_lo:.3}–{nano_hi:.3}"
     );
-    // Measured, not yet met (issue 40's target is 20 % at every latency to 10 ms): 3 of the
-    // 320 runs at 0–10 ms exceed +20 % (17 with protocol 3, 31 with protocol 2), all at 10 ms:
-    // the brick on a Delta.3 (loose, 10 ms, jitter and loss: 2.67 N against 1.81 N): the
-    // carried brick lands on the house while the device's body, which meets only the planes
-    // the answer named, is a round trip behind the world's. The 10 kHz trap's 14 went with
-    // protocol 4 (below). Tried and not kept for the trap, each measured on this grid: the
-    // envelope's edge as a plane moving at the particle's velocity (13 runs unstable: chatter
-    // as the hand left the edge); the residual's spring drifting at the particle's velocity
-    // (6 unstable to 10 ms); the world's stiffness reported only beyond the envelope (21 over
-    // +20 %, 16 unstable); a follower whose envelope did not move with the particle's
-    // velocity (11 of 128 trap runs unstable: its replay fell a round trip's worth of drift
-    // behind the world's, 0.85–1.9 mm on a firm Falcon, felt as a jump at each answer).
-    assert_eq!(over_peak.len(), 3, "{over_peak:#?}");
+    // Issue 40's target, 20 % of the ideal link's peak both ways at every latency to 10 ms, is
+    // held above in every run; the range measured (docs/devices.md) is 0.822–1.105. Before the
+    // brick world stopped sending a neighbour's edge as a plane (`Hand::carried_contacts`), 3
+    // runs exceeded +20 %, all the brick on a Delta.3 at 10 ms (loose, jitter and loss: 2.67 N
+    // against 1.81 N, now 1.49 N): the carried brick, lowered past a neighbour's edge into
+    // the house, saw that edge across the gap first below it, then at every angle to the
+    // side; each angle arrived as a plane a round trip late and stopped the device's body
+    // where the world's brick went on down. 17 exceeded it with protocol 3, 31 with protocol
+    // 2; the 10 kHz trap's 14 went with protocol 4 (below). Tried and not kept for the trap,
+    // each measured on this grid: the envelope's edge as a plane moving at the particle's
+    // velocity (13 runs unstable: chatter as the hand left the edge); the residual's spring
+    // drifting at the particle's velocity (6 unstable to 10 ms); the world's stiffness
+    // reported only beyond the envelope (21 over +20 %, 16 unstable); a follower whose
+    // envelope did not move with the particle's velocity (11 of 128 trap runs unstable: its
+    // replay fell a round trip's worth of drift behind the world's, 0.85–1.9 mm on a firm
+    // Falcon, felt as a jump at each answer).
+    assert!(over_peak.is_empty(), "{over_peak:#?}");
     assert!(
-        (1.47..1.49).contains(&peak_hi),
-        "worst peak {peak_hi:.3} of the ideal link's"
-    );
-    assert!(
-        over_peak
-            .iter()
-            .all(|l| l.starts_with("brickworld.toml delta3 ") && l.contains(" 10 ms")),
-        "{over_peak:#?}"
+        (0.815..0.83).contains(&peak_lo) && (1.10..1.11).contains(&peak_hi),
+        "peak {peak_lo:.3}–{peak_hi:.3} of the ideal link's"
     );
     // The hand against the world itself (docs/devices.md): in every scene the peak felt force
-    // is 0.879–1.143 of the largest force the loop answered in the same run, so what the hand
+    // is 0.952–1.143 of the largest force the loop answered in the same run (0.879 before the
+    // brick's edge planes went), so what the hand
     // feels is the world's. With protocol 3 the 10 kHz trap was not: 37 of its 64 runs
     // exceeded 1.2 ×, up to 31.3 × (the drag of `K (p − p0)` inside the envelope, where the
     // world answers zero; see the test below).
     assert!(
-        own_lo >= 0.87 && own_hi <= 1.15,
+        (0.945..0.96).contains(&own_lo) && (1.135..1.15).contains(&own_hi),
         "felt / world peak {own_lo:.3}–{own_hi:.3}"
     );
     assert!(over_own.is_empty(), "{over_own:#?}");

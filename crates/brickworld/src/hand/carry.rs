@@ -3,7 +3,9 @@
 //! the grip point), the switch between the two, and what the device's local model needs to
 //! know of a coupled brick (its body and the surfaces it touches).
 
+use rapier3d_f64::math::Pose;
 use rapier3d_f64::math::Vector;
+use rapier3d_f64::parry::query::{self, ShapeCastOptions};
 use rapier3d_f64::parry::shape::Cuboid;
 use rapier3d_f64::prelude::{QueryFilter, RigidBodyType};
 use world_form::Limits;
@@ -52,11 +54,20 @@ impl Hand {
     /// normal on that body) and how far it may go the other way (the gap); the nearest
     /// surface of each collider, deduplicated by normal, at most [`crate::local::MAX_PLANES`]
     /// (nearest first).
+    ///
+    /// A plane stands for a face: a face of either brick that the other's nearest feature
+    /// faces, or a contact already made. A neighbour's edge or corner seen across a gap is
+    /// not one: a brick lowered past a neighbour's edge with room to spare sees that edge
+    /// first straight below it, then at every angle to the side, and a plane at any of those
+    /// angles stops the device's body where the world's brick goes on. Such a collider is
+    /// announced only where the brick, moving on at `velocity_m_per_s`, strikes it within
+    /// the margin, as the plane of the surface it strikes there.
     pub(crate) fn carried_contacts(
         &self,
         params: &Params,
         bricks: &BrickSet,
         grip_m: [f64; 3],
+        velocity_m_per_s: [f64; 3],
         margin_m: f64,
     ) -> Vec<haptic_types::local::Plane> {
         let mut out: Vec<haptic_types::local::Plane> = Vec::new();
@@ -72,22 +83,39 @@ impl Hand {
         let brick = Cuboid::new(e);
         let grown = Cuboid::new(e + Vector::splat(margin_m));
         let x = Vector::from_array(grip_m);
+        let v = Vector::from_array(velocity_m_per_s);
+        let heading = (v.length() > 0.0 && v.is_finite()).then(|| v.normalize());
         let qp = bricks
             .phys
             .query_pipeline_with_filter(QueryFilter::default().exclude_collider(me));
         let mut found: Vec<(f64, Vector)> = qp
             .intersect_shape(pose, &grown)
             .filter_map(|(_, co)| {
-                let c = rapier3d_f64::parry::query::contact(
+                let c =
+                    query::contact(&pose, &brick, co.position(), co.shape(), margin_m).ok()??;
+                let n = c.normal2;
+                if !(n.is_finite() && c.dist.is_finite()) {
+                    return None;
+                }
+                if c.dist <= 0.0 || faces(n, &pose) || faces(n, co.position()) {
+                    return Some((c.dist, n));
+                }
+                let dir = heading?;
+                let options = ShapeCastOptions::with_max_time_of_impact(margin_m);
+                let hit = query::cast_shapes(
                     &pose,
+                    dir,
                     &brick,
                     co.position(),
+                    Vector::ZERO,
                     co.shape(),
-                    margin_m,
+                    options,
                 )
                 .ok()??;
-                let n = c.normal2;
-                (n.is_finite() && c.dist.is_finite()).then_some((c.dist, n))
+                let n = hit.normal2;
+                // The gap along the surface's normal to the grip point where it strikes.
+                let gap = -hit.time_of_impact * n.dot(dir);
+                (n.is_finite() && gap.is_finite()).then_some((gap, n))
             })
             .collect();
         found.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -245,4 +273,12 @@ impl Hand {
         self.damper = Vector::ZERO;
         true
     }
+}
+
+/// Whether `n` is (to rounding) the normal of a face of the cuboid at `pose`: the contact's
+/// normal of a face, not of an edge or a corner.
+fn faces(n: Vector, pose: &Pose) -> bool {
+    [Vector::X, Vector::Y, Vector::Z]
+        .into_iter()
+        .any(|a| (pose.rotation * a).dot(n).abs() > 1.0 - 1e-9)
 }
