@@ -12,6 +12,8 @@
 //!   (`docs/bench/<name>.md`) and its figures (`docs/figures/`) go, and the machine facts
 //!   stated at the top of every section (CPU model, core count, load average at the start and
 //!   at the end of the run);
+//! * [`verdict`]: the rules that turn a measured figure into "met" or "not met" against its
+//!   target (inclusive or strict, NaN never met), tested on both sides of a target;
 //! * [`chart`]: the workspace's one chart engine, the `chart` crate re-exported (line, dot and
 //!   bar charts on linear or log axes, reference lines, legends, rows and grids of charts),
 //!   drawn with tiny-skia and the embedded font: no system fonts, the same PNG bytes
@@ -34,9 +36,11 @@ pub mod report;
 pub mod stats;
 pub mod table;
 pub mod timer;
+pub mod verdict;
 
 pub use chart;
 pub use report::Report;
 pub use stats::{Summary, percentile};
 pub use table::{Align, Table};
 pub use timer::{Span, Timings, best_block_cpu_s, span};
+pub use verdict::Verdict;

@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 
 use bench_harness::chart::{Chart, Legend, PALETTE, Series, Style, write_grid_png};
-use bench_harness::{Align, Report, Summary, Table, Timings};
+use bench_harness::{Align, Report, Summary, Table, Timings, Verdict};
 use brickworld::{AccelEstimator, BrickId, BrickPlacement, Grip, MotionEstimator, Params, World};
 use world_form::Limits;
 
@@ -540,14 +540,14 @@ fn main() {
         md,
         "- Target tick p99 ≤ 500 µs with 100 bricks (50 stacked), CPU time: **{}** (worst CPU p99 {worst_p99:.1} µs over the three 100-brick scenes, \
          including the case where sleeping is disabled and all 100 bricks are simulated). Wall-clock p99 on this loaded machine is not a property of the code.",
-        if worst_p99 <= 500.0 { "met" } else { "not met" }
+        Verdict::at_most(worst_p99, 500.0).word()
     )
     .unwrap();
     writeln!(
         md,
         "- Resting bricks cost close to nothing: **{}** — 100 sleeping bricks add {resting_cost:.2} µs per tick to an empty world, \
          {:.2} % of what the same 100 bricks cost awake ({awake_cost:.1} µs). Criterion: below 5 %.\n",
-        if resting_cost < 0.05 * awake_cost { "met" } else { "not met" },
+        Verdict::below(resting_cost, 0.05 * awake_cost).word(),
         100.0 * resting_cost / awake_cost
     )
     .unwrap();
@@ -559,7 +559,7 @@ fn main() {
          (p50 {:.1} µs, p99 {:.1} µs). The knocked-over wall, with up to 1400 real contacts, costs p50 {:.1} µs, p99 {:.1} µs. \
          Before the contact hook skipped idle speculative contacts (docs/brickworld.md), the two layers cost 4.9 times the instructions \
          per tick (28.7 million against 5.8 million, counted with valgrind), the first 0.6 s of the wall 1.25 times.\n",
-        if two.cpu.p99() <= 500.0 { "met" } else { "not met" },
+        Verdict::at_most(two.cpu.p99(), 500.0).word(),
         two.cpu.median(),
         two.cpu.p99(),
         wall.cpu.median(),
@@ -630,7 +630,7 @@ fn main() {
     md.table(&t);
     md.para(&format!(
         "Target within 3 %: **{}** (worst {:.2} %). Without the crate's impact hook rapier 0.36 gives 0.10 for e = 0.5 (see docs/brickworld.md).",
-        if worst_b < 0.03 { "met" } else { "not met" },
+        Verdict::below(worst_b, 0.03).word(),
         worst_b * 100.0
     ));
 
@@ -672,7 +672,7 @@ fn main() {
         "Target within 1°: **{}** (worst {worst_s:.2}°; the 5 mm-in-1 s criterion itself accounts for about 0.06°). \
          Sliding distance off by at most {:.2} %. rapier's per-point `Coulomb` friction model, by contrast, starts sliding \
          up to 1° early and, 2° above atan μ, slides 30–53 % too far; the crate uses the default `Simplified` model.",
-        if worst_s <= 1.0 { "met" } else { "not met" },
+        Verdict::at_most(worst_s, 1.0).word(),
         worst_a * 100.0
     ));
 

@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bench_harness::report::out_arg;
-use bench_harness::{Report, Summary, Table, span};
+use bench_harness::{Report, Summary, Table, Verdict, span};
 
 use haptic_loop::session::SessionArrays;
 use haptic_loop::sound::session_sound;
@@ -133,11 +133,7 @@ fn main() {
             .map(|t| format!("{t:.2} s"))
             .collect::<Vec<_>>()
             .join(", "),
-        if median(times.clone()) < 10.0 {
-            "met"
-        } else {
-            "not met"
-        },
+        Verdict::below(median(times.clone()), 10.0).word(),
     );
     let throw =
         s.brick_throw.distance_m / (s.brick_throw.release_speed_m_per_s * s.brick_throw.flight_s);
@@ -211,15 +207,18 @@ fn main() {
     md.table(&acc);
     let _ = writeln!(
         md,
-        "Target: {}.\n",
-        if s.sweep.kept_below_m_per_s2 < s.sweep.predicted_hand_m_per_s2
-            && s.sweep.thrown_from_m_per_s2 >= s.sweep.predicted_hand_m_per_s2
-            && (s.hysteresis.ratio - 10.0).abs() < 1e-9
-        {
-            "every stated figure within its reference's error as listed (pull-off 10× exact, threshold bracketed) — **met**"
-        } else {
-            "**missed** (see the table)"
-        },
+        "Target: the pull-off 10× the snap (to 1e-9) and the atom's throw threshold bracketed \
+         by the hand's prediction — {}; the other rows are measured against their references \
+         as listed.\n",
+        Verdict::all([
+            Verdict::below(s.sweep.kept_below_m_per_s2, s.sweep.predicted_hand_m_per_s2),
+            Verdict::at_least(
+                s.sweep.thrown_from_m_per_s2,
+                s.sweep.predicted_hand_m_per_s2
+            ),
+            Verdict::below((s.hysteresis.ratio - 10.0).abs(), 1e-9),
+        ])
+        .bold(),
     );
     let _ = writeln!(
         md,
@@ -236,7 +235,7 @@ fn main() {
          instructions (1 830 and 1 020 instructions per tick of about 48 000).",
         onset.1,
         onset.0 * 1e3,
-        if onset.0 <= 1e-3 { "met" } else { "missed" }
+        Verdict::at_most(onset.0, 1e-3).word()
     );
     let (out, _) = md.finish().expect("write report");
     println!("wrote {}", out.display());

@@ -7,7 +7,7 @@ use std::error::Error;
 use std::fmt::Write as _;
 
 use bench_harness::chart::{Chart, Legend, Level, PALETTE, Scale, Series, Style};
-use bench_harness::{Align, Report, Summary, Table, Timings, span};
+use bench_harness::{Align, Report, Summary, Table, Timings, Verdict, span};
 use nalgebra::Vector3;
 use nanoworld::{
     CurveSpec, ForceCurve, GAME_FALCON_LIMITS, Interaction, PairKind, Params, TipInput, World,
@@ -196,11 +196,7 @@ fn main() -> Res<()> {
     writeln!(
         md,
         "- Target tick p99 ≤ 250 µs at 10⁵ substrate atoms: **{}** ({:.2} µs at {} atoms).",
-        if r5.tick.p99() <= 250.0 {
-            "met"
-        } else {
-            "not met"
-        },
+        Verdict::at_most(r5.tick.p99(), 250.0).word(),
         r5.tick.p99(),
         r5.atoms
     )?;

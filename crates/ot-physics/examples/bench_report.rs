@@ -13,7 +13,8 @@
 mod common;
 
 use bench_harness::chart::{Chart, Level, PALETTE, Scale, Series, Style, write_grid_png};
-use bench_harness::{Report, Table, span};
+use bench_harness::verdict::speedup_word;
+use bench_harness::{Report, Table, Verdict, span};
 use common::{Problem, Row, cheapest_within, errors, measure, our_settings, peer, time_at_error};
 use nalgebra::Vector2;
 use ot_physics::analysis::{
@@ -103,7 +104,9 @@ fn main() -> Result<(), BoxError> {
             default_row.ns_per_traj,
             default_row.evals_per_traj
         ),
-        yes(default_row.max_err_nm <= TARGET_NM).to_string(),
+        Verdict::at_most(default_row.max_err_nm, TARGET_NM)
+            .yes_no()
+            .to_string(),
     ])?;
     let peer_best = cheapest_within(&peer_rows, "ode_solvers Dop853", TARGET_NM);
     // "equal error": each family's time interpolated at exactly 0.01 nm,
@@ -134,13 +137,7 @@ fn main() -> Result<(), BoxError> {
                     q.ns_per_traj,
                     q.max_err_nm
                 ),
-                if tp / to >= 2.0 {
-                    "yes".to_string()
-                } else if tp / batch >= 2.0 {
-                    "batch: yes; single call: **no**".to_string()
-                } else {
-                    "**no**".to_string()
-                },
+                speedup_word(tp / to, tp / batch, 2.0).to_string(),
             ])?;
         }
         _ => {
@@ -164,7 +161,7 @@ fn main() -> Result<(), BoxError> {
                         "scipy {} {:.0} ns ({:.1e} nm, {} starts); ratio at exactly 0.01 nm **{:.0}×**",
                         q.setting, q.ns_per_traj, q.max_err_nm, s.n, ratio
                     ),
-                    yes(ratio >= 300.0).to_string(),
+                    Verdict::at_least(ratio, 300.0).yes_no().to_string(),
                 ])?;
             }
             None => {
@@ -197,7 +194,12 @@ fn main() -> Result<(), BoxError> {
                 b.seconds,
                 b.max_err_nm
             ),
-            yes(b.seconds < 1.0 && b.max_err_nm <= TARGET_NM).to_string(),
+            Verdict::all([
+                Verdict::below(b.seconds, 1.0),
+                Verdict::at_most(b.max_err_nm, TARGET_NM),
+            ])
+            .yes_no()
+            .to_string(),
         ])?;
     }
     md.table(&targets);
@@ -240,10 +242,6 @@ fn main() -> Result<(), BoxError> {
     writeln!(md, "{}", thermal)?;
     md.finish()?;
     Ok(())
-}
-
-fn yes(b: bool) -> &'static str {
-    if b { "yes" } else { "**no**" }
 }
 
 /// Our cheapest method within `target` nm, as (method, row).

@@ -28,6 +28,7 @@
 #[path = "../tests/common/cdp.rs"]
 mod cdp;
 
+use bench_harness::Verdict;
 use cdp::Browser;
 use haptic_loop::session::SceneSource;
 use play::{LatencyMs, PlayConfig, Running, start};
@@ -580,12 +581,12 @@ fn main() {
             .find(|(l, o)| o.scene == scene && l == label)
             .map(|(_, o)| o)
     };
-    let verdict = |ok: bool| if ok { "**met**" } else { "**not met**" };
+    let verdict = |v: Verdict| v.bold();
     if let Some(o) = find("brickworld", "1") {
         let p99 = o.input.map_or(f64::INFINITY, |l| l.p99);
         line(format!(
             "- Browser input → applied force p99 ≤ 20 ms: {} ({p99:.1} ms with one page; {} without a browser).",
-            verdict(p99 <= 20.0),
+            verdict(Verdict::at_most(p99, 20.0)),
             find("brickworld", "0")
                 .and_then(|o| o.input)
                 .map_or("–".into(), |l| format!("{:.1} ms", l.p99))
@@ -594,7 +595,7 @@ fn main() {
         let s50 = o.sound.map_or(f64::INFINITY, |l| l.p50);
         line(format!(
             "- Sound within 50 ms of its tick, the browser's output latency included: {} (p50 {s50:.1} ms, p99 {s99:.1} ms over {} sounds with one page; the output latency is the last column above).",
-            verdict(s99 <= 50.0),
+            verdict(Verdict::at_most(s99, 50.0)),
             o.sound.map_or(0, |l| l.n)
         ));
     }
@@ -606,15 +607,14 @@ fn main() {
     if !fps.is_empty() {
         let min = fps.iter().copied().fold(f64::INFINITY, f64::min);
         line(format!(
-            "- 60 frames/s drawn for the brick and nano worlds: {} (lowest {min:.1} frames/s with one page; {:.1}, rounding 59.5 up).",
-            verdict(min >= 59.5),
-            min
+            "- 60 frames/s drawn for the brick and nano worlds: {} (lowest {min:.1} frames/s with one page; 59.5 or more counts as 60).",
+            verdict(Verdict::at_least(min, 59.5)),
         ));
     }
     if let Some(o) = find("brickworld", "3") {
         line(format!(
             "- 0 missed 1 kHz deadlines with three browsers watching one session: {} ({} of {} ticks; {} with no browser on the same machine).",
-            verdict(o.missed_n == 0),
+            verdict(Verdict::from_bool(o.missed_n == 0)),
             o.missed,
             o.ticks,
             find("brickworld", "0").map_or("–".into(), |b| b.missed.to_string())

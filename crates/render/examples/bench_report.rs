@@ -10,7 +10,7 @@
 mod scenes;
 
 use bench_harness::chart::{Bar, BarChart, PALETTE, Scale};
-use bench_harness::{Align, Report, Span, Table, span};
+use bench_harness::{Align, Report, Span, Table, Verdict, span};
 use haptic_types::Rgba;
 use render::{Camera, Frame, GifWriter, Image, Palette, Style, View};
 use scenes::*;
@@ -385,10 +385,9 @@ fn report(
             format!("{judged:.1} s"),
             format!(
                 "{} ({judged:.1} s)",
-                if judged <= TARGET_S {
-                    "met"
-                } else {
-                    "**not met**"
+                match Verdict::at_most(judged, TARGET_S) {
+                    Verdict::Met => "met",
+                    Verdict::NotMet => "**not met**",
                 }
             ),
             format!("{:.2} MB", r.gif_bytes as f64 / 1e6),
