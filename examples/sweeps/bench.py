@@ -116,6 +116,18 @@ def median(xs):
     return sorted(xs)[len(xs) // 2]
 
 
+GOAL_SPEEDUP = 1.8  # the goal: Dask on 2 workers ≥ 1.8× serial ...
+GOAL_SERIAL_S = 30.0  # ... for every study of ≥ 30 s serially
+
+
+def dask_goal(serial_s: float, dask_s: float) -> bool | None:
+    """The goal for one study run: Dask on 2 workers at least 1.8× as fast as serial — True
+    or False; None when the study took under 30 s serially (the goal is for studies of ≥ 30 s)."""
+    if serial_s < GOAL_SERIAL_S:
+        return None
+    return serial_s >= GOAL_SPEEDUP * dask_s
+
+
 # ------------------------------------------------------------------------------ per-task costs
 
 
@@ -283,7 +295,10 @@ def write(out: Path, size: str, repeats: int, t_start: str, costs, pickles, rows
         s2 = median([r[6]["serial"][0] / r[6]["2 threads"][0] for r in mine])
         sd = median([r[6]["serial"][0] / r[6]["Dask"][0] for r in mine])
         lines.append(f"| {name} | {w1:.1f} | {s2:.2f}× | {sd:.2f}× |")
-    lines.append("")
+    judged = [v for v in (dask_goal(r[6]["serial"][0], r[6]["Dask"][0]) for r in rows) if v is not None]
+    lines += ["", f"The goal — Dask on 2 workers ≥ {GOAL_SPEEDUP:g}× for every study of ≥ {GOAL_SERIAL_S:g} s "
+              f"serially: met in {sum(judged)} of {len(judged)} such study runs ({len(rows) - len(judged)} "
+              f"shorter), **{'met' if judged and all(judged) else 'not met'}**.", ""]
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text("\n".join(lines) + (TEMPLATE_TAIL if size == "large" else ""), encoding="utf-8")
 
