@@ -17,36 +17,8 @@ use recording::read_recording_file;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// A 60 s workload: press into the wall and slide, every 1.5 s, the centre button held while
-/// pressing (so contact, clamp and button events keep happening).
-fn workload_script(seconds: f64) -> String {
-    let mut s = format!("[script]\nname = \"bench: repeated presses\"\nduration_s = {seconds}\n");
-    let mut t = 0.0;
-    let mut k = 0;
-    while t <= seconds {
-        let (x, z) = match k % 3 {
-            0 => (0.0, 8.0),
-            1 => (-10.0, -12.0),
-            _ => (10.0, -30.0),
-        };
-        let _ = write!(
-            s,
-            "[[waypoint]]\nt_s = {t}\nposition_mm = [{x}, 0.0, {z}]\n"
-        );
-        if k % 3 == 1 {
-            let _ = write!(s, "[[button]]\nt_s = {t}\nname = \"centre\"\ndown = true\n");
-        }
-        if k % 3 == 0 && k > 0 {
-            let _ = write!(
-                s,
-                "[[button]]\nt_s = {t}\nname = \"centre\"\ndown = false\n"
-            );
-        }
-        t += 0.5;
-        k += 1;
-    }
-    s
-}
+mod bench_figures;
+use bench_figures::workload_script;
 
 fn us(ns: u64) -> f64 {
     ns as f64 / 1e3
@@ -125,46 +97,11 @@ fn main() {
     let replay_s = replay.wall_s;
     let rt_v = verify(&read_recording_file(&rt_rec, false).unwrap()).unwrap();
 
-    // 4. Accuracy of the rendering: a rigid stylus pushed slowly 20 mm into the wall.
-    let ramp = "[script]\nname = \"ramp\"\n[[waypoint]]\nt_s = 0.0\nposition_mm = [0.0, 0.0, -4.0]\n\
-                [[waypoint]]\nt_s = 4.0\nposition_mm = [0.0, 0.0, -25.0]\n";
-    let mut o = SessionOptions::new(scene.clone());
-    o.script = Some(ramp.to_string());
-    o.operator = OperatorChoice::Rigid;
-    let ramp_run = run_session(&o, &mut |_, _| {}).unwrap();
+    // 4. Accuracy of the rendering: a rigid stylus pushed slowly 21 mm into the wall.
+    let ramp_run = bench_figures::ramp_session(&scene);
     let a = &ramp_run.arrays;
     let pen = a.state_column("penetration_m").unwrap();
-    let engaged: Vec<usize> = (0..a.tick.len())
-        .filter(|&i| a.engagement[i] == 1.0 && a.status[i] == 0 && pen[i] > 1e-4)
-        .collect();
-    // Expected: k_cap·d − b·v_n with the capped 3000 N/m and the scene's 1 N·s/m damping.
-    let stiff_err = engaged
-        .iter()
-        .map(|&i| {
-            let v_n = (a.cursor_m[i][2] - a.cursor_m[i - 1][2]) * 1000.0;
-            let expected = 3000.0 * pen[i] - 1.0 * v_n;
-            (a.device_force_n[i][2] - expected).abs() / expected
-        })
-        .fold(0.0, f64::max);
-    let clamp_err = a
-        .device_force_n
-        .iter()
-        .zip(&a.status)
-        .filter(|(_, s)| **s & 1 != 0)
-        .map(|(f, _)| ((f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt() - 8.0).abs())
-        .fold(0.0, f64::max);
-    let clamp_dir = a
-        .device_force_n
-        .iter()
-        .zip(&a.world_force_n)
-        .filter(|(f, _)| f[2] > 0.0)
-        .map(|(f, g)| {
-            let nf = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-            let ng = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-            let c = (f[0] * g[0] + f[1] * g[1] + f[2] * g[2]) / (nf * ng);
-            c.clamp(-1.0, 1.0).acos()
-        })
-        .fold(0.0, f64::max);
+    let (stiff_err, clamp_err, clamp_dir) = bench_figures::rendering_errors(a);
 
     // Figures.
     plot_ticks(
