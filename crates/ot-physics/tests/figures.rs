@@ -6,7 +6,6 @@
 //! paper's one-step figures, the `flow_batch` check, and the thermal-mode table (same seed).
 #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
-#[allow(dead_code)]
 #[path = "../examples/common/mod.rs"]
 mod common;
 
