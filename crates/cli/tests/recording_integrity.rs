@@ -462,3 +462,43 @@ fn a_summary_record_removed_fails_the_summary_crc_first_then_the_footer_offsets(
         )
     );
 }
+
+/// docs/recording-format.md's two example messages, on the golden wall recording (4000 ticks;
+/// chunks: the description, then ticks 0–999, …, 3000–3999): a chunk's CRC field changed, and
+/// the file cut inside its last chunk.
+#[test]
+fn the_documented_corrupt_and_truncated_messages() {
+    let b = std::fs::read(root().join("recordings/wall.mcap")).unwrap();
+    let chunks = of(&b, 0x06);
+    assert_eq!(chunks.len(), 5);
+    let (at, _) = chunks[2];
+    assert_eq!(at, 111_404);
+    let size = u64::from_le_bytes(b[at + 25..at + 33].try_into().unwrap());
+    assert_eq!(size, 459_217);
+    let crc = u32::from_le_bytes(b[at + 33..at + 37].try_into().unwrap());
+    let mut m = b.clone();
+    m[at + 33..at + 37].copy_from_slice(&(crc ^ 1).to_le_bytes());
+    assert_eq!(
+        err(&m),
+        format!(
+            "corrupt recording: chunk at byte 111404: the CRC-32 of its 459217 decompressed \
+             bytes is 0x{crc:08x}, the chunk says 0x{:08x} (the chunk was changed or damaged)",
+            crc ^ 1
+        )
+    );
+    // cut 1000 bytes into the last chunk (ticks 3000–3999)
+    let (last, _) = chunks[4];
+    let e = err(&b[..last + 1000]);
+    assert!(
+        e.starts_with("truncated recording: ")
+            && e.ends_with("; 3000 complete ticks are readable (salvage them with --salvage)"),
+        "{e}"
+    );
+    let part = read_recording(&b[..last + 1000], true).unwrap();
+    let ticks = part
+        .messages
+        .iter()
+        .filter(|m| matches!(m.channel, recording::Channel::Timing))
+        .count();
+    assert_eq!(ticks, 3000);
+}

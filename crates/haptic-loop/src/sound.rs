@@ -245,8 +245,30 @@ mod tests {
                 ..
             }
         ));
-        assert!(matches!(s[3].sound, Sound::Snap { .. }));
-        assert!(matches!(s[4].sound, Sound::PullOff { .. }));
+        // docs/render.md: "x_ref = 1 N·s for impacts and 0.5 nN for nano clicks"
+        assert_eq!(IMPULSE_REF_N_S, 1.0);
+        assert_eq!(CONTACT_FORCE_REF_N, 0.5e-9);
+        // a 0.3 nN snap and a 3 nN pull-off: 0.8 · (1 − exp(−x / 0.5 nN))
+        assert_eq!(
+            s[3].sound,
+            Sound::Snap {
+                amplitude: audio::amplitude(3e-10, 0.5e-9)
+            }
+        );
+        assert_eq!(
+            s[4].sound,
+            Sound::PullOff {
+                amplitude: audio::amplitude(3e-9, 0.5e-9)
+            }
+        );
+        let Sound::Snap { amplitude: snap } = s[3].sound else {
+            unreachable!()
+        };
+        assert!(
+            (snap - 0.8 * (1.0 - (-0.6f64).exp())).abs() < 1e-12,
+            "{snap}"
+        );
+        assert!((snap - 0.36095).abs() < 5e-6, "{snap}");
         let out = session_sound(&a, "brickworld", true, 8000).unwrap();
         assert_eq!(out.samples.len(), 8000);
     }
@@ -272,5 +294,66 @@ mod tests {
             "--proximity: the wall scene records no distance to the nearest object \
              (allowed: brickworld, nanoworld)"
         );
+    }
+
+    /// docs/render.md: the tone sounds "within 0.1 m of the nearest object in the brick world
+    /// (5 mm of stylus) or 1 nm in the nano world (6.7 mm of stylus)", with the built-in
+    /// scenes' `workspace_scale` (world metres per stylus metre).
+    #[test]
+    fn the_proximity_distances_in_stylus_millimetres() {
+        let scale = |name: &str| {
+            let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../scenes")
+                .join(name);
+            let text = std::fs::read_to_string(p).unwrap();
+            crate::scene::file::load_scene(&text, None)
+                .unwrap()
+                .config
+                .mapping
+                .workspace_scale
+        };
+        let brick = proximity_on_distance_m("brickworld").unwrap();
+        let nano = proximity_on_distance_m("nanoworld").unwrap();
+        assert_eq!((brick, nano), (0.1, 1e-9));
+        assert_eq!(scale("brickworld.toml"), 20.0);
+        assert_eq!(scale("nanoworld.toml"), 1.5e-7);
+        let brick_mm = brick / scale("brickworld.toml") * 1e3;
+        let nano_mm = nano / scale("nanoworld.toml") * 1e3;
+        assert!((brick_mm - 5.0).abs() < 0.05, "{brick_mm} mm");
+        assert!((nano_mm - 6.7).abs() < 0.05, "{nano_mm} mm");
+        assert_eq!(proximity_on_distance_m("wall"), None);
+        assert_eq!(proximity_on_distance_m("optical_tweezers"), None);
+    }
+
+    /// docs/recording-format.md: "`brick.impact` is a collision: a contact that began this step
+    /// between bodies approaching at 0.05 m/s or faster", with the example's fields; every
+    /// impact of the golden brick recording.
+    #[test]
+    fn every_recorded_impact_approaches_at_the_threshold_speed_or_faster() {
+        assert_eq!(brickworld::impact::IMPACT_MIN_SPEED_M_PER_S, 0.05);
+        let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../recordings/brickworld.mcap");
+        let rec = recording::read_recording_file(&p, false).unwrap();
+        let a = SessionArrays::from_recording(&rec).unwrap();
+        let mut n = 0;
+        let mut slowest = f64::INFINITY;
+        for (_, name, detail) in &a.events {
+            if name != "brick.impact" {
+                continue;
+            }
+            let v: serde_json::Value = serde_json::from_str(detail).unwrap();
+            let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+            keys.sort_unstable();
+            assert_eq!(
+                keys,
+                ["a", "b", "impulse_n_s", "point_m", "speed_m_per_s", "type"]
+            );
+            let speed = v["speed_m_per_s"].as_f64().unwrap();
+            assert!(speed >= 0.05, "{detail}");
+            slowest = slowest.min(speed);
+            n += 1;
+        }
+        eprintln!("{n} impacts, slowest {slowest} m/s");
+        assert!(n > 5, "{n} impacts");
     }
 }

@@ -507,4 +507,47 @@ mod tests {
                 .starts_with("view.elevation_rad = 2 is out of range")
         );
     }
+
+    /// docs/render.md: "`View::oblique_default()` is azimuth −60°, elevation 30°".
+    #[test]
+    fn the_default_oblique_view_is_azimuth_minus_60_elevation_30() {
+        let View::Oblique {
+            azimuth_rad,
+            elevation_rad,
+        } = View::oblique_default()
+        else {
+            panic!("not oblique")
+        };
+        assert!(
+            (azimuth_rad.to_degrees() + 60.0).abs() < 1e-9,
+            "{azimuth_rad}"
+        );
+        assert!(
+            (elevation_rad.to_degrees() - 30.0).abs() < 1e-9,
+            "{elevation_rad}"
+        );
+    }
+
+    /// docs/render.md: a backdrop is "a slab whose thinnest side is under a tenth of its
+    /// widest" (both sides of the tenth).
+    #[test]
+    fn a_backdrop_is_a_slab_thinner_than_a_tenth_of_its_width() {
+        let slab = |h: [f64; 3]| {
+            Primitive::Box(OrientedBox {
+                center_m: [0.0; 3],
+                half_extents_m: h,
+                rotation: [0.0, 0.0, 0.0, 1.0],
+                color: haptic_types::Rgba([0.5, 0.5, 0.5, 1.0]),
+            })
+        };
+        assert!(is_backdrop(&slab([1.0, 0.5, 0.099_999])));
+        assert!(!is_backdrop(&slab([1.0, 0.5, 0.1])));
+        assert!(is_backdrop(&slab([0.999, 10.0, 5.0])));
+        assert!(!is_backdrop(&slab([1.0, 10.0, 5.0])));
+        assert!(!is_backdrop(&Primitive::Sphere(Ball {
+            center_m: [0.0; 3],
+            radius_m: 1.0,
+            color: haptic_types::Rgba([0.5, 0.5, 0.5, 1.0]),
+        })));
+    }
 }

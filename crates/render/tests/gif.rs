@@ -253,3 +253,12 @@ fn decode_local(bytes: &[u8]) -> Vec<Vec<[u8; 3]>> {
     }
     out
 }
+
+/// docs/render.md: a frame switches the palette when "more than `BAD_PIXEL_SHARE` = 0.05 % of
+/// its pixels [lie] in 15-bit cells farther than `BAD_PIXEL_ERROR` = 40 from their palette
+/// colour".
+#[test]
+fn the_palette_switch_thresholds_are_the_documented_ones() {
+    assert_eq!(render::BAD_PIXEL_SHARE, 0.0005);
+    assert_eq!(render::BAD_PIXEL_ERROR, 40);
+}

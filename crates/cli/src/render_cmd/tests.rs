@@ -322,6 +322,7 @@ fn a_brick_dropped_from_higher_sounds_louder() {
     std::fs::create_dir_all(&dir).expect("dir");
     let [x0, y0, z0] = BRICK_PICK_MM;
     let mut level = Vec::new();
+    let mut heights = Vec::new();
     for (i, z) in [0.0, 6.0, 15.0].into_iter().enumerate() {
         // Pick the brick up, lift it to z mm of stylus (20× in the world), hold, let go.
         let script = ScriptText::new("drop")
@@ -340,6 +341,12 @@ fn a_brick_dropped_from_higher_sounds_louder() {
         o.operator = OperatorChoice::Rigid;
         o.out = Some(rec.clone());
         run_session(&o, &mut |_, _| {}).expect("session");
+        // the cursor's world height as the brick is let go (tick 1999, before the 2.0 s release)
+        let arrays = haptic_loop::session::SessionArrays::from_recording(
+            &read_recording_file(&rec, false).expect("recording"),
+        )
+        .expect("arrays");
+        heights.push(arrays.cursor_m[1999][2]);
         let wav = dir.join(format!("drop{i}.wav"));
         let args = RenderArgs {
             input: rec.clone(),
@@ -356,6 +363,16 @@ fn a_brick_dropped_from_higher_sounds_louder() {
         level.push((j, peak));
     }
     eprintln!("(impulse N·s, peak) for drops from 0, 6, 15 mm: {level:?}");
+    // docs/render.md: "0, 6 and 15 mm of stylus height (0, 0.12 and 0.30 m higher in the
+    // world)": workspace_scale 20
+    let above: Vec<f64> = heights.iter().map(|z| z - heights[0]).collect();
+    eprintln!("cursor heights at release {heights:?} m, above the first {above:?} m");
+    for (a, d) in above.iter().zip([0.0, 0.12, 0.30]) {
+        assert!(
+            (a - d).abs() <= 0.005,
+            "{a} m above the first drop, doc {d}"
+        );
+    }
     // docs/render.md: "bricks let go from 0, 6 and 15 mm of stylus height (0.12 m apart in the
     // world) land with impulses 0.97, 1.34 and 1.75 N·s, and their sounds peak at 0.50, 0.59
     // and 0.66 in the WAV" (to the printed digits)

@@ -308,3 +308,106 @@ fn draw_recorded(
     }
     Ok(ticks)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rate and display cadence of a scene file under `scenes/`.
+    fn rates(name: &str) -> (u64, u64) {
+        let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes")
+            .join(name);
+        let text = std::fs::read_to_string(p).unwrap();
+        let s = crate::scene::file::load_scene(&text, None).unwrap();
+        (
+            u64::from(s.config.rate_hz),
+            u64::from(s.config.display_every),
+        )
+    }
+
+    fn every(every: Option<u64>, gif: bool) -> FramesOptions {
+        FramesOptions {
+            every,
+            gif: gif.then(|| "x.gif".into()),
+            ..FramesOptions::default()
+        }
+    }
+
+    /// docs/render.md: "the default cadence is the display tick nearest 30 frames/s (every 40
+    /// ticks at 1 kHz with a 50 Hz display: 25 frames/s)"; recomputed, "tick rate / 30".
+    #[test]
+    fn the_default_cadence_is_the_display_tick_nearest_30_frames_per_second() {
+        let (rate, display) = rates("optical_tweezers.toml");
+        assert_eq!((rate, display), (1000, 20));
+        let rec = cadence(&every(None, true), rate, display, true).unwrap();
+        assert_eq!(rec, 40);
+        assert_eq!(rate / rec, 25);
+        // recomputed scenes: every 33 ticks at 1 kHz (30.3 frames/s)
+        for scene in ["brickworld.toml", "nanoworld.toml", "wall.toml"] {
+            let (rate, display) = rates(scene);
+            assert_eq!((rate, display), (1000, 20), "{scene}");
+            assert_eq!(
+                cadence(&every(None, true), rate, display, false).unwrap(),
+                33
+            );
+        }
+        // at 10 kHz with a 50 Hz display: every 400 ticks, 25 frames/s again
+        let (rate, display) = rates("optical_tweezers_10khz.toml");
+        assert_eq!((rate, display), (10_000, 200));
+        assert_eq!(
+            cadence(&every(None, true), rate, display, true).unwrap(),
+            400
+        );
+        assert_eq!(
+            cadence(&every(None, true), rate, display, false).unwrap(),
+            333
+        );
+        // a display cadence above rate / 30 is kept (never 0 frames)
+        assert_eq!(cadence(&every(None, false), 1000, 100, true).unwrap(), 100);
+        // an explicit --every is taken as given
+        assert_eq!(cadence(&every(Some(30), true), 1000, 20, true).unwrap(), 30);
+    }
+
+    /// docs/render.md: a 60 s session (60 000 ticks at 1 kHz) gives 1819 frames recomputed
+    /// (brick and nano worlds, every 33 ticks) and 1500 drawn from the recorded state
+    /// (optical tweezers, every 40): ticks 0, N, 2N, … below 60 000.
+    #[test]
+    fn a_60_s_session_has_1819_recomputed_or_1500_recorded_state_frames() {
+        let frames = |every: u64| (0..60_000u64).filter(|n| n % every == 0).count();
+        let (rate, display) = rates("brickworld.toml");
+        assert_eq!(
+            frames(cadence(&every(None, true), rate, display, false).unwrap()),
+            1819
+        );
+        let (rate, display) = rates("optical_tweezers.toml");
+        assert_eq!(
+            frames(cadence(&every(None, true), rate, display, true).unwrap()),
+            1500
+        );
+    }
+
+    /// docs/render.md: "`--every` must keep a GIF at most 50 frames/s: at 1 kHz, N ≥ 20".
+    #[test]
+    fn a_gif_cadence_under_20_ticks_at_1_khz_is_refused() {
+        assert_eq!(
+            cadence(&every(Some(20), true), 1000, 20, false).unwrap(),
+            20
+        );
+        assert_eq!(
+            cadence(&every(Some(19), true), 1000, 20, false)
+                .unwrap_err()
+                .to_string(),
+            "every = 19 is out of range: allowed 20 or more ticks (a GIF plays at most 50 \
+             frames/s)"
+        );
+        // without a GIF any positive cadence goes, 0 does not
+        assert_eq!(cadence(&every(Some(1), false), 1000, 20, false).unwrap(), 1);
+        assert_eq!(
+            cadence(&every(Some(0), false), 1000, 20, false)
+                .unwrap_err()
+                .to_string(),
+            "every = 0 is out of range: allowed 1 or more ticks"
+        );
+    }
+}

@@ -576,6 +576,13 @@ mod tests {
         w.string("nanohaptics-recording/2");
         d = DescriptionMsg::decode(&w.finish()).unwrap_err();
         assert_eq!(d, CdrError::Format("nanohaptics-recording/2".into()));
+        // docs/recording-format.md quotes this message whole
+        assert_eq!(
+            d.to_string(),
+            "recorded with format nanohaptics-recording/2; this build reads \
+             nanohaptics-recording/3 (re-record the session, or replay it with the build that \
+             wrote it)"
+        );
         let st = StateMsg {
             tick: 2,
             cursor_m: [1.0, 2.0, 3.0],

@@ -194,3 +194,70 @@ fn chunk_crc_and_decompression_errors_are_ours() {
         "{e}"
     );
 }
+
+/// A chunk record announcing `size` uncompressed bytes for the records `z`.
+fn chunk_sized(size: u64, compression: &str, z: &[u8], crc: u32) -> Vec<u8> {
+    let mut b = Vec::new();
+    b.extend_from_slice(&1u64.to_le_bytes());
+    b.extend_from_slice(&1u64.to_le_bytes());
+    b.extend_from_slice(&size.to_le_bytes());
+    b.extend_from_slice(&crc.to_le_bytes());
+    b.extend_from_slice(&(compression.len() as u32).to_le_bytes());
+    b.extend_from_slice(compression.as_bytes());
+    b.extend_from_slice(&(z.len() as u64).to_le_bytes());
+    b.extend_from_slice(z);
+    rec(op::CHUNK, &b)
+}
+
+/// docs/recording-format.md: a chunk's uncompressed size is bounded "≤ 1 GiB and ≤ 1000 × its
+/// compressed size + 1 MiB": each bound is accepted (the file then fails further on) and one
+/// byte past it is refused before anything is allocated.
+#[test]
+fn a_chunk_size_at_its_bound_passes_it_and_one_byte_more_is_refused() {
+    // 1000 × the compressed size + 1 MiB (zstd)
+    let mut records = rec(op::SCHEMA, &[0; 14]);
+    records.extend(rec(op::SCHEMA, &[0; 14]));
+    let z = zstd::bulk::compress(&records, 3).unwrap();
+    let crc = crc32fast::hash(&records);
+    let bound = 1000 * z.len() as u64 + (1 << 20);
+    let body = 40 + "zstd".len() + z.len();
+    let mut f = start();
+    f.extend(chunk_sized(bound, "zstd", &z, crc));
+    assert_eq!(
+        err(&f),
+        format!(
+            "corrupt recording: chunk at byte 26: the records decompress to fewer bytes than the \
+             {bound} the chunk announces"
+        )
+    );
+    let mut f = start();
+    f.extend(chunk_sized(bound + 1, "zstd", &z, crc));
+    assert_eq!(
+        err(&f),
+        format!(
+            "corrupt recording: chunk at byte 26: uncompressed size {} bytes is over the bound \
+             of {bound} bytes for a {body}-byte chunk (a damaged size field)",
+            bound + 1
+        )
+    );
+    // 1 GiB: 1 100 000 bytes of records would allow 1.1 GB by the first rule
+    let records = vec![0u8; 1_100_000];
+    let gib = 1u64 << 30;
+    let body = 40 + records.len();
+    let mut f = start();
+    f.extend(chunk_sized(gib, "", &records, 1));
+    assert_eq!(
+        err(&f),
+        "corrupt recording: chunk at byte 26: its 1100000 bytes of uncompressed records are not \
+         the 1073741824 bytes it announces"
+    );
+    let mut f = start();
+    f.extend(chunk_sized(gib + 1, "", &records, 1));
+    assert_eq!(
+        err(&f),
+        format!(
+            "corrupt recording: chunk at byte 26: uncompressed size 1073741825 bytes is over the \
+             bound of 1073741824 bytes for a {body}-byte chunk (a damaged size field)"
+        )
+    );
+}
