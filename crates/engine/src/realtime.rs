@@ -572,6 +572,20 @@ mod sys {
 mod tests {
     use super::*;
 
+    /// docs/realtime.md: `SCHED_FIFO` priority 50 by default, memory locked, the thread pinned.
+    #[test]
+    fn the_default_request_is_fifo_50_locked_and_pinned() {
+        assert_eq!(DEFAULT_PRIORITY, 50);
+        assert_eq!(
+            RtRequest::default(),
+            RtRequest {
+                priority: 50,
+                lock_memory: true,
+                pin: true,
+            }
+        );
+    }
+
     #[test]
     fn priority_outside_1_to_99_is_refused_by_name() {
         assert_eq!(RtRequest::with_priority(80).map(|r| r.priority), Ok(80));
@@ -619,6 +633,15 @@ mod tests {
             ..RtStatus::default()
         };
         assert!(container.advice().unwrap().contains("--cap-add SYS_NICE"));
+        // docs/realtime.md's container fix, to the figure.
+        assert!(
+            container
+                .advice()
+                .unwrap()
+                .contains("--ulimit rtprio=95 --cpu-rt-runtime=950000"),
+            "{:?}",
+            container.advice()
+        );
     }
 
     /// Whatever the system grants, the guard puts the thread back as it was, and a thread the

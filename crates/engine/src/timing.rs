@@ -344,6 +344,36 @@ mod tests {
         );
     }
 
+    /// docs/realtime.md, "sleep": with `SCHED_FIFO` the spin is a quarter of the period, at most
+    /// 50 µs; without it, 100 µs.
+    #[test]
+    fn the_spin_is_a_quarter_period_up_to_50_us_with_fifo_and_100_us_without() {
+        let fifo = crate::realtime::RtStatus {
+            requested: true,
+            priority: Some(50),
+            ..Default::default()
+        };
+        let refused = crate::realtime::RtStatus {
+            requested: true,
+            ..Default::default()
+        };
+        let us = |p: Pacer| p.spin().as_nanos();
+        // 1 kHz: a quarter is 250 µs, capped at 50 µs; 10 kHz: a quarter, 25 µs.
+        assert_eq!(us(Pacer::for_thread(1_000_000, &fifo)), 50_000);
+        assert_eq!(us(Pacer::for_thread(100_000, &fifo)), 25_000);
+        for period_ns in [1_000_000, 100_000] {
+            assert_eq!(us(Pacer::for_thread(period_ns, &refused)), 100_000);
+            assert_eq!(
+                us(Pacer::for_thread(
+                    period_ns,
+                    &crate::realtime::RtStatus::default()
+                )),
+                100_000
+            );
+            assert_eq!(us(Pacer::new(period_ns)), 100_000);
+        }
+    }
+
     #[test]
     fn pacer_never_starts_early() {
         let mut p = Pacer::new(200_000);

@@ -15,8 +15,8 @@
 //! specifications they carry, into the loop), `cli` (the `nanohaptics` program's options, one
 //! process per input).
 //!
-//! Input `i` of a campaign is a seed input with 1–4 mutations drawn from a generator seeded by
-//! `(seed, i)`, so any input is regenerated alone. The inputs run in batches in child processes
+//! Input `i` of a campaign is a seed input with 1–4 mutations (1–2 for `cli`) drawn from a
+//! generator seeded by `(seed, i)`, so any input is regenerated alone. The inputs run in batches in child processes
 //! (`--worker`): a panic is caught per input (`catch_unwind`); a hang (an input over the time
 //! limit) is reported by the child's watchdog, which then exits; an abort kills the child, and
 //! the batch is re-run one input per process to name the culprit. Every finding's input is
@@ -64,6 +64,12 @@ fn usage() -> String {
 }
 
 fn parse_args() -> Result<Args, String> {
+    parse_args_from(std::env::args().skip(1))
+}
+
+/// The arguments `args` (without the program's name) as [`Args`], with the defaults for what
+/// they do not set.
+fn parse_args_from(args: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut a = Args {
         target: None,
         inputs: u64::MAX,
@@ -80,7 +86,7 @@ fn parse_args() -> Result<Args, String> {
         ci: false,
         write_seeds: None,
     };
-    let mut it = std::env::args().skip(1);
+    let mut it = args;
     while let Some(f) = it.next() {
         let mut val = |name: &str| {
             it.next()
@@ -605,5 +611,24 @@ mod tests {
         listed.sort();
         want.sort();
         assert_eq!(listed, want);
+    }
+
+    /// docs/fuzzing.md, "How it runs": batches of 500 inputs, a 10 s time limit per input
+    /// (`--timeout-ms`), the `cli` target's process killed at 80 % of it, and 1–4 mutations per
+    /// input (1–2 for `cli`).
+    #[test]
+    fn the_defaults_docs_fuzzing_md_states_are_the_codes() {
+        let args = |v: &[&str]| super::parse_args_from(v.iter().map(|s| s.to_string()));
+        let a = args(&["--target", "scene"]).unwrap();
+        assert_eq!((a.batch, a.timeout_ms, a.inputs), (500, 10_000, 10_000));
+        let a = args(&["--ci", "--batch", "7", "--timeout-ms", "250"]).unwrap();
+        assert_eq!((a.batch, a.timeout_ms), (7, 250));
+        assert!(args(&[]).unwrap_err().starts_with("give --target or --ci"));
+        assert_eq!(nanohaptics_fuzz::targets::KILL_AT, 0.8);
+        let most = nanohaptics_fuzz::targets::max_mutations;
+        assert_eq!(
+            (most("cli"), most("scene"), most("bridge"), most("page")),
+            (2, 4, 4, 4)
+        );
     }
 }

@@ -233,3 +233,72 @@ fn collisions_carry_their_impulse_and_the_house_is_scored() {
     assert!(near.iter().any(|d| *d < 1e-5));
     assert!(near.iter().any(|d| *d > 0.05));
 }
+
+/// The loading-zone brick grabbed as the house script does, lifted `lift_mm` (device mm; the
+/// brick world maps 1 mm to 2 cm), held until it hangs still, let go at 3 s: the events and the
+/// session's `dropped` count at the end.
+fn release_from(lift_mm: f64) -> (Vec<(u64, String, String)>, f64) {
+    let (x, y, z) = (-22.5, 2.5, -6.8);
+    let mut s = String::from("[script]\nname = \"drop test\"\noperator = \"rigid\"\n");
+    for (t, zz) in [
+        (0.0, 7.5),
+        (0.6, z),
+        (0.7, z),
+        (1.3, z + lift_mm),
+        (4.0, z + lift_mm),
+    ] {
+        s.push_str(&format!(
+            "\n[[waypoint]]\nt_s = {t:?}\nposition_mm = [{x:?}, {y:?}, {zz:?}]\n"
+        ));
+    }
+    for (t, down) in [(0.65, true), (3.0, false)] {
+        s.push_str(&format!(
+            "\n[[button]]\nt_s = {t:?}\nname = \"centre\"\ndown = {down}\n"
+        ));
+    }
+    let a = run("brickworld.toml", Some(s), 4.0, None);
+    let n = a.state_fields.len();
+    let col = a.state_fields.iter().position(|f| f == "dropped").unwrap();
+    let dropped = a.state[a.state.len() - n + col];
+    (a.events, dropped)
+}
+
+/// The drop rule (`haptic_loop::scene::score::DROP_HEIGHT_M`, docs/lesson.md "The score"): a
+/// brick the hand lets go counts as dropped when its centre is 1 cm or more below where it was
+/// let go at its first impact. Let go still, hanging 2 cm above its rest, it is dropped; 5 mm
+/// above, it is not. The height is measured from the fall itself: released at rest, the brick
+/// falls freely until it first touches the ground, so its height above its rest is v² / 2g of
+/// the impact's approach speed and g t² / 2 of the ticks it fell (1 ms each).
+#[test]
+fn a_brick_let_go_2_cm_above_its_rest_is_dropped_and_5_mm_above_is_not() {
+    assert_eq!(haptic_loop::scene::score::DROP_HEIGHT_M, 0.01);
+    let g = 9.81;
+    // Device mm lifted (20 mm in the world per mm, less the brick's sag on the coupling).
+    for (lift_mm, height_m, dropped_want) in [(1.12, 0.020, 1.0), (0.325, 0.005, 0.0)] {
+        let (ev, dropped) = release_from(lift_mm);
+        let released = ev.iter().find(|e| e.1 == "brick.released").unwrap().0;
+        assert_eq!(released, 3000);
+        let first = ev
+            .iter()
+            .find(|e| e.1 == "brick.impact" && e.0 > released)
+            .unwrap();
+        let j = json(&first.2);
+        assert_eq!(
+            (&j["a"], &j["b"]),
+            (
+                &serde_json::json!("ground"),
+                &serde_json::json!({"brick": 0})
+            )
+        );
+        let v = j["speed_m_per_s"].as_f64().unwrap();
+        let t = (first.0 - released) as f64 * 1e-3;
+        let (by_speed, by_time) = (v * v / (2.0 * g), 0.5 * g * t * t);
+        for h in [by_speed, by_time] {
+            assert!(
+                (h - height_m).abs() < 0.5e-3,
+                "lift {lift_mm} mm: fell {h} m"
+            );
+        }
+        assert_eq!(dropped, dropped_want, "let go {height_m} m above its rest");
+    }
+}

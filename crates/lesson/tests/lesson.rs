@@ -159,3 +159,73 @@ fn the_lesson_measures_what_it_says() {
     let rec = recording::read_recording_file(&out.join("nano_house.mcap"), false).unwrap();
     assert!(haptic_loop::replay::verify(&rec).unwrap().ok());
 }
+
+/// docs/lesson.md's figures about the committed report and the lesson's own data, without
+/// running the lesson (the test above holds `docs/lesson/lesson.json` equal to a fresh run):
+/// the copy's figures are 1000 px wide and its sounds 22 050 Hz; the heavy-atom throws are
+/// seven, of a 3 g "atom" with gravity off, swings of 0.3 to 0.1 s; the lift carries 0.45 m in
+/// 0.9 s; the built-in atom, 10⁻²⁵ kg held with 3 nN, leaves the tip at 3·10¹⁶ m/s² in the
+/// world, 2·10²³ m/s² of hand acceleration at the scene's 1 mm = 0.15 nm.
+#[test]
+fn the_committed_report_and_the_lessons_data_are_as_docs_lesson_md_says() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/lesson");
+    let mut pngs = 0;
+    let mut wavs = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        let b = std::fs::read(&p).unwrap();
+        match p.extension().and_then(|x| x.to_str()) {
+            Some("png") => {
+                // The IHDR chunk: width, then height, big-endian.
+                assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n", "{}", p.display());
+                assert_eq!(&b[12..16], b"IHDR");
+                let w = u32::from_be_bytes(b[16..20].try_into().unwrap());
+                let h = u32::from_be_bytes(b[20..24].try_into().unwrap());
+                assert_eq!((w, h), (1000, 500), "{}", p.display());
+                pngs += 1;
+            }
+            Some("wav") => {
+                // A canonical RIFF/WAVE header: the `fmt ` chunk first, its sample rate at 24.
+                assert_eq!((&b[..4], &b[8..16]), (&b"RIFF"[..], &b"WAVEfmt "[..]));
+                let rate = u32::from_le_bytes(b[24..28].try_into().unwrap());
+                assert_eq!(rate, 22_050, "{}", p.display());
+                wavs += 1;
+            }
+            _ => {}
+        }
+    }
+    assert_eq!((pngs, wavs), (8, 2));
+    // The heavy-atom throws.
+    assert_eq!(lesson::SWEEP_MASS_KG, 3e-3);
+    let sw = lesson::SWEEP_SWING_S;
+    assert_eq!((sw.len(), sw[0], sw[6]), (7, 0.3, 0.1));
+    assert!(sw.windows(2).all(|w| w[0] > w[1]), "{sw:?}");
+    let committed: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("lesson.json")).unwrap()).unwrap();
+    let swings: Vec<f64> = committed["sweep"]["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r[0].as_f64().unwrap())
+        .collect();
+    assert_eq!(swings, sw);
+    assert_eq!(committed["sweep"]["mass_kg"], 3e-3);
+    // The lift: carried from 2.1 s to 3.0 s; the distance D from the minimum-jerk prediction
+    // M·5.7735·D/T² the report states.
+    let (_, [_, _, carry_start, carry_end]) = lesson::scripts::brick_lift(&[]);
+    let t = carry_end - carry_start;
+    assert!((t - 0.9).abs() < 1e-12, "{t}");
+    let f = |k: &str| committed[k].as_f64().unwrap();
+    let d = f("lift_inertia_predicted_n") * t * t / (f("brick_mass_kg") * 10.0 / 3f64.sqrt());
+    assert!((d - 0.45).abs() < 1e-9, "{d}");
+    // The built-in atom and its threshold, in the world and at the hand.
+    let near = |x: f64, want: f64| (x / want - 1.0).abs() < 1e-9;
+    assert!(near(f("atom_mass_kg"), 1e-25));
+    assert!(near(f("atom_hold_n"), 3e-9));
+    let world = f("atom_hold_n") / f("atom_mass_kg");
+    assert!(near(world, 3e16), "{world}");
+    let hand = f("atom_threshold_hand_m_per_s2");
+    assert!(near(hand, 2e23), "{hand}");
+    // World metres per device metre: 0.15 nm per mm.
+    assert!(near(world / hand, 0.15e-9 / 1e-3), "{}", world / hand);
+}

@@ -7,6 +7,10 @@ use crate::mutate::{self, Rng};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// The share of the time limit after which a `cli` input's process is killed (and counted
+/// as a hang): the harness's own limit then still catches a stuck worker.
+pub const KILL_AT: f64 = 0.8;
+
 impl Target {
     pub(super) fn run_cli(&self, input: &[u8]) -> Outcome {
         let Some((prog, dir)) = &self.cli else {
@@ -29,7 +33,7 @@ impl Target {
         let Ok(mut child) = child else {
             return Outcome::Refused;
         };
-        let limit = self.timeout.mul_f64(0.8);
+        let limit = self.timeout.mul_f64(KILL_AT);
         let t0 = Instant::now();
         let status = loop {
             match child.try_wait() {

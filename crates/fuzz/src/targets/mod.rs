@@ -4,6 +4,7 @@
 //! `script`, `bridge`); `params` lives in [`crate::params`].
 
 mod cli;
+pub use cli::KILL_AT;
 mod physics;
 mod recordings;
 
@@ -126,11 +127,11 @@ impl Target {
         &self.seeds
     }
 
-    /// Input `index` of a campaign with `seed`: a seed with 1–4 mutations.
+    /// Input `index` of a campaign with `seed`: a seed with 1 to [`max_mutations`] mutations.
     pub fn input(&self, seed: u64, index: u64) -> Vec<u8> {
         let mut r = Rng::for_input(seed, index);
         let mut b = r.pick(&self.seeds).clone();
-        let n = 1 + r.below(if self.name == "cli" { 2 } else { 4 });
+        let n = 1 + r.below(max_mutations(self.name));
         for _ in 0..n {
             match self.name {
                 "scene" | "script" | "params" => mutate::mutate_text(&mut r, &mut b, &self.seeds),
@@ -311,4 +312,10 @@ fn seed_welcome() -> Vec<u8> {
         roles: Some([0, 1, 2, 3]),
     }
     .encode()
+}
+
+/// Most mutations an input of the target `name` gets (each gets 1 to this many): 4, and 2 for
+/// `cli`, whose every input is a process.
+pub fn max_mutations(name: &str) -> usize {
+    if name == "cli" { 2 } else { 4 }
 }
