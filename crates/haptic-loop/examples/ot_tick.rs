@@ -18,18 +18,11 @@
 //!
 //! `cargo run --release -p haptic-loop --example ot_tick -- [--rounds N] [--realtime]`
 
+mod ot_replay;
+
 use bench_harness::Summary;
 use bench_harness::machine::LoadAvg;
-use haptic_loop::scene::SceneFile;
-use haptic_loop::scene::optical::OtParams;
 use haptic_loop::session::{SceneSource, SessionOptions, SessionReport, run_session};
-use nalgebra::Vector2;
-use ot_envelope::geometry::hausdorff;
-use ot_envelope::steer::{ParticleState, SteerParams};
-use ot_envelope::tick::{TickController, TickParams};
-use ot_envelope::{EnvelopeOptions, OffsetRegion, working_envelope_with};
-use ot_physics::TrapModel;
-use ot_physics::budget::{choose_tick_map, converged};
 use std::path::{Path, PathBuf};
 
 type BoxError = Box<dyn std::error::Error>;
@@ -75,144 +68,23 @@ fn load() -> String {
 
 /// Replays the new session's steering from its recorded states and measures the envelope's
 /// Hausdorff distance from converged dynamics every `every` grabbed ticks.
-fn hausdorff_check(text: &str, r: &SessionReport, every: usize) -> Result<String, BoxError> {
-    let file = SceneFile::parse(text)?;
-    let p: OtParams = file.world()?.ok_or("not an optical scene")?;
-    let old = !p.warm_start;
-    let model = TrapModel::builder(
-        p.depth_nj * 1e-9,
-        [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
-    )
-    .mass(p.mass_g * 1e-3)
-    .build()?;
-    let dt = p.dt_us * 1e-6;
-    let prop = match p.rk4_substeps {
-        Some(n) => ot_physics::Propagator::new(model, ot_physics::Method::Rk4 { substeps: n }, dt)?,
-        None => choose_tick_map(model, dt, p.tick_map_tol_nm.unwrap_or(0.01) * 1e-9, 0.1)?.0,
-    };
-    let truth = converged(model, dt)?;
-    let tol = p
-        .envelope_tol_nm
-        .map_or(ot_envelope::DEFAULT_TOL, |t| t * 1e-9);
-    // the scene's region and grid: fixed by hand, or chosen from the tolerance
-    let (margin, cell) = match (p.envelope_margin_waists, p.envelope_cell_waists) {
-        (Some(m), Some(c)) => (m, c),
-        (m, c) => {
-            let g = ot_envelope::grid::choose_grid(&prop, tol, 0.1)?;
-            (m.unwrap_or(g.margin_waists), c.unwrap_or(g.cell_waists))
-        }
-    };
-    let mut tp = TickParams::new(SteerParams {
-        stiffness: p.stiffness_n_per_m,
-        mode: p.clip,
-        tol,
-        margin_waists: margin,
-    });
-    tp.warm_start = !old;
-    tp.cell_waists = Some(cell);
-    tp.build_evals_per_tick = match (p.spread_build, p.envelope_build_evals_per_tick) {
-        (false, _) => None,
-        (true, b) => Some(b.unwrap_or(ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK)),
-    };
-    let mut c = TickController::new(tp)?;
-    // as the world: the first envelope for the particle at rest, before the first grab
-    c.prebuild(&prop, &Vector2::zeros())?;
-    let a = &r.arrays;
-    let col = |n: &str| a.state_column(n).ok_or(format!("no column {n}"));
-    let (px, py, vx, vy) = (
-        col("particle_x_m")?,
-        col("particle_y_m")?,
-        col("particle_vx_m_per_s")?,
-        col("particle_vy_m_per_s")?,
-    );
-    let (tx, ty, g) = (col("trap_x_m")?, col("trap_y_m")?, col("grabbed")?);
-    let start = Vector2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
-    let (mut worst, mut worst_cold, mut n, mut grabbed, mut mismatch) = (0.0f64, 0.0f64, 0, 0, 0);
-    let (mut worst_spread, mut n_spread, mut max_slice) = (0.0f64, 0, 0u64);
-    for i in 0..a.tick.len() {
-        let v_before = if i == 0 {
-            Vector2::zeros()
-        } else {
-            Vector2::new(vx[i - 1], vy[i - 1])
-        };
-        if g[i] != 1.0 {
-            // as the world between grabs: keep the envelope fresh
-            if !old {
-                c.prepare(&prop, &v_before)?;
-            }
-            continue;
-        }
-        if i == 0 || g[i - 1] != 1.0 {
-            // as the world on grab: continue from the trap the particle sits in
-            let trap = if i == 0 {
-                start
-            } else {
-                Vector2::new(tx[i - 1], ty[i - 1])
-            };
-            c.continue_from(&trap);
-        }
-        let s = if i == 0 {
-            ParticleState {
-                position: start,
-                velocity: Vector2::zeros(),
-            }
-        } else {
-            ParticleState {
-                position: Vector2::new(px[i - 1], py[i - 1]),
-                velocity: Vector2::new(vx[i - 1], vy[i - 1]),
-            }
-        };
-        let cur = a.cursor_m[i];
-        let out = c.step(&prop, &s, &Vector2::new(cur[0], cur[1]))?;
-        if out.trap.x.to_bits() != tx[i].to_bits() || out.trap.y.to_bits() != ty[i].to_bits() {
-            mismatch += 1;
-        }
-        grabbed += 1;
-        max_slice = max_slice.max(out.slice_evals);
-        // every tick served while a spread build is under way is checked
-        let spreading = c.building() || out.slice_evals > 0;
-        if grabbed % every == 0 || spreading {
-            // converged dynamics over a wider region than the scene's
-            let reference = working_envelope_with(
-                &truth,
-                &s.velocity,
-                &EnvelopeOptions {
-                    tol: 0.02e-9,
-                    coarse_grid: false,
-                    region: Some(OffsetRegion::around_drift(&truth, &s.velocity, 4.5)?),
-                    ..Default::default()
-                },
-            )?;
-            let cold = working_envelope_with(
-                &prop,
-                &s.velocity,
-                &EnvelopeOptions {
-                    tol,
-                    cell_waists: Some(cell),
-                    region: Some(OffsetRegion::around_drift(&prop, &s.velocity, margin)?),
-                    ..Default::default()
-                },
-            )?;
-            let h = hausdorff(c.envelope(), &reference.polygon, 0.05e-9);
-            worst = worst.max(h);
-            worst_cold = worst_cold.max(hausdorff(&cold.polygon, &reference.polygon, 0.05e-9));
-            n += 1;
-            if spreading {
-                worst_spread = worst_spread.max(h);
-                n_spread += 1;
-            }
-        }
-    }
+fn hausdorff_check(text: &str, r: &SessionReport, every: u64) -> Result<String, BoxError> {
+    let f = ot_replay::replay(text, r, every)?;
     Ok(format!(
-        "envelope Hausdorff from converged dynamics (tol 0.02 nm reference), {n} of {grabbed} grabbed ticks: \
+        "envelope Hausdorff from converged dynamics (tol 0.02 nm reference), {} of {} grabbed ticks: \
          tick envelope (warm or rebuilt) {:.3} nm, a full rebuild at the same tick {:.3} nm; \
-         of which the {n_spread} ticks served during a spread build (all checked): {:.3} nm; \
-         most force evaluations of a build slice in a grabbed tick: {max_slice}; \
-         reconstruction mismatches with the recorded trap: {mismatch}; {:?}",
-        worst * 1e9,
-        worst_cold * 1e9,
-        worst_spread * 1e9,
-        c.stats()
+         of which the {} ticks served during a spread build (all checked): {:.3} nm; \
+         most force evaluations of a build slice in a grabbed tick: {}; \
+         reconstruction mismatches with the recorded trap: {}; {:?}",
+        f.checked,
+        f.grabbed,
+        f.worst_nm,
+        f.worst_cold_nm,
+        f.checked_spread,
+        f.worst_spread_nm,
+        f.max_slice,
+        f.mismatches,
+        f.stats
     ))
 }
 
@@ -312,7 +184,7 @@ fn main() -> Result<(), BoxError> {
         {
             println!("{}", e.2);
         }
-        let every: usize = flag("--hausdorff-every").map_or(Ok(50), |s| s.parse())?;
+        let every: u64 = flag("--hausdorff-every").map_or(Ok(50), |s| s.parse())?;
         println!("new: {}", hausdorff_check(&text, r, every.max(1))?);
         if let Some(ro) = &last_old {
             println!("old: {}", hausdorff_check(&old, ro, every.max(1))?);

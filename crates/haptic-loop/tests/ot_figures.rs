@@ -6,38 +6,19 @@
 //! while a spread build was under way (every one of them) and at every `every`-th grabbed tick.
 #![allow(clippy::unwrap_used)] // a failed unwrap in a test is a failed test
 
+#[path = "../examples/ot_replay/mod.rs"]
+mod ot_replay;
+
 use haptic_loop::scene::SceneFile;
 use haptic_loop::scene::optical::OtParams;
 use haptic_loop::session::{SceneSource, SessionOptions, run_session};
-use nalgebra::Vector2;
-use ot_envelope::geometry::hausdorff;
-use ot_envelope::steer::{ParticleState, SteerParams};
-use ot_envelope::tick::{TickController, TickParams, TickStats};
-use ot_envelope::{EnvelopeOptions, OffsetRegion, working_envelope_with};
-use ot_physics::TrapModel;
-use ot_physics::budget::{choose_tick_map, converged};
+use ot_envelope::tick::TickStats;
+use ot_replay::Replay;
 use std::path::Path;
 
-type V2 = Vector2<f64>;
-
-/// What one scene's session gave.
-struct Figures {
-    stats: TickStats,
-    grabbed: u64,
-    /// Ticks whose envelope was checked, and of which served during a spread build.
-    checked: u64,
-    checked_spread: u64,
-    /// Worst Hausdorff distance (nm) of the served envelope over the checked ticks.
-    worst_nm: f64,
-    /// Worst Hausdorff distance (nm) of a whole build at the same ticks.
-    worst_cold_nm: f64,
-    /// Ticks whose replayed trap differs from the recorded one.
-    mismatches: u64,
-    /// The most force evaluations one slice spent in a grabbed tick.
-    max_slice: u64,
-}
-
-fn figures(scene: &str, every: u64) -> Figures {
+/// A batch session of `scene` on its default script for 6 s, its steering replayed
+/// (`examples/ot_replay`) with every `every`-th grabbed tick checked.
+fn figures(scene: &str, every: u64) -> Replay {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let text = std::fs::read_to_string(root.join("scenes").join(scene)).unwrap();
     let mut src = SceneSource::from_text(&text, scene);
@@ -48,127 +29,7 @@ fn figures(scene: &str, every: u64) -> Figures {
 
     let p: OtParams = SceneFile::parse(&text).unwrap().world().unwrap().unwrap();
     assert!(p.warm_start && p.spread_build && p.rk4_substeps.is_none());
-    let model = TrapModel::builder(
-        p.depth_nj * 1e-9,
-        [p.waist_x_nm * 1e-9, p.waist_y_nm * 1e-9],
-    )
-    .mass(p.mass_g * 1e-3)
-    .build()
-    .unwrap();
-    let dt = p.dt_us * 1e-6;
-    let prop = choose_tick_map(model, dt, p.tick_map_tol_nm.unwrap_or(0.01) * 1e-9, 0.1)
-        .unwrap()
-        .0;
-    let truth = converged(model, dt).unwrap();
-    let tol = p
-        .envelope_tol_nm
-        .map_or(ot_envelope::DEFAULT_TOL, |t| t * 1e-9);
-    let g = ot_envelope::grid::choose_grid(&prop, tol, 0.1).unwrap();
-    let margin = p.envelope_margin_waists.unwrap_or(g.margin_waists);
-    let cell = p.envelope_cell_waists.unwrap_or(g.cell_waists);
-    let mut tp = TickParams::new(SteerParams {
-        stiffness: p.stiffness_n_per_m,
-        mode: p.clip,
-        tol,
-        margin_waists: margin,
-    });
-    tp.cell_waists = Some(cell);
-    tp.build_evals_per_tick = Some(
-        p.envelope_build_evals_per_tick
-            .unwrap_or(ot_envelope::tick::DEFAULT_BUILD_EVALS_PER_TICK),
-    );
-    let mut c = TickController::new(tp).unwrap();
-    c.prebuild(&prop, &V2::zeros()).unwrap();
-
-    let a = &r.arrays;
-    let col = |n: &str| a.state_column(n).unwrap();
-    let (px, py, vx, vy) = (
-        col("particle_x_m"),
-        col("particle_y_m"),
-        col("particle_vx_m_per_s"),
-        col("particle_vy_m_per_s"),
-    );
-    let (tx, ty, gr) = (col("trap_x_m"), col("trap_y_m"), col("grabbed"));
-    let start = V2::new(p.start_um[0] * 1e-6, p.start_um[1] * 1e-6);
-    let mut f = Figures {
-        stats: TickStats::default(),
-        grabbed: 0,
-        checked: 0,
-        checked_spread: 0,
-        worst_nm: 0.0,
-        worst_cold_nm: 0.0,
-        mismatches: 0,
-        max_slice: 0,
-    };
-    for i in 0..a.tick.len() {
-        let v_before = if i == 0 {
-            V2::zeros()
-        } else {
-            V2::new(vx[i - 1], vy[i - 1])
-        };
-        if gr[i] != 1.0 {
-            c.prepare(&prop, &v_before).unwrap();
-            continue;
-        }
-        if i == 0 || gr[i - 1] != 1.0 {
-            let trap = if i == 0 {
-                start
-            } else {
-                V2::new(tx[i - 1], ty[i - 1])
-            };
-            c.continue_from(&trap);
-        }
-        let s = if i == 0 {
-            ParticleState {
-                position: start,
-                velocity: V2::zeros(),
-            }
-        } else {
-            ParticleState {
-                position: V2::new(px[i - 1], py[i - 1]),
-                velocity: V2::new(vx[i - 1], vy[i - 1]),
-            }
-        };
-        let cur = a.cursor_m[i];
-        let out = c.step(&prop, &s, &V2::new(cur[0], cur[1])).unwrap();
-        if out.trap.x.to_bits() != tx[i].to_bits() || out.trap.y.to_bits() != ty[i].to_bits() {
-            f.mismatches += 1;
-        }
-        f.grabbed += 1;
-        f.max_slice = f.max_slice.max(out.slice_evals);
-        let spreading = c.building() || out.slice_evals > 0;
-        if f.grabbed % every == 0 || spreading {
-            let reference = working_envelope_with(
-                &truth,
-                &s.velocity,
-                &EnvelopeOptions {
-                    tol: 0.02e-9,
-                    coarse_grid: false,
-                    region: Some(OffsetRegion::around_drift(&truth, &s.velocity, 4.5).unwrap()),
-                    ..Default::default()
-                },
-            )
-            .unwrap();
-            let cold = working_envelope_with(
-                &prop,
-                &s.velocity,
-                &EnvelopeOptions {
-                    tol,
-                    cell_waists: Some(cell),
-                    region: Some(OffsetRegion::around_drift(&prop, &s.velocity, margin).unwrap()),
-                    ..Default::default()
-                },
-            )
-            .unwrap();
-            let h = hausdorff(c.envelope(), &reference.polygon, 0.05e-9) * 1e9;
-            let hc = hausdorff(&cold.polygon, &reference.polygon, 0.05e-9) * 1e9;
-            f.worst_nm = f.worst_nm.max(h);
-            f.worst_cold_nm = f.worst_cold_nm.max(hc);
-            f.checked += 1;
-            f.checked_spread += u64::from(spreading);
-        }
-    }
-    f.stats = c.stats();
+    let f = ot_replay::replay(&text, &r, every).unwrap();
     eprintln!(
         "{scene}: {} grabbed, {} checked ({} during a spread build), worst {:.4} nm \
          (a whole build {:.4} nm), max slice {}, {:?}",
@@ -207,19 +68,52 @@ fn expected(ticks: u64, spread_builds: u64, build_slices: u64) -> TickStats {
     }
 }
 
+/// One scene's printed figures: `grabbed` ticks, `spread_builds` in `build_slices` slices, the
+/// largest 280 evaluations, `checked` ticks of which `checked_spread` served during a spread
+/// build, the served envelope's and a whole build's worst Hausdorff distance (nm, 3 decimals).
+struct Printed {
+    grabbed: u64,
+    spread_builds: u64,
+    build_slices: u64,
+    checked: u64,
+    checked_spread: u64,
+    served_nm: f64,
+    whole_nm: f64,
+}
+
+/// `scene`'s session, every `every`-th grabbed tick checked, gives the `want` figures.
+fn holds(scene: &str, every: u64, want: &Printed) {
+    let f = figures(scene, every);
+    assert_eq!(f.mismatches, 0);
+    assert_eq!(
+        f.stats,
+        expected(want.grabbed, want.spread_builds, want.build_slices)
+    );
+    assert_eq!(f.max_slice, 280);
+    assert_eq!(
+        (f.grabbed, f.checked, f.checked_spread),
+        (want.grabbed, want.checked, want.checked_spread)
+    );
+    assert_printed("served envelope (nm)", f.worst_nm, want.served_nm, 3);
+    assert_printed("whole build (nm)", f.worst_cold_nm, want.whole_nm, 3);
+}
+
 /// docs/ot-envelope.md "Measured"; BENCHMARKS.md "Work per tick" and "Accuracy reached",
 /// 1 kHz row: 5,000 grabbed ticks, 14 spread builds in 126 slices, the largest 280
 /// evaluations; every 10th grabbed tick and all 126 served during a spread build checked (612):
 /// served envelope 0.062 nm, a whole build at the same ticks 0.060 nm.
 #[test]
 fn scene_1khz_default_script() {
-    let f = figures("optical_tweezers.toml", 10);
-    assert_eq!(f.mismatches, 0);
-    assert_eq!(f.stats, expected(5000, 14, 126));
-    assert_eq!(f.max_slice, 280);
-    assert_eq!((f.grabbed, f.checked, f.checked_spread), (5000, 612, 126));
-    assert_printed("served envelope (nm)", f.worst_nm, 0.062, 3);
-    assert_printed("whole build (nm)", f.worst_cold_nm, 0.060, 3);
+    let want = Printed {
+        grabbed: 5000,
+        spread_builds: 14,
+        build_slices: 126,
+        checked: 612,
+        checked_spread: 126,
+        served_nm: 0.062,
+        whole_nm: 0.060,
+    };
+    holds("optical_tweezers.toml", 10, &want);
 }
 
 /// BENCHMARKS.md "Work per tick" and "Accuracy reached", 10 kHz row: 50,000 grabbed ticks,
@@ -228,11 +122,14 @@ fn scene_1khz_default_script() {
 /// same ticks 0.060 nm.
 #[test]
 fn scene_10khz_default_script() {
-    let f = figures("optical_tweezers_10khz.toml", 50);
-    assert_eq!(f.mismatches, 0);
-    assert_eq!(f.stats, expected(50_000, 7, 63));
-    assert_eq!(f.max_slice, 280);
-    assert_eq!((f.grabbed, f.checked, f.checked_spread), (50_000, 1062, 63));
-    assert_printed("served envelope (nm)", f.worst_nm, 0.061, 3);
-    assert_printed("whole build (nm)", f.worst_cold_nm, 0.060, 3);
+    let want = Printed {
+        grabbed: 50_000,
+        spread_builds: 7,
+        build_slices: 63,
+        checked: 1062,
+        checked_spread: 63,
+        served_nm: 0.061,
+        whole_nm: 0.060,
+    };
+    holds("optical_tweezers_10khz.toml", 50, &want);
 }

@@ -5,17 +5,19 @@
 //! Run: `cargo run --release -p ot-envelope --example ot-envelope-report`
 //! (about two minutes; single thread).
 
+mod hard_cases;
+
 use bench_harness::chart::{Chart, PALETTE, Scale, Series, Style};
 use bench_harness::verdict::slowdown_lower_bound;
 use bench_harness::{Report, Summary, Table, Timings, Verdict, span};
-use nalgebra::{Vector2, Vector3};
-use ot_envelope::envelope3::working_envelope_3d;
+use hard_cases::{hard_case, hard_case_3d, model};
+use nalgebra::Vector2;
 use ot_envelope::geometry::nearest_on_boundary;
 use ot_envelope::inverse::TrapSolver;
 use ot_envelope::paper::paper_envelope;
 use ot_envelope::reference::Reference;
-use ot_envelope::{OffsetRegion, SampledMap, envelope_from_map, working_envelope};
-use ot_physics::{Method, Propagator, TrapModel};
+use ot_envelope::working_envelope;
+use ot_physics::{Method, Propagator};
 use std::fmt::Write as _;
 
 type V2 = Vector2<f64>;
@@ -25,13 +27,6 @@ const NM: f64 = 1e-9;
 fn time<T>(n: usize, f: impl FnMut() -> T) -> (f64, f64) {
     let t = Timings::repeat(n, f).wall_us().expect("n > 0 runs");
     (t.min() * 1e-6, t.median() * 1e-6)
-}
-
-fn model(w: [f64; 2]) -> TrapModel<2> {
-    TrapModel::builder(1e-15, w)
-        .mass(1e-15)
-        .build()
-        .expect("model")
 }
 
 fn met(v: Verdict) -> &'static str {
@@ -406,60 +401,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
     ];
     for (name, w, v0, dt, meth) in cases {
-        let p = Propagator::new(model(w), meth, dt)?;
-        let region = OffsetRegion::around_drift(&p, &v0, 3.0)?;
-        let map = SampledMap::build(&p, &v0, &region, None)?;
-        let we = envelope_from_map(&p, &map, 0.5e-9)?;
-        let (tmin, _) = time(5, || working_envelope(&p, &v0, None));
-        let r = Reference::sample(&p, &v0, &we.region, 700)?;
-        let e = r.errors(&p, &we.polygon, 2.0 * NM)?;
+        let c = hard_case(w, v0, dt, meth)?;
+        let (tmin, _) = time(5, || working_envelope(&c.prop, &v0, None));
         t.row([
             name.to_string(),
             meth.name().to_string(),
-            we.fold_curves.to_string(),
-            we.polygon.len().to_string(),
+            c.fold_curves.to_string(),
+            c.vertices.to_string(),
             format!("{:.2}", tmin * 1e3),
-            we.contains(&V2::zeros()).to_string(),
-            format!("{:.3}", e.hausdorff() / NM),
+            c.inside.to_string(),
+            format!("{:.3}", c.hausdorff_nm),
         ])?;
     }
     // 3D
-    let m3 = TrapModel::builder(1e-15, [600e-9, 300e-9, 900e-9])
-        .mass(1e-15)
-        .build()?;
-    let p3 = Propagator::new(m3, Method::Rk4 { substeps: 8 }, 1e-6)?;
-    let v3 = Vector3::new(0.05, 0.0, 0.02);
-    let (we3, s3) = span(|| working_envelope_3d(&p3, &v3, 4, 3.0, 0.1));
-    let (we3, t3) = (we3?, s3.wall_s);
-    let mut worst: f64 = 0.0;
-    let n = 30;
-    let w3 = Vector3::new(600e-9, 300e-9, 900e-9);
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let z = Vector3::new(i as f64, j as f64, k as f64) / (n - 1) as f64 * 4.8
-                    - Vector3::repeat(2.4);
-                let (d, _, _) = p3.flow(&(z.component_mul(&w3) + v3 * 0.5e-6), &v3)?;
-                if we3.mesh.winding(&d) < 0.5 {
-                    worst = worst.max(we3.mesh.distance(&d));
-                }
-            }
-        }
-    }
+    let c3 = hard_case_3d()?;
     t.row([
         "3D, waists 600/300/900 nm, v0 = (50, 0, 20) nm/µs".to_string(),
         "rk4".to_string(),
         "1 surface".to_string(),
-        format!(
-            "{} vertices, {} triangles",
-            we3.mesh.vertices.len(),
-            we3.mesh.triangles.len()
-        ),
-        format!("{:.0}", t3 * 1e3),
+        format!("{} vertices, {} triangles", c3.vertices, c3.triangles),
+        format!("{:.0}", c3.build_s * 1e3),
         "true".to_string(),
         format!(
             "{:.2} (sampled displacements outside the mesh, 30³ offsets)",
-            worst / NM
+            c3.worst_nm
         ),
     ])?;
     md.table(&t);

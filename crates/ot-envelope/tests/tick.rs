@@ -238,16 +238,6 @@ fn the_documented_defaults() {
     assert_eq!(ot_envelope::tick::DEFAULT_WARM_DV, 30e-3);
 }
 
-/// `x` rounds to `printed` at `decimals` decimals (two-sided).
-fn assert_printed(what: &str, x: f64, printed: f64, decimals: i32) {
-    let half = 0.5 * 10f64.powi(-decimals);
-    assert!(
-        (x - printed).abs() <= half + 1e-12,
-        "{what}: {x} does not print as {printed:.*}",
-        decimals as usize
-    );
-}
-
 /// docs/ot-envelope.md, "Spread rebuilds", the guarantee: how far the translated envelope is
 /// from converged dynamics at the scene's tick and grid (`scenes/optical_tweezers.toml`: the
 /// budget map at Δt = 0.2 µs, the grid `choose_grid` sizes for the default tolerance). A

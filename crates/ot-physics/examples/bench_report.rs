@@ -15,13 +15,12 @@ mod common;
 use bench_harness::chart::{Chart, Level, PALETTE, Scale, Series, Style, write_grid_png};
 use bench_harness::verdict::speedup_word;
 use bench_harness::{Report, Table, Verdict, span};
-use common::{Problem, Row, cheapest_within, errors, measure, our_settings, peer, time_at_error};
-use nalgebra::Vector2;
-use ot_physics::analysis::{
-    autocorrelation, block_periodogram, fit_corner_aliased, fit_corner_lorentzian, mean_variance,
+use common::{
+    Problem, Row, batch_offsets, cheapest_within, errors, measure, our_settings, peer, thermal,
+    time_at_error,
 };
-use ot_physics::langevin::{Scheme, ThermalRun, simulate};
-use ot_physics::{BOLTZMANN, DEFAULT_RTOL, Method, Phase, Propagator, TrapModel, paper};
+use nalgebra::Vector2;
+use ot_physics::{DEFAULT_RTOL, Method, Propagator, paper};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -265,14 +264,7 @@ struct Batch {
 /// v0 = (100, 100) nm/µs), one thread.
 fn batch_million(p: &Problem, method: Method) -> Result<Batch, BoxError> {
     let n = 1_000_000;
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * paper::OFFSET_SPAN
-    };
-    let offsets: Vec<Vector2<f64>> = (0..n).map(|_| Vector2::new(next(), next())).collect();
+    let offsets = batch_offsets(n);
     let v = [Vector2::from(paper::V0_MOVING)];
     let mut out = vec![Vector2::zeros(); n];
     let prop = Propagator::new(p.model, method, paper::DT)?;
@@ -384,46 +376,14 @@ fn run_scipy(p: &Problem, root: &Path) -> Result<Scipy, String> {
 
 /// The thermal validation of the issue, as a Markdown table.
 fn thermal_validation() -> Result<String, BoxError> {
-    let (kappa, radius, eta, temp, waist, fs) = (1e-4, 0.5e-6, 1.002e-3, 293.15, 1e-6, 78_125.0);
-    let mass = 1050.0 * 4.0 / 3.0 * std::f64::consts::PI * radius * radius * radius;
-    let depth = kappa * waist * waist / (2.0 * std::f64::consts::LN_2);
-    let model = TrapModel::builder(depth, [waist, waist])
-        .mass(mass)
-        .stokes_drag(radius, eta)
-        .temperature(Some(temp))
-        .build()?;
-    let gamma = model.drag.unwrap_or(f64::NAN);
-    let run = ThermalRun {
-        duration: 10.0,
-        sample_rate: fs,
-        substeps: 1,
-        scheme: Scheme::Auto,
-        seed: 20261121,
-    };
-    let start = Phase {
-        r: Vector2::zeros(),
-        v: Vector2::zeros(),
-    };
-    let (xs, s) = span(|| simulate(&model, start, &run));
-    let (xs, secs) = (xs?, s.wall_s);
-    let x: Vec<f64> = xs.iter().map(|p| p.x).collect();
-    let (_, var) = mean_variance(&x);
-    let kt = BOLTZMANN * temp;
-    let fc_true = kappa / (2.0 * std::f64::consts::PI * gamma);
-    let (f, psd) = block_periodogram(&x, fs, 4096);
-    let fc_alias = fit_corner_aliased(&f, &psd, fs).unwrap_or(f64::NAN);
-    let fc_lor = fit_corner_lorentzian(&f, &psd).unwrap_or(f64::NAN);
-    let ac = autocorrelation(&x, 40);
-    let ac_err = ac
-        .iter()
-        .enumerate()
-        .map(|(k, c)| (c - (-kappa * k as f64 / (fs * gamma)).exp()).abs())
-        .fold(0.0, f64::max);
+    let t = thermal()?;
     let mut s = String::new();
     writeln!(
         s,
-        "1 µm polystyrene bead (m = {mass:.3e} kg) in water at 20 °C (η = 1.002 mPa·s), κ = 0.1 pN/nm, 10 s at 78 125 Hz; m/γ = {:.0} ns ≪ 12.8 µs so `auto` picks the overdamped exact-OU scheme. Simulated in {secs:.2} s.\n",
-        mass / gamma * 1e9
+        "1 µm polystyrene bead (m = {:.3e} kg) in water at 20 °C (η = 1.002 mPa·s), κ = 0.1 pN/nm, 10 s at 78 125 Hz; m/γ = {:.0} ns ≪ 12.8 µs so `auto` picks the overdamped exact-OU scheme. Simulated in {:.2} s.\n",
+        t.mass,
+        t.mass / t.gamma * 1e9,
+        t.simulate_s
     )?;
     writeln!(
         s,
@@ -432,28 +392,33 @@ fn thermal_validation() -> Result<String, BoxError> {
     writeln!(
         s,
         "| variance ⟨x²⟩ | kT/κ = {:.3} nm² | {:.3} nm² | {:+.2}% | 1% |",
-        kt / kappa * 1e18,
-        var * 1e18,
-        100.0 * (var / (kt / kappa) - 1.0)
+        t.kt / t.kappa * 1e18,
+        t.var * 1e18,
+        100.0 * (t.var / (t.kt / t.kappa) - 1.0)
     )?;
     writeln!(
         s,
-        "| corner frequency, aliased (AR(1)) fit | κ/(2πγ) = {fc_true:.1} Hz | {fc_alias:.1} Hz | {:+.2}% | 2% |",
-        100.0 * (fc_alias / fc_true - 1.0)
+        "| corner frequency, aliased (AR(1)) fit | κ/(2πγ) = {:.1} Hz | {:.1} Hz | {:+.2}% | 2% |",
+        t.fc_true,
+        t.fc_alias,
+        100.0 * (t.fc_alias / t.fc_true - 1.0)
     )?;
     writeln!(
         s,
-        "| corner frequency, naive Lorentzian fit | {fc_true:.1} Hz | {fc_lor:.1} Hz | {:+.2}% | (biased by aliasing) |",
-        100.0 * (fc_lor / fc_true - 1.0)
+        "| corner frequency, naive Lorentzian fit | {:.1} Hz | {:.1} Hz | {:+.2}% | (biased by aliasing) |",
+        t.fc_true,
+        t.fc_lor,
+        100.0 * (t.fc_lor / t.fc_true - 1.0)
     )?;
     writeln!(
         s,
-        "| autocorrelation vs exp(−κt/γ), lags 0–40 | — | max deviation {ac_err:.4} | — | 0.02 |"
+        "| autocorrelation vs exp(−κt/γ), lags 0–40 | — | max deviation {:.4} | — | 0.02 |",
+        t.ac_err
     )?;
     writeln!(
         s,
         "\nSampling: instantaneous position samples alias the spectrum above fs/2 back into the band, so a continuous Lorentzian fitted to them underestimates nothing at low f but misreads the tail (row 3). We fit the exact spectrum of instantaneously sampled Ornstein–Uhlenbeck motion, `σ²Δt/(1 + c² − 2c·cos 2πfΔt)` with `c = exp(−2π·fc·Δt)` (Berg-Sørensen & Flyvbjerg 2004), on 4096-sample block periodograms averaged over {} blocks; this is unbiased at any sample rate. A fair continuous-Lorentzian fit instead needs fs ≫ fc and a fit band well below fs/2.",
-        x.len() / 4096
+        t.blocks
     )?;
     Ok(s)
 }

@@ -9,13 +9,9 @@
 #[path = "../examples/common/mod.rs"]
 mod common;
 
-use common::{Problem, measure, measure_batch, our_settings, peer};
+use common::{Problem, batch_offsets, measure, measure_batch, our_settings, peer, thermal};
 use nalgebra::Vector2;
-use ot_physics::analysis::{
-    autocorrelation, block_periodogram, fit_corner_aliased, fit_corner_lorentzian, mean_variance,
-};
-use ot_physics::langevin::{Scheme, ThermalRun, simulate};
-use ot_physics::{BOLTZMANN, Method, Phase, Propagator, TrapModel, paper};
+use ot_physics::{Method, Propagator, paper};
 
 /// The work-precision table as printed (method, setting, max error nm, mean error nm, force
 /// evaluations per trajectory), BENCHMARKS.md "Work-precision table".
@@ -208,15 +204,7 @@ fn work_precision_figures() {
         .min_by(|a, b| a.evals_per_traj.total_cmp(&b.evals_per_traj))
         .unwrap();
     assert_eq!(cheapest.setting, "n=4");
-    let n = 1_000_000;
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * paper::OFFSET_SPAN
-    };
-    let offsets: Vec<Vector2<f64>> = (0..n).map(|_| Vector2::new(next(), next())).collect();
+    let offsets = batch_offsets(1_000_000);
     let checked: Vec<Vector2<f64>> = offsets.iter().step_by(500).copied().collect();
     assert_eq!(checked.len(), 2000);
     let v = [Vector2::from(paper::V0_MOVING)];
@@ -242,54 +230,20 @@ fn work_precision_figures() {
 /// naive Lorentzian +41.91 %, the autocorrelation's largest deviation 0.0091, 190 blocks.
 #[test]
 fn thermal_figures() {
-    let (kappa, radius, eta, temp, waist, fs) = (1e-4, 0.5e-6, 1.002e-3, 293.15, 1e-6, 78_125.0);
-    let mass = 1050.0 * 4.0 / 3.0 * std::f64::consts::PI * radius * radius * radius;
-    let depth = kappa * waist * waist / (2.0 * std::f64::consts::LN_2);
-    let model = TrapModel::builder(depth, [waist, waist])
-        .mass(mass)
-        .stokes_drag(radius, eta)
-        .temperature(Some(temp))
-        .build()
-        .unwrap();
-    let gamma = model.drag.unwrap();
-    let run = ThermalRun {
-        duration: 10.0,
-        sample_rate: fs,
-        substeps: 1,
-        scheme: Scheme::Auto,
-        seed: 20261121,
-    };
-    let start = Phase {
-        r: Vector2::zeros(),
-        v: Vector2::zeros(),
-    };
-    let xs = simulate(&model, start, &run).unwrap();
-    let x: Vec<f64> = xs.iter().map(|p| p.x).collect();
-    let (_, var) = mean_variance(&x);
-    let kt = BOLTZMANN * temp;
-    let fc_true = kappa / (2.0 * std::f64::consts::PI * gamma);
-    let (f, psd) = block_periodogram(&x, fs, 4096);
-    let fc_alias = fit_corner_aliased(&f, &psd, fs).unwrap();
-    let fc_lor = fit_corner_lorentzian(&f, &psd).unwrap();
-    let ac = autocorrelation(&x, 40);
-    let ac_err = ac
-        .iter()
-        .enumerate()
-        .map(|(k, c)| (c - (-kappa * k as f64 / (fs * gamma)).exp()).abs())
-        .fold(0.0, f64::max);
+    let t = thermal().unwrap();
     let got = [
-        format!("{mass:.3e}"),
-        format!("{:.0}", mass / gamma * 1e9),
-        format!("{:.3}", kt / kappa * 1e18),
-        format!("{:.3}", var * 1e18),
-        format!("{:+.2}", 100.0 * (var / (kt / kappa) - 1.0)),
-        format!("{fc_true:.1}"),
-        format!("{fc_alias:.1}"),
-        format!("{:+.2}", 100.0 * (fc_alias / fc_true - 1.0)),
-        format!("{fc_lor:.1}"),
-        format!("{:+.2}", 100.0 * (fc_lor / fc_true - 1.0)),
-        format!("{ac_err:.4}"),
-        format!("{}", x.len() / 4096),
+        format!("{:.3e}", t.mass),
+        format!("{:.0}", t.mass / t.gamma * 1e9),
+        format!("{:.3}", t.kt / t.kappa * 1e18),
+        format!("{:.3}", t.var * 1e18),
+        format!("{:+.2}", 100.0 * (t.var / (t.kt / t.kappa) - 1.0)),
+        format!("{:.1}", t.fc_true),
+        format!("{:.1}", t.fc_alias),
+        format!("{:+.2}", 100.0 * (t.fc_alias / t.fc_true - 1.0)),
+        format!("{:.1}", t.fc_lor),
+        format!("{:+.2}", 100.0 * (t.fc_lor / t.fc_true - 1.0)),
+        format!("{:.4}", t.ac_err),
+        format!("{}", t.blocks),
     ];
     assert_eq!(
         got,

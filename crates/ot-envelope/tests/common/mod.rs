@@ -27,3 +27,14 @@ pub fn v(x: f64, y: f64) -> Vector2<f64> {
 }
 
 pub const NM: f64 = 1e-9;
+
+/// `x` rounds to `printed` at `decimals` decimals (two-sided): a figure held to the digit it
+/// is printed with.
+pub fn assert_printed(what: &str, x: f64, printed: f64, decimals: i32) {
+    let half = 0.5 * 10f64.powi(-decimals);
+    assert!(
+        (x - printed).abs() <= half + 1e-12,
+        "{what}: {x} does not print as {printed:.*}",
+        decimals as usize
+    );
+}

@@ -1,9 +1,15 @@
 //! Work-precision measurement on the paper problem, shared by the
-//! `paper_table` and `bench_report` examples.
+//! `paper_table` and `bench_report` examples; the report's batch offsets and thermal-mode run,
+//! shared with `tests/figures.rs`.
 #![allow(dead_code)]
 
+use bench_harness::span;
 use nalgebra::Vector2;
-use ot_physics::{Method, PhysicsError, Propagator, TrapModel, paper};
+use ot_physics::analysis::{
+    autocorrelation, block_periodogram, fit_corner_aliased, fit_corner_lorentzian, mean_variance,
+};
+use ot_physics::langevin::{Scheme, ThermalRun, simulate};
+use ot_physics::{BOLTZMANN, Method, Phase, PhysicsError, Propagator, TrapModel, paper};
 use std::hint::black_box;
 
 /// Start states and their converged displacements.
@@ -331,5 +337,96 @@ pub fn time_at_error(rows: &[Row], method: &str, target_nm: f64) -> Option<f64> 
     pts.windows(2).find_map(|w| {
         let ((e0, c0), (e1, c1)) = (w[0], w[1]);
         (e0 >= t && t >= e1 && e0 > e1).then(|| (c0 + (c1 - c0) * (e0 - t) / (e0 - e1)).exp())
+    })
+}
+
+/// `n` trap offsets from a fixed LCG, uniform in ±`paper::OFFSET_SPAN` in x and y (the
+/// report's 10^6-flow batch).
+pub fn batch_offsets(n: usize) -> Vec<Vector2<f64>> {
+    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * paper::OFFSET_SPAN
+    };
+    (0..n).map(|_| Vector2::new(next(), next())).collect()
+}
+
+/// Samples per block of the thermal run's periodogram.
+pub const THERMAL_BLOCK: usize = 4096;
+
+/// The thermal validation's figures (SI units): a 1 µm polystyrene bead in water at 20 °C,
+/// κ = 0.1 pN/nm, 10 s at 78 125 Hz, seed 20261121.
+pub struct Thermal {
+    /// Trap stiffness κ (N/m).
+    pub kappa: f64,
+    /// The bead's mass (kg).
+    pub mass: f64,
+    /// Stokes drag γ (kg/s; NaN if the model has none).
+    pub gamma: f64,
+    /// kT (J).
+    pub kt: f64,
+    /// Measured variance of x (m²).
+    pub var: f64,
+    /// Expected corner frequency κ/(2πγ) (Hz).
+    pub fc_true: f64,
+    /// Corner frequency of the aliased (AR(1)) fit (Hz; NaN if the fit failed).
+    pub fc_alias: f64,
+    /// Corner frequency of the naive Lorentzian fit (Hz; NaN if the fit failed).
+    pub fc_lor: f64,
+    /// Largest deviation of the autocorrelation from exp(−κt/γ), lags 0–40.
+    pub ac_err: f64,
+    /// Periodogram blocks averaged.
+    pub blocks: usize,
+    /// Wall-clock seconds of `simulate`.
+    pub simulate_s: f64,
+}
+
+/// Runs the thermal validation (BENCHMARKS.md "Thermal mode (harmonic limit)").
+pub fn thermal() -> Result<Thermal, PhysicsError> {
+    let (kappa, radius, eta, temp, waist, fs) = (1e-4, 0.5e-6, 1.002e-3, 293.15, 1e-6, 78_125.0);
+    let mass = 1050.0 * 4.0 / 3.0 * std::f64::consts::PI * radius * radius * radius;
+    let depth = kappa * waist * waist / (2.0 * std::f64::consts::LN_2);
+    let model = TrapModel::builder(depth, [waist, waist])
+        .mass(mass)
+        .stokes_drag(radius, eta)
+        .temperature(Some(temp))
+        .build()?;
+    let gamma = model.drag.unwrap_or(f64::NAN);
+    let run = ThermalRun {
+        duration: 10.0,
+        sample_rate: fs,
+        substeps: 1,
+        scheme: Scheme::Auto,
+        seed: 20261121,
+    };
+    let start = Phase {
+        r: Vector2::zeros(),
+        v: Vector2::zeros(),
+    };
+    let (xs, s) = span(|| simulate(&model, start, &run));
+    let (xs, simulate_s) = (xs?, s.wall_s);
+    let x: Vec<f64> = xs.iter().map(|p| p.x).collect();
+    let (_, var) = mean_variance(&x);
+    let (f, psd) = block_periodogram(&x, fs, THERMAL_BLOCK);
+    let ac = autocorrelation(&x, 40);
+    let ac_err = ac
+        .iter()
+        .enumerate()
+        .map(|(k, c)| (c - (-kappa * k as f64 / (fs * gamma)).exp()).abs())
+        .fold(0.0, f64::max);
+    Ok(Thermal {
+        kappa,
+        mass,
+        gamma,
+        kt: BOLTZMANN * temp,
+        var,
+        fc_true: kappa / (2.0 * std::f64::consts::PI * gamma),
+        fc_alias: fit_corner_aliased(&f, &psd, fs).unwrap_or(f64::NAN),
+        fc_lor: fit_corner_lorentzian(&f, &psd).unwrap_or(f64::NAN),
+        ac_err,
+        blocks: x.len() / THERMAL_BLOCK,
+        simulate_s,
     })
 }
