@@ -1,7 +1,7 @@
 """Power-spectrum calibration of a trap across sampling rates (the aliasing, quantified).
 
 A 1 µm bead (radius 0.5 µm, water at 293.15 K, γ = 6πηr) in a trap of stiffness κ = 1e-4 N/m
-(0.1 pN/nm, corner frequency fc = κ/(2πγ) ≈ 1.69 kHz) is sampled at rates from 1 kHz to
+(0.1 pN/nm, corner frequency fc = κ/(2πγ) ≈ 1.69 kHz) is sampled at rates from 2 kHz to
 100 kHz, 2 s each, with 8 seeds per rate (run_seed of the sweep: every run its own thermal
 stream). Each trace is calibrated as pylake does it — a blocked periodogram, a fit of the
 corner frequency, κ = 2πγ·fc — three ways: with the continuous Lorentzian D/(π²(fc² + f²)),

@@ -140,7 +140,7 @@ def figure(df, tables, path: Path) -> None:
     for r in rows:
         a1.annotate(f"{r[0]}²", (r[2] / 1024, a1.get_ylim()[0]), textcoords="offset points",
                     xytext=(0, 4), ha="center", fontsize=8)
-    a1.set_xlabel(f"cache size, kB (r(θ) at 256 angles, float64; 3² … {rows[-1][0]}² velocities)")
+    a1.set_xlabel(f"cache size, KiB (r(θ) at 256 angles, float64; 3² … {rows[-1][0]}² velocities)")
     a1.set_ylabel("interpolated vs on-line envelope, max |Δr|, nm")
     a1.set_title(f"Bilinear interpolation error at {len(tests_of(df, next(iter(tables))))} random velocities")
     a1.grid(True, which="both", alpha=0.3)
@@ -177,7 +177,7 @@ def main() -> None:
         print(f"Δt = {dt * 1e6:g} µs: {len(cache)} envelopes, {cache['vertices'].sum()} vertices, "
               f"{cache['polygon_bytes'].sum() / 1e6:.2f} MB as polygons, "
               f"{len(cache) * ANGLES * 8 / 1e6:.2f} MB as r(θ) at {ANGLES} angles")
-        print("| velocities | step, nm/µs | cache, kB | median error, nm | largest error, nm | median relative | largest relative |")
+        print("| velocities | step, nm/µs | cache, KiB | median error, nm | largest error, nm | median relative | largest relative |")
         print("|---|---|---|---|---|---|---|")
         for n, step, b, med, mx, rmed, rmx in rows:
             print(f"| {n}² | {step:.2f} | {b / 1024:.1f} | {med:.3f} | {mx:.3f} | {rmed:.1e} | {rmx:.1e} |")
