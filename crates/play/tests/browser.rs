@@ -244,6 +244,10 @@ fn check_recording(out: &std::path::Path, summary: &PlaySummary, page: &Value) {
     );
     assert_eq!(page["sound"]["firstTick"], 0);
     assert_eq!(page["sound"]["gaps"], 0);
+    // The page is cross-origin isolated (the server's headers), so the ticks went to the
+    // synthesis through its shared ring, every one (none waited past the ring's room).
+    assert_eq!(page["sound"]["ring"], true);
+    assert_eq!(page["sound"]["overflow"], 0);
     assert_eq!(
         page["sound"]["ticks"].as_u64(),
         Some(summary.session.stats.ticks)

@@ -38,36 +38,15 @@ mod common;
 
 use common::cdp::{Browser, base64_decode};
 use common::live;
+use common::page::{PageServer, base64, block};
 use haptic_engine::runner::EndReason;
-use haptic_loop::session::{SceneSource, SessionArrays, read_arrays};
-use play::PlayConfig;
+use haptic_loop::session::{SessionArrays, read_arrays};
 use play::protocol::{ServerMsg, SoundKind, SoundOn, SoundTick, SoundTicks};
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// Standard base64 with padding.
-fn base64(b: &[u8]) -> String {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::with_capacity(b.len().div_ceil(3) * 4);
-    for c in b.chunks(3) {
-        let n = (u32::from(c[0]) << 16)
-            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
-            | u32::from(*c.get(2).unwrap_or(&0));
-        for i in 0..4 {
-            if i <= c.len() {
-                s.push(A[(n >> (18 - 6 * i)) as usize & 63] as char);
-            } else {
-                s.push('=');
-            }
-        }
-    }
-    s
 }
 
 /// The recording's sound ticks as the `play` publisher sends them: blocks of
@@ -190,31 +169,6 @@ fn compare(b: &mut Browser, rec: &Path, kind: &str, sr: u32) -> (usize, usize, u
     // Not silence: the recording's impacts or snaps and its tone are in it.
     assert!(peak > 0.1, "{peak}");
     (want.len(), differ, max_ulps, max_abs)
-}
-
-/// A play server for the page's files (its session waits for a Start that never comes), its
-/// recording `name` under the target folder, and a browser on its page.
-struct PageServer {
-    stop: Arc<AtomicBool>,
-    handle: std::thread::JoinHandle<Result<play::PlaySummary, play::PlayError>>,
-}
-
-impl PageServer {
-    fn open(name: &str) -> (Browser, PageServer) {
-        let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
-        let mut c = PlayConfig::new(SceneSource::resolve("wall".as_ref()).unwrap(), out);
-        c.port = 0;
-        let stop = Arc::new(AtomicBool::new(false));
-        let play::Running { url, handle } = play::start(c, stop.clone()).unwrap();
-        let mut b = Browser::launch(800, 600).unwrap();
-        b.open(&url).unwrap();
-        (b, PageServer { stop, handle })
-    }
-
-    fn close(self) {
-        self.stop.store(true, Ordering::Relaxed);
-        let _ = self.handle.join();
-    }
 }
 
 #[test]
@@ -558,32 +512,6 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_no_underrun_lengthens_it() 
     server.close();
 }
 
-/// A sound-ticks message from `first` of `walls.len()` ticks (their wall times, ms), with a
-/// thud on each tick of `sounds` ([tick, index]), base64.
-fn block(first: u64, walls: &[f64], sounds: &[[u64; 2]]) -> String {
-    let m = SoundTicks {
-        first_tick: first,
-        tone_on_distance_m: None,
-        ticks: walls
-            .iter()
-            .map(|&wall_ms| SoundTick {
-                wall_ms,
-                nearest_m: 1.0,
-            })
-            .collect(),
-        sounds: sounds
-            .iter()
-            .map(|&[tick, index]| SoundOn {
-                tick,
-                index: index as u32,
-                kind: SoundKind::Thud,
-                amplitude: 0.5,
-            })
-            .collect(),
-    };
-    base64(&m.encode())
-}
-
 /// The link's route (route.js), driven in the page with no socket and no clock: what reaches
 /// the worklet's port, in order, and the counts the page reads. A lesson's second world
 /// restarts the stream after the first world's finish and before its own first ticks; a
@@ -652,7 +580,8 @@ fn the_links_route_keeps_restarts_and_finishes_in_the_order_of_the_ticks() {
     // (Whole milliseconds come back from the page as integers.)
     let counts = |messages, ticks, sounds, first: i64, next, gaps, restarts, sent, link| {
         json!({"messages": messages, "ticks": ticks, "sounds": sounds, "firstTick": first,
-            "nextTick": next, "gaps": gaps, "restarts": restarts, "sent": sent, "linkMs": link})
+            "nextTick": next, "gaps": gaps, "restarts": restarts, "overflow": 0, "sent": sent,
+            "linkMs": link})
     };
     assert_eq!(
         v["lesson"],

@@ -14,11 +14,19 @@ use std::time::Duration;
 /// How long the loop sleeps when no connection is waiting, ms.
 const IDLE_MS: u64 = 5;
 
-/// Writes a complete response (`Connection: close`, never cached); `extra` is more header
-/// lines, each ending in `\r\n`.
+/// The cross-origin isolation every response asks for: a page of ours shares no window with
+/// another origin's (`Cross-Origin-Opener-Policy`), loads nothing another origin did not
+/// offer (`Cross-Origin-Embedder-Policy`; every page loads only its own server's files), and
+/// is loaded by no other origin's page (`Cross-Origin-Resource-Policy`). An isolated page may
+/// share memory between its threads (`SharedArrayBuffer`): the play page's sound ring
+/// (docs/play.md).
+pub const ISOLATION: &str = "Cross-Origin-Opener-Policy: same-origin\r\nCross-Origin-Embedder-Policy: require-corp\r\nCross-Origin-Resource-Policy: same-origin\r\n";
+
+/// Writes a complete response (`Connection: close`, never cached, cross-origin isolated:
+/// [`ISOLATION`]); `extra` is more header lines, each ending in `\r\n`.
 pub fn respond(stream: &mut TcpStream, status: &str, ctype: &str, extra: &str, body: &[u8]) {
     let head = format!(
-        "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n{extra}Connection: close\r\n\r\n",
+        "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n{ISOLATION}{extra}Connection: close\r\n\r\n",
         body.len()
     );
     let _ = stream.write_all(head.as_bytes());
@@ -246,5 +254,28 @@ mod tests {
             "the request line is not `METHOD TARGET HTTP/1.1`\n"
         );
         assert_eq!((counts.head, counts.total()), (1, 1));
+    }
+
+    #[test]
+    fn every_answer_asks_for_cross_origin_isolation() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let mut client = TcpStream::connect(listener.local_addr().unwrap()).unwrap();
+        let (mut server, _) = listener.accept().unwrap();
+        respond(&mut server, "200 OK", "text/html", "X-Extra: 1\r\n", b"<p>");
+        drop(server);
+        let mut a = String::new();
+        client.read_to_string(&mut a).unwrap();
+        let (head, body) = a.split_once("\r\n\r\n").unwrap();
+        let lines: Vec<&str> = head.split("\r\n").collect();
+        for want in [
+            "Cross-Origin-Opener-Policy: same-origin",
+            "Cross-Origin-Embedder-Policy: require-corp",
+            "Cross-Origin-Resource-Policy: same-origin",
+            "X-Extra: 1",
+            "Content-Length: 3",
+        ] {
+            assert!(lines.contains(&want), "{want} in {lines:?}");
+        }
+        assert_eq!(body, "<p>");
     }
 }

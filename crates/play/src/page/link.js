@@ -9,7 +9,8 @@
 //
 // From the page: `{ open: URL }` opens the socket; `{ send: TEXT }` sends a page message (not
 // when the socket is not open); `{ audio: 'on' | 'none' }` the audio opened, or there is none;
-// `{ port }` the synthesis's port. To the page: a text message (a string); `{ counts }` the
+// `{ port }` the synthesis's port, or `{ ring }` its ring (a SharedArrayBuffer, route.js's
+// SoundRing; on a cross-origin isolated page). To the page: a text message (a string); `{ counts }` the
 // route's report; `{ stamp: MS }` the wall time of a tick with a sound, when the link passes
 // it on (the page times tick → its main thread from it); `{ closed: true }` the server
 // closed the link.
@@ -44,9 +45,11 @@ self.onmessage = (e) => {
   const m = e.data;
   if (typeof m.send === 'string') { if (ws && ws.readyState === 1) ws.send(m.send); }
   else if (m.port) route.connect(m.port);
+  else if (m.ring) route.connectRing(m.ring);
   else if (m.audio === 'on') route.audioOn();
   else if (m.audio === 'none') route.audioNone();
   else if (typeof m.open === 'string' && ws === null) open(m.open);
 };
 
-setInterval(report, 100);
+// The counts, and what waited for room in the ring, every 100 ms.
+setInterval(() => { route.flush(); report(); }, 100);

@@ -9,21 +9,69 @@
 // else after the last tick the page heard. Until the audio opens (the Start press) the ticks
 // are not kept; while the synthesis loads they wait (at most WAITING_MAX messages).
 
-// Sound-ticks messages kept while the synthesis loads.
+// Sound-ticks messages kept while the synthesis loads (or while its ring is full).
 const WAITING_MAX = 2000;
+// The kinds of a ring's records (synth.js's RingReader reads them): a sound-ticks message, a
+// restart, a finish (its payload the ticks, an f64).
+const RING_TICKS = 0, RING_RESTART = 1, RING_FINISH = 2;
+
+// The sound ring's writing end (the reading end is synth.js's RingReader): a
+// SharedArrayBuffer the link worker writes and the worklet reads at the start of each render
+// quantum, so a sound tick reaches the synthesis without a task on the audio thread (a
+// message on its port waits for the thread's next task, after a burst of quanta it renders
+// back to back). Its layout: two Int32 offsets into the data, where the writer writes next and
+// where the reader reads next (equal: empty; the writer leaves one byte free), then the data,
+// a byte ring of records: the payload's length (u32), the kind (u32), the payload.
+export class SoundRing {
+  constructor(sab) {
+    this.at = new Int32Array(sab, 0, 2);
+    this.data = new Uint8Array(sab, 8);
+    this.cap = this.data.length;
+  }
+
+  // Writes one record of `kind` with payload `bytes` (a Uint8Array); false, writing nothing,
+  // when it does not fit.
+  write(kind, bytes) {
+    const w = Atomics.load(this.at, 0), r = Atomics.load(this.at, 1);
+    const used = (w - r + this.cap) % this.cap;
+    if (8 + bytes.length > this.cap - 1 - used) return false;
+    const head = new Uint8Array(8), dv = new DataView(head.buffer);
+    dv.setUint32(0, bytes.length, true); dv.setUint32(4, kind, true);
+    const end = this.put(bytes, this.put(head, w));
+    // The offset is stored last: the reader sees a record whole or not at all.
+    Atomics.store(this.at, 0, end);
+    return true;
+  }
+
+  put(src, at) {
+    const first = Math.min(src.length, this.cap - at);
+    this.data.set(src.subarray(0, first), at);
+    if (first < src.length) this.data.set(src.subarray(first), 0);
+    return (at + src.length) % this.cap;
+  }
+}
+
+// A message for the synthesis as a ring record [kind, payload].
+function record(m) {
+  if (m instanceof ArrayBuffer) return [RING_TICKS, new Uint8Array(m)];
+  if (m.restart) return [RING_RESTART, new Uint8Array(0)];
+  const b = new Uint8Array(8);
+  new DataView(b.buffer).setFloat64(0, m.finish, true);
+  return [RING_FINISH, b];
+}
 // The first bytes of a message of each of the types the route looks at, as serde_json writes
 // a ServerMsg (`{"type":"hello",...}`: the tag first, no spaces).
 const HELLO = '{"type":"hello"', END = '{"type":"end"', LESSON = '{"type":"lesson"';
 
 export class SoundRoute {
   constructor() {
-    // 'off' (no audio yet), 'waiting' (the synthesis loads), 'port' (it plays), 'none'
-    // (no sound in this browser).
-    this.audio = 'off'; this.port = null; this.waiting = [];
+    // 'off' (no audio yet), 'waiting' (the synthesis loads), 'port' or 'ring' (it plays, fed
+    // through its port or its ring), 'none' (no sound in this browser).
+    this.audio = 'off'; this.port = null; this.ring = null; this.waiting = [];
     this.lesson = false; this.hello = false;
     // The counts the tests and benches read (window.__play.sound), and what is new in the
     // lists since the last report.
-    this.counts = { messages: 0, ticks: 0, sounds: 0, firstTick: -1, nextTick: 0, gaps: 0, restarts: 0 };
+    this.counts = { messages: 0, ticks: 0, sounds: 0, firstTick: -1, nextTick: 0, gaps: 0, restarts: 0, overflow: 0 };
     this.sent = []; this.linkMs = []; this.kept = 0; this.timed = 0; this.dirty = false;
   }
 
@@ -85,11 +133,25 @@ export class SoundRoute {
 
   finish(ticks) { this.deliver({ finish: ticks }, false); }
 
-  // To the synthesis, or kept while it loads (sound ticks up to WAITING_MAX); nothing before
-  // the audio opens or when there is none.
+  // To the synthesis, or kept while it loads or its ring is full (sound ticks up to
+  // WAITING_MAX; a sound tick beyond is counted in `overflow`); nothing before the audio
+  // opens or when there is none.
   deliver(m, bounded) {
-    if (this.audio === 'port') this.port.postMessage(m, m instanceof ArrayBuffer ? [m] : []);
-    else if (this.audio === 'waiting' && (!bounded || this.waiting.length < WAITING_MAX)) this.waiting.push(m);
+    if (this.audio === 'off' || this.audio === 'none') return;
+    if (this.audio === 'port') { this.port.postMessage(m, m instanceof ArrayBuffer ? [m] : []); return; }
+    if (this.audio === 'ring' && this.flush() && this.ring.write(...record(m))) return;
+    if (!bounded || this.waiting.length < WAITING_MAX) this.waiting.push(m);
+    else { this.counts.overflow++; this.dirty = true; }
+  }
+
+  // What waited, into the ring while it fits; true when nothing waits. The link calls it on
+  // its timer too, so what waited goes on when no more ticks come.
+  flush() {
+    if (this.audio !== 'ring') return this.waiting.length === 0;
+    let n = 0;
+    while (n < this.waiting.length && this.ring.write(...record(this.waiting[n]))) n++;
+    if (n > 0) this.waiting.splice(0, n);
+    return this.waiting.length === 0;
   }
 
   // The audio opened (the Start press): keep the ticks until the synthesis's port comes.
@@ -101,6 +163,14 @@ export class SoundRoute {
     this.port = port; this.audio = 'port';
     for (const m of this.waiting) port.postMessage(m, m instanceof ArrayBuffer ? [m] : []);
     this.waiting = [];
+  }
+
+  // The synthesis's ring (a SharedArrayBuffer, SoundRing's layout): what waited first, then
+  // everything as it comes.
+  connectRing(sab) {
+    if (this.audio === 'none') return;
+    this.ring = new SoundRing(sab); this.audio = 'ring';
+    this.flush();
   }
 
   // No sound in this browser: nothing is kept.

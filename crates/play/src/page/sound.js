@@ -24,6 +24,9 @@ const LEAD_MAX_S = 0.03;
 // bursts of 3 to 4 quanta at 'interactive').
 const LATENCY_HINT_S = 0.001;
 const SYNTH_URL = new URL('./synth.js', import.meta.url);
+// The sound ring's data, bytes: 1 MiB, about 30 s of the server's sound ticks (a 2-tick
+// message is about 56 bytes, 500 a second) should the audio thread stop reading.
+const RING_BYTES = 1 << 20;
 
 // Opens the audio output (on the Start press: a user gesture) and loads the synthesis.
 export function startAudio() {
@@ -40,10 +43,20 @@ export function startAudio() {
       });
       node.port.onmessage = (e) => onWorklet(e.data);
       node.connect(gain);
-      // The link's port to the worklet: the sound ticks (and what waited) go through it.
-      const ch = new MessageChannel();
-      node.port.postMessage({ link: ch.port1 }, [ch.port1]);
-      toLink({ port: ch.port2 }, [ch.port2]);
+      // The link's way to the worklet: the sound ticks (and what waited) go through it. A
+      // ring both read and write (shared memory, on a cross-origin isolated page: the server
+      // asks for it), else a port of their own.
+      if (globalThis.crossOriginIsolated && typeof SharedArrayBuffer === 'function') {
+        const ring = new SharedArrayBuffer(8 + RING_BYTES);
+        node.port.postMessage({ ring });
+        toLink({ ring });
+        P.sound.ring = true;
+      } else {
+        const ch = new MessageChannel();
+        node.port.postMessage({ link: ch.port1 }, [ch.port1]);
+        toLink({ port: ch.port2 }, [ch.port2]);
+        P.sound.ring = false;
+      }
     }).catch(() => { node = null; toLink({ audio: 'none' }); say('sound is not available in this browser'); });
     // The link keeps the ticks from now until the worklet's port comes.
     toLink({ audio: 'on' });
@@ -64,7 +77,7 @@ export function onLinkReport(d) {
   const s = P.sound;
   if (d.counts) {
     const c = d.counts;
-    for (const k of ['messages', 'ticks', 'sounds', 'firstTick', 'nextTick', 'gaps', 'restarts']) s[k] = c[k];
+    for (const k of ['messages', 'ticks', 'sounds', 'firstTick', 'nextTick', 'gaps', 'restarts', 'overflow']) s[k] = c[k];
     for (const x of c.sent) s.sent.push(x);
     for (const x of c.linkMs) s.linkMs.push(x);
   } else if (Number.isFinite(d.stamp) && s.pageMs.length < 100000) s.pageMs.push(Date.now() - d.stamp);

@@ -223,6 +223,34 @@ class Fifo {
   clear(first) { this.head = 0; this.tail = 0; this.first = first; }
 }
 
+// The sound ring's reading end (route.js's SoundRing writes it; the layout is there): the
+// records the link worker wrote, in order, each once.
+class RingReader {
+  constructor(sab) {
+    this.at = new Int32Array(sab, 0, 2);
+    this.data = new Uint8Array(sab, 8);
+    this.cap = this.data.length;
+  }
+
+  // The next record, [kind, payload (an ArrayBuffer of its own)], or null when there is none.
+  next() {
+    const w = Atomics.load(this.at, 0), r = Atomics.load(this.at, 1);
+    if (w === r) return null;
+    const dv = new DataView(this.get(r, 8).buffer);
+    const len = dv.getUint32(0, true), kind = dv.getUint32(4, true);
+    const body = this.get((r + 8) % this.cap, len);
+    Atomics.store(this.at, 1, (r + 8 + len) % this.cap);
+    return [kind, body.buffer];
+  }
+
+  get(at, n) {
+    const out = new Uint8Array(n), first = Math.min(n, this.cap - at);
+    out.set(this.data.subarray(at, at + first));
+    if (first < n) out.set(this.data.subarray(0, n - first), first);
+    return out;
+  }
+}
+
 // The audio thread's render cadence, in the wall clock: quanta rendered back to back (within
 // 1 ms of the one before; Date.now() counts whole ms) are one callback of the output device. A
 // device that renders k quanta at a time makes every arrival look up to k quanta late against
@@ -303,11 +331,15 @@ class Synth extends AudioWorkletProcessor {
     }
     // The node's port (the page), and the link worker's (`{ link: MessagePort }`, sent by the
     // page through the node's): sound ticks, restarts and finishes, in the order they came.
+    // Or the link worker's ring (`{ ring: SharedArrayBuffer }`, on a cross-origin isolated
+    // page): the same, read at the start of each render quantum (`drain`).
+    this.ring = null;
     const onMessage = (e) => {
       if (e.data instanceof ArrayBuffer) this.take(e.data, Date.now());
       else if (e.data && Number.isFinite(e.data.finish)) this.finish(e.data.finish);
       else if (e.data && e.data.restart) this.restart();
       else if (e.data && e.data.link) e.data.link.onmessage = onMessage;
+      else if (e.data && e.data.ring) this.ring = new RingReader(e.data.ring);
     };
     this.port.onmessage = onMessage;
   }
@@ -428,9 +460,21 @@ class Synth extends AudioWorkletProcessor {
     return [early, late];
   }
 
+  // Everything the ring holds, in the order it was written (route.js's record kinds: 0 sound
+  // ticks, 1 restart, 2 finish).
+  drain(nowMs) {
+    for (let r = this.ring.next(); r !== null; r = this.ring.next()) {
+      const [kind, buf] = r;
+      if (kind === 0) this.take(buf, nowMs);
+      else if (kind === 1) this.restart();
+      else if (kind === 2 && buf.byteLength === 8) this.finish(new DataView(buf).getFloat64(0, true));
+    }
+  }
+
   process(inputs, outputs) {
     const out = outputs[0][0];
     if (!out) return true;
+    if (this.ring !== null) this.drain(Date.now());
     if (!this.offline) this.cadence.quantum(Date.now());
     const r = this.render(out);
     this.clock += out.length;

@@ -3,6 +3,7 @@ pub mod cdp;
 pub mod class;
 pub mod live;
 pub mod module;
+pub mod page;
 pub mod pilot;
 
 use std::path::PathBuf;
