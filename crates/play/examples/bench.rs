@@ -216,7 +216,7 @@ fn session(
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
-        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs, S.cadence]; })()")?;
+        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs, S.cadence, S.spread]; })()")?;
         for p in v[5].as_array().into_iter().flatten() {
             for (k, part) in parts.iter_mut().take(3).enumerate() {
                 if let Some(x) = p[k].as_f64() {
@@ -258,6 +258,13 @@ fn session(
             eprintln!(
                 "{scene}: the audio thread rendered {} quanta a callback (largest {}), one every {} ms p50, {} ms p99 ({} callbacks)",
                 c["quanta"][0], c["quanta"][1], c["ms"][0], c["ms"][1], c["callbacks"]
+            );
+        }
+        let sp = &v[17];
+        if sp.is_object() {
+            eprintln!(
+                "{scene}: each sound-ticks message's lateness past its 4 s window's earliest (what sizes the lead) p50 {} ms, p99 {} ms, p99.9 {} ms, largest {} ms ({} messages; 0.5 ms bins)",
+                sp["ms"][0], sp["ms"][1], sp["ms"][2], sp["ms"][3], sp["messages"]
             );
         }
         b.check()?;

@@ -249,6 +249,9 @@ struct LivePath {
     heard: live::Heard,
     leads: Vec<[f64; 3]>,
     lead_ms: f64,
+    /// The messages' lateness past their window's earliest, ms: p50, p99, p99.9, the largest
+    /// (each its 0.5 ms bin's start).
+    spread_ms: [f64; 4],
 }
 
 /// Plays the recording's sound ticks through the worklet's live path at `sr` Hz over `link`,
@@ -328,6 +331,7 @@ fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> L
         heard,
         leads,
         lead_ms: v["live"]["leadMs"].as_f64().unwrap(),
+        spread_ms: [0, 1, 2, 3].map(|k| v["live"]["spread"]["ms"][k].as_f64().unwrap()),
     }
 }
 
@@ -395,9 +399,23 @@ fn the_worklets_live_path_plays_the_samples_of_render_audio() {
         let path = workspace().join(format!("recordings/{rec}.mcap"));
         let p = live_path(&mut b, &path, kind, sr, &Link::idle());
         let h = &p.heard;
-        println!("{rec}, idle page, {sr} Hz: {h:?}, lead {} ms", p.lead_ms);
+        println!(
+            "{rec}, idle page, {sr} Hz: {h:?}, lead {} ms, spread {:?} ms",
+            p.lead_ms, p.spread_ms
+        );
         // An idle page: every sample of the track, every sound, no underrun, no drop.
         assert_eq!((h.underruns, h.dropped), (0, 0), "{rec}: {h:?}");
+        // The messages' lateness past their window's earliest (the probe, in 0.5 ms bins):
+        // the 3 ms jitter plus the wait for the next quantum at most, most of the jitter at
+        // least; the median within it.
+        let (lo, hi) = lead_for(3.0, sr);
+        let [p50, _, _, largest] = p.spread_ms;
+        assert!(
+            (lo - MARGIN_MS - 0.5..=hi - MARGIN_MS).contains(&largest),
+            "{rec}: {:?}",
+            p.spread_ms
+        );
+        assert!((0.5..=largest).contains(&p50), "{rec}: {:?}", p.spread_ms);
         assert_eq!(h.played_samples, h.track_samples);
         assert_eq!((h.played, h.lost), (h.sent, 0));
         assert!(h.sent > 0);

@@ -90,7 +90,7 @@ function onWorklet(m) {
   const s = P.sound;
   if (m.kind === 'done') {
     s.live = m;
-    s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence;
+    s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence; s.spread = m.spread;
   }
   else if (m.kind === 'stream') s.streams.push(m);
   else if (m.kind === 'lost') s.lost.push([m.tick, m.index]);
@@ -104,7 +104,7 @@ function onWorklet(m) {
 // getOutputTimestamp() (the output's own estimate of when it plays), minus the same.
 function onRendered(m) {
   const s = P.sound;
-  s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence;
+  s.underruns = m.underruns; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence; s.spread = m.spread;
   if (s.latencyMs.length >= 100000) return;
   const outS = actx.outputLatency || 0, baseS = actx.baseLatency || 0;
   s.outputLatencyS = outS; s.baseLatencyS = baseS;

@@ -7,7 +7,9 @@
 // ±0.98 ceiling limited to it. Its input is the server's binary sound ticks (protocol/sound.rs's
 // SoundTicks): per tick its wall time and nearest distance, and the sounds starting on it,
 // with the restarts and finishes, which come from the page's link worker (link.js, route.js)
-// on a MessagePort of their own (the page posts it to the node's port as `{ link: port }`).
+// through a ring in shared memory it reads before each render quantum (the page posts the
+// SharedArrayBuffer to the node's port as `{ ring: sab }`), or, without shared memory, on a
+// MessagePort of their own (`{ link: port }`).
 //
 // The samples go through a FIFO to the output, which plays a lead behind the processor's
 // clock sized from the ticks' measured arrival jitter. The processor counts the samples it
@@ -251,6 +253,18 @@ class RingReader {
   }
 }
 
+// Counts of values in bins of `width` from 0 (the last bin: everything from its start on),
+// and the nearest-rank percentiles of what was counted, as the bin's start.
+class Hist {
+  constructor(bins, width) { this.bins = new Uint32Array(bins); this.width = width; this.n = 0; }
+  add(x) { this.bins[Math.min(this.bins.length - 1, Math.max(0, Math.floor(x / this.width)))]++; this.n++; }
+  at(q) {
+    let c = 0;
+    for (let b = 0; b < this.bins.length; b++) { c += this.bins[b]; if (c >= q * this.n) return b * this.width; }
+    return (this.bins.length - 1) * this.width;
+  }
+}
+
 // The audio thread's render cadence, in the wall clock: quanta rendered back to back (within
 // 1 ms of the one before; Date.now() counts whole ms) are one callback of the output device. A
 // device that renders k quanta at a time makes every arrival look up to k quanta late against
@@ -261,7 +275,7 @@ class Cadence {
   constructor() {
     this.last = -Infinity; this.start = -Infinity; this.size = 0;
     this.sizes = new Uint32Array(33); // callbacks by their quanta (32: 32 or more)
-    this.gaps = new Uint32Array(201); // callbacks by the ms from the one before (200: 200 or more)
+    this.gaps = new Hist(201, 1); // callbacks by the ms from the one before (200: 200 or more)
   }
 
   quantum(now) {
@@ -269,7 +283,7 @@ class Cadence {
     else {
       if (this.size > 0) {
         this.sizes[Math.min(this.size, 32)]++;
-        if (Number.isFinite(this.start)) this.gaps[Math.min(200, now - this.start)]++;
+        if (Number.isFinite(this.start)) this.gaps.add(now - this.start);
       }
       this.start = now; this.size = 1;
     }
@@ -279,15 +293,14 @@ class Cadence {
   // The quanta of a callback (the most frequent, the largest) and the ms between callbacks
   // (p50, p99); null before two callbacks.
   report() {
-    let mode = 0, max = 0, n = 0;
+    let mode = 0, max = 0;
     for (let k = 1; k < this.sizes.length; k++) {
       if (this.sizes[k] > this.sizes[mode]) mode = k;
       if (this.sizes[k]) max = k;
     }
-    for (const c of this.gaps) n += c;
-    if (!n) return null;
-    const at = (q) => { let c = 0; for (let g = 0; g < this.gaps.length; g++) { c += this.gaps[g]; if (c >= q * n) return g; } return this.gaps.length - 1; };
-    return { quanta: [mode, max], ms: [at(0.5), at(0.99)], callbacks: n };
+    const g = this.gaps;
+    if (!g.n) return null;
+    return { quanta: [mode, max], ms: [g.at(0.5), g.at(0.99)], callbacks: g.n };
   }
 }
 
@@ -319,6 +332,9 @@ class Synth extends AudioWorkletProcessor {
     this.minLevel = Infinity; this.quanta = 0;
     this.offline = !!o.offline;
     this.cadence = new Cadence();
+    // Each message's lateness past its window's earliest, in 0.5 ms bins to 100 ms (a probe:
+    // what sizes the lead, the bulk or its rare late messages).
+    this.spread = new Hist(201, 0.5);
     // What was heard: the FNV-1a hash of the samples played, their count, the first one's
     // session index, a checkpoint of the hash every second played, the [index, count] of each
     // drop, the restarts after a long gap; `ending`: the stream was finished.
@@ -430,6 +446,7 @@ class Synth extends AudioWorkletProcessor {
     const k = this.bucket % LATE_BUCKETS;
     if (late > this.late[k]) this.late[k] = late;
     if (late < this.early[k]) this.early[k] = late;
+    this.spread.add((late - this.window()[0]) / sampleRate * 1000);
     this.sizeLead();
   }
 
@@ -541,11 +558,14 @@ class Synth extends AudioWorkletProcessor {
   }
 
   // The lead past the window's earliest arrival and the window's jitter (its largest minus
-  // its smallest lateness), ms (null: nothing measured), and the render cadence.
+  // its smallest lateness), ms (null: nothing measured), the render cadence, and the messages'
+  // lateness past their window's earliest, ms (p50, p99, p99.9, the largest bin's start).
   leadReport() {
     const [early, late] = this.window();
     const ms = (x) => (Number.isFinite(x) ? x / sampleRate * 1000 : null);
-    return { leadMs: ms(this.lead - early), jitterMs: ms(late - early), cadence: this.cadence.report() };
+    const sp = this.spread;
+    const spread = sp.n ? { ms: [sp.at(0.5), sp.at(0.99), sp.at(0.999), sp.at(1)], messages: sp.n } : null;
+    return { leadMs: ms(this.lead - early), jitterMs: ms(late - early), cadence: this.cadence.report(), spread };
   }
 
   // The counts and what was heard (`kind`: 'done' at the end of the stream).
