@@ -110,7 +110,8 @@ fn the_ring_carries_what_the_port_would_in_the_same_order() {
 /// A ring of 199 bytes of room holds three 64-byte tick records: the fourth and fifth wait;
 /// the reader's room lets the route's flush write them, across the ring's end; every record
 /// comes out once, in order. Full with 2000 waiting, the next tick message is counted in
-/// `overflow` (and not kept); the finish after it still waits, and comes last.
+/// `overflow` (and not kept); the finish after it still waits, and comes last. A tick message
+/// larger than the whole ring is counted and holds up nothing behind it.
 #[test]
 fn a_full_ring_keeps_the_order_and_counts_what_it_could_not_keep() {
     let (mut b, server) = PageServer::open("nh-sound-ring-full.mcap");
@@ -141,7 +142,12 @@ fn a_full_ring_keeps_the_order_and_counts_what_it_could_not_keep() {
     for (const d of drain(reader2)) {{ if (d.startsWith('ticks')) ticks++; last = d; }}
     r2.flush();
   }}
-  return {{ waited, some, wrote, rest, counted, ticks, last }};
+  // A message larger than the whole ring is counted and holds up nothing behind it.
+  const r3 = new SoundRoute(), sab3 = new SharedArrayBuffer(8 + 40), reader3 = new RingReader(sab3);
+  r3.audioOn(); r3.binary(blocks[0].slice(0), 0); r3.binary(blocks[1].slice(0), 0); r3.finish(4);
+  r3.connectRing(sab3);
+  const huge = [r3.report().overflow, drain(reader3)];
+  return {{ waited, some, wrote, rest, counted, ticks, last, huge }};
 }})()"#,
         prelude = prelude(),
         blocks = json!(blocks),
@@ -155,6 +161,9 @@ fn a_full_ring_keeps_the_order_and_counts_what_it_could_not_keep() {
     assert_eq!(v["counted"], 1);
     assert_eq!(v["ticks"], 2003);
     assert_eq!(v["last"], r#"{"finish":7}"#);
+    // A ring of 39 bytes of room never holds a 64-byte tick record: both are counted, and
+    // the 16-byte finish behind them still comes.
+    assert_eq!(v["huge"], json!([2, [r#"{"finish":4}"#]]));
     b.check().unwrap();
     server.close();
 }

@@ -43,6 +43,9 @@ export class SoundRing {
     return true;
   }
 
+  // Whether a record of `n` payload bytes fits in the ring when it is empty.
+  holds(n) { return 8 + n <= this.cap - 1; }
+
   put(src, at) {
     const first = Math.min(src.length, this.cap - at);
     this.data.set(src.subarray(0, first), at);
@@ -139,9 +142,9 @@ export class SoundRoute {
   deliver(m, bounded) {
     if (this.audio === 'off' || this.audio === 'none') return;
     if (this.audio === 'port') { this.port.postMessage(m, m instanceof ArrayBuffer ? [m] : []); return; }
-    if (this.audio === 'ring' && this.flush() && this.ring.write(...record(m))) return;
+    if (this.audio === 'ring' && this.flush() && this.put(m)) return;
     if (!bounded || this.waiting.length < WAITING_MAX) this.waiting.push(m);
-    else { this.counts.overflow++; this.dirty = true; }
+    else this.overflow();
   }
 
   // What waited, into the ring while it fits; true when nothing waits. The link calls it on
@@ -149,10 +152,20 @@ export class SoundRoute {
   flush() {
     if (this.audio !== 'ring') return this.waiting.length === 0;
     let n = 0;
-    while (n < this.waiting.length && this.ring.write(...record(this.waiting[n]))) n++;
+    while (n < this.waiting.length && this.put(this.waiting[n])) n++;
     if (n > 0) this.waiting.splice(0, n);
     return this.waiting.length === 0;
   }
+
+  // `m` into the ring: true when written, or when it could never fit (counted in `overflow`,
+  // so it holds up nothing behind it); false when the ring is too full for it now.
+  put(m) {
+    const [kind, bytes] = record(m);
+    if (!this.ring.holds(bytes.length)) { this.overflow(); return true; }
+    return this.ring.write(kind, bytes);
+  }
+
+  overflow() { this.counts.overflow++; this.dirty = true; }
 
   // The audio opened (the Start press): keep the ticks until the synthesis's port comes.
   audioOn() { if (this.audio === 'off') this.audio = 'waiting'; }
