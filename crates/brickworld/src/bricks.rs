@@ -7,8 +7,8 @@
 
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{
-    ActiveHooks, ColliderBuilder, ColliderHandle, FrictionModel, PhysicsHooks, PhysicsWorld,
-    RigidBodyBuilder, RigidBodyHandle, RigidBodyType,
+    ActiveHooks, ColliderBuilder, ColliderHandle, FrictionModel, PhysicsWorld, RigidBodyBuilder,
+    RigidBodyHandle, RigidBodyType,
 };
 use serde::Serialize;
 
@@ -16,6 +16,7 @@ use crate::error::WorldError;
 use crate::event::{Body, BrickId, Touch};
 use crate::impact::hook::ImpactHook;
 use crate::params::{BrickPlacement, BrickProps, Lo, Params, finite3, placement, range};
+use crate::rest::{BRICK_HOOKS, ContactMode};
 
 /// Half-extent of the ground slab in x and y, m (the ground is a 100 m × 100 m slab whose top
 /// face is the plane z = 0).
@@ -99,6 +100,10 @@ pub(crate) struct BrickSet {
     ground: ColliderHandle,
     obstacles: Vec<ColliderHandle>,
     bricks: Vec<Brick>,
+    /// Whether the coming step is quiet (see [`crate::rest`]).
+    contacts: ContactMode,
+    /// Largest distance, m, of a brick's point from its centre.
+    radius_m: f64,
 }
 
 impl BrickSet {
@@ -148,11 +153,15 @@ impl BrickSet {
             );
             obstacles.push(co);
         }
+        let contacts = ContactMode::new(&mut phys);
+        let h = params.brick_half_extents_m;
         let mut set = BrickSet {
             phys,
             ground,
             obstacles,
             bricks: Vec::new(),
+            contacts,
+            radius_m: h[0].hypot(h[1]).hypot(h[2]),
         };
         for b in &params.bricks {
             set.insert(params, b, &BrickProps::default());
@@ -170,8 +179,21 @@ impl BrickSet {
         self.phys.integration_parameters.dt = dt;
     }
 
+    /// Decides whether the coming step is quiet (see [`crate::rest`]; never when `allowed` is
+    /// false) and sets rapier up for it; returns whether it is.
+    pub(crate) fn prepare_step(&mut self, allowed: bool) -> bool {
+        let bricks = self.bricks.iter().map(|b| (b.body, b.collider));
+        self.contacts
+            .before_step(&mut self.phys, bricks, self.radius_m, allowed)
+    }
+
+    /// Whether the last step ran quiet (see [`crate::rest`]).
+    pub(crate) fn quiet(&self) -> bool {
+        self.contacts.is_quiet()
+    }
+
     /// Advances rapier by one `dt_s` with the contact-modification `hook`.
-    pub(crate) fn step(&mut self, hook: &dyn PhysicsHooks) {
+    pub(crate) fn step(&mut self, hook: &ImpactHook) {
         self.phys.step_with_events(hook, &());
     }
 
@@ -197,9 +219,11 @@ impl BrickSet {
                 .friction(props.friction.unwrap_or(params.friction))
                 .restitution(props.restitution.unwrap_or(params.restitution))
                 .user_data(TAG_BRICK | id.0 as u128)
-                .active_hooks(
-                    ActiveHooks::FILTER_CONTACT_PAIRS | ActiveHooks::MODIFY_SOLVER_CONTACTS,
-                ),
+                .active_hooks(if self.contacts.is_quiet() {
+                    ActiveHooks::empty()
+                } else {
+                    BRICK_HOOKS
+                }),
             Some(body),
         );
         if let Some(rb) = self.phys.bodies.get_mut(body) {
@@ -424,6 +448,8 @@ impl BrickSet {
         for (_, co) in self.phys.all_colliders_mut() {
             co.set_restitution(e);
         }
+        // A recycled contact keeps the material it was computed with (see `crate::rest`).
+        self.contacts.refresh();
         self.phys.wake_up_all(true);
     }
 
@@ -432,6 +458,8 @@ impl BrickSet {
         for (_, co) in self.phys.all_colliders_mut() {
             co.set_friction(mu);
         }
+        // A recycled contact keeps the material it was computed with (see `crate::rest`).
+        self.contacts.refresh();
         self.phys.wake_up_all(true);
     }
 
@@ -447,6 +475,7 @@ impl BrickSet {
                 rb.recompute_mass_properties_from_colliders(&self.phys.colliders);
             }
         }
+        self.contacts.refresh();
         self.phys.wake_up_all(true);
     }
 }

@@ -47,6 +47,7 @@ pub mod input;
 pub mod local;
 pub mod params;
 pub mod proxy;
+pub mod rest;
 pub mod script;
 pub mod spawner;
 pub mod world;

@@ -58,7 +58,7 @@ pub struct World {
     /// What the device renders, in the world's units.
     limits: Limits,
     /// Ground, obstacles and bricks: rapier's bodies and colliders.
-    bricks: BrickSet,
+    pub(crate) bricks: BrickSet,
     /// The cursor proxy and what it carries.
     hand: Hand,
     /// The blueprint's slots and what fills them.
@@ -71,6 +71,8 @@ pub struct World {
     tick: u64,
     /// Keep the contacts the hook would skip as idle (the crate's tests compare the two ways).
     keep_idle_contacts: bool,
+    /// Never run a step quiet (see [`crate::rest`]; the crate's tests compare the two ways).
+    pub(crate) never_quiet: bool,
 }
 
 impl World {
@@ -89,6 +91,7 @@ impl World {
             limits: *limits,
             tick: 0,
             keep_idle_contacts: false,
+            never_quiet: false,
         })
     }
 
@@ -304,6 +307,12 @@ impl World {
         )
     }
 
+    /// Whether the last step ran quiet: every awake brick slower than
+    /// [`crate::rest::QUIET_SPEED_M_PER_S`], resting contacts reused (see [`crate::rest`]).
+    pub fn quiet(&self) -> bool {
+        self.bricks.quiet()
+    }
+
     /// Number of bricks the physics engine currently simulates (awake), for cost accounting.
     pub fn awake_brick_count(&self) -> usize {
         self.bricks.awake_count()
@@ -329,13 +338,23 @@ impl World {
             .step(cursor, proxy, params, bricks, &mut events);
 
         // 6. Rigid-body physics (the sleep veto first: see `BrickSet::veto_sleep`).
+        // A quiet step (see `crate::rest`) has no impact to solve or report and no hook. It
+        // is never taken while the hand touches or carries something: what the hand feels is
+        // computed from contacts computed afresh.
         bricks.veto_sleep(params, self.tick);
-        let mut hook = ImpactHook::for_step(&bricks.phys);
+        let hand_free = self.hand.touching().is_empty() && self.hand.held_brick().is_none();
+        let quiet = bricks.prepare_step(!self.keep_idle_contacts && !self.never_quiet && hand_free);
+        let mut hook = if quiet {
+            ImpactHook::quiet(&bricks.phys)
+        } else {
+            ImpactHook::for_step(&bricks.phys)
+        };
         hook.keep_idle = self.keep_idle_contacts;
-        self.impacts.before_step(&bricks.phys, bricks.bodies());
+        self.impacts
+            .before_step(&bricks.phys, bricks.bodies(), quiet);
         bricks.step(&hook);
         self.impacts
-            .after_step(&bricks.phys, |c| bricks.body_of(c), &mut events);
+            .after_step(&bricks.phys, |c| bricks.body_of(c), quiet, &mut events);
 
         // 7. Blueprint.
         self.slots
@@ -420,6 +439,9 @@ impl World {
 }
 
 #[cfg(test)]
+mod quiet_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -428,6 +450,25 @@ mod tests {
             center_m: c,
             rotation_deg: [0.0; 3],
         }
+    }
+
+    /// A floor of 5 × 4 bricks laid 5 mm apart on the ground, sleeping off.
+    pub(super) fn floor() -> Params {
+        let mut p = Params {
+            sleeping: false,
+            ..Params::default()
+        };
+        let h = p.brick_half_extents_m;
+        for i in 0..5 {
+            for j in 0..4 {
+                p.bricks.push(at([
+                    i as f64 * (2.0 * h[0] + 0.005),
+                    j as f64 * (2.0 * h[1] + 0.005),
+                    h[2],
+                ]));
+            }
+        }
+        p
     }
 
     /// Every brick's pose and velocity, bit for bit.
@@ -443,14 +484,17 @@ mod tests {
             .collect()
     }
 
+    /// `ticks` steps of a world of `p` and `extra`, keeping idle contacts or not, never quiet
+    /// or quiet when it can be.
     fn run(
         p: &Params,
-        keep_idle: bool,
+        (keep_idle, never_quiet): (bool, bool),
         ticks: usize,
         extra: &[(BrickPlacement, BrickProps)],
     ) -> World {
         let mut w = World::new(p, &Limits::FALCON).unwrap();
         w.keep_idle_contacts = keep_idle;
+        w.never_quiet = never_quiet;
         for (pl, props) in extra {
             w.add_brick_with(*pl, *props).unwrap();
         }
@@ -485,22 +529,9 @@ mod tests {
     /// The floor stays put either way, to the micrometre.
     #[test]
     fn idle_speculative_contacts_of_a_floor_are_skipped() {
-        let mut p = Params {
-            sleeping: false,
-            ..Params::default()
-        };
-        let h = p.brick_half_extents_m;
-        for i in 0..5 {
-            for j in 0..4 {
-                p.bricks.push(at([
-                    i as f64 * (2.0 * h[0] + 0.005),
-                    j as f64 * (2.0 * h[1] + 0.005),
-                    h[2],
-                ]));
-            }
-        }
-        let skip = run(&p, false, 500, &[]);
-        let keep = run(&p, true, 500, &[]);
+        let p = floor();
+        let skip = run(&p, (false, false), 500, &[]);
+        let keep = run(&p, (true, true), 500, &[]);
         assert_eq!(solver_contacts(&skip), (80, 0));
         let (n, idle) = solver_contacts(&keep);
         assert!(n > 80 && idle == n - 80, "{n} solver contacts, {idle} idle");
@@ -512,7 +543,8 @@ mod tests {
         }
     }
 
-    /// Where no contact is idle the skipping changes nothing, to the bit: a settling stack of
+    /// Where no contact is idle the skipping changes nothing, to the bit (neither run quiet,
+    /// whose recycled contacts differ in the last bits: see `crate::rest`): a settling stack of
     /// ten bricks (every contact touching), and a brick dropped from 1.5 m beside it onto the
     /// ground (its pair with the ground is within rapier's prediction distance only once it
     /// is within 4 steps of closing anyway).
@@ -524,8 +556,8 @@ mod tests {
             .map(|i| at([0.0, 0.0, h[2] * (2 * i + 1) as f64]))
             .collect();
         let drop = [(at([0.6, 0.0, h[2] + 1.5]), BrickProps::default())];
-        let skip = run(&p, false, 2000, &drop);
-        let keep = run(&p, true, 2000, &drop);
+        let skip = run(&p, (false, true), 2000, &drop);
+        let keep = run(&p, (true, true), 2000, &drop);
         assert_eq!(state(&skip), state(&keep));
         // The dropped brick did land and rest.
         let b = skip.brick(BrickId(10)).unwrap();
@@ -550,8 +582,8 @@ mod tests {
                 wall.push((at([x, 0.0, h[2] * (2 * c + 1) as f64]), props));
             }
         }
-        let a = run(&p, false, 1500, &wall);
-        let b = run(&p, false, 1500, &wall);
+        let a = run(&p, (false, false), 1500, &wall);
+        let b = run(&p, (false, false), 1500, &wall);
         assert_eq!(state(&a), state(&b));
         // The top half fell: some brick of it is now below its start height by a course.
         let fell = a

@@ -50,13 +50,6 @@ fn the_solver_fields_default_to_today_and_are_range_checked() {
 }
 
 /// The largest distance any brick moved between two snapshots, m.
-fn moved(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>().sqrt())
-        .fold(0.0, f64::max)
-}
-
 #[test]
 fn the_scene_opts_into_a_cheaper_solver() {
     let (p, d) = (fast(), Params::default());
@@ -108,16 +101,7 @@ fn a_wall_of_200_bricks_stands() {
     let mut p = fast();
     p.sleeping = false;
     let h = p.brick_half_extents_m;
-    for c in 0..20 {
-        let shift = if c % 2 == 0 { 0.0 } else { h[0] };
-        for i in 0..10 {
-            p.bricks.push(at([
-                (i as f64 - 4.5) * (2.0 * h[0] + 0.001) + shift - h[0] / 2.0,
-                0.0,
-                h[2] * (2 * c + 1) as f64,
-            ]));
-        }
-    }
+    running_bond_wall(&mut p);
     let mut w = world(p);
     for _ in 0..1000 {
         idle(&mut w, PARK);

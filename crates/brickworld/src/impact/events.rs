@@ -10,7 +10,9 @@
 //! until the bounces are slower than the threshold.
 
 use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::{ColliderHandle, PairContacts, PhysicsWorld, RigidBodyHandle};
+use rapier3d_f64::prelude::{
+    ColliderHandle, ContactPair, PairContacts, PhysicsWorld, RigidBodyHandle, RigidPairContacts,
+};
 
 use super::IMPACT_MIN_SPEED_M_PER_S;
 use crate::event::{Body, Event};
@@ -23,6 +25,8 @@ pub struct ImpactTracker {
     cur: Vec<Key>,
     /// Velocities (linear, angular) of dynamic bodies just before the step.
     before: Vec<(RigidBodyHandle, Vector, Vector)>,
+    /// `prev` was not kept up to date over quiet steps: rebuild it before the next other step.
+    stale: bool,
 }
 
 /// A collider pair by the handles' raw parts, smaller first.
@@ -34,12 +38,29 @@ fn key(a: ColliderHandle, b: ColliderHandle) -> Key {
 }
 
 impl ImpactTracker {
-    /// Remembers the velocities of `bodies` before the step.
+    /// Remembers the velocities of `bodies` before the step. A `quiet` step (see
+    /// [`crate::rest`]: no two bodies close at [`IMPACT_MIN_SPEED_M_PER_S`]) has no impact, and
+    /// the tracker skips it: before the next other step it rebuilds, from the contacts as they
+    /// are, the pairs that carried impulse after the last one.
     pub fn before_step(
         &mut self,
         phys: &PhysicsWorld,
         bodies: impl Iterator<Item = RigidBodyHandle>,
+        quiet: bool,
     ) {
+        if quiet {
+            self.stale = true;
+            return;
+        }
+        if std::mem::take(&mut self.stale) {
+            self.prev.clear();
+            for pair in phys.narrow_phase.contact_pairs() {
+                if carried_impulse(pair).is_some() && super::pair_colliders(phys, pair).is_some() {
+                    self.prev.push(key(pair.collider1, pair.collider2));
+                }
+            }
+            self.prev.sort_unstable();
+        }
         self.before.clear();
         for h in bodies {
             if let Some(rb) = phys.bodies.get(h) {
@@ -71,33 +92,27 @@ impl ImpactTracker {
     }
 
     /// Appends an [`Event::Impact`] for each contact that began this step fast enough;
-    /// `body_of` names a collider's body.
+    /// `body_of` names a collider's body. A `quiet` step is skipped (see
+    /// [`ImpactTracker::before_step`]).
     pub fn after_step(
         &mut self,
         phys: &PhysicsWorld,
         body_of: impl Fn(ColliderHandle) -> Body,
+        quiet: bool,
         events: &mut Vec<Event>,
     ) {
+        if quiet {
+            return;
+        }
         self.cur.clear();
         let mut found: Vec<(Key, ColliderHandle, ColliderHandle, f64, f64, Vector)> = Vec::new();
         for pair in phys.narrow_phase.contact_pairs() {
-            let PairContacts::Rigid(rc) = &pair.contacts else {
+            let Some((rc, impulse, points)) = carried_impulse(pair) else {
                 continue;
             };
             let Some((c1, c2)) = super::pair_colliders(phys, pair) else {
                 continue;
             };
-            let mut impulse = 0.0;
-            let mut points = 0usize;
-            for m in &rc.manifolds {
-                for p in &m.points {
-                    impulse += p.data.impulse;
-                    points += 1;
-                }
-            }
-            if impulse <= 0.0 || points == 0 {
-                continue;
-            }
             let k = key(pair.collider1, pair.collider2);
             self.cur.push(k);
             if self.prev.binary_search(&k).is_ok() {
@@ -145,4 +160,21 @@ impl ImpactTracker {
             });
         }
     }
+}
+
+/// A pair's rigid contacts, their total normal impulse (N·s) and number of points, if the pair
+/// carried impulse on the last step.
+fn carried_impulse(pair: &ContactPair) -> Option<(&RigidPairContacts, f64, usize)> {
+    let PairContacts::Rigid(rc) = &pair.contacts else {
+        return None;
+    };
+    let mut impulse = 0.0;
+    let mut points = 0usize;
+    for m in &rc.manifolds {
+        for p in &m.points {
+            impulse += p.data.impulse;
+            points += 1;
+        }
+    }
+    (impulse > 0.0 && points > 0).then_some((rc, impulse, points))
 }

@@ -155,6 +155,21 @@ impl ImpactHook {
     /// above it. An off-centre load keeps every support point: its lever arms are physical.
     /// `phys` is the world before the step.
     pub fn for_step(phys: &PhysicsWorld) -> ImpactHook {
+        Self::build(phys)
+    }
+
+    /// The hook of a quiet step (see [`crate::rest`]): no brick has hooks then, so it keeps no
+    /// table and has no impact.
+    pub fn quiet(phys: &PhysicsWorld) -> ImpactHook {
+        ImpactHook {
+            impacted: Vec::new(),
+            dt_s: phys.integration_parameters.dt,
+            reach: Vec::new(),
+            keep_idle: false,
+        }
+    }
+
+    fn build(phys: &PhysicsWorld) -> ImpactHook {
         // Most steps of a resting or sleeping world have no fast support contact at all: find
         // that out cheaply first (a contact between bodies that do not move cannot approach),
         // and only then build the support links the impact would follow.
