@@ -23,8 +23,9 @@
 //! colliders of ground, obstacles and bricks; placement checks; views), [`hand`] (cursor proxy,
 //! grab / release / throw / turn, the felt force with weight and inertia, scaled to the
 //! device's [`world_form::Limits`]), [`blueprint`] (slots and score), [`spawner`] (the loading zone),
-//! [`impact`] (what an impact is; its restitution in the solver and its events), [`event`] (what a
-//! step reports) and [`world`], which holds the [`World`] (parameters, limits and those sets)
+//! [`impact`] (what an impact is; its restitution in the solver and its events), [`rest`] (quiet
+//! steps: resting contacts reused while nothing moves), [`event`] (what a step reports) and
+//! [`world`], which holds the [`World`] (parameters, limits and those sets)
 //! and orchestrates [`World::step`].
 //!
 //! ```

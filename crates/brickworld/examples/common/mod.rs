@@ -119,10 +119,15 @@ pub struct Timing {
 
 /// Times `n` ticks with the cursor parked.
 pub fn time_parked(w: &mut World, n: usize) -> Timing {
+    time_moving(w, n, |_| PARK)
+}
+
+/// Times `n` ticks with the cursor at `at(k)` on tick `k`, no buttons.
+pub fn time_moving(w: &mut World, n: usize, at: impl Fn(usize) -> [f64; 3]) -> Timing {
     let mut t = Timings::with_capacity(n);
     let mut awake = 0;
-    for _ in 0..n {
-        let i = w.input(PARK, Grip::default()).unwrap();
+    for k in 0..n {
+        let i = w.input(at(k), Grip::default()).unwrap();
         t.time(|| std::hint::black_box(w.step(&i)));
         awake = awake.max(w.awake_brick_count());
     }
@@ -131,4 +136,15 @@ pub fn time_parked(w: &mut World, n: usize) -> Timing {
         wall: t.wall_us().expect("n > 0 ticks"),
         awake,
     }
+}
+
+/// Times `n` ticks of the hand sweeping through the scene at `speed_m_per_s` along y, back and
+/// forth between y = ±0.5 m, at height `z_m` over x = 0 (the cursor pushes what it meets).
+pub fn time_sweep(w: &mut World, n: usize, z_m: f64, speed_m_per_s: f64) -> Timing {
+    let dt = w.params().dt_s;
+    time_moving(w, n, |k| {
+        // A triangle wave of amplitude 0.5 m starting at y = -0.5.
+        let s = (k as f64 * dt * speed_m_per_s).rem_euclid(2.0);
+        [0.0, if s < 1.0 { s - 0.5 } else { 1.5 - s }, z_m]
+    })
 }
