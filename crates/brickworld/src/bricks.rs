@@ -7,8 +7,8 @@
 
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{
-    ActiveHooks, ColliderBuilder, ColliderHandle, FrictionModel, PhysicsWorld, RigidBodyBuilder,
-    RigidBodyHandle, RigidBodyType,
+    ActiveHooks, ColliderBuilder, ColliderHandle, FrictionModel, IntegrationParameters,
+    PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, RigidBodyType,
 };
 use serde::Serialize;
 
@@ -17,6 +17,32 @@ use crate::event::{Body, BrickId, Touch};
 use crate::impact::hook::ImpactHook;
 use crate::params::{BrickPlacement, BrickProps, Lo, Params, finite3, placement, range};
 use crate::rest::{BRICK_HOOKS, ContactMode};
+
+/// rapier's `length_unit` for the brick world, m: 1/32 (a power of two, see
+/// [`scale_to_length_unit`]).
+///
+/// rapier's broad phase pads every collider's box by `0.04 × length_unit` beyond its contact
+/// margin, so that a box is moved in its tree only when the collider leaves the padding: with
+/// rapier's default unit (1, for worlds in metres) that is 4 cm around a 6 cm-thick brick, and
+/// every brick is paired with each neighbour within 10 cm, all of them pairs the impact hook
+/// then filters out step after step. At 1/32 the padding is 1.25 mm. Every other parameter
+/// that rapier scales by the unit is divided by it ([`scale_to_length_unit`]), so each physical
+/// value is what it was, bit for bit (the goldens replay unchanged); a knocked-over wall and a
+/// wall swept by the hand cost about a tenth less (BENCHMARKS.md, "Quiet steps").
+pub const LENGTH_UNIT: f64 = 1.0 / 32.0;
+
+/// Sets rapier's `length_unit` to [`LENGTH_UNIT`] and divides every parameter rapier scales
+/// by it, so that each physical value stays as it was to the bit (a division by a power of
+/// two is exact).
+fn scale_to_length_unit(p: &mut IntegrationParameters) {
+    let l = LENGTH_UNIT / p.length_unit;
+    p.length_unit = LENGTH_UNIT;
+    p.normalized_allowed_linear_error /= l;
+    p.normalized_max_corrective_velocity /= l;
+    p.normalized_prediction_distance /= l;
+    p.normalized_max_linear_velocity /= l;
+    p.normalized_contact_recycle_distance /= l;
+}
 
 /// Half-extent of the ground slab in x and y, m (the ground is a 100 m × 100 m slab whose top
 /// face is the plane z = 0).
@@ -114,6 +140,7 @@ impl BrickSet {
         phys.gravity = Vector::new(0.0, 0.0, -params.gravity_m_per_s2);
         phys.integration_parameters.dt = params.dt_s;
         phys.integration_parameters.num_solver_iterations = params.solver_iterations;
+        scale_to_length_unit(&mut phys.integration_parameters);
         // rapier's default friction model (one friction constraint per manifold plus a twist
         // constraint) matches Coulomb's law on a ramp: onset at tan θ = μ within 0.1° and the
         // sliding acceleration to 4 digits; the per-point `Coulomb` model slides up to 1° early
@@ -227,7 +254,8 @@ impl BrickSet {
             Some(body),
         );
         if let Some(rb) = self.phys.bodies.get_mut(body) {
-            rb.activation_mut().normalized_linear_threshold = SLEEP_SPEED_M_PER_S;
+            rb.activation_mut().normalized_linear_threshold =
+                SLEEP_SPEED_M_PER_S / self.phys.integration_parameters.length_unit;
             if props.velocity_m_per_s != [0.0; 3] {
                 rb.set_linvel(Vector::from_array(props.velocity_m_per_s), true);
             }

@@ -440,6 +440,8 @@ impl World {
 
 #[cfg(test)]
 mod quiet_tests;
+#[cfg(test)]
+mod unit_tests;
 
 #[cfg(test)]
 mod tests {
@@ -454,6 +456,11 @@ mod tests {
 
     /// A floor of 5 × 4 bricks laid 5 mm apart on the ground, sleeping off.
     pub(super) fn floor() -> Params {
+        floor_with_gaps(0.005)
+    }
+
+    /// A floor of 5 × 4 bricks laid `gap_m` apart on the ground, sleeping off.
+    pub(super) fn floor_with_gaps(gap_m: f64) -> Params {
         let mut p = Params {
             sleeping: false,
             ..Params::default()
@@ -462,8 +469,8 @@ mod tests {
         for i in 0..5 {
             for j in 0..4 {
                 p.bricks.push(at([
-                    i as f64 * (2.0 * h[0] + 0.005),
-                    j as f64 * (2.0 * h[1] + 0.005),
+                    i as f64 * (2.0 * h[0] + gap_m),
+                    j as f64 * (2.0 * h[1] + gap_m),
                     h[2],
                 ]));
             }
