@@ -130,6 +130,8 @@ pub(crate) struct BrickSet {
     contacts: ContactMode,
     /// Largest distance, m, of a brick's point from its centre.
     radius_m: f64,
+    /// Whether bricks may sleep ([`Params::sleeping`]).
+    sleeping: bool,
 }
 
 impl BrickSet {
@@ -189,6 +191,7 @@ impl BrickSet {
             bricks: Vec::new(),
             contacts,
             radius_m: h[0].hypot(h[1]).hypot(h[2]),
+            sleeping: params.sleeping,
         };
         for b in &params.bricks {
             set.insert(params, b, &BrickProps::default());
@@ -210,8 +213,13 @@ impl BrickSet {
     /// false) and sets rapier up for it; returns whether it is.
     pub(crate) fn prepare_step(&mut self, allowed: bool) -> bool {
         let bricks = self.bricks.iter().map(|b| (b.body, b.collider));
-        self.contacts
-            .before_step(&mut self.phys, bricks, self.radius_m, allowed)
+        self.contacts.before_step(
+            &mut self.phys,
+            bricks,
+            self.radius_m,
+            allowed,
+            !self.sleeping,
+        )
     }
 
     /// Whether the last step ran quiet (see [`crate::rest`]).

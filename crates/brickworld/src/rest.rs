@@ -24,19 +24,24 @@
 //! friction, restitution or mass makes the next step a full one: a
 //! recycled pair keeps the material it was computed with.
 //!
+//! **Where nothing can sleep** (`Params::sleeping` off), a step that turns quiet also marks
+//! every brick collider moved, so that rapier fits its broad-phase box to the short prediction
+//! distance and drops the pairs of neighbours no longer within it, each otherwise checked every
+//! step (20 bricks laid 5 mm apart keep their 20 ground pairs of 75, test); marking a collider
+//! wakes the bodies it touches, hence only where none sleeps.
+//!
 //! **What it costs in accuracy.** A recycled pair keeps its contact normal and points, frozen
 //! to the bodies, until the pair moved [`RECYCLE_DISTANCE_M`] (0.1 mm); rapier measures that
 //! motion with the larger collider's extent, so a brick on the 100 m ground slab refreshes its
-//! ground pair after a turn of 0.7 µrad. Measured (BENCHMARKS.md, `brickworld-report
-//! errors`): the error table is unchanged but for the 200-brick wall's drift from 1 s to 5 s,
-//! 0.0003 → 0.0001 mm (default solver) and 0.0174 → 0.0127 mm (the scene's), each a test. The
-//! recycle distance is not a free knob: rapier re-anchors a refreshed pair where it is, and at
-//! 1 mm the default solver's wall crept 0.28 mm in 4 s (and before the 50 ms wait, at 1 µm, the
-//! scene's 7.4 mm). A drop onto
-//! a resting stack gives the same impacts on the same ticks as with no quiet steps (test).
+//! ground pair after a turn of 0.7 µrad. Measured (BENCHMARKS.md, `brickworld-report errors`):
+//! the error table is unchanged at both shipped settings but for the 200-brick wall's drift
+//! from 1 s to 5 s under the scene's, 0.0174 → 0.0127 mm (tests `quiet::a_quiet_wall_stands`,
+//! `fast_solver::a_wall_of_200_bricks_stands`); settings that let the wall creep without quiet
+//! steps let it creep more (1 iteration at 250 Hz: 5.9 → 12.1 mm in 4 s). A drop onto a resting
+//! stack gives the same impacts on the same ticks as with no quiet steps (test).
 //! A brick that falls asleep after creeping quiet to the edge of its broad-phase box (rapier's
-//! boxes are 4 cm fatter than the shape) can keep a box fattened by the short prediction only;
-//! a fast brick then meets it 11 mm ahead instead of 20 mm: 2.5 steps at 4.4 m/s (a 1 m drop),
+//! boxes are padded beyond the shape) can keep a box fattened by the short prediction only; a
+//! fast brick then meets it 11 mm ahead instead of 20 mm: 2.5 steps at 4.4 m/s (a 1 m drop),
 //! where the impact rule reads the manifold 2 steps ahead.
 
 use rapier3d_f64::prelude::{ActiveHooks, ColliderHandle, PhysicsWorld, RigidBodyHandle};
@@ -109,6 +114,8 @@ impl ContactMode {
     /// Sets the mode of the coming step from the bricks (`(body, collider)`, no point farther
     /// than `radius_m` from the centre of mass) and returns whether it is quiet: if `allowed`
     /// and every awake brick is dynamic and slower than [`QUIET_SPEED_M_PER_S`] at every point.
+    /// With `refit` (no brick can sleep), a step that turns quiet also fits the bricks'
+    /// broad-phase boxes to the short prediction distance.
     /// Then no impact can be solved or reported (two bricks close slower than the impact rule's
     /// [`IMPACT_MIN_SPEED_M_PER_S`]), and the hook has nothing to do.
     pub(crate) fn before_step(
@@ -117,6 +124,7 @@ impl ContactMode {
         bricks: impl Iterator<Item = (RigidBodyHandle, ColliderHandle)> + Clone,
         radius_m: f64,
         allowed: bool,
+        refit: bool,
     ) -> bool {
         let refresh = std::mem::take(&mut self.refresh);
         let slow = allowed && !refresh && all_slow(phys, bricks.clone(), radius_m);
@@ -145,6 +153,15 @@ impl ContactMode {
                 } else {
                     BRICK_HOOKS
                 });
+                if quiet && refit {
+                    // The collider's broad-phase box still has the 2 cm margin: marking the
+                    // collider moved has rapier fit it to the short one, and drop the pairs of
+                    // neighbours no longer within it. (It also wakes the bodies it touches, so
+                    // only where none can sleep.)
+                    if let Some(pose) = co.position_wrt_parent().copied() {
+                        co.set_position_wrt_parent(pose);
+                    }
+                }
             }
         }
         quiet
