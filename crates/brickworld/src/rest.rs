@@ -3,8 +3,9 @@
 //!
 //! rapier 0.36 reuses ("recycles") a contact pair whose colliders' relative pose moved less than
 //! its recycle distance since the pair's last full update, but never a pair in which either
-//! collider has active hooks, and the brick world's [`crate::impact::hook::ImpactHook`] needs the hooks for two jobs:
-//! the impact rule (a fast landing merged to one point) and skipping idle speculative contacts,
+//! collider has active hooks, and the brick world's [`crate::impact::hook::ImpactHook`] needs
+//! the hooks for two jobs: the impact rule (a fast landing merged to one point) and skipping
+//! idle speculative contacts,
 //! which exist because rapier's 2 cm prediction distance looks several steps ahead for the
 //! impact rule. While every brick is slower than [`QUIET_SPEED_M_PER_S`], neither job has
 //! anything to do that a short prediction distance does not do as well:
@@ -21,8 +22,8 @@
 //! rapier recycles their resting pairs; the first step that is not quiet turns the hooks and
 //! the 2 cm prediction back on for every brick before it is solved. The decision reads only
 //! the world's state, so a replay makes the same decisions on the same ticks. Changing
-//! friction, restitution or mass makes the next step a full one: a
-//! recycled pair keeps the material it was computed with.
+//! friction, restitution or mass makes the next step a full one: a recycled pair keeps the
+//! material it was computed with.
 //!
 //! **Where nothing can sleep** (`Params::sleeping` off), a step that turns quiet also marks
 //! every brick collider moved, so that rapier fits its broad-phase box to the short prediction
@@ -73,13 +74,14 @@ pub fn quiet_prediction_m(dt_s: f64) -> f64 {
     2.0 * SPECULATIVE_KEEP_M + PAIR_LOOKAHEAD_STEPS * dt_s * 2.0 * QUIET_SPEED_M_PER_S
 }
 
-/// Whether the last step was quiet, and rapier's own prediction distance to go back to.
+/// Whether the last step was quiet, what decides the next, and rapier's own prediction distance
+/// to go back to.
 #[derive(Debug, Clone)]
 pub(crate) struct ContactMode {
     quiet: bool,
     /// The next step must not be quiet, so that every pair is computed afresh.
     refresh: bool,
-    /// Consecutive steps before this one with every brick slow.
+    /// Consecutive steps, the coming one included, with every brick slow before it.
     slow_steps: u32,
     /// rapier's normalized prediction distance outside quiet steps.
     normal_prediction: f64,
@@ -113,11 +115,11 @@ impl ContactMode {
 
     /// Sets the mode of the coming step from the bricks (`(body, collider)`, no point farther
     /// than `radius_m` from the centre of mass) and returns whether it is quiet: if `allowed`
-    /// and every awake brick is dynamic and slower than [`QUIET_SPEED_M_PER_S`] at every point.
-    /// With `refit` (no brick can sleep), a step that turns quiet also fits the bricks'
-    /// broad-phase boxes to the short prediction distance.
-    /// Then no impact can be solved or reported (two bricks close slower than the impact rule's
-    /// [`IMPACT_MIN_SPEED_M_PER_S`]), and the hook has nothing to do.
+    /// and every awake brick is dynamic and has been slower than [`QUIET_SPEED_M_PER_S`] at
+    /// every point for [`QUIET_AFTER_S`]. Then no impact can be solved or reported (two bricks
+    /// close slower than the impact rule's [`IMPACT_MIN_SPEED_M_PER_S`]), and the hook has
+    /// nothing to do. With `refit` (no brick can sleep), a step that turns quiet also fits the
+    /// bricks' broad-phase boxes to the short prediction distance.
     pub(crate) fn before_step(
         &mut self,
         phys: &mut PhysicsWorld,

@@ -58,7 +58,7 @@ pub struct World {
     /// What the device renders, in the world's units.
     limits: Limits,
     /// Ground, obstacles and bricks: rapier's bodies and colliders.
-    pub(crate) bricks: BrickSet,
+    bricks: BrickSet,
     /// The cursor proxy and what it carries.
     hand: Hand,
     /// The blueprint's slots and what fills them.
@@ -72,7 +72,7 @@ pub struct World {
     /// Keep the contacts the hook would skip as idle (the crate's tests compare the two ways).
     keep_idle_contacts: bool,
     /// Never run a step quiet (see [`crate::rest`]; the crate's tests compare the two ways).
-    pub(crate) never_quiet: bool,
+    never_quiet: bool,
 }
 
 impl World {

@@ -147,17 +147,6 @@ impl Reach {
 }
 
 impl ImpactHook {
-    /// The bodies of an impact about to be solved (see [`ImpactHook`]): a body touched by a
-    /// support contact (within 45° of vertical) approaching faster than
-    /// [`IMPACT_MIN_SPEED_M_PER_S`] at its centroid — a new contact, or a resting one that the body
-    /// above has just driven down — whose load passes through the body's centre of mass
-    /// (within [`CENTRAL_LOAD_M`]), and, through such central supports, the bodies below and
-    /// above it. An off-centre load keeps every support point: its lever arms are physical.
-    /// `phys` is the world before the step.
-    pub fn for_step(phys: &PhysicsWorld) -> ImpactHook {
-        Self::build(phys)
-    }
-
     /// The hook of a quiet step (see [`crate::rest`]): no brick has hooks then, so it keeps no
     /// table and has no impact.
     pub fn quiet(phys: &PhysicsWorld) -> ImpactHook {
@@ -169,7 +158,14 @@ impl ImpactHook {
         }
     }
 
-    fn build(phys: &PhysicsWorld) -> ImpactHook {
+    /// The bodies of an impact about to be solved (see [`ImpactHook`]): a body touched by a
+    /// support contact (within 45° of vertical) approaching faster than
+    /// [`IMPACT_MIN_SPEED_M_PER_S`] at its centroid — a new contact, or a resting one that the body
+    /// above has just driven down — whose load passes through the body's centre of mass
+    /// (within [`CENTRAL_LOAD_M`]), and, through such central supports, the bodies below and
+    /// above it. An off-centre load keeps every support point: its lever arms are physical.
+    /// `phys` is the world before the step.
+    pub fn for_step(phys: &PhysicsWorld) -> ImpactHook {
         // Most steps of a resting or sleeping world have no fast support contact at all: find
         // that out cheaply first (a contact between bodies that do not move cannot approach),
         // and only then build the support links the impact would follow.
