@@ -119,16 +119,7 @@ fn wall_error(p: &Params) -> (f64, f64) {
         ..p.clone()
     };
     let h = p.brick_half_extents_m;
-    for c in 0..20 {
-        let shift = if c % 2 == 0 { 0.0 } else { h[0] };
-        for i in 0..10 {
-            p.bricks.push(at([
-                (i as f64 - 4.5) * (2.0 * h[0] + 0.001) + shift - h[0] / 2.0,
-                0.0,
-                h[2] * (2 * c + 1) as f64,
-            ]));
-        }
-    }
+    common::running_bond_wall(&mut p);
     let top0 = h[2] * 39.0;
     let mut w = World::new(&p, &Limits::FALCON).unwrap();
     for _ in 0..1000 {

@@ -75,6 +75,22 @@ pub fn layers(p: &Params, layers: usize, gap_m: f64) -> World {
     World::new(&p, &Limits::FALCON).expect("valid scene")
 }
 
+/// Adds to `p` a 200-brick wall of 20 courses in running bond (1 mm joints), 1.2 m high,
+/// standing on the ground (the report's wall, and the tests' through `tests/common`).
+pub fn running_bond_wall(p: &mut Params) {
+    let h = p.brick_half_extents_m;
+    for c in 0..20 {
+        let shift = if c % 2 == 0 { 0.0 } else { h[0] };
+        for i in 0..10 {
+            p.bricks.push(at([
+                (i as f64 - 4.5) * (2.0 * h[0] + 0.001) + shift - h[0] / 2.0,
+                0.0,
+                h[2] * (2 * c + 1) as f64,
+            ]));
+        }
+    }
+}
+
 /// A wall of `courses` courses of 10 bricks in running bond (each course shifted by half a
 /// brick), 2 m wide, standing on the ground, 1 mm between neighbours, with every brick of its top `knocked` courses
 /// moving at `speed` m/s along +y: the moment a student knocks a tower over. Sleeping as in

@@ -76,20 +76,13 @@ pub fn hold(w: &mut World, pos: [f64; 3], down: bool) -> StepReport {
     w.step(&i)
 }
 
-/// Adds to `p` a 200-brick wall of 20 courses in running bond (1 mm joints), 1.2 m high.
-pub fn running_bond_wall(p: &mut Params) {
-    let h = p.brick_half_extents_m;
-    for c in 0..20 {
-        let shift = if c % 2 == 0 { 0.0 } else { h[0] };
-        for i in 0..10 {
-            p.bricks.push(at([
-                (i as f64 - 4.5) * (2.0 * h[0] + 0.001) + shift - h[0] / 2.0,
-                0.0,
-                h[2] * (2 * c + 1) as f64,
-            ]));
-        }
-    }
-}
+/// The report example's scenes (`examples/common`), shared with the tests.
+#[path = "../../examples/common/mod.rs"]
+#[allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+mod scenes;
+
+#[allow(unused_imports)] // not every test file builds the wall
+pub use scenes::running_bond_wall;
 
 /// The largest distance, m, between the same brick's positions in `a` and `b`.
 pub fn moved(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
