@@ -216,7 +216,7 @@ fn session(
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
-        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs, S.cadence, S.spread]; })()")?;
+        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs, S.cadence, S.spread, S.guesses, S.concealed]; })()")?;
         for p in v[5].as_array().into_iter().flatten() {
             for (k, part) in parts.iter_mut().take(3).enumerate() {
                 if let Some(x) = p[k].as_f64() {
@@ -267,6 +267,13 @@ fn session(
                 sp["ms"][0], sp["ms"][1], sp["ms"][2], sp["ms"][3], sp["messages"]
             );
         }
+        eprintln!(
+            "{scene}: the worklet guessed over {} late messages; {} samples played were not the track's (concealed), {} underruns, {} samples dropped",
+            v[18].as_u64().unwrap_or(0),
+            v[19].as_u64().unwrap_or(0),
+            v[4].as_u64().unwrap_or(0),
+            v[9].as_u64().unwrap_or(0)
+        );
         b.check()?;
     }
     browsers[0].key("e", true, false)?;

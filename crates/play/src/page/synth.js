@@ -17,12 +17,27 @@
 // lateness is the clock at its arrival (the next render quantum's) minus the session index of
 // its first new sample (the two origins differ by a constant: only differences of lateness
 // mean something). The output plays sample `clock − lead` at each clock, the lead being the
-// largest lateness of the last 4 s (eight 0.5 s buckets) plus a 1 ms margin: every message no
-// later than that arrives before the quantum that plays its first sample. The lead is at most
-// `leadMaxS` past the window's earliest arrival, and while less than 4 s has been measured at
-// least `leadS` past it. Playback starts, and restarts after an underrun, once the clock is a
-// lead past the next sample (and a quantum of it is queued): an underrun plays silence and
-// waits, but does not lengthen the lead. Every 0.1 s of quanta, when the output plays more
+// 95th percentile of the lateness of the last 4 s (eight 0.5 s buckets, taken each time the
+// window moves on) plus a 1 ms margin: 95 % of the messages arrive before the quantum that
+// plays their first sample. The lead is at most `leadMaxS` past the window's earliest arrival,
+// and while less than 4 s has been measured at least `leadS` past it.
+//
+// A message later than the lead is *guessed over*: when the FIFO runs short, the synthesis
+// goes on as if the ticks to come held the last one (its tone, no sound starting; at most
+// GUESS_MAX_S), from a copy of itself as the ticks left it. That is what the world sounds like
+// unless a sound starts or the tone moves, so most guesses are the track's samples to the bit.
+// When the ticks come, the synthesis goes back to the copy and runs them: the guessed samples
+// still queued are replaced, and those already played are checked against what the ticks
+// make (the same bits: heard, as any other; else *concealed*: played, listed, not hashed). A
+// sound whose first sample was played over as a guess starts at once, on the first sample
+// not yet played, and the samples it spans are concealed: a late sound is late by its
+// message's lateness, not lost and not held for a lead.
+//
+// Playback starts, and restarts after an underrun, once the clock is a lead past the next
+// sample (and a quantum of it is queued). An underrun (silence, then the wait) happens only
+// where a guess cannot help: when the lead has grown a quantum or more past where the output
+// plays (the window measured later arrivals: the wait sets the new lead), or a stall outlasts
+// GUESS_MAX_S. Every 0.1 s of quanta, when the output plays more
 // than 5 ms behind the lead (a backlog after a stall, or jitter that has passed), the excess is
 // dropped (counted and listed), never below one quantum queued at the window's lowest. For
 // each sound's first sample the processor reports when it was rendered (Date.now() at the
@@ -46,6 +61,9 @@ const HEADER = 24, TICK = 16, SOUND = 24;
 // The lead's window (LATE_BUCKETS buckets of LATE_BUCKET_S of the processor's clock), the margin
 // on top of the largest lateness, and the excess over the lead that is dropped, s.
 const LATE_BUCKETS = 8, LATE_BUCKET_S = 0.5, MARGIN_S = 0.001, TRIM_S = 0.005;
+// The share of the window's messages the lead covers (the rest are guessed over, see above),
+// and the longest guess, s (a longer stall underruns).
+const LEAD_QUANTILE = 0.95, GUESS_MAX_S = 0.05;
 
 // 64-bit unsigned arithmetic on [hi, lo] 32-bit halves (the noise is xorshift64*).
 function mul64(ah, al, bh, bl) {
@@ -144,10 +162,12 @@ class StreamSynth {
     this.phase = 0; this.lastF = 220.0;
     this.limited = 0;
   }
-  push(tS, kind, amplitude, index) {
+  // A sound at `tS`; `at`: the sample it starts on instead (a late sound played at once), or
+  // undefined. Returns [the sample it starts on, its length], or null when it is silent.
+  push(tS, kind, amplitude, index, at) {
     const e = eventSamples(tS, kind, amplitude, index, this.sr);
-    if (e === null) return;
-    const [start, s] = e;
+    if (e === null) return null;
+    const s = e[1], start = at === undefined ? e[0] : at;
     for (let k = 0; k < s.length; k++) {
       const rel = start + k - this.nextSample;
       if (rel < 0) continue;
@@ -155,11 +175,27 @@ class StreamSynth {
       while (this.pending.length <= at) this.pending.push(0);
       this.pending[at] += s[k];
     }
+    return [start, s.length];
   }
   // The tone's (pitch, amplitude) at each tick are kept rather than its distance: the same
   // values, computed once per tick.
   tick(d) { this.distances.push(this.on === null ? null : toneAt(d, this.on)); this.ticks++; this.emit(-1); }
+  // A tick whose data has not come: the last tick's tone held, no sound starting on it.
+  hold() {
+    const n = this.distances.length;
+    this.distances.push(n > this.dh ? this.distances[n - 1] : (this.on === null ? null : SILENT));
+    this.ticks++; this.emit(-1);
+  }
   finish(durationS) { this.emit(Math.round(durationS * this.sr)); }
+  // A copy of the synthesis as it stands (the sounds still to sum, the tones to come, the
+  // phase), writing to the same output.
+  clone() {
+    const c = Object.create(StreamSynth.prototype);
+    Object.assign(c, this);
+    c.pending = this.pending.slice(this.ph); c.ph = 0;
+    c.distances = this.distances.slice(this.dh); c.dh = 0;
+    return c;
+  }
   at(j) {
     const r = j - this.baseTick;
     const v = r >= 0 ? this.distances[this.dh + r] : undefined;
@@ -189,7 +225,7 @@ class StreamSynth {
         v += amp * Math.sin(this.phase);
       }
       if (Math.abs(v) > CEILING) { this.limited++; v = v < 0 ? -CEILING : CEILING; }
-      this.out(v);
+      this.out(v, k);
       this.nextSample++;
       while (this.baseTick < i && this.dh < this.distances.length) { this.dh++; this.baseTick++; }
     }
@@ -222,6 +258,8 @@ class Fifo {
     return n;
   }
   drop(n) { n = Math.min(n, this.length); this.head += n; this.first += n; }
+  // Keeps the first `n` samples queued, forgets the rest.
+  truncate(n) { this.tail = this.head + Math.max(0, Math.min(n, this.length)); }
   clear(first) { this.head = 0; this.tail = 0; this.first = first; }
 }
 
@@ -326,7 +364,16 @@ class Synth extends AudioWorkletProcessor {
     this.bucketLen = Math.round(LATE_BUCKET_S * sampleRate);
     this.late = new Float64Array(LATE_BUCKETS).fill(-Infinity);
     this.early = new Float64Array(LATE_BUCKETS).fill(Infinity);
+    this.lates = Array.from({ length: LATE_BUCKETS }, () => []);
+    this.quantile = -Infinity; // LEAD_QUANTILE of the window's lateness, at its last move
     this.bucket = -1; this.since = -1;
+    // The guess over a late message (see above): null, or the synthesis as the ticks left it
+    // (`snap`), the session index of the first sample guessed (`from`) and the values guessed
+    // from it (Float32; those before the FIFO's first were played). `deviate`: the session
+    // samples [from, to) that are not the track's (a late sound played at once).
+    this.guess = null; this.guessing = false; this.deviate = [0, 0];
+    this.guesses = 0; this.concealedSamples = 0;
+    this.one = new Float32Array(1);
     this.primed = false;
     this.underruns = 0; this.dropped = 0;
     this.minLevel = Infinity; this.quanta = 0;
@@ -338,7 +385,7 @@ class Synth extends AudioWorkletProcessor {
     // What was heard: the FNV-1a hash of the samples played, their count, the first one's
     // session index, a checkpoint of the hash every second played, the [index, count] of each
     // drop, the restarts after a long gap; `ending`: the stream was finished.
-    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], restarts: 0 };
+    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], concealed: [], restarts: 0 };
     this.ending = false; this.done = false;
     if (o.offline) {
       for (const b of o.offline.blocks) this.take(b, 0);
@@ -363,29 +410,113 @@ class Synth extends AudioWorkletProcessor {
   // A new stream (a lesson's next world, its ticks from 0): what the last one heard is
   // reported (`stream`; `complete`: it was played to its end), then heard afresh.
   restart() {
+    this.dropGuess();
     this.port.postMessage({ ...this.report('stream'), complete: this.done });
     // The last stream's samples not yet played are not the new one's.
     this.synth = null; this.ending = false; this.done = false;
-    this.fifo.clear(0); this.primed = false; this.onsets = [];
-    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], restarts: 1 };
+    this.fifo.clear(0); this.primed = false; this.onsets = []; this.deviate = [0, 0];
+    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], concealed: [], restarts: 1 };
+  }
+
+  // The samples the processor makes, in order (`k`: the session index): to the FIFO; while
+  // guessing, also kept; once the ticks came, those already played as a guess are checked
+  // against it instead (the same bits, not a late sound's: heard; else concealed).
+  sample(v, k) {
+    const g = this.guess, fifo = this.fifo;
+    const f = Math.fround(v);
+    if (g !== null && k < fifo.first) {
+      if (this.guessing) return; // played already, as the earlier guess
+      const dev = k >= this.deviate[0] && k < this.deviate[1];
+      if (!dev && g.values[k - g.from] === f) { this.one[0] = f; this.hash(this.one, 0, 1); }
+      else this.conceal(k, 1);
+      return;
+    }
+    if (this.guessing) g.values[k - g.from] = f;
+    fifo.push(v);
+  }
+
+  // The FIFO runs short of `need` samples: a late message. Unless the lead has grown a quantum
+  // past where the output plays (then the underrun sets it), guess the ticks to come as the
+  // last one held (its tone, no sound starting) for at most GUESS_MAX_S: what an idle world
+  // sounds like, the samples the ticks will make unless a sound starts or the tone moves.
+  extend(need, quantum, at) {
+    const s = this.synth, fifo = this.fifo;
+    if (s === null || this.lead - (this.clock + at - fifo.first) >= quantum) return;
+    if (this.guess === null) {
+      this.guess = { snap: s.clone(), from: s.nextSample, values: [] };
+      this.guesses++;
+    }
+    const cap = this.guess.snap.ticks + Math.ceil(GUESS_MAX_S / this.dt);
+    this.guessing = true;
+    while (fifo.length < need && s.ticks < cap) s.hold();
+    this.guessing = false;
+  }
+
+  // Ticks came while guessing: back to the synthesis as the ticks left it, the guessed samples
+  // still queued forgotten (those played are checked as the ticks make them again).
+  unguess() {
+    const g = this.guess;
+    this.synth = g.snap; g.snap = null;
+    this.fifo.truncate(g.from - this.fifo.first);
+  }
+
+  // After the ticks: what was played as a guess past them waits for the next ones.
+  settle() {
+    const g = this.guess, s = this.synth;
+    if (g === null || g.snap !== null) return;
+    if (s === null || s.nextSample >= this.fifo.first) { this.guess = null; return; }
+    g.values = g.values.slice(s.nextSample - g.from); g.from = s.nextSample; g.snap = s.clone();
+  }
+
+  // The stream ends or restarts with a guess played: its samples not checked are concealed.
+  dropGuess() {
+    const g = this.guess;
+    if (g === null) return;
+    const from = this.synth !== null && g.snap === null ? this.synth.nextSample : g.from;
+    if (from < this.fifo.first) this.conceal(from, this.fifo.first - from);
+    this.guess = null;
+  }
+
+  // Samples [k, k + n) played that are not the track's: listed, not hashed.
+  conceal(k, n) {
+    const c = this.heard.concealed, last = c[c.length - 1];
+    if (last && last[0] + last[1] === k) last[1] += n;
+    else if (c.length < 10000) c.push([k, n]);
+    this.concealedSamples += n;
   }
 
   // The session ended after `ticks` ticks: the stream's last samples, then the end.
   finish(ticks) {
     if (this.ending) return;
+    if (this.guess !== null) this.unguess();
     const s = this.synth;
     if (s !== null) {
       while (s.ticks < ticks) s.tick(NaN);
       s.finish(ticks * this.dt);
     }
+    // A guess played past the stream's end is not the track's.
+    this.dropGuess();
     this.ending = true; this.primed = true;
   }
 
   // Hashes the `n` samples just played from `out` at `at` (session indices from `from`).
+  // Guessed samples wait to be checked; those of a late sound played at once are concealed.
   hear(out, at, n, from) {
+    if (n > 0 && this.heard.first < 0) this.heard.first = from;
+    for (let i = 0; i < n;) {
+      const k = from + i, g = this.guess, [lo, hi] = this.deviate;
+      if (g !== null && k >= g.from) return;
+      if (k >= lo && k < hi) { const m = Math.min(n - i, hi - k); this.conceal(k, m); i += m; continue; }
+      let m = n - i;
+      if (lo > k) m = Math.min(m, lo - k);
+      if (g !== null) m = Math.min(m, g.from - k);
+      this.hash(out, at + i, m); i += m;
+    }
+  }
+
+  // Adds `n` samples of `out` from `at` to the hash of what was heard.
+  hash(out, at, n) {
     const h = this.heard;
-    if (n === 0) return;
-    if (h.first < 0) h.first = from;
     const bytes = new Uint8Array(out.buffer, out.byteOffset + at * 4, n * 4);
     let x = h.hash;
     for (let i = 0; i < bytes.length; i++) x = Math.imul(x ^ bytes[i], 0x01000193) >>> 0;
@@ -405,12 +536,16 @@ class Synth extends AudioWorkletProcessor {
     if (buf.byteLength !== HEADER + TICK * nt + SOUND * ns) return;
     let s = this.synth;
     // A gap (messages the server dropped for this page): silent ticks; a long one, a restart.
-    if (s !== null && first > s.ticks && first - s.ticks > 5000) { s = null; this.heard.restarts++; }
     if (this.ending) return;
+    if (this.guess !== null) { this.unguess(); s = this.synth; }
+    if (s !== null && first > s.ticks && first - s.ticks > 5000) { s = null; this.heard.restarts++; }
     if (s === null) {
-      s = this.synth = new StreamSynth(sampleRate, this.dt, on, first, (v) => this.fifo.push(v));
+      this.dropGuess(); this.deviate = [0, 0];
+      s = this.synth = new StreamSynth(sampleRate, this.dt, on, first, (v, k) => this.sample(v, k));
       this.fifo.clear(s.nextSample); this.primed = this.offline; this.onsets = [];
       this.late.fill(-Infinity); this.early.fill(Infinity); this.since = -1;
+      for (const l of this.lates) l.length = 0;
+      this.quantile = -Infinity;
     }
     while (s.ticks < first) s.tick(NaN);
     const from = s.nextSample;
@@ -424,15 +559,23 @@ class Synth extends AudioWorkletProcessor {
         const st = Number(dv.getBigUint64(at, true));
         if (st > tick) break;
         if (st < tick || tick < s.ticks) continue;
-        const tS = st * this.dt;
-        s.push(tS, dv.getUint32(at + 12, true), dv.getFloat64(at + 16, true), dv.getUint32(at + 8, true));
-        const k = Math.round(tS * sampleRate);
-        const index = dv.getUint32(at + 8, true);
+        const tS = st * this.dt, index = dv.getUint32(at + 8, true);
+        // A sound whose first samples were played as a guess (its message was late) starts at
+        // once, on the first sample not yet played; the samples it spans are not the track's.
+        let k = Math.round(tS * sampleRate);
+        const late = k < this.fifo.first;
+        const r = s.push(tS, dv.getUint32(at + 12, true), dv.getFloat64(at + 16, true), index, late ? this.fifo.first : undefined);
+        if (late) {
+          const [lo, hi] = this.deviate, to = r === null ? k : r[0] + r[1];
+          this.deviate = hi > lo ? [Math.min(lo, k), Math.max(hi, to)] : [k, to];
+          k = this.fifo.first;
+        }
         if (!this.offline && k >= s.nextSample && this.onsets.length < 1000) this.onsets.push([k, st, wallMs, gotMs, index]);
       }
       if (tick < s.ticks) continue; // already had
       s.tick(dv.getFloat64(HEADER + TICK * i + 8, true));
     }
+    this.settle();
     if (!this.offline && s.nextSample > from) this.arrived(this.clock - from);
   }
 
@@ -446,6 +589,7 @@ class Synth extends AudioWorkletProcessor {
     const k = this.bucket % LATE_BUCKETS;
     if (late > this.late[k]) this.late[k] = late;
     if (late < this.early[k]) this.early[k] = late;
+    this.lates[k].push(late);
     this.spread.add((late - this.window()[0]) / sampleRate * 1000);
     this.sizeLead();
   }
@@ -454,18 +598,25 @@ class Synth extends AudioWorkletProcessor {
   rotate() {
     const b = Math.floor(this.clock / this.bucketLen);
     if (this.since < 0 || b <= this.bucket) return;
-    if (b - this.bucket >= LATE_BUCKETS) { this.late.fill(-Infinity); this.early.fill(Infinity); }
-    else for (let i = this.bucket + 1; i <= b; i++) { this.late[i % LATE_BUCKETS] = -Infinity; this.early[i % LATE_BUCKETS] = Infinity; }
+    for (let i = Math.max(this.bucket + 1, b - LATE_BUCKETS + 1); i <= b; i++) {
+      const k = i % LATE_BUCKETS;
+      this.late[k] = -Infinity; this.early[k] = Infinity; this.lates[k].length = 0;
+    }
     this.bucket = b;
+    // The window's LEAD_QUANTILE lateness (nearest rank), once each time the window moves.
+    const all = [];
+    for (const l of this.lates) for (const x of l) all.push(x);
+    all.sort((x, y) => x - y);
+    this.quantile = all.length ? all[Math.max(0, Math.ceil(LEAD_QUANTILE * all.length) - 1)] : -Infinity;
   }
 
-  // The lead from the window's lateness: its largest plus the margin, between lead0 (while
-  // the window is not full) and leadMax past its smallest.
+  // The lead from the window's lateness: its LEAD_QUANTILE plus the margin, between lead0
+  // (while the window is not full) and leadMax past its smallest.
   sizeLead() {
     this.rotate();
     const [early, late] = this.window();
     if (!Number.isFinite(late)) return;
-    let lead = late + this.margin;
+    let lead = Math.max(this.quantile, early) + this.margin;
     if (this.clock - this.since < LATE_BUCKETS * this.bucketLen) lead = Math.max(lead, early + this.lead0);
     this.lead = Math.min(lead, early + this.leadMax);
   }
@@ -518,7 +669,8 @@ class Synth extends AudioWorkletProcessor {
     if (++this.quanta >= Math.ceil(0.1 * sampleRate / out.length)) {
       const excess = this.clock - fifo.first - this.lead;
       if (!this.offline && !this.ending && excess > this.trim) {
-        const n = Math.min(excess, this.minLevel - out.length);
+        // (Never a guessed sample: those played are checked when the ticks come.)
+        const n = Math.min(excess, this.minLevel - out.length, this.guess === null ? Infinity : this.guess.from - fifo.first);
         if (n > 0) {
           if (this.heard.drops.length < 10000) this.heard.drops.push([fifo.first, n]);
           fifo.drop(n); this.dropped += n;
@@ -526,6 +678,7 @@ class Synth extends AudioWorkletProcessor {
       }
       this.minLevel = Infinity; this.quanta = 0;
     }
+    if (!this.offline && !this.ending && fifo.length < out.length - at) this.extend(out.length - at, out.length, at);
     const from = fifo.first;
     const n = fifo.take(out, at);
     if (!this.offline) this.hear(out, at, n, from);
@@ -550,7 +703,7 @@ class Synth extends AudioWorkletProcessor {
           kind: 'onset', tick, index, wallMs, gotMs, renderMs, frame, sampleRate,
           contextTime: currentTime + frame / sampleRate,
           underruns: this.underruns, dropped: this.dropped, limited: this.synth ? this.synth.limited : 0,
-          level: fifo.length, ...this.leadReport(),
+          guesses: this.guesses, concealedSamples: this.concealedSamples, level: fifo.length, ...this.leadReport(),
         });
       }
     }
@@ -572,7 +725,7 @@ class Synth extends AudioWorkletProcessor {
   report(kind) {
     return {
       kind, sampleRate, underruns: this.underruns, dropped: this.dropped,
-      limited: this.synth ? this.synth.limited : 0, emitted: this.synth ? this.synth.nextSample : 0,
+      guesses: this.guesses, concealedSamples: this.concealedSamples, limited: this.synth ? this.synth.limited : 0, emitted: this.synth ? this.synth.nextSample : 0,
       ...this.leadReport(), ...this.heard,
     };
   }

@@ -5,8 +5,11 @@
 //! What the worklet hashes: every sample it played from its FIFO, in the order played (FNV-1a
 //! over the Float32 little-endian bytes), from the first one (`first`, a session sample index)
 //! on; the silence of its wait for the lead and of an underrun is not the session's and is not
-//! hashed; samples it dropped are listed (`drops`, [session index, count]). So the samples it
-//! played are exactly the track from `first` on without the dropped ranges, whatever the
+//! hashed; samples it dropped are listed (`drops`, [session index, count]), and so are the
+//! samples it played that are not the track's (`concealed`: a guess over a late message that
+//! the ticks, when they came, did not bear out, or a late sound played at once), which are not
+//! hashed. So the samples it hashed are exactly the track from `first` on without the dropped
+//! and concealed ranges, whatever the
 //! machine's load, and the test asks for them bit for bit (the standard of the offline test,
 //! `browser_sound.rs`: 0 ulp). The start offset: `first` is 0, the page being there from the
 //! session's first tick (docs/play.md); the output's own start (the lead, the context's time
@@ -29,6 +32,9 @@ pub struct Heard {
     /// Underruns, samples dropped.
     pub underruns: u64,
     pub dropped: u64,
+    /// Guesses over late messages, and the samples played that were not the track's.
+    pub guesses: u64,
+    pub concealed: u64,
     /// Sounds sent to the page, played (first sample rendered), lost in a drop.
     pub sent: usize,
     pub played: usize,
@@ -54,19 +60,32 @@ fn pairs(v: &Value) -> Vec<(u64, u64)> {
         .collect()
 }
 
-/// The samples the worklet should have played: `track` from `first` on without the dropped
-/// ranges ([session index, count]).
-pub fn expected_played(track: &[f32], first: usize, drops: &[(u64, u64)]) -> Vec<f32> {
+/// The samples the worklet should have hashed: `track` from `first` on without the dropped
+/// ranges and the concealed ones ([session index, count] each; a concealed range may run past
+/// the track's end, a guess played after its last tick).
+pub fn expected_played(
+    track: &[f32],
+    first: usize,
+    drops: &[(u64, u64)],
+    concealed: &[(u64, u64)],
+) -> Vec<f32> {
     let mut out = Vec::with_capacity(track.len());
     let mut at = first;
-    for &(d, n) in drops {
+    let mut cut: Vec<(u64, u64, bool)> = drops
+        .iter()
+        .map(|&(d, n)| (d, n, true))
+        .chain(concealed.iter().map(|&(d, n)| (d, n, false)))
+        .collect();
+    cut.sort_unstable();
+    for (d, n, drop) in cut {
         let (d, n) = (d as usize, n as usize);
         assert!(
-            d >= at && d + n <= track.len(),
-            "drop [{d}, +{n}) from {at}"
+            d >= at && (d + n <= track.len() || (!drop && d <= track.len())),
+            "{} [{d}, +{n}) from {at}",
+            if drop { "drop" } else { "concealed" }
         );
         out.extend_from_slice(&track[at..d]);
-        at = d + n;
+        at = (d + n).min(track.len());
     }
     out.extend_from_slice(&track[at.min(track.len())..]);
     out
@@ -119,13 +138,14 @@ pub fn check_samples(
         "the first sample played is the track's first"
     );
     let drops = pairs(&r["drops"]);
-    let mut want = expected_played(&track, 0, &drops);
+    let concealed = pairs(&r["concealed"]);
+    let mut want = expected_played(&track, 0, &drops, &concealed);
     let played = r["played"].as_u64().unwrap() as usize;
     if complete {
         assert_eq!(
             played,
             want.len(),
-            "samples played: every sample of the track once, but those dropped"
+            "samples hashed: every sample of the track once, but those dropped or concealed"
         );
     } else {
         assert!(played <= want.len(), "{played} of {}", want.len());
@@ -152,6 +172,11 @@ pub fn check(a: &SessionArrays, kind: &str, live: &Value, sound: &Value) -> Hear
     assert_eq!(live["kind"], "done", "the worklet ended its stream: {live}");
     assert_eq!(live["restarts"], 0, "no gap restarted the synthesis");
     let (sr, track, drops, played) = check_samples(a, kind, live, true);
+    assert_eq!(
+        pairs(&live["concealed"]).iter().map(|c| c.1).sum::<u64>(),
+        live["concealedSamples"].as_u64().unwrap(),
+        "every concealed sample listed"
+    );
     let dropped = live["dropped"].as_u64().unwrap();
     assert_eq!(
         drops.iter().map(|d| d.1).sum::<u64>(),
@@ -202,6 +227,8 @@ pub fn check(a: &SessionArrays, kind: &str, live: &Value, sound: &Value) -> Hear
         played_samples: played,
         underruns: live["underruns"].as_u64().unwrap(),
         dropped,
+        guesses: live["guesses"].as_u64().unwrap(),
+        concealed: live["concealedSamples"].as_u64().unwrap(),
         sent: sent.len(),
         played: played_sounds.len(),
         lost: lost.len(),
