@@ -4,20 +4,23 @@
 //! sounds on their ticks), sample by sample against the Rust synthesis of the same recording at
 //! the same sample rate.
 //!
-//! The live path (the FIFO, the lead sized from the arrivals' jitter, the underrun and drop
-//! logic, which the offline path skips): the same processor, not offline, driven one
-//! 128-sample render quantum at a time by an audio clock in the page (one quantum per device
-//! callback, as on the page's smallest output buffer), its sound ticks delivered by a schedule
-//! of arrival times (the `play` publisher's blocks of `PLAY_SOUND_BLOCK_TICKS` ticks, each sent
-//! when its last tick ends). No wall clock is involved, so the schedule can promise what real
-//! time in headless Chromium on two shared cores cannot: an idle page (each block arriving 2 ms
-//! after its last tick, plus up to 3 ms of jitter) must play with 0 underruns and 0 drops,
-//! every sample of the track and every sound sent, its lead a few ms past the earliest
-//! arrival; when the jitter rises to 12 ms the lead follows it, and when it falls back the lead
-//! comes back and the excess is dropped (counted, every sample played or dropped); eight 50 ms
-//! stalls underrun eight times, never lengthen the lead past its cap, and drop each backlog; a
-//! 50 ms stall and a 300 ms stall over the first sound underrun, drop the backlog and still
-//! play only the track's samples, each sound played or lost once.
+//! The live path (the FIFO, the lead sized from the arrivals' jitter, the guesses over late
+//! messages, the underrun and drop logic, which the offline path skips): the same processor,
+//! not offline, driven one 128-sample render quantum at a time by an audio clock in the page
+//! (one quantum per device callback, as on the page's smallest output buffer), its sound ticks
+//! delivered by a schedule of arrival times (the `play` publisher's blocks of
+//! `PLAY_SOUND_BLOCK_TICKS` ticks, each sent when its last tick ends). No wall clock is
+//! involved, so the schedule can promise what real time in headless Chromium on two shared
+//! cores cannot: an idle page (each block arriving 2 ms after its last tick, plus up to 3 ms of
+//! jitter) must play with 0 underruns and 0 drops, every sound sent, every sample of the track
+//! but the few a guess over its latest messages concealed, every sound's own part the same,
+//! its lead a few ms past the earliest arrival; a 50 ms stall is guessed over with no underrun;
+//! a sound whose message is 20 ms late plays 20 ms plus at most a quantum after its tick; when
+//! the jitter rises to 12 ms the lead follows it, and when it falls back the lead comes back
+//! and the excess is dropped (counted, every sample played, concealed or dropped); eight 50 ms
+//! stalls are guessed over with no underrun and the lead is the idle page's after them; a
+//! 300 ms stall over the first sound underruns, drops the backlog and still plays only the
+//! track's samples, each sound played or lost once.
 //!
 //! The link worker's route (route.js), also clock-free: fed the server's own messages in a
 //! lesson's order, it sends the worklet the first world's ticks, its finish, the restart and
@@ -418,7 +421,7 @@ fn the_worklets_live_path_plays_the_samples_of_render_audio() {
             "{rec}, idle page, {sr} Hz: {h:?}, lead {} ms, spread {:?} ms, own part {:?} ms",
             p.lead_ms, p.spread_ms, p.own_ms
         );
-        // An idle page: every sample of the track, every sound, no underrun, no drop.
+        // An idle page: every sound, no underrun, no drop.
         assert_eq!((h.underruns, h.dropped), (0, 0), "{rec}: {h:?}");
         // The messages' lateness past their window's earliest (the probe, in 0.5 ms bins):
         // the 3 ms jitter plus the wait for the next quantum at most, most of the jitter at

@@ -427,7 +427,8 @@ class Synth extends AudioWorkletProcessor {
     if (g !== null && k < fifo.first) {
       if (this.guessing) return; // played already, as the earlier guess
       const dev = k >= this.deviate[0] && k < this.deviate[1];
-      if (!dev && g.values[k - g.from] === f) { this.one[0] = f; this.hash(this.one, 0, 1); }
+      const played = g.values[k - g.from];
+      if (!dev && played === f) { this.one[0] = played; this.hash(this.one, 0, 1); }
       else this.conceal(k, 1);
       return;
     }
