@@ -82,6 +82,12 @@ export function onLinkReport(d) {
   } else if (Number.isFinite(d.stamp) && s.pageMs.length < 100000) s.pageMs.push(Date.now() - d.stamp);
 }
 
+// The worklet's counts, as its latest report (an onset or the end) gives them.
+function counts(s, m) {
+  s.underruns = m.underruns; s.guesses = m.guesses; s.concealed = m.concealedSamples; s.dropped = m.dropped;
+  s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence; s.spread = m.spread;
+}
+
 // The worklet's reports: the end of the stream (what it heard), a stream a restart ended (a
 // lesson's world before the next: what it heard), a sound lost to a drop, or a sound's first
 // sample rendered.
@@ -89,7 +95,7 @@ function onWorklet(m) {
   const s = P.sound;
   if (m.kind === 'done') {
     s.live = m;
-    s.underruns = m.underruns; s.guesses = m.guesses; s.concealed = m.concealedSamples; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence; s.spread = m.spread;
+    counts(s, m);
   }
   else if (m.kind === 'stream') s.streams.push(m);
   else if (m.kind === 'lost') s.lost.push([m.tick, m.index]);
@@ -103,7 +109,7 @@ function onWorklet(m) {
 // getOutputTimestamp() (the output's own estimate of when it plays), minus the same.
 function onRendered(m) {
   const s = P.sound;
-  s.underruns = m.underruns; s.guesses = m.guesses; s.concealed = m.concealedSamples; s.dropped = m.dropped; s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence; s.spread = m.spread;
+  counts(s, m);
   if (s.latencyMs.length >= 100000) return;
   const outS = actx.outputLatency || 0, baseS = actx.baseLatency || 0;
   s.outputLatencyS = outS; s.baseLatencyS = baseS;
