@@ -200,12 +200,15 @@ fn the_pages_worklet_makes_the_samples_of_render_audio() {
 /// How the live test's sound ticks reach the worklet: each block `delay_ms` after its last
 /// tick ends, plus a jitter in [0, `jitter_ms`) (a fixed sequence; blocks keep their order;
 /// from `from_ms` on, while a `phases` entry (from, to, jitter ms) covers it, that jitter
-/// instead), and the blocks sent during a stall (from, to, ms) held until its end.
+/// instead), and the blocks sent during a stall (from, to, ms) held until its end. With
+/// `restart_ms`, the blocks due before it are a first stream, a restart comes then, and the
+/// session's blocks again are the second, from that time on (a lesson's next world).
 struct Link {
     delay_ms: f64,
     jitter_ms: f64,
     phases: Vec<(f64, f64, f64)>,
     stalls: Vec<(f64, f64)>,
+    restart_ms: Option<f64>,
 }
 
 impl Link {
@@ -215,6 +218,7 @@ impl Link {
             jitter_ms: 3.0,
             phases: Vec::new(),
             stalls: Vec::new(),
+            restart_ms: None,
         }
     }
 }
@@ -280,7 +284,15 @@ fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> L
     let js = format!(
         r#"(async () => {{
   const ab = (s) => Uint8Array.from(atob(s), (c) => c.charCodeAt(0)).buffer;
-  const blocks = {blocks}.map(ab), at = {at}, sr = {sr};
+  const blocks = {blocks}.map(ab), at = {at}, sr = {sr}, restartMs = {restart};
+  // What reaches the port, when (ms): with a restart, the blocks due before it, the restart,
+  // then every block again, that much later.
+  const sched = [], off = restartMs === null ? 0 : restartMs;
+  if (restartMs !== null) {{
+    for (let i = 0; i < blocks.length && at[i] < restartMs; i++) sched.push([at[i], blocks[i]]);
+    sched.push([restartMs, {{ restart: true }}]);
+  }}
+  for (let i = 0; i < blocks.length; i++) sched.push([at[i] + off, blocks[i]]);
   const src = await (await fetch('/synth.js')).text();
   // The AudioWorkletGlobalScope the processor sees: its base class and port, the context's
   // sample rate and time, registerProcessor.
@@ -298,25 +310,27 @@ fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> L
   const leads = [], every = Math.round(sr / 2 / 128);
   for (let q = 0; q < 1e7 && !p.done; q++) {{
     const ms = q * 128 / sr * 1000;
-    for (; m < blocks.length && at[m] <= ms; m++) p.port.onmessage({{ data: blocks[m] }});
+    for (; m < sched.length && sched[m][0] <= ms; m++) p.port.onmessage({{ data: sched[m][1] }});
     // The page's `end` follows the last sound ticks.
-    if (m === blocks.length && !finished) {{ p.port.onmessage({{ data: {{ finish: {ticks} }} }}); finished = true; }}
+    if (m === sched.length && !finished) {{ p.port.onmessage({{ data: {{ finish: {ticks} }} }}); finished = true; }}
     globalThis.currentTime = q * 128 / sr; globalThis.quantum = q;
     p.process([], [[out]]);
-    if (q % every === 0) {{ const r = p.leadReport(); if (r.leadMs !== null) leads.push([ms, r.leadMs, r.jitterMs]); }}
+    if (q % every === 0) {{ const r = p.leadReport(); if (r.leadMs !== null) leads.push([ms - off, r.leadMs, r.jitterMs]); }}
   }}
-  const onsets = reports.filter((r) => r.kind === 'onset');
+  // The last stream's (the reports after a restart's `stream`).
+  const last = reports.findIndex((r) => r.kind === 'stream');
+  const onsets = reports.slice(last + 1).filter((r) => r.kind === 'onset');
   return {{
     leads,
     live: reports.find((r) => r.kind === 'done') || null,
     sound: {{
       sent: {sent},
       played: onsets.map((r) => [r.tick, r.index]),
-      lost: reports.filter((r) => r.kind === 'lost').map((r) => [r.tick, r.index]),
+      lost: reports.slice(last + 1).filter((r) => r.kind === 'lost').map((r) => [r.tick, r.index]),
       latencyMs: onsets.map(() => 0),
     }},
     // Each sound played: its tick, and when its first sample played, ms of the clock.
-    onsetMs: onsets.map((r) => [r.tick, (r.q * 128 + r.frame) / sr * 1000]),
+    onsetMs: onsets.map((r) => [r.tick, (r.q * 128 + r.frame) / sr * 1000 - off]),
   }};
 }})()"#,
         blocks = json!(blocks),
@@ -326,9 +340,11 @@ fn live_path(b: &mut Browser, rec: &Path, kind: &str, sr: u32, link: &Link) -> L
         lead_max = LEAD_MAX_S,
         ticks = a.tick.len(),
         sent = json!(sent),
+        restart = json!(link.restart_ms),
     );
     let v = b.eval(&js).unwrap();
-    let heard = live::check(&a, kind, &v["live"], &v["sound"]);
+    let restarts = u64::from(link.restart_ms.is_some());
+    let heard = live::check_stream(&a, kind, &v["live"], &v["sound"], restarts);
     let leads = v["leads"]
         .as_array()
         .unwrap()
@@ -636,6 +652,81 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
         after.0 >= idle_lo && after.1 <= idle_hi,
         "{after:?} vs {idle_lo}..{idle_hi}"
     );
+    capped(&p);
+
+    // The worklet loading for the session's first 355 ms (three loaded pages measured that):
+    // the ticks the link kept meanwhile come at once, the first 355 ms late, and a message
+    // 20 ms late at 1 s. The backlog is not the link's jitter: the late message is guessed
+    // over, not underrun; from the first sound on, the lead is the idle page's, and every
+    // sound's own part is the idle page's within a quantum.
+    let idle = live_path(&mut b, &path, kind, sr, &Link::idle());
+    let backlog = Link {
+        stalls: vec![(0.0, 355.0), (1000.0, 1020.0)],
+        ..Link::idle()
+    };
+    let p = live_path(&mut b, &path, kind, sr, &backlog);
+    let h = &p.heard;
+    let first_ms = idle.own_ms[0].0 as f64;
+    println!(
+        "a 355 ms start-up backlog: {h:?}; lead {:?} ms from the first sound at {first_ms} ms, {:?} ms after 4.5 s; own part {:?} ms (idle {:?} ms)",
+        lead_in(&p, first_ms, 4500.0),
+        lead_in(&p, 4500.0, 21_900.0),
+        p.own_ms,
+        idle.own_ms,
+    );
+    assert_eq!(h.underruns, 0, "{h:?}");
+    assert!(h.guesses >= 1, "{h:?}");
+    let first_lead = (LEAD_S * f64::from(sr)).round() / f64::from(sr) * 1000.0;
+    let (lo, hi) = lead_in(&p, first_ms, 4500.0);
+    assert!(
+        lo >= idle_lo.min(first_lead) && hi <= idle_hi.max(first_lead + 1e-9),
+        "{lo}..{hi} ms vs {idle_lo}..{idle_hi} ms"
+    );
+    let quantum_ms = 128.0 / f64::from(sr) * 1000.0;
+    assert_eq!(p.own_ms.len(), idle.own_ms.len());
+    for (&(tick, own), &(_, own_idle)) in p.own_ms.iter().zip(&idle.own_ms) {
+        assert!(
+            (own - own_idle).abs() <= quantum_ms,
+            "tick {tick}: {own} ms, idle {own_idle} ms"
+        );
+    }
+    assert_eq!(
+        h.played_samples as u64 + h.concealed + h.dropped,
+        h.track_samples as u64
+    );
+    assert_eq!((h.played, h.lost), (h.sent, 0));
+    capped(&p);
+
+    // A lesson's next world: a restart after 2 s of a first stream, the session again from
+    // its tick 0 (its lateness counted from another origin). The second stream is the idle
+    // page's: its lead from 4.5 s on, every sound's own part within a quantum, nothing
+    // guessed over, no underrun.
+    let restarted = Link {
+        restart_ms: Some(2000.0),
+        ..Link::idle()
+    };
+    let p = live_path(&mut b, &path, kind, sr, &restarted);
+    let h = &p.heard;
+    println!(
+        "a restart at 2 s: {h:?}; lead {:?} ms after 4.5 s; own part {:?} ms",
+        lead_in(&p, 4500.0, 21_900.0),
+        p.own_ms,
+    );
+    assert_eq!((h.underruns, h.dropped, h.concealed), (0, 0, 0), "{h:?}");
+    let (lo, hi) = lead_in(&p, 4500.0, 21_900.0);
+    assert!(
+        lo >= idle_lo && hi <= idle_hi,
+        "{lo}..{hi} ms vs {idle_lo}..{idle_hi} ms"
+    );
+    assert_eq!(p.own_ms.len(), idle.own_ms.len());
+    for (&(tick, own), &(_, own_idle)) in p.own_ms.iter().zip(&idle.own_ms) {
+        assert!(
+            (own - own_idle).abs() <= quantum_ms,
+            "tick {tick}: {own} ms, idle {own_idle} ms"
+        );
+    }
+    assert_eq!(h.played_samples, h.track_samples);
+    assert_eq!((h.played, h.lost), (h.sent, 0));
     capped(&p);
     b.check().unwrap();
     server.close();

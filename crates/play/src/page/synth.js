@@ -20,7 +20,9 @@
 // 95th percentile of the lateness of the last 4 s (eight 0.5 s buckets, taken each time the
 // window moves on) plus a 1 ms margin: 95 % of the messages arrive before the quantum that
 // plays their first sample. The lead is at most `leadMaxS` past the window's earliest arrival,
-// and while less than 4 s has been measured at least `leadS` past it.
+// and while less than 4 s has been measured at least `leadS` past it. The measuring starts
+// afresh when a stream first plays (what came before was its start-up backlog, not the link's
+// jitter) and at a restart.
 //
 // A message later than the lead is *guessed over*: when the FIFO runs short, the synthesis
 // goes on as if the ticks to come held the last one (its tone, no sound starting; at most
@@ -544,9 +546,7 @@ class Synth extends AudioWorkletProcessor {
       this.dropGuess(); this.deviate = [0, 0];
       s = this.synth = new StreamSynth(sampleRate, this.dt, on, first, (v, k) => this.sample(v, k));
       this.fifo.clear(s.nextSample); this.primed = this.offline; this.onsets = [];
-      this.late.fill(-Infinity); this.early.fill(Infinity); this.since = -1;
-      for (const l of this.lates) l.length = 0;
-      this.quantile = -Infinity;
+      this.forget();
     }
     while (s.ticks < first) s.tick(NaN);
     const from = s.nextSample;
@@ -593,6 +593,17 @@ class Synth extends AudioWorkletProcessor {
     this.lates[k].push(late);
     this.spread.add((late - this.window()[0]) / sampleRate * 1000);
     this.sizeLead();
+  }
+
+  // The lateness measured so far is forgotten (the window empties; the lead stands until the
+  // next arrival sizes it). At a new stream (a restart, or a gap that restarts the synthesis)
+  // its ticks count from another origin; at a stream's first sample played, what came before
+  // was its start-up backlog (the ticks the link kept while the worklet loaded, which come at
+  // once, the first as late as the load took), not the link's jitter.
+  forget() {
+    this.late.fill(-Infinity); this.early.fill(Infinity);
+    for (const l of this.lates) l.length = 0;
+    this.quantile = -Infinity; this.bucket = -1; this.since = -1;
   }
 
   // The window moves on with the clock: the buckets it left are emptied.
@@ -663,6 +674,7 @@ class Synth extends AudioWorkletProcessor {
       at = Math.max(0, wait);
       out.fill(0, 0, at);
       this.primed = true;
+      if (this.heard.first < 0 && !this.offline) this.forget();
     }
     // Playing more than TRIM_S behind the lead: drop the excess (keeping a quantum queued at
     // the lowest of the last ~0.1 s of quanta).
