@@ -656,9 +656,11 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
 
     // The worklet loading for the session's first 355 ms (three loaded pages measured that):
     // the ticks the link kept meanwhile come at once, the first 355 ms late, and a message
-    // 20 ms late at 1 s. The backlog is not the link's jitter: the late message is guessed
-    // over, not underrun; from the first sound on, the lead is the idle page's, and every
-    // sound's own part is the idle page's within a quantum.
+    // 20 ms late at 1 s. The backlog is dropped at once, up to a lead behind the clock (not
+    // left to the trim, which keeps a quantum queued and leaves the output up to 5 ms behind
+    // the lead), and is not the link's jitter: the late message is guessed over, not
+    // underrun; from the first sound on, the lead is the idle page's, and every sound's own
+    // part is the idle page's within a quantum.
     let idle = live_path(&mut b, &path, kind, sr, &Link::idle());
     let backlog = Link {
         stalls: vec![(0.0, 355.0), (1000.0, 1020.0)],
@@ -676,6 +678,13 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
     );
     assert_eq!(h.underruns, 0, "{h:?}");
     assert!(h.guesses >= 1, "{h:?}");
+    let (at, n) = h.drops[0];
+    let n_ms = n as f64 / f64::from(sr) * 1000.0;
+    assert!(
+        at == 0 && (355.0 - 12.0..=355.0).contains(&n_ms),
+        "{:?}",
+        h.drops
+    );
     let first_lead = (LEAD_S * f64::from(sr)).round() / f64::from(sr) * 1000.0;
     let (lo, hi) = lead_in(&p, first_ms, 4500.0);
     assert!(

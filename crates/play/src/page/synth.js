@@ -661,6 +661,13 @@ class Synth extends AudioWorkletProcessor {
     return r;
   }
 
+  // Drops the FIFO's first `n` samples (none if `n` ≤ 0), counted and listed.
+  drop(n) {
+    if (n <= 0) return;
+    if (this.heard.drops.length < 10000) this.heard.drops.push([this.fifo.first, n]);
+    this.fifo.drop(n); this.dropped += n;
+  }
+
   // One render quantum into `out`.
   render(out) {
     const fifo = this.fifo;
@@ -671,10 +678,18 @@ class Synth extends AudioWorkletProcessor {
     if (!this.primed) {
       const wait = this.synth === null ? Infinity : fifo.first + this.lead - this.clock;
       if (wait >= out.length || fifo.length < out.length) { out.fill(0); return true; }
-      at = Math.max(0, wait);
+      // A stream's first play with its next sample more than TRIM_S past the lead (its
+      // start-up backlog): the samples due before now are dropped, so it starts a lead behind
+      // the clock rather than anywhere up to TRIM_S behind it, where the trim would leave it.
+      const first = this.heard.first < 0 && !this.offline;
+      if (first && wait < -this.trim) {
+        this.heard.first = fifo.first; // the stream's first sample, dropped
+        this.drop(Math.min(-wait, fifo.length - out.length));
+      }
+      at = Math.max(0, fifo.first + this.lead - this.clock);
       out.fill(0, 0, at);
       this.primed = true;
-      if (this.heard.first < 0 && !this.offline) this.forget();
+      if (first) this.forget();
     }
     // Playing more than TRIM_S behind the lead: drop the excess (keeping a quantum queued at
     // the lowest of the last ~0.1 s of quanta).
@@ -684,10 +699,7 @@ class Synth extends AudioWorkletProcessor {
       if (!this.offline && !this.ending && excess > this.trim) {
         // (Never a guessed sample: those played are checked when the ticks come.)
         const n = Math.min(excess, this.minLevel - out.length, this.guess === null ? Infinity : this.guess.from - fifo.first);
-        if (n > 0) {
-          if (this.heard.drops.length < 10000) this.heard.drops.push([fifo.first, n]);
-          fifo.drop(n); this.dropped += n;
-        }
+        this.drop(n);
       }
       this.minLevel = Infinity; this.quanta = 0;
     }

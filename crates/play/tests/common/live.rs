@@ -29,9 +29,10 @@ pub struct Heard {
     /// Samples of the track, and the samples the worklet played (the same bits).
     pub track_samples: usize,
     pub played_samples: usize,
-    /// Underruns, samples dropped.
+    /// Underruns, samples dropped, and each drop ([session index, samples]).
     pub underruns: u64,
     pub dropped: u64,
+    pub drops: Vec<(u64, u64)>,
     /// Guesses over late messages, and the samples played that were not the track's.
     pub guesses: u64,
     pub concealed: u64,
@@ -239,6 +240,7 @@ pub fn check_stream(
         played_samples: played,
         underruns: live["underruns"].as_u64().unwrap(),
         dropped,
+        drops,
         guesses: live["guesses"].as_u64().unwrap(),
         concealed: live["concealedSamples"].as_u64().unwrap(),
         sent: sent.len(),
