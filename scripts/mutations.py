@@ -73,6 +73,15 @@ MUTATIONS = (
         tests=(("-p", "nanohaptics-play", "--test", "browser_sound"),),
     ),
     Mutation(
+        name="skip-unheard",
+        what="the page's sound skips the queued samples to follow the lead whether or not they are silent",
+        path="crates/play/src/page/synth.js",
+        old="while (z < limit && fifo.buf[fifo.head + z] === 0) z++;",
+        new="while (z < limit) z++;",
+        count=1,
+        tests=(("-p", "nanohaptics-play", "--test", "browser_sound"),),
+    ),
+    Mutation(
         name="welcome-at-1khz",
         what="the bridge welcomes every scene at 1 kHz (a 10 kHz scene's device sends 1000 samples/s)",
         path="crates/devices/src/bridge/udp.rs",

@@ -216,7 +216,7 @@ fn session(
     // Let the last sounds play out.
     std::thread::sleep(Duration::from_millis(500));
     for b in browsers.iter_mut() {
-        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs, S.cadence, S.spread, S.guesses, S.concealed]; })()")?;
+        let v = b.eval("(() => { const P = window.__play, S = P.sound; return [P.draws, performance.now() - P.drawT0, S.latencyMs, S.outputLatencyS, S.underruns, S.parts, S.latencyTsMs, S.baseLatencyS, S.sampleRate, S.dropped, S.leadMs, S.sounds, S.ticks, S.jitterMs, S.pageMs, S.linkMs, S.cadence, S.spread, S.guesses, S.concealed, S.skipped, S.waited]; })()")?;
         for p in v[5].as_array().into_iter().flatten() {
             for (k, part) in parts.iter_mut().take(3).enumerate() {
                 if let Some(x) = p[k].as_f64() {
@@ -268,11 +268,13 @@ fn session(
             );
         }
         eprintln!(
-            "{scene}: the worklet guessed over {} late messages; {} samples played were not the track's (concealed), {} underruns, {} samples dropped",
+            "{scene}: the worklet guessed over {} late messages; {} samples played were not the track's (concealed), {} underruns, {} samples dropped, {} silent ones skipped and {} waited to follow the lead",
             v[18].as_u64().unwrap_or(0),
             v[19].as_u64().unwrap_or(0),
             v[4].as_u64().unwrap_or(0),
-            v[9].as_u64().unwrap_or(0)
+            v[9].as_u64().unwrap_or(0),
+            v[20].as_u64().unwrap_or(0),
+            v[21].as_u64().unwrap_or(0)
         );
         b.check()?;
     }

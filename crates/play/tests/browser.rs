@@ -277,13 +277,15 @@ fn check_live_sound(out: &std::path::Path, page: &Value) -> live::Heard {
     }
     println!(
         "live sound ({kind}, {} Hz): {} of {} samples played, as render --audio's; \
-         {} underruns, {} samples dropped, {} late messages guessed over, {} samples concealed; \
-         sounds sent {}, played {}, lost in a drop {}",
+         {} underruns, {} samples dropped, {} silent ones skipped, {} waited, {} late messages \
+         guessed over, {} samples concealed; sounds sent {}, played {}, lost in a drop {}",
         h.sample_rate_hz,
         h.played_samples,
         h.track_samples,
         h.underruns,
         h.dropped,
+        h.skipped,
+        h.waited,
         h.guesses,
         h.concealed,
         h.sent,

@@ -16,11 +16,15 @@
 //! but the few a guess over its latest messages concealed, every sound's own part the same,
 //! its lead a few ms past the earliest arrival; a 50 ms stall is guessed over with no underrun;
 //! a sound whose message is 20 ms late plays 20 ms plus at most a quantum after its tick; when
-//! the jitter rises to 12 ms the lead follows it, and when it falls back the lead comes back
-//! and the excess is dropped (counted, every sample played, concealed or dropped); eight 50 ms
-//! stalls are guessed over with no underrun and the lead is the idle page's after them; a
-//! 300 ms stall over the first sound underruns, drops the backlog and still plays only the
-//! track's samples, each sound played or lost once.
+//! the jitter rises to 12 ms the lead follows it, the output waiting in silence, with no
+//! underrun, and when it falls back the lead comes back and the output skips silent samples
+//! to follow it (every sample played, concealed or skipped, each skip silence in the track);
+//! eight 50 ms stalls are guessed over with no underrun and the lead is the idle page's after
+//! them; a 300 ms stall over the first sound underruns, drops the backlog and still plays only
+//! the track's samples, each sound played or lost once; a 355 ms start-up backlog is dropped
+//! at once and is not taken for jitter; a restart (a lesson's next world) plays as an idle
+//! page. The following itself is checked on a processor whose FIFO the test fills: it skips
+//! and waits only in silence.
 //!
 //! The link worker's route (route.js), also clock-free: fed the server's own messages in a
 //! lesson's order, it sends the worklet the first world's ticks, its finish, the restart and
@@ -460,10 +464,7 @@ fn the_worklets_live_path_plays_the_samples_of_render_audio() {
             assert!((1..=20).contains(&h.guesses), "{rec}: {h:?}");
             assert!(h.concealed < h.guesses * 128, "{rec}: {h:?}");
         }
-        assert_eq!(
-            h.played_samples as u64 + h.concealed,
-            h.track_samples as u64
-        );
+        assert_eq!(h.accounted(), h.track_samples as u64);
         assert_eq!((h.played, h.lost), (h.sent, 0));
         assert!(h.sent > 0);
         // Its lead: the 3 ms jitter's once 4 s are measured (the brick world's 22 s); before
@@ -515,10 +516,7 @@ fn the_worklets_live_path_plays_the_samples_of_render_audio() {
         } else {
             assert!((1.0..=stall).contains(&more), "{rec}: {h:?}");
         }
-        assert_eq!(
-            h.played_samples as u64 + h.concealed + h.dropped,
-            h.track_samples as u64
-        );
+        assert_eq!(h.accounted(), h.track_samples as u64);
         assert_eq!(h.played + h.lost, h.sent);
         capped(&p);
         // A 300 ms stall from 240 ms before the first sound: the backlog (about 300 ms, less
@@ -555,17 +553,17 @@ fn the_worklets_live_path_plays_the_samples_of_render_audio() {
         assert_eq!(&p.own_ms[1..], &idle.own_ms[1..], "{rec}");
         assert_eq!((h.underruns, h.dropped, h.lost), (0, 0, 0), "{rec}: {h:?}");
         assert!(h.guesses >= 1 && h.concealed > 0, "{rec}: {h:?}");
-        assert_eq!(
-            h.played_samples as u64 + h.concealed,
-            h.track_samples as u64
-        );
+        assert_eq!(h.accounted(), h.track_samples as u64);
         let over = Link {
             stalls: vec![(first_ms - 240.0, first_ms + 60.0)],
             ..Link::idle()
         };
         let p = live_path(&mut b, &path, kind, sr, &over);
         let h = &p.heard;
-        println!("{rec}, a 300 ms stall over its first sound (at {first_ms} ms), {sr} Hz: {h:?}");
+        println!(
+            "{rec}, a 300 ms stall over its first sound (at {first_ms} ms), {sr} Hz: {h:?} own {:?} idle {:?}",
+            p.own_ms, idle.own_ms
+        );
         assert!(h.lost >= 1, "{rec}: {h:?}");
         assert!(h.underruns >= 1 && h.guesses >= 1, "{rec}: {h:?}");
         assert_eq!(h.played + h.lost, h.sent);
@@ -608,15 +606,14 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
         after.0 >= idle_lo && after.1 <= idle_hi,
         "{after:?} vs {idle_lo}..{idle_hi}"
     );
-    // The rise: the late messages are guessed over while the window learns it, and the lead's
-    // growth underruns, once or a few times; the fall drops the excess; every sample is
-    // played (the track's, or concealed) or dropped.
-    assert!((1..=6).contains(&h.underruns), "{h:?}");
-    assert!(h.guesses > 0 && h.dropped > 0, "{h:?}");
-    assert_eq!(
-        h.played_samples as u64 + h.concealed + h.dropped,
-        h.track_samples as u64
-    );
+    // The rise: the late messages are guessed over while the window learns it, and the
+    // output follows the lead's growth by waiting in the silence between the bricks' sounds,
+    // so nothing underruns (it did, once or a few times, when only an underrun moved it);
+    // the fall is skipped in silence, nothing dropped; every sample is played (the track's,
+    // or concealed) or skipped.
+    assert_eq!((h.underruns, h.dropped), (0, 0), "{h:?}");
+    assert!(h.guesses > 0 && h.waited > 0 && h.skipped > 0, "{h:?}");
+    assert_eq!(h.accounted(), h.track_samples as u64);
     assert_eq!(h.played + h.lost, h.sent);
     capped(&p);
 
@@ -643,10 +640,7 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
     // track's to the bit.
     assert_eq!(h.dropped, 0, "{h:?}");
     assert!(h.concealed as f64 <= 8.0 * 0.05 * f64::from(sr), "{h:?}");
-    assert_eq!(
-        h.played_samples as u64 + h.concealed,
-        h.track_samples as u64
-    );
+    assert_eq!(h.accounted(), h.track_samples as u64);
     assert_eq!(h.played + h.lost, h.sent);
     assert!(
         after.0 >= idle_lo && after.1 <= idle_hi,
@@ -699,10 +693,7 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
             "tick {tick}: {own} ms, idle {own_idle} ms"
         );
     }
-    assert_eq!(
-        h.played_samples as u64 + h.concealed + h.dropped,
-        h.track_samples as u64
-    );
+    assert_eq!(h.accounted(), h.track_samples as u64);
     assert_eq!((h.played, h.lost), (h.sent, 0));
     capped(&p);
 
@@ -734,7 +725,7 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
             "tick {tick}: {own} ms, idle {own_idle} ms"
         );
     }
-    assert_eq!(h.played_samples, h.track_samples);
+    assert_eq!(h.accounted(), h.track_samples as u64);
     assert_eq!((h.played, h.lost), (h.sent, 0));
     capped(&p);
     b.check().unwrap();
@@ -893,4 +884,84 @@ fn the_worklets_cadence_counts_the_quanta_of_each_callback_and_the_ms_between_th
         v["regular"],
         json!({"quanta": [1, 1], "ms": [3, 3], "callbacks": 999})
     );
+}
+
+/// The output's following of the lead in silence (synth.js's `follow`), on a processor whose
+/// FIFO, clock and lead the test sets, with no clock of its own: where the lead fell behind
+/// the output by at most 5 ms, the silent samples queued are skipped, and no further than the
+/// first sample that sounds (a tone starting, which no onset marks) or the next sound's first
+/// sample; further behind, nothing is skipped (the trim's job); where the lead grew past the
+/// output, it waits, up to the rest of the quantum, unless the next sample sounds.
+#[test]
+fn the_worklet_skips_and_waits_only_in_silence_to_follow_the_lead() {
+    let (mut b, _server) = PageServer::open("nh-sound-follow.mcap");
+    let js = r#"(async () => {
+  const src = await (await fetch('/synth.js')).text();
+  globalThis.sampleRate = 44100; globalThis.currentTime = 0;
+  globalThis.AudioWorkletProcessor = class {
+    constructor() { this.port = { postMessage: () => {}, onmessage: null }; }
+  };
+  let Proc = null;
+  globalThis.registerProcessor = (name, cls) => { Proc = cls; };
+  new Function(src)();
+  // A processor whose FIFO holds `queued` from session sample 1000, its clock `behind`
+  // samples past where the lead puts the output, `onset` the next sound's first sample.
+  const run = (queued, behind, onset, at) => {
+    const p = new Proc({ processorOptions: { rateHz: 1000, leadS: 0.005, leadMaxS: 0.03 } });
+    p.fifo.clear(1000);
+    for (const v of queued) p.fifo.push(v);
+    p.lead = 220; p.clock = 1000 + 220 + behind - at;
+    if (onset !== null) p.onsets = [[onset, 0, 0, 0, 0]];
+    const out = new Float32Array(128).fill(7).fill(0, 0, at);
+    const from = p.follow(out, at);
+    return { from, first: p.fifo.first, skipped: p.skipped, waited: p.waited, dropped: p.dropped,
+             skips: p.heard.skips, zeros: out.slice(0, from).every((v) => v === 0), untouched: out.slice(from).every((v) => v === 7) };
+  };
+  const z = (n) => new Array(n).fill(0);
+  return {
+    toTone: run([...z(3), 0.25, ...z(20)], 10, null, 0),
+    toOnset: run(z(24), 10, 1002, 0),
+    allSilent: run(z(24), 10, null, 0),
+    tooFar: run(z(400), 222, null, 0),
+    grew: run(z(24), -50, null, 0),
+    grewPastQuantum: run(z(24), -300, null, 28),
+    grewBeforeTone: run([0.25, ...z(23)], -50, null, 0),
+  };
+})()"#;
+    let v = b.eval(js).unwrap();
+    let get = |k: &str| {
+        let r = &v[k];
+        (
+            r["from"].as_u64().unwrap(),
+            r["first"].as_u64().unwrap(),
+            r["skipped"].as_u64().unwrap(),
+            r["waited"].as_u64().unwrap(),
+        )
+    };
+    // (the frame it plays the FIFO from, the FIFO's first, skipped, waited)
+    assert_eq!(get("toTone"), (0, 1003, 3, 0), "{v}");
+    assert_eq!(v["toTone"]["skips"], json!([[1000, 3]]));
+    assert_eq!(get("toOnset"), (0, 1002, 2, 0), "{v}");
+    assert_eq!(get("allSilent"), (0, 1010, 10, 0), "{v}");
+    // 222 samples (5.03 ms) behind: past TRIM_S (221 samples), left to the trim.
+    assert_eq!(get("tooFar"), (0, 1000, 0, 0), "{v}");
+    assert_eq!(get("grew"), (50, 1000, 0, 50), "{v}");
+    assert_eq!(get("grewPastQuantum"), (128, 1000, 0, 100), "{v}");
+    assert_eq!(get("grewBeforeTone"), (0, 1000, 0, 0), "{v}");
+    for k in [
+        "toTone",
+        "toOnset",
+        "allSilent",
+        "tooFar",
+        "grew",
+        "grewPastQuantum",
+        "grewBeforeTone",
+    ] {
+        assert_eq!(v[k]["dropped"], 0, "{k}");
+        assert_eq!(
+            (&v[k]["zeros"], &v[k]["untouched"]),
+            (&json!(true), &json!(true)),
+            "{k}: {v}"
+        );
+    }
 }

@@ -10,7 +10,7 @@ export const P = (window.__play = {
   events: [], sounds: [], switched: [], errors: [], ended: null,
   sound: {
     messages: 0, ticks: 0, sounds: 0, firstTick: -1, nextTick: 0, gaps: 0, overflow: 0, ring: null, sampleRate: null,
-    underruns: 0, guesses: 0, concealed: 0, dropped: 0, limited: 0, leadMs: null, jitterMs: null, cadence: null, spread: null, outputLatencyS: null, baseLatencyS: null,
+    underruns: 0, guesses: 0, concealed: 0, dropped: 0, skipped: 0, waited: 0, limited: 0, leadMs: null, jitterMs: null, cadence: null, spread: null, outputLatencyS: null, baseLatencyS: null,
     latencyMs: [], latencyTsMs: [], parts: [], pageMs: [], linkMs: [],
     sent: [], played: [], lost: [], live: null, streams: [], restarts: 0,
   },

@@ -85,6 +85,7 @@ export function onLinkReport(d) {
 // The worklet's counts, as its latest report (an onset or the end) gives them.
 function counts(s, m) {
   s.underruns = m.underruns; s.guesses = m.guesses; s.concealed = m.concealedSamples; s.dropped = m.dropped;
+  s.skipped = m.skipped; s.waited = m.waited;
   s.limited = m.limited; s.leadMs = m.leadMs; s.jitterMs = m.jitterMs; s.cadence = m.cadence; s.spread = m.spread;
 }
 

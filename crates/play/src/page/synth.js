@@ -378,6 +378,9 @@ class Synth extends AudioWorkletProcessor {
     this.one = new Float32Array(1);
     this.primed = false;
     this.underruns = 0; this.dropped = 0;
+    // Silent samples skipped and waited to follow the lead (see follow), and the last sample
+    // the output played from the FIFO (0 after silence).
+    this.skipped = 0; this.waited = 0; this.lastOut = 0;
     this.minLevel = Infinity; this.quanta = 0;
     this.offline = !!o.offline;
     this.cadence = new Cadence();
@@ -387,7 +390,7 @@ class Synth extends AudioWorkletProcessor {
     // What was heard: the FNV-1a hash of the samples played, their count, the first one's
     // session index, a checkpoint of the hash every second played, the [index, count] of each
     // drop, the restarts after a long gap; `ending`: the stream was finished.
-    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], concealed: [], restarts: 0 };
+    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], skips: [], concealed: [], restarts: 0 };
     this.ending = false; this.done = false;
     if (o.offline) {
       for (const b of o.offline.blocks) this.take(b, 0);
@@ -416,8 +419,8 @@ class Synth extends AudioWorkletProcessor {
     this.port.postMessage({ ...this.report('stream'), complete: this.done });
     // The last stream's samples not yet played are not the new one's.
     this.synth = null; this.ending = false; this.done = false;
-    this.fifo.clear(0); this.primed = false; this.onsets = []; this.deviate = [0, 0];
-    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], concealed: [], restarts: 1 };
+    this.fifo.clear(0); this.primed = false; this.onsets = []; this.deviate = [0, 0]; this.lastOut = 0;
+    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], skips: [], concealed: [], restarts: 1 };
   }
 
   // The samples the processor makes, in order (`k`: the session index): to the FIFO; while
@@ -661,11 +664,39 @@ class Synth extends AudioWorkletProcessor {
     return r;
   }
 
-  // Drops the FIFO's first `n` samples (none if `n` ≤ 0), counted and listed.
-  drop(n) {
+  // Drops the FIFO's first `n` samples (none if `n` ≤ 0): listed and counted as dropped or,
+  // when `silent` (all of them 0, between silences), as skipped.
+  drop(n, silent) {
     if (n <= 0) return;
-    if (this.heard.drops.length < 10000) this.heard.drops.push([this.fifo.first, n]);
-    this.fifo.drop(n); this.dropped += n;
+    if (this.heard.first < 0) this.heard.first = this.fifo.first; // the stream's first sample
+    const list = silent ? this.heard.skips : this.heard.drops;
+    if (list.length < 10000) list.push([this.fifo.first, n]);
+    this.fifo.drop(n);
+    if (silent) this.skipped += n; else this.dropped += n;
+  }
+
+  // While the output plays silence, it follows the lead to the sample: where the lead grew
+  // past it, it waits (silence, not the session's, not hashed; up to the rest of the quantum
+  // from frame `at`) unless a sample queued is about to sound; where the lead fell behind it
+  // by at most TRIM_S, it skips the silent samples queued (0, up to the next sound's first
+  // sample; further behind, the trim drops the excess, sound or not). Returns the frame the
+  // quantum plays the FIFO from.
+  follow(out, at) {
+    const fifo = this.fifo;
+    const behind = this.clock + at - fifo.first - this.lead;
+    if (behind < 0) {
+      if (fifo.length > 0 && fifo.buf[fifo.head] !== 0) return at;
+      const w = Math.min(-behind, out.length - at);
+      out.fill(0, at, at + w); this.waited += w;
+      return at + w;
+    }
+    if (behind > this.trim) return at;
+    const next = this.onsets.length ? this.onsets[0][0] - fifo.first : Infinity;
+    const limit = Math.min(behind, fifo.length, next);
+    let z = 0;
+    while (z < limit && fifo.buf[fifo.head + z] === 0) z++;
+    this.drop(z, true);
+    return at;
   }
 
   // One render quantum into `out`.
@@ -682,10 +713,7 @@ class Synth extends AudioWorkletProcessor {
       // start-up backlog): the samples due before now are dropped, so it starts a lead behind
       // the clock rather than anywhere up to TRIM_S behind it, where the trim would leave it.
       const first = this.heard.first < 0 && !this.offline;
-      if (first && wait < -this.trim) {
-        this.heard.first = fifo.first; // the stream's first sample, dropped
-        this.drop(Math.min(-wait, fifo.length - out.length));
-      }
+      if (first && wait < -this.trim) this.drop(Math.min(-wait, fifo.length - out.length));
       at = Math.max(0, fifo.first + this.lead - this.clock);
       out.fill(0, 0, at);
       this.primed = true;
@@ -703,10 +731,12 @@ class Synth extends AudioWorkletProcessor {
       }
       this.minLevel = Infinity; this.quanta = 0;
     }
+    if (!this.offline && !this.ending && this.guess === null && this.lastOut === 0) at = this.follow(out, at);
     if (!this.offline && !this.ending && fifo.length < out.length - at) this.extend(out.length - at, out.length, at);
     const from = fifo.first;
     const n = fifo.take(out, at);
     if (!this.offline) this.hear(out, at, n, from);
+    this.lastOut = n > 0 ? out[at + n - 1] : 0;
     if (at + n < out.length) {
       out.fill(0, at + n);
       if (this.ending) {
@@ -727,7 +757,7 @@ class Synth extends AudioWorkletProcessor {
         this.port.postMessage({
           kind: 'onset', tick, index, wallMs, gotMs, renderMs, frame, sampleRate,
           contextTime: currentTime + frame / sampleRate,
-          underruns: this.underruns, dropped: this.dropped, limited: this.synth ? this.synth.limited : 0,
+          underruns: this.underruns, dropped: this.dropped, skipped: this.skipped, waited: this.waited, limited: this.synth ? this.synth.limited : 0,
           guesses: this.guesses, concealedSamples: this.concealedSamples, level: fifo.length, ...this.leadReport(),
         });
       }
@@ -749,7 +779,7 @@ class Synth extends AudioWorkletProcessor {
   // The counts and what was heard (`kind`: 'done' at the end of the stream).
   report(kind) {
     return {
-      kind, sampleRate, underruns: this.underruns, dropped: this.dropped,
+      kind, sampleRate, underruns: this.underruns, dropped: this.dropped, skipped: this.skipped, waited: this.waited,
       guesses: this.guesses, concealedSamples: this.concealedSamples, limited: this.synth ? this.synth.limited : 0, emitted: this.synth ? this.synth.nextSample : 0,
       ...this.leadReport(), ...this.heard,
     };

@@ -29,17 +29,31 @@ pub struct Heard {
     /// Samples of the track, and the samples the worklet played (the same bits).
     pub track_samples: usize,
     pub played_samples: usize,
-    /// Underruns, samples dropped, and each drop ([session index, samples]).
+    /// Underruns (the worklet's life's), and this stream's samples dropped, and each drop
+    /// ([session index, samples]).
     pub underruns: u64,
     pub dropped: u64,
     pub drops: Vec<(u64, u64)>,
-    /// Guesses over late messages, and the samples played that were not the track's.
+    /// Silent samples skipped (this stream's), and silence waited (the worklet's life's), to
+    /// follow the lead.
+    pub skipped: u64,
+    pub waited: u64,
+    /// Guesses over late messages (the worklet's life's), and this stream's samples played
+    /// that were not the track's.
     pub guesses: u64,
     pub concealed: u64,
     /// Sounds sent to the page, played (first sample rendered), lost in a drop.
     pub sent: usize,
     pub played: usize,
     pub lost: usize,
+}
+
+impl Heard {
+    /// Every sample of the track, accounted for once: played (the track's bits), played but
+    /// concealed, dropped, or skipped.
+    pub fn accounted(&self) -> u64 {
+        self.played_samples as u64 + self.concealed + self.dropped + self.skipped
+    }
 }
 
 fn u64s(v: &Value) -> Vec<u64> {
@@ -139,14 +153,24 @@ pub fn check_samples(
         "the first sample played is the track's first"
     );
     let drops = pairs(&r["drops"]);
+    // What was skipped to follow the lead was silence: the track is 0 throughout each range.
+    let skips = pairs(&r["skips"]);
+    for &(d, n) in &skips {
+        let (d, n) = (d as usize, n as usize);
+        assert!(
+            d + n <= track.len() && track[d..d + n].iter().all(|&v| v == 0.0),
+            "the skip [{d}, +{n}) is not silence"
+        );
+    }
+    let cut: Vec<(u64, u64)> = drops.iter().chain(&skips).copied().collect();
     let concealed = pairs(&r["concealed"]);
-    let mut want = expected_played(&track, 0, &drops, &concealed);
+    let mut want = expected_played(&track, 0, &cut, &concealed);
     let played = r["played"].as_u64().unwrap() as usize;
     if complete {
         assert_eq!(
             played,
             want.len(),
-            "samples hashed: every sample of the track once, but those dropped or concealed"
+            "samples hashed: every sample of the track once, but those dropped, skipped or concealed"
         );
     } else {
         assert!(played <= want.len(), "{played} of {}", want.len());
@@ -185,17 +209,23 @@ pub fn check_stream(
     assert_eq!(live["kind"], "done", "the worklet ended its stream: {live}");
     assert_eq!(live["restarts"], restarts, "the streams restarted");
     let (sr, track, drops, played) = check_samples(a, kind, live, true);
-    assert_eq!(
-        pairs(&live["concealed"]).iter().map(|c| c.1).sum::<u64>(),
-        live["concealedSamples"].as_u64().unwrap(),
-        "every concealed sample listed"
-    );
-    let dropped = live["dropped"].as_u64().unwrap();
-    assert_eq!(
-        drops.iter().map(|d| d.1).sum::<u64>(),
-        dropped,
-        "every drop listed"
-    );
+    // Every drop, skip and concealed sample listed (after a restart the counts are the
+    // worklet's life's, the lists the stream's, which the Heard reports).
+    let listed = |v: &Value| pairs(v).iter().map(|d| d.1).sum::<u64>();
+    let [dropped, skipped, concealed] = [
+        ("drops", "dropped"),
+        ("skips", "skipped"),
+        ("concealed", "concealedSamples"),
+    ]
+    .map(|(list, count)| {
+        let (here, life) = (listed(&live[list]), live[count].as_u64().unwrap());
+        if restarts == 0 {
+            assert_eq!(here, life, "every one of the {count} listed");
+        } else {
+            assert!(here <= life, "{here} {list} listed of {life} {count}");
+        }
+        here
+    });
     // The sounds: the page was sent the recording's, each once; each was played (its first
     // sample rendered) or lost in a drop (its first sample in a dropped range), once.
     let rate = f64::from(a.rate_hz);
@@ -241,8 +271,10 @@ pub fn check_stream(
         underruns: live["underruns"].as_u64().unwrap(),
         dropped,
         drops,
+        skipped,
+        waited: live["waited"].as_u64().unwrap(),
         guesses: live["guesses"].as_u64().unwrap(),
-        concealed: live["concealedSamples"].as_u64().unwrap(),
+        concealed,
         sent: sent.len(),
         played: played_sounds.len(),
         lost: lost.len(),
