@@ -36,12 +36,17 @@
 // message's lateness, not lost and not held for a lead.
 //
 // Playback starts, and restarts after an underrun, once the clock is a lead past the next
-// sample (and a quantum of it is queued). An underrun (silence, then the wait) happens only
-// where a guess cannot help: when the lead has grown a quantum or more past where the output
-// plays (the window measured later arrivals: the wait sets the new lead), or a stall outlasts
-// GUESS_MAX_S. Every 0.1 s of quanta, when the output plays more
-// than 5 ms behind the lead (a backlog after a stall, or jitter that has passed), the excess is
-// dropped (counted and listed), never below one quantum queued at the window's lowest. For
+// sample (and a quantum of it is queued); a stream whose first sample is already more than
+// 5 ms past that (its start-up backlog) drops the samples due and starts on the lead. While
+// the output plays silence it follows the lead to the sample: it waits (silence, not hashed)
+// where the lead grew past it, and skips silent samples queued where the lead fell behind it
+// (listed and counted apart from drops; never past a sample that sounds). While it sounds, an
+// underrun (silence, then the wait) happens only where a guess cannot help: when the lead has
+// grown a quantum or more past where the output plays (the window measured later arrivals:
+// the wait sets the new lead), or a stall outlasts GUESS_MAX_S. Every 0.1 s of quanta, when
+// the output plays more than 5 ms behind the lead (a backlog after a stall, or jitter that
+// has passed), the excess is dropped (counted and listed), sound or not, never below one
+// quantum queued at the window's lowest. For
 // each sound's first sample the processor reports when it was rendered (Date.now() at the
 // render quantum, the frame within it, the context time) so the page can measure tick →
 // output, or that it was dropped (`lost`). It hashes
