@@ -617,6 +617,25 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
     assert_eq!(h.played + h.lost, h.sent);
     capped(&p);
 
+    // The nano world with the jitter rising to 12 ms for its last second, while its tone
+    // sounds and its two sounds start: the guesses over its late messages are checked, each
+    // sample played concealed at most once (a late sound's samples were concealed as played
+    // up to the quantum's end, into the guess that followed, and again when its ticks came).
+    let npath = workspace().join("recordings/nanoworld.mcap");
+    let jumpy = Link {
+        phases: vec![(2000.0, 3000.0, 12.0)],
+        ..Link::idle()
+    };
+    let p = live_path(&mut b, &npath, "nanoworld", sr, &jumpy);
+    let h = &p.heard;
+    println!(
+        "the nano world, jitter 3 -> 12 ms from 2 s: {h:?}, own {:?}",
+        p.own_ms
+    );
+    assert!(h.guesses > 0 && h.concealed > 0, "{h:?}");
+    assert_eq!(h.accounted(), h.track_samples as u64);
+    assert_eq!((h.played, h.lost), (h.sent, 0));
+
     // Eight 50 ms stalls, 2 s apart: each is guessed over and none underruns, the output
     // staying at its lead; 4 s after the last the lead is the idle page's again.
     let stalls: Vec<(f64, f64)> = (1..=8)

@@ -517,7 +517,11 @@ class Synth extends AudioWorkletProcessor {
     for (let i = 0; i < n;) {
       const k = from + i, g = this.guess, [lo, hi] = this.deviate;
       if (g !== null && k >= g.from) return;
-      if (k >= lo && k < hi) { const m = Math.min(n - i, hi - k); this.conceal(k, m); i += m; continue; }
+      if (k >= lo && k < hi) {
+        // (Up to the guess: what it played is checked when the ticks come.)
+        const m = Math.min(n - i, hi - k, g === null ? Infinity : g.from - k);
+        this.conceal(k, m); i += m; continue;
+      }
       let m = n - i;
       if (lo > k) m = Math.min(m, lo - k);
       if (g !== null) m = Math.min(m, g.from - k);
