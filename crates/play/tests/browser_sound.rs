@@ -618,7 +618,7 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
     capped(&p);
 
     // The nano world with the jitter rising to 12 ms for its last second, while its tone
-    // sounds and its two sounds start: the guesses over its late messages are checked, each
+    // sounds and its two sounds start: no underrun; the guesses over its late messages are checked, each
     // sample played concealed at most once (a late sound's samples were concealed as played
     // up to the quantum's end, into the guess that followed, and again when its ticks came).
     let npath = workspace().join("recordings/nanoworld.mcap");
@@ -635,6 +635,9 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
     assert!(h.guesses > 0 && h.concealed > 0, "{h:?}");
     assert_eq!(h.accounted(), h.track_samples as u64);
     assert_eq!((h.played, h.lost), (h.sent, 0));
+    // The lead grows while the tone sounds: the output, ahead of it, guesses over the late
+    // messages until the next silence (it underran once when the growth's underrun moved it).
+    assert_eq!(h.underruns, 0, "{h:?}");
 
     // Eight 50 ms stalls, 2 s apart: each is guessed over and none underruns, the output
     // staying at its lead; 4 s after the last the lead is the idle page's again.

@@ -40,13 +40,12 @@
 // 5 ms past that (its start-up backlog) drops the samples due and starts on the lead. While
 // the output plays silence it follows the lead to the sample: it waits (silence, not hashed)
 // where the lead grew past it, and skips silent samples queued where the lead fell behind it
-// (listed and counted apart from drops; never past a sample that sounds). While it sounds, an
-// underrun (silence, then the wait) happens only where a guess cannot help: when the lead has
-// grown a quantum or more past where the output plays (the window measured later arrivals:
-// the wait sets the new lead), or a stall outlasts GUESS_MAX_S. Every 0.1 s of quanta, when
-// the output plays more than 5 ms behind the lead (a backlog after a stall, or jitter that
-// has passed), the excess is dropped (counted and listed), sound or not, never below one
-// quantum queued at the window's lowest. For
+// (listed and counted apart from drops; never past a sample that sounds). While it sounds, a
+// lead that grew is guessed over until the next silence; an underrun (silence, then the wait)
+// happens only where a guess cannot help, a stall outlasting GUESS_MAX_S. Every 0.1 s of
+// quanta, when the output plays more than 5 ms behind the lead (a backlog after a stall, or
+// jitter that has passed), the excess is dropped (counted and listed), sound or not, never
+// below one quantum queued at the window's lowest. For
 // each sound's first sample the processor reports when it was rendered (Date.now() at the
 // render quantum, the frame within it, the context time) so the page can measure tick →
 // output, or that it was dropped (`lost`). It hashes
@@ -446,13 +445,14 @@ class Synth extends AudioWorkletProcessor {
     fifo.push(v);
   }
 
-  // The FIFO runs short of `need` samples: a late message. Unless the lead has grown a quantum
-  // past where the output plays (then the underrun sets it), guess the ticks to come as the
-  // last one held (its tone, no sound starting) for at most GUESS_MAX_S: what an idle world
-  // sounds like, the samples the ticks will make unless a sound starts or the tone moves.
-  extend(need, quantum, at) {
+  // The FIFO runs short of `need` samples: a late message. Guess the ticks to come as the last
+  // one held (its tone, no sound starting) for at most GUESS_MAX_S: what an idle world sounds
+  // like, the samples the ticks will make unless a sound starts or the tone moves. (Also when
+  // the lead has grown past where the output plays: the output moves to it in the next
+  // silence, see follow, rather than with an underrun's gap while a sound plays.)
+  extend(need) {
     const s = this.synth, fifo = this.fifo;
-    if (s === null || this.lead - (this.clock + at - fifo.first) >= quantum) return;
+    if (s === null) return;
     if (this.guess === null) {
       this.guess = { snap: s.clone(), from: s.nextSample, values: [] };
       this.guesses++;
@@ -741,7 +741,7 @@ class Synth extends AudioWorkletProcessor {
       this.minLevel = Infinity; this.quanta = 0;
     }
     if (!this.offline && !this.ending && this.guess === null && this.lastOut === 0) at = this.follow(out, at);
-    if (!this.offline && !this.ending && fifo.length < out.length - at) this.extend(out.length - at, out.length, at);
+    if (!this.offline && !this.ending && fifo.length < out.length - at) this.extend(out.length - at);
     const from = fifo.first;
     const n = fifo.take(out, at);
     if (!this.offline) this.hear(out, at, n, from);
