@@ -404,6 +404,24 @@ fn lead_in(p: &LivePath, from: f64, to: f64) -> (f64, f64) {
     )
 }
 
+/// A live path that played as the idle page `idle` did: every sound, each sound's own part
+/// within a quantum of the idle page's, every sample of the track accounted for once, no
+/// lead past the cap.
+fn as_idle(p: &LivePath, idle: &LivePath, sr: u32) {
+    let quantum_ms = 128.0 / f64::from(sr) * 1000.0;
+    assert_eq!(p.own_ms.len(), idle.own_ms.len());
+    for (&(tick, own), &(_, own_idle)) in p.own_ms.iter().zip(&idle.own_ms) {
+        assert!(
+            (own - own_idle).abs() <= quantum_ms,
+            "tick {tick}: {own} ms, idle {own_idle} ms"
+        );
+    }
+    let h = &p.heard;
+    assert_eq!(h.accounted(), h.track_samples as u64);
+    assert_eq!((h.played, h.lost), (h.sent, 0));
+    capped(p);
+}
+
 /// Every lead sampled is at most the cap.
 fn capped(p: &LivePath) {
     for &[ms, lead, _] in &p.leads {
@@ -707,17 +725,7 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
         lo >= idle_lo.min(first_lead) && hi <= idle_hi.max(first_lead + 1e-9),
         "{lo}..{hi} ms vs {idle_lo}..{idle_hi} ms"
     );
-    let quantum_ms = 128.0 / f64::from(sr) * 1000.0;
-    assert_eq!(p.own_ms.len(), idle.own_ms.len());
-    for (&(tick, own), &(_, own_idle)) in p.own_ms.iter().zip(&idle.own_ms) {
-        assert!(
-            (own - own_idle).abs() <= quantum_ms,
-            "tick {tick}: {own} ms, idle {own_idle} ms"
-        );
-    }
-    assert_eq!(h.accounted(), h.track_samples as u64);
-    assert_eq!((h.played, h.lost), (h.sent, 0));
-    capped(&p);
+    as_idle(&p, &idle, sr);
 
     // A lesson's next world: a restart after 2 s of a first stream, the session again from
     // its tick 0 (its lateness counted from another origin). The second stream is the idle
@@ -740,16 +748,7 @@ fn the_worklets_lead_follows_the_arrivals_jitter_and_a_stall_is_guessed_over() {
         lo >= idle_lo && hi <= idle_hi,
         "{lo}..{hi} ms vs {idle_lo}..{idle_hi} ms"
     );
-    assert_eq!(p.own_ms.len(), idle.own_ms.len());
-    for (&(tick, own), &(_, own_idle)) in p.own_ms.iter().zip(&idle.own_ms) {
-        assert!(
-            (own - own_idle).abs() <= quantum_ms,
-            "tick {tick}: {own} ms, idle {own_idle} ms"
-        );
-    }
-    assert_eq!(h.accounted(), h.track_samples as u64);
-    assert_eq!((h.played, h.lost), (h.sent, 0));
-    capped(&p);
+    as_idle(&p, &idle, sr);
     b.check().unwrap();
     server.close();
 }
