@@ -71,6 +71,11 @@ const LATE_BUCKETS = 8, LATE_BUCKET_S = 0.5, MARGIN_S = 0.001, TRIM_S = 0.005;
 // and the longest guess, s (a longer stall underruns).
 const LEAD_QUANTILE = 0.95, GUESS_MAX_S = 0.05;
 
+// What a stream heard, afresh (see the processor's `heard`): `restarts` 1 after a restart.
+function heardAfresh(restarts) {
+  return { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], skips: [], concealed: [], restarts };
+}
+
 // 64-bit unsigned arithmetic on [hi, lo] 32-bit halves (the noise is xorshift64*).
 function mul64(ah, al, bh, bl) {
   const a48 = ah >>> 16, a32 = ah & 0xffff, a16 = al >>> 16, a00 = al & 0xffff;
@@ -394,7 +399,7 @@ class Synth extends AudioWorkletProcessor {
     // What was heard: the FNV-1a hash of the samples played, their count, the first one's
     // session index, a checkpoint of the hash every second played, the [index, count] of each
     // drop, the restarts after a long gap; `ending`: the stream was finished.
-    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], skips: [], concealed: [], restarts: 0 };
+    this.heard = heardAfresh(0);
     this.ending = false; this.done = false;
     if (o.offline) {
       for (const b of o.offline.blocks) this.take(b, 0);
@@ -424,7 +429,7 @@ class Synth extends AudioWorkletProcessor {
     // The last stream's samples not yet played are not the new one's.
     this.synth = null; this.ending = false; this.done = false;
     this.fifo.clear(0); this.primed = false; this.onsets = []; this.deviate = [0, 0]; this.lastOut = 0;
-    this.heard = { hash: 0x811c9dc5, played: 0, first: -1, checkpoints: [], drops: [], skips: [], concealed: [], restarts: 1 };
+    this.heard = heardAfresh(1);
   }
 
   // The samples the processor makes, in order (`k`: the session index): to the FIFO; while
